@@ -1,0 +1,212 @@
+//! Camera and arcball (Shoemake): a rotation about the scene centre, a zoom, and an
+//! orthographic or perspective projection. Pure glam, no GL.
+
+use glam::{DMat4, DQuat, DVec2, DVec3};
+
+/// Projection kind.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Projection {
+    /// Parallel projection (the cell-projection seed's per-vertex exit case).
+    #[default]
+    Orthographic,
+    /// Pinhole perspective.
+    Perspective,
+}
+
+/// Where the scene is seen from. The scene occupies [-1, 1]³ in world units.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Camera {
+    /// Orthographic or perspective.
+    pub projection: Projection,
+    /// Rotation of the scene as a quaternion `[x, y, z, w]`.
+    pub rotation: [f64; 4],
+    /// Magnification (1 = the [-1, 1] square fills the shorter side).
+    pub zoom: f64,
+    /// Vertical field of view in degrees (perspective only).
+    pub fov_y_deg: f64,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera {
+            projection: Projection::Orthographic,
+            rotation: [0.0, 0.0, 0.0, 1.0],
+            zoom: 1.0,
+            fov_y_deg: 30.0,
+        }
+    }
+}
+
+impl Camera {
+    /// The rotation as a normalized quaternion (identity when degenerate).
+    pub fn quat(&self) -> DQuat {
+        let q = DQuat::from_array(self.rotation);
+        if q.length_squared() > 1e-12 && q.is_finite() {
+            q.normalize()
+        } else {
+            DQuat::IDENTITY
+        }
+    }
+
+    /// Model-view matrix: rotate the scene, then (perspective) move it in front of the eye.
+    pub fn view(&self) -> DMat4 {
+        let rotate = DMat4::from_quat(self.quat());
+        match self.projection {
+            Projection::Orthographic => rotate,
+            Projection::Perspective => {
+                DMat4::from_translation(DVec3::new(0.0, 0.0, -self.eye_distance())) * rotate
+            }
+        }
+    }
+
+    /// Distance from the eye to the scene centre in perspective (fits the unit sphere).
+    pub fn eye_distance(&self) -> f64 {
+        let half = (self.fov_y_deg.clamp(1.0, 170.0).to_radians() / 2.0).tan();
+        3f64.sqrt() / half / self.zoom.max(1e-6)
+    }
+
+    /// Projection matrix for `aspect` = width / height; the depth range holds [-√3, √3].
+    pub fn projection_matrix(&self, aspect: f64) -> DMat4 {
+        let aspect = if aspect.is_finite() && aspect > 0.0 { aspect } else { 1.0 };
+        let (sx, sy) = if aspect >= 1.0 { (aspect, 1.0) } else { (1.0, 1.0 / aspect) };
+        match self.projection {
+            Projection::Orthographic => {
+                let z = self.zoom.max(1e-6);
+                orthographic_gl(-sx / z, sx / z, -sy / z, sy / z, -2.0, 2.0)
+            }
+            Projection::Perspective => {
+                let d = self.eye_distance();
+                let fov = self.fov_y_deg.clamp(1.0, 170.0).to_radians();
+                let fov = if aspect >= 1.0 { fov } else { 2.0 * ((fov / 2.0).tan() * sy).atan() };
+                perspective_gl(fov, aspect, (d - 2.0).max(1e-3), d + 2.0)
+            }
+        }
+    }
+
+    /// Projection times view.
+    pub fn view_projection(&self, aspect: f64) -> DMat4 {
+        self.projection_matrix(aspect) * self.view()
+    }
+}
+
+/// `glOrtho`'s matrix (right-handed eye space, depth to [-1, 1]).
+pub fn orthographic_gl(l: f64, r: f64, b: f64, t: f64, n: f64, f: f64) -> DMat4 {
+    DMat4::from_cols_array(&[
+        2.0 / (r - l), 0.0, 0.0, 0.0,
+        0.0, 2.0 / (t - b), 0.0, 0.0,
+        0.0, 0.0, -2.0 / (f - n), 0.0,
+        -(r + l) / (r - l), -(t + b) / (t - b), -(f + n) / (f - n), 1.0,
+    ])
+}
+
+/// `gluPerspective`'s matrix (vertical field of view in radians).
+pub fn perspective_gl(fov_y: f64, aspect: f64, near: f64, far: f64) -> DMat4 {
+    let f = 1.0 / (fov_y / 2.0).tan();
+    DMat4::from_cols_array(&[
+        f / aspect, 0.0, 0.0, 0.0,
+        0.0, f, 0.0, 0.0,
+        0.0, 0.0, (far + near) / (near - far), -1.0,
+        0.0, 0.0, 2.0 * far * near / (near - far), 0.0,
+    ])
+}
+
+/// Arcball dragging: maps window points to the unit sphere and composes rotations.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Arcball {
+    start: Option<(DVec3, DQuat)>,
+}
+
+impl Arcball {
+    /// Map a window point (pixels, y down) in a `size` window onto the arcball sphere.
+    pub fn sphere_point(p: DVec2, size: DVec2) -> DVec3 {
+        let r = size.x.min(size.y).max(1.0) / 2.0;
+        let x = (p.x - size.x / 2.0) / r;
+        let y = (size.y / 2.0 - p.y) / r;
+        let d2 = x * x + y * y;
+        if d2 <= 1.0 {
+            DVec3::new(x, y, (1.0 - d2).sqrt())
+        } else {
+            DVec3::new(x, y, 0.0) / d2.sqrt()
+        }
+    }
+
+    /// Start a drag at window point `p` with the camera's current rotation.
+    pub fn begin(&mut self, camera: &Camera, p: DVec2, size: DVec2) {
+        self.start = Some((Self::sphere_point(p, size), camera.quat()));
+    }
+
+    /// Continue the drag to `p`, updating the camera's rotation.
+    pub fn drag(&mut self, camera: &mut Camera, p: DVec2, size: DVec2) {
+        if let Some((from, q0)) = self.start {
+            let to = Self::sphere_point(p, size);
+            let q = DQuat::from_rotation_arc(from, to) * q0;
+            camera.rotation = q.normalize().to_array();
+        }
+    }
+
+    /// End the drag.
+    pub fn end(&mut self) {
+        self.start = None;
+    }
+
+    /// Whether a drag is under way.
+    pub fn dragging(&self) -> bool {
+        self.start.is_some()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_orthographic_maps_unit_square_to_clip_square() {
+        let m = Camera::default().view_projection(1.0);
+        let p = m.project_point3(DVec3::new(1.0, -1.0, 0.0));
+        assert!((p - DVec3::new(1.0, -1.0, 0.0)).length() < 1e-12);
+    }
+
+    #[test]
+    fn wide_aspect_keeps_square_pixels() {
+        let m = Camera::default().view_projection(2.0);
+        let p = m.project_point3(DVec3::new(1.0, 1.0, 0.0));
+        assert!((p.x - 0.5).abs() < 1e-12 && (p.y - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn arcball_drag_right_rotates_about_y() {
+        let size = DVec2::new(200.0, 200.0);
+        let mut cam = Camera::default();
+        let mut ball = Arcball::default();
+        ball.begin(&cam, DVec2::new(100.0, 100.0), size);
+        ball.drag(&mut cam, DVec2::new(150.0, 100.0), size);
+        let q = cam.quat();
+        let (axis, angle) = q.to_axis_angle();
+        assert!((axis - DVec3::Y).length() < 1e-9, "axis {axis}");
+        assert!((angle - 0.5f64.asin()).abs() < 1e-9, "angle {angle}");
+    }
+
+    #[test]
+    fn degenerate_rotation_is_identity() {
+        let cam = Camera {
+            rotation: [0.0, 0.0, 0.0, 0.0],
+            ..Camera::default()
+        };
+        assert_eq!(cam.quat(), DQuat::IDENTITY);
+    }
+
+    #[test]
+    fn perspective_keeps_scene_in_depth_range() {
+        let cam = Camera {
+            projection: Projection::Perspective,
+            ..Camera::default()
+        };
+        let m = cam.view_projection(1.0);
+        for z in [-1.0, 1.0] {
+            let p = m.project_point3(DVec3::new(0.0, 0.0, z));
+            assert!(p.z > -1.0 && p.z < 1.0, "z {z} -> {}", p.z);
+        }
+    }
+}

@@ -1,0 +1,100 @@
+//! One draw call: a program, a mesh, textures on named units, a blend mode, into a
+//! target or the window's framebuffer. GL state is saved before and restored after.
+
+use glow::HasContext;
+
+use super::error::{GlError, GlResult};
+use super::gpu::Gpu;
+use super::mesh::Mesh;
+use super::program::Program;
+use super::state::StateGuard;
+use super::target::Target;
+use super::texture::Texture;
+
+/// How fragments combine with the target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Blend {
+    /// Fragments replace the target.
+    #[default]
+    Replace,
+    /// Back-to-front "over" of non-premultiplied colour: `SRC_ALPHA, ONE_MINUS_SRC_ALPHA`.
+    Over,
+    /// Back-to-front "over" of premultiplied colour: `ONE, ONE_MINUS_SRC_ALPHA`.
+    PremultipliedOver,
+}
+
+/// Where a draw goes.
+#[derive(Clone, Copy)]
+pub enum Surface<'a> {
+    /// An offscreen target (its whole area).
+    Target(&'a Target),
+    /// The default framebuffer, in the viewport `[x, y, width, height]`.
+    Window([i32; 4]),
+}
+
+/// Everything one draw needs.
+pub struct DrawCall<'a> {
+    /// The program pair.
+    pub program: &'a Program,
+    /// The vertices (triangles).
+    pub mesh: &'a Mesh,
+    /// First vertex and vertex count; `None` draws all.
+    pub range: Option<(usize, usize)>,
+    /// Textures and the units they go on.
+    pub textures: &'a [(u32, &'a Texture)],
+    /// Blending.
+    pub blend: Blend,
+}
+
+/// Execute `call` on `surface`; the state the draw set is restored afterwards.
+pub fn draw(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<()> {
+    let (first, count) = call.range.unwrap_or((0, call.mesh.vertex_count()));
+    if first + count > call.mesh.vertex_count() {
+        return Err(GlError::Invalid(format!(
+            "draw range {first}+{count} exceeds {} vertices",
+            call.mesh.vertex_count()
+        )));
+    }
+    let _guard = StateGuard::save(gpu);
+    let gl = gpu.glow();
+    match surface {
+        Surface::Target(t) => t.bind(),
+        // SAFETY: plain state calls.
+        Surface::Window([x, y, w, h]) => unsafe {
+            gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+            gl.viewport(x, y, w, h);
+        },
+    }
+    // SAFETY: plain state calls.
+    unsafe {
+        gl.disable(glow::DEPTH_TEST);
+        gl.disable(glow::CULL_FACE);
+        gl.disable(glow::SCISSOR_TEST);
+        gl.color_mask(true, true, true, true);
+        match call.blend {
+            Blend::Replace => gl.disable(glow::BLEND),
+            Blend::Over => {
+                gl.enable(glow::BLEND);
+                gl.blend_equation(glow::FUNC_ADD);
+                gl.blend_func(glow::SRC_ALPHA, glow::ONE_MINUS_SRC_ALPHA);
+            }
+            Blend::PremultipliedOver => {
+                gl.enable(glow::BLEND);
+                gl.blend_equation(glow::FUNC_ADD);
+                gl.blend_func(glow::ONE, glow::ONE_MINUS_SRC_ALPHA);
+            }
+        }
+    }
+    for (unit, texture) in call.textures {
+        texture.bind(*unit);
+    }
+    call.program.bind();
+    if count > 0 {
+        call.mesh.draw_triangles(first, count);
+    }
+    for (unit, texture) in call.textures {
+        texture.unbind(*unit);
+    }
+    crate::gl_debug_check!(gpu)
+}

@@ -1,0 +1,30 @@
+//! The GL layer — the only module with `unsafe`.
+//!
+//! Contexts (EGL device/surfaceless and OSMesa offscreen; glutin windows in
+//! [`window`]), the ARB program loader, the `Program` abstraction over ARB and GLSL,
+//! owned textures, meshes and render targets (each freed on Drop), a state guard, and
+//! error checking that names the Rust file and line of the failed call.
+
+mod arb;
+mod draw;
+mod error;
+mod gpu;
+mod headless;
+mod mesh;
+pub mod position;
+mod program;
+mod state;
+mod target;
+mod texture;
+#[cfg(feature = "viewer")]
+pub mod window;
+
+pub use draw::{draw, Blend, DrawCall, Surface};
+pub use error::{error_name, CompileError, GlError, GlResult};
+pub use gpu::{renderer_is_software, ArbLimits, Caps, Gpu, Resource};
+pub use headless::{Backend, Headless, OSMESA_LIBRARIES};
+pub use mesh::Mesh;
+pub use program::{Program, ProgramChoice, ProgramKind, ProgramText, MAX_LOCALS, MAX_UNITS};
+pub use state::StateGuard;
+pub use target::{Target, TargetFormat};
+pub use texture::{Extent, Filter, TexelData, TexelFormat, Texture};

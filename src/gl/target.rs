@@ -1,0 +1,231 @@
+//! Offscreen render targets: a framebuffer object with one colour texture in RGBA8,
+//! RGBA16F or RGBA32F, read back into an [`Image`].
+
+use std::sync::Arc;
+
+use glow::HasContext;
+
+use super::error::{GlError, GlResult};
+use super::gpu::Gpu;
+use crate::image::Image;
+
+/// Colour-target precision; faithful mode draws into RGBA8 as the original did.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum TargetFormat {
+    /// 8 bits per channel, normalized.
+    #[default]
+    Rgba8,
+    /// 16-bit float per channel.
+    Rgba16f,
+    /// 32-bit float per channel.
+    Rgba32f,
+}
+
+impl TargetFormat {
+    /// Bytes per pixel.
+    pub fn bytes_per_pixel(self) -> u64 {
+        match self {
+            TargetFormat::Rgba8 => 4,
+            TargetFormat::Rgba16f => 8,
+            TargetFormat::Rgba32f => 16,
+        }
+    }
+
+    /// Smallest step between two stored values near 1.0, the quantum tolerances derive from.
+    pub fn quantum(self) -> f32 {
+        match self {
+            TargetFormat::Rgba8 => 1.0 / 255.0,
+            TargetFormat::Rgba16f => 1.0 / 1024.0, // 10-bit mantissa
+            TargetFormat::Rgba32f => f32::EPSILON,
+        }
+    }
+
+    /// Name as written in scenes and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            TargetFormat::Rgba8 => "rgba8",
+            TargetFormat::Rgba16f => "rgba16f",
+            TargetFormat::Rgba32f => "rgba32f",
+        }
+    }
+
+    fn internal(self) -> u32 {
+        match self {
+            TargetFormat::Rgba8 => glow::RGBA8,
+            TargetFormat::Rgba16f => glow::RGBA16F,
+            TargetFormat::Rgba32f => glow::RGBA32F,
+        }
+    }
+}
+
+/// An owned framebuffer with one colour texture; deleted on Drop.
+pub struct Target {
+    gl: Arc<glow::Context>,
+    framebuffer: glow::Framebuffer,
+    color: glow::Texture,
+    width: u32,
+    height: u32,
+    format: TargetFormat,
+}
+
+impl Target {
+    /// Create a `width` x `height` target of `format`, cleared to transparent black.
+    pub fn new(gpu: &Gpu, width: u32, height: u32, format: TargetFormat) -> GlResult<Target> {
+        if width == 0 || height == 0 || width > 16384 || height > 16384 {
+            return Err(GlError::Invalid(format!(
+                "target size {width}x{height} (each side 1..=16384)"
+            )));
+        }
+        let gl = gpu.glow().clone();
+        // SAFETY: fresh objects; the previous framebuffer and texture bindings are restored.
+        let (framebuffer, color, status) = unsafe {
+            let prev_fb = gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING);
+            gl.active_texture(glow::TEXTURE0);
+            let prev_tex = gl.get_parameter_texture(glow::TEXTURE_BINDING_2D);
+            let color = gl.create_texture().map_err(GlError::Invalid)?;
+            gl.bind_texture(glow::TEXTURE_2D, Some(color));
+            gl.tex_storage_2d(
+                glow::TEXTURE_2D,
+                1,
+                format.internal(),
+                width as i32,
+                height as i32,
+            );
+            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MIN_FILTER, glow::NEAREST as i32);
+            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAG_FILTER, glow::NEAREST as i32);
+            let framebuffer = gl.create_framebuffer().map_err(GlError::Invalid)?;
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
+            gl.framebuffer_texture_2d(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::TEXTURE_2D,
+                Some(color),
+                0,
+            );
+            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            gl.clear_color(0.0, 0.0, 0.0, 0.0);
+            gl.clear(glow::COLOR_BUFFER_BIT);
+            gl.bind_framebuffer(glow::FRAMEBUFFER, prev_fb);
+            gl.bind_texture(glow::TEXTURE_2D, prev_tex);
+            (framebuffer, color, status)
+        };
+        let target = Target {
+            gl,
+            framebuffer,
+            color,
+            width,
+            height,
+            format,
+        };
+        if status != glow::FRAMEBUFFER_COMPLETE {
+            return Err(GlError::Framebuffer(status));
+        }
+        crate::gl_check!(gpu)?;
+        gpu.record(
+            "framebuffer",
+            format!("target {width}x{height} {}", format.name()),
+            width as u64 * height as u64 * format.bytes_per_pixel(),
+        );
+        Ok(target)
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Colour precision.
+    pub fn format(&self) -> TargetFormat {
+        self.format
+    }
+
+    /// Bind for drawing and set the viewport to the whole target.
+    pub(crate) fn bind(&self) {
+        // SAFETY: plain state calls with a live framebuffer.
+        unsafe {
+            self.gl
+                .bind_framebuffer(glow::FRAMEBUFFER, Some(self.framebuffer));
+            self.gl
+                .viewport(0, 0, self.width as i32, self.height as i32);
+        }
+    }
+
+    /// Clear to `rgba`.
+    pub fn clear(&self, gpu: &Gpu, rgba: [f32; 4]) -> GlResult<()> {
+        let _guard = super::state::StateGuard::save(gpu);
+        self.bind();
+        // SAFETY: plain state calls on the bound framebuffer.
+        unsafe {
+            self.gl.disable(glow::SCISSOR_TEST);
+            self.gl.color_mask(true, true, true, true);
+            self.gl.clear_color(rgba[0], rgba[1], rgba[2], rgba[3]);
+            self.gl.clear(glow::COLOR_BUFFER_BIT);
+        }
+        crate::gl_check!(gpu)
+    }
+
+    /// Read the whole target, top row first. RGBA8 keeps its bytes exactly (as `k/255`).
+    pub fn read(&self, gpu: &Gpu) -> GlResult<Image> {
+        let _guard = super::state::StateGuard::save(gpu);
+        let (w, h) = (self.width as usize, self.height as usize);
+        let mut data = vec![0f32; w * h * 4];
+        // SAFETY: the buffers hold exactly w*h*4 values of the type asked for.
+        unsafe {
+            self.gl
+                .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.framebuffer));
+            self.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            match self.format {
+                TargetFormat::Rgba8 => {
+                    let mut bytes = vec![0u8; w * h * 4];
+                    self.gl.read_pixels(
+                        0,
+                        0,
+                        w as i32,
+                        h as i32,
+                        glow::RGBA,
+                        glow::UNSIGNED_BYTE,
+                        glow::PixelPackData::Slice(Some(&mut bytes)),
+                    );
+                    for (d, b) in data.iter_mut().zip(&bytes) {
+                        *d = *b as f32 / 255.0;
+                    }
+                }
+                _ => {
+                    let bytes = std::slice::from_raw_parts_mut(
+                        data.as_mut_ptr().cast::<u8>(),
+                        data.len() * 4,
+                    );
+                    self.gl.read_pixels(
+                        0,
+                        0,
+                        w as i32,
+                        h as i32,
+                        glow::RGBA,
+                        glow::FLOAT,
+                        glow::PixelPackData::Slice(Some(bytes)),
+                    );
+                }
+            }
+        }
+        crate::gl_check!(gpu)?;
+        Ok(Image::from_bottom_up(self.width, self.height, self.format, data))
+    }
+}
+
+impl Drop for Target {
+    fn drop(&mut self) {
+        // SAFETY: deleted once, on the context that created them.
+        unsafe {
+            self.gl.delete_framebuffer(self.framebuffer);
+            self.gl.delete_texture(self.color);
+        }
+    }
+}

@@ -1,0 +1,279 @@
+//! Owned textures (1D, 2D, 3D) with explicit formats, filters and units.
+
+use std::sync::Arc;
+
+use glow::HasContext;
+
+use super::error::{GlError, GlResult};
+use super::gpu::Gpu;
+
+/// Texel formats the techniques use.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TexelFormat {
+    /// 3 x u8 (v3o2's packed attribute volume).
+    Rgb8,
+    /// 4 x u8 (colour tables).
+    Rgba8,
+    /// 4 x f32.
+    Rgba32f,
+    /// 1 x f32.
+    R32f,
+}
+
+impl TexelFormat {
+    /// Bytes per texel.
+    pub fn bytes(self) -> usize {
+        match self {
+            TexelFormat::Rgb8 => 3,
+            TexelFormat::Rgba8 => 4,
+            TexelFormat::Rgba32f => 16,
+            TexelFormat::R32f => 4,
+        }
+    }
+
+    fn gl(self) -> (u32, u32, u32) {
+        match self {
+            TexelFormat::Rgb8 => (glow::RGB8, glow::RGB, glow::UNSIGNED_BYTE),
+            TexelFormat::Rgba8 => (glow::RGBA8, glow::RGBA, glow::UNSIGNED_BYTE),
+            TexelFormat::Rgba32f => (glow::RGBA32F, glow::RGBA, glow::FLOAT),
+            TexelFormat::R32f => (glow::R32F, glow::RED, glow::FLOAT),
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            TexelFormat::Rgb8 => "RGB8",
+            TexelFormat::Rgba8 => "RGBA8",
+            TexelFormat::Rgba32f => "RGBA32F",
+            TexelFormat::R32f => "R32F",
+        }
+    }
+}
+
+/// Texture filtering for both minification and magnification (no mipmaps).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Filter {
+    /// `GL_NEAREST`.
+    #[default]
+    Nearest,
+    /// `GL_LINEAR`.
+    Linear,
+}
+
+/// Texel data to upload.
+#[derive(Debug, Clone, Copy)]
+pub enum TexelData<'a> {
+    /// Bytes for 8-bit formats.
+    U8(&'a [u8]),
+    /// Floats for float formats.
+    F32(&'a [f32]),
+}
+
+/// Texture dimensionality and size.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Extent {
+    /// 1D texture of this width.
+    D1(u32),
+    /// 2D texture.
+    D2(u32, u32),
+    /// 3D texture.
+    D3(u32, u32, u32),
+}
+
+impl Extent {
+    fn texels(self) -> usize {
+        match self {
+            Extent::D1(w) => w as usize,
+            Extent::D2(w, h) => w as usize * h as usize,
+            Extent::D3(w, h, d) => w as usize * h as usize * d as usize,
+        }
+    }
+    fn target(self) -> u32 {
+        match self {
+            Extent::D1(_) => glow::TEXTURE_1D,
+            Extent::D2(..) => glow::TEXTURE_2D,
+            Extent::D3(..) => glow::TEXTURE_3D,
+        }
+    }
+}
+
+/// An owned GL texture; deleted on Drop.
+pub struct Texture {
+    gl: Arc<glow::Context>,
+    raw: glow::Texture,
+    extent: Extent,
+    format: TexelFormat,
+}
+
+impl Texture {
+    /// Create and fill a texture; clamp-to-edge wrapping, `filter` both ways.
+    pub fn new(
+        gpu: &Gpu,
+        label: &str,
+        extent: Extent,
+        format: TexelFormat,
+        filter: Filter,
+        data: TexelData<'_>,
+    ) -> GlResult<Texture> {
+        let expected = extent.texels() * format.bytes();
+        let (given, float_data) = match data {
+            TexelData::U8(d) => (d.len(), false),
+            TexelData::F32(d) => (d.len() * 4, true),
+        };
+        let float_format = matches!(format, TexelFormat::Rgba32f | TexelFormat::R32f);
+        if given != expected || float_data != float_format {
+            return Err(GlError::Invalid(format!(
+                "texture {label}: {extent:?} {} needs {expected} bytes of {} data, got {given} bytes",
+                format.name(),
+                if float_format { "f32" } else { "u8" }
+            )));
+        }
+        let gl = gpu.glow().clone();
+        let target = extent.target();
+        let (internal, fmt, ty) = format.gl();
+        let bytes: &[u8] = match data {
+            TexelData::U8(d) => d,
+            TexelData::F32(d) => bytemuck_f32(d),
+        };
+        let gl_filter = match filter {
+            Filter::Nearest => glow::NEAREST,
+            Filter::Linear => glow::LINEAR,
+        } as i32;
+        // SAFETY: sizes checked above; the texture is bound to its own target only while
+        // being filled, and the previous binding of unit 0's target is restored.
+        let raw = unsafe {
+            let raw = gl.create_texture().map_err(GlError::Invalid)?;
+            let binding = match extent {
+                Extent::D1(_) => glow::TEXTURE_BINDING_1D,
+                Extent::D2(..) => glow::TEXTURE_BINDING_2D,
+                Extent::D3(..) => glow::TEXTURE_BINDING_3D,
+            };
+            let prev_active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
+            gl.active_texture(glow::TEXTURE0);
+            let prev = gl.get_parameter_texture(binding);
+            gl.bind_texture(target, Some(raw));
+            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
+            let src = glow::PixelUnpackData::Slice(Some(bytes));
+            match extent {
+                Extent::D1(w) => {
+                    gl.tex_image_1d(target, 0, internal as i32, w as i32, 0, fmt, ty, src)
+                }
+                Extent::D2(w, h) => gl.tex_image_2d(
+                    target,
+                    0,
+                    internal as i32,
+                    w as i32,
+                    h as i32,
+                    0,
+                    fmt,
+                    ty,
+                    src,
+                ),
+                Extent::D3(w, h, d) => gl.tex_image_3d(
+                    target,
+                    0,
+                    internal as i32,
+                    w as i32,
+                    h as i32,
+                    d as i32,
+                    0,
+                    fmt,
+                    ty,
+                    src,
+                ),
+            }
+            gl.tex_parameter_i32(target, glow::TEXTURE_MIN_FILTER, gl_filter);
+            gl.tex_parameter_i32(target, glow::TEXTURE_MAG_FILTER, gl_filter);
+            for wrap in [glow::TEXTURE_WRAP_S, glow::TEXTURE_WRAP_T, glow::TEXTURE_WRAP_R] {
+                gl.tex_parameter_i32(target, wrap, glow::CLAMP_TO_EDGE as i32);
+            }
+            gl.bind_texture(target, prev);
+            gl.active_texture(prev_active);
+            raw
+        };
+        let texture = Texture {
+            gl,
+            raw,
+            extent,
+            format,
+        };
+        crate::gl_check!(gpu)?;
+        gpu.record(
+            "texture",
+            format!("{label} {extent:?} {}", format.name()),
+            expected as u64,
+        );
+        Ok(texture)
+    }
+
+    /// Replace all texels (same size and format).
+    pub fn update(&self, gpu: &Gpu, data: &[u8]) -> GlResult<()> {
+        let expected = self.extent.texels() * self.format.bytes();
+        if data.len() != expected {
+            return Err(GlError::Invalid(format!(
+                "texture update needs {expected} bytes, got {}",
+                data.len()
+            )));
+        }
+        let (internal, fmt, ty) = self.format.gl();
+        let gl = &self.gl;
+        let target = self.extent.target();
+        // SAFETY: size checked; unit 0's binding is restored.
+        unsafe {
+            let prev_active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
+            gl.active_texture(glow::TEXTURE0);
+            gl.bind_texture(target, Some(self.raw));
+            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
+            let src = glow::PixelUnpackData::Slice(Some(data));
+            match self.extent {
+                // glow has no glTexSubImage1D: re-specify the (same-size) image.
+                Extent::D1(w) => gl.tex_image_1d(target, 0, internal as i32, w as i32, 0, fmt, ty, src),
+                Extent::D2(w, h) => {
+                    gl.tex_sub_image_2d(target, 0, 0, 0, w as i32, h as i32, fmt, ty, src)
+                }
+                Extent::D3(w, h, d) => gl.tex_sub_image_3d(
+                    target, 0, 0, 0, 0, w as i32, h as i32, d as i32, fmt, ty, src,
+                ),
+            }
+            gl.bind_texture(target, None);
+            gl.active_texture(prev_active);
+        }
+        crate::gl_check!(gpu)
+    }
+
+    /// Size and dimensionality.
+    pub fn extent(&self) -> Extent {
+        self.extent
+    }
+
+    /// Bind to texture unit `unit` (unit's active binding for this texture's target).
+    pub(crate) fn bind(&self, unit: u32) {
+        // SAFETY: plain state calls with a live texture.
+        unsafe {
+            self.gl.active_texture(glow::TEXTURE0 + unit);
+            self.gl.bind_texture(self.extent.target(), Some(self.raw));
+        }
+    }
+
+    /// Unbind this texture's target on `unit`.
+    pub(crate) fn unbind(&self, unit: u32) {
+        // SAFETY: plain state calls.
+        unsafe {
+            self.gl.active_texture(glow::TEXTURE0 + unit);
+            self.gl.bind_texture(self.extent.target(), None);
+        }
+    }
+}
+
+impl Drop for Texture {
+    fn drop(&mut self) {
+        // SAFETY: deleted once, on the context that created it.
+        unsafe { self.gl.delete_texture(self.raw) };
+    }
+}
+
+fn bytemuck_f32(d: &[f32]) -> &[u8] {
+    // SAFETY: f32 has no invalid bit patterns and u8 has alignment 1.
+    unsafe { std::slice::from_raw_parts(d.as_ptr().cast(), std::mem::size_of_val(d)) }
+}

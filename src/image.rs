@@ -1,0 +1,166 @@
+//! Images read back from targets: RGBA f32, top row first, with the precision they came
+//! from; comparison metrics (max abs, RMSE, PSNR) and diff images for tests and studies.
+
+use crate::gl::TargetFormat;
+
+/// An RGBA image, top row first, channels in 0..1 (float targets may exceed that).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Image {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Precision of the target it was read from.
+    pub format: TargetFormat,
+    /// `width * height * 4` values, row-major from the top.
+    pub data: Vec<f32>,
+}
+
+/// How two images differ.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct Difference {
+    /// Largest absolute channel difference.
+    pub max_abs: f64,
+    /// Root mean square channel difference.
+    pub rmse: f64,
+    /// Peak signal-to-noise ratio in dB for a peak of 1 (infinite when identical).
+    pub psnr: f64,
+    /// Pixels with any channel differing by more than the tolerance given to `compare`.
+    pub pixels_over: usize,
+    /// Where the largest difference is (x, y).
+    pub worst: (u32, u32),
+}
+
+impl Image {
+    /// Build from GL's bottom-up rows.
+    pub fn from_bottom_up(width: u32, height: u32, format: TargetFormat, data: Vec<f32>) -> Image {
+        let row = width as usize * 4;
+        let mut flipped = Vec::with_capacity(data.len());
+        for r in data.chunks_exact(row).rev() {
+            flipped.extend_from_slice(r);
+        }
+        Image {
+            width,
+            height,
+            format,
+            data: flipped,
+        }
+    }
+
+    /// A `width` x `height` image filled with `rgba`.
+    pub fn filled(width: u32, height: u32, format: TargetFormat, rgba: [f32; 4]) -> Image {
+        Image {
+            width,
+            height,
+            format,
+            data: rgba.repeat(width as usize * height as usize),
+        }
+    }
+
+    /// The RGBA value at (x, y), y counted from the top.
+    pub fn pixel(&self, x: u32, y: u32) -> [f32; 4] {
+        let i = (y as usize * self.width as usize + x as usize) * 4;
+        [self.data[i], self.data[i + 1], self.data[i + 2], self.data[i + 3]]
+    }
+
+    /// Set the RGBA value at (x, y).
+    pub fn set_pixel(&mut self, x: u32, y: u32, rgba: [f32; 4]) {
+        let i = (y as usize * self.width as usize + x as usize) * 4;
+        self.data[i..i + 4].copy_from_slice(&rgba);
+    }
+
+    /// The RGBA value at (x, y) as 8-bit levels (rounded, clamped).
+    pub fn pixel_u8(&self, x: u32, y: u32) -> [u8; 4] {
+        self.pixel(x, y).map(to_u8)
+    }
+
+    /// 8-bit RGBA bytes (rounded, clamped), top row first.
+    pub fn to_rgba8(&self) -> Vec<u8> {
+        self.data.iter().map(|&v| to_u8(v)).collect()
+    }
+
+    /// 16-bit RGBA samples (rounded, clamped), top row first.
+    pub fn to_rgba16(&self) -> Vec<u16> {
+        self.data
+            .iter()
+            .map(|&v| (v.clamp(0.0, 1.0) * 65535.0).round() as u16)
+            .collect()
+    }
+
+    /// Compare with `other`; `tolerance` sets what counts in `pixels_over`.
+    /// `None` when the sizes differ.
+    pub fn compare(&self, other: &Image, tolerance: f32) -> Option<Difference> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return None;
+        }
+        let (mut max_abs, mut sum_sq, mut over, mut worst) = (0f64, 0f64, 0usize, (0, 0));
+        for (i, (a, b)) in self
+            .data
+            .chunks_exact(4)
+            .zip(other.data.chunks_exact(4))
+            .enumerate()
+        {
+            let mut pixel_max = 0f64;
+            for (x, y) in a.iter().zip(b) {
+                // NaN compares as the largest possible difference.
+                let d = if x.is_nan() != y.is_nan() {
+                    f64::INFINITY
+                } else if x.is_nan() {
+                    0.0
+                } else {
+                    (*x as f64 - *y as f64).abs()
+                };
+                sum_sq += if d.is_finite() { d * d } else { 1.0 };
+                pixel_max = pixel_max.max(d);
+            }
+            if pixel_max > tolerance as f64 {
+                over += 1;
+            }
+            if pixel_max > max_abs {
+                max_abs = pixel_max;
+                worst = (i as u32 % self.width, i as u32 / self.width);
+            }
+        }
+        let rmse = (sum_sq / self.data.len().max(1) as f64).sqrt();
+        let psnr = if rmse == 0.0 {
+            f64::INFINITY
+        } else {
+            20.0 * (1.0 / rmse).log10()
+        };
+        Some(Difference {
+            max_abs,
+            rmse,
+            psnr,
+            pixels_over: over,
+            worst,
+        })
+    }
+
+    /// A diff image: each pixel's largest channel difference, scaled by `gain`, as grey;
+    /// pixels over `tolerance` in red. Opaque.
+    pub fn diff_image(&self, other: &Image, tolerance: f32, gain: f32) -> Option<Image> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return None;
+        }
+        let mut out = Image::filled(self.width, self.height, TargetFormat::Rgba8, [0.0; 4]);
+        for (o, (a, b)) in out
+            .data
+            .chunks_exact_mut(4)
+            .zip(self.data.chunks_exact(4).zip(other.data.chunks_exact(4)))
+        {
+            let d = a
+                .iter()
+                .zip(b)
+                .map(|(x, y)| (x - y).abs())
+                .fold(0f32, |m, v| if v.is_nan() { 1.0 } else { m.max(v) });
+            let g = (d * gain).min(1.0);
+            let rgba = if d > tolerance { [1.0, 0.0, 0.0, 1.0] } else { [g, g, g, 1.0] };
+            o.copy_from_slice(&rgba);
+        }
+        Some(out)
+    }
+}
+
+fn to_u8(v: f32) -> u8 {
+    (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}

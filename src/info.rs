@@ -1,0 +1,32 @@
+//! `arbvis info`: what the driver is and what it can do for ARB programs.
+
+use crate::gl::{Backend, Caps};
+
+/// Human-readable report of `caps` on `backend`.
+pub fn format_info(backend: Backend, caps: &Caps) -> String {
+    let yes = |b: bool| if b { "yes" } else { "no" };
+    let mut s = String::new();
+    s += &format!("backend:                 {}\n", backend.name());
+    s += &format!("GL_VENDOR:               {}\n", caps.vendor);
+    s += &format!("GL_RENDERER:             {}\n", caps.renderer);
+    s += &format!("GL_VERSION:              {}\n", caps.version);
+    s += &format!("profile:                 {}\n", caps.profile);
+    s += &format!("software renderer:       {}\n", yes(caps.software));
+    s += &format!("GL_ARB_fragment_program: {}\n", yes(caps.arb_fragment_program));
+    s += &format!("GL_ARB_vertex_program:   {}\n", yes(caps.arb_vertex_program));
+    s += &format!("texture image units:     {}\n", caps.max_texture_units);
+    s += &format!("max 3D texture size:     {}\n", caps.max_3d_texture_size);
+    for (name, l, frag) in [
+        ("fragment", caps.fragment_limits, true),
+        ("vertex", caps.vertex_limits, false),
+    ] {
+        s += &format!("ARB {name} program native limits:\n");
+        s += &format!("  instructions:          {}\n", l.native_instructions);
+        s += &format!("  temporaries:           {}\n", l.native_temporaries);
+        if frag {
+            s += &format!("  texture indirections:  {}\n", l.native_tex_indirections);
+        }
+        s += &format!("  local parameters:      {}\n", l.local_parameters);
+    }
+    s
+}

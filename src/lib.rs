@@ -1,0 +1,19 @@
+//! arbvis: GPU visualization techniques of the programmable-shader era — v3o2's 3D
+//! opacity, isosurfaces by cell projection, multi-resolution clip textures and
+//! point-based geological sections — each in a faithful mode (the original programs,
+//! 8-bit targets) and a precise mode (corrected maths, float targets).
+//!
+//! Layers, top to bottom: [`scene`] → data → [`techniques`] (CPU preparation, GL
+//! renderer, CPU reference) → [`gl`] (the only `unsafe`) → [`image`] / [`png_io`].
+
+pub mod camera;
+pub mod gl;
+pub mod image;
+pub mod info;
+pub mod png_io;
+pub mod programs;
+pub mod render;
+pub mod scene;
+pub mod techniques;
+#[cfg(feature = "viewer")]
+pub mod viewer;

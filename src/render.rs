@@ -1,0 +1,97 @@
+//! Offscreen rendering of a scene: context, renderer, target, one frame, read back.
+
+use std::time::{Duration, Instant};
+
+use crate::gl::{Backend, Caps, GlResult, Headless, ProgramKind, Resource, Surface, Target};
+use crate::image::Image;
+use crate::scene::Scene;
+use crate::techniques::{self, Frame};
+
+/// One rendered scene and what made it.
+pub struct Rendered {
+    /// The image, top row first.
+    pub image: Image,
+    /// The program kind that drew it.
+    pub program_kind: ProgramKind,
+    /// The backend that drew it.
+    pub backend: Backend,
+    /// The driver.
+    pub caps: Caps,
+    /// Every GL resource created, with its bytes.
+    pub resources: Vec<Resource>,
+    /// Time to build the renderer (programs, uploads).
+    pub build_time: Duration,
+    /// Time to draw and finish the frame.
+    pub draw_time: Duration,
+}
+
+impl Rendered {
+    /// PNG text chunks: scene, program kind, fidelity, renderer.
+    pub fn png_text(&self, scene: &Scene, origin: &str) -> Vec<(&'static str, String)> {
+        vec![
+            ("Software", format!("arbvis {}", env!("CARGO_PKG_VERSION"))),
+            ("arbvis:scene-origin", origin.to_string()),
+            ("arbvis:scene", scene.to_toml()),
+            ("arbvis:technique", scene.technique.name().to_string()),
+            ("arbvis:programs", self.program_kind.name().to_string()),
+            ("arbvis:fidelity", scene.fidelity.name().to_string()),
+            ("arbvis:target", scene.target_format().name().to_string()),
+            ("arbvis:backend", self.backend.name().to_string()),
+            (
+                "arbvis:renderer",
+                format!("{} | {} | {}", self.caps.vendor, self.caps.renderer, self.caps.version),
+            ),
+        ]
+    }
+}
+
+/// Render `scene` offscreen on `backend`.
+pub fn render(scene: &Scene, backend: Backend) -> GlResult<Rendered> {
+    let headless = Headless::new(backend)?;
+    render_on(&headless, scene)
+}
+
+/// Render `scene` with an existing context.
+pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
+    let gpu = headless.gpu();
+    let kind = scene.programs.resolve(gpu);
+    let [width, height] = scene.size;
+    let t0 = Instant::now();
+    let target = Target::new(gpu, width, height, scene.target_format())?;
+    let mut renderer = techniques::build(gpu, scene, kind)?;
+    gpu.finish();
+    let build_time = t0.elapsed();
+    let t1 = Instant::now();
+    target.clear(gpu, scene.background)?;
+    let frame = Frame {
+        camera: scene.camera,
+        width,
+        height,
+    };
+    renderer.draw(gpu, Surface::Target(&target), &frame)?;
+    crate::gl_check!(gpu)?;
+    gpu.finish();
+    let draw_time = t1.elapsed();
+    let image = target.read(gpu)?;
+    Ok(Rendered {
+        image,
+        program_kind: renderer.program_kind(),
+        backend: headless.backend(),
+        caps: gpu.caps().clone(),
+        resources: gpu.resources(),
+        build_time,
+        draw_time,
+    })
+}
+
+/// `--stats`: every resource, one line each, and the total.
+pub fn format_stats(resources: &[Resource]) -> String {
+    let mut s = String::from("GL resources created:\n");
+    let mut total = 0;
+    for r in resources {
+        s += &format!("  {:<12} {:>12} B  {}\n", r.kind, r.bytes, r.label);
+        total += r.bytes;
+    }
+    s += &format!("  {} resources, {} bytes in total\n", resources.len(), total);
+    s
+}

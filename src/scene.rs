@@ -1,0 +1,260 @@
+//! The scene model: one technique, its parameters, camera, size, fidelity, program kind
+//! and target precision, read from TOML. Technique issues add variants to
+//! [`TechniqueScene`]; a renderer builds only what its scene names.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::camera::Camera;
+use crate::gl::{ProgramChoice, TargetFormat};
+use crate::techniques::quad::QuadScene;
+
+/// Faithful (the original programs, 8-bit targets, original formulas) or precise
+/// (corrected maths, float targets). DESIGN.md §3.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Fidelity {
+    /// As the original system did it.
+    #[default]
+    Faithful,
+    /// As it should be done.
+    Precise,
+}
+
+impl Fidelity {
+    /// The target precision this fidelity uses unless the scene names one.
+    pub fn default_target(self) -> TargetFormat {
+        match self {
+            Fidelity::Faithful => TargetFormat::Rgba8,
+            Fidelity::Precise => TargetFormat::Rgba32f,
+        }
+    }
+
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fidelity::Faithful => "faithful",
+            Fidelity::Precise => "precise",
+        }
+    }
+}
+
+/// Which technique and its parameters; in TOML a `[technique.NAME]` table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", deny_unknown_fields)]
+pub enum TechniqueScene {
+    /// The full-screen quad demo.
+    Quad(QuadScene),
+}
+
+impl TechniqueScene {
+    /// Technique name as written in scenes.
+    pub fn name(&self) -> &'static str {
+        match self {
+            TechniqueScene::Quad(_) => "quad",
+        }
+    }
+}
+
+/// A whole scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Image size in pixels `[width, height]`.
+    #[serde(default = "default_size")]
+    pub size: [u32; 2],
+    /// Faithful or precise.
+    #[serde(default)]
+    pub fidelity: Fidelity,
+    /// ARB, GLSL or auto.
+    #[serde(default)]
+    pub programs: ProgramChoice,
+    /// Colour target; by default RGBA8 when faithful, RGBA32F when precise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<TargetFormat>,
+    /// Clear colour, RGBA.
+    #[serde(default)]
+    pub background: [f32; 4],
+    /// The camera.
+    #[serde(default)]
+    pub camera: Camera,
+    /// The technique and its parameters.
+    pub technique: TechniqueScene,
+}
+
+fn default_size() -> [u32; 2] {
+    [256, 256]
+}
+
+/// Errors reading a scene; each names the file and, for syntax, the line and column.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The scene file.
+        path: String,
+        /// What failed.
+        source: std::io::Error,
+    },
+    /// TOML syntax or a value of the wrong shape.
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse {
+        /// The scene file.
+        path: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What was expected.
+        message: String,
+    },
+    /// Values that parse but cannot be rendered.
+    #[error("{path}: {message}")]
+    Invalid {
+        /// The scene file.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// No built-in demo of that name.
+    #[error("no demo named {0:?}; demos: {demos}", demos = DEMOS.iter().map(|d| d.0).collect::<Vec<_>>().join(", "))]
+    UnknownDemo(String),
+}
+
+/// Built-in demos: name and scene text (files under `scenes/demo/`).
+pub const DEMOS: &[(&str, &str)] = &[("quad", include_str!("../scenes/demo/quad.toml"))];
+
+impl Scene {
+    /// Parse scene text; `origin` names it in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
+        let scene: Scene = toml::from_str(text).map_err(|e| {
+            let (line, column) = e
+                .span()
+                .map(|s| line_column(text, s.start))
+                .unwrap_or((1, 1));
+            SceneError::Parse {
+                path: origin.to_string(),
+                line,
+                column,
+                message: e.message().to_string(),
+            }
+        })?;
+        scene.validate(origin)?;
+        Ok(scene)
+    }
+
+    /// Read and parse a scene file.
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        Scene::parse(&text, &path.display().to_string())
+    }
+
+    /// A built-in demo scene.
+    pub fn demo(name: &str) -> Result<Scene, SceneError> {
+        let (_, text) = DEMOS
+            .iter()
+            .find(|(n, _)| *n == name)
+            .ok_or_else(|| SceneError::UnknownDemo(name.to_string()))?;
+        Scene::parse(text, &format!("demo:{name}"))
+    }
+
+    /// The scene as TOML (what the viewer saves).
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot serialize: {e}\n"))
+    }
+
+    /// The target precision in effect.
+    pub fn target_format(&self) -> TargetFormat {
+        self.target.unwrap_or(self.fidelity.default_target())
+    }
+
+    fn validate(&self, origin: &str) -> Result<(), SceneError> {
+        let [w, h] = self.size;
+        if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+            return Err(SceneError::Invalid {
+                path: origin.into(),
+                message: format!("size {w}x{h}: each side must be 1..=16384"),
+            });
+        }
+        if self.background.iter().any(|v| !v.is_finite()) {
+            return Err(SceneError::Invalid {
+                path: origin.into(),
+                message: "background must be finite".into(),
+            });
+        }
+        Ok(())
+    }
+}
+
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.len() - before.rfind('\n').map_or(0, |p| p + 1) + 1;
+    (line, column)
+}
+
+/// Parse `WxH` (e.g. `256x256`).
+pub fn parse_size(s: &str) -> Result<[u32; 2], String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT, e.g. 256x256"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|n| (1..=16384).contains(n))
+            .ok_or_else(|| format!("{s:?}: each side must be a whole number in 1..=16384"))
+    };
+    Ok([parse(w)?, parse(h)?])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_demo_parses() {
+        for (name, _) in DEMOS {
+            Scene::demo(name).unwrap();
+        }
+    }
+
+    #[test]
+    fn unknown_key_names_line_and_column() {
+        let text = "size = [64, 64]\nbogus = 1\n[technique.quad]\n";
+        match Scene::parse(text, "x.toml") {
+            Err(SceneError::Parse { line, column, message, .. }) => {
+                assert_eq!((line, column), (2, 1), "{message}");
+                assert!(message.contains("bogus"), "{message}");
+            }
+            other => panic!("expected a parse error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn bad_size_is_rejected() {
+        let text = "size = [0, 64]\n[technique.quad]\n";
+        assert!(matches!(Scene::parse(text, "x"), Err(SceneError::Invalid { .. })));
+    }
+
+    #[test]
+    fn round_trips_through_toml() {
+        let scene = Scene::demo("quad").unwrap();
+        assert_eq!(Scene::parse(&scene.to_toml(), "again").unwrap(), scene);
+    }
+
+    #[test]
+    fn sizes() {
+        assert_eq!(parse_size("320x240"), Ok([320, 240]));
+        assert!(parse_size("320").is_err());
+        assert!(parse_size("0x5").is_err());
+        assert!(parse_size("axb").is_err());
+    }
+}

@@ -1,0 +1,45 @@
+//! One module per technique, each with the same parts: a `//!` "How it works", the scene
+//! parameters, CPU preparation (testable without GL), the renderer, and a CPU reference
+//! of the same maths. The seed techniques (`opacity3d`, `cellproj`, `clip`, `splats`)
+//! slot in beside `quad`, the foundation's demo.
+
+pub mod quad;
+
+use crate::camera::Camera;
+use crate::gl::{GlResult, Gpu, ProgramKind, Surface};
+use crate::scene::{Scene, TechniqueScene};
+
+/// What changes from frame to frame.
+#[derive(Debug, Clone, Copy)]
+pub struct Frame {
+    /// The camera.
+    pub camera: Camera,
+    /// Surface width in pixels.
+    pub width: u32,
+    /// Surface height in pixels.
+    pub height: u32,
+}
+
+impl Frame {
+    /// Width / height.
+    pub fn aspect(&self) -> f64 {
+        self.width as f64 / self.height.max(1) as f64
+    }
+}
+
+/// A technique's long-lived GL state (programs, textures, buffers), drawn once per frame.
+pub trait Renderer {
+    /// Draw one frame onto `surface` (already cleared by the caller).
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()>;
+    /// Take changed parameters (the viewer's editors); resends what changed.
+    fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()>;
+    /// The program kind in use.
+    fn program_kind(&self) -> ProgramKind;
+}
+
+/// Build the renderer a scene names, with programs of `kind`; nothing else is created.
+pub fn build(gpu: &Gpu, scene: &Scene, kind: ProgramKind) -> GlResult<Box<dyn Renderer>> {
+    Ok(match &scene.technique {
+        TechniqueScene::Quad(params) => Box::new(quad::QuadRenderer::new(gpu, kind, params)?),
+    })
+}

@@ -1,0 +1,161 @@
+//! `--demo quad`: a full-screen quad drawn by a tiny ARB fragment program and its GLSL
+//! twin — the foundation's smallest end-to-end check of contexts, programs, locals,
+//! targets and PNG output.
+//!
+//! # How it works
+//! Two triangles cover clip space [-1, 1]² (the camera rotates and zooms them in the
+//! viewer; by default they fill the target). Texture coordinate (u, v) runs from (0, 0)
+//! at the bottom left to (1, 1) at the top right. The fragment program computes
+//! `c = mix(left, right, u)` with `left = program.local[0]`, `right = program.local[1]`,
+//! and outputs `(c.rgb * v, c.a)`. [`reference`] computes the same at pixel centres in f64.
+
+use glam::{DMat4, DVec3};
+use serde::{Deserialize, Serialize};
+
+use super::{Frame, Renderer};
+use crate::gl::{self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface};
+use crate::image::Image;
+use crate::programs;
+use crate::scene::TechniqueScene;
+
+/// Parameters of the quad demo.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct QuadScene {
+    /// Colour at the left edge (RGBA), `program.local[0]`.
+    pub left: [f64; 4],
+    /// Colour at the right edge (RGBA), `program.local[1]`.
+    pub right: [f64; 4],
+}
+
+impl Default for QuadScene {
+    fn default() -> Self {
+        QuadScene {
+            left: [1.0, 0.2, 0.0, 1.0],
+            right: [0.0, 0.4, 1.0, 1.0],
+        }
+    }
+}
+
+/// The quad's vertices: position (x, y, z, w) then texture coordinate (u, v, 0, 1).
+pub fn quad_vertices() -> Vec<f32> {
+    let corner = |x: f32, y: f32| [x, y, 0.0, 1.0, (x + 1.0) / 2.0, (y + 1.0) / 2.0, 0.0, 1.0];
+    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+        .iter()
+        .flat_map(|&(x, y)| corner(x, y))
+        .collect()
+}
+
+/// The quad's transform: the camera's rotation and zoom; depth halved so a rotated quad
+/// stays inside the clip volume. Identity for the default camera.
+pub fn transform(frame: &Frame) -> DMat4 {
+    let zoom = frame.camera.zoom.max(1e-6);
+    DMat4::from_scale(DVec3::new(zoom, zoom, 0.5)) * DMat4::from_quat(frame.camera.quat())
+}
+
+/// The quad demo's GL state.
+pub struct QuadRenderer {
+    program: Program,
+    mesh: Mesh,
+}
+
+impl QuadRenderer {
+    /// Compile the programs of `kind`, upload the quad, set the colours.
+    pub fn new(gpu: &Gpu, kind: ProgramKind, params: &QuadScene) -> GlResult<QuadRenderer> {
+        let pair = programs::with_transform(kind, &programs::QUAD_ARBFP, &programs::QUAD_FRAG);
+        let program = Program::new(gpu, kind, &pair.vertex, &pair.fragment)?;
+        let mesh = Mesh::new(gpu, "quad", &[4, 4], &quad_vertices())?;
+        let renderer = QuadRenderer { program, mesh };
+        renderer.set_colours(gpu, params)?;
+        Ok(renderer)
+    }
+
+    fn set_colours(&self, gpu: &Gpu, params: &QuadScene) -> GlResult<()> {
+        if params.left.iter().chain(&params.right).any(|v| !v.is_finite()) {
+            return Err(GlError::Invalid("quad colours must be finite".into()));
+        }
+        self.program.set_local(gpu, 0, params.left)?;
+        self.program.set_local(gpu, 1, params.right)
+    }
+}
+
+impl Renderer for QuadRenderer {
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+        self.program.set_transform(gpu, transform(frame))?;
+        gl::draw(
+            gpu,
+            surface,
+            &DrawCall {
+                program: &self.program,
+                mesh: &self.mesh,
+                range: None,
+                textures: &[],
+                blend: Blend::Replace,
+            },
+        )
+    }
+
+    fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()> {
+        let TechniqueScene::Quad(params) = technique;
+        self.set_colours(gpu, params)
+    }
+
+    fn program_kind(&self) -> ProgramKind {
+        self.program.kind()
+    }
+}
+
+/// CPU reference (f64) of the default-camera image at pixel centres, top row first;
+/// `clamp` as a normalized (RGBA8) target clamps.
+pub fn reference(params: &QuadScene, width: u32, height: u32, clamp: bool) -> Vec<[f64; 4]> {
+    let mut out = Vec::with_capacity(width as usize * height as usize);
+    for y in 0..height {
+        let v = 1.0 - (y as f64 + 0.5) / height as f64;
+        for x in 0..width {
+            let u = (x as f64 + 0.5) / width as f64;
+            let c: [f64; 4] = std::array::from_fn(|i| params.left[i] * (1.0 - u) + params.right[i] * u);
+            let px = [c[0] * v, c[1] * v, c[2] * v, c[3]];
+            out.push(if clamp { px.map(|p| p.clamp(0.0, 1.0)) } else { px });
+        }
+    }
+    out
+}
+
+/// [`reference`] as an [`Image`] of `format`, for comparisons.
+pub fn reference_image(params: &QuadScene, width: u32, height: u32, format: gl::TargetFormat) -> Image {
+    let clamp = format == gl::TargetFormat::Rgba8;
+    let data = reference(params, width, height, clamp)
+        .into_iter()
+        .flat_map(|p| p.map(|v| v as f32))
+        .collect();
+    Image {
+        width,
+        height,
+        format,
+        data,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reference_corners() {
+        let p = QuadScene {
+            left: [1.0, 0.0, 0.0, 1.0],
+            right: [0.0, 0.0, 1.0, 0.5],
+        };
+        let img = reference(&p, 2, 2, true);
+        // Top-left pixel centre: u = 0.25, v = 0.75.
+        let tl = img[0];
+        assert!((tl[0] - 0.75 * 0.75).abs() < 1e-12);
+        assert!((tl[2] - 0.25 * 0.75).abs() < 1e-12);
+        assert!((tl[3] - 0.875).abs() < 1e-12);
+    }
+
+    #[test]
+    fn six_vertices_of_eight_floats() {
+        assert_eq!(quad_vertices().len(), 6 * 8);
+    }
+}
