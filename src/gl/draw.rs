@@ -47,6 +47,31 @@ pub struct DrawCall<'a> {
     pub blend: Blend,
 }
 
+/// Clear `surface` (only its viewport, for a window) to `rgba`.
+pub fn clear(gpu: &Gpu, surface: Surface<'_>, rgba: [f32; 4]) -> GlResult<()> {
+    let _guard = StateGuard::save(gpu);
+    let gl = gpu.glow();
+    // SAFETY: plain state calls.
+    unsafe {
+        match surface {
+            Surface::Target(t) => {
+                t.bind();
+                gl.disable(glow::SCISSOR_TEST);
+            }
+            Surface::Window([x, y, w, h]) => {
+                gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+                gl.viewport(x, y, w, h);
+                gl.enable(glow::SCISSOR_TEST);
+                gl.scissor(x, y, w, h);
+            }
+        }
+        gl.color_mask(true, true, true, true);
+        gl.clear_color(rgba[0], rgba[1], rgba[2], rgba[3]);
+        gl.clear(glow::COLOR_BUFFER_BIT);
+    }
+    crate::gl_check!(gpu)
+}
+
 /// Execute `call` on `surface`; the state the draw set is restored afterwards.
 pub fn draw(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<()> {
     let (first, count) = call.range.unwrap_or((0, call.mesh.vertex_count()));

@@ -160,64 +160,72 @@ impl Target {
 
     /// Clear to `rgba`.
     pub fn clear(&self, gpu: &Gpu, rgba: [f32; 4]) -> GlResult<()> {
-        let _guard = super::state::StateGuard::save(gpu);
-        self.bind();
-        // SAFETY: plain state calls on the bound framebuffer.
-        unsafe {
-            self.gl.disable(glow::SCISSOR_TEST);
-            self.gl.color_mask(true, true, true, true);
-            self.gl.clear_color(rgba[0], rgba[1], rgba[2], rgba[3]);
-            self.gl.clear(glow::COLOR_BUFFER_BIT);
-        }
-        crate::gl_check!(gpu)
+        super::draw::clear(gpu, super::draw::Surface::Target(self), rgba)
     }
 
     /// Read the whole target, top row first. RGBA8 keeps its bytes exactly (as `k/255`).
     pub fn read(&self, gpu: &Gpu) -> GlResult<Image> {
         let _guard = super::state::StateGuard::save(gpu);
-        let (w, h) = (self.width as usize, self.height as usize);
-        let mut data = vec![0f32; w * h * 4];
-        // SAFETY: the buffers hold exactly w*h*4 values of the type asked for.
+        // SAFETY: plain state call with a live framebuffer.
         unsafe {
             self.gl
                 .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.framebuffer));
-            self.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
-            match self.format {
-                TargetFormat::Rgba8 => {
-                    let mut bytes = vec![0u8; w * h * 4];
-                    self.gl.read_pixels(
-                        0,
-                        0,
-                        w as i32,
-                        h as i32,
-                        glow::RGBA,
-                        glow::UNSIGNED_BYTE,
-                        glow::PixelPackData::Slice(Some(&mut bytes)),
-                    );
-                    for (d, b) in data.iter_mut().zip(&bytes) {
-                        *d = *b as f32 / 255.0;
-                    }
-                }
-                _ => {
-                    let bytes = std::slice::from_raw_parts_mut(
-                        data.as_mut_ptr().cast::<u8>(),
-                        data.len() * 4,
-                    );
-                    self.gl.read_pixels(
-                        0,
-                        0,
-                        w as i32,
-                        h as i32,
-                        glow::RGBA,
-                        glow::FLOAT,
-                        glow::PixelPackData::Slice(Some(bytes)),
-                    );
-                }
-            }
         }
-        crate::gl_check!(gpu)?;
-        Ok(Image::from_bottom_up(self.width, self.height, self.format, data))
+        read_bound(gpu, [0, 0, self.width as i32, self.height as i32], self.format)
     }
+}
+
+/// Read `[x, y, width, height]` of the window's back buffer as RGBA8 (screenshots).
+pub fn read_window(gpu: &Gpu, rect: [i32; 4]) -> GlResult<Image> {
+    let _guard = super::state::StateGuard::save(gpu);
+    // SAFETY: plain state calls on the default framebuffer.
+    unsafe {
+        gpu.glow().bind_framebuffer(glow::READ_FRAMEBUFFER, None);
+        gpu.glow().read_buffer(glow::BACK);
+    }
+    read_bound(gpu, rect, TargetFormat::Rgba8)
+}
+
+fn read_bound(gpu: &Gpu, [x, y, w, h]: [i32; 4], format: TargetFormat) -> GlResult<Image> {
+    if w <= 0 || h <= 0 {
+        return Err(GlError::Invalid(format!("read of {w}x{h} pixels")));
+    }
+    let gl = gpu.glow();
+    let (wu, hu) = (w as usize, h as usize);
+    let mut data = vec![0f32; wu * hu * 4];
+    // SAFETY: the buffers hold exactly w*h*4 values of the type asked for.
+    unsafe {
+        gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+        if format == TargetFormat::Rgba8 {
+            let mut bytes = vec![0u8; wu * hu * 4];
+            gl.read_pixels(
+                x,
+                y,
+                w,
+                h,
+                glow::RGBA,
+                glow::UNSIGNED_BYTE,
+                glow::PixelPackData::Slice(Some(&mut bytes)),
+            );
+            for (d, b) in data.iter_mut().zip(&bytes) {
+                *d = *b as f32 / 255.0;
+            }
+        } else {
+            let bytes =
+                std::slice::from_raw_parts_mut(data.as_mut_ptr().cast::<u8>(), data.len() * 4);
+            gl.read_pixels(
+                x,
+                y,
+                w,
+                h,
+                glow::RGBA,
+                glow::FLOAT,
+                glow::PixelPackData::Slice(Some(bytes)),
+            );
+        }
+    }
+    crate::gl_check!(gpu)?;
+    Ok(Image::from_bottom_up(w as u32, h as u32, format, data))
 }
 
 impl Drop for Target {
