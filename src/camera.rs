@@ -69,8 +69,16 @@ impl Camera {
 
     /// Projection matrix for `aspect` = width / height; the depth range holds [-√3, √3].
     pub fn projection_matrix(&self, aspect: f64) -> DMat4 {
-        let aspect = if aspect.is_finite() && aspect > 0.0 { aspect } else { 1.0 };
-        let (sx, sy) = if aspect >= 1.0 { (aspect, 1.0) } else { (1.0, 1.0 / aspect) };
+        let aspect = if aspect.is_finite() && aspect > 0.0 {
+            aspect
+        } else {
+            1.0
+        };
+        let (sx, sy) = if aspect >= 1.0 {
+            (aspect, 1.0)
+        } else {
+            (1.0, 1.0 / aspect)
+        };
         match self.projection {
             Projection::Orthographic => {
                 let z = self.zoom.max(1e-6);
@@ -79,7 +87,11 @@ impl Camera {
             Projection::Perspective => {
                 let d = self.eye_distance();
                 let fov = self.fov_y_deg.clamp(1.0, 170.0).to_radians();
-                let fov = if aspect >= 1.0 { fov } else { 2.0 * ((fov / 2.0).tan() * sy).atan() };
+                let fov = if aspect >= 1.0 {
+                    fov
+                } else {
+                    2.0 * ((fov / 2.0).tan() * sy).atan()
+                };
                 perspective_gl(fov, aspect, (d - 2.0).max(1e-3), d + 2.0)
             }
         }
@@ -94,10 +106,22 @@ impl Camera {
 /// `glOrtho`'s matrix (right-handed eye space, depth to [-1, 1]).
 pub fn orthographic_gl(l: f64, r: f64, b: f64, t: f64, n: f64, f: f64) -> DMat4 {
     DMat4::from_cols_array(&[
-        2.0 / (r - l), 0.0, 0.0, 0.0,
-        0.0, 2.0 / (t - b), 0.0, 0.0,
-        0.0, 0.0, -2.0 / (f - n), 0.0,
-        -(r + l) / (r - l), -(t + b) / (t - b), -(f + n) / (f - n), 1.0,
+        2.0 / (r - l),
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        2.0 / (t - b),
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        -2.0 / (f - n),
+        0.0,
+        -(r + l) / (r - l),
+        -(t + b) / (t - b),
+        -(f + n) / (f - n),
+        1.0,
     ])
 }
 
@@ -105,10 +129,22 @@ pub fn orthographic_gl(l: f64, r: f64, b: f64, t: f64, n: f64, f: f64) -> DMat4 
 pub fn perspective_gl(fov_y: f64, aspect: f64, near: f64, far: f64) -> DMat4 {
     let f = 1.0 / (fov_y / 2.0).tan();
     DMat4::from_cols_array(&[
-        f / aspect, 0.0, 0.0, 0.0,
-        0.0, f, 0.0, 0.0,
-        0.0, 0.0, (far + near) / (near - far), -1.0,
-        0.0, 0.0, 2.0 * far * near / (near - far), 0.0,
+        f / aspect,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        f,
+        0.0,
+        0.0,
+        0.0,
+        0.0,
+        (far + near) / (near - far),
+        -1.0,
+        0.0,
+        0.0,
+        2.0 * far * near / (near - far),
+        0.0,
     ])
 }
 

@@ -60,7 +60,12 @@ impl Image {
     /// The RGBA value at (x, y), y counted from the top.
     pub fn pixel(&self, x: u32, y: u32) -> [f32; 4] {
         let i = (y as usize * self.width as usize + x as usize) * 4;
-        [self.data[i], self.data[i + 1], self.data[i + 2], self.data[i + 3]]
+        [
+            self.data[i],
+            self.data[i + 1],
+            self.data[i + 2],
+            self.data[i + 3],
+        ]
     }
 
     /// Set the RGBA value at (x, y).
@@ -154,7 +159,11 @@ impl Image {
                 .map(|(x, y)| (x - y).abs())
                 .fold(0f32, |m, v| if v.is_nan() { 1.0 } else { m.max(v) });
             let g = (d * gain).min(1.0);
-            let rgba = if d > tolerance { [1.0, 0.0, 0.0, 1.0] } else { [g, g, g, 1.0] };
+            let rgba = if d > tolerance {
+                [1.0, 0.0, 0.0, 1.0]
+            } else {
+                [g, g, g, 1.0]
+            };
             o.copy_from_slice(&rgba);
         }
         Some(out)
@@ -163,4 +172,42 @@ impl Image {
 
 fn to_u8(v: f32) -> u8 {
     (v.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn compare_finds_the_worst_pixel_and_counts_those_over() {
+        let a = Image::filled(4, 3, TargetFormat::Rgba8, [0.5; 4]);
+        let mut b = a.clone();
+        b.set_pixel(2, 1, [0.5, 0.6, 0.5, 0.5]);
+        b.set_pixel(0, 0, [0.51, 0.5, 0.5, 0.5]);
+        let d = a.compare(&b, 0.05).unwrap();
+        assert!((d.max_abs - 0.1).abs() < 1e-6);
+        assert_eq!(d.worst, (2, 1));
+        assert_eq!(d.pixels_over, 1);
+        assert!(d.psnr.is_finite());
+        assert_eq!(a.compare(&a, 0.0).unwrap().psnr, f64::INFINITY);
+        let diff = a.diff_image(&b, 0.05, 10.0).unwrap();
+        assert_eq!(diff.pixel(2, 1), [1.0, 0.0, 0.0, 1.0]);
+        assert!(a
+            .compare(&Image::filled(3, 3, TargetFormat::Rgba8, [0.0; 4]), 0.0)
+            .is_none());
+    }
+
+    #[test]
+    fn nan_counts_as_a_difference() {
+        let a = Image::filled(1, 1, TargetFormat::Rgba32f, [0.0; 4]);
+        let b = Image::filled(1, 1, TargetFormat::Rgba32f, [f32::NAN, 0.0, 0.0, 0.0]);
+        assert_eq!(a.compare(&b, 1.0).unwrap().pixels_over, 1);
+    }
+
+    #[test]
+    fn rows_are_flipped_to_top_first() {
+        let data = vec![0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0];
+        let img = Image::from_bottom_up(1, 2, TargetFormat::Rgba8, data);
+        assert_eq!(img.pixel(0, 0), [1.0; 4]);
+    }
 }

@@ -12,8 +12,14 @@ pub fn format_info(backend: Backend, caps: &Caps) -> String {
     s += &format!("GL_VERSION:              {}\n", caps.version);
     s += &format!("profile:                 {}\n", caps.profile);
     s += &format!("software renderer:       {}\n", yes(caps.software));
-    s += &format!("GL_ARB_fragment_program: {}\n", yes(caps.arb_fragment_program));
-    s += &format!("GL_ARB_vertex_program:   {}\n", yes(caps.arb_vertex_program));
+    s += &format!(
+        "GL_ARB_fragment_program: {}\n",
+        yes(caps.arb_fragment_program)
+    );
+    s += &format!(
+        "GL_ARB_vertex_program:   {}\n",
+        yes(caps.arb_vertex_program)
+    );
     s += &format!("texture image units:     {}\n", caps.max_texture_units);
     s += &format!("max 3D texture size:     {}\n", caps.max_3d_texture_size);
     for (name, l, frag) in [

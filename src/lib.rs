@@ -6,7 +6,10 @@
 //! Layers, top to bottom: [`scene`] → data → [`techniques`] (CPU preparation, GL
 //! renderer, CPU reference) → [`gl`] (the only `unsafe`) → [`image`] / [`png_io`].
 
+#![deny(unsafe_code)]
+
 pub mod camera;
+#[allow(unsafe_code)] // the one module allowed to call GL and the platform
 pub mod gl;
 pub mod image;
 pub mod info;

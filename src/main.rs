@@ -1,4 +1,5 @@
 //! The `arbvis` command line.
+#![forbid(unsafe_code)]
 
 use std::path::PathBuf;
 use std::process::ExitCode;

@@ -61,7 +61,11 @@ pub fn write_png(path: &Path, image: &Image, text: &[(&str, String)]) -> Result<
             let mut enc = png::Encoder::new(&mut w, image.width, image.height);
             enc.set_color(png::ColorType::Rgba);
             let sixteen = image.format != TargetFormat::Rgba8;
-            enc.set_depth(if sixteen { png::BitDepth::Sixteen } else { png::BitDepth::Eight });
+            enc.set_depth(if sixteen {
+                png::BitDepth::Sixteen
+            } else {
+                png::BitDepth::Eight
+            });
             for (k, v) in text {
                 enc.add_text_chunk(k.to_string(), v.clone()).map_err(fmt)?;
             }
@@ -107,7 +111,9 @@ pub fn read_png(path: &Path) -> Result<(Image, Vec<(String, String)>), PngError>
         .output_buffer_size()
         .ok_or_else(|| fmt("image too large".into()))?;
     let mut buf = vec![0; size];
-    let info = reader.next_frame(&mut buf).map_err(|e| fmt(e.to_string()))?;
+    let info = reader
+        .next_frame(&mut buf)
+        .map_err(|e| fmt(e.to_string()))?;
     let text = reader
         .info()
         .uncompressed_latin1_text
@@ -127,7 +133,11 @@ pub fn read_png(path: &Path) -> Result<(Image, Vec<(String, String)>), PngError>
         .zip(buf[..info.buffer_size()].chunks_exact(channels))
     {
         for c in 0..4 {
-            o[c] = if c < channels { px[c] as f32 / 255.0 } else { 1.0 };
+            o[c] = if c < channels {
+                px[c] as f32 / 255.0
+            } else {
+                1.0
+            };
         }
     }
     Ok((image, text))
@@ -141,7 +151,9 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     };
     let tmp = dir.join(format!(
         ".{}.tmp-{}",
-        path.file_name().map(|f| f.to_string_lossy()).unwrap_or_default(),
+        path.file_name()
+            .map(|f| f.to_string_lossy())
+            .unwrap_or_default(),
         std::process::id()
     ));
     let result = (|| {

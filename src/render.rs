@@ -39,7 +39,10 @@ impl Rendered {
             ("arbvis:backend", self.backend.name().to_string()),
             (
                 "arbvis:renderer",
-                format!("{} | {} | {}", self.caps.vendor, self.caps.renderer, self.caps.version),
+                format!(
+                    "{} | {} | {}",
+                    self.caps.vendor, self.caps.renderer, self.caps.version
+                ),
             ),
         ]
     }
@@ -92,6 +95,10 @@ pub fn format_stats(resources: &[Resource]) -> String {
         s += &format!("  {:<12} {:>12} B  {}\n", r.kind, r.bytes, r.label);
         total += r.bytes;
     }
-    s += &format!("  {} resources, {} bytes in total\n", resources.len(), total);
+    s += &format!(
+        "  {} resources, {} bytes in total\n",
+        resources.len(),
+        total
+    );
     s
 }

@@ -12,9 +12,7 @@ use crate::techniques::quad::QuadScene;
 
 /// Faithful (the original programs, 8-bit targets, original formulas) or precise
 /// (corrected maths, float targets). DESIGN.md §3.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum,
-)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Fidelity {
     /// As the original system did it.
@@ -230,7 +228,12 @@ mod tests {
     fn unknown_key_names_line_and_column() {
         let text = "size = [64, 64]\nbogus = 1\n[technique.quad]\n";
         match Scene::parse(text, "x.toml") {
-            Err(SceneError::Parse { line, column, message, .. }) => {
+            Err(SceneError::Parse {
+                line,
+                column,
+                message,
+                ..
+            }) => {
                 assert_eq!((line, column), (2, 1), "{message}");
                 assert!(message.contains("bogus"), "{message}");
             }
@@ -241,7 +244,10 @@ mod tests {
     #[test]
     fn bad_size_is_rejected() {
         let text = "size = [0, 64]\n[technique.quad]\n";
-        assert!(matches!(Scene::parse(text, "x"), Err(SceneError::Invalid { .. })));
+        assert!(matches!(
+            Scene::parse(text, "x"),
+            Err(SceneError::Invalid { .. })
+        ));
     }
 
     #[test]

@@ -18,16 +18,28 @@ fn every_program_compiles_on_this_driver() {
     let pairs = programs::all_pairs();
     for pair in &pairs {
         if let Err(e) = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment) {
-            failures.push(format!("{} + {}: {e}", pair.vertex.name, pair.fragment.name));
+            failures.push(format!(
+                "{} + {}: {e}",
+                pair.vertex.name, pair.fragment.name
+            ));
         }
     }
-    assert!(failures.is_empty(), "{} of {} program pairs failed:\n{}", failures.len(), pairs.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} of {} program pairs failed:\n{}",
+        failures.len(),
+        pairs.len(),
+        failures.join("\n")
+    );
 }
 
 #[test]
 fn every_file_in_programs_is_embedded() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("programs");
-    let embedded: Vec<String> = programs::all_texts().iter().map(|t| t.name.to_string()).collect();
+    let embedded: Vec<String> = programs::all_texts()
+        .iter()
+        .map(|t| t.name.to_string())
+        .collect();
     let mut missing = Vec::new();
     for dir in std::fs::read_dir(&root).unwrap() {
         let dir = dir.unwrap().path();
@@ -46,16 +58,26 @@ fn every_file_in_programs_is_embedded() {
             }
         }
     }
-    assert!(missing.is_empty(), "in programs/ but not in src/programs.rs: {missing:?}");
+    assert!(
+        missing.is_empty(),
+        "in programs/ but not in src/programs.rs: {missing:?}"
+    );
     // And every embedded text equals its file, byte for byte.
     for t in programs::all_texts() {
         let on_disk = std::fs::read(root.join(&*t.name)).unwrap();
-        assert_eq!(on_disk, t.text.as_bytes(), "{} differs from its file", t.name);
+        assert_eq!(
+            on_disk,
+            t.text.as_bytes(),
+            "{} differs from its file",
+            t.name
+        );
     }
 }
 
 fn fixture(name: &str) -> ProgramText {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/broken").join(name);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/fixtures/broken")
+        .join(name);
     ProgramText {
         name: format!("broken/{name}").into(),
         text: std::fs::read_to_string(path).unwrap().into(),
@@ -63,7 +85,11 @@ fn fixture(name: &str) -> ProgramText {
 }
 
 /// Compile `broken` with a working partner of the same kind and return the error.
-fn compile_error(kind: ProgramKind, broken: &ProgramText, broken_is_vertex: bool) -> arbvis::gl::CompileError {
+fn compile_error(
+    kind: ProgramKind,
+    broken: &ProgramText,
+    broken_is_vertex: bool,
+) -> arbvis::gl::CompileError {
     let h = headless(Backend::Egl);
     let good_vertex = match kind {
         ProgramKind::Arb => programs::TRANSFORM_ARBVP,
@@ -94,7 +120,10 @@ fn arb_typo_reports_line_and_column() {
     assert!(!e.message.is_empty());
     let shown = e.to_string();
     assert!(shown.starts_with("broken/typo.arbfp:4:1: "), "{shown}");
-    assert!(shown.contains(&e.message) && shown.contains("MOVE c"), "{shown}");
+    assert!(
+        shown.contains(&e.message) && shown.contains("MOVE c"),
+        "{shown}"
+    );
 }
 
 #[test]
@@ -105,7 +134,10 @@ fn arb_error_in_joined_string_has_column_on_line_one() {
     let col = e.column.expect("a column") as usize;
     // The driver points at or just after the undeclared name.
     let at = text.text.find("undeclared").unwrap() + 1;
-    assert!((at..=at + "undeclared".len()).contains(&col), "column {col}, name at {at}: {e}");
+    assert!(
+        (at..=at + "undeclared".len()).contains(&col),
+        "column {col}, name at {at}: {e}"
+    );
 }
 
 #[test]
@@ -123,12 +155,20 @@ fn glsl_error_reports_line_and_column() {
     assert_eq!(e.line, 5, "{e}");
     assert!(e.column.is_some(), "{e}");
     assert!(e.message.contains("undeclared_gain"), "{e}");
-    assert_eq!(e.source_line.trim(), "frag_color = v_texcoord0 * undeclared_gain;");
+    assert_eq!(
+        e.source_line.trim(),
+        "frag_color = v_texcoord0 * undeclared_gain;"
+    );
 }
 
 #[test]
 fn no_gl_error_left_behind_after_a_failed_compile() {
     let h = headless(Backend::Egl);
-    let _ = Program::new(h.gpu(), ProgramKind::Arb, &programs::TRANSFORM_ARBVP, &fixture("typo.arbfp"));
+    let _ = Program::new(
+        h.gpu(),
+        ProgramKind::Arb,
+        &programs::TRANSFORM_ARBVP,
+        &fixture("typo.arbfp"),
+    );
     arbvis::gl_check!(h.gpu()).expect("the failed compile consumed its own error");
 }

@@ -26,8 +26,16 @@ fn params(scene: &Scene) -> QuadScene {
 #[test]
 fn arb_and_glsl_agree_within_one_level() {
     let h = headless(Backend::Egl);
-    let arb = render_on(&h, &quad_scene(ProgramChoice::Arb, TargetFormat::Rgba8, 128)).unwrap();
-    let glsl = render_on(&h, &quad_scene(ProgramChoice::Glsl, TargetFormat::Rgba8, 128)).unwrap();
+    let arb = render_on(
+        &h,
+        &quad_scene(ProgramChoice::Arb, TargetFormat::Rgba8, 128),
+    )
+    .unwrap();
+    let glsl = render_on(
+        &h,
+        &quad_scene(ProgramChoice::Glsl, TargetFormat::Rgba8, 128),
+    )
+    .unwrap();
     assert_eq!(arb.program_kind, ProgramKind::Arb);
     assert_eq!(glsl.program_kind, ProgramKind::Glsl);
     // Both compute the same f32 expression; each stores round(255 v), so they may differ
@@ -100,7 +108,12 @@ fn egl_and_osmesa_give_identical_pixels() {
 #[test]
 fn golden_quad() {
     let h = headless(Backend::Egl);
-    let img = render_on(&h, &quad_scene(ProgramChoice::Arb, TargetFormat::Rgba8, 128)).unwrap().image;
+    let img = render_on(
+        &h,
+        &quad_scene(ProgramChoice::Arb, TargetFormat::Rgba8, 128),
+    )
+    .unwrap()
+    .image;
     // Golden made on llvmpipe (Mesa 22.3.6); one level covers other drivers' rounding.
     common::assert_snapshot("quad/quad_arb_128", &img, LEVEL);
 }
@@ -108,9 +121,22 @@ fn golden_quad() {
 #[test]
 fn stats_list_only_what_the_scene_names() {
     let h = headless(Backend::Egl);
-    let r = render_on(&h, &quad_scene(ProgramChoice::Arb, TargetFormat::Rgba16f, 32)).unwrap();
+    let r = render_on(
+        &h,
+        &quad_scene(ProgramChoice::Arb, TargetFormat::Rgba16f, 32),
+    )
+    .unwrap();
     let kinds: Vec<&str> = r.resources.iter().map(|r| r.kind).collect();
-    assert_eq!(kinds, ["framebuffer", "program", "buffer"], "{:?}", r.resources);
+    assert_eq!(
+        kinds,
+        ["framebuffer", "program", "buffer"],
+        "{:?}",
+        r.resources
+    );
     assert_eq!(r.resources[0].bytes, 32 * 32 * 8, "RGBA16F target bytes");
-    assert_eq!(r.resources[2].bytes, 6 * 8 * 4, "six vertices of eight floats");
+    assert_eq!(
+        r.resources[2].bytes,
+        6 * 8 * 4,
+        "six vertices of eight floats"
+    );
 }

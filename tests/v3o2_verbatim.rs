@@ -53,14 +53,32 @@ fn hand_computed_sum_pixel(backend: Backend) {
     // whatever the interpolation, the fetched texel is exactly these bytes.
     let voxel = [30u8, 200, 90];
     let volume: Vec<u8> = voxel.repeat(8);
-    let vol = Texture::new(gpu, "volume", Extent::D3(2, 2, 2), TexelFormat::Rgb8, Filter::Nearest, TexelData::U8(&volume)).unwrap();
+    let vol = Texture::new(
+        gpu,
+        "volume",
+        Extent::D3(2, 2, 2),
+        TexelFormat::Rgb8,
+        Filter::Nearest,
+        TexelData::U8(&volume),
+    )
+    .unwrap();
     // Tables: the entry the program reads holds the value; all others are decoys, so a
     // wrong channel or a wrong index shows. With NEAREST, coordinate k/255 on 256 texels
     // lands on texel floor(k/255*256) = k for k < 255.
     let t1 = table(200, [200, 40, 0, 255], [7, 7, 7, 7]);
     let t2 = table(90, [0, 160, 80, 128], [9, 9, 9, 9]);
     let t3 = table(30, [100, 0, 250, 64], [11, 11, 11, 11]);
-    let lut = |d: &[u8], n| Texture::new(gpu, n, Extent::D2(256, 1), TexelFormat::Rgba8, Filter::Nearest, TexelData::U8(d)).unwrap();
+    let lut = |d: &[u8], n| {
+        Texture::new(
+            gpu,
+            n,
+            Extent::D2(256, 1),
+            TexelFormat::Rgba8,
+            Filter::Nearest,
+            TexelData::U8(d),
+        )
+        .unwrap()
+    };
     let (lut1, lut2, lut3) = (lut(&t1, "lut1"), lut(&t2, "lut2"), lut(&t3, "lut3"));
 
     // Upload the seed's bytes, not the embedded file, so the test checks the seed itself.
@@ -68,7 +86,8 @@ fn hand_computed_sum_pixel(backend: Backend) {
         name: "seed/sum".into(),
         text: SEED_SUM_LINES.concat().into(),
     };
-    let program = Program::new(gpu, ProgramKind::Arb, &programs::TRANSFORM_ARBVP, &fragment).unwrap();
+    let program =
+        Program::new(gpu, ProgramKind::Arb, &programs::TRANSFORM_ARBVP, &fragment).unwrap();
     program.set_transform(gpu, glam::DMat4::IDENTITY).unwrap();
     let c1 = [1.0, 0.5, 0.25, 1.0];
     let c2 = [0.5, 1.0, 0.0, 0.5];
@@ -79,13 +98,18 @@ fn hand_computed_sum_pixel(backend: Backend) {
 
     let mesh = Mesh::new(gpu, "quad", &[4, 4], &quad_vertices()).unwrap();
     let target = Target::new(gpu, 8, 8, TargetFormat::Rgba8).unwrap();
-    draw(gpu, Surface::Target(&target), &DrawCall {
-        program: &program,
-        mesh: &mesh,
-        range: None,
-        textures: &[(0, &vol), (2, &lut1), (3, &lut2), (4, &lut3)],
-        blend: Blend::Replace,
-    }).unwrap();
+    draw(
+        gpu,
+        Surface::Target(&target),
+        &DrawCall {
+            program: &program,
+            mesh: &mesh,
+            range: None,
+            textures: &[(0, &vol), (2, &lut1), (3, &lut2), (4, &lut3)],
+            blend: Blend::Replace,
+        },
+    )
+    .unwrap();
     let image = target.read(gpu).unwrap();
 
     // By hand: temp = c1*lut1 + c2*lut2 + c3*lut3, result = temp * 0.3333, stored as
@@ -100,12 +124,22 @@ fn hand_computed_sum_pixel(backend: Backend) {
     let mut by_formula = [0u8; 4];
     for ch in 0..4 {
         let lut_v = |t: &[u8], k: u8| t[k as usize * 4 + ch] as f64 / 255.0;
-        let v = (c1[ch] * lut_v(&t1, 200) + c2[ch] * lut_v(&t2, 90) + c3[ch] * lut_v(&t3, 30)) * 0.3333;
+        let v =
+            (c1[ch] * lut_v(&t1, 200) + c2[ch] * lut_v(&t2, 90) + c3[ch] * lut_v(&t3, 30)) * 0.3333;
         by_formula[ch] = (v * 255.0).round() as u8;
     }
-    assert_eq!(by_formula, expected, "the hand computation and its formula agree");
+    assert_eq!(
+        by_formula, expected,
+        "the hand computation and its formula agree"
+    );
     for (x, y) in [(0, 0), (3, 4), (7, 7)] {
-        common::assert_pixel_u8(&image, x, y, expected, &format!("v3o2 sum on {}", backend.name()));
+        common::assert_pixel_u8(
+            &image,
+            x,
+            y,
+            expected,
+            &format!("v3o2 sum on {}", backend.name()),
+        );
     }
 }
 

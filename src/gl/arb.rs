@@ -53,24 +53,24 @@ impl ArbFns {
     /// Load every entry point; `None` when any is missing.
     pub(crate) fn load(loader: &mut dyn FnMut(&CStr) -> *const c_void) -> Option<ArbFns> {
         macro_rules! load {
-            ($name:literal) => {{
+            ($name:literal, $ty:ty) => {{
                 let p = loader($name);
                 if p.is_null() {
                     return None;
                 }
                 // SAFETY: the pointer comes from the context's loader for this exact
                 // entry point, whose C signature is the one of the target type.
-                unsafe { std::mem::transmute::<*const c_void, _>(p) }
+                unsafe { std::mem::transmute::<*const c_void, $ty>(p) }
             }};
         }
         Some(ArbFns {
-            gen_programs: load!(c"glGenProgramsARB"),
-            delete_programs: load!(c"glDeleteProgramsARB"),
-            bind_program: load!(c"glBindProgramARB"),
-            program_string: load!(c"glProgramStringARB"),
-            program_local_4d: load!(c"glProgramLocalParameter4dARB"),
-            get_programiv: load!(c"glGetProgramivARB"),
-            get_string: load!(c"glGetString"),
+            gen_programs: load!(c"glGenProgramsARB", GenPrograms),
+            delete_programs: load!(c"glDeleteProgramsARB", DeletePrograms),
+            bind_program: load!(c"glBindProgramARB", BindProgram),
+            program_string: load!(c"glProgramStringARB", ProgramString),
+            program_local_4d: load!(c"glProgramLocalParameter4dARB", ProgramLocal4d),
+            get_programiv: load!(c"glGetProgramivARB", GetProgramiv),
+            get_string: load!(c"glGetString", GetString),
         })
     }
 

@@ -83,9 +83,16 @@ impl Caps {
 /// says true for llvmpipe, so the string is the only reliable sign.)
 pub fn renderer_is_software(renderer: &str) -> bool {
     let r = renderer.to_ascii_lowercase();
-    ["llvmpipe", "softpipe", "swrast", "software", "lavapipe", "swiftshader"]
-        .iter()
-        .any(|s| r.contains(s))
+    [
+        "llvmpipe",
+        "softpipe",
+        "swrast",
+        "software",
+        "lavapipe",
+        "swiftshader",
+    ]
+    .iter()
+    .any(|s| r.contains(s))
 }
 
 /// One GL resource created through this `Gpu`.

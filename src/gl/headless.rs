@@ -52,7 +52,9 @@ enum HeadlessContext {
         _context: PossiblyCurrentContext,
         _display: Display,
     },
-    Osmesa { _context: OsmesaContext },
+    Osmesa {
+        _context: OsmesaContext,
+    },
 }
 
 impl Headless {

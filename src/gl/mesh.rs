@@ -41,7 +41,14 @@ impl Mesh {
             let mut offset = 0;
             for (i, &c) in components.iter().enumerate() {
                 gl.enable_vertex_attrib_array(i as u32);
-                gl.vertex_attrib_pointer_f32(i as u32, c as i32, glow::FLOAT, false, stride, offset);
+                gl.vertex_attrib_pointer_f32(
+                    i as u32,
+                    c as i32,
+                    glow::FLOAT,
+                    false,
+                    stride,
+                    offset,
+                );
                 offset += (c * 4) as i32;
             }
             gl.bind_vertex_array(prev_vao);
@@ -58,7 +65,11 @@ impl Mesh {
         };
         mesh.upload(vertices)?;
         crate::gl_check!(gpu)?;
-        gpu.record("buffer", format!("vertices {label}"), (vertices.len() * 4) as u64);
+        gpu.record(
+            "buffer",
+            format!("vertices {label}"),
+            (vertices.len() * 4) as u64,
+        );
         Ok(mesh)
     }
 
@@ -69,7 +80,7 @@ impl Mesh {
     }
 
     fn upload(&mut self, vertices: &[f32]) -> GlResult<()> {
-        if vertices.len() % self.floats_per_vertex != 0 {
+        if !vertices.len().is_multiple_of(self.floats_per_vertex) {
             return Err(GlError::Invalid(format!(
                 "mesh {}: {} floats is not a whole number of {}-float vertices",
                 self.label,

@@ -26,7 +26,10 @@ pub fn from_byte_offset(text: &str, offset: usize) -> Position {
     let offset = offset.min(text.len());
     let before = &text.as_bytes()[..offset];
     let line = before.iter().filter(|&&b| b == b'\n').count() as u32 + 1;
-    let line_start = before.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |p| p + 1);
     Position {
         line,
         column: Some((offset - line_start) as u32 + 1),
@@ -65,7 +68,9 @@ fn arb_style(message: &str) -> Option<Position> {
 fn mesa_glsl_style(message: &str) -> Option<Position> {
     for (i, _) in message.match_indices(':') {
         let head = &message[..i];
-        let src_start = head.rfind(|c: char| !c.is_ascii_digit()).map_or(0, |p| p + 1);
+        let src_start = head
+            .rfind(|c: char| !c.is_ascii_digit())
+            .map_or(0, |p| p + 1);
         if src_start == head.len() {
             continue;
         }
@@ -106,20 +111,39 @@ mod tests {
 
     #[test]
     fn parses_mesa_arb_message() {
-        let p = from_message("line 3, char 14: error: syntax error, unexpected $undefined").unwrap();
-        assert_eq!(p, Position { line: 3, column: Some(14) });
+        let p =
+            from_message("line 3, char 14: error: syntax error, unexpected $undefined").unwrap();
+        assert_eq!(
+            p,
+            Position {
+                line: 3,
+                column: Some(14)
+            }
+        );
     }
 
     #[test]
     fn parses_mesa_glsl_message() {
         let p = from_message("0:7(12): error: `foo' undeclared").unwrap();
-        assert_eq!(p, Position { line: 7, column: Some(12) });
+        assert_eq!(
+            p,
+            Position {
+                line: 7,
+                column: Some(12)
+            }
+        );
     }
 
     #[test]
     fn parses_nvidia_glsl_message() {
         let p = from_message("0(9) : error C1008: undefined variable \"foo\"").unwrap();
-        assert_eq!(p, Position { line: 9, column: None });
+        assert_eq!(
+            p,
+            Position {
+                line: 9,
+                column: None
+            }
+        );
     }
 
     #[test]
@@ -130,8 +154,20 @@ mod tests {
     #[test]
     fn byte_offset_to_line_and_column() {
         let text = "!!ARBfp1.0\nTEMP a;\nMOV b, a;\n";
-        assert_eq!(from_byte_offset(text, 0), Position { line: 1, column: Some(1) });
-        assert_eq!(from_byte_offset(text, 15), Position { line: 2, column: Some(5) });
+        assert_eq!(
+            from_byte_offset(text, 0),
+            Position {
+                line: 1,
+                column: Some(1)
+            }
+        );
+        assert_eq!(
+            from_byte_offset(text, 15),
+            Position {
+                line: 2,
+                column: Some(5)
+            }
+        );
         assert_eq!(from_byte_offset(text, 10_000).line, 4);
         assert_eq!(source_line(text, 3), "MOV b, a;");
     }

@@ -46,7 +46,15 @@ impl ProgramKind {
 
 /// What the user asked for: a kind, or `auto` (ARB where the driver has it).
 #[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
 )]
 #[serde(rename_all = "lowercase")]
 pub enum ProgramChoice {
@@ -122,11 +130,12 @@ impl Program {
         let stages = match kind {
             ProgramKind::Arb => {
                 let vertex = compile_arb(gpu, arb::VERTEX_PROGRAM, vertex)?;
-                let fragment = compile_arb(gpu, arb::FRAGMENT_PROGRAM, fragment).inspect_err(|_| {
-                    if let Ok(a) = gpu.arb() {
-                        a.delete_program(vertex)
-                    }
-                })?;
+                let fragment =
+                    compile_arb(gpu, arb::FRAGMENT_PROGRAM, fragment).inspect_err(|_| {
+                        if let Ok(a) = gpu.arb() {
+                            a.delete_program(vertex)
+                        }
+                    })?;
                 Stages::Arb { vertex, fragment }
             }
             ProgramKind::Glsl => link_glsl(gpu, vertex, fragment)?,
@@ -175,7 +184,11 @@ impl Program {
         match &self.stages {
             Stages::Arb { vertex, fragment } => {
                 let a = gpu.arb()?;
-                let id = if stage == arb::VERTEX_PROGRAM { *vertex } else { *fragment };
+                let id = if stage == arb::VERTEX_PROGRAM {
+                    *vertex
+                } else {
+                    *fragment
+                };
                 a.bind_program(stage, id);
                 a.program_local_4d(stage, index as u32, v);
             }
@@ -184,7 +197,11 @@ impl Program {
                 fragment_locals,
                 vertex_locals,
             } => {
-                let locals = if stage == arb::VERTEX_PROGRAM { vertex_locals } else { fragment_locals };
+                let locals = if stage == arb::VERTEX_PROGRAM {
+                    vertex_locals
+                } else {
+                    fragment_locals
+                };
                 if let Some(loc) = &locals[index] {
                     // SAFETY: a live program and one of its uniform locations.
                     unsafe {

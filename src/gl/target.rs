@@ -11,7 +11,15 @@ use crate::image::Image;
 
 /// Colour-target precision; faithful mode draws into RGBA8 as the original did.
 #[derive(
-    Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize, clap::ValueEnum,
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
 )]
 #[serde(rename_all = "lowercase")]
 pub enum TargetFormat {
@@ -94,8 +102,16 @@ impl Target {
                 width as i32,
                 height as i32,
             );
-            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MIN_FILTER, glow::NEAREST as i32);
-            gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAG_FILTER, glow::NEAREST as i32);
+            gl.tex_parameter_i32(
+                glow::TEXTURE_2D,
+                glow::TEXTURE_MIN_FILTER,
+                glow::NEAREST as i32,
+            );
+            gl.tex_parameter_i32(
+                glow::TEXTURE_2D,
+                glow::TEXTURE_MAG_FILTER,
+                glow::NEAREST as i32,
+            );
             let framebuffer = gl.create_framebuffer().map_err(GlError::Invalid)?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
             gl.framebuffer_texture_2d(
@@ -171,7 +187,11 @@ impl Target {
             self.gl
                 .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.framebuffer));
         }
-        read_bound(gpu, [0, 0, self.width as i32, self.height as i32], self.format)
+        read_bound(
+            gpu,
+            [0, 0, self.width as i32, self.height as i32],
+            self.format,
+        )
     }
 }
 

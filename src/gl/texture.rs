@@ -185,7 +185,11 @@ impl Texture {
             }
             gl.tex_parameter_i32(target, glow::TEXTURE_MIN_FILTER, gl_filter);
             gl.tex_parameter_i32(target, glow::TEXTURE_MAG_FILTER, gl_filter);
-            for wrap in [glow::TEXTURE_WRAP_S, glow::TEXTURE_WRAP_T, glow::TEXTURE_WRAP_R] {
+            for wrap in [
+                glow::TEXTURE_WRAP_S,
+                glow::TEXTURE_WRAP_T,
+                glow::TEXTURE_WRAP_R,
+            ] {
                 gl.tex_parameter_i32(target, wrap, glow::CLAMP_TO_EDGE as i32);
             }
             gl.bind_texture(target, prev);
@@ -228,7 +232,9 @@ impl Texture {
             let src = glow::PixelUnpackData::Slice(Some(data));
             match self.extent {
                 // glow has no glTexSubImage1D: re-specify the (same-size) image.
-                Extent::D1(w) => gl.tex_image_1d(target, 0, internal as i32, w as i32, 0, fmt, ty, src),
+                Extent::D1(w) => {
+                    gl.tex_image_1d(target, 0, internal as i32, w as i32, 0, fmt, ty, src)
+                }
                 Extent::D2(w, h) => {
                     gl.tex_sub_image_2d(target, 0, 0, 0, w as i32, h as i32, fmt, ty, src)
                 }

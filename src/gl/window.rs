@@ -51,7 +51,13 @@ impl GlWindow {
             .build(event_loop, ConfigTemplateBuilder::new(), |configs| {
                 // Fewest samples: pixels must be what the programs computed.
                 configs
-                    .reduce(|a, b| if b.num_samples() < a.num_samples() { b } else { a })
+                    .reduce(|a, b| {
+                        if b.num_samples() < a.num_samples() {
+                            b
+                        } else {
+                            a
+                        }
+                    })
                     .expect("glutin offers at least one config when find_configs succeeds")
             })
             .map_err(err)?;
@@ -80,8 +86,8 @@ impl GlWindow {
             .build_surface_attributes(Default::default())
             .map_err(err)?;
         // SAFETY: the surface is created for this window, which outlives it (field order).
-        let surface = unsafe { display.create_window_surface(&config, &surface_attrs) }
-            .map_err(err)?;
+        let surface =
+            unsafe { display.create_window_surface(&config, &surface_attrs) }.map_err(err)?;
         let context = not_current.make_current(&surface).map_err(err)?;
         // No vsync: the FPS readout shows what the renderer costs.
         let _ = surface.set_swap_interval(&context, SwapInterval::DontWait);

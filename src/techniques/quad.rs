@@ -13,7 +13,9 @@ use glam::{DMat4, DVec3};
 use serde::{Deserialize, Serialize};
 
 use super::{Frame, Renderer};
-use crate::gl::{self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface};
+use crate::gl::{
+    self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface,
+};
 use crate::image::Image;
 use crate::programs;
 use crate::scene::TechniqueScene;
@@ -40,10 +42,17 @@ impl Default for QuadScene {
 /// The quad's vertices: position (x, y, z, w) then texture coordinate (u, v, 0, 1).
 pub fn quad_vertices() -> Vec<f32> {
     let corner = |x: f32, y: f32| [x, y, 0.0, 1.0, (x + 1.0) / 2.0, (y + 1.0) / 2.0, 0.0, 1.0];
-    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
-        .iter()
-        .flat_map(|&(x, y)| corner(x, y))
-        .collect()
+    [
+        (-1.0, -1.0),
+        (1.0, -1.0),
+        (1.0, 1.0),
+        (-1.0, -1.0),
+        (1.0, 1.0),
+        (-1.0, 1.0),
+    ]
+    .iter()
+    .flat_map(|&(x, y)| corner(x, y))
+    .collect()
 }
 
 /// The quad's transform: the camera's rotation and zoom; depth halved so a rotated quad
@@ -71,7 +80,12 @@ impl QuadRenderer {
     }
 
     fn set_colours(&self, gpu: &Gpu, params: &QuadScene) -> GlResult<()> {
-        if params.left.iter().chain(&params.right).any(|v| !v.is_finite()) {
+        if params
+            .left
+            .iter()
+            .chain(&params.right)
+            .any(|v| !v.is_finite())
+        {
             return Err(GlError::Invalid("quad colours must be finite".into()));
         }
         self.program.set_local(gpu, 0, params.left)?;
@@ -113,16 +127,26 @@ pub fn reference(params: &QuadScene, width: u32, height: u32, clamp: bool) -> Ve
         let v = 1.0 - (y as f64 + 0.5) / height as f64;
         for x in 0..width {
             let u = (x as f64 + 0.5) / width as f64;
-            let c: [f64; 4] = std::array::from_fn(|i| params.left[i] * (1.0 - u) + params.right[i] * u);
+            let c: [f64; 4] =
+                std::array::from_fn(|i| params.left[i] * (1.0 - u) + params.right[i] * u);
             let px = [c[0] * v, c[1] * v, c[2] * v, c[3]];
-            out.push(if clamp { px.map(|p| p.clamp(0.0, 1.0)) } else { px });
+            out.push(if clamp {
+                px.map(|p| p.clamp(0.0, 1.0))
+            } else {
+                px
+            });
         }
     }
     out
 }
 
 /// [`reference`] as an [`Image`] of `format`, for comparisons.
-pub fn reference_image(params: &QuadScene, width: u32, height: u32, format: gl::TargetFormat) -> Image {
+pub fn reference_image(
+    params: &QuadScene,
+    width: u32,
+    height: u32,
+    format: gl::TargetFormat,
+) -> Image {
     let clamp = format == gl::TargetFormat::Rgba8;
     let data = reference(params, width, height, clamp)
         .into_iter()

@@ -99,7 +99,10 @@ impl App {
         let [w, h] = scene.size;
         let attributes = Window::default_attributes()
             .with_title(format!("arbvis — {}", self.options.origin))
-            .with_inner_size(LogicalSize::new(w as f64 + PANEL_WIDTH as f64, h.max(480) as f64));
+            .with_inner_size(LogicalSize::new(
+                w as f64 + PANEL_WIDTH as f64,
+                h.max(480) as f64,
+            ));
         let prefer_egl = std::env::var_os("ARBVIS_PREFER_EGL").is_some_and(|v| v == "1");
         let window = GlWindow::new(event_loop, attributes, prefer_egl)?;
         let gpu = window.gpu();
@@ -135,7 +138,9 @@ impl ApplicationHandler for App {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
-        let Some(r) = self.running.as_mut() else { return };
+        let Some(r) = self.running.as_mut() else {
+            return;
+        };
         let response = r.egui.on_window_event(r.window.window(), &event);
         if response.repaint {
             r.window.window().request_redraw();
@@ -201,12 +206,15 @@ impl Running {
 
         // Camera from pointer input on the view.
         let view_size = DVec2::new(out.view.width() as f64, out.view.height() as f64);
-        let local = |p: egui::Pos2| DVec2::new((p.x - out.view.min.x) as f64, (p.y - out.view.min.y) as f64);
+        let local = |p: egui::Pos2| {
+            DVec2::new((p.x - out.view.min.x) as f64, (p.y - out.view.min.y) as f64)
+        };
         if let Some(p) = out.input.drag_start {
             self.arcball.begin(&self.scene.camera, local(p), view_size);
         }
         if let Some(p) = out.input.drag_to {
-            self.arcball.drag(&mut self.scene.camera, local(p), view_size);
+            self.arcball
+                .drag(&mut self.scene.camera, local(p), view_size);
         }
         if out.input.drag_end {
             self.arcball.end();
@@ -221,7 +229,10 @@ impl Running {
             match action {
                 UiAction::SetPrograms(kind) => self.set_programs(*kind),
                 UiAction::ParamsChanged => {
-                    if let Err(e) = self.renderer.update(self.window.gpu(), &self.scene.technique) {
+                    if let Err(e) = self
+                        .renderer
+                        .update(self.window.gpu(), &self.scene.technique)
+                    {
                         self.panel.status = format!("error: {e}");
                     }
                 }
@@ -239,14 +250,19 @@ impl Running {
         let y = win.height as i32 - (out.view.max.y * ppp).round() as i32;
         self.view_px = [x, y, w, h];
         let gpu = self.window.gpu();
-        gl::clear(gpu, Surface::Window([0, 0, win.width as i32, win.height as i32]), [0.1, 0.1, 0.1, 1.0])?;
+        gl::clear(
+            gpu,
+            Surface::Window([0, 0, win.width as i32, win.height as i32]),
+            [0.1, 0.1, 0.1, 1.0],
+        )?;
         gl::clear(gpu, Surface::Window(self.view_px), self.scene.background)?;
         let frame = Frame {
             camera: self.scene.camera,
             width: w as u32,
             height: h as u32,
         };
-        self.renderer.draw(gpu, Surface::Window(self.view_px), &frame)?;
+        self.renderer
+            .draw(gpu, Surface::Window(self.view_px), &frame)?;
         if screenshot {
             self.screenshot(options);
         }
@@ -272,22 +288,30 @@ impl Running {
 
     fn screenshot(&mut self, options: &ViewerOptions) {
         let gpu = self.window.gpu();
-        let result = gl::read_window(gpu, self.view_px).map_err(anyhow::Error::from).and_then(|image| {
-            self.screenshots += 1;
-            let path = options
-                .screenshot_dir
-                .join(format!("arbvis-screenshot-{:03}.png", self.screenshots));
-            let caps = gpu.caps();
-            let text = [
-                ("Software", format!("arbvis {}", env!("CARGO_PKG_VERSION"))),
-                ("arbvis:scene-origin", options.origin.clone()),
-                ("arbvis:scene", self.scene.to_toml()),
-                ("arbvis:programs", self.renderer.program_kind().name().to_string()),
-                ("arbvis:renderer", format!("{} | {} | {}", caps.vendor, caps.renderer, caps.version)),
-            ];
-            png_io::write_png(&path, &image, &text)?;
-            Ok(path)
-        });
+        let result = gl::read_window(gpu, self.view_px)
+            .map_err(anyhow::Error::from)
+            .and_then(|image| {
+                self.screenshots += 1;
+                let path = options
+                    .screenshot_dir
+                    .join(format!("arbvis-screenshot-{:03}.png", self.screenshots));
+                let caps = gpu.caps();
+                let text = [
+                    ("Software", format!("arbvis {}", env!("CARGO_PKG_VERSION"))),
+                    ("arbvis:scene-origin", options.origin.clone()),
+                    ("arbvis:scene", self.scene.to_toml()),
+                    (
+                        "arbvis:programs",
+                        self.renderer.program_kind().name().to_string(),
+                    ),
+                    (
+                        "arbvis:renderer",
+                        format!("{} | {} | {}", caps.vendor, caps.renderer, caps.version),
+                    ),
+                ];
+                png_io::write_png(&path, &image, &text)?;
+                Ok(path)
+            });
         self.panel.status = match result {
             Ok(p) => format!("saved {}", p.display()),
             Err(e) => format!("screenshot failed: {e}"),
@@ -322,7 +346,11 @@ struct ScriptRunner {
 }
 
 impl ScriptRunner {
-    fn step(&mut self, widgets: &std::collections::HashMap<String, egui::Rect>, view: egui::Rect) -> anyhow::Result<ScriptStep> {
+    fn step(
+        &mut self,
+        widgets: &std::collections::HashMap<String, egui::Rect>,
+        view: egui::Rect,
+    ) -> anyhow::Result<ScriptStep> {
         use egui::{Event, Modifiers, PointerButton};
         if !self.active {
             return Ok(ScriptStep::Events(Vec::new()));
@@ -355,7 +383,9 @@ impl ScriptRunner {
                 (_, None) if self.frames_in_action > 10 => {
                     let mut known: Vec<_> = widgets.keys().cloned().collect();
                     known.sort();
-                    return Err(anyhow!("script: no widget labelled {label:?}; widgets: {known:?}"));
+                    return Err(anyhow!(
+                        "script: no widget labelled {label:?}; widgets: {known:?}"
+                    ));
                 }
                 (_, None) => {}
             },

@@ -65,7 +65,12 @@ pub struct PanelOutput {
 }
 
 /// Build the UI for one frame.
-pub fn show(ui: &mut egui::Ui, scene: &mut Scene, state: &mut PanelState, caps: &Caps) -> PanelOutput {
+pub fn show(
+    ui: &mut egui::Ui,
+    scene: &mut Scene,
+    state: &mut PanelState,
+    caps: &Caps,
+) -> PanelOutput {
     let mut actions = Vec::new();
     state.widgets.clear();
     egui::Panel::left("controls")
@@ -180,7 +185,11 @@ fn camera_editor(ui: &mut egui::Ui, camera: &mut Camera, widgets: &mut HashMap<S
             widgets.insert(label.into(), r.rect);
         }
     });
-    ui.add(egui::Slider::new(&mut camera.zoom, 0.1..=10.0).logarithmic(true).text("zoom"));
+    ui.add(
+        egui::Slider::new(&mut camera.zoom, 0.1..=10.0)
+            .logarithmic(true)
+            .text("zoom"),
+    );
     let r = ui.button("Reset camera");
     widgets.insert("Reset camera".into(), r.rect);
     if r.clicked() {

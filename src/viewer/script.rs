@@ -106,7 +106,11 @@ mod tests {
 
     #[test]
     fn parses_every_action() {
-        let s = Script::parse("wait 2\nclick Save scene # comment\n\ndrag 10 -5\nquit\n", "t").unwrap();
+        let s = Script::parse(
+            "wait 2\nclick Save scene # comment\n\ndrag 10 -5\nquit\n",
+            "t",
+        )
+        .unwrap();
         assert_eq!(
             s.actions,
             vec![

@@ -73,7 +73,11 @@ pub fn assert_snapshot(name: &str, image: &Image, tolerance: f32) {
     };
     // Compare what the PNG can hold: 8-bit levels.
     let actual = arbvis::image::Image {
-        data: image8.to_rgba8().iter().map(|&b| b as f32 / 255.0).collect(),
+        data: image8
+            .to_rgba8()
+            .iter()
+            .map(|&b| b as f32 / 255.0)
+            .collect(),
         ..image8
     };
     let Some(d) = actual.compare(&expected, tolerance) else {

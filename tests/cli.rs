@@ -1,0 +1,195 @@
+//! The `arbvis` binary as a user runs it: the README's main job, `info`, `--stats`,
+//! and bad input that ends in a clear error and no output file.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+use arbvis::png_io::read_png;
+
+fn arbvis(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("arbvis-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn text(out: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn demo_render_writes_png_with_provenance() {
+    let dir = temp_dir("demo");
+    let png = dir.join("quad.png");
+    let out = arbvis(&[
+        "render",
+        "--demo",
+        "quad",
+        "--size",
+        "96x64",
+        "-o",
+        png.to_str().unwrap(),
+        "--stats",
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("3 resources"), "{stdout}");
+    let (img, chunks) = read_png(&png).unwrap();
+    assert_eq!((img.width, img.height), (96, 64));
+    let get = |k: &str| {
+        chunks
+            .iter()
+            .find(|(key, _)| key == k)
+            .map(|(_, v)| v.as_str())
+            .unwrap_or("")
+    };
+    assert_eq!(get("arbvis:technique"), "quad");
+    assert_eq!(
+        get("arbvis:programs"),
+        "arb",
+        "auto picks ARB on a driver that has it"
+    );
+    assert_eq!(get("arbvis:target"), "rgba8");
+    assert!(!get("arbvis:renderer").is_empty());
+    assert!(get("arbvis:scene").contains("[technique.quad]"));
+    // No temporary file is left beside the output.
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(leftovers.len(), 1, "{leftovers:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn float_target_writes_sixteen_bit_png() {
+    let dir = temp_dir("float");
+    let png = dir.join("quad16.png");
+    let out = arbvis(&[
+        "render",
+        "--demo",
+        "quad",
+        "--size",
+        "8x8",
+        "--fidelity",
+        "precise",
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+    let reader = decoder.read_info().unwrap();
+    assert_eq!(reader.info().bit_depth, png::BitDepth::Sixteen);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn info_reports_arb_support_and_limits() {
+    let out = arbvis(&["info"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    for field in [
+        "GL_RENDERER:",
+        "GL_VERSION:",
+        "profile:",
+        "software renderer:",
+        "instructions:",
+        "temporaries:",
+        "texture indirections:",
+    ] {
+        assert!(stdout.contains(field), "missing {field}:\n{stdout}");
+    }
+    // Mesa's llvmpipe (what CI has) offers both ARB program extensions in the compat profile.
+    if stdout.contains("llvmpipe") {
+        assert!(stdout.contains("GL_ARB_fragment_program: yes"), "{stdout}");
+        assert!(stdout.contains("GL_ARB_vertex_program:   yes"), "{stdout}");
+        assert!(
+            stdout.contains("profile:                 compatibility"),
+            "{stdout}"
+        );
+        assert!(stdout.contains("software renderer:       yes"), "{stdout}");
+    }
+    let json = arbvis(&["info", "--json", "--backend", "osmesa"]);
+    let (j, _) = text(&json);
+    assert!(
+        json.status.success()
+            && j.trim_start().starts_with('{')
+            && j.contains("\"arb_fragment_program\""),
+        "{j}"
+    );
+}
+
+#[test]
+fn bad_scene_names_file_line_column_and_writes_nothing() {
+    let dir = temp_dir("bad");
+    let scene = dir.join("bad.toml");
+    std::fs::write(
+        &scene,
+        "size = [64, 64]\n[technique.quad]\nleft = [1.0, 0.0]x\n",
+    )
+    .unwrap();
+    let png = dir.join("out.png");
+    let out = arbvis(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ]);
+    let (_, stderr) = text(&out);
+    assert!(!out.status.success());
+    assert!(stderr.contains("bad.toml:3:"), "{stderr}");
+    assert!(!png.exists(), "no output on error");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn unknown_demo_lists_the_demos() {
+    let out = arbvis(&["render", "--demo", "nope", "-o", "/tmp/never.png"]);
+    let (_, stderr) = text(&out);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("nope") && stderr.contains("quad"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn unwritable_output_is_a_clear_error() {
+    let out = arbvis(&[
+        "render",
+        "--demo",
+        "quad",
+        "--size",
+        "8x8",
+        "-o",
+        "/nonexistent-dir/x.png",
+    ]);
+    let (_, stderr) = text(&out);
+    assert!(!out.status.success());
+    assert!(stderr.contains("/nonexistent-dir"), "{stderr}");
+}
+
+#[test]
+fn bad_size_flag_is_rejected() {
+    let out = arbvis(&[
+        "render",
+        "--demo",
+        "quad",
+        "--size",
+        "0x10",
+        "-o",
+        "/tmp/never.png",
+    ]);
+    assert!(!out.status.success());
+    assert!(text(&out).1.contains("1..=16384"));
+}
