@@ -193,3 +193,18 @@ fn bad_size_flag_is_rejected() {
     assert!(!out.status.success());
     assert!(text(&out).1.contains("1..=16384"));
 }
+
+#[test]
+fn missing_osmesa_library_is_named_with_a_hint() {
+    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args(["info", "--backend", "osmesa"])
+        .env("ARBVIS_OSMESA_LIBRARY", "libOSMesa-not-here.so.99")
+        .output()
+        .unwrap();
+    let (_, stderr) = text(&out);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("libOSMesa-not-here.so.99") && stderr.contains("libosmesa6"),
+        "{stderr}"
+    );
+}

@@ -157,7 +157,7 @@ impl Headless {
     }
 }
 
-/// File names tried for libOSMesa, newest soname first.
+/// File names tried for libOSMesa, newest soname first (`ARBVIS_OSMESA_LIBRARY` overrides).
 pub const OSMESA_LIBRARIES: [&str; 3] = ["libOSMesa.so.8", "libOSMesa.so.6", "libOSMesa.so"];
 const OSMESA_RGBA: u32 = 0x1908; // GL_RGBA
 const GL_UNSIGNED_BYTE: u32 = 0x1401;
@@ -178,9 +178,15 @@ struct OsmesaContext {
 
 impl OsmesaContext {
     fn new() -> GlResult<OsmesaContext> {
+        // ARBVIS_OSMESA_LIBRARY names one file to load instead (a custom Mesa build).
+        let custom = std::env::var("ARBVIS_OSMESA_LIBRARY").ok();
+        let names: Vec<&str> = match &custom {
+            Some(c) => vec![c.as_str()],
+            None => OSMESA_LIBRARIES.to_vec(),
+        };
         let mut last = String::new();
         let mut library = None;
-        for name in OSMESA_LIBRARIES {
+        for &name in &names {
             // SAFETY: loading libOSMesa runs its initializers, which have no preconditions.
             match unsafe { libloading::Library::new(name) } {
                 Ok(l) => {
@@ -192,7 +198,7 @@ impl OsmesaContext {
         }
         let library = library.ok_or_else(|| GlError::MissingLibrary {
             library: "libOSMesa",
-            tried: OSMESA_LIBRARIES.join(", "),
+            tried: names.join(", "),
             reason: last,
             hint: "install Debian's libosmesa6 (apt-get install libosmesa6), or use --backend egl",
         })?;

@@ -25,6 +25,6 @@ pub use gpu::{renderer_is_software, ArbLimits, Caps, Gpu, Resource};
 pub use headless::{Backend, Headless, OSMESA_LIBRARIES};
 pub use mesh::Mesh;
 pub use program::{Program, ProgramChoice, ProgramKind, ProgramText, MAX_LOCALS, MAX_UNITS};
-pub use state::StateGuard;
+pub use state::{SavedState, StateGuard};
 pub use target::{read_window, Target, TargetFormat};
 pub use texture::{Extent, Filter, TexelData, TexelFormat, Texture};

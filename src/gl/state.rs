@@ -9,6 +9,12 @@ use super::gpu::Gpu;
 /// Saved state; restored when dropped.
 pub struct StateGuard<'a> {
     gpu: &'a Gpu,
+    saved: SavedState,
+}
+
+/// The state a [`StateGuard`] saves, comparable (for tests of state hygiene).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SavedState {
     blend: bool,
     blend_src_rgb: i32,
     blend_dst_rgb: i32,
@@ -29,14 +35,23 @@ pub struct StateGuard<'a> {
 impl<'a> StateGuard<'a> {
     /// Save the current state.
     pub fn save(gpu: &'a Gpu) -> StateGuard<'a> {
+        StateGuard {
+            gpu,
+            saved: SavedState::read(gpu),
+        }
+    }
+}
+
+impl SavedState {
+    /// Read the state a guard would save.
+    pub fn read(gpu: &Gpu) -> SavedState {
         let gl = gpu.glow();
         let has_arb = gpu.caps().has_arb();
         // SAFETY: plain queries.
         unsafe {
             let mut viewport = [0i32; 4];
             gl.get_parameter_i32_slice(glow::VIEWPORT, &mut viewport);
-            StateGuard {
-                gpu,
+            SavedState {
                 blend: gl.is_enabled(glow::BLEND),
                 blend_src_rgb: gl.get_parameter_i32(glow::BLEND_SRC_RGB),
                 blend_dst_rgb: gl.get_parameter_i32(glow::BLEND_DST_RGB),
@@ -70,12 +85,18 @@ fn set(gl: &glow::Context, cap: u32, on: bool) {
 
 impl Drop for StateGuard<'_> {
     fn drop(&mut self) {
-        let gl = self.gpu.glow();
+        self.saved.restore(self.gpu);
+    }
+}
+
+impl SavedState {
+    fn restore(&self, gpu: &Gpu) {
+        let gl = gpu.glow();
         set(gl, glow::BLEND, self.blend);
         set(gl, glow::DEPTH_TEST, self.depth_test);
         set(gl, glow::CULL_FACE, self.cull_face);
         set(gl, glow::SCISSOR_TEST, self.scissor_test);
-        if self.gpu.caps().has_arb() {
+        if gpu.caps().has_arb() {
             set(gl, arb::FRAGMENT_PROGRAM, self.fragment_program);
             set(gl, arb::VERTEX_PROGRAM, self.vertex_program);
         }
@@ -94,5 +115,57 @@ impl Drop for StateGuard<'_> {
             gl.bind_vertex_array(self.vertex_array);
             gl.active_texture(self.active_texture as u32);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gl::{
+        draw, Backend, Blend, DrawCall, Headless, Mesh, Program, ProgramKind, Surface, Target,
+        TargetFormat,
+    };
+
+    #[test]
+    fn draw_and_clear_leave_state_as_they_found_it() {
+        let h = Headless::new(Backend::Egl).unwrap();
+        let gpu = h.gpu();
+        let gl = gpu.glow();
+        // A state unlike what draw() sets: scissor on, odd blend, small viewport.
+        // SAFETY: plain state calls on the current context.
+        unsafe {
+            gl.enable(glow::SCISSOR_TEST);
+            gl.enable(glow::BLEND);
+            gl.blend_func(glow::ONE, glow::ONE);
+            gl.viewport(1, 2, 3, 4);
+            gl.active_texture(glow::TEXTURE5);
+        }
+        let before = SavedState::read(gpu);
+        let target = Target::new(gpu, 8, 8, TargetFormat::Rgba8).unwrap();
+        let pair = crate::programs::with_transform(
+            ProgramKind::Arb,
+            &crate::programs::QUAD_ARBFP,
+            &crate::programs::QUAD_FRAG,
+        );
+        let program = Program::new(gpu, ProgramKind::Arb, &pair.vertex, &pair.fragment).unwrap();
+        let mesh = Mesh::new(
+            gpu,
+            "quad",
+            &[4, 4],
+            &crate::techniques::quad::quad_vertices(),
+        )
+        .unwrap();
+        target.clear(gpu, [0.0; 4]).unwrap();
+        let call = DrawCall {
+            program: &program,
+            mesh: &mesh,
+            range: None,
+            textures: &[],
+            blend: Blend::Over,
+        };
+        draw(gpu, Surface::Target(&target), &call).unwrap();
+        target.read(gpu).unwrap();
+        assert_eq!(SavedState::read(gpu), before);
+        crate::gl_check!(gpu).unwrap();
     }
 }

@@ -91,6 +91,7 @@ impl Target {
         // SAFETY: fresh objects; the previous framebuffer and texture bindings are restored.
         let (framebuffer, color, status) = unsafe {
             let prev_fb = gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING);
+            let prev_active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
             gl.active_texture(glow::TEXTURE0);
             let prev_tex = gl.get_parameter_texture(glow::TEXTURE_BINDING_2D);
             let color = gl.create_texture().map_err(GlError::Invalid)?;
@@ -126,6 +127,7 @@ impl Target {
             gl.clear(glow::COLOR_BUFFER_BIT);
             gl.bind_framebuffer(glow::FRAMEBUFFER, prev_fb);
             gl.bind_texture(glow::TEXTURE_2D, prev_tex);
+            gl.active_texture(prev_active);
             (framebuffer, color, status)
         };
         let target = Target {
