@@ -116,11 +116,7 @@ impl Headless {
             .next()
             .ok_or("no PBUFFER-capable OpenGL config")?;
         let mut last = String::new();
-        for version in [Some(Version::new(4, 5)), Some(Version::new(3, 0)), None] {
-            let attrs = ContextAttributesBuilder::new()
-                .with_profile(GlProfile::Compatibility)
-                .with_context_api(ContextApi::OpenGl(version))
-                .build(None);
+        for attrs in compatibility_attributes(None) {
             // SAFETY: config belongs to display; no window handle.
             match unsafe { display.create_context(&config, &attrs) } {
                 Ok(ctx) => {
@@ -155,6 +151,22 @@ impl Headless {
             _context: HeadlessContext::Osmesa { _context: ctx },
         })
     }
+}
+
+/// Context attributes to try, best first: compatibility profile 4.5, then 3.0, then any
+/// version (a context without a profile is Core 3.3 on Mesa, which has no ARB programs).
+pub(super) fn compatibility_attributes(
+    window: Option<raw_window_handle::RawWindowHandle>,
+) -> Vec<glutin::context::ContextAttributes> {
+    [Some(Version::new(4, 5)), Some(Version::new(3, 0)), None]
+        .into_iter()
+        .map(|version| {
+            ContextAttributesBuilder::new()
+                .with_profile(GlProfile::Compatibility)
+                .with_context_api(ContextApi::OpenGl(version))
+                .build(window)
+        })
+        .collect()
 }
 
 /// File names tried for libOSMesa, newest soname first (`ARBVIS_OSMESA_LIBRARY` overrides).

@@ -4,10 +4,7 @@
 use std::num::NonZeroU32;
 
 use glutin::config::{ConfigTemplateBuilder, GlConfig};
-use glutin::context::{
-    ContextApi, ContextAttributesBuilder, GlProfile, NotCurrentGlContext, PossiblyCurrentContext,
-    Version,
-};
+use glutin::context::{NotCurrentGlContext, PossiblyCurrentContext};
 use glutin::display::{GetGlDisplay, GlDisplay};
 use glutin::surface::{GlSurface, Surface, SwapInterval, WindowSurface};
 use glutin_winit::{ApiPreference, DisplayBuilder, GlWindow as _};
@@ -66,11 +63,7 @@ impl GlWindow {
         let display = config.display();
         let mut last = String::new();
         let mut not_current = None;
-        for version in [Some(Version::new(4, 5)), Some(Version::new(3, 0)), None] {
-            let attrs = ContextAttributesBuilder::new()
-                .with_profile(GlProfile::Compatibility)
-                .with_context_api(ContextApi::OpenGl(version))
-                .build(raw);
+        for attrs in super::headless::compatibility_attributes(raw) {
             // SAFETY: the config and window handle belong to this display.
             match unsafe { display.create_context(&config, &attrs) } {
                 Ok(c) => {

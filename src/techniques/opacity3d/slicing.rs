@@ -84,7 +84,7 @@ pub fn slice_box(half: DVec3, toward_viewer: DVec3, count: usize) -> Slices {
     let polygons = (0..count)
         .filter_map(|i| {
             let t = t_min + (i as f64 + 0.5) * spacing;
-            let positions = cut(half, n, t, &depths, u, v);
+            let positions = cut(half, t, &depths, u, v);
             (positions.len() >= 3).then(|| SlicePolygon {
                 texcoords: positions.iter().map(|&p| texcoord(p, half)).collect(),
                 positions,
@@ -94,8 +94,9 @@ pub fn slice_box(half: DVec3, toward_viewer: DVec3, count: usize) -> Slices {
     Slices { polygons, spacing }
 }
 
-/// The polygon where plane `n·p = t` meets the box, sorted counter-clockwise about `n`.
-fn cut(half: DVec3, n: DVec3, t: f64, depths: &[f64], u: DVec3, v: DVec3) -> Vec<DVec3> {
+/// The polygon where plane `n·p = t` meets the box (`depths` = `n·corner`), sorted
+/// counter-clockwise about `n = u × v`.
+fn cut(half: DVec3, t: f64, depths: &[f64], u: DVec3, v: DVec3) -> Vec<DVec3> {
     let mut points: Vec<DVec3> = Vec::with_capacity(6);
     for &(a, b) in &EDGES {
         let (da, db) = (depths[a] - t, depths[b] - t);
