@@ -27,20 +27,19 @@ fn text(out: &Output) -> (String, String) {
     )
 }
 
+/// `arbvis render --demo quad -o DIR/FILE ARGS...` in a fresh temporary folder; returns
+/// the command's output, the folder and the PNG path.
+fn render_quad(name: &str, file: &str, args: &[&str]) -> (Output, PathBuf, PathBuf) {
+    let dir = temp_dir(name);
+    let png = dir.join(file);
+    let mut all = vec!["render", "--demo", "quad", "-o", png.to_str().unwrap()];
+    all.extend_from_slice(args);
+    (arbvis(&all), dir, png)
+}
+
 #[test]
 fn demo_render_writes_png_with_provenance() {
-    let dir = temp_dir("demo");
-    let png = dir.join("quad.png");
-    let out = arbvis(&[
-        "render",
-        "--demo",
-        "quad",
-        "--size",
-        "96x64",
-        "-o",
-        png.to_str().unwrap(),
-        "--stats",
-    ]);
+    let (out, dir, png) = render_quad("demo", "quad.png", &["--size", "96x64", "--stats"]);
     let (stdout, stderr) = text(&out);
     assert!(out.status.success(), "{stderr}");
     assert!(stdout.contains("3 resources"), "{stdout}");
@@ -73,19 +72,11 @@ fn demo_render_writes_png_with_provenance() {
 
 #[test]
 fn float_target_writes_sixteen_bit_png() {
-    let dir = temp_dir("float");
-    let png = dir.join("quad16.png");
-    let out = arbvis(&[
-        "render",
-        "--demo",
-        "quad",
-        "--size",
-        "8x8",
-        "--fidelity",
-        "precise",
-        "-o",
-        png.to_str().unwrap(),
-    ]);
+    let (out, dir, png) = render_quad(
+        "float",
+        "quad16.png",
+        &["--size", "8x8", "--fidelity", "precise"],
+    );
     assert!(out.status.success(), "{}", text(&out).1);
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
     let reader = decoder.read_info().unwrap();

@@ -137,17 +137,25 @@ fn run_viewer(display: &Display, dir: &Path, script: &str) -> (bool, String) {
     }
 }
 
+/// Run `script` in the viewer (one test at a time) and return its screenshot folder,
+/// or `None` when the test is skipped for lack of a display. Fails if the viewer fails.
+fn run_script(name: &str, script: &str) -> Option<PathBuf> {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let display = display()?;
+    let dir = temp_dir(name);
+    let (ok, stderr) = run_viewer(&display, &dir, script);
+    assert!(ok, "viewer failed: {stderr}");
+    Some(dir)
+}
+
 #[test]
 fn frame_screenshot_and_program_switch() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let Some(display) = display() else { return };
-    let dir = temp_dir("switch");
-    let (ok, stderr) = run_viewer(
-        &display,
-        &dir,
+    let Some(dir) = run_script(
+        "switch",
         "wait 2\nclick Screenshot\nwait 1\nclick GLSL\nwait 2\nclick Screenshot\nwait 1\nclick Save scene\nwait 1\n",
-    );
-    assert!(ok, "viewer failed: {stderr}");
+    ) else {
+        return;
+    };
 
     let (arb, arb_text) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
     let (glsl, glsl_text) = read_png(&dir.join("arbvis-screenshot-002.png")).unwrap();
@@ -186,15 +194,12 @@ fn frame_screenshot_and_program_switch() {
 
 #[test]
 fn drag_rotates_the_camera() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let Some(display) = display() else { return };
-    let dir = temp_dir("drag");
-    let (ok, stderr) = run_viewer(
-        &display,
-        &dir,
+    let Some(dir) = run_script(
+        "drag",
         "wait 2\ndrag 60 0\nwait 1\nclick Save scene\nwait 1\n",
-    );
-    assert!(ok, "viewer failed: {stderr}");
+    ) else {
+        return;
+    };
     let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
     // A horizontal drag rotates about the vertical axis only.
     let q = saved.camera.quat();
