@@ -18,5 +18,7 @@ pub mod programs;
 pub mod render;
 pub mod scene;
 pub mod techniques;
+pub mod volume;
+pub mod colortable;
 #[cfg(feature = "viewer")]
 pub mod viewer;

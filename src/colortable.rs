@@ -1,0 +1,270 @@
+//! 256-entry RGBA colour tables, as v3o2 used one per attribute: built-ins (the seismic
+//! red-white-blue, grey, and the common scientific maps from the `colorous` crate), table
+//! files a user edits and saves, and an optional piecewise-linear alpha curve from the
+//! scene. Entries are 8-bit in both fidelity modes: v3o2's tables were.
+//!
+//! Table file format (`.table`): text, `#` starts a comment, 256 lines of four integers
+//! 0..255 (`r g b a`), entry 0 first.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+/// Names of the built-in tables.
+pub const BUILTINS: &[&str] = &[
+    "seismic", "grey", "viridis", "magma", "inferno", "plasma", "cividis", "turbo", "red",
+    "green", "blue",
+];
+
+/// A table as a scene names it: a built-in or a file, and an optional alpha curve.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TableSpec {
+    /// A built-in name (see [`BUILTINS`]), used when `file` is absent.
+    #[serde(default = "default_builtin")]
+    pub builtin: String,
+    /// A table file (relative to the scene's folder); wins over `builtin`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+    /// Alpha as a piecewise-linear curve through `[position 0..1, alpha 0..1]` points,
+    /// replacing the table's own alpha.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub alpha: Vec<[f64; 2]>,
+}
+
+fn default_builtin() -> String {
+    "grey".into()
+}
+
+impl TableSpec {
+    /// A built-in table with its own alpha.
+    pub fn builtin(name: &str) -> TableSpec {
+        TableSpec {
+            builtin: name.into(),
+            file: None,
+            alpha: Vec::new(),
+        }
+    }
+
+    /// Build the table; relative files are read from `base`.
+    pub fn build(&self, base: &Path) -> Result<ColorTable, String> {
+        let mut table = match &self.file {
+            Some(f) => ColorTable::load(&base.join(f))?,
+            None => ColorTable::builtin(&self.builtin)?,
+        };
+        if !self.alpha.is_empty() {
+            table.set_alpha_curve(&self.alpha)?;
+        }
+        Ok(table)
+    }
+}
+
+impl Default for TableSpec {
+    fn default() -> Self {
+        TableSpec::builtin("grey")
+    }
+}
+
+/// 256 RGBA entries.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ColorTable {
+    /// Entry `k` is the colour of quantized value `k`.
+    pub entries: Vec<[u8; 4]>,
+}
+
+impl ColorTable {
+    /// A built-in table by name. Alpha: `seismic` is opaque at both extremes and clear in
+    /// the middle (`|2t - 1|`); the others ramp from 0 to 1.
+    pub fn builtin(name: &str) -> Result<ColorTable, String> {
+        let gradient = match name {
+            "viridis" => Some(colorous::VIRIDIS),
+            "magma" => Some(colorous::MAGMA),
+            "inferno" => Some(colorous::INFERNO),
+            "plasma" => Some(colorous::PLASMA),
+            "cividis" => Some(colorous::CIVIDIS),
+            "turbo" => Some(colorous::TURBO),
+            _ => None,
+        };
+        let byte = |t: f64| (t * 255.0).round().clamp(0.0, 255.0) as u8;
+        let entries = (0..256)
+            .map(|k| {
+                let t = k as f64 / 255.0;
+                let ramp = byte(t);
+                if let Some(g) = gradient {
+                    let c = g.eval_continuous(t);
+                    return Ok([c.r, c.g, c.b, ramp]);
+                }
+                Ok(match name {
+                    "grey" => [ramp, ramp, ramp, ramp],
+                    "red" => [255, 0, 0, ramp],
+                    "green" => [0, 255, 0, ramp],
+                    "blue" => [0, 0, 255, ramp],
+                    "seismic" => {
+                        // Blue (negative) through white to red (positive).
+                        let (r, g, b) = if t < 0.5 {
+                            let s = t * 2.0;
+                            (s, s, 1.0)
+                        } else {
+                            let s = (1.0 - t) * 2.0;
+                            (1.0, s, s)
+                        };
+                        [byte(r), byte(g), byte(b), byte((2.0 * t - 1.0).abs())]
+                    }
+                    _ => {
+                        return Err(format!(
+                            "no built-in colour table {name:?}; built-ins: {}",
+                            BUILTINS.join(", ")
+                        ))
+                    }
+                })
+            })
+            .collect::<Result<Vec<_>, String>>()?;
+        Ok(ColorTable { entries })
+    }
+
+    /// Replace alpha by the piecewise-linear curve through `points` (`[position, alpha]`,
+    /// both in 0..1, positions ascending); constant beyond the ends.
+    pub fn set_alpha_curve(&mut self, points: &[[f64; 2]]) -> Result<(), String> {
+        let valid = points
+            .iter()
+            .all(|p| p.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)))
+            && points.windows(2).all(|w| w[0][0] <= w[1][0]);
+        if points.is_empty() || !valid {
+            return Err(format!(
+                "alpha curve {points:?}: points must be [position, alpha] in 0..1, positions ascending"
+            ));
+        }
+        for (k, e) in self.entries.iter_mut().enumerate() {
+            let t = k as f64 / 255.0;
+            let a = alpha_at(points, t);
+            e[3] = (a * 255.0).round() as u8;
+        }
+        Ok(())
+    }
+
+    /// The entries as RGBA8 bytes (a 256 x 1 texture).
+    pub fn texels(&self) -> Vec<u8> {
+        self.entries.iter().flatten().copied().collect()
+    }
+
+    /// Parse table text; `origin` names it in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<ColorTable, String> {
+        let mut entries = Vec::with_capacity(256);
+        for (n, line) in text.lines().enumerate() {
+            let content = line.split('#').next().unwrap_or("").trim();
+            if content.is_empty() {
+                continue;
+            }
+            let fields: Vec<&str> = content.split_whitespace().collect();
+            let values: Option<Vec<u8>> = fields.iter().map(|f| f.parse::<u8>().ok()).collect();
+            match values {
+                Some(v) if v.len() == 4 && entries.len() < 256 => {
+                    entries.push([v[0], v[1], v[2], v[3]])
+                }
+                Some(v) if v.len() == 4 => {
+                    return Err(format!("{origin}:{}: more than 256 entries", n + 1))
+                }
+                _ => {
+                    return Err(format!(
+                        "{origin}:{}: expected four integers 0..255 (r g b a), found {content:?}",
+                        n + 1
+                    ))
+                }
+            }
+        }
+        if entries.len() != 256 {
+            return Err(format!(
+                "{origin}: {} entries; a colour table has exactly 256",
+                entries.len()
+            ));
+        }
+        Ok(ColorTable { entries })
+    }
+
+    /// Read a table file.
+    pub fn load(path: &Path) -> Result<ColorTable, String> {
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        ColorTable::parse(&text, &path.display().to_string())
+    }
+
+    /// The table as file text.
+    pub fn to_text(&self) -> String {
+        let mut s = String::from("# arbvis colour table: 256 lines of r g b a (0..255), entry 0 first\n");
+        for e in &self.entries {
+            s += &format!("{} {} {} {}\n", e[0], e[1], e[2], e[3]);
+        }
+        s
+    }
+
+    /// Write the table file atomically.
+    pub fn save(&self, path: &Path) -> Result<(), String> {
+        crate::png_io::write_atomic(path, self.to_text().as_bytes())
+            .map_err(|e| format!("{}: {e}", path.display()))
+    }
+}
+
+/// The piecewise-linear curve through `points` at `t`.
+pub fn alpha_at(points: &[[f64; 2]], t: f64) -> f64 {
+    let first = points[0];
+    let last = points[points.len() - 1];
+    if t <= first[0] {
+        return first[1];
+    }
+    if t >= last[0] {
+        return last[1];
+    }
+    for w in points.windows(2) {
+        let ([x0, a0], [x1, a1]) = (w[0], w[1]);
+        if t >= x0 && t <= x1 {
+            return if x1 > x0 {
+                a0 + (a1 - a0) * (t - x0) / (x1 - x0)
+            } else {
+                a1
+            };
+        }
+    }
+    last[1]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_builtin_has_256_entries() {
+        for name in BUILTINS {
+            let t = ColorTable::builtin(name).unwrap();
+            assert_eq!(t.entries.len(), 256);
+        }
+        assert!(ColorTable::builtin("nope").unwrap_err().contains("seismic"));
+        let s = ColorTable::builtin("seismic").unwrap();
+        assert_eq!(s.entries[0], [0, 0, 255, 255]);
+        assert_eq!(s.entries[255], [255, 0, 0, 255]);
+        assert!(s.entries[128][3] <= 1);
+    }
+
+    #[test]
+    fn text_round_trip_and_errors() {
+        let t = ColorTable::builtin("viridis").unwrap();
+        assert_eq!(ColorTable::parse(&t.to_text(), "t").unwrap(), t);
+        let mut bad = t.to_text();
+        bad = bad.replacen("\n", "\n1 2 three 4\n", 1);
+        let e = ColorTable::parse(&bad, "my.table").unwrap_err();
+        assert!(e.starts_with("my.table:2:") && e.contains("four integers"), "{e}");
+        let short: String = t.to_text().lines().take(100).collect::<Vec<_>>().join("\n");
+        assert!(ColorTable::parse(&short, "s").unwrap_err().contains("99 entries"));
+    }
+
+    #[test]
+    fn alpha_curve() {
+        let mut t = ColorTable::builtin("grey").unwrap();
+        t.set_alpha_curve(&[[0.25, 0.0], [0.5, 1.0], [0.75, 0.0]])
+            .unwrap();
+        assert_eq!(t.entries[0][3], 0);
+        // t = 128/255 lies just past the peak: 1 - (128/255 - 0.5) / 0.25 = 0.99216 -> 253.
+        assert_eq!(t.entries[128][3], 253);
+        assert_eq!(t.entries[255][3], 0);
+        assert!(t.set_alpha_curve(&[[0.5, 2.0]]).is_err());
+        assert!(t.set_alpha_curve(&[[0.5, 0.0], [0.2, 0.0]]).is_err());
+    }
+}

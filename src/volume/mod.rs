@@ -1,0 +1,331 @@
+//! Attribute volumes: one scalar per voxel on a regular grid, from SEG-Y, NIfTI, raw files
+//! or a synthetic seismic cube; derived attributes (Hilbert envelope, phase, ...); and the
+//! quantization to 0..255 that v3o2 applied before packing.
+//!
+//! Axes: `dims = [ni, nj, nk]` with `i` fastest in [`Volume::values`]; the renderers map
+//! `i, j, k` to texture `s, t, r` and object `x, y, z`. Seismic volumes keep the trace
+//! order of the file: `i` = sample (time), `j` = crossline, `k` = inline.
+
+pub mod attributes;
+pub mod nifti_file;
+pub mod quantize;
+pub mod raw;
+pub mod segy;
+pub mod synthetic;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+/// A scalar volume.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Volume {
+    /// Voxels along i (fastest), j, k.
+    pub dims: [usize; 3],
+    /// Physical size of one voxel along i, j, k (sets the box's aspect).
+    pub spacing: [f64; 3],
+    /// `ni * nj * nk` samples, i fastest. May hold NaN or infinities from files.
+    pub values: Vec<f32>,
+}
+
+impl Volume {
+    /// A volume of `dims`, checking that `values` has the right length.
+    pub fn new(dims: [usize; 3], spacing: [f64; 3], values: Vec<f32>) -> Result<Volume, String> {
+        let n = dims.iter().try_fold(1usize, |a, &d| a.checked_mul(d));
+        if n != Some(values.len()) || dims.contains(&0) {
+            return Err(format!(
+                "volume of {}x{}x{} needs as many samples, got {}",
+                dims[0],
+                dims[1],
+                dims[2],
+                values.len()
+            ));
+        }
+        Ok(Volume {
+            dims,
+            spacing,
+            values,
+        })
+    }
+
+    /// Number of voxels.
+    pub fn len(&self) -> usize {
+        self.values.len()
+    }
+
+    /// True for no voxels (never, for a volume made by [`Volume::new`]).
+    pub fn is_empty(&self) -> bool {
+        self.values.is_empty()
+    }
+
+    /// Index of voxel `(i, j, k)`.
+    pub fn index(&self, i: usize, j: usize, k: usize) -> usize {
+        i + self.dims[0] * (j + self.dims[1] * k)
+    }
+
+    /// Minimum, maximum and mean over the finite samples, and how many were not finite.
+    pub fn stats(&self) -> Stats {
+        let mut s = Stats {
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+            mean: 0.0,
+            non_finite: 0,
+        };
+        let mut sum = 0.0;
+        for &v in &self.values {
+            if v.is_finite() {
+                let v = v as f64;
+                s.min = s.min.min(v);
+                s.max = s.max.max(v);
+                sum += v;
+            } else {
+                s.non_finite += 1;
+            }
+        }
+        let finite = self.values.len() - s.non_finite;
+        s.mean = if finite > 0 {
+            sum / finite as f64
+        } else {
+            f64::NAN
+        };
+        s
+    }
+
+    /// Half-extents of the volume's box in object space: the longest side spans [-1, 1].
+    pub fn half_extent(&self) -> [f64; 3] {
+        let size: [f64; 3] = std::array::from_fn(|a| {
+            let s = self.spacing[a];
+            self.dims[a] as f64 * if s.is_finite() && s > 0.0 { s } else { 1.0 }
+        });
+        let longest = size.iter().copied().fold(0.0, f64::max);
+        size.map(|s| s / longest)
+    }
+}
+
+/// Value statistics of a volume.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stats {
+    /// Smallest finite sample (+inf when none).
+    pub min: f64,
+    /// Largest finite sample (-inf when none).
+    pub max: f64,
+    /// Mean of the finite samples (NaN when none).
+    pub mean: f64,
+    /// Samples that are NaN or infinite.
+    pub non_finite: usize,
+}
+
+/// Errors reading volumes: each names the file, a byte offset where one applies, and what
+/// was expected there.
+#[derive(Debug, thiserror::Error)]
+pub enum VolumeError {
+    /// The file could not be opened or read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What failed.
+        source: std::io::Error,
+    },
+    /// The content is not what the format requires.
+    #[error("{path}: at byte {offset}: {message}")]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// Byte offset of the problem.
+        offset: u64,
+        /// What was expected and what was found.
+        message: String,
+    },
+    /// The file is valid but cannot be used here (e.g. a pre-stack or irregular SEG-Y).
+    #[error("{path}: {message}")]
+    Unsupported {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// Parameters (from a scene) that cannot describe a volume.
+    #[error("{0}")]
+    Invalid(String),
+}
+
+impl VolumeError {
+    pub(crate) fn format(path: &Path, offset: u64, message: impl Into<String>) -> VolumeError {
+        VolumeError::Format {
+            path: path.to_path_buf(),
+            offset,
+            message: message.into(),
+        }
+    }
+    pub(crate) fn io(path: &Path, source: std::io::Error) -> VolumeError {
+        VolumeError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+}
+
+/// Sample types of raw files.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SampleType {
+    /// Unsigned 8-bit.
+    U8,
+    /// Signed 8-bit.
+    I8,
+    /// Unsigned 16-bit.
+    U16,
+    /// Signed 16-bit.
+    I16,
+    /// Unsigned 32-bit.
+    U32,
+    /// Signed 32-bit.
+    I32,
+    /// IEEE 754 single.
+    F32,
+    /// IEEE 754 double.
+    F64,
+}
+
+impl SampleType {
+    /// Bytes per sample.
+    pub fn bytes(self) -> usize {
+        match self {
+            SampleType::U8 | SampleType::I8 => 1,
+            SampleType::U16 | SampleType::I16 => 2,
+            SampleType::U32 | SampleType::I32 | SampleType::F32 => 4,
+            SampleType::F64 => 8,
+        }
+    }
+
+    /// Decode one sample from exactly [`SampleType::bytes`] bytes.
+    pub fn decode(self, b: &[u8], big_endian: bool) -> f32 {
+        macro_rules! num {
+            ($t:ty) => {{
+                let a = b.try_into().expect("caller passes bytes() bytes");
+                if big_endian {
+                    <$t>::from_be_bytes(a)
+                } else {
+                    <$t>::from_le_bytes(a)
+                }
+            }};
+        }
+        match self {
+            SampleType::U8 => b[0] as f32,
+            SampleType::I8 => b[0] as i8 as f32,
+            SampleType::U16 => num!(u16) as f32,
+            SampleType::I16 => num!(i16) as f32,
+            SampleType::U32 => num!(u32) as f32,
+            SampleType::I32 => num!(i32) as f32,
+            SampleType::F32 => num!(f32),
+            SampleType::F64 => num!(f64) as f32,
+        }
+    }
+
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            SampleType::U8 => "u8",
+            SampleType::I8 => "i8",
+            SampleType::U16 => "u16",
+            SampleType::I16 => "i16",
+            SampleType::U32 => "u32",
+            SampleType::I32 => "i32",
+            SampleType::F32 => "f32",
+            SampleType::F64 => "f64",
+        }
+    }
+}
+
+/// Byte order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Endian {
+    /// Least significant byte first.
+    #[default]
+    Little,
+    /// Most significant byte first (SEG-Y's standard order).
+    Big,
+}
+
+/// Where a volume comes from, as written in a scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase", deny_unknown_fields)]
+pub enum VolumeSource {
+    /// A SEG-Y file (rev 1 or 2), gridded from its trace headers.
+    Segy(PathBuf),
+    /// A NIfTI-1 file (`.nii` or `.nii.gz`); the first 3D volume.
+    Nifti(PathBuf),
+    /// A headerless file described in the scene.
+    Raw(raw::RawSpec),
+    /// The built-in seismic-like cube.
+    Synthetic(synthetic::SyntheticSpec),
+}
+
+impl VolumeSource {
+    /// Read the volume; relative paths are taken from `base` (the scene's folder).
+    pub fn load(&self, base: &Path) -> Result<Volume, VolumeError> {
+        match self {
+            VolumeSource::Segy(p) => Ok(segy::read(&base.join(p))?.volume),
+            VolumeSource::Nifti(p) => nifti_file::read(&base.join(p)),
+            VolumeSource::Raw(spec) => raw::read(base, spec),
+            VolumeSource::Synthetic(spec) => synthetic::amplitude(spec),
+        }
+    }
+
+    /// The file it names, if any.
+    pub fn path(&self) -> Option<&Path> {
+        match self {
+            VolumeSource::Segy(p) | VolumeSource::Nifti(p) => Some(p),
+            VolumeSource::Raw(spec) => Some(&spec.path),
+            VolumeSource::Synthetic(_) => None,
+        }
+    }
+}
+
+/// `arbvis inspect`: what the loaders see in `path` (format chosen from the content and
+/// the extension), as text.
+pub fn inspect(path: &Path) -> Result<String, VolumeError> {
+    let name = path.to_string_lossy().to_lowercase();
+    if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+        let v = nifti_file::read(path)?;
+        let header = nifti_file::describe_header(path)?;
+        Ok(format!(
+            "{}\nformat: NIfTI-1\n{header}{}",
+            path.display(),
+            describe(&v)
+        ))
+    } else {
+        let s = segy::read(path)?;
+        Ok(format!("{}\n{}{}", path.display(), s.describe(), describe(&s.volume)))
+    }
+}
+
+/// Dimensions and value statistics, one item per line.
+pub fn describe(v: &Volume) -> String {
+    let s = v.stats();
+    format!(
+        "dimensions (i, j, k): {} x {} x {} = {} samples\nspacing: {} x {} x {}\nvalues: min {} max {} mean {:.6}{}\n",
+        v.dims[0],
+        v.dims[1],
+        v.dims[2],
+        v.len(),
+        v.spacing[0],
+        v.spacing[1],
+        v.spacing[2],
+        s.min,
+        s.max,
+        s.mean,
+        if s.non_finite > 0 {
+            format!(" ({} NaN or infinite samples)", s.non_finite)
+        } else {
+            String::new()
+        }
+    )
+}
+
+/// Read a whole file, naming it in the error.
+pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, VolumeError> {
+    std::fs::read(path).map_err(|e| VolumeError::io(path, e))
+}

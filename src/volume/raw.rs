@@ -1,0 +1,77 @@
+//! Headerless volumes described in the scene: dimensions, sample type, byte order and a
+//! byte offset. The file must hold exactly `offset + ni*nj*nk*bytes` bytes (a size that
+//! does not match is an error, because it usually means wrong dimensions or type).
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::{read_file, Endian, SampleType, Volume, VolumeError};
+
+/// A raw file's description, as in a scene:
+/// `{ path = "a.raw", dims = [64, 64, 64], type = "u16", endian = "little" }`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSpec {
+    /// The file (relative to the scene's folder).
+    pub path: PathBuf,
+    /// Samples along i (fastest), j, k.
+    pub dims: [usize; 3],
+    /// Sample type.
+    #[serde(rename = "type")]
+    pub sample: SampleType,
+    /// Byte order.
+    #[serde(default)]
+    pub endian: Endian,
+    /// Bytes to skip at the start.
+    #[serde(default)]
+    pub offset: u64,
+    /// Voxel size along i, j, k.
+    #[serde(default = "unit_spacing")]
+    pub spacing: [f64; 3],
+}
+
+fn unit_spacing() -> [f64; 3] {
+    [1.0; 3]
+}
+
+/// Read a raw file; `base` resolves a relative path.
+pub fn read(base: &Path, spec: &RawSpec) -> Result<Volume, VolumeError> {
+    let path = base.join(&spec.path);
+    let count = spec
+        .dims
+        .iter()
+        .try_fold(1usize, |a, &d| a.checked_mul(d))
+        .filter(|&n| n > 0)
+        .ok_or_else(|| {
+            VolumeError::Invalid(format!(
+                "{}: dims {:?} must be positive and not overflow",
+                path.display(),
+                spec.dims
+            ))
+        })?;
+    let bytes = read_file(&path)?;
+    let need = count as u64 * spec.sample.bytes() as u64 + spec.offset;
+    if bytes.len() as u64 != need {
+        return Err(VolumeError::format(
+            &path,
+            bytes.len().min(need as usize) as u64,
+            format!(
+                "the file has {} bytes but {}x{}x{} samples of {} after an offset of {} need {need}",
+                bytes.len(),
+                spec.dims[0],
+                spec.dims[1],
+                spec.dims[2],
+                spec.sample.name(),
+                spec.offset
+            ),
+        ));
+    }
+    let big = spec.endian == Endian::Big;
+    let width = spec.sample.bytes();
+    let values = bytes[spec.offset as usize..]
+        .chunks_exact(width)
+        .map(|b| spec.sample.decode(b, big))
+        .collect();
+    Volume::new(spec.dims, spec.spacing, values).map_err(VolumeError::Invalid)
+}

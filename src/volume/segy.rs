@@ -1,0 +1,635 @@
+//! SEG-Y (rev 0/1/2) post-stack cubes: 3200-byte textual header, 400-byte binary header,
+//! extended textual headers, then traces of a 240-byte header and samples.
+//!
+//! Sample formats: 1 IBM float, 2 int32, 3 int16, 5 IEEE float, 6 IEEE double, 8 int8,
+//! 10 uint32, 11 uint16, 16 uint8. Byte order: big-endian by the standard; little-endian
+//! when the rev 2 byte-order word (bytes 3297-3300) says so, or when the format code only
+//! makes sense read little-endian (as segyio guesses). Geometry: inline from trace bytes
+//! 189-192, crossline from 193-196; every (inline, crossline) pair must occur exactly once
+//! on a full rectangular grid, in any order, or the file is refused as pre-stack or
+//! irregular. The volume's axes are sample (i), crossline (j), inline (k).
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use super::{read_file, Volume, VolumeError};
+
+const TEXT_HEADER: usize = 3200;
+const BINARY_HEADER: usize = 400;
+const TRACE_HEADER: usize = 240;
+
+/// Sample encodings (binary header bytes 3225-3226).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SampleFormat {
+    /// 1: 4-byte IBM hexadecimal float.
+    IbmFloat,
+    /// 2: 4-byte two's complement integer.
+    Int32,
+    /// 3: 2-byte two's complement integer.
+    Int16,
+    /// 5: 4-byte IEEE float.
+    IeeeFloat,
+    /// 6: 8-byte IEEE float (rev 2).
+    IeeeDouble,
+    /// 8: 1-byte two's complement integer.
+    Int8,
+    /// 10: 4-byte unsigned integer (rev 2).
+    UInt32,
+    /// 11: 2-byte unsigned integer (rev 2).
+    UInt16,
+    /// 16: 1-byte unsigned integer (rev 2).
+    UInt8,
+}
+
+impl SampleFormat {
+    /// From the binary header's code.
+    pub fn from_code(code: u16) -> Option<SampleFormat> {
+        Some(match code {
+            1 => SampleFormat::IbmFloat,
+            2 => SampleFormat::Int32,
+            3 => SampleFormat::Int16,
+            5 => SampleFormat::IeeeFloat,
+            6 => SampleFormat::IeeeDouble,
+            8 => SampleFormat::Int8,
+            10 => SampleFormat::UInt32,
+            11 => SampleFormat::UInt16,
+            16 => SampleFormat::UInt8,
+            _ => return None,
+        })
+    }
+
+    /// The binary header's code.
+    pub fn code(self) -> u16 {
+        match self {
+            SampleFormat::IbmFloat => 1,
+            SampleFormat::Int32 => 2,
+            SampleFormat::Int16 => 3,
+            SampleFormat::IeeeFloat => 5,
+            SampleFormat::IeeeDouble => 6,
+            SampleFormat::Int8 => 8,
+            SampleFormat::UInt32 => 10,
+            SampleFormat::UInt16 => 11,
+            SampleFormat::UInt8 => 16,
+        }
+    }
+
+    /// Bytes per sample.
+    pub fn bytes(self) -> usize {
+        match self {
+            SampleFormat::Int8 | SampleFormat::UInt8 => 1,
+            SampleFormat::Int16 | SampleFormat::UInt16 => 2,
+            SampleFormat::IeeeDouble => 8,
+            _ => 4,
+        }
+    }
+
+    /// Human name.
+    pub fn name(self) -> &'static str {
+        match self {
+            SampleFormat::IbmFloat => "IBM float (1)",
+            SampleFormat::Int32 => "int32 (2)",
+            SampleFormat::Int16 => "int16 (3)",
+            SampleFormat::IeeeFloat => "IEEE float (5)",
+            SampleFormat::IeeeDouble => "IEEE double (6)",
+            SampleFormat::Int8 => "int8 (8)",
+            SampleFormat::UInt32 => "uint32 (10)",
+            SampleFormat::UInt16 => "uint16 (11)",
+            SampleFormat::UInt8 => "uint8 (16)",
+        }
+    }
+
+    /// Decode one sample.
+    pub fn decode(self, b: &[u8], big: bool) -> f32 {
+        let u32_of = |b: &[u8]| {
+            let a = [b[0], b[1], b[2], b[3]];
+            if big {
+                u32::from_be_bytes(a)
+            } else {
+                u32::from_le_bytes(a)
+            }
+        };
+        let u16_of = |b: &[u8]| {
+            let a = [b[0], b[1]];
+            if big {
+                u16::from_be_bytes(a)
+            } else {
+                u16::from_le_bytes(a)
+            }
+        };
+        match self {
+            SampleFormat::IbmFloat => ibm_to_f32(u32_of(b)),
+            SampleFormat::Int32 => u32_of(b) as i32 as f32,
+            SampleFormat::Int16 => u16_of(b) as i16 as f32,
+            SampleFormat::IeeeFloat => f32::from_bits(u32_of(b)),
+            SampleFormat::IeeeDouble => {
+                let a: [u8; 8] = b[..8].try_into().expect("8 bytes");
+                (if big {
+                    f64::from_be_bytes(a)
+                } else {
+                    f64::from_le_bytes(a)
+                }) as f32
+            }
+            SampleFormat::Int8 => b[0] as i8 as f32,
+            SampleFormat::UInt32 => u32_of(b) as f32,
+            SampleFormat::UInt16 => u16_of(b) as f32,
+            SampleFormat::UInt8 => b[0] as f32,
+        }
+    }
+
+    /// Encode one sample (for writing test files); integers round and saturate.
+    pub fn encode(self, v: f32, big: bool) -> Vec<u8> {
+        let order4 = |x: u32| {
+            if big {
+                x.to_be_bytes().to_vec()
+            } else {
+                x.to_le_bytes().to_vec()
+            }
+        };
+        let order2 = |x: u16| {
+            if big {
+                x.to_be_bytes().to_vec()
+            } else {
+                x.to_le_bytes().to_vec()
+            }
+        };
+        let r = v.round();
+        match self {
+            SampleFormat::IbmFloat => order4(f32_to_ibm(v)),
+            SampleFormat::Int32 => order4(r as i32 as u32),
+            SampleFormat::Int16 => order2(r as i16 as u16),
+            SampleFormat::IeeeFloat => order4(v.to_bits()),
+            SampleFormat::IeeeDouble => {
+                let d = v as f64;
+                if big {
+                    d.to_be_bytes().to_vec()
+                } else {
+                    d.to_le_bytes().to_vec()
+                }
+            }
+            SampleFormat::Int8 => vec![r as i8 as u8],
+            SampleFormat::UInt32 => order4(r as u32),
+            SampleFormat::UInt16 => order2(r as u16),
+            SampleFormat::UInt8 => vec![r as u8],
+        }
+    }
+}
+
+/// IBM System/360 single float: sign, 7-bit base-16 exponent biased by 64, 24-bit fraction.
+pub fn ibm_to_f32(bits: u32) -> f32 {
+    let sign = if bits >> 31 == 1 { -1.0 } else { 1.0 };
+    let exponent = ((bits >> 24) & 0x7f) as i32 - 64;
+    let fraction = (bits & 0x00ff_ffff) as f64 / 16_777_216.0;
+    (sign * fraction * 16f64.powi(exponent)) as f32
+}
+
+/// The IBM float nearest to `v` (truncating the fraction, as most writers do); zero for
+/// NaN, saturating for out-of-range values.
+pub fn f32_to_ibm(v: f32) -> u32 {
+    if v == 0.0 || !v.is_finite() {
+        return 0;
+    }
+    let sign = if v < 0.0 { 0x8000_0000 } else { 0 };
+    let mut m = (v as f64).abs();
+    let mut e = 64i32;
+    while m >= 1.0 {
+        m /= 16.0;
+        e += 1;
+    }
+    while m < 1.0 / 16.0 {
+        m *= 16.0;
+        e -= 1;
+    }
+    if e > 127 {
+        return sign | 0x7fff_ffff;
+    }
+    if e < 0 {
+        return 0;
+    }
+    let fraction = ((m * 16_777_216.0) as u32).min(0x00ff_ffff);
+    sign | ((e as u32) << 24) | fraction
+}
+
+/// A gridded SEG-Y cube and what its headers said.
+#[derive(Debug, Clone)]
+pub struct SegyCube {
+    /// The samples; axes sample, crossline, inline.
+    pub volume: Volume,
+    /// Revision from bytes 3501-3502 (major, minor).
+    pub revision: (u8, u8),
+    /// Sample encoding.
+    pub format: SampleFormat,
+    /// Byte order of the file.
+    pub big_endian: bool,
+    /// Textual header encoding: true for EBCDIC.
+    pub ebcdic: bool,
+    /// Sample interval in microseconds.
+    pub interval_us: u32,
+    /// Inline numbers, ascending.
+    pub inlines: Vec<i32>,
+    /// Crossline numbers, ascending.
+    pub crosslines: Vec<i32>,
+    /// Number of traces.
+    pub traces: usize,
+}
+
+impl SegyCube {
+    /// What `arbvis inspect` prints about the headers.
+    pub fn describe(&self) -> String {
+        let range = |v: &[i32]| {
+            let step = if v.len() > 1 { v[1] - v[0] } else { 0 };
+            format!(
+                "{}..={} ({} values, step {step})",
+                v[0],
+                v[v.len() - 1],
+                v.len()
+            )
+        };
+        let ns = self.volume.dims[0];
+        format!(
+            "format: SEG-Y rev {}.{}, textual header {}\nsample type: {}\nendianness: {}\ntraces: {}\ninlines: {}\ncrosslines: {}\nsamples: {} per trace, interval {} us, 0..={} ms\n",
+            self.revision.0,
+            self.revision.1,
+            if self.ebcdic { "EBCDIC" } else { "ASCII" },
+            self.format.name(),
+            if self.big_endian { "big-endian" } else { "little-endian" },
+            self.traces,
+            range(&self.inlines),
+            range(&self.crosslines),
+            ns,
+            self.interval_us,
+            (ns.saturating_sub(1)) as f64 * self.interval_us as f64 / 1000.0,
+        )
+    }
+}
+
+struct Reader<'a> {
+    bytes: &'a [u8],
+    big: bool,
+}
+
+impl Reader<'_> {
+    fn u16(&self, at: usize) -> u16 {
+        let a = [self.bytes[at], self.bytes[at + 1]];
+        if self.big {
+            u16::from_be_bytes(a)
+        } else {
+            u16::from_le_bytes(a)
+        }
+    }
+    fn i32(&self, at: usize) -> i32 {
+        let a = self.bytes[at..at + 4].try_into().expect("4 bytes");
+        if self.big {
+            i32::from_be_bytes(a)
+        } else {
+            i32::from_le_bytes(a)
+        }
+    }
+    fn u32(&self, at: usize) -> u32 {
+        self.i32(at) as u32
+    }
+}
+
+/// Read and grid a post-stack SEG-Y file.
+pub fn read(path: &Path) -> Result<SegyCube, VolumeError> {
+    let bytes = read_file(path)?;
+    parse(path, &bytes)
+}
+
+/// Parse SEG-Y bytes; `path` names the file in errors.
+pub fn parse(path: &Path, bytes: &[u8]) -> Result<SegyCube, VolumeError> {
+    let bin = TEXT_HEADER;
+    if bytes.len() < TEXT_HEADER + BINARY_HEADER {
+        return Err(VolumeError::format(
+            path,
+            bytes.len() as u64,
+            format!(
+                "file ends after {} bytes; a SEG-Y file starts with a 3200-byte textual and a 400-byte binary header",
+                bytes.len()
+            ),
+        ));
+    }
+    let be = Reader { bytes, big: true };
+    let le = Reader { bytes, big: false };
+    // Byte order: the rev 2 byte-order word, else whichever order gives a known format.
+    let big = match be.u32(bin + 96) {
+        0x0102_0304 => true,
+        0x0403_0201 => false,
+        _ => {
+            SampleFormat::from_code(be.u16(bin + 24)).is_some()
+                || SampleFormat::from_code(le.u16(bin + 24)).is_none()
+        }
+    };
+    let r = if big { be } else { le };
+    let code = r.u16(bin + 24);
+    let format = SampleFormat::from_code(code).ok_or_else(|| {
+        VolumeError::format(
+            path,
+            (bin + 24) as u64,
+            format!("sample format code {code} is not one of 1, 2, 3, 5, 6, 8, 10, 11, 16"),
+        )
+    })?;
+    let revision = (bytes[bin + 300], bytes[bin + 301]);
+    let mut samples = r.u16(bin + 20) as usize;
+    if samples == 0 && revision.0 >= 2 {
+        samples = r.u32(bin + 68) as usize;
+    }
+    let mut interval_us = r.u16(bin + 16) as u32;
+    let extended = r.u16(bin + 304) as i16;
+    if extended < 0 {
+        return Err(VolumeError::Unsupported {
+            path: path.into(),
+            message: format!(
+                "a variable number of extended textual headers ({extended} at byte 3505) is not supported"
+            ),
+        });
+    }
+    let first_trace = TEXT_HEADER + BINARY_HEADER + extended as usize * TEXT_HEADER;
+    if samples == 0 {
+        // Fall back on the first trace header's count (bytes 115-116).
+        if bytes.len() >= first_trace + TRACE_HEADER {
+            samples = r.u16(first_trace + 114) as usize;
+        }
+        if samples == 0 {
+            return Err(VolumeError::format(
+                path,
+                (bin + 20) as u64,
+                "samples per trace is 0 in the binary header and in the first trace header",
+            ));
+        }
+    }
+    if interval_us == 0 && bytes.len() >= first_trace + TRACE_HEADER {
+        interval_us = r.u16(first_trace + 116) as u32;
+    }
+    let trace_len = TRACE_HEADER + samples * format.bytes();
+    let data = bytes.len().checked_sub(first_trace).ok_or_else(|| {
+        VolumeError::format(
+            path,
+            bytes.len() as u64,
+            format!("file ends before the first trace, which the headers place at byte {first_trace} ({extended} extended textual headers)"),
+        )
+    })?;
+    if data % trace_len != 0 {
+        let whole = data / trace_len;
+        let start = first_trace + whole * trace_len;
+        return Err(VolumeError::format(
+            path,
+            bytes.len() as u64,
+            format!(
+                "file ends inside trace {} (which starts at byte {start}): each trace is {trace_len} bytes (240-byte header + {samples} samples of {}), {} bytes are missing; the file is truncated or its headers are wrong",
+                whole + 1,
+                format.name(),
+                trace_len - (data - whole * trace_len)
+            ),
+        ));
+    }
+    let traces = data / trace_len;
+    if traces == 0 {
+        return Err(VolumeError::format(
+            path,
+            first_trace as u64,
+            "no traces after the headers",
+        ));
+    }
+    let mut cells: BTreeMap<(i32, i32), usize> = BTreeMap::new();
+    for t in 0..traces {
+        let h = first_trace + t * trace_len;
+        let key = (r.i32(h + 188), r.i32(h + 192));
+        if let Some(previous) = cells.insert(key, t) {
+            return Err(VolumeError::Unsupported {
+                path: path.into(),
+                message: format!(
+                    "traces {} and {} (bytes {} and {h}) both sit at inline {} crossline {} (bytes 189-196): a pre-stack or otherwise non-gridded file; arbvis grids one trace per inline/crossline",
+                    previous + 1,
+                    t + 1,
+                    first_trace + previous * trace_len,
+                    key.0,
+                    key.1
+                ),
+            });
+        }
+    }
+    let mut inlines: Vec<i32> = cells.keys().map(|k| k.0).collect();
+    inlines.dedup();
+    let mut crosslines: Vec<i32> = cells.keys().map(|k| k.1).collect();
+    crosslines.sort_unstable();
+    crosslines.dedup();
+    if inlines.len() * crosslines.len() != traces {
+        return Err(VolumeError::Unsupported {
+            path: path.into(),
+            message: format!(
+                "{traces} traces do not fill the grid of {} inlines x {} crosslines (inline {}..={}, crossline {}..={}): an irregular survey that arbvis cannot grid",
+                inlines.len(),
+                crosslines.len(),
+                inlines[0],
+                inlines[inlines.len() - 1],
+                crosslines[0],
+                crosslines[crosslines.len() - 1]
+            ),
+        });
+    }
+    let dims = [samples, crosslines.len(), inlines.len()];
+    let mut values = vec![0f32; samples * traces];
+    for (k, &il) in inlines.iter().enumerate() {
+        for (j, &xl) in crosslines.iter().enumerate() {
+            let t = cells[&(il, xl)];
+            let start = first_trace + t * trace_len + TRACE_HEADER;
+            let out = &mut values[(k * dims[1] + j) * samples..][..samples];
+            for (s, v) in out.iter_mut().enumerate() {
+                *v = format.decode(&bytes[start + s * format.bytes()..], big);
+            }
+        }
+    }
+    // Spacing: one sample, one crossline step and one inline step each count as one unit;
+    // SEG-Y has no common unit for time and distance.
+    let volume = Volume::new(dims, [1.0, 1.0, 1.0], values).map_err(VolumeError::Invalid)?;
+    Ok(SegyCube {
+        volume,
+        revision,
+        format,
+        big_endian: big,
+        ebcdic: bytes[0] == 0xC3 || bytes[0] == 0x40,
+        interval_us,
+        inlines,
+        crosslines,
+        traces,
+    })
+}
+
+/// Options for [`write`].
+#[derive(Debug, Clone, Copy)]
+pub struct WriteOptions {
+    /// Sample encoding.
+    pub format: SampleFormat,
+    /// Byte order.
+    pub big_endian: bool,
+    /// 1 or 2 (rev 2 writes the byte-order word).
+    pub revision: u8,
+    /// First inline number.
+    pub first_inline: i32,
+    /// First crossline number.
+    pub first_crossline: i32,
+    /// Sample interval, microseconds.
+    pub interval_us: u16,
+}
+
+/// Encode a volume (axes sample, crossline, inline) as a SEG-Y file, inline-sorted.
+pub fn write(volume: &Volume, o: &WriteOptions) -> Vec<u8> {
+    let [ns, nx, ni] = volume.dims;
+    let mut out = vec![0x40u8; TEXT_HEADER]; // EBCDIC spaces
+    let mut bin = vec![0u8; BINARY_HEADER];
+    let put16 = |buf: &mut [u8], at: usize, v: u16| {
+        let b = if o.big_endian {
+            v.to_be_bytes()
+        } else {
+            v.to_le_bytes()
+        };
+        buf[at..at + 2].copy_from_slice(&b);
+    };
+    let put32 = |buf: &mut [u8], at: usize, v: u32| {
+        let b = if o.big_endian {
+            v.to_be_bytes()
+        } else {
+            v.to_le_bytes()
+        };
+        buf[at..at + 4].copy_from_slice(&b);
+    };
+    put16(&mut bin, 16, o.interval_us);
+    put16(&mut bin, 20, ns as u16);
+    put16(&mut bin, 24, o.format.code());
+    if o.revision >= 2 {
+        put32(&mut bin, 96, 0x0102_0304);
+    }
+    bin[300] = o.revision;
+    put16(&mut bin, 302, 1);
+    out.extend_from_slice(&bin);
+    for k in 0..ni {
+        for j in 0..nx {
+            let mut h = vec![0u8; TRACE_HEADER];
+            put32(&mut h, 188, (o.first_inline + k as i32) as u32);
+            put32(&mut h, 192, (o.first_crossline + j as i32) as u32);
+            put16(&mut h, 114, ns as u16);
+            put16(&mut h, 116, o.interval_us);
+            out.extend_from_slice(&h);
+            for i in 0..ns {
+                out.extend(o.format.encode(volume.values[volume.index(i, j, k)], o.big_endian));
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ibm_known_values() {
+        // -118.625 is 0xC276A000 (the classic example of IBM's own documentation).
+        assert_eq!(ibm_to_f32(0xC276_A000), -118.625);
+        assert_eq!(f32_to_ibm(-118.625), 0xC276_A000);
+        assert_eq!(ibm_to_f32(0x4110_0000), 1.0);
+        assert_eq!(ibm_to_f32(0), 0.0);
+        for v in [1.0f32, 0.5, 3.25, -1e-3, 12345.678, 1e30] {
+            let back = ibm_to_f32(f32_to_ibm(v));
+            // IBM keeps 21 to 24 significant bits (hex normalization): relative 2^-20.
+            assert!(((back - v) / v).abs() < 1e-6, "{v} -> {back}");
+        }
+    }
+
+    fn cube() -> Volume {
+        let dims = [5, 3, 4];
+        let values = (0..60).map(|n| n as f32 - 20.0).collect();
+        Volume::new(dims, [1.0; 3], values).unwrap()
+    }
+
+    #[test]
+    fn round_trips_every_format_and_order() {
+        let v = cube();
+        for code in [1, 2, 3, 5, 6, 8, 10, 11, 16] {
+            let format = SampleFormat::from_code(code).unwrap();
+            for big_endian in [true, false] {
+                for revision in [1, 2] {
+                    let o = WriteOptions {
+                        format,
+                        big_endian,
+                        revision,
+                        first_inline: 100,
+                        first_crossline: 7,
+                        interval_us: 2000,
+                    };
+                    let unsigned = matches!(code, 10 | 11 | 16);
+                    let mut src = v.clone();
+                    if unsigned {
+                        src.values.iter_mut().for_each(|x| *x += 20.0);
+                    }
+                    let cube = parse(Path::new("mem.sgy"), &write(&src, &o)).unwrap();
+                    assert_eq!(cube.volume, src, "format {code} big {big_endian} rev {revision}");
+                    assert_eq!(cube.big_endian, big_endian);
+                    assert_eq!(cube.format, format);
+                    assert_eq!(cube.inlines, vec![100, 101, 102, 103]);
+                    assert_eq!(cube.crosslines, vec![7, 8, 9]);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn any_trace_order_grids_the_same() {
+        let v = cube();
+        let o = WriteOptions {
+            format: SampleFormat::IeeeFloat,
+            big_endian: true,
+            revision: 1,
+            first_inline: 1,
+            first_crossline: 1,
+            interval_us: 4000,
+        };
+        let bytes = write(&v, &o);
+        // Swap the first and last traces.
+        let trace = TRACE_HEADER + 5 * 4;
+        let mut swapped = bytes.clone();
+        let (a, b) = (3600, 3600 + 11 * trace);
+        swapped[a..a + trace].copy_from_slice(&bytes[b..b + trace]);
+        swapped[b..b + trace].copy_from_slice(&bytes[a..a + trace]);
+        assert_eq!(parse(Path::new("m"), &swapped).unwrap().volume, v);
+    }
+
+    #[test]
+    fn prestack_and_irregular_and_truncated_are_refused() {
+        let v = cube();
+        let o = WriteOptions {
+            format: SampleFormat::Int16,
+            big_endian: true,
+            revision: 1,
+            first_inline: 1,
+            first_crossline: 1,
+            interval_us: 4000,
+        };
+        let bytes = write(&v, &o);
+        let trace = TRACE_HEADER + 5 * 2;
+        // Trace 2 claims trace 1's position: a second offset at one CDP.
+        let mut prestack = bytes.clone();
+        prestack[3600 + trace + 192..3600 + trace + 196].copy_from_slice(&1i32.to_be_bytes());
+        let e = parse(Path::new("p.sgy"), &prestack).unwrap_err().to_string();
+        assert!(e.contains("pre-stack") && e.contains("p.sgy"), "{e}");
+        // Drop the last trace: 11 traces cannot fill 4 x 3.
+        let e = parse(Path::new("i.sgy"), &bytes[..bytes.len() - trace])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("irregular"), "{e}");
+        // Cut inside a trace.
+        let e = parse(Path::new("t.sgy"), &bytes[..bytes.len() - 3])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("truncated") && e.contains("trace 12"), "{e}");
+        // Headers only.
+        assert!(parse(Path::new("h"), &bytes[..100]).is_err());
+        // Unknown format code.
+        let mut bad = bytes.clone();
+        bad[3224..3226].copy_from_slice(&[0, 99]);
+        bad[3225] = 99;
+        bad[3224] = 0;
+        let e = parse(Path::new("f"), &bad).unwrap_err().to_string();
+        assert!(e.contains("at byte 3224"), "{e}");
+    }
+}
