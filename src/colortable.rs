@@ -12,8 +12,8 @@ use serde::{Deserialize, Serialize};
 
 /// Names of the built-in tables.
 pub const BUILTINS: &[&str] = &[
-    "seismic", "grey", "viridis", "magma", "inferno", "plasma", "cividis", "turbo", "red",
-    "green", "blue",
+    "seismic", "grey", "viridis", "magma", "inferno", "plasma", "cividis", "turbo", "red", "green",
+    "blue",
 ];
 
 /// A table as a scene names it: a built-in or a file, and an optional alpha curve.
@@ -189,7 +189,8 @@ impl ColorTable {
 
     /// The table as file text.
     pub fn to_text(&self) -> String {
-        let mut s = String::from("# arbvis colour table: 256 lines of r g b a (0..255), entry 0 first\n");
+        let mut s =
+            String::from("# arbvis colour table: 256 lines of r g b a (0..255), entry 0 first\n");
         for e in &self.entries {
             s += &format!("{} {} {} {}\n", e[0], e[1], e[2], e[3]);
         }
@@ -250,9 +251,14 @@ mod tests {
         let mut bad = t.to_text();
         bad = bad.replacen("\n", "\n1 2 three 4\n", 1);
         let e = ColorTable::parse(&bad, "my.table").unwrap_err();
-        assert!(e.starts_with("my.table:2:") && e.contains("four integers"), "{e}");
+        assert!(
+            e.starts_with("my.table:2:") && e.contains("four integers"),
+            "{e}"
+        );
         let short: String = t.to_text().lines().take(100).collect::<Vec<_>>().join("\n");
-        assert!(ColorTable::parse(&short, "s").unwrap_err().contains("99 entries"));
+        assert!(ColorTable::parse(&short, "s")
+            .unwrap_err()
+            .contains("99 entries"));
     }
 
     #[test]

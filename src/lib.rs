@@ -9,6 +9,7 @@
 #![deny(unsafe_code)]
 
 pub mod camera;
+pub mod colortable;
 #[allow(unsafe_code)] // the one module allowed to call GL and the platform
 pub mod gl;
 pub mod image;
@@ -18,7 +19,6 @@ pub mod programs;
 pub mod render;
 pub mod scene;
 pub mod techniques;
-pub mod volume;
-pub mod colortable;
 #[cfg(feature = "viewer")]
 pub mod viewer;
+pub mod volume;

@@ -25,6 +25,16 @@ pub const OPACITY3D_SUM_FRAG: ProgramText = program!("opacity3d/sum.frag");
 /// GLSL port of the product program.
 pub const OPACITY3D_PRODUCT_FRAG: ProgramText = program!("opacity3d/product.frag");
 
+/// Precise sum (new): texel-centre lookup, clamp, opacity correction.
+pub const OPACITY3D_SUM_PRECISE_ARBFP: ProgramText = program!("opacity3d/sum_precise.arbfp");
+/// GLSL twin of [`OPACITY3D_SUM_PRECISE_ARBFP`].
+pub const OPACITY3D_SUM_PRECISE_FRAG: ProgramText = program!("opacity3d/sum_precise.frag");
+/// Precise product (new).
+pub const OPACITY3D_PRODUCT_PRECISE_ARBFP: ProgramText =
+    program!("opacity3d/product_precise.arbfp");
+/// GLSL twin of [`OPACITY3D_PRODUCT_PRECISE_ARBFP`].
+pub const OPACITY3D_PRODUCT_PRECISE_FRAG: ProgramText = program!("opacity3d/product_precise.frag");
+
 /// A vertex + fragment pair of one kind.
 #[derive(Debug, Clone)]
 pub struct ProgramPair {
@@ -59,6 +69,11 @@ pub fn all_pairs() -> Vec<ProgramPair> {
         (QUAD_ARBFP, QUAD_FRAG),
         (OPACITY3D_SUM_ARBFP, OPACITY3D_SUM_FRAG),
         (OPACITY3D_PRODUCT_ARBFP, OPACITY3D_PRODUCT_FRAG),
+        (OPACITY3D_SUM_PRECISE_ARBFP, OPACITY3D_SUM_PRECISE_FRAG),
+        (
+            OPACITY3D_PRODUCT_PRECISE_ARBFP,
+            OPACITY3D_PRODUCT_PRECISE_FRAG,
+        ),
     ];
     let mut pairs = Vec::new();
     for (arb, glsl) in &fragments {
@@ -80,5 +95,9 @@ pub fn all_texts() -> Vec<ProgramText> {
         OPACITY3D_PRODUCT_ARBFP,
         OPACITY3D_SUM_FRAG,
         OPACITY3D_PRODUCT_FRAG,
+        OPACITY3D_SUM_PRECISE_ARBFP,
+        OPACITY3D_SUM_PRECISE_FRAG,
+        OPACITY3D_PRODUCT_PRECISE_ARBFP,
+        OPACITY3D_PRODUCT_PRECISE_FRAG,
     ]
 }

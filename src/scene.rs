@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::camera::Camera;
 use crate::gl::{ProgramChoice, TargetFormat};
+use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::quad::QuadScene;
 
 /// Faithful (the original programs, 8-bit targets, original formulas) or precise
@@ -46,6 +47,8 @@ impl Fidelity {
 pub enum TechniqueScene {
     /// The full-screen quad demo.
     Quad(QuadScene),
+    /// v3o2's 3D opacity (boxed: it is much larger than the other variants).
+    Opacity3d(Box<Opacity3dScene>),
 }
 
 impl TechniqueScene {
@@ -53,6 +56,7 @@ impl TechniqueScene {
     pub fn name(&self) -> &'static str {
         match self {
             TechniqueScene::Quad(_) => "quad",
+            TechniqueScene::Opacity3d(_) => "opacity3d",
         }
     }
 }
@@ -81,6 +85,10 @@ pub struct Scene {
     pub camera: Camera,
     /// The technique and its parameters.
     pub technique: TechniqueScene,
+    /// Folder that relative data paths are read from: the scene file's folder, or the
+    /// current folder for demos and scenes given as text.
+    #[serde(skip)]
+    pub base: std::path::PathBuf,
 }
 
 fn default_size() -> [u32; 2] {
@@ -124,7 +132,14 @@ pub enum SceneError {
 }
 
 /// Built-in demos: name and scene text (files under `scenes/demo/`).
-pub const DEMOS: &[(&str, &str)] = &[("quad", include_str!("../scenes/demo/quad.toml"))];
+pub const DEMOS: &[(&str, &str)] = &[
+    ("quad", include_str!("../scenes/demo/quad.toml")),
+    ("v3o2-sum", include_str!("../scenes/demo/v3o2-sum.toml")),
+    (
+        "v3o2-product",
+        include_str!("../scenes/demo/v3o2-product.toml"),
+    ),
+];
 
 impl Scene {
     /// Parse scene text; `origin` names it in errors.
@@ -151,7 +166,9 @@ impl Scene {
             path: path.display().to_string(),
             source,
         })?;
-        Scene::parse(&text, &path.display().to_string())
+        let mut scene = Scene::parse(&text, &path.display().to_string())?;
+        scene.base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Ok(scene)
     }
 
     /// A built-in demo scene.
@@ -168,6 +185,25 @@ impl Scene {
         toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot serialize: {e}\n"))
     }
 
+    /// A copy whose relative data paths (volumes, table files) are made absolute against
+    /// [`Scene::base`], so it can be saved anywhere.
+    pub fn with_absolute_paths(&self) -> Scene {
+        let mut scene = self.clone();
+        let base = std::path::absolute(&self.base).unwrap_or_else(|_| self.base.clone());
+        if let TechniqueScene::Opacity3d(o) = &mut scene.technique {
+            for attr in o.attributes_mut().into_iter().flatten() {
+                if let Some(p) = attr.volume.path_mut() {
+                    *p = base.join(&*p);
+                }
+                if let Some(f) = &mut attr.table.file {
+                    *f = base.join(&*f);
+                }
+            }
+        }
+        scene.base = base;
+        scene
+    }
+
     /// The target precision in effect.
     pub fn target_format(&self) -> TargetFormat {
         self.target.unwrap_or(self.fidelity.default_target())
@@ -180,6 +216,12 @@ impl Scene {
                 path: origin.into(),
                 message: format!("size {w}x{h}: each side must be 1..=16384"),
             });
+        }
+        if let TechniqueScene::Opacity3d(o) = &self.technique {
+            o.validate().map_err(|message| SceneError::Invalid {
+                path: origin.into(),
+                message: format!("technique.opacity3d: {message}"),
+            })?;
         }
         if self.background.iter().any(|v| !v.is_finite()) {
             return Err(SceneError::Invalid {

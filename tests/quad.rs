@@ -19,7 +19,9 @@ fn quad_scene(programs: ProgramChoice, target: TargetFormat, size: u32) -> Scene
 }
 
 fn params(scene: &Scene) -> QuadScene {
-    let arbvis::scene::TechniqueScene::Quad(p) = &scene.technique;
+    let arbvis::scene::TechniqueScene::Quad(p) = &scene.technique else {
+        panic!("the quad demo is a quad scene")
+    };
     p.clone()
 }
 

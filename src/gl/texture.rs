@@ -18,6 +18,11 @@ pub enum TexelFormat {
     Rgba32f,
     /// 1 x f32.
     R32f,
+    /// 3 x f16, filled from u8 data (normalized k/255, converted by GL): filtering in
+    /// float instead of 8-bit arithmetic, at 6 bytes per texel.
+    Rgb16f,
+    /// 4 x f32, filled from u8 data (normalized k/255, converted by GL).
+    Rgba32fFromU8,
 }
 
 impl TexelFormat {
@@ -28,7 +33,22 @@ impl TexelFormat {
             TexelFormat::Rgba8 => 4,
             TexelFormat::Rgba32f => 16,
             TexelFormat::R32f => 4,
+            TexelFormat::Rgb16f => 6,
+            TexelFormat::Rgba32fFromU8 => 16,
         }
+    }
+
+    /// Bytes per texel of the data handed to GL.
+    pub fn source_bytes(self) -> usize {
+        match self {
+            TexelFormat::Rgb16f => 3,
+            TexelFormat::Rgba32fFromU8 => 4,
+            other => other.bytes(),
+        }
+    }
+
+    fn float_source(self) -> bool {
+        matches!(self, TexelFormat::Rgba32f | TexelFormat::R32f)
     }
 
     fn gl(self) -> (u32, u32, u32) {
@@ -37,6 +57,8 @@ impl TexelFormat {
             TexelFormat::Rgba8 => (glow::RGBA8, glow::RGBA, glow::UNSIGNED_BYTE),
             TexelFormat::Rgba32f => (glow::RGBA32F, glow::RGBA, glow::FLOAT),
             TexelFormat::R32f => (glow::R32F, glow::RED, glow::FLOAT),
+            TexelFormat::Rgb16f => (glow::RGB16F, glow::RGB, glow::UNSIGNED_BYTE),
+            TexelFormat::Rgba32fFromU8 => (glow::RGBA32F, glow::RGBA, glow::UNSIGNED_BYTE),
         }
     }
 
@@ -46,6 +68,8 @@ impl TexelFormat {
             TexelFormat::Rgba8 => "RGBA8",
             TexelFormat::Rgba32f => "RGBA32F",
             TexelFormat::R32f => "R32F",
+            TexelFormat::Rgb16f => "RGB16F",
+            TexelFormat::Rgba32fFromU8 => "RGBA32F",
         }
     }
 }
@@ -116,12 +140,12 @@ impl Texture {
         filter: Filter,
         data: TexelData<'_>,
     ) -> GlResult<Texture> {
-        let expected = extent.texels() * format.bytes();
+        let expected = extent.texels() * format.source_bytes();
         let (given, float_data) = match data {
             TexelData::U8(d) => (d.len(), false),
             TexelData::F32(d) => (d.len() * 4, true),
         };
-        let float_format = matches!(format, TexelFormat::Rgba32f | TexelFormat::R32f);
+        let float_format = format.float_source();
         if given != expected || float_data != float_format {
             return Err(GlError::Invalid(format!(
                 "texture {label}: {extent:?} {} needs {expected} bytes of {} data, got {given} bytes",
@@ -206,14 +230,14 @@ impl Texture {
         gpu.record(
             "texture",
             format!("{label} {extent:?} {}", format.name()),
-            expected as u64,
+            (extent.texels() * format.bytes()) as u64,
         );
         Ok(texture)
     }
 
     /// Replace all texels (same size and format).
     pub fn update(&self, gpu: &Gpu, data: &[u8]) -> GlResult<()> {
-        let expected = self.extent.texels() * self.format.bytes();
+        let expected = self.extent.texels() * self.format.source_bytes();
         if data.len() != expected {
             return Err(GlError::Invalid(format!(
                 "texture update needs {expected} bytes, got {}",

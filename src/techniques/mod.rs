@@ -42,5 +42,12 @@ pub trait Renderer {
 pub fn build(gpu: &Gpu, scene: &Scene, kind: ProgramKind) -> GlResult<Box<dyn Renderer>> {
     Ok(match &scene.technique {
         TechniqueScene::Quad(params) => Box::new(quad::QuadRenderer::new(gpu, kind, params)?),
+        TechniqueScene::Opacity3d(params) => Box::new(opacity3d::Opacity3dRenderer::new(
+            gpu,
+            kind,
+            scene.fidelity,
+            params,
+            &scene.base,
+        )?),
     })
 }

@@ -110,8 +110,13 @@ impl Renderer for QuadRenderer {
     }
 
     fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()> {
-        let TechniqueScene::Quad(params) = technique;
-        self.set_colours(gpu, params)
+        match technique {
+            TechniqueScene::Quad(params) => self.set_colours(gpu, params),
+            other => Err(GlError::Invalid(format!(
+                "quad renderer given a {} scene",
+                other.name()
+            ))),
+        }
     }
 
     fn program_kind(&self) -> ProgramKind {

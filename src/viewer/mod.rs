@@ -2,6 +2,7 @@
 //! side panel over the GL view, an arcball camera, a screenshot button and an FPS
 //! readout. It reuses the offscreen renderers and scene model and adds only interaction.
 
+pub mod lut3d;
 pub mod panel;
 pub mod script;
 
@@ -21,7 +22,7 @@ use crate::camera::Arcball;
 use crate::gl::window::GlWindow;
 use crate::gl::{self, ProgramKind, Surface};
 use crate::png_io;
-use crate::scene::Scene;
+use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::{self, Frame, Renderer};
 use panel::{PanelState, UiAction, PANEL_WIDTH};
 use script::{Action, Script};
@@ -238,6 +239,11 @@ impl Running {
                 }
                 UiAction::Screenshot => screenshot = true,
                 UiAction::SaveScene => self.save_scene(options),
+                UiAction::SetFidelity => {
+                    let kind = self.renderer.program_kind();
+                    self.set_programs(kind);
+                }
+                UiAction::SaveTables => self.save_tables(options),
             }
         }
 
@@ -318,13 +324,41 @@ impl Running {
         };
     }
 
+    fn save_tables(&mut self, options: &ViewerOptions) {
+        self.panel.status = match save_tables(&mut self.scene, &options.screenshot_dir) {
+            Ok(paths) => format!("saved {}", paths.join(", ")),
+            Err(e) => format!("cannot save tables: {e}"),
+        };
+    }
+
     fn save_scene(&mut self, options: &ViewerOptions) {
         let path = options.screenshot_dir.join("arbvis-scene.toml");
-        self.panel.status = match png_io::write_atomic(&path, self.scene.to_toml().as_bytes()) {
+        let scene = self.scene.with_absolute_paths();
+        self.panel.status = match png_io::write_atomic(&path, scene.to_toml().as_bytes()) {
             Ok(()) => format!("saved {}", path.display()),
             Err(e) => format!("cannot save {}: {e}", path.display()),
         };
     }
+}
+
+/// Write each opacity3d table (with its alpha curve applied) as
+/// `arbvis-table-ROLE.table` in `dir`, and point the scene at the files.
+fn save_tables(scene: &mut Scene, dir: &std::path::Path) -> Result<Vec<String>, String> {
+    let base = scene.base.clone();
+    let TechniqueScene::Opacity3d(o) = &mut scene.technique else {
+        return Err("this scene has no colour tables".into());
+    };
+    let mut written = Vec::new();
+    for (role, attr) in lut3d::ROLES.iter().zip(o.attributes_mut()) {
+        let Some(attr) = attr else { continue };
+        let table = attr.table.build(&base)?;
+        let path = dir.join(format!("arbvis-table-{role}.table"));
+        table.save(&path)?;
+        attr.table.file = Some(std::fs::canonicalize(&path).unwrap_or(path.clone()));
+        attr.table.alpha.clear();
+        written.push(path.display().to_string());
+    }
+    Ok(written)
 }
 
 /// What the script does this frame.

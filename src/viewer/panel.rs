@@ -24,6 +24,10 @@ pub enum UiAction {
     Screenshot,
     /// Save the scene as TOML.
     SaveScene,
+    /// Fidelity changed (rebuilds the renderer).
+    SetFidelity,
+    /// Write the colour tables as table files.
+    SaveTables,
 }
 
 /// Pointer input on the GL view, in points.
@@ -52,6 +56,8 @@ pub struct PanelState {
     pub kind: Option<ProgramKind>,
     /// Where each labelled widget was drawn last frame (points).
     pub widgets: HashMap<String, Rect>,
+    /// The lut 3D editor's lock check boxes.
+    pub locks: [bool; 3],
 }
 
 /// Output of one UI pass.
@@ -98,9 +104,11 @@ pub fn show(
             });
             ui.separator();
 
-            if technique_editor(ui, &mut scene.technique, &mut state.widgets) {
-                actions.push(UiAction::ParamsChanged);
-            }
+            egui::ScrollArea::vertical()
+                .max_height(ui.available_height() * 0.6)
+                .show(ui, |ui| {
+                    actions.extend(technique_editor(ui, scene, state));
+                });
             ui.separator();
 
             camera_editor(ui, &mut scene.camera, &mut state.widgets);
@@ -148,13 +156,23 @@ pub fn show(
     }
 }
 
-fn technique_editor(
-    ui: &mut egui::Ui,
-    technique: &mut TechniqueScene,
-    widgets: &mut HashMap<String, Rect>,
-) -> bool {
+fn technique_editor(ui: &mut egui::Ui, scene: &mut Scene, state: &mut PanelState) -> Vec<UiAction> {
     let mut changed = false;
-    match technique {
+    let widgets = &mut state.widgets;
+    match &mut scene.technique {
+        TechniqueScene::Opacity3d(o) => {
+            let edit = super::lut3d::editor(ui, o, &mut scene.fidelity, &mut state.locks, widgets);
+            let mut actions = Vec::new();
+            if edit.fidelity {
+                actions.push(UiAction::SetFidelity);
+            } else if edit.params {
+                actions.push(UiAction::ParamsChanged);
+            }
+            if edit.save_tables {
+                actions.push(UiAction::SaveTables);
+            }
+            return actions;
+        }
         TechniqueScene::Quad(q) => {
             ui.label("Quad colours");
             for (label, colour) in [("Left", &mut q.left), ("Right", &mut q.right)] {
@@ -171,7 +189,11 @@ fn technique_editor(
             }
         }
     }
-    changed
+    if changed {
+        vec![UiAction::ParamsChanged]
+    } else {
+        Vec::new()
+    }
 }
 
 fn camera_editor(ui: &mut egui::Ui, camera: &mut Camera, widgets: &mut HashMap<String, Rect>) {

@@ -114,7 +114,11 @@ pub fn derive(amplitude: &Volume, attribute: Attribute) -> Volume {
                     }
                 }
             };
-            *d = if src[i].is_finite() { v as f32 } else { f32::NAN };
+            *d = if src[i].is_finite() {
+                v as f32
+            } else {
+                f32::NAN
+            };
         }
     }
     out

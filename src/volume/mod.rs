@@ -274,6 +274,15 @@ impl VolumeSource {
         }
     }
 
+    /// The file it names, if any, for rewriting.
+    pub fn path_mut(&mut self) -> Option<&mut PathBuf> {
+        match self {
+            VolumeSource::Segy(p) | VolumeSource::Nifti(p) => Some(p),
+            VolumeSource::Raw(spec) => Some(&mut spec.path),
+            VolumeSource::Synthetic(_) => None,
+        }
+    }
+
     /// The file it names, if any.
     pub fn path(&self) -> Option<&Path> {
         match self {
@@ -298,7 +307,12 @@ pub fn inspect(path: &Path) -> Result<String, VolumeError> {
         ))
     } else {
         let s = segy::read(path)?;
-        Ok(format!("{}\n{}{}", path.display(), s.describe(), describe(&s.volume)))
+        Ok(format!(
+            "{}\n{}{}",
+            path.display(),
+            s.describe(),
+            describe(&s.volume)
+        ))
     }
 }
 

@@ -39,7 +39,11 @@ pub fn read(path: &Path) -> Result<Volume, VolumeError> {
     let volume = object.into_volume();
     let dim = volume.dim().to_vec();
     if dim.len() < 3 && dim.iter().product::<u16>() == 0 {
-        return Err(VolumeError::format(path, 40, format!("dim {dim:?}: no voxels")));
+        return Err(VolumeError::format(
+            path,
+            40,
+            format!("dim {dim:?}: no voxels"),
+        ));
     }
     let dims = [
         dim.first().copied().unwrap_or(1) as usize,

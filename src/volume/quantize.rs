@@ -65,9 +65,7 @@ pub fn range(volume: &Volume, how: Quantization) -> Result<(f64, f64), String> {
             }
         }
         Quantization::Percentile([p_low, p_high]) => {
-            if !(0.0..=100.0).contains(&p_low)
-                || !(0.0..=100.0).contains(&p_high)
-                || p_low > p_high
+            if !(0.0..=100.0).contains(&p_low) || !(0.0..=100.0).contains(&p_high) || p_low > p_high
             {
                 return Err(format!(
                     "percentiles [{p_low}, {p_high}] must be ordered within 0..100"

@@ -511,7 +511,10 @@ pub fn write(volume: &Volume, o: &WriteOptions) -> Vec<u8> {
             put16(&mut h, 116, o.interval_us);
             out.extend_from_slice(&h);
             for i in 0..ns {
-                out.extend(o.format.encode(volume.values[volume.index(i, j, k)], o.big_endian));
+                out.extend(
+                    o.format
+                        .encode(volume.values[volume.index(i, j, k)], o.big_endian),
+                );
             }
         }
     }
@@ -563,7 +566,10 @@ mod tests {
                         src.values.iter_mut().for_each(|x| *x += 20.0);
                     }
                     let cube = parse(Path::new("mem.sgy"), &write(&src, &o)).unwrap();
-                    assert_eq!(cube.volume, src, "format {code} big {big_endian} rev {revision}");
+                    assert_eq!(
+                        cube.volume, src,
+                        "format {code} big {big_endian} rev {revision}"
+                    );
                     assert_eq!(cube.big_endian, big_endian);
                     assert_eq!(cube.format, format);
                     assert_eq!(cube.inlines, vec![100, 101, 102, 103]);
@@ -610,7 +616,9 @@ mod tests {
         // Trace 2 claims trace 1's position: a second offset at one CDP.
         let mut prestack = bytes.clone();
         prestack[3600 + trace + 192..3600 + trace + 196].copy_from_slice(&1i32.to_be_bytes());
-        let e = parse(Path::new("p.sgy"), &prestack).unwrap_err().to_string();
+        let e = parse(Path::new("p.sgy"), &prestack)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("pre-stack") && e.contains("p.sgy"), "{e}");
         // Drop the last trace: 11 traces cannot fill 4 x 3.
         let e = parse(Path::new("i.sgy"), &bytes[..bytes.len() - trace])

@@ -144,7 +144,10 @@ mod tests {
         assert_eq!(a, amplitude(&spec).unwrap());
         let s = a.stats();
         // Zero-mean wavelet: the mean is small next to the peaks; both signs occur.
-        assert!(s.min < -0.2 && s.max > 0.2 && s.mean.abs() < 0.1 * s.max, "{s:?}");
+        assert!(
+            s.min < -0.2 && s.max > 0.2 && s.mean.abs() < 0.1 * s.max,
+            "{s:?}"
+        );
         let other = amplitude(&SyntheticSpec { seed: 2, ..spec }).unwrap();
         assert_ne!(a, other);
     }

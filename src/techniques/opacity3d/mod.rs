@@ -1,9 +1,172 @@
-//! v3o2's 3D opacity (seed `000_7bcb64b2a3c67198.txt`): three attribute volumes packed in
-//! one RGB 3D texture (G primary, B secondary, R tertiary) on unit 0, colour tables on
-//! units 2/3/4, twelve coefficients in `program.local[1..3]`, combined by the verbatim
-//! sum or product `!!ARBfp1.0` program, drawn as view-aligned slices back to front.
+//! v3o2's 3D opacity (seed `000_7bcb64b2a3c67198.txt`): up to three attribute volumes of
+//! one block, each quantized to 0..255 and packed in one RGB 3D texture on unit 0
+//! (G primary, B secondary, R tertiary), a 256-entry colour table per attribute on units
+//! 2/3/4, twelve coefficients in `program.local[1..3]`, combined by the verbatim sum
+//! (eq. 1, a union) or product (eqs. 2-3, an intersection) `!!ARBfp1.0` program, drawn as
+//! view-aligned slices back to front with "over" blending.
 //!
-//! Built so far: [`slicing`], the CPU geometry of the view-aligned slices. The renderer,
-//! data loaders, CPU reference and editor are the rest of the technique's issue.
+//! # How it works
+//! 1. [`prepare`] (CPU, no GL): load each attribute's volume (SEG-Y, NIfTI, raw,
+//!    synthetic), derive the attribute (envelope, phase, ...), quantize, pack RGB, build
+//!    the tables.
+//! 2. [`renderer`] uploads them, picks the program (faithful: the verbatim text; precise:
+//!    `*_precise`), and each frame cuts the box into slices ([`slicing`]) perpendicular to
+//!    the view direction and draws them far to near.
+//! 3. [`reference`] computes the same image on the CPU: the exact emission-absorption
+//!    integral in f64 (what precise mode aims at) and an emulation of the faithful 8-bit
+//!    pipeline (what v3o2 showed).
+//!
+//! # Decisions the seed leaves open (DESIGN §3)
+//! - Blending: `SRC_ALPHA, ONE_MINUS_SRC_ALPHA`, back to front (the usual choice for
+//!   non-premultiplied slice colours); the target's alpha is therefore not coverage.
+//! - Filtering: the volume is LINEAR (interpolate quantized values, then look up: post-
+//!   classification); tables are LINEAR by default, so the original addressing
+//!   `coord = k/255` into 256 texels blends neighbouring entries (`table_filter`).
+//! - Missing attributes (1D / 2D opacity): R (and B) are 0, as Silva did; no table is
+//!   built for them. Their coefficients are forced to 0 in a sum (no contribution) and, in
+//!   a product, a 1x1 white table is bound with coefficients 1 (neutral).
+//! - Precise mode: texel-centre lookup, exact 1/3 and a clamp to [0, 1], and opacity
+//!   correction `a' = 1 - (1 - a)^(spacing / reference)`, the reference spacing being one
+//!   voxel along the longest axis. Correction uses the spacing along the view axis:
+//!   exact for orthographic views, off by `1/cos` of the angle to the axis in perspective.
+//!
+//! # Extremes (DESIGN §4), each with a test
+//! Coefficients 0, 1 and above 1 (faithful: the 8-bit target clamps; precise: clamped in
+//! the program); tables with alpha 0 / 1; one slice and thousands; a 1-voxel volume and a
+//! 1 x N volume; constant attributes (all quantize to 0); NaN samples (quantize to 0);
+//! volumes of different grids (an error naming both).
 
+pub mod prepare;
+pub mod reference;
+pub mod renderer;
 pub mod slicing;
+
+use serde::{Deserialize, Serialize};
+
+use crate::colortable::TableSpec;
+use crate::gl::Filter;
+use crate::volume::attributes::Attribute;
+use crate::volume::quantize::Quantization;
+use crate::volume::VolumeSource;
+
+pub use renderer::Opacity3dRenderer;
+
+/// Sum (eq. 1) or product (eqs. 2-3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Combine {
+    /// `C = (C1 R1 + C2 R2 + C3 R3) * 0.3333`: the union of the regions of interest.
+    #[default]
+    Sum,
+    /// `C = C1 R1 * C2 R2 * C3 R3`: their intersection.
+    Product,
+}
+
+/// One attribute: where its volume comes from, which attribute of it, how it is
+/// quantized, its table and its four coefficients.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AttributeScene {
+    /// The volume.
+    pub volume: VolumeSource,
+    /// Derived attribute of that volume (amplitude = the samples themselves).
+    #[serde(default)]
+    pub attribute: Attribute,
+    /// Quantization range.
+    #[serde(default)]
+    pub quantize: Quantization,
+    /// Colour table.
+    #[serde(default)]
+    pub table: TableSpec,
+    /// `[Cr, Cg, Cb, Ca]`, nominally in [0, 1].
+    #[serde(default = "unit_coefficients")]
+    pub coefficients: [f64; 4],
+}
+
+fn unit_coefficients() -> [f64; 4] {
+    [1.0; 4]
+}
+
+/// `[technique.opacity3d]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Opacity3dScene {
+    /// Sum or product.
+    #[serde(default)]
+    pub combine: Combine,
+    /// Number of view-aligned slices.
+    #[serde(default = "default_slices")]
+    pub slices: usize,
+    /// Filtering of the packed volume.
+    #[serde(default = "linear")]
+    pub volume_filter: Filter,
+    /// Filtering of the colour tables.
+    #[serde(default = "linear")]
+    pub table_filter: Filter,
+    /// Opacity correction; by default on when precise, off when faithful (which has none).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub opacity_correction: Option<bool>,
+    /// The primary attribute (G, table on unit 2).
+    pub primary: AttributeScene,
+    /// The secondary attribute (B, unit 3); absent for 1D opacity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub secondary: Option<AttributeScene>,
+    /// The tertiary attribute (R, unit 4); absent for 1D and 2D opacity.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tertiary: Option<AttributeScene>,
+}
+
+fn default_slices() -> usize {
+    256
+}
+
+fn linear() -> Filter {
+    Filter::Linear
+}
+
+/// Largest slice count accepted (a 16k-slice stack is already far past any use).
+pub const MAX_SLICES: usize = 16384;
+
+impl Opacity3dScene {
+    /// The attributes in texture order: primary, secondary, tertiary.
+    pub fn attributes(&self) -> [Option<&AttributeScene>; 3] {
+        [
+            Some(&self.primary),
+            self.secondary.as_ref(),
+            self.tertiary.as_ref(),
+        ]
+    }
+
+    /// Mutable [`Opacity3dScene::attributes`].
+    pub fn attributes_mut(&mut self) -> [Option<&mut AttributeScene>; 3] {
+        [
+            Some(&mut self.primary),
+            self.secondary.as_mut(),
+            self.tertiary.as_mut(),
+        ]
+    }
+
+    /// Check values that parse but cannot render.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(1..=MAX_SLICES).contains(&self.slices) {
+            return Err(format!(
+                "slices = {}: must be 1..={MAX_SLICES}",
+                self.slices
+            ));
+        }
+        for (name, a) in ["primary", "secondary", "tertiary"]
+            .iter()
+            .zip(self.attributes())
+        {
+            if let Some(a) = a {
+                if a.coefficients.iter().any(|c| !c.is_finite() || *c < 0.0) {
+                    return Err(format!(
+                        "{name}.coefficients {:?}: must be finite and not negative",
+                        a.coefficients
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,170 @@
+//! CPU preparation of the 3D-opacity data (no GL): load each attribute's volume once per
+//! distinct source, derive the attribute, quantize it, pack the three bytes of each voxel
+//! as RGB (R tertiary, G primary, B secondary), and build the colour tables.
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::{AttributeScene, Opacity3dScene};
+use crate::colortable::ColorTable;
+use crate::volume::attributes::derive;
+use crate::volume::quantize::{quantize, Quantization};
+use crate::volume::{Volume, VolumeSource};
+
+/// Everything the renderer uploads, and the CPU references read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Prepared {
+    /// Grid size (i, j, k).
+    pub dims: [usize; 3],
+    /// Half-extents of the box (longest side spans [-1, 1]).
+    pub half: DVec3,
+    /// RGB per voxel, i fastest: R tertiary, G primary, B secondary (0 when absent).
+    pub packed: Vec<u8>,
+    /// Tables of primary, secondary, tertiary (None when the attribute is absent).
+    pub tables: [Option<ColorTable>; 3],
+    /// Value range each attribute was quantized over.
+    pub ranges: [Option<(f64, f64)>; 3],
+}
+
+/// Byte of attribute `a` (0 primary, 1 secondary, 2 tertiary) in a packed RGB texel.
+pub const CHANNEL: [usize; 3] = [1, 2, 0];
+
+impl Prepared {
+    /// Quantized value of attribute `a` at voxel index `v`.
+    pub fn byte(&self, v: usize, a: usize) -> u8 {
+        self.packed[v * 3 + CHANNEL[a]]
+    }
+
+    /// Number of attributes present.
+    pub fn count(&self) -> usize {
+        self.tables.iter().filter(|t| t.is_some()).count()
+    }
+
+    /// Object-space spacing that table alphas are defined for (precise mode's opacity
+    /// correction): one voxel along the longest axis.
+    pub fn reference_spacing(&self) -> f64 {
+        let longest = (0..3)
+            .max_by(|&a, &b| self.half[a].total_cmp(&self.half[b]))
+            .unwrap_or(0);
+        2.0 * self.half[longest] / self.dims[longest] as f64
+    }
+}
+
+/// Pack quantized attributes (all of one length) into RGB.
+pub fn pack(quantized: [Option<&[u8]>; 3], voxels: usize) -> Vec<u8> {
+    let mut packed = vec![0u8; voxels * 3];
+    for (a, q) in quantized.iter().enumerate() {
+        if let Some(q) = q {
+            for (v, &b) in q.iter().enumerate() {
+                packed[v * 3 + CHANNEL[a]] = b;
+            }
+        }
+    }
+    packed
+}
+
+/// Prepare from volumes already in memory: each present attribute's volume, its
+/// quantization and its table. All volumes must share one grid.
+pub fn from_volumes(
+    attributes: [Option<(&Volume, Quantization, ColorTable)>; 3],
+) -> Result<Prepared, String> {
+    let first = attributes[0]
+        .as_ref()
+        .ok_or("the primary attribute is required")?
+        .0;
+    let names = ["primary", "secondary", "tertiary"];
+    let mut quantized: [Option<Vec<u8>>; 3] = Default::default();
+    let mut ranges = [None; 3];
+    let mut tables: [Option<ColorTable>; 3] = Default::default();
+    for (a, attr) in attributes.into_iter().enumerate() {
+        let Some((volume, how, table)) = attr else {
+            continue;
+        };
+        if volume.dims != first.dims {
+            return Err(format!(
+                "the {} volume is {:?} but the primary is {:?}: all attributes must share one grid",
+                names[a], volume.dims, first.dims
+            ));
+        }
+        let q = quantize(volume, how).map_err(|e| format!("{}: {e}", names[a]))?;
+        ranges[a] = Some((q.low, q.high));
+        quantized[a] = Some(q.bytes);
+        tables[a] = Some(table);
+    }
+    let packed = pack([0, 1, 2].map(|a| quantized[a].as_deref()), first.len());
+    Ok(Prepared {
+        dims: first.dims,
+        half: DVec3::from_array(first.half_extent()),
+        packed,
+        tables,
+        ranges,
+    })
+}
+
+/// Prepare a scene: load each distinct source once, derive, quantize, pack, build tables.
+pub fn prepare(scene: &Opacity3dScene, base: &Path) -> Result<Prepared, String> {
+    let mut loaded: Vec<(VolumeSource, Volume)> = Vec::new();
+    let mut derived: [Option<Volume>; 3] = Default::default();
+    let mut tables: [Option<ColorTable>; 3] = Default::default();
+    let names = ["primary", "secondary", "tertiary"];
+    for (a, attr) in scene.attributes().into_iter().enumerate() {
+        let Some(AttributeScene {
+            volume,
+            attribute,
+            table,
+            ..
+        }) = attr
+        else {
+            continue;
+        };
+        let index = match loaded.iter().position(|(s, _)| s == volume) {
+            Some(i) => i,
+            None => {
+                let v = volume.load(base).map_err(|e| e.to_string())?;
+                loaded.push((volume.clone(), v));
+                loaded.len() - 1
+            }
+        };
+        derived[a] = Some(derive(&loaded[index].1, *attribute));
+        tables[a] = Some(
+            table
+                .build(base)
+                .map_err(|e| format!("{} table: {e}", names[a]))?,
+        );
+    }
+    let attrs = scene.attributes();
+    let inputs: [Option<(&Volume, Quantization, ColorTable)>; 3] =
+        std::array::from_fn(|a| match (&derived[a], &tables[a], attrs[a]) {
+            (Some(v), Some(t), Some(s)) => Some((v, s.quantize, t.clone())),
+            _ => None,
+        });
+    from_volumes(inputs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn packs_g_primary_b_secondary_r_tertiary() {
+        let p = pack([Some(&[10, 11]), Some(&[20, 21]), Some(&[30, 31])], 2);
+        assert_eq!(p, vec![30, 10, 20, 31, 11, 21]);
+        let two = pack([Some(&[10]), Some(&[20]), None], 1);
+        assert_eq!(two, vec![0, 10, 20], "2D opacity leaves R at 0");
+    }
+
+    #[test]
+    fn grids_must_match() {
+        let a = Volume::new([2, 2, 2], [1.0; 3], vec![0.0; 8]).unwrap();
+        let b = Volume::new([2, 2, 1], [1.0; 3], vec![0.0; 4]).unwrap();
+        let grey = ColorTable::builtin("grey").unwrap();
+        let e = from_volumes([
+            Some((&a, Quantization::MinMax, grey.clone())),
+            Some((&b, Quantization::MinMax, grey)),
+            None,
+        ])
+        .unwrap_err();
+        assert!(e.contains("secondary") && e.contains("one grid"), "{e}");
+    }
+}
