@@ -46,6 +46,12 @@ enum Command {
         #[arg(long)]
         stats: bool,
     },
+    /// Print what the loaders see in a volume file (SEG-Y, NIfTI): format, dimensions,
+    /// inline/crossline/sample ranges, sample type, byte order, value statistics.
+    Inspect {
+        /// A `.sgy`/`.segy` or `.nii`/`.nii.gz` file.
+        file: PathBuf,
+    },
     /// Open the desktop viewer (winit + glutin + egui).
     #[cfg(feature = "viewer")]
     View {
@@ -159,6 +165,9 @@ fn run(cli: Cli) -> Result<()> {
                     rendered.draw_time.as_secs_f64() * 1e3
                 );
             }
+        }
+        Command::Inspect { file } => {
+            print!("{}", arbvis::volume::inspect(&file)?);
         }
         #[cfg(feature = "viewer")]
         Command::View {

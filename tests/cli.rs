@@ -5,19 +5,15 @@ use std::path::PathBuf;
 use std::process::{Command, Output};
 
 use arbvis::png_io::read_png;
+use common::temp_dir;
+
+mod common;
 
 fn arbvis(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_arbvis"))
         .args(args)
         .output()
         .unwrap()
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("arbvis-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 fn text(out: &Output) -> (String, String) {

@@ -13,15 +13,7 @@ use arbvis::scene::{Fidelity, Scene, TechniqueScene};
 use arbvis::techniques::opacity3d::prepare::prepare;
 use arbvis::techniques::opacity3d::reference::{emulate_faithful, reference};
 use arbvis::techniques::opacity3d::Opacity3dScene;
-use common::{headless, LEVEL};
-
-/// A folder of crafted raw volumes for one test (removed at the start of each run).
-fn fixture_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("arbvis-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+use common::{headless, temp_dir, LEVEL};
 
 /// Write `n³` u8 samples from `f(i, j, k)` as a raw file.
 fn write_raw(dir: &Path, file: &str, n: usize, f: impl Fn(usize, usize, usize) -> u8) {
@@ -93,7 +85,7 @@ fn background(scene: &Scene) -> [f64; 4] {
 /// Three overlapping gradient volumes: primary ramps along i, secondary along j,
 /// tertiary is a ball.
 fn gradient_fixture(name: &str, n: usize) -> PathBuf {
-    let dir = fixture_dir(name);
+    let dir = temp_dir(name);
     let scale = 255.0 / (n - 1) as f64;
     write_raw(&dir, "a.raw", n, |i, _, _| (i as f64 * scale).round() as u8);
     write_raw(&dir, "b.raw", n, |_, j, _| (j as f64 * scale).round() as u8);

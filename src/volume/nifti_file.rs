@@ -6,13 +6,27 @@ use std::path::Path;
 
 use nifti::{NiftiError, NiftiObject, NiftiType, NiftiVolume, ReaderOptions};
 
-use super::{Volume, VolumeError};
+use super::{SampleType, Volume, VolumeError};
 
 /// NIfTI-1's header size; voxel data begins at `vox_offset` (usually 352).
 const HEADER_BYTES: u64 = 348;
 
 fn error(path: &Path, e: NiftiError, vox_offset: u64) -> VolumeError {
     match e {
+        NiftiError::Io(source)
+            if source.kind() == std::io::ErrorKind::UnexpectedEof
+                || source.to_string().contains("deflate") =>
+        {
+            let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+            VolumeError::format(
+                path,
+                size,
+                format!(
+                    "the file ends early ({}): it is truncated; a NIfTI-1 file holds a 348-byte header, then dim x datatype bytes of voxels",
+                    source.kind()
+                ),
+            )
+        }
         NiftiError::Io(source) => VolumeError::Io {
             path: path.into(),
             source,
@@ -51,27 +65,38 @@ pub fn read(path: &Path) -> Result<Volume, VolumeError> {
         dim.get(2).copied().unwrap_or(1) as usize,
     ];
     let count = dims[0] * dims[1] * dims[2];
-    let datatype = volume.data_type();
-    let supported = matches!(
-        datatype,
-        NiftiType::Uint8
-            | NiftiType::Int8
-            | NiftiType::Int16
-            | NiftiType::Uint16
-            | NiftiType::Int32
-            | NiftiType::Uint32
-            | NiftiType::Float32
-            | NiftiType::Float64
-    );
-    if !supported {
-        return Err(VolumeError::Unsupported {
-            path: path.into(),
-            message: format!("datatype {datatype:?} (header byte 70) is not a scalar arbvis reads"),
-        });
-    }
+    let sample = match volume.data_type() {
+        NiftiType::Uint8 => SampleType::U8,
+        NiftiType::Int8 => SampleType::I8,
+        NiftiType::Int16 => SampleType::I16,
+        NiftiType::Uint16 => SampleType::U16,
+        NiftiType::Int32 => SampleType::I32,
+        NiftiType::Uint32 => SampleType::U32,
+        NiftiType::Float32 => SampleType::F32,
+        NiftiType::Float64 => SampleType::F64,
+        other => {
+            return Err(VolumeError::Unsupported {
+                path: path.into(),
+                message: format!(
+                    "datatype {other:?} (header bytes 70-71) is not a scalar type arbvis reads"
+                ),
+            })
+        }
+    };
+    let big = header.endianness == nifti::Endianness::Big;
     let raw: Vec<f32> = volume
-        .into_nifti_typed_data::<f32>()
-        .map_err(|e| error(path, e, vox_offset))?;
+        .raw_data()
+        .chunks_exact(sample.bytes())
+        .take(count)
+        .map(|b| sample.decode(b, big))
+        .collect();
+    if raw.len() < count {
+        return Err(VolumeError::format(
+            path,
+            vox_offset + (raw.len() * sample.bytes()) as u64,
+            format!("{} voxels of data where dim promises {count}", raw.len()),
+        ));
+    }
     let (slope, inter) = (header.scl_slope, header.scl_inter);
     let scale = slope != 0.0 && slope.is_finite() && !(slope == 1.0 && inter == 0.0);
     let values: Vec<f32> = raw

@@ -246,7 +246,7 @@ impl SegyCube {
         };
         let ns = self.volume.dims[0];
         format!(
-            "format: SEG-Y rev {}.{}, textual header {}\nsample type: {}\nendianness: {}\ntraces: {}\ninlines: {}\ncrosslines: {}\nsamples: {} per trace, interval {} us, 0..={} ms\n",
+            "format: SEG-Y rev {}.{} (bytes 3501-3502), textual header {}\nsample type: {}\nendianness: {}\ntraces: {}\ninlines: {}\ncrosslines: {}\nsamples: {} per trace, interval {} us, 0..={} ms\n",
             self.revision.0,
             self.revision.1,
             if self.ebcdic { "EBCDIC" } else { "ASCII" },

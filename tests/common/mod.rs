@@ -110,3 +110,32 @@ pub fn assert_snapshot(name: &str, image: &Image, tolerance: f32) {
     let _ = std::fs::remove_file(&new);
     let _ = std::fs::remove_file(&diff);
 }
+
+/// A file under `../shared/data/` (the project's real test data), or `None` with a note
+/// when this clone has no `../shared` (a user's clone). `ARBVIS_NO_SKIP=1` (set by
+/// `.ci/run`, which always has the data) turns the skip into a failure.
+pub fn shared_data(relative: &str) -> Option<std::path::PathBuf> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data")
+        .join(relative);
+    if path.exists() {
+        return Some(path);
+    }
+    let reason = format!(
+        "{} is missing (no ../shared/data in this clone)",
+        path.display()
+    );
+    if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
+        panic!("ARBVIS_NO_SKIP=1 but {reason}");
+    }
+    eprintln!("SKIPPED: {reason}");
+    None
+}
+
+/// A fresh, empty folder for one test's files (emptied at the start of each run).
+pub fn temp_dir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("arbvis-test-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}

@@ -106,6 +106,10 @@ pub struct Opacity3dScene {
     /// Opacity correction; by default on when precise, off when faithful (which has none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub opacity_correction: Option<bool>,
+    /// Voxel size along i, j, k, overriding the files' (SEG-Y has no common unit for
+    /// time and distance: this sets the box's aspect).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spacing: Option<[f64; 3]>,
     /// The primary attribute (G, table on unit 2).
     pub primary: AttributeScene,
     /// The secondary attribute (B, unit 3); absent for 1D opacity.
@@ -153,6 +157,11 @@ impl Opacity3dScene {
                 "slices = {}: must be 1..={MAX_SLICES}",
                 self.slices
             ));
+        }
+        if let Some(s) = self.spacing {
+            if s.iter().any(|v| !v.is_finite() || *v <= 0.0) {
+                return Err(format!("spacing {s:?}: must be positive"));
+            }
         }
         for (name, a) in ["primary", "secondary", "tertiary"]
             .iter()

@@ -126,7 +126,11 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path) -> Result<Prepared, String> 
                 loaded.len() - 1
             }
         };
-        derived[a] = Some(derive(&loaded[index].1, *attribute));
+        let mut volume = derive(&loaded[index].1, *attribute);
+        if let Some(spacing) = scene.spacing {
+            volume.spacing = spacing;
+        }
+        derived[a] = Some(volume);
         tables[a] = Some(
             table
                 .build(base)

@@ -1,0 +1,261 @@
+//! Loaders on real files from `../shared/data/` (skipped with a note where this clone has
+//! none, failures under `ARBVIS_NO_SKIP=1`), and bad input: a truncated SEG-Y, truncated
+//! NIfTI files and raw files of the wrong size, each ending in an error that names the
+//! file and position, and no output file.
+
+mod common;
+
+use std::io::{Read, Write};
+use std::path::Path;
+use std::process::Command;
+
+use arbvis::gl::{Backend, ProgramChoice, TargetFormat};
+use arbvis::render::render_on;
+use arbvis::scene::Scene;
+use arbvis::volume::raw::RawSpec;
+use arbvis::volume::{nifti_file, raw, segy, Endian, SampleType, VolumeError};
+use common::{headless, shared_data, temp_dir, LEVEL};
+
+#[test]
+fn f3_grids_from_its_trace_headers() {
+    let Some(path) = shared_data("seismic/f3.sgy") else {
+        return;
+    };
+    let cube = segy::read(&path).unwrap();
+    // The README of ../shared/data: 23 inlines x 18 crosslines x 75 samples, format 3.
+    assert_eq!(cube.volume.dims, [75, 18, 23]);
+    assert_eq!(cube.format, segy::SampleFormat::Int16);
+    assert!(cube.big_endian);
+    assert_eq!((cube.inlines[0], cube.inlines[22]), (111, 133));
+    assert_eq!((cube.crosslines[0], cube.crosslines[17]), (875, 892));
+    assert_eq!(cube.interval_us, 4000);
+    let s = cube.volume.stats();
+    assert_eq!((s.min, s.max), (-10239.0, 10827.0));
+    // The same crop re-encoded as IBM float decodes to the same numbers.
+    let Some(ibm) = shared_data("seismic/Format1msb.sgy") else {
+        return;
+    };
+    let ibm = segy::read(&ibm).unwrap();
+    assert_eq!(ibm.format, segy::SampleFormat::IbmFloat);
+    assert_eq!(ibm.volume, cube.volume);
+}
+
+#[test]
+fn small_and_tiny_ibm_files() {
+    for (file, dims) in [
+        ("seismic/small.sgy", [50, 5, 5]),
+        ("seismic/tiny.sgy", [4, 2, 3]),
+    ] {
+        let Some(path) = shared_data(file) else {
+            return;
+        };
+        let cube = segy::read(&path).unwrap();
+        assert_eq!(cube.volume.dims, dims, "{file}");
+        // segyio's synthetic files hold inline.crossline0sample-like values: 1.2 at the
+        // first sample of inline 1, crossline 20.
+        assert!((cube.volume.values[0] - 1.2).abs() < 1e-6, "{file}");
+    }
+}
+
+#[test]
+fn broken_segy_is_a_clear_error() {
+    let Some(path) = shared_data("seismic/broken.sgy") else {
+        return;
+    };
+    let e = segy::read(&path).unwrap_err().to_string();
+    assert!(
+        e.contains("broken.sgy") && e.contains("at byte 10836"),
+        "{e}"
+    );
+    assert!(e.contains("truncated") && e.contains("trace 4"), "{e}");
+    // And through the CLI: an error naming the file, no PNG.
+    let dir = temp_dir("broken-segy");
+    let scene = dir.join("s.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "[technique.opacity3d.primary]\nvolume = {{ segy = {:?} }}\n",
+            path.display().to_string()
+        ),
+    )
+    .unwrap();
+    let png = dir.join("out.png");
+    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("broken.sgy") && stderr.contains("truncated"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        1,
+        "only the scene file remains"
+    );
+}
+
+fn gunzip(path: &Path) -> Vec<u8> {
+    let mut out = Vec::new();
+    flate2::read::GzDecoder::new(std::fs::File::open(path).unwrap())
+        .read_to_end(&mut out)
+        .unwrap();
+    out
+}
+
+#[test]
+fn icbm152_volumes_share_one_grid() {
+    for name in ["t1", "gm", "wm"] {
+        let file = format!("volumes/mni_icbm152_{name}_tal_nlin_sym_09a_converted.nii.gz");
+        let Some(path) = shared_data(&file) else {
+            return;
+        };
+        let v = nifti_file::read(&path).unwrap();
+        assert_eq!(v.dims, [197, 233, 189], "{name}");
+        assert_eq!(v.spacing, [1.0; 3]);
+        let s = v.stats();
+        assert!(
+            s.min >= 0.0 && s.max <= 255.0 && s.max > 100.0,
+            "{name}: {s:?}"
+        );
+    }
+}
+
+#[test]
+fn truncated_nifti_is_a_clear_error() {
+    let Some(path) = shared_data("volumes/mni_icbm152_gm_tal_nlin_sym_09a_converted.nii.gz") else {
+        return;
+    };
+    let dir = temp_dir("truncated-nifti");
+    let bytes = gunzip(&path);
+    // Uncompressed, cut in the middle of the voxel data.
+    let cut = dir.join("cut.nii");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let e = nifti_file::read(&cut).unwrap_err();
+    let msg = e.to_string();
+    assert!(matches!(e, VolumeError::Format { .. }), "{msg}");
+    assert!(
+        msg.contains("cut.nii") && msg.contains("truncated"),
+        "{msg}"
+    );
+    assert!(
+        msg.contains(&format!("at byte {}", bytes.len() / 2)),
+        "{msg}"
+    );
+    // Compressed, the gzip stream cut short.
+    let gz = dir.join("cut.nii.gz");
+    let mut enc = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::fast());
+    enc.write_all(&bytes).unwrap();
+    let packed = enc.finish().unwrap();
+    std::fs::write(&gz, &packed[..packed.len() / 2]).unwrap();
+    let msg = nifti_file::read(&gz).unwrap_err().to_string();
+    assert!(
+        msg.contains("cut.nii.gz") && msg.contains("truncated"),
+        "{msg}"
+    );
+    // A header cut short.
+    let header = dir.join("header.nii");
+    std::fs::write(&header, &bytes[..100]).unwrap();
+    let msg = nifti_file::read(&header).unwrap_err().to_string();
+    assert!(
+        msg.contains("header.nii") && msg.contains("truncated"),
+        "{msg}"
+    );
+}
+
+#[test]
+fn raw_size_mismatch_is_a_clear_error() {
+    let dir = temp_dir("raw-mismatch");
+    std::fs::write(dir.join("v.raw"), vec![0u8; 1000]).unwrap();
+    let spec = RawSpec {
+        path: "v.raw".into(),
+        dims: [10, 10, 6],
+        sample: SampleType::U16,
+        endian: Endian::Big,
+        offset: 0,
+        spacing: [1.0; 3],
+    };
+    let msg = raw::read(&dir, &spec).unwrap_err().to_string();
+    assert!(
+        msg.contains("v.raw") && msg.contains("1000 bytes") && msg.contains("need 1200"),
+        "{msg}"
+    );
+    let spec = RawSpec {
+        dims: [10, 10, 10],
+        ..spec
+    };
+    let msg = raw::read(&dir, &spec).unwrap_err().to_string();
+    assert!(msg.contains("need 2000"), "{msg}");
+    // With matching dims it loads, big-endian.
+    std::fs::write(dir.join("v.raw"), [0u8, 1, 1, 0]).unwrap();
+    let ok = raw::read(
+        &dir,
+        &RawSpec {
+            dims: [2, 1, 1],
+            ..spec
+        },
+    )
+    .unwrap();
+    assert_eq!(ok.values, vec![1.0, 256.0]);
+}
+
+#[test]
+fn data_scenes_render_and_their_arb_and_glsl_agree() {
+    let h = headless(Backend::Egl);
+    for file in ["scenes/data/f3.toml", "scenes/data/icbm152.toml"] {
+        if shared_data("seismic/f3.sgy").is_none() {
+            return;
+        }
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
+        let mut scene = Scene::load(&path).unwrap();
+        scene.size = [128, 128];
+        scene.target = Some(TargetFormat::Rgba8);
+        scene.programs = ProgramChoice::Arb;
+        let arb = render_on(&h, &scene).unwrap();
+        scene.programs = ProgramChoice::Glsl;
+        let glsl = render_on(&h, &scene).unwrap();
+        let d = arb.image.compare(&glsl.image, LEVEL).unwrap();
+        // Same instructions, both 8-bit: one level (see tests/opacity3d.rs).
+        assert!(d.max_abs <= LEVEL as f64 * 1.01, "{file}: {d:?}");
+        // Something is drawn: at least a tenth of the pixels differ from the background.
+        let lit = (0..128 * 128)
+            .filter(|i| {
+                arb.image.data[i * 4..i * 4 + 3]
+                    .iter()
+                    .any(|&v| v > 2.0 * LEVEL)
+            })
+            .count();
+        assert!(lit > 128 * 128 / 10, "{file}: only {lit} pixels lit");
+    }
+}
+
+#[test]
+fn inspect_prints_what_the_loader_sees() {
+    let Some(path) = shared_data("seismic/f3.sgy") else {
+        return;
+    };
+    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args(["inspect", path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}");
+    for expect in [
+        "SEG-Y rev 1.0",
+        "int16 (3)",
+        "big-endian",
+        "inlines: 111..=133 (23 values",
+        "crosslines: 875..=892 (18 values",
+        "samples: 75 per trace, interval 4000 us",
+        "min -10239 max 10827",
+    ] {
+        assert!(text.contains(expect), "missing {expect:?} in\n{text}");
+    }
+}
