@@ -8,12 +8,17 @@
 mod common;
 
 use std::path::{Path, PathBuf};
+
+use common::temp_dir;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+use arbvis::gl::Backend;
 use arbvis::gl::TargetFormat;
 use arbvis::png_io::read_png;
-use arbvis::scene::Scene;
+use arbvis::render::render;
+use arbvis::scene::{Scene, TechniqueScene};
+use arbvis::techniques::opacity3d::Combine;
 use arbvis::techniques::quad::{reference_image, QuadScene};
 
 struct Display {
@@ -92,26 +97,18 @@ fn display() -> Option<Display> {
     skip("no DISPLAY and Xvfb did not come up")
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("arbvis-viewer-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
-
-/// Run `arbvis view --demo quad` with `script`; returns (success, stderr).
-fn run_viewer(display: &Display, dir: &Path, script: &str) -> (bool, String) {
+/// Run `arbvis view --demo DEMO --size SIZE` with `script`; returns (success, stderr).
+fn run_viewer(
+    display: &Display,
+    dir: &Path,
+    demo: &str,
+    size: &str,
+    script: &str,
+) -> (bool, String) {
     let script_path = dir.join("script.txt");
     std::fs::write(&script_path, script).unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args([
-            "view",
-            "--demo",
-            "quad",
-            "--size",
-            "160x160",
-            "--screenshot-dir",
-        ])
+        .args(["view", "--demo", demo, "--size", size, "--screenshot-dir"])
         .arg(dir)
         .arg("--script")
         .arg(&script_path)
@@ -137,13 +134,14 @@ fn run_viewer(display: &Display, dir: &Path, script: &str) -> (bool, String) {
     }
 }
 
-/// Run `script` in the viewer (one test at a time) and return its screenshot folder,
-/// or `None` when the test is skipped for lack of a display. Fails if the viewer fails.
-fn run_script(name: &str, script: &str) -> Option<PathBuf> {
+/// Run `script` in the viewer on `demo` (one test at a time) and return its screenshot
+/// folder, or `None` when the test is skipped for lack of a display. Fails if the viewer
+/// fails.
+fn run_script(name: &str, demo: &str, size: &str, script: &str) -> Option<PathBuf> {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let display = display()?;
     let dir = temp_dir(name);
-    let (ok, stderr) = run_viewer(&display, &dir, script);
+    let (ok, stderr) = run_viewer(&display, &dir, demo, size, script);
     assert!(ok, "viewer failed: {stderr}");
     Some(dir)
 }
@@ -152,6 +150,8 @@ fn run_script(name: &str, script: &str) -> Option<PathBuf> {
 fn frame_screenshot_and_program_switch() {
     let Some(dir) = run_script(
         "switch",
+        "quad",
+        "160x160",
         "wait 2\nclick Screenshot\nwait 1\nclick GLSL\nwait 2\nclick Screenshot\nwait 1\nclick Save scene\nwait 1\n",
     ) else {
         return;
@@ -196,6 +196,8 @@ fn frame_screenshot_and_program_switch() {
 fn drag_rotates_the_camera() {
     let Some(dir) = run_script(
         "drag",
+        "quad",
+        "160x160",
         "wait 2\ndrag 60 0\nwait 1\nclick Save scene\nwait 1\n",
     ) else {
         return;
@@ -214,11 +216,48 @@ fn script_naming_a_missing_widget_fails_clearly() {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let Some(display) = display() else { return };
     let dir = temp_dir("missing");
-    let (ok, stderr) = run_viewer(&display, &dir, "wait 1\nclick No such button\n");
+    let (ok, stderr) = run_viewer(
+        &display,
+        &dir,
+        "quad",
+        "160x160",
+        "wait 1\nclick No such button\n",
+    );
     assert!(!ok, "a bad script must fail the viewer");
     assert!(
         stderr.contains("No such button") && stderr.contains("Screenshot"),
         "{stderr}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn lut3d_editor_switches_combination_and_locks_a_table() {
+    let Some(dir) = run_script(
+        "lut3d",
+        "v3o2-sum",
+        "160x400",
+        "wait 2\nclick Product\nwait 2\nclick Lock primary\nwait 2\nclick Screenshot\nwait 1\nclick Save scene\nwait 1\n",
+    ) else {
+        return;
+    };
+    // The edits are in the saved scene: product, and the locked primary's four
+    // coefficients made one (the demo's are [1, 1, 1, 0.8]; the lock takes Cr).
+    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let TechniqueScene::Opacity3d(o) = &saved.technique else {
+        panic!("saved scene is not opacity3d");
+    };
+    assert_eq!(o.combine, Combine::Product);
+    assert_eq!(o.primary.coefficients, [1.0; 4]);
+    // And they showed on the next frame: the screenshot equals an offscreen render of the
+    // saved scene at the view's size, within one 8-bit level (same driver, same program,
+    // an 8-bit back buffer as the RGBA8 target).
+    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
+    let mut scene = saved.clone();
+    scene.size = [shot.width, shot.height];
+    scene.programs = arbvis::gl::ProgramChoice::Arb;
+    let offscreen = render(&scene, Backend::Egl).unwrap().image;
+    let d = shot.compare(&offscreen, common::LEVEL).unwrap();
+    assert!(d.max_abs <= common::LEVEL as f64 * 1.01, "{d:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
