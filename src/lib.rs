@@ -18,6 +18,7 @@ pub mod png_io;
 pub mod programs;
 pub mod render;
 pub mod scene;
+pub mod study;
 pub mod techniques;
 #[cfg(feature = "viewer")]
 pub mod viewer;

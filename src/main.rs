@@ -52,6 +52,25 @@ enum Command {
         /// A `.sgy`/`.segy` or `.nii`/`.nii.gz` file.
         file: PathBuf,
     },
+    /// Time v3o2's 3D opacity on a synthetic volume³ x 3 attributes at size² (faithful and
+    /// precise, ARB and GLSL, over slice counts); no scoring.
+    Bench {
+        #[command(flatten)]
+        sweep: SweepArgs,
+    },
+    /// The speed-for-accuracy study of 3D opacity: every slice count, target precision,
+    /// opacity correction on/off and program kind, timed and scored against the f64
+    /// reference; writes OUT/opacity3d.csv and OUT/opacity3d.png.
+    Study {
+        #[command(flatten)]
+        sweep: SweepArgs,
+        /// Reference steps per voxel.
+        #[arg(long, default_value_t = 4.0)]
+        oversample: f64,
+        /// Output folder.
+        #[arg(long, default_value = "study")]
+        out: PathBuf,
+    },
     /// Open the desktop viewer (winit + glutin + egui).
     #[cfg(feature = "viewer")]
     View {
@@ -65,6 +84,47 @@ enum Command {
         script: Option<PathBuf>,
     },
 }
+
+/// The sizes a bench or study sweeps.
+#[derive(Args)]
+struct SweepArgs {
+    /// Voxels per side of the synthetic volume.
+    #[arg(long, default_value_t = 256)]
+    volume: usize,
+    /// Image side in pixels.
+    #[arg(long, default_value_t = 512)]
+    size: u32,
+    /// Slice counts, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [64, 128, 256, 512, 1024])]
+    slices: Vec<usize>,
+    /// Timed frames per setting (median reported).
+    #[arg(long, default_value_t = 3)]
+    frames: usize,
+    /// Offscreen backend.
+    #[arg(long, value_enum, default_value_t = Backend::Egl)]
+    backend: Backend,
+}
+
+impl SweepArgs {
+    fn options(&self, score: bool, full: bool) -> Result<arbvis::study::StudyOptions> {
+        if self.volume == 0 || self.size == 0 || self.slices.contains(&0) {
+            bail!("volume, size and slice counts must be positive");
+        }
+        Ok(arbvis::study::StudyOptions {
+            volume: self.volume,
+            size: self.size,
+            slices: self.slices.clone(),
+            frames: self.frames.max(1),
+            score,
+            full,
+            ..Default::default()
+        })
+    }
+}
+
+/// VTK 9.7's GPU ray caster on a 3-component 256³ volume at 512², llvmpipe, 2 cores
+/// (DESIGN.md §8, measured on an idle machine of this kind): the study's yardstick.
+const VTK_MS: f64 = 1260.0;
 
 /// Where the scene comes from and what overrides it.
 #[derive(Args)]
@@ -165,6 +225,35 @@ fn run(cli: Cli) -> Result<()> {
                     rendered.draw_time.as_secs_f64() * 1e3
                 );
             }
+        }
+        Command::Bench { sweep } => {
+            let headless = Headless::new(sweep.backend)?;
+            println!("{}", headless.gpu().caps().renderer);
+            let options = sweep.options(false, false)?;
+            arbvis::study::run(&headless, &options, |line| println!("{line}"))?;
+        }
+        Command::Study {
+            sweep,
+            oversample,
+            out,
+        } => {
+            let headless = Headless::new(sweep.backend)?;
+            let caps = headless.gpu().caps().clone();
+            let mut options = sweep.options(true, true)?;
+            options.oversample = oversample;
+            let rows = arbvis::study::run(&headless, &options, |line| eprintln!("{line}"))?;
+            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+            let csv = out.join("opacity3d.csv");
+            arbvis::png_io::write_atomic(&csv, arbvis::study::to_csv(&rows).as_bytes())
+                .with_context(|| format!("writing {}", csv.display()))?;
+            let png = out.join("opacity3d.png");
+            let title = format!(
+                "v3o2 3D opacity, {0}^3 x 3 attributes at {1}x{1}: {2}",
+                options.volume, options.size, caps.renderer
+            );
+            arbvis::study::plot(&rows, &png, &title, VTK_MS)?;
+            print!("{}", arbvis::study::summary(&rows, VTK_MS));
+            println!("wrote {} and {}", csv.display(), png.display());
         }
         Command::Inspect { file } => {
             print!("{}", arbvis::volume::inspect(&file)?);

@@ -195,3 +195,43 @@ fn missing_osmesa_library_is_named_with_a_hint() {
         "{stderr}"
     );
 }
+
+#[test]
+fn study_writes_csv_and_plot_and_bench_times() {
+    // A small sweep (16³ volume, 32², two slice counts): the full study is a benchmark.
+    let dir = temp_dir("study");
+    let out = arbvis(&[
+        "study",
+        "--volume",
+        "16",
+        "--size",
+        "32",
+        "--slices",
+        "8,32",
+        "--frames",
+        "1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let csv = std::fs::read_to_string(dir.join("opacity3d.csv")).unwrap();
+    // Per slice count and program kind: 1 faithful + 3 targets x 2 corrections = 7.
+    assert_eq!(csv.lines().count(), 1 + 2 * 2 * 7, "{csv}");
+    for line in csv.lines().skip(1) {
+        let rmse: f64 = line.split(',').nth(7).unwrap().parse().unwrap();
+        assert!(rmse.is_finite() && rmse >= 0.0, "{line}");
+    }
+    let (plot, _) = read_png(&dir.join("opacity3d.png")).unwrap();
+    assert_eq!((plot.width, plot.height), (1100, 700));
+    assert!(stdout.contains("wrote"), "{stdout}");
+    let bench = arbvis(&[
+        "bench", "--volume", "8", "--size", "16", "--slices", "4", "--frames", "1",
+    ]);
+    let (stdout, stderr) = text(&bench);
+    assert!(bench.status.success(), "{stderr}");
+    assert!(
+        stdout.contains("faithful") && stdout.contains("ms"),
+        "{stdout}"
+    );
+}

@@ -111,6 +111,10 @@ fn arb_and_glsl_agree_within_one_level_in_both_modes() {
             let mut scene = Scene::demo(demo).unwrap();
             scene.size = [128, 128];
             scene.fidelity = fidelity;
+            // Perspective for the product: slicing and the transform hold in both.
+            if demo == "v3o2-product" {
+                scene.camera.projection = arbvis::camera::Projection::Perspective;
+            }
             scene.target = Some(TargetFormat::Rgba8);
             scene.programs = ProgramChoice::Arb;
             let arb = render(&h, &scene);
