@@ -250,13 +250,16 @@ pub fn run(
             rmse,
             psnr,
         };
+        let score = if options.score {
+            format!("  rmse {rmse:.5}  max {max_abs:.4}")
+        } else {
+            String::new()
+        };
         progress(&format!(
-            "{:<36} {:>5} slices {:>9.1} ms  rmse {:.5}  max {:.4}",
+            "{:<36} {:>5} slices {:>9.1} ms{score}",
             row.series(),
             slices,
-            ms,
-            rmse,
-            max_abs
+            ms
         ));
         rows.push(row);
     }
