@@ -47,6 +47,25 @@ impl Image {
         }
     }
 
+    /// An image from f64 pixels (a CPU reference's output), top row first.
+    pub fn from_f64_pixels(
+        width: u32,
+        height: u32,
+        format: TargetFormat,
+        pixels: impl IntoIterator<Item = [f64; 4]>,
+    ) -> Image {
+        let data = pixels
+            .into_iter()
+            .flat_map(|p| p.map(|v| v as f32))
+            .collect();
+        Image {
+            width,
+            height,
+            format,
+            data,
+        }
+    }
+
     /// A `width` x `height` image filled with `rgba`.
     pub fn filled(width: u32, height: u32, format: TargetFormat, rgba: [f32; 4]) -> Image {
         Image {

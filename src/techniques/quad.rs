@@ -153,16 +153,12 @@ pub fn reference_image(
     format: gl::TargetFormat,
 ) -> Image {
     let clamp = format == gl::TargetFormat::Rgba8;
-    let data = reference(params, width, height, clamp)
-        .into_iter()
-        .flat_map(|p| p.map(|v| v as f32))
-        .collect();
-    Image {
+    Image::from_f64_pixels(
         width,
         height,
         format,
-        data,
-    }
+        reference(params, width, height, clamp),
+    )
 }
 
 #[cfg(test)]

@@ -539,6 +539,17 @@ mod tests {
         }
     }
 
+    fn options(format: SampleFormat) -> WriteOptions {
+        WriteOptions {
+            format,
+            big_endian: true,
+            revision: 1,
+            first_inline: 1,
+            first_crossline: 1,
+            interval_us: 4000,
+        }
+    }
+
     fn cube() -> Volume {
         let dims = [5, 3, 4];
         let values = (0..60).map(|n| n as f32 - 20.0).collect();
@@ -582,14 +593,7 @@ mod tests {
     #[test]
     fn any_trace_order_grids_the_same() {
         let v = cube();
-        let o = WriteOptions {
-            format: SampleFormat::IeeeFloat,
-            big_endian: true,
-            revision: 1,
-            first_inline: 1,
-            first_crossline: 1,
-            interval_us: 4000,
-        };
+        let o = options(SampleFormat::IeeeFloat);
         let bytes = write(&v, &o);
         // Swap the first and last traces.
         let trace = TRACE_HEADER + 5 * 4;
@@ -603,14 +607,7 @@ mod tests {
     #[test]
     fn prestack_and_irregular_and_truncated_are_refused() {
         let v = cube();
-        let o = WriteOptions {
-            format: SampleFormat::Int16,
-            big_endian: true,
-            revision: 1,
-            first_inline: 1,
-            first_crossline: 1,
-            interval_us: 4000,
-        };
+        let o = options(SampleFormat::Int16);
         let bytes = write(&v, &o);
         let trace = TRACE_HEADER + 5 * 2;
         // Trace 2 claims trace 1's position: a second offset at one CDP.

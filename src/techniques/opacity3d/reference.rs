@@ -190,25 +190,6 @@ fn box_interval(origin: DVec3, dir: DVec3, half: DVec3) -> Option<(f64, f64)> {
     (hi > lo).then_some((lo, hi))
 }
 
-fn image_from_rows(
-    width: u32,
-    height: u32,
-    format: TargetFormat,
-    rows: Vec<Vec<[f64; 4]>>,
-) -> Image {
-    let data = rows
-        .into_iter()
-        .flatten()
-        .flat_map(|p| p.map(|v| v as f32))
-        .collect();
-    Image {
-        width,
-        height,
-        format,
-        data,
-    }
-}
-
 /// The f64 reference image (see the module doc); `oversample` steps per reference
 /// spacing (8 or more keeps the quadrature error far below 8-bit steps).
 pub fn reference(
@@ -224,7 +205,7 @@ pub fn reference(
     let inverse = camera.view_projection(aspect).inverse();
     let reference = prepared.reference_spacing();
     let half = prepared.half;
-    let rows = (0..height)
+    let rows: Vec<Vec<[f64; 4]>> = (0..height)
         .into_par_iter()
         .map(|y| {
             (0..width)
@@ -263,7 +244,12 @@ pub fn reference(
                 .collect()
         })
         .collect();
-    image_from_rows(width, height, TargetFormat::Rgba32f, rows)
+    Image::from_f64_pixels(
+        width,
+        height,
+        TargetFormat::Rgba32f,
+        rows.into_iter().flatten(),
+    )
 }
 
 /// Independent emulation of the faithful pipeline into an 8-bit target (see the module
@@ -284,7 +270,7 @@ pub fn emulate_faithful(
     let count = params.slices;
     let spacing = 2.0 * extent / count as f64;
     let to8 = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round();
-    let rows = (0..height)
+    let rows: Vec<Vec<[f64; 4]>> = (0..height)
         .into_par_iter()
         .map(|y| {
             (0..width)
@@ -324,7 +310,12 @@ pub fn emulate_faithful(
                 .collect()
         })
         .collect();
-    image_from_rows(width, height, TargetFormat::Rgba8, rows)
+    Image::from_f64_pixels(
+        width,
+        height,
+        TargetFormat::Rgba8,
+        rows.into_iter().flatten(),
+    )
 }
 
 #[cfg(test)]
