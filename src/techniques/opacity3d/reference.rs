@@ -190,6 +190,31 @@ fn box_interval(origin: DVec3, dir: DVec3, half: DVec3) -> Option<(f64, f64)> {
     (hi > lo).then_some((lo, hi))
 }
 
+/// Trace one ray per pixel centre (object space, near to far) in parallel rows and
+/// collect `shade(origin, dir)` as an image of `format`, top row first.
+fn trace_pixels(
+    camera: &Camera,
+    size: [u32; 2],
+    format: TargetFormat,
+    shade: impl Fn(DVec3, DVec3) -> [f64; 4] + Sync,
+) -> Image {
+    let [width, height] = size;
+    let aspect = width as f64 / height.max(1) as f64;
+    let inverse = camera.view_projection(aspect).inverse();
+    let rows: Vec<Vec<[f64; 4]>> = (0..height)
+        .into_par_iter()
+        .map(|y| {
+            (0..width)
+                .map(|x| {
+                    let (origin, dir) = pixel_ray(&inverse, x, y, width, height);
+                    shade(origin, dir)
+                })
+                .collect()
+        })
+        .collect();
+    Image::from_f64_pixels(width, height, format, rows.into_iter().flatten())
+}
+
 /// The f64 reference image (see the module doc); `oversample` steps per reference
 /// spacing (8 or more keeps the quadrature error far below 8-bit steps).
 pub fn reference(
@@ -200,56 +225,37 @@ pub fn reference(
     background: [f64; 4],
     oversample: f64,
 ) -> Image {
-    let [width, height] = size;
-    let aspect = width as f64 / height.max(1) as f64;
-    let inverse = camera.view_projection(aspect).inverse();
     let reference = prepared.reference_spacing();
     let half = prepared.half;
-    let rows: Vec<Vec<[f64; 4]>> = (0..height)
-        .into_par_iter()
-        .map(|y| {
-            (0..width)
-                .map(|x| {
-                    let (origin, dir) = pixel_ray(&inverse, x, y, width, height);
-                    let mut dst = background;
-                    let Some((enter, exit)) = box_interval(origin, dir, half) else {
-                        return dst;
-                    };
-                    let length = (exit - enter) * dir.length();
-                    let steps = ((length / reference * oversample).ceil() as usize).max(1);
-                    let h = length / steps as f64;
-                    let exponent = h / reference;
-                    // Far to near.
-                    for s in (0..steps).rev() {
-                        let t = enter + (exit - enter) * (s as f64 + 0.5) / steps as f64;
-                        let p = origin + dir * t;
-                        let tc = (p + half) / (2.0 * half);
-                        let c = classify(
-                            prepared,
-                            params,
-                            tc,
-                            Addressing::TexelCentre,
-                            1.0 / 3.0,
-                            Filtering::Exact,
-                        )
-                        .map(|v| v.clamp(0.0, 1.0));
-                        let a = 1.0 - (1.0 - c[3]).powf(exponent);
-                        for ch in 0..3 {
-                            dst[ch] = c[ch] * a + dst[ch] * (1.0 - a);
-                        }
-                        dst[3] = a * a + dst[3] * (1.0 - a);
-                    }
-                    dst
-                })
-                .collect()
-        })
-        .collect();
-    Image::from_f64_pixels(
-        width,
-        height,
-        TargetFormat::Rgba32f,
-        rows.into_iter().flatten(),
-    )
+    trace_pixels(camera, size, TargetFormat::Rgba32f, |origin, dir| {
+        let mut dst = background;
+        let Some((enter, exit)) = box_interval(origin, dir, half) else {
+            return dst;
+        };
+        let length = (exit - enter) * dir.length();
+        let steps = ((length / reference * oversample).ceil() as usize).max(1);
+        let exponent = length / steps as f64 / reference;
+        // Far to near.
+        for s in (0..steps).rev() {
+            let t = enter + (exit - enter) * (s as f64 + 0.5) / steps as f64;
+            let tc = (origin + dir * t + half) / (2.0 * half);
+            let c = classify(
+                prepared,
+                params,
+                tc,
+                Addressing::TexelCentre,
+                1.0 / 3.0,
+                Filtering::Exact,
+            )
+            .map(|v| v.clamp(0.0, 1.0));
+            let a = 1.0 - (1.0 - c[3]).powf(exponent);
+            for ch in 0..3 {
+                dst[ch] = c[ch] * a + dst[ch] * (1.0 - a);
+            }
+            dst[3] = a * a + dst[3] * (1.0 - a);
+        }
+        dst
+    })
 }
 
 /// Independent emulation of the faithful pipeline into an 8-bit target (see the module
@@ -261,61 +267,43 @@ pub fn emulate_faithful(
     size: [u32; 2],
     background: [f64; 4],
 ) -> Image {
-    let [width, height] = size;
-    let aspect = width as f64 / height.max(1) as f64;
-    let inverse = camera.view_projection(aspect).inverse();
     let half = prepared.half;
     let n = (camera.quat().inverse() * DVec3::Z).normalize();
     let extent = (half * n.abs()).element_sum();
     let count = params.slices;
     let spacing = 2.0 * extent / count as f64;
     let to8 = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round();
-    let rows: Vec<Vec<[f64; 4]>> = (0..height)
-        .into_par_iter()
-        .map(|y| {
-            (0..width)
-                .map(|x| {
-                    let (origin, dir) = pixel_ray(&inverse, x, y, width, height);
-                    let mut dst = background.map(to8);
-                    let along = dir.dot(n);
-                    if along.abs() < 1e-300 {
-                        return dst.map(|v| v / 255.0);
-                    }
-                    for i in 0..count {
-                        let depth = -extent + (i as f64 + 0.5) * spacing;
-                        let t = (depth - origin.dot(n)) / along;
-                        let p = origin + dir * t;
-                        if (p.abs() - half).max_element() > 1e-9 {
-                            continue;
-                        }
-                        let tc = (p + half) / (2.0 * half);
-                        let src = classify(
-                            prepared,
-                            params,
-                            tc,
-                            Addressing::Original,
-                            0.3333_f32 as f64,
-                            Filtering::Unorm8,
-                        )
-                        .map(to8);
-                        let a = src[3];
-                        // 8-bit blending: each product rounded on its own, then summed.
-                        let mul = |x: f64, y: f64| (x * y / 255.0).round();
-                        for ch in 0..4 {
-                            dst[ch] = (mul(src[ch], a) + mul(dst[ch], 255.0 - a)).min(255.0);
-                        }
-                    }
-                    dst.map(|v| v / 255.0)
-                })
-                .collect()
-        })
-        .collect();
-    Image::from_f64_pixels(
-        width,
-        height,
-        TargetFormat::Rgba8,
-        rows.into_iter().flatten(),
-    )
+    // 8-bit blending: each product rounded on its own, then summed.
+    let mul = |x: f64, y: f64| (x * y / 255.0).round();
+    trace_pixels(camera, size, TargetFormat::Rgba8, |origin, dir| {
+        let mut dst = background.map(to8);
+        let along = dir.dot(n);
+        if along.abs() < 1e-300 {
+            return dst.map(|v| v / 255.0);
+        }
+        for i in 0..count {
+            let depth = -extent + (i as f64 + 0.5) * spacing;
+            let p = origin + dir * ((depth - origin.dot(n)) / along);
+            if (p.abs() - half).max_element() > 1e-9 {
+                continue;
+            }
+            let tc = (p + half) / (2.0 * half);
+            let src = classify(
+                prepared,
+                params,
+                tc,
+                Addressing::Original,
+                0.3333_f32 as f64,
+                Filtering::Unorm8,
+            )
+            .map(to8);
+            let a = src[3];
+            for ch in 0..4 {
+                dst[ch] = (mul(src[ch], a) + mul(dst[ch], 255.0 - a)).min(255.0);
+            }
+        }
+        dst.map(|v| v / 255.0)
+    })
 }
 
 #[cfg(test)]
