@@ -14,6 +14,7 @@ pub mod colortable;
 pub mod gl;
 pub mod image;
 pub mod info;
+pub mod input;
 pub mod png_io;
 pub mod programs;
 pub mod render;

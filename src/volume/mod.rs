@@ -339,7 +339,7 @@ pub fn describe(v: &Volume) -> String {
     )
 }
 
-/// Read a whole file, naming it in the error.
-pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, VolumeError> {
-    std::fs::read(path).map_err(|e| VolumeError::io(path, e))
+/// Read a whole regular file of at most `max_bytes`, naming it in the error.
+pub(crate) fn read_file(path: &Path, max_bytes: u64) -> Result<Vec<u8>, VolumeError> {
+    crate::input::read_regular(path, max_bytes).map_err(|e| VolumeError::io(path, e))
 }

@@ -50,15 +50,25 @@ pub fn read(base: &Path, spec: &RawSpec) -> Result<Volume, VolumeError> {
                 spec.dims
             ))
         })?;
-    let bytes = read_file(&path)?;
-    let need = count as u64 * spec.sample.bytes() as u64 + spec.offset;
-    if bytes.len() as u64 != need {
+    let need = (count as u64)
+        .checked_mul(spec.sample.bytes() as u64)
+        .and_then(|n| n.checked_add(spec.offset))
+        .ok_or_else(|| {
+            VolumeError::Invalid(format!(
+                "{}: dims {:?} of {} after an offset of {} bytes: the size overflows 64 bits",
+                path.display(),
+                spec.dims,
+                spec.sample.name(),
+                spec.offset
+            ))
+        })?;
+    let (_, len) = crate::input::open_regular(&path).map_err(|e| VolumeError::io(&path, e))?;
+    if len != need {
         return Err(VolumeError::format(
             &path,
-            bytes.len().min(need as usize) as u64,
+            len.min(need),
             format!(
-                "the file has {} bytes but {}x{}x{} samples of {} after an offset of {} need {need}",
-                bytes.len(),
+                "the file has {len} bytes but {}x{}x{} samples of {} after an offset of {} need {need}",
                 spec.dims[0],
                 spec.dims[1],
                 spec.dims[2],
@@ -67,6 +77,7 @@ pub fn read(base: &Path, spec: &RawSpec) -> Result<Volume, VolumeError> {
             ),
         ));
     }
+    let bytes = read_file(&path, need)?;
     let big = spec.endian == Endian::Big;
     let width = spec.sample.bytes();
     let values = bytes[spec.offset as usize..]

@@ -291,7 +291,7 @@ impl Reader<'_> {
 
 /// Read and grid a post-stack SEG-Y file.
 pub fn read(path: &Path) -> Result<SegyCube, VolumeError> {
-    let bytes = read_file(path)?;
+    let bytes = read_file(path, u64::MAX)?;
     parse(path, &bytes)
 }
 
