@@ -46,6 +46,26 @@ impl TableSpec {
         }
     }
 
+    /// Check what can be checked without reading files: the built-in name and the alpha
+    /// curve. The error names the key (`builtin` or `alpha`).
+    pub fn validate(&self) -> Result<(), crate::scene::FieldError> {
+        use crate::scene::FieldError;
+        if self.file.is_none() && !BUILTINS.contains(&self.builtin.as_str()) {
+            return Err(FieldError::new(
+                "builtin",
+                format!(
+                    "no built-in colour table {:?}; built-ins: {}",
+                    crate::input::shorten(&self.builtin, 40),
+                    BUILTINS.join(", ")
+                ),
+            ));
+        }
+        if !self.alpha.is_empty() {
+            check_alpha_curve(&self.alpha).map_err(|m| FieldError::new("alpha", m))?;
+        }
+        Ok(())
+    }
+
     /// Build the table; relative files are read from `base`.
     pub fn build(&self, base: &Path) -> Result<ColorTable, String> {
         let mut table = match &self.file {
@@ -125,15 +145,7 @@ impl ColorTable {
     /// Replace alpha by the piecewise-linear curve through `points` (`[position, alpha]`,
     /// both in 0..1, positions ascending); constant beyond the ends.
     pub fn set_alpha_curve(&mut self, points: &[[f64; 2]]) -> Result<(), String> {
-        let valid = points
-            .iter()
-            .all(|p| p.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)))
-            && points.windows(2).all(|w| w[0][0] <= w[1][0]);
-        if points.is_empty() || !valid {
-            return Err(format!(
-                "alpha curve {points:?}: points must be [position, alpha] in 0..1, positions ascending"
-            ));
-        }
+        check_alpha_curve(points)?;
         for (k, e) in self.entries.iter_mut().enumerate() {
             let t = k as f64 / 255.0;
             let a = alpha_at(points, t);
@@ -183,7 +195,9 @@ impl ColorTable {
 
     /// Read a table file.
     pub fn load(path: &Path) -> Result<ColorTable, String> {
-        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        // 256 lines of four numbers with comments: 1 MiB is far beyond any real table.
+        let text = crate::input::read_text(path, crate::input::MAX_SMALL_TEXT_BYTES)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
         ColorTable::parse(&text, &path.display().to_string())
     }
 
@@ -202,6 +216,22 @@ impl ColorTable {
         crate::png_io::write_atomic(path, self.to_text().as_bytes())
             .map_err(|e| format!("{}: {e}", path.display()))
     }
+}
+
+/// An alpha curve is at least one `[position, alpha]` point, both in 0..1, positions
+/// ascending.
+fn check_alpha_curve(points: &[[f64; 2]]) -> Result<(), String> {
+    let valid = points
+        .iter()
+        .all(|p| p.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)))
+        && points.windows(2).all(|w| w[0][0] <= w[1][0]);
+    if points.is_empty() || !valid {
+        let shown = crate::input::shorten(&format!("{points:?}"), 120);
+        return Err(format!(
+            "alpha curve {shown}: points must be [position, alpha] in 0..1, positions ascending"
+        ));
+    }
+    Ok(())
 }
 
 /// The piecewise-linear curve through `points` at `t`.

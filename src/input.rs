@@ -24,7 +24,7 @@ pub fn invalid(message: impl Into<String>) -> io::Error {
 /// Open `path` for reading if it is a regular file; returns it with its length.
 /// Directories, FIFOs, sockets and devices are refused by name (following symlinks).
 pub fn open_regular(path: &Path) -> io::Result<(File, u64)> {
-    let meta = std::fs::metadata(path)?;
+    let meta = std::fs::metadata(path).map_err(|e| not_found_where(path, e))?;
     let kind = meta.file_type();
     if !kind.is_file() {
         return Err(invalid(format!(
@@ -34,6 +34,21 @@ pub fn open_regular(path: &Path) -> io::Result<(File, u64)> {
     }
     let file = File::open(path)?;
     Ok((file, meta.len()))
+}
+
+/// A relative path that does not resolve: say which absolute path was tried (a scene's
+/// data paths are relative to the scene's folder, not to the current one).
+fn not_found_where(path: &Path, e: io::Error) -> io::Error {
+    if e.kind() != io::ErrorKind::NotFound || path.is_absolute() {
+        return e;
+    }
+    match std::path::absolute(path) {
+        Ok(abs) => io::Error::new(
+            io::ErrorKind::NotFound,
+            format!("no such file (looked for {})", abs.display()),
+        ),
+        Err(_) => e,
+    }
 }
 
 fn describe_kind(kind: &std::fs::FileType) -> &'static str {

@@ -46,8 +46,8 @@ enum Command {
         #[arg(long)]
         stats: bool,
     },
-    /// Print what the loaders see in a volume file (SEG-Y, NIfTI): format, dimensions,
-    /// inline/crossline/sample ranges, sample type, byte order, value statistics.
+    /// Print what the loaders see in a file (SEG-Y, NIfTI): format, dimensions,
+    /// inline/crossline/offset/sample ranges, sample type, byte order, value statistics.
     Inspect {
         /// A `.sgy`/`.segy` or `.nii`/`.nii.gz` file.
         file: PathBuf,
@@ -173,6 +173,7 @@ impl SceneArgs {
 }
 
 fn main() -> ExitCode {
+    arbvis::png_io::remove_temporaries_on_signals();
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
@@ -256,7 +257,7 @@ fn run(cli: Cli) -> Result<()> {
             println!("wrote {} and {}", csv.display(), png.display());
         }
         Command::Inspect { file } => {
-            print!("{}", arbvis::volume::inspect(&file)?);
+            print!("{}", arbvis::inspect::inspect(&file)?);
         }
         #[cfg(feature = "viewer")]
         Command::View {

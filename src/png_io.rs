@@ -2,8 +2,9 @@
 //! text chunks saying what made them; read back for golden-image tests.
 
 use std::fs::File;
-use std::io::{BufReader, BufWriter, Write};
-use std::path::Path;
+use std::io::{BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use crate::gl::TargetFormat;
 use crate::image::Image;
@@ -12,12 +13,12 @@ use crate::image::Image;
 #[derive(Debug, thiserror::Error)]
 pub enum PngError {
     /// An I/O failure.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: String,
         /// What failed.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The PNG encoder or decoder failed.
     #[error("{path}: {message}")]
@@ -33,63 +34,63 @@ pub enum PngError {
 /// written as 8-bit PNG, float images as 16-bit PNG (values clamped to 0..1).
 pub fn write_png(path: &Path, image: &Image, text: &[(&str, String)]) -> Result<(), PngError> {
     let name = path.display().to_string();
-    let io = |source| PngError::Io {
-        path: name.clone(),
-        source,
-    };
     let fmt = |e: png::EncodingError| PngError::Format {
         path: name.clone(),
         message: e.to_string(),
     };
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
-    };
-    let file_name = path.file_name().ok_or_else(|| PngError::Format {
-        path: name.clone(),
-        message: "not a file path".into(),
-    })?;
-    let tmp = dir.join(format!(
-        ".{}.tmp-{}",
-        file_name.to_string_lossy(),
-        std::process::id()
-    ));
-    let result = (|| {
-        let file = File::create(&tmp).map_err(io)?;
-        let mut w = BufWriter::new(file);
-        {
-            let mut enc = png::Encoder::new(&mut w, image.width, image.height);
-            enc.set_color(png::ColorType::Rgba);
-            let sixteen = image.format != TargetFormat::Rgba8;
-            enc.set_depth(if sixteen {
-                png::BitDepth::Sixteen
-            } else {
-                png::BitDepth::Eight
-            });
-            for (k, v) in text {
-                enc.add_text_chunk(k.to_string(), v.clone()).map_err(fmt)?;
-            }
-            let mut writer = enc.write_header().map_err(fmt)?;
-            if sixteen {
-                let bytes: Vec<u8> = image
-                    .to_rgba16()
-                    .iter()
-                    .flat_map(|v| v.to_be_bytes())
-                    .collect();
-                writer.write_image_data(&bytes).map_err(fmt)?;
-            } else {
-                writer.write_image_data(&image.to_rgba8()).map_err(fmt)?;
-            }
-            writer.finish().map_err(fmt)?;
+    let mut bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut bytes, image.width, image.height);
+        enc.set_color(png::ColorType::Rgba);
+        let sixteen = image.format != TargetFormat::Rgba8;
+        enc.set_depth(if sixteen {
+            png::BitDepth::Sixteen
+        } else {
+            png::BitDepth::Eight
+        });
+        let mut writer = enc.write_header().map_err(fmt)?;
+        for (k, v) in text {
+            writer.write_text_chunk(&text_chunk(k, v)).map_err(fmt)?;
         }
-        let file = w.into_inner().map_err(|e| io(e.into_error()))?;
-        file.sync_all().map_err(io)?;
-        std::fs::rename(&tmp, path).map_err(io)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
+        if sixteen {
+            let data: Vec<u8> = image
+                .to_rgba16()
+                .iter()
+                .flat_map(|v| v.to_be_bytes())
+                .collect();
+            writer.write_image_data(&data).map_err(fmt)?;
+        } else {
+            writer.write_image_data(&image.to_rgba8()).map_err(fmt)?;
+        }
+        writer.finish().map_err(fmt)?;
     }
-    result
+    write_atomic(path, &bytes).map_err(|error| PngError::Io { path: name, error })
+}
+
+/// Largest text embedded in one chunk; longer texts (a scene with a huge inline table)
+/// are cut there, with a note saying so.
+pub const MAX_TEXT_BYTES: usize = 256 * 1024;
+
+/// One text chunk: iTXt (UTF-8, so paths in any script survive), compressed when long.
+fn text_chunk(key: &str, value: &str) -> png::text_metadata::ITXtChunk {
+    let value = if value.len() > MAX_TEXT_BYTES {
+        let mut cut = MAX_TEXT_BYTES;
+        while !value.is_char_boundary(cut) {
+            cut -= 1;
+        }
+        format!(
+            "{}\n# ... cut: {} of {} bytes embedded\n",
+            &value[..cut],
+            cut,
+            value.len()
+        )
+    } else {
+        value.to_string()
+    };
+    let long = value.len() > 1024;
+    let mut chunk = png::text_metadata::ITXtChunk::new(key, value);
+    chunk.compressed = long;
+    chunk
 }
 
 /// Read a PNG as an RGBA8 [`Image`] (8-bit RGBA files only, as this crate writes for
@@ -100,9 +101,9 @@ pub fn read_png(path: &Path) -> Result<(Image, Vec<(String, String)>), PngError>
         path: name.clone(),
         message,
     };
-    let file = File::open(path).map_err(|source| PngError::Io {
+    let file = File::open(path).map_err(|error| PngError::Io {
         path: name.clone(),
-        source,
+        error,
     })?;
     let mut decoder = png::Decoder::new(BufReader::new(file));
     decoder.set_transformations(png::Transformations::EXPAND);
@@ -114,12 +115,20 @@ pub fn read_png(path: &Path) -> Result<(Image, Vec<(String, String)>), PngError>
     let info = reader
         .next_frame(&mut buf)
         .map_err(|e| fmt(e.to_string()))?;
-    let text = reader
-        .info()
+    let meta = reader.info();
+    let mut text: Vec<(String, String)> = meta
         .uncompressed_latin1_text
         .iter()
         .map(|t| (t.keyword.clone(), t.text.clone()))
         .collect();
+    for t in &meta.utf8_text {
+        let mut t = t.clone();
+        if t.decompress_text_with_limit(2 * MAX_TEXT_BYTES).is_ok() {
+            if let Ok(v) = t.get_text() {
+                text.push((t.keyword.clone(), v));
+            }
+        }
+    }
     let (w, h) = (info.width, info.height);
     let channels = match (info.color_type, info.bit_depth) {
         (png::ColorType::Rgba, png::BitDepth::Eight) => 4,
@@ -143,19 +152,31 @@ pub fn read_png(path: &Path) -> Result<(Image, Vec<(String, String)>), PngError>
     Ok((image, text))
 }
 
-/// Write bytes to `path` atomically (temporary file + rename), e.g. CSV or TOML output.
+/// Temporaries being written now, removed by [`remove_temporaries`] when the process is
+/// interrupted.
+static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
+/// The marker in temporary names: `.NAME.arbvis-tmp.PID`.
+const TMP_MARK: &str = ".arbvis-tmp.";
+
+/// Write bytes to `path` atomically: a temporary file in the same folder, synced, then
+/// renamed over `path`. Nothing is left behind on error; on SIGINT/SIGTERM the handler
+/// installed by [`remove_temporaries_on_signals`] removes the temporary; a temporary left
+/// by a process that died harder (SIGKILL, power loss) is removed by the next write to
+/// the same path, once its process is gone.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => std::path::PathBuf::from("."),
+        _ => PathBuf::from("."),
     };
-    let tmp = dir.join(format!(
-        ".{}.tmp-{}",
-        path.file_name()
-            .map(|f| f.to_string_lossy())
-            .unwrap_or_default(),
-        std::process::id()
-    ));
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| crate::input::invalid("not a file path"))?
+        .to_string_lossy()
+        .to_string();
+    remove_stale(&dir, &file_name);
+    let tmp = dir.join(format!(".{file_name}{TMP_MARK}{}", std::process::id()));
+    lock_temporaries().push(tmp.clone());
     let result = (|| {
         let mut f = File::create(&tmp)?;
         f.write_all(bytes)?;
@@ -165,5 +186,119 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }
+    lock_temporaries().retain(|t| t != &tmp);
     result
+}
+
+fn lock_temporaries() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Remove the temporaries of writes in progress (called on SIGINT/SIGTERM).
+pub fn remove_temporaries() {
+    for t in lock_temporaries().drain(..) {
+        let _ = std::fs::remove_file(t);
+    }
+}
+
+/// Install a SIGINT/SIGTERM handler that removes temporaries and exits with 130.
+pub fn remove_temporaries_on_signals() {
+    let _ = ctrlc::set_handler(|| {
+        remove_temporaries();
+        std::process::exit(130);
+    });
+}
+
+/// Remove `.NAME.arbvis-tmp.PID` files in `dir` whose process no longer runs.
+fn remove_stale(dir: &Path, file_name: &str) {
+    let prefix = format!(".{file_name}{TMP_MARK}");
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name().to_string_lossy().to_string();
+        let Some(pid) = name
+            .strip_prefix(&prefix)
+            .and_then(|p| p.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if pid != std::process::id() && !process_alive(pid) {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Whether process `pid` runs (Linux: `/proc/PID` exists; elsewhere assume it does, so
+/// nothing of a running process is ever removed).
+fn process_alive(pid: u32) -> bool {
+    if Path::new("/proc/self").exists() {
+        Path::new(&format!("/proc/{pid}")).exists()
+    } else {
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stale_temporaries_of_dead_processes_are_removed() {
+        let dir = std::env::temp_dir().join(format!("arbvis-png-io-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // A pid that cannot run: above Linux's pid_max limit (2^22).
+        let dead = dir.join(format!(".out.csv{TMP_MARK}{}", (1u32 << 22) + 7));
+        let other = dir.join(format!(".other.csv{TMP_MARK}{}", (1u32 << 22) + 7));
+        std::fs::write(&dead, b"half").unwrap();
+        std::fs::write(&other, b"half").unwrap();
+        write_atomic(&dir.join("out.csv"), b"a,b\n").unwrap();
+        assert!(!dead.exists(), "the stale temporary of out.csv is removed");
+        assert!(other.exists(), "another file's temporary is left alone");
+        assert_eq!(std::fs::read(dir.join("out.csv")).unwrap(), b"a,b\n");
+        let leftovers: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .flatten()
+            .filter(|e| e.file_name().to_string_lossy().starts_with(".out.csv"))
+            .collect();
+        assert!(leftovers.is_empty());
+    }
+
+    #[test]
+    fn an_interrupt_removes_the_temporaries_in_progress() {
+        let dir = std::env::temp_dir().join(format!("arbvis-png-int-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let tmp = dir.join(format!(".x.png{TMP_MARK}{}", std::process::id()));
+        std::fs::write(&tmp, b"half a png").unwrap();
+        lock_temporaries().push(tmp.clone());
+        remove_temporaries(); // what the SIGINT/SIGTERM handler runs before exiting
+        assert!(!tmp.exists());
+    }
+
+    #[test]
+    fn long_and_non_latin_texts_survive() {
+        let dir = std::env::temp_dir().join(format!("arbvis-png-text-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("t.png");
+        let image = Image::filled(2, 2, TargetFormat::Rgba8, [0.5; 4]);
+        let long = "x = 1\n".repeat(100_000);
+        write_png(
+            &path,
+            &image,
+            &[
+                ("arbvis:scene", long.clone()),
+                ("path", "données/σ.sgy".into()),
+            ],
+        )
+        .unwrap();
+        let size = std::fs::metadata(&path).unwrap().len();
+        assert!(
+            size < 20_000,
+            "600 kB of scene compressed and capped: {size} bytes"
+        );
+        let (_, text) = read_png(&path).unwrap();
+        let scene = &text.iter().find(|(k, _)| k == "arbvis:scene").unwrap().1;
+        assert!(scene.len() < long.len() && scene.contains("cut: 262144 of 600000"));
+        assert!(text.contains(&("path".into(), "données/σ.sgy".into())));
+    }
 }

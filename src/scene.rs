@@ -98,13 +98,14 @@ fn default_size() -> [u32; 2] {
 /// Errors reading a scene; each names the file and, for syntax, the line and column.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// The file could not be read.
-    #[error("{path}: {source}")]
+    /// The file could not be read (not named `source`, so that a `{:#}` chain does not
+    /// print the OS error twice).
+    #[error("{path}: {error}")]
     Io {
         /// The scene file.
         path: String,
         /// What failed.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// TOML syntax or a value of the wrong shape.
     #[error("{path}:{line}:{column}: {message}")]
@@ -118,11 +119,17 @@ pub enum SceneError {
         /// What was expected.
         message: String,
     },
-    /// Values that parse but cannot be rendered.
-    #[error("{path}: {message}")]
+    /// Values that parse but cannot be rendered, at the key that holds them.
+    #[error("{path}:{line}:{column}: {key}: {message}")]
     Invalid {
         /// The scene file.
         path: String,
+        /// 1-based line of the key (or of its nearest table present in the text).
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// Dotted key, e.g. `technique.opacity3d.slices`.
+        key: String,
         /// What is wrong.
         message: String,
     },
@@ -145,27 +152,38 @@ impl Scene {
     /// Parse scene text; `origin` names it in errors.
     pub fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
         let scene: Scene = toml::from_str(text).map_err(|e| {
-            let (line, column) = e
-                .span()
-                .map(|s| line_column(text, s.start))
-                .unwrap_or((1, 1));
+            let start = e.span().map_or(0, |s| s.start);
+            let (line, column) = line_column(text, start);
             SceneError::Parse {
                 path: origin.to_string(),
                 line,
                 column,
-                message: e.message().to_string(),
+                message: parse_message(text, start, e.message()),
             }
         })?;
-        scene.validate(origin)?;
+        scene.validate().map_err(|e| {
+            let (line, column) = key_position(text, &e.key);
+            SceneError::Invalid {
+                path: origin.to_string(),
+                line,
+                column,
+                key: e.key,
+                message: crate::input::shorten(&e.message, MESSAGE_CHARS),
+            }
+        })?;
         Ok(scene)
     }
 
-    /// Read and parse a scene file.
+    /// Read and parse a scene file (a regular file of at most
+    /// [`crate::input::MAX_SCENE_BYTES`], UTF-8).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-            path: path.display().to_string(),
-            source,
-        })?;
+        let text =
+            crate::input::read_text(path, crate::input::MAX_SCENE_BYTES).map_err(|error| {
+                SceneError::Io {
+                    path: path.display().to_string(),
+                    error,
+                }
+            })?;
         let mut scene = Scene::parse(&text, &path.display().to_string())?;
         scene.base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Ok(scene)
@@ -209,27 +227,104 @@ impl Scene {
         self.target.unwrap_or(self.fidelity.default_target())
     }
 
-    fn validate(&self, origin: &str) -> Result<(), SceneError> {
+    /// Check values that parse but cannot be rendered; the error names the key.
+    pub fn validate(&self) -> Result<(), FieldError> {
         let [w, h] = self.size;
         if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
-            return Err(SceneError::Invalid {
-                path: origin.into(),
-                message: format!("size {w}x{h}: each side must be 1..=16384"),
-            });
-        }
-        if let TechniqueScene::Opacity3d(o) = &self.technique {
-            o.validate().map_err(|message| SceneError::Invalid {
-                path: origin.into(),
-                message: format!("technique.opacity3d: {message}"),
-            })?;
+            return Err(FieldError::new(
+                "size",
+                format!("{w}x{h}: each side must be 1..=16384"),
+            ));
         }
         if self.background.iter().any(|v| !v.is_finite()) {
-            return Err(SceneError::Invalid {
-                path: origin.into(),
-                message: "background must be finite".into(),
-            });
+            return Err(FieldError::new("background", "must be finite"));
+        }
+        if let TechniqueScene::Opacity3d(o) = &self.technique {
+            o.validate().map_err(|e| e.within("technique.opacity3d"))?;
         }
         Ok(())
+    }
+}
+
+/// Longest message quoted from a scene error (a 50 MB key must not reach the terminal).
+const MESSAGE_CHARS: usize = 300;
+
+/// A value that parses but cannot be used: the dotted key that holds it, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldError {
+    /// Dotted key relative to where the check ran, e.g. `primary.table.builtin`.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl FieldError {
+    /// An error at `key`.
+    pub fn new(key: impl Into<String>, message: impl Into<String>) -> FieldError {
+        FieldError {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// The same error seen from the enclosing table `prefix`.
+    pub fn within(self, prefix: &str) -> FieldError {
+        FieldError {
+            key: if self.key.is_empty() {
+                prefix.to_string()
+            } else {
+                format!("{prefix}.{}", self.key)
+            },
+            message: self.message,
+        }
+    }
+}
+
+impl std::fmt::Display for FieldError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.key, self.message)
+    }
+}
+
+/// Line and column of the dotted `key` in `text`, or of its longest prefix that the text
+/// spells out (a value left at its default has no position of its own).
+fn key_position(text: &str, key: &str) -> (usize, usize) {
+    use toml::de::{DeTable, DeValue};
+    let Ok(root) = DeTable::parse(text) else {
+        return (1, 1);
+    };
+    let mut table = root.get_ref();
+    let mut at = 0;
+    for part in key.split('.') {
+        let Some((k, v)) = table.get_key_value(part) else {
+            break;
+        };
+        at = k.span().start;
+        match v.get_ref() {
+            DeValue::Table(t) => table = t,
+            _ => break,
+        }
+    }
+    line_column(text, at)
+}
+
+/// The parser's message, shortened, with a hint for the commonest slip: a bare word
+/// where TOML needs a quoted string (`fidelity = faithful`).
+fn parse_message(text: &str, start: usize, message: &str) -> String {
+    let rest = text.get(start..).unwrap_or("");
+    let word: String = rest
+        .chars()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_')
+        .collect();
+    let bare = !word.is_empty()
+        && word.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+        && !matches!(word.as_str(), "true" | "false" | "inf" | "nan")
+        && text[..start].trim_end().ends_with('=');
+    let message = crate::input::shorten(message.trim(), MESSAGE_CHARS);
+    if bare {
+        format!("{message} (a word must be quoted: \"{word}\")")
+    } else {
+        message
     }
 }
 
@@ -285,11 +380,45 @@ mod tests {
 
     #[test]
     fn bad_size_is_rejected() {
-        let text = "size = [0, 64]\n[technique.quad]\n";
-        assert!(matches!(
-            Scene::parse(text, "x"),
-            Err(SceneError::Invalid { .. })
-        ));
+        let text = "background = [0.0, 0.0, 0.0, 1.0]\nsize = [0, 64]\n[technique.quad]\n";
+        match Scene::parse(text, "x") {
+            Err(
+                e @ SceneError::Invalid {
+                    line: 2, column: 1, ..
+                },
+            ) => {
+                assert!(e.to_string().starts_with("x:2:1: size: 0x64"), "{e}")
+            }
+            other => panic!("expected an invalid size at 2:1, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn errors_after_parsing_point_at_the_key() {
+        let text = "size = [64, 64]\n[technique.opacity3d]\ncombine = \"sum\"\n  slices = 0\n[technique.opacity3d.primary]\nvolume = { synthetic = { size = [8, 8, 8] } }\n";
+        let e = Scene::parse(text, "s.toml").unwrap_err().to_string();
+        assert!(
+            e.starts_with("s.toml:4:3: technique.opacity3d.slices: slices = 0"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_bare_word_gets_a_hint_and_long_keys_are_shortened() {
+        let e = Scene::parse("fidelity = faithful\n[technique.quad]\n", "a.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("a.toml:1:12:") && e.contains("\"faithful\""),
+            "{e}"
+        );
+        let long = format!("{} = 1\n[technique.quad]\n", "k".repeat(100_000));
+        let e = Scene::parse(&long, "b.toml").unwrap_err().to_string();
+        assert!(
+            e.len() < 2000 && e.contains("more characters"),
+            "{}",
+            e.len()
+        );
     }
 
     #[test]

@@ -168,7 +168,12 @@ pub fn run(
 ) -> anyhow::Result<Vec<Row>> {
     let base_scene = study_scene(options);
     let t0 = Instant::now();
-    let prepared = prepare(params(&base_scene), &base_scene.base).map_err(anyhow::Error::msg)?;
+    let prepared = prepare(
+        params(&base_scene),
+        &base_scene.base,
+        &headless.gpu().volume_limits(),
+    )
+    .map_err(anyhow::Error::msg)?;
     progress(&format!(
         "prepared {0}^3 x 3 attributes in {1:.1} s",
         options.volume,

@@ -21,7 +21,7 @@ fn f3_grids_from_its_trace_headers() {
     let Some(path) = shared_data("seismic/f3.sgy") else {
         return;
     };
-    let cube = segy::read(&path).unwrap();
+    let cube = segy::read(&path, &Default::default()).unwrap();
     // The README of ../shared/data: 23 inlines x 18 crosslines x 75 samples, format 3.
     assert_eq!(cube.volume.dims, [75, 18, 23]);
     assert_eq!(cube.format, segy::SampleFormat::Int16);
@@ -35,7 +35,7 @@ fn f3_grids_from_its_trace_headers() {
     let Some(ibm) = shared_data("seismic/Format1msb.sgy") else {
         return;
     };
-    let ibm = segy::read(&ibm).unwrap();
+    let ibm = segy::read(&ibm, &Default::default()).unwrap();
     assert_eq!(ibm.format, segy::SampleFormat::IbmFloat);
     assert_eq!(ibm.volume, cube.volume);
 }
@@ -49,7 +49,7 @@ fn small_and_tiny_ibm_files() {
         let Some(path) = shared_data(file) else {
             return;
         };
-        let cube = segy::read(&path).unwrap();
+        let cube = segy::read(&path, &Default::default()).unwrap();
         assert_eq!(cube.volume.dims, dims, "{file}");
         // segyio's synthetic files hold inline.crossline0sample-like values: 1.2 at the
         // first sample of inline 1, crossline 20.
@@ -62,7 +62,9 @@ fn broken_segy_is_a_clear_error() {
     let Some(path) = shared_data("seismic/broken.sgy") else {
         return;
     };
-    let e = segy::read(&path).unwrap_err().to_string();
+    let e = segy::read(&path, &Default::default())
+        .unwrap_err()
+        .to_string();
     assert!(
         e.contains("broken.sgy") && e.contains("at byte 10836"),
         "{e}"
@@ -117,7 +119,7 @@ fn icbm152_volumes_share_one_grid() {
         let Some(path) = shared_data(&file) else {
             return;
         };
-        let v = nifti_file::read(&path).unwrap();
+        let v = nifti_file::read(&path, &Default::default()).unwrap();
         assert_eq!(v.dims, [197, 233, 189], "{name}");
         assert_eq!(v.spacing, [1.0; 3]);
         let s = v.stats();
@@ -138,7 +140,7 @@ fn truncated_nifti_is_a_clear_error() {
     // Uncompressed, cut in the middle of the voxel data.
     let cut = dir.join("cut.nii");
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
-    let e = nifti_file::read(&cut).unwrap_err();
+    let e = nifti_file::read(&cut, &Default::default()).unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, VolumeError::Format { .. }), "{msg}");
     assert!(
@@ -155,7 +157,9 @@ fn truncated_nifti_is_a_clear_error() {
     enc.write_all(&bytes).unwrap();
     let packed = enc.finish().unwrap();
     std::fs::write(&gz, &packed[..packed.len() / 2]).unwrap();
-    let msg = nifti_file::read(&gz).unwrap_err().to_string();
+    let msg = nifti_file::read(&gz, &Default::default())
+        .unwrap_err()
+        .to_string();
     assert!(
         msg.contains("cut.nii.gz") && msg.contains("truncated"),
         "{msg}"
@@ -163,7 +167,9 @@ fn truncated_nifti_is_a_clear_error() {
     // A header cut short.
     let header = dir.join("header.nii");
     std::fs::write(&header, &bytes[..100]).unwrap();
-    let msg = nifti_file::read(&header).unwrap_err().to_string();
+    let msg = nifti_file::read(&header, &Default::default())
+        .unwrap_err()
+        .to_string();
     assert!(
         msg.contains("header.nii") && msg.contains("truncated"),
         "{msg}"
@@ -182,7 +188,9 @@ fn raw_size_mismatch_is_a_clear_error() {
         offset: 0,
         spacing: [1.0; 3],
     };
-    let msg = raw::read(&dir, &spec).unwrap_err().to_string();
+    let msg = raw::read(&dir, &spec, &Default::default())
+        .unwrap_err()
+        .to_string();
     assert!(
         msg.contains("v.raw") && msg.contains("1000 bytes") && msg.contains("need 1200"),
         "{msg}"
@@ -191,7 +199,9 @@ fn raw_size_mismatch_is_a_clear_error() {
         dims: [10, 10, 10],
         ..spec
     };
-    let msg = raw::read(&dir, &spec).unwrap_err().to_string();
+    let msg = raw::read(&dir, &spec, &Default::default())
+        .unwrap_err()
+        .to_string();
     assert!(msg.contains("need 2000"), "{msg}");
     // With matching dims it loads, big-endian.
     std::fs::write(dir.join("v.raw"), [0u8, 1, 1, 0]).unwrap();
@@ -199,11 +209,30 @@ fn raw_size_mismatch_is_a_clear_error() {
         &dir,
         &RawSpec {
             dims: [2, 1, 1],
-            ..spec
+            ..spec.clone()
         },
+        &Default::default(),
     )
     .unwrap();
     assert_eq!(ok.values, vec![1.0, 256.0]);
+    // dims whose byte count wraps 64 bits (2^61 - 1 samples of 8 bytes + 8) on an empty
+    // file: an error naming the file, not a panic (the fuzzer found this one).
+    std::fs::write(dir.join("empty.raw"), []).unwrap();
+    // With offset 8 the size overflows; with offset 0 it fits 64 bits and the texture
+    // limit refuses it, still before the file is read.
+    for (offset, cause) in [(8, "64 bits"), (0, "GL_MAX_3D_TEXTURE_SIZE")] {
+        let huge = RawSpec {
+            path: "empty.raw".into(),
+            dims: [2305843009213693951, 1, 1],
+            sample: SampleType::F64,
+            offset,
+            ..spec.clone()
+        };
+        let msg = raw::read(&dir, &huge, &Default::default())
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("empty.raw") && msg.contains(cause), "{msg}");
+    }
 }
 
 #[test]

@@ -147,7 +147,7 @@ fn faithful_equals_the_cpu_emulation_of_the_8_bit_pipeline() {
                     params_mut(&mut scene).volume_filter = volume_filter;
                     let gpu = render(&h, &scene);
                     let p = params(&scene);
-                    let prepared = prepare(p, &dir).unwrap();
+                    let prepared = prepare(p, &dir, &Default::default()).unwrap();
                     let cpu = emulate_faithful(
                         &prepared,
                         p,
@@ -186,7 +186,7 @@ fn precise_agrees_with_the_reference_integral() {
             scene.fidelity = Fidelity::Precise;
             let gpu = render(&h, &scene);
             let p = params(&scene);
-            let prepared = prepare(p, &dir).unwrap();
+            let prepared = prepare(p, &dir, &Default::default()).unwrap();
             let cpu = reference(
                 &prepared,
                 p,
@@ -297,7 +297,7 @@ fn figure_15_sum_is_a_union_and_product_an_intersection() {
 fn assert_matches_emulation(h: &Headless, scene: &Scene, dir: &Path, what: &str) -> Image {
     let gpu = render(h, scene).image;
     let p = params(scene);
-    let prepared = prepare(p, dir).unwrap();
+    let prepared = prepare(p, dir, &Default::default()).unwrap();
     let cpu = emulate_faithful(&prepared, p, &scene.camera, scene.size, background(scene));
     let d = gpu.compare(&cpu, LEVEL).unwrap();
     assert!(d.max_abs <= 2.0 * LEVEL as f64 * 1.01, "{what}: {d:?}");
@@ -377,7 +377,7 @@ fn extremes_coefficients_zero_one_and_above_one() {
 }
 
 fn prepared_of(scene: &Scene, dir: &Path) -> arbvis::techniques::opacity3d::prepare::Prepared {
-    prepare(params(scene), dir).unwrap()
+    prepare(params(scene), dir, &Default::default()).unwrap()
 }
 
 #[test]

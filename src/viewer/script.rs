@@ -31,26 +31,39 @@ pub struct Script {
     pub actions: Vec<Action>,
 }
 
-/// A script line that could not be parsed.
+/// A script that could not be read or parsed.
 #[derive(Debug, thiserror::Error)]
-#[error("{path}:{line}: {message}")]
-pub struct ScriptError {
-    /// The script file.
-    pub path: String,
-    /// 1-based line.
-    pub line: usize,
-    /// What was expected.
-    pub message: String,
+pub enum ScriptError {
+    /// The file could not be read.
+    #[error("{path}: {error}")]
+    File {
+        /// The script file.
+        path: String,
+        /// What failed.
+        error: std::io::Error,
+    },
+    /// A line that is not an action.
+    #[error("{path}:{line}: {message}")]
+    Line {
+        /// The script file.
+        path: String,
+        /// 1-based line.
+        line: usize,
+        /// What was expected.
+        message: String,
+    },
 }
 
 impl Script {
     /// Read a script file.
     pub fn load(path: &Path) -> Result<Script, ScriptError> {
-        let text = std::fs::read_to_string(path).map_err(|e| ScriptError {
-            path: path.display().to_string(),
-            line: 0,
-            message: e.to_string(),
-        })?;
+        let text =
+            crate::input::read_text(path, crate::input::MAX_SMALL_TEXT_BYTES).map_err(|e| {
+                ScriptError::File {
+                    path: path.display().to_string(),
+                    error: e,
+                }
+            })?;
         Script::parse(&text, &path.display().to_string())
     }
 
@@ -62,7 +75,7 @@ impl Script {
             if line.is_empty() {
                 continue;
             }
-            let bad = |message: String| ScriptError {
+            let bad = |message: String| ScriptError::Line {
                 path: origin.to_string(),
                 line: i + 1,
                 message,
@@ -125,8 +138,15 @@ mod tests {
     #[test]
     fn errors_name_the_line() {
         let e = Script::parse("wait 1\nwait x\n", "s.txt").unwrap_err();
-        assert_eq!(e.line, 2);
+        assert!(matches!(e, ScriptError::Line { line: 2, .. }), "{e}");
         assert!(e.to_string().starts_with("s.txt:2: "), "{e}");
+        let missing = Script::load(Path::new("nothere.txt"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            missing.starts_with("nothere.txt: no such file (looked for /"),
+            "{missing}"
+        );
         assert!(Script::parse("jump 3", "s").is_err());
         assert!(Script::parse("drag 1", "s").is_err());
         assert!(Script::parse("drag 1 NaN", "s").is_err());

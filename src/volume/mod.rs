@@ -65,30 +65,9 @@ impl Volume {
 
     /// Minimum, maximum and mean over the finite samples, and how many were not finite.
     pub fn stats(&self) -> Stats {
-        let mut s = Stats {
-            min: f64::INFINITY,
-            max: f64::NEG_INFINITY,
-            mean: 0.0,
-            non_finite: 0,
-        };
-        let mut sum = 0.0;
-        for &v in &self.values {
-            if v.is_finite() {
-                let v = v as f64;
-                s.min = s.min.min(v);
-                s.max = s.max.max(v);
-                sum += v;
-            } else {
-                s.non_finite += 1;
-            }
-        }
-        let finite = self.values.len() - s.non_finite;
-        s.mean = if finite > 0 {
-            sum / finite as f64
-        } else {
-            f64::NAN
-        };
-        s
+        let mut s = Stats::accumulator();
+        self.values.iter().for_each(|&v| s.add(v));
+        s.finish()
     }
 
     /// Half-extents of the volume's box in object space: the longest side spans [-1, 1].
@@ -115,17 +94,84 @@ pub struct Stats {
     pub non_finite: usize,
 }
 
+impl Stats {
+    /// Running statistics, fed one sample at a time (for streamed files).
+    pub fn accumulator() -> StatsAccumulator {
+        StatsAccumulator {
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+            sum: 0.0,
+            finite: 0,
+            non_finite: 0,
+        }
+    }
+
+    /// One line: `values: min .. max .. mean ..` and the count of NaN/inf samples.
+    pub fn describe(&self) -> String {
+        format!(
+            "values: min {} max {} mean {:.6}{}\n",
+            self.min,
+            self.max,
+            self.mean,
+            if self.non_finite > 0 {
+                format!(" ({} NaN or infinite samples)", self.non_finite)
+            } else {
+                String::new()
+            }
+        )
+    }
+}
+
+/// [`Stats`] being gathered.
+#[derive(Debug, Clone)]
+pub struct StatsAccumulator {
+    min: f64,
+    max: f64,
+    sum: f64,
+    finite: u64,
+    non_finite: usize,
+}
+
+impl StatsAccumulator {
+    /// Count one sample.
+    pub fn add(&mut self, v: f32) {
+        if v.is_finite() {
+            let v = v as f64;
+            self.min = self.min.min(v);
+            self.max = self.max.max(v);
+            self.sum += v;
+            self.finite += 1;
+        } else {
+            self.non_finite += 1;
+        }
+    }
+
+    /// The statistics so far.
+    pub fn finish(&self) -> Stats {
+        Stats {
+            min: self.min,
+            max: self.max,
+            mean: if self.finite > 0 {
+                self.sum / self.finite as f64
+            } else {
+                f64::NAN
+            },
+            non_finite: self.non_finite,
+        }
+    }
+}
+
 /// Errors reading volumes: each names the file, a byte offset where one applies, and what
 /// was expected there.
 #[derive(Debug, thiserror::Error)]
 pub enum VolumeError {
     /// The file could not be opened or read.
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// What failed.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The content is not what the format requires.
     #[error("{path}: at byte {offset}: {message}")]
@@ -158,10 +204,10 @@ impl VolumeError {
             message: message.into(),
         }
     }
-    pub(crate) fn io(path: &Path, source: std::io::Error) -> VolumeError {
+    pub(crate) fn io(path: &Path, error: std::io::Error) -> VolumeError {
         VolumeError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         }
     }
 }
@@ -253,8 +299,9 @@ pub enum Endian {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum VolumeSource {
-    /// A SEG-Y file (rev 1 or 2), gridded from its trace headers.
-    Segy(PathBuf),
+    /// A SEG-Y file (rev 0-2), gridded from its trace headers; pre-stack files with an
+    /// offset or stacked.
+    Segy(segy::SegySource),
     /// A NIfTI-1 file (`.nii` or `.nii.gz`); the first 3D volume.
     Nifti(PathBuf),
     /// A headerless file described in the scene.
@@ -263,21 +310,89 @@ pub enum VolumeSource {
     Synthetic(synthetic::SyntheticSpec),
 }
 
+/// What a volume may hold, checked against the dimensions a file or scene declares
+/// *before* its samples are read or generated (the GL's 3D texture limit, passed down by
+/// the renderer, and a voxel budget).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limits {
+    /// Largest side in voxels (`GL_MAX_3D_TEXTURE_SIZE`).
+    pub max_side: usize,
+    /// Largest voxel count.
+    pub max_voxels: u64,
+}
+
+impl Default for Limits {
+    /// Without a GL at hand: 16384 per side (what the largest drivers allow) and 2^31
+    /// voxels (8 GiB of f32 samples).
+    fn default() -> Self {
+        Limits {
+            max_side: 16384,
+            max_voxels: 1 << 31,
+        }
+    }
+}
+
+impl Limits {
+    /// Check `dims` declared by `what` (a file or a scene value).
+    pub fn check(&self, dims: [usize; 3], what: &str) -> Result<(), VolumeError> {
+        let voxels = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d as u64));
+        let side = dims.iter().copied().max().unwrap_or(0);
+        if dims.contains(&0) {
+            return Err(VolumeError::Invalid(format!(
+                "{what}: dimensions {dims:?} hold no voxels"
+            )));
+        }
+        if side > self.max_side {
+            return Err(VolumeError::Invalid(format!(
+                "{what}: dimensions {dims:?} exceed the largest 3D texture side, {} (GL_MAX_3D_TEXTURE_SIZE)",
+                self.max_side
+            )));
+        }
+        match voxels {
+            Some(n) if n <= self.max_voxels => Ok(()),
+            _ => Err(VolumeError::Invalid(format!(
+                "{what}: dimensions {dims:?} exceed the limit of {} voxels",
+                self.max_voxels
+            ))),
+        }
+    }
+}
+
 impl VolumeSource {
-    /// Read the volume; relative paths are taken from `base` (the scene's folder).
-    pub fn load(&self, base: &Path) -> Result<Volume, VolumeError> {
+    /// Read the volume; relative paths are taken from `base` (the scene's folder). The
+    /// dimensions are checked against `limits` before any sample is read.
+    pub fn load(&self, base: &Path, limits: &Limits) -> Result<Volume, VolumeError> {
         match self {
-            VolumeSource::Segy(p) => Ok(segy::read(&base.join(p))?.volume),
-            VolumeSource::Nifti(p) => nifti_file::read(&base.join(p)),
-            VolumeSource::Raw(spec) => raw::read(base, spec),
-            VolumeSource::Synthetic(spec) => synthetic::amplitude(spec),
+            VolumeSource::Segy(s) => {
+                let options = segy::ReadOptions {
+                    limits: *limits,
+                    prestack: s.prestack,
+                };
+                Ok(segy::read(&base.join(&s.path), &options)?.volume)
+            }
+            VolumeSource::Nifti(p) => nifti_file::read(&base.join(p), limits),
+            VolumeSource::Raw(spec) => raw::read(base, spec, limits),
+            VolumeSource::Synthetic(spec) => synthetic::amplitude(spec, limits),
+        }
+    }
+
+    /// Check the scene values that can be checked without reading files.
+    pub fn validate(&self) -> Result<(), crate::scene::FieldError> {
+        use crate::scene::FieldError;
+        match self {
+            VolumeSource::Synthetic(spec) => {
+                spec.validate().map_err(|e| FieldError::new("synthetic", e))
+            }
+            VolumeSource::Raw(spec) => spec.validate().map_err(|e| FieldError::new("raw", e)),
+            VolumeSource::Segy(_) | VolumeSource::Nifti(_) => Ok(()),
         }
     }
 
     /// The file it names, if any, for rewriting.
     pub fn path_mut(&mut self) -> Option<&mut PathBuf> {
         match self {
-            VolumeSource::Segy(p) | VolumeSource::Nifti(p) => Some(p),
+            VolumeSource::Segy(s) => Some(&mut s.path),
+            VolumeSource::Nifti(p) => Some(p),
             VolumeSource::Raw(spec) => Some(&mut spec.path),
             VolumeSource::Synthetic(_) => None,
         }
@@ -286,41 +401,38 @@ impl VolumeSource {
     /// The file it names, if any.
     pub fn path(&self) -> Option<&Path> {
         match self {
-            VolumeSource::Segy(p) | VolumeSource::Nifti(p) => Some(p),
+            VolumeSource::Segy(s) => Some(&s.path),
+            VolumeSource::Nifti(p) => Some(p),
             VolumeSource::Raw(spec) => Some(&spec.path),
             VolumeSource::Synthetic(_) => None,
         }
     }
 }
 
-/// `arbvis inspect`: what the loaders see in `path` (format chosen from the content and
-/// the extension), as text.
+/// `arbvis inspect` for volumes: what the loaders see in `path`, the format chosen from
+/// the content (gzip or NIfTI's magic) and the extension; anything else is read as SEG-Y.
 pub fn inspect(path: &Path) -> Result<String, VolumeError> {
     let name = path.to_string_lossy().to_lowercase();
     if name.ends_with(".nii") || name.ends_with(".nii.gz") {
-        let v = nifti_file::read(path)?;
-        let header = nifti_file::describe_header(path)?;
-        Ok(format!(
-            "{}\nformat: NIfTI-1\n{header}{}",
+        return Ok(format!(
+            "{}\n{}",
             path.display(),
-            describe(&v)
-        ))
-    } else {
-        let s = segy::read(path)?;
-        Ok(format!(
-            "{}\n{}{}",
-            path.display(),
-            s.describe(),
-            describe(&s.volume)
-        ))
+            nifti_file::inspect(path)?
+        ));
     }
+    let s = segy::read(path, &segy::ReadOptions::default())?;
+    Ok(format!(
+        "{}\n{}{}",
+        path.display(),
+        s.describe(),
+        describe(&s.volume)
+    ))
 }
 
 /// Dimensions and value statistics, one item per line.
 pub fn describe(v: &Volume) -> String {
-    let s = v.stats();
     format!(
-        "dimensions (i, j, k): {} x {} x {} = {} samples\nspacing: {} x {} x {}\nvalues: min {} max {} mean {:.6}{}\n",
+        "dimensions (i, j, k): {} x {} x {} = {} samples\nspacing: {} x {} x {}\n{}",
         v.dims[0],
         v.dims[1],
         v.dims[2],
@@ -328,14 +440,7 @@ pub fn describe(v: &Volume) -> String {
         v.spacing[0],
         v.spacing[1],
         v.spacing[2],
-        s.min,
-        s.max,
-        s.mean,
-        if s.non_finite > 0 {
-            format!(" ({} NaN or infinite samples)", s.non_finite)
-        } else {
-            String::new()
-        }
+        v.stats().describe()
     )
 }
 

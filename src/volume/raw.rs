@@ -35,33 +35,46 @@ fn unit_spacing() -> [f64; 3] {
     [1.0; 3]
 }
 
-/// Read a raw file; `base` resolves a relative path.
-pub fn read(base: &Path, spec: &RawSpec) -> Result<Volume, VolumeError> {
+impl RawSpec {
+    /// Check what the scene says: positive dims whose byte size fits 64 bits, positive
+    /// finite spacing.
+    pub fn validate(&self) -> Result<(), String> {
+        self.byte_size().map(|_| ())?;
+        if self.spacing.iter().any(|v| !v.is_finite() || *v <= 0.0) {
+            return Err(format!("spacing {:?}: must be positive", self.spacing));
+        }
+        Ok(())
+    }
+
+    /// Bytes the file must hold: `offset + ni*nj*nk*bytes`, with checked arithmetic.
+    fn byte_size(&self) -> Result<u64, String> {
+        let samples = self
+            .dims
+            .iter()
+            .try_fold(1u64, |a, &d| a.checked_mul(d as u64))
+            .filter(|&n| n > 0);
+        samples
+            .and_then(|n| n.checked_mul(self.sample.bytes() as u64))
+            .and_then(|n| n.checked_add(self.offset))
+            .ok_or_else(|| {
+                format!(
+                    "dims {:?} of {} after an offset of {} bytes: the dims must be positive and the size must fit 64 bits",
+                    self.dims,
+                    self.sample.name(),
+                    self.offset
+                )
+            })
+    }
+}
+
+/// Read a raw file; `base` resolves a relative path. The size the scene declares is
+/// checked against `limits` and the file's length before anything is read.
+pub fn read(base: &Path, spec: &RawSpec, limits: &super::Limits) -> Result<Volume, VolumeError> {
     let path = base.join(&spec.path);
-    let count = spec
-        .dims
-        .iter()
-        .try_fold(1usize, |a, &d| a.checked_mul(d))
-        .filter(|&n| n > 0)
-        .ok_or_else(|| {
-            VolumeError::Invalid(format!(
-                "{}: dims {:?} must be positive and not overflow",
-                path.display(),
-                spec.dims
-            ))
-        })?;
-    let need = (count as u64)
-        .checked_mul(spec.sample.bytes() as u64)
-        .and_then(|n| n.checked_add(spec.offset))
-        .ok_or_else(|| {
-            VolumeError::Invalid(format!(
-                "{}: dims {:?} of {} after an offset of {} bytes: the size overflows 64 bits",
-                path.display(),
-                spec.dims,
-                spec.sample.name(),
-                spec.offset
-            ))
-        })?;
+    let need = spec
+        .byte_size()
+        .map_err(|e| VolumeError::Invalid(format!("{}: {e}", path.display())))?;
+    limits.check(spec.dims, &path.display().to_string())?;
     let (_, len) = crate::input::open_regular(&path).map_err(|e| VolumeError::io(&path, e))?;
     if len != need {
         return Err(VolumeError::format(

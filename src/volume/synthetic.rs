@@ -58,20 +58,40 @@ pub fn ricker(t: f64, f: f64) -> f64 {
     (1.0 - 2.0 * a) * (-a).exp()
 }
 
-/// The amplitude cube.
-pub fn amplitude(spec: &SyntheticSpec) -> Result<Volume, VolumeError> {
+/// Highest Ricker peak frequency: 50 cycles per 100 samples is the Nyquist frequency.
+pub const MAX_PEAK: f64 = 50.0;
+
+impl SyntheticSpec {
+    /// Check the parameters: each side at least 1, `0 < peak <= 50` (Nyquist), noise finite.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.size.contains(&0) {
+            return Err(format!(
+                "size {:?}: each side must be at least 1",
+                self.size
+            ));
+        }
+        if !(self.peak.is_finite() && self.peak > 0.0 && self.peak <= MAX_PEAK) {
+            return Err(format!(
+                "peak = {}: must be in (0, {MAX_PEAK}] cycles per 100 samples (50 is the Nyquist frequency)",
+                self.peak
+            ));
+        }
+        if !(self.noise.is_finite() && self.noise.abs() <= 1e6) {
+            return Err(format!(
+                "noise = {}: must be finite, at most 1e6",
+                self.noise
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The amplitude cube; its size is checked against `limits` before anything is made.
+pub fn amplitude(spec: &SyntheticSpec, limits: &super::Limits) -> Result<Volume, VolumeError> {
+    spec.validate()
+        .map_err(|e| VolumeError::Invalid(format!("synthetic volume: {e}")))?;
+    limits.check(spec.size, "synthetic volume")?;
     let [ns, nx, ny] = spec.size;
-    if spec.size.contains(&0) || ns.saturating_mul(nx).saturating_mul(ny) > 1 << 28 {
-        return Err(VolumeError::Invalid(format!(
-            "synthetic size {:?}: each side must be at least 1 and the cube at most 2^28 samples",
-            spec.size
-        )));
-    }
-    if !(spec.peak.is_finite() && spec.peak > 0.0 && spec.noise.is_finite()) {
-        return Err(VolumeError::Invalid(
-            "synthetic peak must be positive and noise finite".into(),
-        ));
-    }
     let mut rng = SplitMix::new(spec.seed);
     // Layer boundaries: depth in [0, 1] of the trace, reflection coefficient in [-1, 1].
     let layers = 6 + ns / 6;
@@ -89,7 +109,9 @@ pub fn amplitude(spec: &SyntheticSpec) -> Result<Volume, VolumeError> {
         (0.65 + 0.1 * rng.next_f64(), -0.4, -0.05),
     ];
     let f = spec.peak / 100.0;
-    let half = (1.5 / f).ceil() as i64;
+    // The wavelet is cut at 1.5 periods, and never longer than the trace (beyond it, it
+    // multiplies nothing): a low peak costs no more than a trace-long convolution.
+    let half = (1.5 / f).ceil().min(ns as f64) as i64;
     let wavelet: Vec<f64> = (-half..=half).map(|t| ricker(t as f64, f)).collect();
     let mut values = vec![0f32; ns * nx * ny];
     let mut reflectivity = vec![0f64; ns];
@@ -140,31 +162,72 @@ mod tests {
             size: [48, 20, 16],
             ..Default::default()
         };
-        let a = amplitude(&spec).unwrap();
-        assert_eq!(a, amplitude(&spec).unwrap());
+        let limits = crate::volume::Limits::default();
+        let a = amplitude(&spec, &limits).unwrap();
+        assert_eq!(a, amplitude(&spec, &limits).unwrap());
         let s = a.stats();
         // Zero-mean wavelet: the mean is small next to the peaks; both signs occur.
         assert!(
             s.min < -0.2 && s.max > 0.2 && s.mean.abs() < 0.1 * s.max,
             "{s:?}"
         );
-        let other = amplitude(&SyntheticSpec { seed: 2, ..spec }).unwrap();
+        let other = amplitude(&SyntheticSpec { seed: 2, ..spec }, &limits).unwrap();
         assert_ne!(a, other);
     }
 
     #[test]
     fn bad_sizes_are_errors() {
-        for size in [[0, 4, 4], [1 << 20, 1 << 10, 1 << 10]] {
+        let limits = crate::volume::Limits::default();
+        for size in [[0, 4, 4], [1 << 20, 1 << 10, 1 << 10], [268_435_456, 1, 1]] {
             let spec = SyntheticSpec {
                 size,
                 ..Default::default()
             };
-            assert!(amplitude(&spec).is_err());
+            assert!(amplitude(&spec, &limits).is_err(), "{size:?}");
         }
+        // The GL's limit is checked before anything is generated.
+        let small_gl = crate::volume::Limits {
+            max_side: 64,
+            max_voxels: 1 << 30,
+        };
+        let spec = SyntheticSpec {
+            size: [65, 2, 2],
+            ..Default::default()
+        };
+        let e = amplitude(&spec, &small_gl).unwrap_err().to_string();
+        assert!(e.contains("GL_MAX_3D_TEXTURE_SIZE"), "{e}");
         let one = SyntheticSpec {
             size: [1, 1, 1],
             ..Default::default()
         };
-        assert!(amplitude(&one).unwrap().values[0].is_finite());
+        assert!(amplitude(&one, &limits).unwrap().values[0].is_finite());
+    }
+
+    #[test]
+    fn extreme_peaks_are_refused_or_cheap() {
+        let limits = crate::volume::Limits::default();
+        for peak in [1e-300, 0.0, -1.0, 51.0, f64::NAN] {
+            let spec = SyntheticSpec {
+                peak,
+                ..Default::default()
+            };
+            if peak > 0.0 && peak < 1e-200 {
+                // Within the range but tiny: the wavelet is cut at the trace length, so
+                // this is as fast as any other cube (the fuzzer once saw minutes here).
+                let t0 = std::time::Instant::now();
+                let v = amplitude(
+                    &SyntheticSpec {
+                        size: [16; 3],
+                        ..spec
+                    },
+                    &limits,
+                )
+                .unwrap();
+                assert!(v.values.iter().all(|x| x.is_finite()));
+                assert!(t0.elapsed().as_secs_f64() < 1.0);
+            } else {
+                assert!(amplitude(&spec, &limits).is_err(), "peak {peak}");
+            }
+        }
     }
 }

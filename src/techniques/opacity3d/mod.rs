@@ -45,6 +45,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::colortable::TableSpec;
 use crate::gl::Filter;
+use crate::scene::FieldError;
 use crate::volume::attributes::Attribute;
 use crate::volume::quantize::Quantization;
 use crate::volume::VolumeSource;
@@ -150,32 +151,41 @@ impl Opacity3dScene {
         ]
     }
 
-    /// Check values that parse but cannot render.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Check values that parse but cannot render; the error names the key.
+    pub fn validate(&self) -> Result<(), FieldError> {
         if !(1..=MAX_SLICES).contains(&self.slices) {
-            return Err(format!(
-                "slices = {}: must be 1..={MAX_SLICES}",
-                self.slices
+            return Err(FieldError::new(
+                "slices",
+                format!("slices = {}: must be 1..={MAX_SLICES}", self.slices),
             ));
         }
         if let Some(s) = self.spacing {
             if s.iter().any(|v| !v.is_finite() || *v <= 0.0) {
-                return Err(format!("spacing {s:?}: must be positive"));
+                return Err(FieldError::new(
+                    "spacing",
+                    format!("{s:?}: must be positive"),
+                ));
             }
         }
-        for (name, a) in ["primary", "secondary", "tertiary"]
-            .iter()
-            .zip(self.attributes())
-        {
+        for (name, a) in ATTRIBUTE_NAMES.iter().zip(self.attributes()) {
             if let Some(a) = a {
                 if a.coefficients.iter().any(|c| !c.is_finite() || *c < 0.0) {
-                    return Err(format!(
-                        "{name}.coefficients {:?}: must be finite and not negative",
-                        a.coefficients
+                    return Err(FieldError::new(
+                        format!("{name}.coefficients"),
+                        format!("{:?}: must be finite and not negative", a.coefficients),
                     ));
                 }
+                a.table
+                    .validate()
+                    .map_err(|e| e.within(&format!("{name}.table")))?;
+                a.volume
+                    .validate()
+                    .map_err(|e| e.within(&format!("{name}.volume")))?;
             }
         }
         Ok(())
     }
 }
+
+/// The attributes' names in scenes, in texture order.
+pub const ATTRIBUTE_NAMES: [&str; 3] = ["primary", "secondary", "tertiary"];

@@ -10,7 +10,7 @@ use super::{AttributeScene, Opacity3dScene};
 use crate::colortable::ColorTable;
 use crate::volume::attributes::derive;
 use crate::volume::quantize::{quantize, Quantization};
-use crate::volume::{Volume, VolumeSource};
+use crate::volume::{Limits, Volume, VolumeSource};
 
 /// Everything the renderer uploads, and the CPU references read.
 #[derive(Debug, Clone, PartialEq)]
@@ -73,7 +73,7 @@ pub fn from_volumes(
         .as_ref()
         .ok_or("the primary attribute is required")?
         .0;
-    let names = ["primary", "secondary", "tertiary"];
+    let names = super::ATTRIBUTE_NAMES;
     let mut quantized: [Option<Vec<u8>>; 3] = Default::default();
     let mut ranges = [None; 3];
     let mut tables: [Option<ColorTable>; 3] = Default::default();
@@ -102,12 +102,13 @@ pub fn from_volumes(
     })
 }
 
-/// Prepare a scene: load each distinct source once, derive, quantize, pack, build tables.
-pub fn prepare(scene: &Opacity3dScene, base: &Path) -> Result<Prepared, String> {
+/// Prepare a scene: load each distinct source once (its size checked against `limits`
+/// before loading), derive, quantize, pack, build tables.
+pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> Result<Prepared, String> {
     let mut loaded: Vec<(VolumeSource, Volume)> = Vec::new();
     let mut derived: [Option<Volume>; 3] = Default::default();
     let mut tables: [Option<ColorTable>; 3] = Default::default();
-    let names = ["primary", "secondary", "tertiary"];
+    let names = super::ATTRIBUTE_NAMES;
     for (a, attr) in scene.attributes().into_iter().enumerate() {
         let Some(AttributeScene {
             volume,
@@ -121,7 +122,7 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path) -> Result<Prepared, String> 
         let index = match loaded.iter().position(|(s, _)| s == volume) {
             Some(i) => i,
             None => {
-                let v = volume.load(base).map_err(|e| e.to_string())?;
+                let v = volume.load(base, limits).map_err(|e| e.to_string())?;
                 loaded.push((volume.clone(), v));
                 loaded.len() - 1
             }

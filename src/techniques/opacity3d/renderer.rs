@@ -136,8 +136,10 @@ impl Opacity3dRenderer {
         params: &Opacity3dScene,
         base: &Path,
     ) -> GlResult<Opacity3dRenderer> {
-        params.validate().map_err(GlError::Data)?;
-        let prepared = prepare(params, base).map_err(GlError::Data)?;
+        params
+            .validate()
+            .map_err(|e| GlError::Data(e.to_string()))?;
+        let prepared = prepare(params, base, &gpu.volume_limits()).map_err(GlError::Data)?;
         Opacity3dRenderer::from_prepared(gpu, kind, fidelity, params, base, prepared)
     }
 
@@ -150,7 +152,9 @@ impl Opacity3dRenderer {
         base: &Path,
         prepared: Prepared,
     ) -> GlResult<Opacity3dRenderer> {
-        params.validate().map_err(GlError::Data)?;
+        params
+            .validate()
+            .map_err(|e| GlError::Data(e.to_string()))?;
         let [ni, nj, nk] = prepared.dims;
         let max = gpu.caps().max_3d_texture_size.max(1) as usize;
         if prepared.dims.iter().any(|&d| d > max) {
@@ -193,7 +197,7 @@ impl Opacity3dRenderer {
     }
 
     fn build_tables(&mut self, gpu: &Gpu) -> GlResult<()> {
-        let names = ["primary", "secondary", "tertiary"];
+        let names = super::ATTRIBUTE_NAMES;
         for (a, name) in names.iter().enumerate() {
             self.tables[a] = match &self.prepared.tables[a] {
                 Some(t) => Some(table_texture(
@@ -297,7 +301,7 @@ impl Renderer for Opacity3dRenderer {
                 technique.name()
             )));
         };
-        new.validate().map_err(GlError::Data)?;
+        new.validate().map_err(|e| GlError::Data(e.to_string()))?;
         let new: &Opacity3dScene = new;
         let old = std::mem::replace(&mut self.params, new.clone());
         let data = |p: &Opacity3dScene| {
@@ -305,7 +309,7 @@ impl Renderer for Opacity3dRenderer {
                 .map(|a| a.map(|a| (a.volume.clone(), a.attribute, a.quantize)))
         };
         if data(&old) != data(new) || old.volume_filter != new.volume_filter {
-            let prepared = prepare(new, &self.base).map_err(GlError::Data)?;
+            let prepared = prepare(new, &self.base, &gpu.volume_limits()).map_err(GlError::Data)?;
             let fresh = Opacity3dRenderer::from_prepared(
                 gpu,
                 self.kind,

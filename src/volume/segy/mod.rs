@@ -9,8 +9,15 @@
 //! on a full rectangular grid, in any order, or the file is refused as pre-stack or
 //! irregular. The volume's axes are sample (i), crossline (j), inline (k).
 
-use std::collections::BTreeMap;
+mod grid;
+mod source;
+mod write;
+
 use std::path::Path;
+
+pub use grid::{Prestack, ReadOptions};
+pub use source::SegySource;
+pub use write::{write, WriteOptions};
 
 use super::{read_file, Volume, VolumeError};
 
@@ -230,23 +237,26 @@ pub struct SegyCube {
     pub crosslines: Vec<i32>,
     /// Number of traces.
     pub traces: usize,
+    /// The distinct source-receiver offsets of the traces (trace bytes 37-40).
+    pub offsets: Vec<i32>,
 }
 
 impl SegyCube {
     /// What `arbvis inspect` prints about the headers.
     pub fn describe(&self) -> String {
         let range = |v: &[i32]| {
-            let step = if v.len() > 1 { v[1] - v[0] } else { 0 };
-            format!(
-                "{}..={} ({} values, step {step})",
-                v[0],
-                v[v.len() - 1],
-                v.len()
-            )
+            // Steps in i64: numbers at i32::MIN and i32::MAX are 2^32 - 1 apart.
+            let steps: Vec<i64> = v.windows(2).map(|w| w[1] as i64 - w[0] as i64).collect();
+            let step = match steps.first() {
+                None => return format!("{} (one value)", v[0]),
+                Some(&s) if steps.iter().all(|&t| t == s) => format!("step {s}"),
+                Some(_) => "uneven steps".to_string(),
+            };
+            format!("{}..={} ({} values, {step})", v[0], v[v.len() - 1], v.len())
         };
         let ns = self.volume.dims[0];
         format!(
-            "format: SEG-Y rev {}.{} (bytes 3501-3502), textual header {}\nsample type: {}\nendianness: {}\ntraces: {}\ninlines: {}\ncrosslines: {}\nsamples: {} per trace, interval {} us, 0..={} ms\n",
+            "format: SEG-Y rev {}.{} (bytes 3501-3502), textual header {}\nsample type: {}\nendianness: {}\ntraces: {}\ninlines: {}\ncrosslines: {}\noffsets: {}\nsamples: {} per trace, interval {} us, 0..={} ms\n",
             self.revision.0,
             self.revision.1,
             if self.ebcdic { "EBCDIC" } else { "ASCII" },
@@ -255,6 +265,7 @@ impl SegyCube {
             self.traces,
             range(&self.inlines),
             range(&self.crosslines),
+            range(&self.offsets),
             ns,
             self.interval_us,
             (ns.saturating_sub(1)) as f64 * self.interval_us as f64 / 1000.0,
@@ -289,14 +300,14 @@ impl Reader<'_> {
     }
 }
 
-/// Read and grid a post-stack SEG-Y file.
-pub fn read(path: &Path) -> Result<SegyCube, VolumeError> {
+/// Read and grid a SEG-Y file (the whole file is read: its length bounds the memory).
+pub fn read(path: &Path, options: &ReadOptions) -> Result<SegyCube, VolumeError> {
     let bytes = read_file(path, u64::MAX)?;
-    parse(path, &bytes)
+    parse(path, &bytes, options)
 }
 
 /// Parse SEG-Y bytes; `path` names the file in errors.
-pub fn parse(path: &Path, bytes: &[u8]) -> Result<SegyCube, VolumeError> {
+pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCube, VolumeError> {
     let bin = TEXT_HEADER;
     if bytes.len() < TEXT_HEADER + BINARY_HEADER {
         return Err(VolumeError::format(
@@ -329,7 +340,8 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<SegyCube, VolumeError> {
         )
     })?;
     let revision = (bytes[bin + 300], bytes[bin + 301]);
-    let mut samples = r.u16(bin + 20) as usize;
+    let declared_samples = r.u16(bin + 20) as usize;
+    let mut samples = declared_samples;
     if samples == 0 && revision.0 >= 2 {
         samples = r.u32(bin + 68) as usize;
     }
@@ -390,55 +402,22 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<SegyCube, VolumeError> {
             "no traces after the headers",
         ));
     }
-    let mut cells: BTreeMap<(i32, i32), usize> = BTreeMap::new();
-    for t in 0..traces {
-        let h = first_trace + t * trace_len;
-        let key = (r.i32(h + 188), r.i32(h + 192));
-        if let Some(previous) = cells.insert(key, t) {
-            return Err(VolumeError::Unsupported {
-                path: path.into(),
-                message: format!(
-                    "traces {} and {} (bytes {} and {h}) both sit at inline {} crossline {} (bytes 189-196): a pre-stack or otherwise non-gridded file; arbvis grids one trace per inline/crossline",
-                    previous + 1,
-                    t + 1,
-                    first_trace + previous * trace_len,
-                    key.0,
-                    key.1
-                ),
-            });
-        }
-    }
-    let mut inlines: Vec<i32> = cells.keys().map(|k| k.0).collect();
-    inlines.dedup();
-    let mut crosslines: Vec<i32> = cells.keys().map(|k| k.1).collect();
-    crosslines.sort_unstable();
-    crosslines.dedup();
-    if inlines.len() * crosslines.len() != traces {
-        return Err(VolumeError::Unsupported {
-            path: path.into(),
-            message: format!(
-                "{traces} traces do not fill the grid of {} inlines x {} crosslines (inline {}..={}, crossline {}..={}): an irregular survey that arbvis cannot grid",
-                inlines.len(),
-                crosslines.len(),
-                inlines[0],
-                inlines[inlines.len() - 1],
-                crosslines[0],
-                crosslines[crosslines.len() - 1]
-            ),
-        });
-    }
-    let dims = [samples, crosslines.len(), inlines.len()];
-    let mut values = vec![0f32; samples * traces];
-    for (k, &il) in inlines.iter().enumerate() {
-        for (j, &xl) in crosslines.iter().enumerate() {
-            let t = cells[&(il, xl)];
-            let start = first_trace + t * trace_len + TRACE_HEADER;
-            let out = &mut values[(k * dims[1] + j) * samples..][..samples];
-            for (s, v) in out.iter_mut().enumerate() {
-                *v = format.decode(&bytes[start + s * format.bytes()..], big);
-            }
-        }
-    }
+    let layout = grid::Layout {
+        first_trace,
+        trace_len,
+        traces,
+        samples,
+        format,
+        big,
+        header_samples: declared_samples,
+    };
+    let grid::Gridded {
+        dims,
+        values,
+        inlines,
+        crosslines,
+        offsets,
+    } = grid::grid(path, bytes, &layout, options)?;
     // Spacing: one sample, one crossline step and one inline step each count as one unit;
     // SEG-Y has no common unit for time and distance.
     let volume = Volume::new(dims, [1.0, 1.0, 1.0], values).map_err(VolumeError::Invalid)?;
@@ -452,73 +431,8 @@ pub fn parse(path: &Path, bytes: &[u8]) -> Result<SegyCube, VolumeError> {
         inlines,
         crosslines,
         traces,
+        offsets,
     })
-}
-
-/// Options for [`write`].
-#[derive(Debug, Clone, Copy)]
-pub struct WriteOptions {
-    /// Sample encoding.
-    pub format: SampleFormat,
-    /// Byte order.
-    pub big_endian: bool,
-    /// 1 or 2 (rev 2 writes the byte-order word).
-    pub revision: u8,
-    /// First inline number.
-    pub first_inline: i32,
-    /// First crossline number.
-    pub first_crossline: i32,
-    /// Sample interval, microseconds.
-    pub interval_us: u16,
-}
-
-/// Encode a volume (axes sample, crossline, inline) as a SEG-Y file, inline-sorted.
-pub fn write(volume: &Volume, o: &WriteOptions) -> Vec<u8> {
-    let [ns, nx, ni] = volume.dims;
-    let mut out = vec![0x40u8; TEXT_HEADER]; // EBCDIC spaces
-    let mut bin = vec![0u8; BINARY_HEADER];
-    let put16 = |buf: &mut [u8], at: usize, v: u16| {
-        let b = if o.big_endian {
-            v.to_be_bytes()
-        } else {
-            v.to_le_bytes()
-        };
-        buf[at..at + 2].copy_from_slice(&b);
-    };
-    let put32 = |buf: &mut [u8], at: usize, v: u32| {
-        let b = if o.big_endian {
-            v.to_be_bytes()
-        } else {
-            v.to_le_bytes()
-        };
-        buf[at..at + 4].copy_from_slice(&b);
-    };
-    put16(&mut bin, 16, o.interval_us);
-    put16(&mut bin, 20, ns as u16);
-    put16(&mut bin, 24, o.format.code());
-    if o.revision >= 2 {
-        put32(&mut bin, 96, 0x0102_0304);
-    }
-    bin[300] = o.revision;
-    put16(&mut bin, 302, 1);
-    out.extend_from_slice(&bin);
-    for k in 0..ni {
-        for j in 0..nx {
-            let mut h = vec![0u8; TRACE_HEADER];
-            put32(&mut h, 188, (o.first_inline + k as i32) as u32);
-            put32(&mut h, 192, (o.first_crossline + j as i32) as u32);
-            put16(&mut h, 114, ns as u16);
-            put16(&mut h, 116, o.interval_us);
-            out.extend_from_slice(&h);
-            for i in 0..ns {
-                out.extend(
-                    o.format
-                        .encode(volume.values[volume.index(i, j, k)], o.big_endian),
-                );
-            }
-        }
-    }
-    out
 }
 
 #[cfg(test)]
@@ -576,7 +490,12 @@ mod tests {
                     if unsigned {
                         src.values.iter_mut().for_each(|x| *x += 20.0);
                     }
-                    let cube = parse(Path::new("mem.sgy"), &write(&src, &o)).unwrap();
+                    let cube = parse(
+                        Path::new("mem.sgy"),
+                        &write(&src, &o),
+                        &ReadOptions::default(),
+                    )
+                    .unwrap();
                     assert_eq!(
                         cube.volume, src,
                         "format {code} big {big_endian} rev {revision}"
@@ -601,7 +520,12 @@ mod tests {
         let (a, b) = (3600, 3600 + 11 * trace);
         swapped[a..a + trace].copy_from_slice(&bytes[b..b + trace]);
         swapped[b..b + trace].copy_from_slice(&bytes[a..a + trace]);
-        assert_eq!(parse(Path::new("m"), &swapped).unwrap().volume, v);
+        assert_eq!(
+            parse(Path::new("m"), &swapped, &ReadOptions::default())
+                .unwrap()
+                .volume,
+            v
+        );
     }
 
     #[test]
@@ -613,28 +537,132 @@ mod tests {
         // Trace 2 claims trace 1's position: a second offset at one CDP.
         let mut prestack = bytes.clone();
         prestack[3600 + trace + 192..3600 + trace + 196].copy_from_slice(&1i32.to_be_bytes());
-        let e = parse(Path::new("p.sgy"), &prestack)
+        let e = parse(Path::new("p.sgy"), &prestack, &ReadOptions::default())
             .unwrap_err()
             .to_string();
         assert!(e.contains("pre-stack") && e.contains("p.sgy"), "{e}");
         // Drop the last trace: 11 traces cannot fill 4 x 3.
-        let e = parse(Path::new("i.sgy"), &bytes[..bytes.len() - trace])
-            .unwrap_err()
-            .to_string();
+        let e = parse(
+            Path::new("i.sgy"),
+            &bytes[..bytes.len() - trace],
+            &ReadOptions::default(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("irregular"), "{e}");
         // Cut inside a trace.
-        let e = parse(Path::new("t.sgy"), &bytes[..bytes.len() - 3])
-            .unwrap_err()
-            .to_string();
+        let e = parse(
+            Path::new("t.sgy"),
+            &bytes[..bytes.len() - 3],
+            &ReadOptions::default(),
+        )
+        .unwrap_err()
+        .to_string();
         assert!(e.contains("truncated") && e.contains("trace 12"), "{e}");
         // Headers only.
-        assert!(parse(Path::new("h"), &bytes[..100]).is_err());
+        assert!(parse(Path::new("h"), &bytes[..100], &ReadOptions::default()).is_err());
         // Unknown format code.
         let mut bad = bytes.clone();
         bad[3224..3226].copy_from_slice(&[0, 99]);
         bad[3225] = 99;
         bad[3224] = 0;
-        let e = parse(Path::new("f"), &bad).unwrap_err().to_string();
+        let e = parse(Path::new("f"), &bad, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("at byte 3224"), "{e}");
+    }
+
+    /// Two cubes as one pre-stack file: every cell holds a trace of offset 100 (from
+    /// `a`) and one of offset 300 (from `b`), interleaved.
+    fn prestack_file(a: &Volume, b: &Volume) -> Vec<u8> {
+        let o = options(SampleFormat::IeeeFloat);
+        let (fa, fb) = (write(a, &o), write(b, &o));
+        let trace = TRACE_HEADER + a.dims[0] * 4;
+        let mut out = fa[..3600].to_vec();
+        for t in 0..(fa.len() - 3600) / trace {
+            for (f, offset) in [(&fa, 100i32), (&fb, 300)] {
+                let mut tr = f[3600 + t * trace..][..trace].to_vec();
+                tr[36..40].copy_from_slice(&offset.to_be_bytes());
+                out.extend(tr);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn prestack_files_pick_an_offset_or_stack() {
+        let a = cube();
+        let mut b = cube();
+        b.values.iter_mut().for_each(|v| *v = *v * 3.0 + 1.0);
+        let bytes = prestack_file(&a, &b);
+        let e = parse(Path::new("g.sgy"), &bytes, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("offsets 100, 300") && e.contains("prestack"),
+            "{e}"
+        );
+        let pick = |prestack| ReadOptions {
+            prestack,
+            ..Default::default()
+        };
+        let near = parse(Path::new("g"), &bytes, &pick(Prestack::Offset(100))).unwrap();
+        assert_eq!(near.volume, a);
+        assert_eq!(near.offsets, vec![100, 300]);
+        let far = parse(Path::new("g"), &bytes, &pick(Prestack::Offset(300))).unwrap();
+        assert_eq!(far.volume, b);
+        let stack = parse(Path::new("g"), &bytes, &pick(Prestack::Stack)).unwrap();
+        for (s, (x, y)) in stack
+            .volume
+            .values
+            .iter()
+            .zip(a.values.iter().zip(&b.values))
+        {
+            assert_eq!(*s, (x + y) / 2.0);
+        }
+        let e = parse(Path::new("g"), &bytes, &pick(Prestack::Offset(200)))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("offsets in the file") && e.contains("100, 300"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn extreme_line_numbers_and_wrong_sample_counts_are_told_plainly() {
+        let v = Volume::new([2, 2, 2], [1.0; 3], vec![1.0; 8]).unwrap();
+        let o = WriteOptions {
+            first_inline: i32::MIN,
+            ..options(SampleFormat::IeeeFloat)
+        };
+        let mut bytes = write(&v, &o);
+        // Move the second inline to i32::MAX: the step is 2^32 - 1, not a wrapped -1.
+        let trace = TRACE_HEADER + 8;
+        for t in [2, 3] {
+            bytes[3600 + t * trace + 188..][..4].copy_from_slice(&i32::MAX.to_be_bytes());
+        }
+        let c = parse(Path::new("x"), &bytes, &ReadOptions::default()).unwrap();
+        assert!(
+            c.describe()
+                .contains("-2147483648..=2147483647 (2 values, step 4294967295)"),
+            "{}",
+            c.describe()
+        );
+        // A header declaring 60,000 samples: the message says what it declares and
+        // what the file then holds.
+        let v = Volume::new([4, 10, 10], [1.0; 3], vec![1.0; 400]).unwrap();
+        let mut bytes = write(&v, &options(SampleFormat::UInt8));
+        bytes[3220..3222].copy_from_slice(&60000u16.to_be_bytes());
+        // Pad so that whole 60,240-byte traces fit: 100 traces of 244 bytes = 24,400,
+        // plus 95,600 bytes of padding = two such traces.
+        bytes.resize(3600 + 2 * 60240, 0);
+        let e = parse(Path::new("s.sgy"), &bytes, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("declares 60000 samples per trace") && e.contains("hold 2 traces"),
+            "{e}"
+        );
     }
 }

@@ -1,0 +1,148 @@
+//! `arbvis inspect FILE`: pick the reader from the file's first bytes and its extension,
+//! and print what that reader sees. A file no reader takes is named for what it looks
+//! like, with the list of what `inspect` reads.
+
+use std::io::Read;
+use std::path::Path;
+
+/// What `inspect` reads, for the message about a file it does not.
+pub const READS: &str = "SEG-Y (.sgy, .segy), NIfTI-1 (.nii, .nii.gz)";
+
+/// The kinds of file `inspect` knows.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// SEG-Y rev 0-2.
+    Segy,
+    /// NIfTI-1, plain or gzip.
+    Nifti,
+}
+
+/// Errors of `inspect`: the reader's own, or a file no reader takes.
+#[derive(Debug, thiserror::Error)]
+pub enum InspectError {
+    /// The file could not be opened.
+    #[error("{path}: {error}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What failed.
+        error: std::io::Error,
+    },
+    /// A volume reader's error.
+    #[error(transparent)]
+    Volume(#[from] crate::volume::VolumeError),
+    /// Not a format arbvis reads.
+    #[error("{path}: {what}; arbvis inspect reads {READS}")]
+    Unknown {
+        /// The file.
+        path: String,
+        /// What the first bytes look like.
+        what: String,
+    },
+}
+
+/// The reader for a file, from its extension or, failing that, its first bytes.
+pub fn kind(path: &Path, head: &[u8]) -> Option<Kind> {
+    let name = path.to_string_lossy().to_lowercase();
+    let ends = |e: &str| name.ends_with(e);
+    if ends(".nii") || ends(".nii.gz") || head.get(344..348) == Some(b"n+1\0") {
+        return Some(Kind::Nifti);
+    }
+    if ends(".sgy") || ends(".segy") || looks_like_segy(head) {
+        return Some(Kind::Segy);
+    }
+    None
+}
+
+/// A SEG-Y binary header at byte 3200 with a known sample format code (either order).
+fn looks_like_segy(head: &[u8]) -> bool {
+    let Some(code) = head.get(3224..3226) else {
+        return false;
+    };
+    [
+        u16::from_be_bytes([code[0], code[1]]),
+        u16::from_le_bytes([code[0], code[1]]),
+    ]
+    .iter()
+    .any(|&c| crate::volume::segy::SampleFormat::from_code(c).is_some())
+}
+
+/// What a file's first bytes look like, for a file no reader takes.
+pub fn looks_like(head: &[u8]) -> String {
+    let magic: &[(&[u8], &str)] = &[
+        (b"\x89PNG", "a PNG image"),
+        (b"\x1f\x8b", "gzip-compressed data"),
+        (b"PK\x03\x04", "a ZIP archive"),
+        (b"%PDF", "a PDF document"),
+        (b"\x7fELF", "an executable (ELF)"),
+        (b"\xff\xd8\xff", "a JPEG image"),
+    ];
+    if let Some((_, what)) = magic.iter().find(|(m, _)| head.starts_with(m)) {
+        return format!("it looks like {what}");
+    }
+    if head.is_empty() {
+        return "the file is empty".into();
+    }
+    let text = head
+        .iter()
+        .take(512)
+        .all(|&b| b.is_ascii_graphic() || b.is_ascii_whitespace());
+    if text {
+        let first = String::from_utf8_lossy(head)
+            .lines()
+            .map(str::trim)
+            .find(|l| !l.is_empty())
+            .unwrap_or("")
+            .to_string();
+        return format!(
+            "it looks like text starting with {:?}",
+            crate::input::shorten(&first, 40)
+        );
+    }
+    format!(
+        "binary data of no known format (starts {:02x?})",
+        &head[..head.len().min(8)]
+    )
+}
+
+/// `arbvis inspect`.
+pub fn inspect(path: &Path) -> Result<String, InspectError> {
+    let io = |error| InspectError::Io {
+        path: path.display().to_string(),
+        error,
+    };
+    let (file, _) = crate::input::open_regular(path).map_err(io)?;
+    let mut head = Vec::new();
+    file.take(4096).read_to_end(&mut head).map_err(io)?;
+    match kind(path, &head) {
+        Some(Kind::Nifti | Kind::Segy) => Ok(crate::volume::inspect(path)?),
+        None => Err(InspectError::Unknown {
+            path: path.display().to_string(),
+            what: looks_like(&head),
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn other_files_are_named_for_what_they_look_like() {
+        let dir = std::env::temp_dir().join(format!("arbvis-inspect-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let toml = dir.join("Cargo.toml");
+        std::fs::write(&toml, "[package]\nname = \"x\"\n").unwrap();
+        let e = inspect(&toml).unwrap_err().to_string();
+        assert!(
+            e.contains("text starting with \"[package]\"") && e.contains("SEG-Y (.sgy"),
+            "{e}"
+        );
+        let png = dir.join("a.bin");
+        std::fs::write(&png, b"\x89PNG\r\n\x1a\n....").unwrap();
+        let e = inspect(&png).unwrap_err().to_string();
+        assert!(e.contains("a PNG image"), "{e}");
+        let e = inspect(Path::new("/dev/zero")).unwrap_err().to_string();
+        assert!(e.contains("not a regular file"), "{e}");
+    }
+}
