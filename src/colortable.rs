@@ -178,8 +178,9 @@ impl ColorTable {
                 }
                 _ => {
                     return Err(format!(
-                        "{origin}:{}: expected four integers 0..255 (r g b a), found {content:?}",
-                        n + 1
+                        "{origin}:{}: expected four integers 0..255 (r g b a), found {:?}",
+                        n + 1,
+                        crate::input::shorten(content, 60)
                     ))
                 }
             }
