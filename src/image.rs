@@ -111,6 +111,55 @@ impl Image {
             .collect()
     }
 
+    /// What the screen shows: the same colours, every pixel opaque. A frame drawn with
+    /// "over" blending onto an opaque background already holds the composited colour;
+    /// only its alpha (which counts coverage, or the SRC_ALPHA rule) is replaced.
+    pub fn opaque(&self) -> Image {
+        let mut out = self.clone();
+        out.data.chunks_exact_mut(4).for_each(|p| p[3] = 1.0);
+        out
+    }
+
+    /// Straight (un-premultiplied) colour and coverage alpha, as image files and
+    /// browsers expect, from a frame cleared to transparent black and blended with
+    /// coverage alpha (colour then holds `C = sum c_i a_i prod (1 - a_j)`, a premultiplied
+    /// colour). Composited over any background `B` it gives `C + B (1 - A)`: the frame
+    /// that would have been drawn on `B`.
+    pub fn unpremultiplied(&self) -> Image {
+        let mut out = self.clone();
+        for p in out.data.chunks_exact_mut(4) {
+            let a = p[3];
+            for c in &mut p[..3] {
+                *c = if a > 0.0 { (*c / a).min(1.0) } else { 0.0 };
+            }
+        }
+        out
+    }
+
+    /// This image (straight colour, coverage alpha) composited over `background`, as a
+    /// browser shows it.
+    pub fn over(&self, background: impl Fn(u32, u32) -> [f32; 3]) -> Image {
+        let mut out = self.clone();
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let p = self.pixel(x, y);
+                let b = background(x, y);
+                let a = p[3];
+                out.set_pixel(
+                    x,
+                    y,
+                    [
+                        p[0] * a + b[0] * (1.0 - a),
+                        p[1] * a + b[1] * (1.0 - a),
+                        p[2] * a + b[2] * (1.0 - a),
+                        1.0,
+                    ],
+                );
+            }
+        }
+        out
+    }
+
     /// Compare with `other`; `tolerance` sets what counts in `pixels_over`.
     /// `None` when the sizes differ.
     pub fn compare(&self, other: &Image, tolerance: f32) -> Option<Difference> {

@@ -146,6 +146,10 @@ struct SceneArgs {
     /// Colour target precision (default from fidelity).
     #[arg(long, value_enum)]
     target: Option<TargetFormat>,
+    /// Transparent background: straight colour with alpha = coverage (default: opaque,
+    /// what the screen shows).
+    #[arg(long)]
+    transparent: bool,
 }
 
 impl SceneArgs {
@@ -167,6 +171,9 @@ impl SceneArgs {
         }
         if let Some(t) = self.target {
             scene.target = Some(t);
+        }
+        if self.transparent {
+            scene.transparent = true;
         }
         Ok((scene, origin))
     }
@@ -205,7 +212,7 @@ fn run(cli: Cli) -> Result<()> {
                 .with_context(|| format!("rendering {origin}"))?;
             arbvis::png_io::write_png(
                 &output,
-                &rendered.image,
+                &scene.picture(&rendered.image),
                 &rendered.png_text(&scene, &origin),
             )?;
             println!(

@@ -9,7 +9,8 @@ use crate::techniques::{self, Frame};
 
 /// One rendered scene and what made it.
 pub struct Rendered {
-    /// The image, top row first.
+    /// The frame as the target holds it, top row first (alpha is coverage); see
+    /// [`Scene::picture`] for what a picture file shows.
     pub image: Image,
     /// The program kind that drew it.
     pub program_kind: ProgramKind,
@@ -65,7 +66,7 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
     gpu.finish();
     let build_time = t0.elapsed();
     let t1 = Instant::now();
-    target.clear(gpu, scene.background)?;
+    target.clear(gpu, scene.clear_colour())?;
     let frame = Frame {
         camera: scene.camera,
         width,

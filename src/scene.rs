@@ -80,6 +80,10 @@ pub struct Scene {
     /// Clear colour, RGBA.
     #[serde(default)]
     pub background: [f32; 4],
+    /// Write pictures with a transparent background (straight colour, alpha = coverage)
+    /// instead of what the screen shows (opaque, composited over `background`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub transparent: bool,
     /// The camera.
     #[serde(default)]
     pub camera: Camera,
@@ -220,6 +224,26 @@ impl Scene {
         }
         scene.base = base;
         scene
+    }
+
+    /// The colour a frame is cleared to: transparent black for transparent pictures
+    /// (colour then accumulates premultiplied), else the background.
+    pub fn clear_colour(&self) -> [f32; 4] {
+        if self.transparent {
+            [0.0; 4]
+        } else {
+            self.background
+        }
+    }
+
+    /// A frame as the scene's pictures show it: opaque, or straight colour with
+    /// coverage alpha when `transparent`.
+    pub fn picture(&self, frame: &crate::image::Image) -> crate::image::Image {
+        if self.transparent {
+            frame.unpremultiplied()
+        } else {
+            frame.opaque()
+        }
     }
 
     /// The target precision in effect.

@@ -18,7 +18,10 @@ pub enum Blend {
     /// Fragments replace the target.
     #[default]
     Replace,
-    /// Back-to-front "over" of non-premultiplied colour: `SRC_ALPHA, ONE_MINUS_SRC_ALPHA`.
+    /// Back-to-front "over" of non-premultiplied colour: `SRC_ALPHA, ONE_MINUS_SRC_ALPHA`
+    /// for colour, `ONE, ONE_MINUS_SRC_ALPHA` for alpha, so that the target's alpha is
+    /// coverage (colour is what v3o2's blend gave; alpha makes the frame usable as a
+    /// transparent picture).
     Over,
     /// Back-to-front "over" of premultiplied colour: `ONE, ONE_MINUS_SRC_ALPHA`.
     PremultipliedOver,
@@ -102,7 +105,12 @@ pub fn draw(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<()
             Blend::Over => {
                 gl.enable(glow::BLEND);
                 gl.blend_equation(glow::FUNC_ADD);
-                gl.blend_func(glow::SRC_ALPHA, glow::ONE_MINUS_SRC_ALPHA);
+                gl.blend_func_separate(
+                    glow::SRC_ALPHA,
+                    glow::ONE_MINUS_SRC_ALPHA,
+                    glow::ONE,
+                    glow::ONE_MINUS_SRC_ALPHA,
+                );
             }
             Blend::PremultipliedOver => {
                 gl.enable(glow::BLEND);

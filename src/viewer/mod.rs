@@ -292,32 +292,50 @@ impl Running {
         }
     }
 
-    fn screenshot(&mut self, options: &ViewerOptions) {
+    /// The view as a picture: what the window shows (opaque), or, for a transparent
+    /// scene, the same frame drawn again offscreen on transparent black (straight colour,
+    /// coverage alpha), exactly as `arbvis render --transparent` writes it.
+    fn picture(&mut self) -> anyhow::Result<crate::image::Image> {
         let gpu = self.window.gpu();
-        let result = gl::read_window(gpu, self.view_px)
-            .map_err(anyhow::Error::from)
-            .and_then(|image| {
-                self.screenshots += 1;
-                let path = options
-                    .screenshot_dir
-                    .join(format!("arbvis-screenshot-{:03}.png", self.screenshots));
-                let caps = gpu.caps();
-                let text = [
-                    ("Software", format!("arbvis {}", env!("CARGO_PKG_VERSION"))),
-                    ("arbvis:scene-origin", options.origin.clone()),
-                    ("arbvis:scene", self.scene.to_toml()),
-                    (
-                        "arbvis:programs",
-                        self.renderer.program_kind().name().to_string(),
-                    ),
-                    (
-                        "arbvis:renderer",
-                        format!("{} | {} | {}", caps.vendor, caps.renderer, caps.version),
-                    ),
-                ];
-                png_io::write_png(&path, &image, &text)?;
-                Ok(path)
-            });
+        if !self.scene.transparent {
+            return Ok(gl::read_window(gpu, self.view_px)?.opaque());
+        }
+        let [_, _, w, h] = self.view_px;
+        let (w, h) = (w.max(1) as u32, h.max(1) as u32);
+        let target = gl::Target::new(gpu, w, h, self.scene.target_format())?;
+        target.clear(gpu, self.scene.clear_colour())?;
+        let frame = Frame {
+            camera: self.scene.camera,
+            width: w,
+            height: h,
+        };
+        self.renderer.draw(gpu, Surface::Target(&target), &frame)?;
+        Ok(self.scene.picture(&target.read(gpu)?))
+    }
+
+    fn screenshot(&mut self, options: &ViewerOptions) {
+        let result = self.picture().and_then(|image| {
+            self.screenshots += 1;
+            let path = options
+                .screenshot_dir
+                .join(format!("arbvis-screenshot-{:03}.png", self.screenshots));
+            let caps = self.window.gpu().caps();
+            let text = [
+                ("Software", format!("arbvis {}", env!("CARGO_PKG_VERSION"))),
+                ("arbvis:scene-origin", options.origin.clone()),
+                ("arbvis:scene", self.scene.to_toml()),
+                (
+                    "arbvis:programs",
+                    self.renderer.program_kind().name().to_string(),
+                ),
+                (
+                    "arbvis:renderer",
+                    format!("{} | {} | {}", caps.vendor, caps.renderer, caps.version),
+                ),
+            ];
+            png_io::write_png(&path, &image, &text)?;
+            Ok(path)
+        });
         self.panel.status = match result {
             Ok(p) => format!("saved {}", p.display()),
             Err(e) => format!("screenshot failed: {e}"),

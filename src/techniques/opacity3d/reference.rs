@@ -17,8 +17,8 @@
 //!   its own (measured on llvmpipe with constant tables: a = 2/255 over black adds exactly
 //!   round(200 * 2 / 255) = 2 per slice, where one rounding of the sum would add 1 or 2).
 //!
-//! Both return the colour the target holds, top row first. The alpha channel follows the
-//! `SRC_ALPHA` blend rule (it is not coverage); compare RGB when scoring.
+//! Both return the colour the target holds, top row first; alpha is coverage (the blend's
+//! alpha factors are `ONE, ONE_MINUS_SRC_ALPHA`).
 
 use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
@@ -252,7 +252,7 @@ pub fn reference(
             for ch in 0..3 {
                 dst[ch] = c[ch] * a + dst[ch] * (1.0 - a);
             }
-            dst[3] = a * a + dst[3] * (1.0 - a);
+            dst[3] = a + dst[3] * (1.0 - a);
         }
         dst
     })
@@ -298,9 +298,10 @@ pub fn emulate_faithful(
             )
             .map(to8);
             let a = src[3];
-            for ch in 0..4 {
+            for ch in 0..3 {
                 dst[ch] = (mul(src[ch], a) + mul(dst[ch], 255.0 - a)).min(255.0);
             }
+            dst[3] = (a + mul(dst[3], 255.0 - a)).min(255.0);
         }
         dst.map(|v| v / 255.0)
     })
