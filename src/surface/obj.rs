@@ -1,5 +1,6 @@
 //! Wavefront OBJ surfaces through the `tobj` crate (the maintained OBJ reader of the Rust
-//! ecosystem: negative indices, `v x y z w`, polygons of any size, groups).
+//! ecosystem: negative indices, `v x y z w`, polygons of any size, groups), with its
+//! `use_f64` feature so coordinates keep double precision.
 //!
 //! # Decisions
 //! - Only geometry is read: `v` and `f`; materials are not loaded (`mtllib` is ignored),
@@ -58,11 +59,7 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
     for model in &models {
         let m = &model.mesh;
         let base = vertices.len();
-        vertices.extend(
-            m.positions
-                .chunks_exact(3)
-                .map(|c| [c[0] as f64, c[1] as f64, c[2] as f64]),
-        );
+        vertices.extend(m.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
         let offset = |i: &u32| (base + *i as usize) as u32;
         if m.face_arities.is_empty() {
             polygons.extend(
