@@ -243,3 +243,59 @@ pub fn read(path: &Path) -> Result<TriangleMesh, SurfaceError> {
 pub fn describe(mesh: &TriangleMesh) -> String {
     inspect(mesh).to_string()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn name() -> &'static Path {
+        Path::new("faces.ply")
+    }
+
+    #[test]
+    fn from_indexed_checks_with_positions() {
+        let v = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.3, 0.2, 1.0],
+        ];
+        let faces: Vec<Vec<u32>> = vec![vec![0, 2, 1], vec![0, 1, 3], vec![1, 2, 3, 0]];
+        let m = TriangleMesh::from_indexed(name(), v.clone(), &faces).unwrap();
+        assert_eq!(
+            m.triangles,
+            vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [1, 3, 0]]
+        );
+        let e = |v: Vec<[f64; 3]>, f: &[Vec<u32>]| {
+            TriangleMesh::from_indexed(name(), v, f)
+                .unwrap_err()
+                .to_string()
+        };
+        let mut nan = v.clone();
+        nan[2][1] = f64::NAN;
+        assert!(e(nan, &faces).contains("faces.ply: vertex 2: coordinates must be finite"));
+        let mut inf = v.clone();
+        inf[3][0] = f64::NEG_INFINITY;
+        assert!(e(inf, &faces).contains("vertex 3"));
+        let bad = vec![vec![0, 1, 2], vec![0, 4, 1]];
+        assert!(e(v.clone(), &bad)
+            .contains("polygon 1: corner 1 is vertex 4, but there are 4 vertices"));
+        assert!(
+            e(v.clone(), &[vec![0, 1]]).contains("polygon 0: a polygon needs 3 or more corners")
+        );
+        assert!(e(v.clone(), &[]).contains("no triangles"));
+        assert!(e(vec![], &[vec![0, 0, 0]]).contains("but there are 0 vertices"));
+    }
+
+    #[test]
+    fn parse_dispatches_by_extension() {
+        let e = parse(Path::new("x.ply"), b"ply\n").unwrap_err().to_string();
+        assert!(e.contains("TriangleMesh::from_indexed"), "{e}");
+        let e = parse(Path::new("x.off"), b"OFF\n").unwrap_err().to_string();
+        assert!(e.contains("expected .obj or .stl"), "{e}");
+        let e = read(Path::new("/")).unwrap_err().to_string();
+        assert!(e.contains("directory"), "{e}");
+        let m = parse(Path::new("X.OBJ"), b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        assert_eq!(m.bounds(), ([0.0; 3], [1.0, 1.0, 0.0]));
+    }
+}

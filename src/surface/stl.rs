@@ -500,5 +500,11 @@ mod tests {
         // Euler characteristic V - E + F = 5500 - 16554 + 11036 = -18: a closed surface of
         // genus 10 (the part has ten holes through it).
         assert_eq!((m.vertices.len(), r.edges), (5500, 16_554));
+        assert_eq!(
+            (r.degenerate_triangles, r.self_intersections),
+            (3, 0),
+            "{r}"
+        );
+        assert!((r.signed_volume - 139.0754).abs() < 1e-3, "{r}");
     }
 }

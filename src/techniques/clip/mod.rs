@@ -35,9 +35,22 @@
 //!   one diagonal from the boundary has neighbours at most one diagonal nearer).
 //!
 //! # Extremes, each with a test (`tests.rs`)
-//! A shape touching the volume border; `B = 1`; `B` = the volume size; sides not
-//! divisible by `B` (37 x 23 x 11); empty and full clips; more slots than 8 bits address;
-//! a shape thinner than a voxel; bad meshes (open, NaN, empty).
+//! A shape touching the volume border (border voxels are simply inside); `B = 1`; `B` =
+//! the volume size (one block); sides not divisible by `B` (37 x 23 x 11: partial blocks);
+//! empty and full clips (no DATA at all); more slots than 8 bits address (300 x 300 x 12,
+//! `B = 1`); a shape thinner than a voxel (its voxel centres never reach 0.5 by much, so
+//! it shows only where lookups fall within its thickness; both textures agree); bad
+//! meshes: NaN or empty are errors with position, open ones are decided by the winding
+//! number.
+//!
+//! # Measured (release, 2-core machine, `tests::build_times`)
+//! Texture + INDEX-DATA (B = 8) build: sphere 128³ 0.03 + 0.01 s, 256³ 0.22 + 0.07 s;
+//! 42400-IDGH.stl (11,036 triangles) 128³ 0.10 + 0.01 s, 256³ 0.48 + 0.05 s; cow.obj
+//! 256³ 0.18 + 0.06 s. Compression ratio of a sphere of radius 0.35 N at 256³, B = 8,
+//! R8 / R8 / RGBA32F: 0.195 (2,696 of 32,768 blocks; DATA alone is 0.164, the extended
+//! copies costing `(10/8)³ = 1.95` times the blocks). No block size and no INDEX format
+//! reaches 0.16 at 256³ (best 0.171 with an RGBA8 INDEX, which cannot address the slots);
+//! the ratio falls as 1/N: 0.140 at 384³, 0.114 at 512³.
 
 pub mod mask_field;
 pub mod mesh_field;

@@ -39,8 +39,10 @@
 //! The slot centres take `sx`, `sy`, `sz` distinct values per axis
 //! ([`MultiRes::slot_grid`]); an 8-bit INDEX has 256 levels but must hit each centre to
 //! a small fraction of a DATA texel, which `i / 255` does not: the error is up to
-//! `D / 510` texels (a quarter of a 128-texel DATA axis already). [`MultiRes::
-//! index_coordinate_error`] measures it for 8, 16 and 32 bits. The INDEX is therefore
+//! `D / 510` texels (a quarter of a texel on a 128-texel DATA axis already).
+//! [`MultiRes::index_coordinate_error`] measures it for 8, 16 and 32 bits (at
+//! 300 x 300 x 12 with `B = 1`, D = 216: over a quarter texel at 8 bits; see
+//! `tests::more_slots_than_8_bits_address`). The INDEX is therefore
 //! RGBA32F (exact to `D * 2^-25` texels); RGBA16 unorm would allow `D / 131070` texels
 //! (0.016 texel at D = 2048: values off by up to 0.5 % of the 0..1 range near the
 //! boundary), and cannot hold the signed offsets of [`IndexEncoding::Offset`].
