@@ -16,7 +16,9 @@
 //! one diagonal of the surface, and elsewhere only the sign. Per k-slice (in parallel):
 //! - distances: each triangle whose bounding box, grown by one diagonal, meets the slice
 //!   writes the exact point-triangle distance (Ericson's closest point) to the voxel
-//!   centres of that grown box; the minimum is kept. Voxels no triangle reached are more
+//!   centres of that grown box that lie within one diagonal of its plane (an x-interval
+//!   per row, so the work follows the surface's area, not its triangles' boxes); the
+//!   minimum is kept. Voxels no triangle reached are more
 //!   than one diagonal away and get `±2 diag`.
 //! - signs: each row `(j, k)` along x collects its crossings with the triangles, found
 //!   with a watertight 2D point-in-triangle test in the yz-plane (exact orientation sign
@@ -36,6 +38,9 @@ use rayon::prelude::*;
 
 use super::texture::ClipGrid;
 use crate::surface::TriangleMesh;
+
+/// Largest number of (triangle, slice) pairs binned before slices scan all triangles.
+const MAX_BIN_ENTRIES: usize = 1 << 26;
 
 /// A mesh placed in object space, ready to evaluate.
 #[derive(Debug)]
@@ -105,6 +110,11 @@ impl MeshShape {
 
     /// Clip distance at every voxel centre (see the module doc), i fastest.
     pub fn field(&self, grid: &ClipGrid) -> Vec<f32> {
+        self.field_binned(grid, MAX_BIN_ENTRIES)
+    }
+
+    /// [`MeshShape::field`] binning at most `max_bin_entries` (triangle, slice) pairs.
+    pub(crate) fn field_binned(&self, grid: &ClipGrid, max_bin_entries: usize) -> Vec<f32> {
         let [ni, nj, nk] = grid.dims;
         let h = grid.voxel();
         let diag = grid.diagonal();
@@ -115,14 +125,21 @@ impl MeshShape {
             let last = ((b - lo[axis]) / h[axis] - 0.5).floor().min(n as f64 - 1.0);
             (first <= last).then_some((first as usize, last as usize))
         };
-        let mut bins: Vec<Vec<u32>> = vec![Vec::new(); nk];
         let boxes: Vec<(DVec3, DVec3)> = self
             .triangles
             .iter()
             .map(|[a, b, c]| (a.min(*b).min(*c), a.max(*b).max(*c)))
             .collect();
-        for (t, (bmin, bmax)) in boxes.iter().enumerate() {
-            if let Some((k0, k1)) = range(bmin.z - diag, bmax.z + diag, 2, nk) {
+        // Triangles per k-slice; when that list would be huge (many triangles spanning
+        // most of the grid), each slice scans all triangles instead.
+        let slices_of = |t: usize| range(boxes[t].0.z - diag, boxes[t].1.z + diag, 2, nk);
+        let entries: usize = (0..boxes.len())
+            .map(|t| slices_of(t).map_or(0, |(k0, k1)| k1 - k0 + 1))
+            .fold(0usize, usize::saturating_add);
+        let binned = entries <= max_bin_entries;
+        let mut bins: Vec<Vec<u32>> = vec![Vec::new(); if binned { nk } else { 0 }];
+        for t in 0..boxes.len() {
+            if let (true, Some((k0, k1))) = (binned, slices_of(t)) {
                 for bin in &mut bins[k0..=k1] {
                     bin.push(t as u32);
                 }
@@ -136,7 +153,18 @@ impl MeshShape {
                 let z = lo.z + (k as f64 + 0.5) * h.z;
                 let mut distance = vec![f64::INFINITY; ni * nj];
                 let mut rows: Vec<Vec<(f64, i32)>> = vec![Vec::new(); nj];
-                for &t in &bins[k] {
+                let all: Vec<u32>;
+                let list = if binned {
+                    &bins[k]
+                } else {
+                    all = (0..boxes.len() as u32)
+                        .filter(|&t| {
+                            slices_of(t as usize).is_some_and(|(k0, k1)| (k0..=k1).contains(&k))
+                        })
+                        .collect();
+                    &all
+                };
+                for &t in list {
                     let tri = self.triangles[t as usize];
                     let (bmin, bmax) = boxes[t as usize];
                     let Some((j0, j1)) = range(bmin.y - diag, bmax.y + diag, 1, nj) else {
@@ -145,9 +173,24 @@ impl MeshShape {
                     // Crossings count even where the triangle lies beyond the grid in x.
                     let i_range = range(bmin.x - diag, bmax.x + diag, 0, ni);
                     let crosses_slice = z >= bmin.z && z <= bmax.z;
+                    // Only centres within one diagonal of the triangle's plane can be within
+                    // one diagonal of it: along a row that is an x-interval.
+                    let normal = (tri[1] - tri[0]).cross(tri[2] - tri[0]);
+                    let reach = diag * normal.length();
                     for j in j0..=j1 {
                         let y = lo.y + (j as f64 + 0.5) * h.y;
-                        if let Some((i0, i1)) = i_range {
+                        let band = i_range.and_then(|(i0, i1)| {
+                            let c = normal.dot(DVec3::new(0.0, y, z) - tri[0]);
+                            if normal.x.abs() > reach * 1e-12 {
+                                let (a, b) = ((-reach - c) / normal.x, (reach - c) / normal.x);
+                                let (x0, x1) = (a.min(b), a.max(b));
+                                let (b0, b1) = range(x0, x1, 0, ni)?;
+                                (b0.max(i0) <= b1.min(i1)).then_some((b0.max(i0), b1.min(i1)))
+                            } else {
+                                (c.abs() <= reach || reach == 0.0).then_some((i0, i1))
+                            }
+                        });
+                        if let Some((i0, i1)) = band {
                             for i in i0..=i1 {
                                 let p = DVec3::new(lo.x + (i as f64 + 0.5) * h.x, y, z);
                                 let d = (closest_point(p, tri) - p).length();

@@ -44,9 +44,9 @@
 //! number.
 //!
 //! # Measured (release, 2-core machine, `tests::build_times`)
-//! Texture + INDEX-DATA (B = 8) build: sphere 128³ 0.03 + 0.01 s, 256³ 0.22 + 0.07 s;
-//! 42400-IDGH.stl (11,036 triangles) 128³ 0.10 + 0.01 s, 256³ 0.48 + 0.05 s; cow.obj
-//! 256³ 0.18 + 0.06 s. Compression ratio of a sphere of radius 0.35 N at 256³, B = 8,
+//! Texture + INDEX-DATA (B = 8) build, seconds (shared machine, ±30 %): sphere 128³
+//! 0.03 + 0.01, 256³ 0.21 + 0.08, 512³ 2.2 + 0.6; 42400-IDGH.stl (11,036 triangles) 128³
+//! 0.09 + 0.01, 256³ 0.33 + 0.07; cow.obj (5,804 triangles) 256³ 0.23 + 0.07. Compression ratio of a sphere of radius 0.35 N at 256³, B = 8,
 //! R8 / R8 / RGBA32F: 0.195 (2,696 of 32,768 blocks; DATA alone is 0.164, the extended
 //! copies costing `(10/8)³ = 1.95` times the blocks). No block size and no INDEX format
 //! reaches 0.16 at 256³ (best 0.171 with an RGBA8 INDEX, which cannot address the slots);

@@ -371,6 +371,19 @@ fn mesh_field_of_a_cube_equals_the_analytic_box() {
         }
     }
     assert_eq!(mesh.repaired_rows(), 0);
+    // Slices scanning every triangle give the same field as binned slices.
+    assert_eq!(mesh.field_binned(&grid, 0), field);
+    // A box far larger than the grid: every voxel inside, at the clamp.
+    let huge = MeshShape::new(
+        &box_mesh([-40.0, -30.0, -20.0], [50.0, 35.0, 25.0]),
+        DVec3::ZERO,
+        DVec3::ONE,
+        glam::DQuat::IDENTITY,
+    );
+    assert!(huge
+        .field(&grid)
+        .iter()
+        .all(|&f| f as f64 == 2.0 * diag as f32 as f64));
 }
 
 #[test]
