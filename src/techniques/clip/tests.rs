@@ -601,6 +601,35 @@ fn scene_specs_parse_and_build() {
     let mr = built.multires.unwrap();
     assert_eq!(mr.index_dims, [3, 3, 2]);
     check_equivalence(&built.single, &mr, 17);
+    // A mask of the synthetic cube (amplitude over 0.1), on its own grid, with a sphere.
+    let text = r#"
+        block = 3
+        shape = { intersection = [
+            { mask = { volume = { synthetic = { size = [20, 16, 12], seed = 4, peak = 8.0, noise = 0.02 } }, threshold = 0.1 } },
+            { sphere = { center = [0.2, 0, 0], radius = 0.6 } } ] }
+    "#;
+    let mask_spec: ClipSpec = toml::from_str(text).unwrap();
+    let built = mask_spec
+        .build(Path::new("."), [20, 16, 12], half([20, 16, 12]), 2048)
+        .unwrap();
+    let mr = built.multires.unwrap();
+    assert!(mr.slots > 0 && mr.classes.contains(&BlockClass::Outside));
+    check_equivalence(&built.single, &mr, 19);
+    let grid = built.single.grid;
+    for k in 0..12 {
+        for j in 0..16 {
+            for i in 0..20 {
+                let v = built.single.values[grid.index(i, j, k)];
+                if v != 0.5 {
+                    assert_eq!(
+                        v > 0.5,
+                        built.shape.inside(grid.centre(i, j, k)),
+                        "{i} {j} {k}: {v}"
+                    );
+                }
+            }
+        }
+    }
     // Round trip.
     let again: ClipSpec = toml::from_str(&toml::to_string(&spec).unwrap()).unwrap();
     assert_eq!(again, spec);
