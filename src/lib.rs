@@ -21,6 +21,7 @@ pub mod programs;
 pub mod render;
 pub mod scene;
 pub mod study;
+pub mod surface;
 pub mod techniques;
 #[cfg(feature = "viewer")]
 pub mod viewer;

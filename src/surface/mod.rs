@@ -1,0 +1,301 @@
+//! Closed triangle surfaces, read from Wavefront OBJ ([`obj`], through the `tobj` crate)
+//! and STL binary or ASCII ([`stl`], by hand), or built from an indexed polygon list
+//! ([`TriangleMesh::from_indexed`], which a PLY face list feeds). Used as clip objects.
+//!
+//! # Decisions
+//! - Polygons of more than three corners are split as a fan from their first corner (as
+//!   `tobj` does); that is right for convex polygons (the cow's quads), not for concave ones.
+//!   Polygons of fewer than three corners are errors.
+//! - Every mesh is validated once, in [`TriangleMesh::from_indexed`]: at least one triangle,
+//!   finite vertices (NaN / infinities name the vertex), indices in range (naming the
+//!   polygon and corner). Formats wrap these errors with their own positions where they
+//!   know them (the OBJ line).
+//! - Defects that leave a surface usable are *not* errors: open edges (used by one
+//!   triangle), non-manifold edges (used by three or more), triangles whose orientation
+//!   disagrees with a neighbour's, degenerate triangles and self-intersections. The clip
+//!   code decides inside and outside by the winding number, which stays defined with
+//!   them (small holes shift it only near the hole). [`topology::inspect`] counts them
+//!   (`arbvis inspect`-style text by [`describe`]).
+//! - STL has no shared vertices: equal positions (bit for bit, after -0 = +0) are welded so
+//!   that the edge counts mean something. OBJ and indexed input keep their indices.
+//! - PLY: the PLY reader (`crate::points::ply`, another branch) yields vertices and face
+//!   lists; `TriangleMesh::from_indexed(name, vertices, faces)` is where they plug in.
+//!   [`read`] does not dispatch `.ply` yet and says so.
+
+pub mod obj;
+pub mod stl;
+pub mod topology;
+
+use std::path::{Path, PathBuf};
+
+pub use topology::{inspect, MeshReport};
+
+/// Largest surface file read (a 256 MiB binary STL holds 5 million triangles).
+pub const MAX_SURFACE_BYTES: u64 = 256 << 20;
+
+/// A triangle surface: vertices and triangles indexing them (counter-clockwise seen from
+/// outside for an outward orientation).
+#[derive(Debug, Clone, PartialEq)]
+pub struct TriangleMesh {
+    /// Vertex positions, all finite.
+    pub vertices: Vec<[f64; 3]>,
+    /// Triangles, every index `< vertices.len()`; at least one.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Where in a file a problem is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Position {
+    /// Text: 1-based line and column.
+    Line {
+        /// Line (1-based).
+        line: usize,
+        /// Column in characters (1-based).
+        column: usize,
+    },
+    /// Binary: byte offset.
+    Byte(u64),
+    /// An item of the mesh (no file position known): "vertex 3", "polygon 7, corner 2".
+    Item(&'static str, usize),
+}
+
+impl std::fmt::Display for Position {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Position::Line { line, column } => write!(f, "line {line}, column {column}"),
+            Position::Byte(b) => write!(f, "at byte {b}"),
+            Position::Item(what, i) => write!(f, "{what} {i}"),
+        }
+    }
+}
+
+/// Errors reading or building surfaces: each names the file (or the mesh's display name)
+/// and the position of the problem.
+#[derive(Debug, thiserror::Error)]
+pub enum SurfaceError {
+    /// The file could not be opened or read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What failed.
+        source: std::io::Error,
+    },
+    /// The content is not what the format requires, or the mesh is unusable.
+    #[error("{path}: {position}: {message}")]
+    Format {
+        /// The file.
+        path: PathBuf,
+        /// Where.
+        position: Position,
+        /// What was expected and what was found.
+        message: String,
+    },
+    /// The format is not one this module reads.
+    #[error("{path}: {message}")]
+    Unsupported {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+}
+
+impl SurfaceError {
+    pub(crate) fn format(path: &Path, position: Position, message: impl Into<String>) -> Self {
+        SurfaceError::Format {
+            path: path.to_path_buf(),
+            position,
+            message: message.into(),
+        }
+    }
+}
+
+impl TriangleMesh {
+    /// Build and validate a mesh from vertices and polygons (3 or more corners each, split
+    /// as fans). `name` names the source in errors. This is the entry point for PLY faces.
+    pub fn from_indexed<I, P>(
+        name: &Path,
+        vertices: Vec<[f64; 3]>,
+        polygons: I,
+    ) -> Result<TriangleMesh, SurfaceError>
+    where
+        I: IntoIterator<Item = P>,
+        P: AsRef<[u32]>,
+    {
+        if let Some((v, p)) = vertices
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(SurfaceError::format(
+                name,
+                Position::Item("vertex", v),
+                format!("coordinates must be finite, found {p:?}"),
+            ));
+        }
+        let n = vertices.len();
+        let mut triangles = Vec::new();
+        for (pi, poly) in polygons.into_iter().enumerate() {
+            let poly = poly.as_ref();
+            if poly.len() < 3 {
+                return Err(SurfaceError::format(
+                    name,
+                    Position::Item("polygon", pi),
+                    format!("a polygon needs 3 or more corners, found {}", poly.len()),
+                ));
+            }
+            if let Some((c, &i)) = poly.iter().enumerate().find(|(_, &i)| i as usize >= n) {
+                return Err(SurfaceError::format(
+                    name,
+                    Position::Item("polygon", pi),
+                    format!("corner {c} is vertex {i}, but there are {n} vertices"),
+                ));
+            }
+            triangles.try_reserve(poly.len() - 2).map_err(|_| {
+                SurfaceError::format(name, Position::Item("polygon", pi), "out of memory")
+            })?;
+            for w in 1..poly.len() - 1 {
+                triangles.push([poly[0], poly[w], poly[w + 1]]);
+            }
+        }
+        if triangles.is_empty() {
+            return Err(SurfaceError::format(
+                name,
+                Position::Item("polygon", 0),
+                "the surface has no triangles",
+            ));
+        }
+        Ok(TriangleMesh {
+            vertices,
+            triangles,
+        })
+    }
+
+    /// The three corners of triangle `t`.
+    pub fn corners(&self, t: usize) -> [[f64; 3]; 3] {
+        self.triangles[t].map(|i| self.vertices[i as usize])
+    }
+
+    /// Smallest and largest corner of the vertices used by triangles.
+    pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for t in &self.triangles {
+            for &i in t {
+                let p = self.vertices[i as usize];
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
+                }
+            }
+        }
+        (lo, hi)
+    }
+
+    /// The mesh with every vertex mapped by `f`.
+    pub fn map_vertices(&self, f: impl Fn([f64; 3]) -> [f64; 3]) -> TriangleMesh {
+        TriangleMesh {
+            vertices: self.vertices.iter().map(|&p| f(p)).collect(),
+            triangles: self.triangles.clone(),
+        }
+    }
+}
+
+/// Parse a surface from bytes; the format is chosen from `name`'s extension (`.obj`,
+/// `.stl`), `name` naming the source in errors.
+pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
+    let ext = name
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "obj" => obj::parse(name, bytes),
+        "stl" => stl::parse(name, bytes),
+        "ply" => Err(SurfaceError::Unsupported {
+            path: name.to_path_buf(),
+            message: "PLY surfaces are read by crate::points::ply (not in this build); \
+                      feed its faces to TriangleMesh::from_indexed"
+                .into(),
+        }),
+        _ => Err(SurfaceError::Unsupported {
+            path: name.to_path_buf(),
+            message: format!(
+                "unknown surface extension {:?}: expected .obj or .stl",
+                crate::input::shorten(&ext, 20)
+            ),
+        }),
+    }
+}
+
+/// Read a surface file (regular files of at most [`MAX_SURFACE_BYTES`]).
+pub fn read(path: &Path) -> Result<TriangleMesh, SurfaceError> {
+    let bytes =
+        crate::input::read_regular(path, MAX_SURFACE_BYTES).map_err(|source| SurfaceError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    parse(path, &bytes)
+}
+
+/// `arbvis inspect` text for a surface: counts, bounds and the defects of
+/// [`topology::inspect`], one item per line.
+pub fn describe(mesh: &TriangleMesh) -> String {
+    inspect(mesh).to_string()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn name() -> &'static Path {
+        Path::new("faces.ply")
+    }
+
+    #[test]
+    fn from_indexed_checks_with_positions() {
+        let v = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.3, 0.2, 1.0],
+        ];
+        let faces: Vec<Vec<u32>> = vec![vec![0, 2, 1], vec![0, 1, 3], vec![1, 2, 3, 0]];
+        let m = TriangleMesh::from_indexed(name(), v.clone(), &faces).unwrap();
+        assert_eq!(
+            m.triangles,
+            vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [1, 3, 0]]
+        );
+        let e = |v: Vec<[f64; 3]>, f: &[Vec<u32>]| {
+            TriangleMesh::from_indexed(name(), v, f)
+                .unwrap_err()
+                .to_string()
+        };
+        let mut nan = v.clone();
+        nan[2][1] = f64::NAN;
+        assert!(e(nan, &faces).contains("faces.ply: vertex 2: coordinates must be finite"));
+        let mut inf = v.clone();
+        inf[3][0] = f64::NEG_INFINITY;
+        assert!(e(inf, &faces).contains("vertex 3"));
+        let bad = vec![vec![0, 1, 2], vec![0, 4, 1]];
+        assert!(e(v.clone(), &bad)
+            .contains("polygon 1: corner 1 is vertex 4, but there are 4 vertices"));
+        assert!(
+            e(v.clone(), &[vec![0, 1]]).contains("polygon 0: a polygon needs 3 or more corners")
+        );
+        assert!(e(v.clone(), &[]).contains("no triangles"));
+        assert!(e(vec![], &[vec![0, 0, 0]]).contains("but there are 0 vertices"));
+    }
+
+    #[test]
+    fn parse_dispatches_by_extension() {
+        let e = parse(Path::new("x.ply"), b"ply\n").unwrap_err().to_string();
+        assert!(e.contains("TriangleMesh::from_indexed"), "{e}");
+        let e = parse(Path::new("x.off"), b"OFF\n").unwrap_err().to_string();
+        assert!(e.contains("expected .obj or .stl"), "{e}");
+        let e = read(Path::new("/")).unwrap_err().to_string();
+        assert!(e.contains("directory"), "{e}");
+        let m = parse(Path::new("X.OBJ"), b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
+        assert_eq!(m.bounds(), ([0.0; 3], [1.0, 1.0, 0.0]));
+    }
+}
