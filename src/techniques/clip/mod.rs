@@ -307,7 +307,7 @@ impl ShapeSpec {
                 if threshold.is_nan() {
                     return Err(ClipError::Invalid("mask threshold is NaN".into()));
                 }
-                let volume = volume.load(base)?;
+                let volume = volume.load(base, &crate::volume::Limits::default())?;
                 Shape::Mask(Box::new(mask_field::MaskShape::new(
                     &volume, *threshold, half,
                 )))
