@@ -131,7 +131,7 @@ fn stats_list_only_what_the_scene_names() {
     let kinds: Vec<&str> = r.resources.iter().map(|r| r.kind).collect();
     assert_eq!(
         kinds,
-        ["framebuffer", "program", "buffer"],
+        ["program", "buffer", "framebuffer"],
         "{:?}",
         r.resources
     );

@@ -48,6 +48,10 @@ pub struct DrawCall<'a> {
     pub textures: &'a [(u32, &'a Texture)],
     /// Blending.
     pub blend: Blend,
+    /// Depth test `LESS` with depth writes (the surface needs a depth buffer).
+    pub depth_test: bool,
+    /// Cull back faces (counter-clockwise triangles face the viewer).
+    pub cull_back: bool,
 }
 
 /// Clear `surface` (only its viewport, for a window) to `rgba`.
@@ -60,6 +64,11 @@ pub fn clear(gpu: &Gpu, surface: Surface<'_>, rgba: [f32; 4]) -> GlResult<()> {
             Surface::Target(t) => {
                 t.bind();
                 gl.disable(glow::SCISSOR_TEST);
+                if t.has_depth() {
+                    gl.depth_mask(true);
+                    gl.clear_depth_f64(1.0);
+                    gl.clear(glow::DEPTH_BUFFER_BIT);
+                }
             }
             Surface::Window([x, y, w, h]) => {
                 gl.bind_framebuffer(glow::FRAMEBUFFER, None);
@@ -96,8 +105,20 @@ pub fn draw(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<()
     }
     // SAFETY: plain state calls.
     unsafe {
-        gl.disable(glow::DEPTH_TEST);
-        gl.disable(glow::CULL_FACE);
+        if call.depth_test {
+            gl.enable(glow::DEPTH_TEST);
+            gl.depth_func(glow::LESS);
+            gl.depth_mask(true);
+        } else {
+            gl.disable(glow::DEPTH_TEST);
+        }
+        if call.cull_back {
+            gl.enable(glow::CULL_FACE);
+            gl.cull_face(glow::BACK);
+            gl.front_face(glow::CCW);
+        } else {
+            gl.disable(glow::CULL_FACE);
+        }
         gl.disable(glow::SCISSOR_TEST);
         gl.color_mask(true, true, true, true);
         match call.blend {

@@ -162,6 +162,8 @@ mod tests {
             range: None,
             textures: &[],
             blend: Blend::Over,
+            depth_test: false,
+            cull_back: false,
         };
         draw(gpu, Surface::Target(&target), &call).unwrap();
         target.read(gpu).unwrap();

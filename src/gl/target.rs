@@ -69,11 +69,13 @@ impl TargetFormat {
     }
 }
 
-/// An owned framebuffer with one colour texture; deleted on Drop.
+/// An owned framebuffer with one colour texture and, when asked for, a 24-bit depth
+/// buffer; deleted on Drop.
 pub struct Target {
     gl: Arc<glow::Context>,
     framebuffer: glow::Framebuffer,
     color: glow::Texture,
+    depth: Option<glow::Renderbuffer>,
     width: u32,
     height: u32,
     format: TargetFormat,
@@ -82,6 +84,26 @@ pub struct Target {
 impl Target {
     /// Create a `width` x `height` target of `format`, cleared to transparent black.
     pub fn new(gpu: &Gpu, width: u32, height: u32, format: TargetFormat) -> GlResult<Target> {
+        Target::create(gpu, width, height, format, false)
+    }
+
+    /// [`Target::new`] with a 24-bit depth buffer (cleared to 1 with the colour).
+    pub fn with_depth(
+        gpu: &Gpu,
+        width: u32,
+        height: u32,
+        format: TargetFormat,
+    ) -> GlResult<Target> {
+        Target::create(gpu, width, height, format, true)
+    }
+
+    fn create(
+        gpu: &Gpu,
+        width: u32,
+        height: u32,
+        format: TargetFormat,
+        with_depth: bool,
+    ) -> GlResult<Target> {
         if width == 0 || height == 0 || width > 16384 || height > 16384 {
             return Err(GlError::Invalid(format!(
                 "target size {width}x{height} (each side 1..=16384)"
@@ -89,7 +111,7 @@ impl Target {
         }
         let gl = gpu.glow().clone();
         // SAFETY: fresh objects; the previous framebuffer and texture bindings are restored.
-        let (framebuffer, color, status) = unsafe {
+        let (framebuffer, color, depth, status) = unsafe {
             let prev_fb = gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING);
             let prev_active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
             gl.active_texture(glow::TEXTURE0);
@@ -122,18 +144,40 @@ impl Target {
                 Some(color),
                 0,
             );
+            let depth = if with_depth {
+                let rb = gl.create_renderbuffer().map_err(GlError::Invalid)?;
+                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
+                gl.renderbuffer_storage(
+                    glow::RENDERBUFFER,
+                    glow::DEPTH_COMPONENT24,
+                    width as i32,
+                    height as i32,
+                );
+                gl.bind_renderbuffer(glow::RENDERBUFFER, None);
+                gl.framebuffer_renderbuffer(
+                    glow::FRAMEBUFFER,
+                    glow::DEPTH_ATTACHMENT,
+                    glow::RENDERBUFFER,
+                    Some(rb),
+                );
+                Some(rb)
+            } else {
+                None
+            };
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
             gl.clear_color(0.0, 0.0, 0.0, 0.0);
-            gl.clear(glow::COLOR_BUFFER_BIT);
+            gl.clear_depth_f64(1.0);
+            gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
             gl.bind_framebuffer(glow::FRAMEBUFFER, prev_fb);
             gl.bind_texture(glow::TEXTURE_2D, prev_tex);
             gl.active_texture(prev_active);
-            (framebuffer, color, status)
+            (framebuffer, color, depth, status)
         };
         let target = Target {
             gl,
             framebuffer,
             color,
+            depth,
             width,
             height,
             format,
@@ -147,6 +191,13 @@ impl Target {
             format!("target {width}x{height} {}", format.name()),
             width as u64 * height as u64 * format.bytes_per_pixel(),
         );
+        if with_depth {
+            gpu.record(
+                "renderbuffer",
+                format!("depth {width}x{height} 24-bit"),
+                width as u64 * height as u64 * 4,
+            );
+        }
         Ok(target)
     }
 
@@ -163,6 +214,45 @@ impl Target {
     /// Colour precision.
     pub fn format(&self) -> TargetFormat {
         self.format
+    }
+
+    /// Whether it has a depth buffer.
+    pub fn has_depth(&self) -> bool {
+        self.depth.is_some()
+    }
+
+    /// Read the depth buffer (window depth in [0, 1], 1 = nothing drawn), top row first;
+    /// `None` without one.
+    pub fn read_depth(&self, gpu: &Gpu) -> GlResult<Option<Vec<f32>>> {
+        if self.depth.is_none() {
+            return Ok(None);
+        }
+        let _guard = super::state::StateGuard::save(gpu);
+        let (w, h) = (self.width as usize, self.height as usize);
+        let mut bottom_up = vec![0f32; w * h];
+        // SAFETY: the buffer holds exactly w*h floats.
+        unsafe {
+            self.gl
+                .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.framebuffer));
+            self.gl.pixel_store_i32(glow::PACK_ALIGNMENT, 1);
+            let bytes = std::slice::from_raw_parts_mut(
+                bottom_up.as_mut_ptr().cast::<u8>(),
+                bottom_up.len() * 4,
+            );
+            self.gl.read_pixels(
+                0,
+                0,
+                w as i32,
+                h as i32,
+                glow::DEPTH_COMPONENT,
+                glow::FLOAT,
+                glow::PixelPackData::Slice(Some(bytes)),
+            );
+        }
+        crate::gl_check!(gpu)?;
+        Ok(Some(
+            bottom_up.chunks_exact(w).rev().flatten().copied().collect(),
+        ))
     }
 
     /// Bind for drawing and set the viewport to the whole target.
@@ -256,6 +346,9 @@ impl Drop for Target {
         unsafe {
             self.gl.delete_framebuffer(self.framebuffer);
             self.gl.delete_texture(self.color);
+            if let Some(rb) = self.depth {
+                self.gl.delete_renderbuffer(rb);
+            }
         }
     }
 }

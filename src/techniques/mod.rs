@@ -37,6 +37,10 @@ pub trait Renderer {
     fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()>;
     /// The program kind in use.
     fn program_kind(&self) -> ProgramKind;
+    /// Whether its surface needs a depth buffer (opaque geometry with a depth test).
+    fn needs_depth(&self) -> bool {
+        false
+    }
 }
 
 /// Build the renderer a scene names, with programs of `kind`; nothing else is created.

@@ -105,6 +105,8 @@ impl Renderer for QuadRenderer {
                 range: None,
                 textures: &[],
                 blend: Blend::Replace,
+                depth_test: false,
+                cull_back: false,
             },
         )
     }

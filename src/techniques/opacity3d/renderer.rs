@@ -290,6 +290,8 @@ impl Renderer for Opacity3dRenderer {
                 range: None,
                 textures: &textures,
                 blend: Blend::Over,
+                depth_test: false,
+                cull_back: false,
             },
         )
     }
