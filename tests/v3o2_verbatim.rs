@@ -107,6 +107,8 @@ fn hand_computed_sum_pixel(backend: Backend) {
             range: None,
             textures: &[(0, &vol), (2, &lut1), (3, &lut2), (4, &lut3)],
             blend: Blend::Replace,
+            depth_test: false,
+            cull_back: false,
         },
     )
     .unwrap();
