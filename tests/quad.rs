@@ -135,9 +135,9 @@ fn stats_list_only_what_the_scene_names() {
         "{:?}",
         r.resources
     );
-    assert_eq!(r.resources[0].bytes, 32 * 32 * 8, "RGBA16F target bytes");
+    assert_eq!(r.resources[2].bytes, 32 * 32 * 8, "RGBA16F target bytes");
     assert_eq!(
-        r.resources[2].bytes,
+        r.resources[1].bytes,
         6 * 8 * 4,
         "six vertices of eight floats"
     );
