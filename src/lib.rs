@@ -15,6 +15,7 @@ pub mod gl;
 pub mod image;
 pub mod info;
 pub mod input;
+pub mod mesh;
 pub mod png_io;
 pub mod programs;
 pub mod render;
