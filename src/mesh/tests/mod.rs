@@ -1,5 +1,7 @@
 //! Tests of the mesh data layer.
 
+mod fixtures;
+mod formats;
 mod real_files;
 
 use std::path::PathBuf;
