@@ -254,6 +254,20 @@ impl Mesh {
             return Err(MeshError::whole_file(name, "more than 2^32 - 1 points"));
         }
         let c = raw.convert(name, bytes, &points)?;
+        if c.tets.is_empty() {
+            let held: Vec<String> = c
+                .cells
+                .iter()
+                .map(|k| format!("{}: {}", k.name, k.count))
+                .collect();
+            return Err(MeshError::whole_file(
+                name,
+                format!(
+                    "no volume cells (tetrahedra, hexahedra, voxels, wedges, pyramids): the file holds {}",
+                    if held.is_empty() { "no cells".to_string() } else { held.join(", ") }
+                ),
+            ));
+        }
         let cell_arrays = cell_arrays
             .into_iter()
             .map(|a| {

@@ -1,7 +1,9 @@
 //! Tests of the mesh data layer.
 
+mod cells;
 mod fixtures;
 mod formats;
+mod generated;
 mod real_files;
 
 use std::path::PathBuf;
