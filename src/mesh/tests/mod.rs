@@ -4,6 +4,7 @@ mod cells;
 mod fixtures;
 mod formats;
 mod generated;
+mod hostile;
 mod real_files;
 
 use std::path::PathBuf;
