@@ -16,6 +16,7 @@ pub mod image;
 pub mod info;
 pub mod input;
 pub mod inspect;
+pub mod mesh;
 pub mod png_io;
 pub mod programs;
 pub mod render;

@@ -1,0 +1,769 @@
+//! VTK legacy files (`# vtk DataFile Version 1.0` to `5.1`), `DATASET UNSTRUCTURED_GRID`,
+//! ASCII or BINARY.
+//!
+//! What is read:
+//! - `POINTS n type`; cells in both layouts: the classic `CELLS n size` (each cell as a
+//!   count and its point indices; versions up to 4.2) and VTK 9's `CELLS nOffsets
+//!   nConnectivity` followed by `OFFSETS type` and `CONNECTIVITY type` arrays (version 5.1,
+//!   `vtktypeint64` or `vtktypeint32`); the layout is chosen by the keyword that follows
+//!   `CELLS`, not by the version. `CELL_TYPES n`.
+//! - In `POINT_DATA n` and `CELL_DATA n`: `SCALARS name type [components]` (with or
+//!   without its `LOOKUP_TABLE` line), `VECTORS`, `NORMALS`, `TENSORS`, `TENSORS6`,
+//!   `TEXTURE_COORDINATES`, `COLOR_SCALARS`, `GLOBAL_IDS`, `PEDIGREE_IDS`, and `FIELD`
+//!   arrays; names are %-decoded (`%20` is a space). Lookup-table definitions, the
+//!   dataset's own `FIELD` data and `METADATA` blocks (up to their blank line) are skipped.
+//! - BINARY data are big-endian, as VTK writes them, and start right after the line end
+//!   of their header line. Type widths: `long`/`unsigned_long` 8 bytes (VTK on 64-bit
+//!   Unix), `vtkIdType` 4 bytes (VTK writes id arrays as 32-bit in legacy files).
+//! - `bit` arrays and binary string arrays are refused; ASCII string arrays in `FIELD`
+//!   data are skipped (one value per line).
+
+use std::path::Path;
+
+use super::cells::{vtk_kind, RawCells};
+use super::read::{nth_token, quote, vec_for, Cursor, Floats, Num};
+use super::{DataArray, Mesh, MeshError, MeshInfo};
+
+/// The numeric type of a legacy type name (`None` for `bit`, strings and unknown names).
+fn num_type(t: &[u8]) -> Option<Num> {
+    let t = String::from_utf8_lossy(t).to_ascii_lowercase();
+    Some(match t.as_str() {
+        "unsigned_char" | "vtktypeuint8" => Num::U8,
+        "char" | "signed_char" | "vtktypeint8" => Num::I8,
+        "unsigned_short" | "vtktypeuint16" => Num::U16,
+        "short" | "vtktypeint16" => Num::I16,
+        "unsigned_int" | "vtktypeuint32" => Num::U32,
+        "int" | "vtkidtype" | "vtktypeint32" => Num::I32,
+        "unsigned_long" | "vtktypeuint64" | "unsigned_long_long" | "unsigned___int64" => Num::U64,
+        "long" | "vtktypeint64" | "long_long" | "__int64" => Num::I64,
+        "float" | "vtktypefloat32" => Num::F32,
+        "double" | "vtktypefloat64" => Num::F64,
+        _ => return None,
+    })
+}
+
+/// Which attribute section arrays go to.
+#[derive(Clone, Copy, PartialEq)]
+enum Target {
+    None,
+    Points(usize),
+    Cells(usize),
+}
+
+struct Reader<'a> {
+    c: Cursor<'a>,
+    binary: bool,
+}
+
+impl<'a> Reader<'a> {
+    /// The remaining tokens of the current line.
+    fn args(&mut self) -> Vec<(usize, &'a [u8])> {
+        let (at, line) = self.c.line();
+        let mut out = Vec::new();
+        let mut i = 0;
+        while i < line.len() {
+            while i < line.len() && line[i].is_ascii_whitespace() {
+                i += 1;
+            }
+            let s = i;
+            while i < line.len() && !line[i].is_ascii_whitespace() {
+                i += 1;
+            }
+            if i > s {
+                out.push((at + s, &line[s..i]));
+            }
+        }
+        out
+    }
+
+    /// Argument `i` of a header line, parsed.
+    fn arg<T: std::str::FromStr>(
+        &self,
+        args: &[(usize, &[u8])],
+        i: usize,
+        kw_at: usize,
+        what: &str,
+    ) -> Result<T, MeshError> {
+        let (at, t) = args.get(i).copied().ok_or_else(|| {
+            self.c.err(
+                kw_at,
+                format!("expected {what} on this line, found the line end"),
+            )
+        })?;
+        std::str::from_utf8(t)
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .ok_or_else(|| {
+                self.c
+                    .err(at, format!("expected {what}, found {}", quote(t)))
+            })
+    }
+
+    /// A type-name argument.
+    fn type_arg(&self, args: &[(usize, &[u8])], i: usize, kw_at: usize) -> Result<Num, MeshError> {
+        let (at, t) = args.get(i).copied().ok_or_else(|| {
+            self.c.err(
+                kw_at,
+                "expected a data type on this line, found the line end",
+            )
+        })?;
+        num_type(t).ok_or_else(|| {
+            self.c.err(
+                at,
+                format!(
+                    "data type {} is not supported (expected unsigned_char, char, short, int, long, float, double, vtktypeint32, vtktypeint64, ...)",
+                    quote(t)
+                ),
+            )
+        })
+    }
+
+    /// A count argument that must fit in the rest of the file.
+    fn count_arg(
+        &self,
+        args: &[(usize, &[u8])],
+        i: usize,
+        kw_at: usize,
+        what: &str,
+        min_bytes: usize,
+    ) -> Result<usize, MeshError> {
+        let n: i64 = self.arg(args, i, kw_at, what)?;
+        let at = args[i].0;
+        if n < 0 {
+            return Err(self.c.err(at, format!("{what} is negative: {n}")));
+        }
+        self.c.check_fits(at, what, n as u64, min_bytes)
+    }
+
+    fn min_bytes(&self, t: Num) -> usize {
+        if self.binary {
+            t.size()
+        } else {
+            2
+        }
+    }
+
+    /// `n` values of type `t` as f64, with the index and offset of the first non-finite.
+    fn values(&mut self, n: usize, t: Num, what: &str) -> Result<Floats, MeshError> {
+        if !self.binary {
+            return self.c.ascii_f64(n, what);
+        }
+        let start = self.c.pos;
+        let len = n.checked_mul(t.size()).ok_or_else(|| {
+            self.c
+                .err_bin(start, format!("{what}: {n} values overflow"))
+        })?;
+        let data = self.c.take(len, what)?;
+        let mut out = vec_for(n, what).map_err(|m| self.c.err_bin(start, m))?;
+        t.decode_f64(data, true, &mut out);
+        let bad = out
+            .iter()
+            .position(|v| !v.is_finite())
+            .map(|i| (i, start + i * t.size()));
+        Ok((out, bad))
+    }
+
+    /// `n` integers of type `t`, with the offset of each value given by `at(i)` later.
+    fn ints(&mut self, n: usize, t: Num, what: &str) -> Result<(Vec<i64>, usize), MeshError> {
+        let start = self.c.pos;
+        if t.is_float() {
+            return Err(self
+                .c
+                .err(start, format!("{what} must be integers, not floats")));
+        }
+        if !self.binary {
+            return Ok((self.c.ascii_int(n, what)?, start));
+        }
+        let len = n.checked_mul(t.size()).ok_or_else(|| {
+            self.c
+                .err_bin(start, format!("{what}: {n} values overflow"))
+        })?;
+        let data = self.c.take(len, what)?;
+        let mut out = vec_for(n, what).map_err(|m| self.c.err_bin(start, m))?;
+        t.decode_int(data, true, &mut out);
+        Ok((out, start))
+    }
+
+    /// An error about integer `i` of an array read by [`Reader::ints`] from `start`.
+    fn int_err(&self, start: usize, i: usize, t: Num, m: String) -> MeshError {
+        if self.binary {
+            self.c.err_bin(start + i * t.size(), m)
+        } else {
+            self.c.err(nth_token(self.c.bytes, start, i), m)
+        }
+    }
+}
+
+/// Decode `%XX` escapes in array names, as VTK writes spaces and other bytes.
+fn decode_name(t: &[u8]) -> String {
+    let mut out = Vec::with_capacity(t.len());
+    let mut i = 0;
+    while i < t.len() {
+        if t[i] == b'%' && i + 3 <= t.len() {
+            if let Ok(v) = u8::from_str_radix(&String::from_utf8_lossy(&t[i + 1..i + 3]), 16) {
+                out.push(v);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(t[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Parse a VTK legacy unstructured grid held in memory; `name` is used in errors.
+pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    let mut c = Cursor::new(name, bytes);
+    c.skip_space();
+    let (at, first) = c.line();
+    let head = b"# vtk datafile version";
+    if first.len() < head.len() || !first[..head.len()].eq_ignore_ascii_case(head) {
+        return Err(c.err(
+            at,
+            format!(
+                "expected \"# vtk DataFile Version x.y\", found {}",
+                quote(first)
+            ),
+        ));
+    }
+    let version = String::from_utf8_lossy(first[head.len()..].trim_ascii()).into_owned();
+    let major = version
+        .split('.')
+        .next()
+        .and_then(|m| m.parse::<u32>().ok())
+        .ok_or_else(|| {
+            c.err(
+                at + head.len(),
+                format!(
+                    "expected a version number, found {}",
+                    quote(version.as_bytes())
+                ),
+            )
+        })?;
+    if !(1..=5).contains(&major) {
+        return Err(c.err(
+            at + head.len(),
+            format!("version {version} is not supported (arbvis reads legacy versions 1.0 to 5.1)"),
+        ));
+    }
+    let _title = c.line();
+    let (at, enc) = c.line();
+    let binary = match enc.trim_ascii().to_ascii_uppercase().as_slice() {
+        b"ASCII" => false,
+        b"BINARY" => true,
+        _ => {
+            return Err(c.err(
+                at,
+                format!("expected ASCII or BINARY, found {}", quote(enc)),
+            ))
+        }
+    };
+    c.keyword("DATASET")?;
+    let (at, kind) = c.need("a dataset type")?;
+    if !kind.eq_ignore_ascii_case(b"UNSTRUCTURED_GRID") {
+        return Err(c.err(
+            at,
+            format!(
+                "DATASET {} is not a volume mesh: arbvis reads DATASET UNSTRUCTURED_GRID",
+                String::from_utf8_lossy(kind)
+            ),
+        ));
+    }
+    c.end_line()?;
+    let mut r = Reader { c, binary };
+    let mut st = State::default();
+    while !r.c.at_end() {
+        let (kw_at, kw) = r.c.need("a section keyword")?;
+        let kw = kw.to_ascii_uppercase();
+        let args = r.args();
+        section(&mut r, &mut st, &kw, kw_at, &args)?;
+    }
+    finish(r, st, version)
+}
+
+#[derive(Default)]
+struct State {
+    points: Option<(usize, Vec<[f64; 3]>)>,
+    cells: Option<(usize, RawCells)>,
+    types: Option<(usize, Vec<super::cells::Kind>)>,
+    target: Option<(usize, Target)>,
+    point_arrays: Vec<DataArray>,
+    cell_arrays: Vec<DataArray>,
+}
+
+fn section(
+    r: &mut Reader,
+    st: &mut State,
+    kw: &[u8],
+    kw_at: usize,
+    args: &[(usize, &[u8])],
+) -> Result<(), MeshError> {
+    let target = st.target.map_or(Target::None, |t| t.1);
+    match kw {
+        b"POINTS" => {
+            let t = r.type_arg(args, 1, kw_at)?;
+            let n = r.count_arg(args, 0, kw_at, "the point count", 3 * r.min_bytes(t))?;
+            let (v, bad) = r.values(3 * n, t, "the point coordinates")?;
+            if let Some((i, at)) = bad {
+                let m = format!("point {} has a coordinate that is not finite ({})", i / 3, v[i]);
+                return Err(if r.binary { r.c.err_bin(at, m) } else { r.c.err(at, m) });
+            }
+            let pts = v.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+            st.points = Some((kw_at, pts));
+        }
+        b"CELLS" => {
+            let a: i64 = r.arg(args, 0, kw_at, "the cell count")?;
+            let b: i64 = r.arg(args, 1, kw_at, "the cell list size")?;
+            if a < 0 || b < 0 {
+                return Err(r.c.err(kw_at, format!("CELLS {a} {b}: negative count")));
+            }
+            let cells = if r.c.peek().is_some_and(|t| t.eq_ignore_ascii_case(b"OFFSETS")) {
+                modern_cells(r, a as u64, b as u64)?
+            } else {
+                classic_cells(r, a as u64, b as u64)?
+            };
+            st.cells = Some((kw_at, cells));
+        }
+        b"CELL_TYPES" => {
+            let t = if r.binary { Num::I32 } else { Num::I64 };
+            let n = r.count_arg(args, 0, kw_at, "the cell type count", r.min_bytes(t))?;
+            let (v, start) = r.ints(n, t, "the cell types")?;
+            let mut kinds = vec_for(n, "cell types").map_err(|m| r.c.err(start, m))?;
+            for (i, &v) in v.iter().enumerate() {
+                kinds.push(vtk_kind(v).map_err(|m| r.int_err(start, i, Num::I32, format!("cell {i}: {m}")))?);
+            }
+            st.types = Some((kw_at, kinds));
+        }
+        b"POINT_DATA" | b"CELL_DATA" => {
+            let n: i64 = r.arg(args, 0, kw_at, "the tuple count")?;
+            let n = usize::try_from(n)
+                .map_err(|_| r.c.err(args[0].0, format!("negative tuple count {n}")))?;
+            st.target = Some((
+                kw_at,
+                if kw == b"POINT_DATA" { Target::Points(n) } else { Target::Cells(n) },
+            ));
+        }
+        b"METADATA" => {
+            // Skip lines up to the first blank one.
+            while r.c.remaining() > 0 {
+                let (_, l) = r.c.line();
+                if l.trim_ascii().is_empty() {
+                    break;
+                }
+            }
+        }
+        b"FIELD" => {
+            let n = r.count_arg(args, 1, kw_at, "the number of field arrays", 4)?;
+            for _ in 0..n {
+                field_array(r, st, target)?;
+            }
+        }
+        b"SCALARS" | b"VECTORS" | b"NORMALS" | b"TENSORS" | b"TENSORS6" | b"TEXTURE_COORDINATES"
+        | b"GLOBAL_IDS" | b"PEDIGREE_IDS" | b"COLOR_SCALARS" | b"LOOKUP_TABLE" => {
+            attribute(r, st, target, kw, kw_at, args)?;
+        }
+        _ => {
+            return Err(r.c.err(
+                kw_at,
+                format!(
+                    "expected a section keyword (POINTS, CELLS, CELL_TYPES, POINT_DATA, CELL_DATA, SCALARS, VECTORS, FIELD, METADATA, ...), found {}",
+                    quote(kw)
+                ),
+            ))
+        }
+    }
+    Ok(())
+}
+
+/// One array of a `FIELD` block: `name components tuples type`, then the values.
+fn field_array(r: &mut Reader, st: &mut State, target: Target) -> Result<(), MeshError> {
+    let (at, name) = r.c.need("a field array name")?;
+    if name == b"NULL_ARRAY" {
+        r.c.end_line()?;
+        return Ok(());
+    }
+    let args = r.args();
+    let comps: i64 = r.arg(&args, 0, at, "the number of components")?;
+    let tuples: i64 = r.arg(&args, 1, at, "the number of tuples")?;
+    let (t_at, t) = args
+        .get(2)
+        .copied()
+        .ok_or_else(|| r.c.err(at, "expected a data type after the tuple count"))?;
+    if comps < 0 || tuples < 0 {
+        return Err(r.c.err(at, format!("negative size {comps} x {tuples}")));
+    }
+    let total = (comps as u64).saturating_mul(tuples as u64);
+    let lower = String::from_utf8_lossy(t).to_ascii_lowercase();
+    if lower == "string" || lower == "utf8_string" {
+        if r.binary {
+            return Err(r.c.err(t_at, "binary string arrays are not supported"));
+        }
+        r.c.check_fits(t_at, "the string count", total, 1)?;
+        for _ in 0..total {
+            r.c.line();
+        }
+        return Ok(());
+    }
+    let num = r.type_arg(&args, 2, at)?;
+    let total =
+        r.c.check_fits(at, "the field array size", total, r.min_bytes(num))?;
+    let (values, _) = r.values(total, num, "the field array values")?;
+    let array = DataArray {
+        name: decode_name(name),
+        components: comps as usize,
+        values,
+    };
+    store(r, st, target, array, tuples as usize, at)
+}
+
+fn store(
+    r: &Reader,
+    st: &mut State,
+    target: Target,
+    array: DataArray,
+    tuples: usize,
+    at: usize,
+) -> Result<(), MeshError> {
+    let (want, list, what) = match target {
+        Target::None => return Ok(()), // the dataset's own field data
+        Target::Points(n) => (n, &mut st.point_arrays, "POINT_DATA"),
+        Target::Cells(n) => (n, &mut st.cell_arrays, "CELL_DATA"),
+    };
+    if tuples != want || array.components == 0 {
+        return Err(r.c.err(
+            at,
+            format!(
+                "array \"{}\" has {tuples} tuples of {} components, but its {what} section has {want} tuples",
+                array.name, array.components
+            ),
+        ));
+    }
+    list.push(array);
+    Ok(())
+}
+
+fn attribute(
+    r: &mut Reader,
+    st: &mut State,
+    target: Target,
+    kw: &[u8],
+    kw_at: usize,
+    args: &[(usize, &[u8])],
+) -> Result<(), MeshError> {
+    let n = match target {
+        Target::Points(n) | Target::Cells(n) => n,
+        Target::None => {
+            return Err(r.c.err(
+                kw_at,
+                format!(
+                    "{} outside POINT_DATA or CELL_DATA",
+                    String::from_utf8_lossy(kw)
+                ),
+            ))
+        }
+    };
+    let (_, name) = args
+        .first()
+        .copied()
+        .ok_or_else(|| r.c.err(kw_at, "expected a name on this line"))?;
+    let name = decode_name(name);
+    let (comps, num) = match kw {
+        b"LOOKUP_TABLE" => {
+            // A table definition: `size` RGBA entries (floats in ASCII, bytes in binary).
+            let size = r.count_arg(
+                args,
+                1,
+                kw_at,
+                "the table size",
+                4 * if r.binary { 1 } else { 2 },
+            )?;
+            r.values(4 * size, Num::U8, "the lookup table")?;
+            return Ok(());
+        }
+        b"COLOR_SCALARS" => {
+            let k: usize = r.arg(args, 1, kw_at, "the number of colour components")?;
+            let total = r.c.check_fits(
+                kw_at,
+                "the colour values",
+                (n as u64).saturating_mul(k as u64),
+                if r.binary { 1 } else { 2 },
+            )?;
+            let (mut values, _) = r.values(total, Num::U8, "the colour values")?;
+            if r.binary {
+                values.iter_mut().for_each(|v| *v /= 255.0);
+            }
+            return store(
+                r,
+                st,
+                target,
+                DataArray {
+                    name,
+                    components: k,
+                    values,
+                },
+                n,
+                kw_at,
+            );
+        }
+        b"SCALARS" => {
+            let t = r.type_arg(args, 1, kw_at)?;
+            let k = if args.len() > 2 {
+                r.arg::<usize>(args, 2, kw_at, "the number of components")?
+            } else {
+                1
+            };
+            // The LOOKUP_TABLE line VTK writes after SCALARS (optional here).
+            let save = r.c.pos;
+            if r.c
+                .token()
+                .is_some_and(|(_, t)| t.eq_ignore_ascii_case(b"LOOKUP_TABLE"))
+            {
+                r.c.line();
+            } else {
+                r.c.pos = save;
+            }
+            (k, t)
+        }
+        b"TEXTURE_COORDINATES" => {
+            let k: usize = r.arg(args, 1, kw_at, "the texture dimension")?;
+            (k, r.type_arg(args, 2, kw_at)?)
+        }
+        b"VECTORS" | b"NORMALS" => (3, r.type_arg(args, 1, kw_at)?),
+        b"TENSORS" => (9, r.type_arg(args, 1, kw_at)?),
+        b"TENSORS6" => (6, r.type_arg(args, 1, kw_at)?),
+        _ => (1, r.type_arg(args, 1, kw_at)?), // GLOBAL_IDS, PEDIGREE_IDS
+    };
+    if comps == 0 {
+        return Err(r.c.err(kw_at, "an array needs at least one component"));
+    }
+    let total = (n as u64).saturating_mul(comps as u64);
+    let total = r.c.check_fits(
+        r.c.pos,
+        &format!("the values of \"{name}\""),
+        total,
+        r.min_bytes(num),
+    )?;
+    let (values, _) = r.values(total, num, &format!("the values of \"{name}\""))?;
+    store(
+        r,
+        st,
+        target,
+        DataArray {
+            name,
+            components: comps,
+            values,
+        },
+        n,
+        kw_at,
+    )
+}
+
+/// `CELLS n size` then `size` integers: for each cell a count and its point indices.
+fn classic_cells(r: &mut Reader, n: u64, size: u64) -> Result<RawCells, MeshError> {
+    let t = if r.binary { Num::I32 } else { Num::I64 };
+    let at = r.c.pos;
+    let size =
+        r.c.check_fits(at, "the cell list size", size, r.min_bytes(t))?;
+    let n = r.c.check_fits(at, "the cell count", n, r.min_bytes(t))?;
+    let (v, start) = r.ints(size, t, "the cell list")?;
+    let mut cells = RawCells {
+        text: !r.binary,
+        token_base: (!r.binary).then_some(start),
+        ..RawCells::default()
+    };
+    cells.offsets = vec_for(n + 1, "cell offsets").map_err(|m| r.c.err(at, m))?;
+    cells.at = vec_for(n, "cell positions").map_err(|m| r.c.err(at, m))?;
+    cells.nodes = vec_for(size.saturating_sub(n), "cell nodes").map_err(|m| r.c.err(at, m))?;
+    cells.offsets.push(0);
+    let mut j = 0;
+    for i in 0..n {
+        let k = *v.get(j).ok_or_else(|| {
+            r.int_err(
+                start,
+                j,
+                Num::I32,
+                format!("the cell list of size {size} ends before cell {i} of {n}"),
+            )
+        })?;
+        if k < 0 || (k as u64) > (size - j - 1) as u64 {
+            return Err(r.int_err(
+                start,
+                j,
+                Num::I32,
+                format!(
+                    "cell {i} has {k} points, but only {} values are left in the cell list",
+                    size - j - 1
+                ),
+            ));
+        }
+        cells.at.push(if r.binary { start + j * 4 } else { j });
+        for (m, &p) in v[j + 1..j + 1 + k as usize].iter().enumerate() {
+            cells.nodes.push(index(r, start, j + 1 + m, p, i)?);
+        }
+        j += 1 + k as usize;
+        cells.offsets.push(cells.nodes.len());
+    }
+    if j != size {
+        return Err(r.int_err(
+            start,
+            j,
+            Num::I32,
+            format!("CELLS declares {size} values but its {n} cells use {j}"),
+        ));
+    }
+    Ok(cells)
+}
+
+fn index(r: &Reader, start: usize, j: usize, p: i64, cell: usize) -> Result<u32, MeshError> {
+    u32::try_from(p)
+        .ok()
+        .filter(|&p| p < u32::MAX)
+        .ok_or_else(|| {
+            r.int_err(
+                start,
+                j,
+                Num::I32,
+                format!("cell {cell} has point index {p}, outside 0 to 2^32 - 2"),
+            )
+        })
+}
+
+/// VTK 9's layout: `CELLS nOffsets nConnectivity`, `OFFSETS type` and
+/// `CONNECTIVITY type` arrays.
+fn modern_cells(r: &mut Reader, n_off: u64, n_conn: u64) -> Result<RawCells, MeshError> {
+    let kw_at = r.c.keyword("OFFSETS")?;
+    let args = r.args();
+    let t = r.type_arg(&args, 0, kw_at)?;
+    let n_off =
+        r.c.check_fits(kw_at, "the offset count", n_off, r.min_bytes(t))?;
+    let (offsets, off_start) = r.ints(n_off, t, "the cell offsets")?;
+    let kw_at = r.c.keyword("CONNECTIVITY")?;
+    let args = r.args();
+    let tc = r.type_arg(&args, 0, kw_at)?;
+    let n_conn =
+        r.c.check_fits(kw_at, "the connectivity size", n_conn, r.min_bytes(tc))?;
+    let (conn, conn_start) = r.ints(n_conn, tc, "the connectivity")?;
+    let n = n_off.saturating_sub(1);
+    let mut cells = RawCells {
+        text: !r.binary,
+        token_base: (!r.binary).then_some(conn_start),
+        ..RawCells::default()
+    };
+    cells.offsets = vec_for(n + 1, "cell offsets").map_err(|m| r.c.err(kw_at, m))?;
+    cells.at = vec_for(n, "cell positions").map_err(|m| r.c.err(kw_at, m))?;
+    cells.offsets.push(0);
+    if offsets.first().is_some_and(|&o| o != 0) {
+        return Err(r.int_err(
+            off_start,
+            0,
+            t,
+            format!("the first offset must be 0, found {}", offsets[0]),
+        ));
+    }
+    for i in 0..n {
+        let (a, b) = (offsets[i], offsets[i + 1]);
+        if b < a || b as u64 > n_conn as u64 {
+            return Err(r.int_err(off_start, i + 1, t, format!(
+                "offset {} is {b}: offsets must not decrease and must stay within the {n_conn} connectivity values", i + 1
+            )));
+        }
+        cells.offsets.push(b as usize);
+        cells.at.push(if r.binary {
+            conn_start + a as usize * tc.size()
+        } else {
+            a as usize
+        });
+    }
+    if n > 0 && offsets[n] as usize != n_conn {
+        return Err(r.int_err(
+            off_start,
+            n,
+            t,
+            format!(
+                "the last offset is {} but CONNECTIVITY has {n_conn} values",
+                offsets[n]
+            ),
+        ));
+    }
+    cells.nodes = vec_for(n_conn, "cell nodes").map_err(|m| r.c.err(kw_at, m))?;
+    let mut cell = 0;
+    for (j, &p) in conn.iter().enumerate() {
+        while cell + 1 < cells.offsets.len() && cells.offsets[cell + 1] <= j {
+            cell += 1;
+        }
+        let m = u32::try_from(p)
+            .ok()
+            .filter(|&p| p < u32::MAX)
+            .ok_or_else(|| {
+                r.int_err(
+                    conn_start,
+                    j,
+                    tc,
+                    format!("cell {cell} has point index {p}, outside 0 to 2^32 - 2"),
+                )
+            })?;
+        cells.nodes.push(m);
+    }
+    Ok(cells)
+}
+
+fn finish(r: Reader, st: State, version: String) -> Result<Mesh, MeshError> {
+    let end = r.c.bytes.len();
+    let (_, points) = st
+        .points
+        .ok_or_else(|| r.c.err(end, "the file has no POINTS section"))?;
+    let (cells_at, mut cells) = st
+        .cells
+        .ok_or_else(|| r.c.err(end, "the file has no CELLS section"))?;
+    let (types_at, kinds) = st
+        .types
+        .ok_or_else(|| r.c.err(end, "the file has no CELL_TYPES section"))?;
+    if kinds.len() != cells.offsets.len() - 1 {
+        return Err(r.c.err(
+            types_at,
+            format!(
+                "CELL_TYPES has {} entries but CELLS (line {}) has {} cells",
+                kinds.len(),
+                super::read::line_column(r.c.bytes, cells_at).0,
+                cells.offsets.len() - 1
+            ),
+        ));
+    }
+    cells.kinds = kinds;
+    for (list, want, what) in [
+        (&st.point_arrays, points.len(), "points"),
+        (&st.cell_arrays, cells.len(), "cells"),
+    ] {
+        if let Some(a) = list.iter().find(|a| a.tuples() != want) {
+            return Err(r.c.err(
+                st.target.map_or(0, |t| t.0),
+                format!(
+                    "array \"{}\" has {} tuples but the mesh has {want} {what}",
+                    a.name,
+                    a.tuples()
+                ),
+            ));
+        }
+    }
+    let info = MeshInfo {
+        format: "VTK legacy".into(),
+        version,
+        encoding: if r.binary {
+            "binary (big-endian)"
+        } else {
+            "ascii"
+        }
+        .into(),
+        ..MeshInfo::default()
+    };
+    Mesh::assemble(
+        r.c.name,
+        r.c.bytes,
+        points,
+        &cells,
+        st.point_arrays,
+        st.cell_arrays,
+        info,
+    )
+}
