@@ -35,6 +35,31 @@ pub const OPACITY3D_PRODUCT_PRECISE_ARBFP: ProgramText =
 /// GLSL twin of [`OPACITY3D_PRODUCT_PRECISE_ARBFP`].
 pub const OPACITY3D_PRODUCT_PRECISE_FRAG: ProgramText = program!("opacity3d/product_precise.frag");
 
+/// The seed's Cg vertex program (reference text, not compiled).
+pub const CELLPROJ_SEED_VERTEX_CG: ProgramText = program!("cellproj/seed_vertex.cg");
+/// The seed's Cg fragment program (reference text, not compiled).
+pub const CELLPROJ_SEED_FRAGMENT_CG: ProgramText = program!("cellproj/seed_fragment.cg");
+/// Cell projection, exit per fragment (the seed's Cg, ported): ARB vertex stage.
+pub const CELLPROJ_PERSPECTIVE_ARBVP: ProgramText = program!("cellproj/perspective.arbvp");
+/// ARB fragment stage of [`CELLPROJ_PERSPECTIVE_ARBVP`].
+pub const CELLPROJ_PERSPECTIVE_ARBFP: ProgramText = program!("cellproj/perspective.arbfp");
+/// GLSL twin of [`CELLPROJ_PERSPECTIVE_ARBVP`].
+pub const CELLPROJ_PERSPECTIVE_VERT: ProgramText = program!("cellproj/perspective.vert");
+/// GLSL twin of [`CELLPROJ_PERSPECTIVE_ARBFP`].
+pub const CELLPROJ_PERSPECTIVE_FRAG: ProgramText = program!("cellproj/perspective.frag");
+/// Cell projection, exit per vertex (the seed's orthographic case): ARB vertex stage.
+pub const CELLPROJ_ORTHOGRAPHIC_ARBVP: ProgramText = program!("cellproj/orthographic.arbvp");
+/// ARB fragment stage of [`CELLPROJ_ORTHOGRAPHIC_ARBVP`].
+pub const CELLPROJ_ORTHOGRAPHIC_ARBFP: ProgramText = program!("cellproj/orthographic.arbfp");
+/// GLSL twin of [`CELLPROJ_ORTHOGRAPHIC_ARBVP`].
+pub const CELLPROJ_ORTHOGRAPHIC_VERT: ProgramText = program!("cellproj/orthographic.vert");
+/// GLSL twin of [`CELLPROJ_ORTHOGRAPHIC_ARBFP`].
+pub const CELLPROJ_ORTHOGRAPHIC_FRAG: ProgramText = program!("cellproj/orthographic.frag");
+/// Precise cell projection (new, GLSL only): vertex stage.
+pub const CELLPROJ_PRECISE_VERT: ProgramText = program!("cellproj/precise.vert");
+/// Precise cell projection: fragment stage (exact crossing, guarded exit, depth, shading).
+pub const CELLPROJ_PRECISE_FRAG: ProgramText = program!("cellproj/precise.frag");
+
 /// A vertex + fragment pair of one kind.
 #[derive(Debug, Clone)]
 pub struct ProgramPair {
@@ -81,6 +106,36 @@ pub fn all_pairs() -> Vec<ProgramPair> {
             pairs.push(with_transform(kind, arb, glsl));
         }
     }
+    let own_vertex_stage = [
+        (
+            ProgramKind::Arb,
+            CELLPROJ_PERSPECTIVE_ARBVP,
+            CELLPROJ_PERSPECTIVE_ARBFP,
+        ),
+        (
+            ProgramKind::Glsl,
+            CELLPROJ_PERSPECTIVE_VERT,
+            CELLPROJ_PERSPECTIVE_FRAG,
+        ),
+        (
+            ProgramKind::Arb,
+            CELLPROJ_ORTHOGRAPHIC_ARBVP,
+            CELLPROJ_ORTHOGRAPHIC_ARBFP,
+        ),
+        (
+            ProgramKind::Glsl,
+            CELLPROJ_ORTHOGRAPHIC_VERT,
+            CELLPROJ_ORTHOGRAPHIC_FRAG,
+        ),
+        (ProgramKind::Glsl, CELLPROJ_PRECISE_VERT, CELLPROJ_PRECISE_FRAG),
+    ];
+    for (kind, vertex, fragment) in own_vertex_stage {
+        pairs.push(ProgramPair {
+            kind,
+            vertex,
+            fragment,
+        });
+    }
     pairs
 }
 
@@ -99,5 +154,17 @@ pub fn all_texts() -> Vec<ProgramText> {
         OPACITY3D_SUM_PRECISE_FRAG,
         OPACITY3D_PRODUCT_PRECISE_ARBFP,
         OPACITY3D_PRODUCT_PRECISE_FRAG,
+        CELLPROJ_SEED_VERTEX_CG,
+        CELLPROJ_SEED_FRAGMENT_CG,
+        CELLPROJ_PERSPECTIVE_ARBVP,
+        CELLPROJ_PERSPECTIVE_ARBFP,
+        CELLPROJ_PERSPECTIVE_VERT,
+        CELLPROJ_PERSPECTIVE_FRAG,
+        CELLPROJ_ORTHOGRAPHIC_ARBVP,
+        CELLPROJ_ORTHOGRAPHIC_ARBFP,
+        CELLPROJ_ORTHOGRAPHIC_VERT,
+        CELLPROJ_ORTHOGRAPHIC_FRAG,
+        CELLPROJ_PRECISE_VERT,
+        CELLPROJ_PRECISE_FRAG,
     ]
 }

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::camera::Camera;
 use crate::gl::{ProgramChoice, TargetFormat};
+use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::quad::QuadScene;
 
@@ -49,6 +50,8 @@ pub enum TechniqueScene {
     Quad(QuadScene),
     /// v3o2's 3D opacity (boxed: it is much larger than the other variants).
     Opacity3d(Box<Opacity3dScene>),
+    /// Isosurfaces of tetrahedral meshes by cell projection.
+    Cellproj(Box<CellprojScene>),
 }
 
 impl TechniqueScene {
@@ -57,6 +60,7 @@ impl TechniqueScene {
         match self {
             TechniqueScene::Quad(_) => "quad",
             TechniqueScene::Opacity3d(_) => "opacity3d",
+            TechniqueScene::Cellproj(_) => "cellproj",
         }
     }
 }
@@ -150,6 +154,14 @@ pub const DEMOS: &[(&str, &str)] = &[
         "v3o2-product",
         include_str!("../scenes/demo/v3o2-product.toml"),
     ),
+    (
+        "cellproj-planar",
+        include_str!("../scenes/demo/cellproj-planar.toml"),
+    ),
+    (
+        "cellproj-spherical",
+        include_str!("../scenes/demo/cellproj-spherical.toml"),
+    ),
 ];
 
 impl Scene {
@@ -212,15 +224,23 @@ impl Scene {
     pub fn with_absolute_paths(&self) -> Scene {
         let mut scene = self.clone();
         let base = std::path::absolute(&self.base).unwrap_or_else(|_| self.base.clone());
-        if let TechniqueScene::Opacity3d(o) = &mut scene.technique {
-            for attr in o.attributes_mut().into_iter().flatten() {
-                if let Some(p) = attr.volume.path_mut() {
-                    *p = base.join(&*p);
-                }
-                if let Some(f) = &mut attr.table.file {
-                    *f = base.join(&*f);
+        match &mut scene.technique {
+            TechniqueScene::Opacity3d(o) => {
+                for attr in o.attributes_mut().into_iter().flatten() {
+                    if let Some(p) = attr.volume.path_mut() {
+                        *p = base.join(&*p);
+                    }
+                    if let Some(f) = &mut attr.table.file {
+                        *f = base.join(&*f);
+                    }
                 }
             }
+            TechniqueScene::Cellproj(c) => {
+                if let Some(p) = c.mesh.path_mut() {
+                    *p = base.join(&*p);
+                }
+            }
+            TechniqueScene::Quad(_) => {}
         }
         scene.base = base;
         scene
@@ -263,10 +283,11 @@ impl Scene {
         if self.background.iter().any(|v| !v.is_finite()) {
             return Err(FieldError::new("background", "must be finite"));
         }
-        if let TechniqueScene::Opacity3d(o) = &self.technique {
-            o.validate().map_err(|e| e.within("technique.opacity3d"))?;
+        match &self.technique {
+            TechniqueScene::Opacity3d(o) => o.validate().map_err(|e| e.within("technique.opacity3d")),
+            TechniqueScene::Cellproj(c) => c.validate().map_err(|e| e.within("technique.cellproj")),
+            TechniqueScene::Quad(_) => Ok(()),
         }
-        Ok(())
     }
 }
 

@@ -4,8 +4,10 @@
 //! slot in beside `quad`, the foundation's demo.
 
 pub mod clip;
+pub mod cellproj;
 pub mod opacity3d;
 pub mod quad;
+pub mod rays;
 
 use crate::camera::Camera;
 use crate::gl::{GlResult, Gpu, ProgramKind, Surface};
@@ -50,6 +52,13 @@ pub fn build(gpu: &Gpu, scene: &Scene, kind: ProgramKind) -> GlResult<Box<dyn Re
         TechniqueScene::Opacity3d(params) => Box::new(opacity3d::Opacity3dRenderer::new(
             gpu,
             kind,
+            scene.fidelity,
+            params,
+            &scene.base,
+        )?),
+        TechniqueScene::Cellproj(params) => Box::new(cellproj::CellprojRenderer::new(
+            gpu,
+            cellproj::renderer::resolve_kind(scene, kind),
             scene.fidelity,
             params,
             &scene.base,

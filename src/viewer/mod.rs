@@ -2,6 +2,7 @@
 //! side panel over the GL view, an arcball camera, a screenshot button and an FPS
 //! readout. It reuses the offscreen renderers and scene model and adds only interaction.
 
+pub mod isovalues;
 pub mod lut3d;
 pub mod panel;
 pub mod script;

@@ -173,6 +173,9 @@ fn technique_editor(ui: &mut egui::Ui, scene: &mut Scene, state: &mut PanelState
             }
             return actions;
         }
+        TechniqueScene::Cellproj(c) => {
+            changed = super::isovalues::editor(ui, c, widgets);
+        }
         TechniqueScene::Quad(q) => {
             ui.label("Quad colours");
             for (label, colour) in [("Left", &mut q.left), ("Right", &mut q.right)] {

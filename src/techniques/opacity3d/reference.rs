@@ -20,8 +20,7 @@
 //! Both return the colour the target holds, top row first; alpha is coverage (the blend's
 //! alpha factors are `ONE, ONE_MINUS_SRC_ALPHA`).
 
-use glam::{DMat4, DVec3, DVec4};
-use rayon::prelude::*;
+use glam::DVec3;
 
 use super::prepare::Prepared;
 use super::renderer::coefficients;
@@ -30,6 +29,7 @@ use crate::camera::Camera;
 use crate::colortable::ColorTable;
 use crate::gl::{Filter, TargetFormat};
 use crate::image::Image;
+use crate::techniques::rays::{box_interval, trace_pixels};
 
 /// How a table is addressed with a value `v` in [0, 1].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -157,62 +157,6 @@ pub fn classify(
         out = out.map(|c| c * sum_scale);
     }
     out
-}
-
-/// A pixel's ray in object space: origin on the near plane, direction toward the far
-/// plane (not normalized: the parameter runs 0..1 from near to far).
-fn pixel_ray(inverse: &DMat4, x: u32, y: u32, width: u32, height: u32) -> (DVec3, DVec3) {
-    let nx = 2.0 * (x as f64 + 0.5) / width as f64 - 1.0;
-    let ny = 1.0 - 2.0 * (y as f64 + 0.5) / height as f64;
-    let unproject = |z: f64| {
-        let p = *inverse * DVec4::new(nx, ny, z, 1.0);
-        p.truncate() / p.w
-    };
-    let near = unproject(-1.0);
-    (near, unproject(1.0) - near)
-}
-
-/// Parameter interval `[enter, exit]` of a ray inside the box `[-half, half]`.
-fn box_interval(origin: DVec3, dir: DVec3, half: DVec3) -> Option<(f64, f64)> {
-    let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
-    for a in 0..3 {
-        if dir[a].abs() < 1e-300 {
-            if origin[a].abs() > half[a] {
-                return None;
-            }
-            continue;
-        }
-        let t0 = (-half[a] - origin[a]) / dir[a];
-        let t1 = (half[a] - origin[a]) / dir[a];
-        lo = lo.max(t0.min(t1));
-        hi = hi.min(t0.max(t1));
-    }
-    (hi > lo).then_some((lo, hi))
-}
-
-/// Trace one ray per pixel centre (object space, near to far) in parallel rows and
-/// collect `shade(origin, dir)` as an image of `format`, top row first.
-fn trace_pixels(
-    camera: &Camera,
-    size: [u32; 2],
-    format: TargetFormat,
-    shade: impl Fn(DVec3, DVec3) -> [f64; 4] + Sync,
-) -> Image {
-    let [width, height] = size;
-    let aspect = width as f64 / height.max(1) as f64;
-    let inverse = camera.view_projection(aspect).inverse();
-    let rows: Vec<Vec<[f64; 4]>> = (0..height)
-        .into_par_iter()
-        .map(|y| {
-            (0..width)
-                .map(|x| {
-                    let (origin, dir) = pixel_ray(&inverse, x, y, width, height);
-                    shade(origin, dir)
-                })
-                .collect()
-        })
-        .collect();
-    Image::from_f64_pixels(width, height, format, rows.into_iter().flatten())
 }
 
 /// The f64 reference image (see the module doc); `oversample` steps per reference
@@ -362,16 +306,5 @@ mod tests {
             Filtering::Exact,
         );
         assert!((mid[0] * 255.0 - (64.0 + 64.0 / 255.0 - 0.5)).abs() < 1e-9);
-    }
-
-    #[test]
-    fn box_interval_of_an_axis_ray() {
-        let half = DVec3::new(1.0, 0.5, 0.25);
-        let (a, b) =
-            box_interval(DVec3::new(0.0, 0.0, 2.0), DVec3::new(0.0, 0.0, -4.0), half).unwrap();
-        assert!((a - 1.75 / 4.0).abs() < 1e-12 && (b - 2.25 / 4.0).abs() < 1e-12);
-        assert!(
-            box_interval(DVec3::new(2.0, 0.0, 2.0), DVec3::new(0.0, 0.0, -4.0), half).is_none()
-        );
     }
 }

@@ -1,0 +1,66 @@
+#version 330
+// arbvis (new): precise cell projection. What changes from the seed's program:
+// - the ray direction is normalized (eye to fragment in perspective, the view
+//   direction in orthographic views);
+// - planes met at grazing angles (|D.N| below 1e-7) and degenerate faces (N = 0) are
+//   skipped instead of divided by, and t starts at 0 (sb = sf) when no plane is ahead;
+// - no table: the first isovalue crossed is found exactly, t_iso = t (v - sf)/(sb - sf)
+//   for each isovalue v in (sf, sb] (rising) or [sb, sf) (falling);
+// - depth is written at the crossing, and the colour may be shaded with the gradient.
+// program_local[0..3]: ModelViewProj rows; [4]: eye in object space (xyz), w = 1 for
+// perspective, 0 for orthographic; [5]: view direction (orthographic, unit);
+// [6]: x = isovalue count, y = shading on (1) / off (0), z = ambient term.
+// texture0: count x 2 RGBA32F, row 0 the colours, row 1 the values (ascending).
+uniform vec4 program_local[7];
+uniform sampler2D texture0;
+in float v_sf;
+in vec3 v_pos, v_vertex3, v_gradient;
+flat in vec3 v_normal0, v_normal1, v_normal2;
+out vec4 color;
+
+float exit_along(vec3 D, vec3 aux1, vec3 n, float t) {
+    float dn = dot(D, n);
+    if (abs(dn) < 1e-7) return t; // grazing or degenerate: this plane is never ahead
+    float ti = dot(aux1, n) / dn;
+    return ti > 0.0 ? min(t, ti) : t;
+}
+
+void main() {
+    vec3 D = program_local[4].w > 0.5 ? normalize(v_pos - program_local[4].xyz)
+                                      : program_local[5].xyz;
+    vec3 aux1 = v_vertex3 - v_pos;
+    float big = 1e30;
+    float t = exit_along(D, aux1, v_normal0, big);
+    t = exit_along(D, aux1, v_normal1, t);
+    t = exit_along(D, aux1, v_normal2, t);
+    if (t == big) t = 0.0;
+    float sf = v_sf;
+    float sb = sf + t * dot(v_gradient, D);
+    int count = int(program_local[6].x + 0.5);
+    int hit = -1;
+    float best = 2.0;
+    for (int k = 0; k < count; k++) {
+        float v = texelFetch(texture0, ivec2(k, 1), 0).r;
+        bool crossed = (sb > sf && v > sf && v <= sb) || (sb < sf && v >= sb && v < sf);
+        if (crossed) {
+            float f = (v - sf) / (sb - sf);
+            if (f < best) { best = f; hit = k; }
+        }
+    }
+    if (hit < 0) discard;
+    vec4 c = texelFetch(texture0, ivec2(hit, 0), 0);
+    vec3 p = v_pos + D * (t * best);
+    vec4 clip = vec4(dot(program_local[0], vec4(p, 1.0)), dot(program_local[1], vec4(p, 1.0)),
+                     dot(program_local[2], vec4(p, 1.0)), dot(program_local[3], vec4(p, 1.0)));
+    gl_FragDepth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);
+    if (program_local[6].y > 0.5) {
+        vec3 g = v_gradient;
+        float len = length(g);
+        vec3 n = len > 0.0 ? g / len : -D;
+        if (dot(n, D) > 0.0) n = -n; // toward the viewer
+        float diffuse = max(dot(n, -D), 0.0);
+        float ambient = program_local[6].z;
+        c.rgb *= ambient + (1.0 - ambient) * diffuse;
+    }
+    color = c;
+}

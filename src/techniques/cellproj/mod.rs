@@ -1,0 +1,204 @@
+//! Isosurfaces of tetrahedral meshes by view-independent cell projection (seed
+//! `001_633e9ef4ec0dfd02.txt`, after Weiler, Kraus and Ertl, "Hardware-Based
+//! View-Independent Cell Projection", IEEE VolVis 2002), as the 2004 PUC-Rio talk drew
+//! them: the front faces of every tetrahedron are rasterized; each fragment knows the
+//! scalar where its ray enters the tetrahedron (`sf`, interpolated by the rasterizer),
+//! finds where the ray leaves it (the smallest positive `t` among the other three face
+//! planes), extrapolates the scalar there with the tetrahedron's constant gradient
+//! (`sb = sf + t G·D`), and looks up the isosurface colour in a 2D table indexed by
+//! `(sf, sb)`: the colour of the first isovalue crossed between the two.
+//!
+//! # How it works
+//! 1. [`prepare`] (CPU, no GL): the mesh (generated or read by [`crate::mesh`]) is
+//!    moved into the object box (centred, longest side [-1, 1], in f64 before anything
+//!    becomes f32, so coordinates far from the origin keep their precision); each
+//!    tetrahedron gives four faces of three vertices with what the seed's vertex program
+//!    takes: position, scalar, the vertex opposite the face, the normals of the other
+//!    three faces and the gradient. Flat and sliver tetrahedra are counted.
+//!    [`prepare::iso_table`] builds the `(sf, sb)` table from the isovalues.
+//! 2. [`renderer`] draws every face once with back-face culling (what makes the method
+//!    view independent: no sorting) and a depth test, and discards fragments whose
+//!    table entry is empty.
+//! 3. [`reference`] ray-casts the same mesh in f64 (a bounding-volume hierarchy over the
+//!    tetrahedra) and finds the exact first isovalue crossing along each pixel's ray.
+//!
+//! # Programs (`programs/cellproj/`)
+//! - `seed_vertex.cg`, `seed_fragment.cg`: the talk's Cg text, kept as reference.
+//! - `perspective.*`: the seed's programs ported to ARB and GLSL as the Cg compiler's
+//!   `arbvp1`/`arbfp1` profiles would compile them: the exit parameters per fragment,
+//!   the ray direction `vertex - EyePos` un-normalized, `t` starting at 10000.
+//! - `orthographic.*`: the seed's orthographic case: the view direction is constant, so
+//!   each `t_i` is computed per vertex and interpolated (exact: `t_i` is affine on a face).
+//! - `precise.*` (GLSL only: it loops over the isovalues; ARB fragment programs have no
+//!   loops): normalized direction, guarded divisions (grazing rays, degenerate faces),
+//!   the exact crossing `t_iso = t (iso - sf) / (sb - sf)` against each isovalue (no
+//!   table quantization), depth written at the crossing, optional shading.
+//!
+//! # Decisions the seed leaves open
+//! - The table: `table_size`² RGBA8 (default 256²), texel `(i, j)` for `sf = (i+½)/N`,
+//!   `sb = (j+½)/N`, read with NEAREST (a LINEAR read would blend colours across an
+//!   isovalue). Its alpha is 0 where nothing is crossed; the ported fragment programs
+//!   `KIL` there, standing in for the alpha test the talk's pipeline leaves unstated.
+//! - "Crossed between sf and sb": an isovalue `v` is crossed when it lies in `(sf, sb]`
+//!   (rising) or `[sb, sf)` (falling). The interval is open at the entry, so a crossing
+//!   exactly on a shared face belongs to exactly one of the two tetrahedra.
+//! - The exit direction of the orthographic variant is the view direction; the seed's Cg
+//!   (`vertex - EyePos`) is the perspective variant.
+//! - Shading (precise only; the seed drew unlit colours): Lambert with a headlight and
+//!   an ambient term, the normal being the gradient turned toward the viewer.
+//!
+//! # Extremes (DESIGN §4), each with a test
+//! Grazing rays (`dot(D, n) → 0`: faithful divides as the seed did, precise skips the
+//! plane); flat tetrahedra (zero gradient: `sf = sb`, nothing crossed) and slivers;
+//! `sf = sb`; isovalues exactly at vertex values (the half-open rule); coordinates far
+//! from the origin (re-centred in f64); a one-tetrahedron mesh; isovalues outside the
+//! data range (nothing drawn).
+
+pub mod prepare;
+pub mod reference;
+pub mod renderer;
+
+use serde::{Deserialize, Serialize};
+
+use crate::mesh::scalars::ScalarSpec;
+use crate::mesh::MeshSource;
+use crate::scene::FieldError;
+
+pub use renderer::CellprojRenderer;
+
+/// One isosurface: the normalized scalar value and its colour.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Isovalue {
+    /// Value in [0, 1] (scalars are normalized over their range, as the seed did).
+    pub value: f64,
+    /// RGBA colour, each in [0, 1].
+    pub color: [f64; 4],
+}
+
+/// Where the exit point is computed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Exit {
+    /// Per vertex for orthographic cameras, per fragment for perspective ones.
+    #[default]
+    Auto,
+    /// Per vertex, interpolated (orthographic only: the direction must be constant).
+    Vertex,
+    /// Per fragment.
+    Fragment,
+}
+
+/// `[technique.cellproj]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CellprojScene {
+    /// The mesh.
+    pub mesh: MeshSource,
+    /// Which point scalar (default: the first point array).
+    #[serde(default)]
+    pub scalars: ScalarSpec,
+    /// The isosurfaces, any order.
+    pub isovalues: Vec<Isovalue>,
+    /// Where the exit point is computed.
+    #[serde(default)]
+    pub exit: Exit,
+    /// Side of the `(sf, sb)` table of the faithful programs.
+    #[serde(default = "default_table_size")]
+    pub table_size: u32,
+    /// Shade with the gradient as the normal (precise only).
+    #[serde(default)]
+    pub shading: bool,
+}
+
+fn default_table_size() -> u32 {
+    256
+}
+
+/// Most isovalues: the precise programs loop over them; the faithful table can separate
+/// at most one per texel row, so more than `table_size` would be lost anyway.
+pub const MAX_ISOVALUES: usize = 256;
+
+impl CellprojScene {
+    /// Check values that parse but cannot render; the error names the key.
+    pub fn validate(&self) -> Result<(), FieldError> {
+        if self.isovalues.len() > MAX_ISOVALUES {
+            return Err(FieldError::new(
+                "isovalues",
+                format!("{} isovalues: at most {MAX_ISOVALUES}", self.isovalues.len()),
+            ));
+        }
+        for (i, iso) in self.isovalues.iter().enumerate() {
+            if !iso.value.is_finite() {
+                return Err(FieldError::new(
+                    format!("isovalues.{i}.value"),
+                    format!("{}: must be finite", iso.value),
+                ));
+            }
+            if iso.color.iter().any(|c| !(0.0..=1.0).contains(c)) {
+                return Err(FieldError::new(
+                    format!("isovalues.{i}.color"),
+                    format!("{:?}: each component in [0, 1]", iso.color),
+                ));
+            }
+        }
+        if !(2..=4096).contains(&self.table_size) {
+            return Err(FieldError::new(
+                "table_size",
+                format!("{}: must be 2..=4096", self.table_size),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The isovalues sorted by value (ties keep their order).
+    pub fn sorted_isovalues(&self) -> Vec<Isovalue> {
+        let mut v = self.isovalues.clone();
+        v.sort_by(|a, b| a.value.total_cmp(&b.value));
+        v
+    }
+}
+
+/// The first isovalue crossed going from `sf` toward `sb`: in `(sf, sb]` when rising,
+/// `[sb, sf)` when falling, none when equal. `sorted` ascending by value.
+pub fn first_crossed(sorted: &[Isovalue], sf: f64, sb: f64) -> Option<usize> {
+    if sb > sf {
+        sorted.iter().position(|i| i.value > sf && i.value <= sb)
+    } else if sb < sf {
+        sorted.iter().rposition(|i| i.value >= sb && i.value < sf)
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn isos(values: &[f64]) -> Vec<Isovalue> {
+        values
+            .iter()
+            .map(|&value| Isovalue {
+                value,
+                color: [1.0; 4],
+            })
+            .collect()
+    }
+
+    #[test]
+    fn first_crossing_follows_the_ray_and_the_half_open_rule() {
+        let s = isos(&[0.3, 0.5, 0.9]);
+        assert_eq!(first_crossed(&s, 0.2, 0.6), Some(0));
+        assert_eq!(first_crossed(&s, 0.6, 0.2), Some(1), "falling: 0.5 first");
+        assert_eq!(first_crossed(&s, 0.31, 0.49), None);
+        assert_eq!(first_crossed(&s, 0.4, 0.4), None, "sf = sb crosses nothing");
+        // Exactly at a vertex value: counted where the ray leaves, not where it enters,
+        // so two tetrahedra sharing the face do not both draw it.
+        assert_eq!(first_crossed(&s, 0.2, 0.3), Some(0));
+        assert_eq!(first_crossed(&s, 0.3, 0.4), None);
+        assert_eq!(first_crossed(&s, 0.4, 0.3), Some(0));
+        assert_eq!(first_crossed(&s, 0.3, 0.2), None);
+        // Outside the data range.
+        assert_eq!(first_crossed(&isos(&[1.5]), 0.0, 1.0), None);
+    }
+}

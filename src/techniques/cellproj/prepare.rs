@@ -1,0 +1,294 @@
+//! CPU preparation for cell projection (no GL): the mesh in the object box, what the
+//! seed's vertex program takes for every face vertex, and the `(sf, sb)` table.
+
+use std::path::Path;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::{first_crossed, CellprojScene, Isovalue};
+use crate::mesh::quality::Quality;
+use crate::mesh::Mesh;
+
+/// Floats per face vertex: position 3, scalar 1, opposite vertex 3, three normals 3
+/// each, gradient 3 (generic attributes 0..6, in this order).
+pub const VERTEX_COMPONENTS: [usize; 7] = [3, 1, 3, 3, 3, 3, 3];
+/// Sum of [`VERTEX_COMPONENTS`].
+pub const FLOATS_PER_VERTEX: usize = 19;
+
+/// The faces of a positively oriented tetrahedron `[0, 1, 2, 3]`, each listed
+/// counter-clockwise seen from outside, with the vertex opposite it.
+pub const FACES: [([usize; 3], usize); 4] = [
+    ([1, 2, 3], 0),
+    ([0, 3, 2], 1),
+    ([0, 1, 3], 2),
+    ([0, 2, 1], 3),
+];
+
+/// A mesh ready to draw and to trace.
+#[derive(Debug, Clone)]
+pub struct Prepared {
+    /// Points in object space: centred on the bounding box, longest side spanning
+    /// [-1, 1] (computed in f64 from the file's coordinates).
+    pub points: Vec<DVec3>,
+    /// Normalized scalar per point.
+    pub scalars: Vec<f64>,
+    /// Tetrahedra that are drawn (positively oriented; those touching a NaN scalar are
+    /// left out and counted in `dropped`).
+    pub tets: Vec<[u32; 4]>,
+    /// Half-extents of the object box.
+    pub half: DVec3,
+    /// Tetrahedra left out for non-finite scalars.
+    pub dropped: usize,
+    /// Flat and sliver counts of the mesh.
+    pub quality: Quality,
+    /// Which array the scalars came from, and its range.
+    pub scalar_name: String,
+    /// Range mapped to [0, 1].
+    pub scalar_range: [f64; 2],
+}
+
+/// Load and prepare a scene's mesh; relative paths from `base`.
+pub fn prepare(scene: &CellprojScene, base: &Path) -> Result<Prepared, String> {
+    let mesh = scene.mesh.load(base).map_err(|e| e.to_string())?;
+    let scalars = scene.scalars.evaluate(&mesh).map_err(|e| e.to_string())?;
+    from_mesh(&mesh, &scalars.values, scalars.name, scalars.range)
+}
+
+/// Prepare a mesh with one normalized scalar per point.
+pub fn from_mesh(
+    mesh: &Mesh,
+    scalars: &[f64],
+    scalar_name: String,
+    scalar_range: [f64; 2],
+) -> Result<Prepared, String> {
+    if scalars.len() != mesh.points.len() {
+        return Err(format!(
+            "{} scalars for {} points",
+            scalars.len(),
+            mesh.points.len()
+        ));
+    }
+    if mesh.tets.is_empty() {
+        return Err(format!("{}: the mesh has no tetrahedra", mesh.info.source));
+    }
+    let (lo, hi) = mesh.bounds().ok_or("the mesh has no points")?;
+    let (lo, hi) = (DVec3::from_array(lo), DVec3::from_array(hi));
+    let centre = (lo + hi) / 2.0;
+    let longest = (hi - lo).max_element();
+    let scale = if longest > 0.0 { 2.0 / longest } else { 1.0 };
+    let points: Vec<DVec3> = mesh
+        .points
+        .iter()
+        .map(|p| (DVec3::from_array(*p) - centre) * scale)
+        .collect();
+    let half = ((hi - lo) * scale / 2.0).max(DVec3::splat(1e-9));
+    let finite = |t: &[u32; 4]| t.iter().all(|&v| scalars[v as usize].is_finite());
+    let tets: Vec<[u32; 4]> = mesh.tets.iter().copied().filter(finite).collect();
+    Ok(Prepared {
+        dropped: mesh.tets.len() - tets.len(),
+        points,
+        scalars: scalars.to_vec(),
+        tets,
+        half,
+        quality: Quality::of(mesh),
+        scalar_name,
+        scalar_range,
+    })
+}
+
+/// The gradient of the linear scalar in a tetrahedron (zero when it is flat).
+pub fn gradient(p: [DVec3; 4], s: [f64; 4]) -> DVec3 {
+    let (e1, e2, e3) = (p[1] - p[0], p[2] - p[0], p[3] - p[0]);
+    let det = e1.dot(e2.cross(e3));
+    if det.abs() <= 1e-300 || !det.is_finite() {
+        return DVec3::ZERO;
+    }
+    // Solve [e1; e2; e3] g = ds by Cramer's rule with the cofactor vectors.
+    let ds = DVec3::new(s[1] - s[0], s[2] - s[0], s[3] - s[0]);
+    (e2.cross(e3) * ds.x + e3.cross(e1) * ds.y + e1.cross(e2) * ds.z) / det
+}
+
+/// The unit normal of triangle `a, b, c` (zero when degenerate).
+pub fn normal(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    (b - a).cross(c - a).normalize_or_zero()
+}
+
+impl Prepared {
+    /// Corners and scalars of tetrahedron `t`.
+    pub fn tet(&self, t: usize) -> ([DVec3; 4], [f64; 4]) {
+        let v = self.tets[t];
+        (
+            v.map(|i| self.points[i as usize]),
+            v.map(|i| self.scalars[i as usize]),
+        )
+    }
+
+    /// Vertex data of every face of every tetrahedron: 4 faces x 3 vertices x
+    /// [`FLOATS_PER_VERTEX`], in parallel.
+    pub fn face_vertices(&self) -> Vec<f32> {
+        (0..self.tets.len())
+            .into_par_iter()
+            .flat_map_iter(|t| self.tet_vertices(t))
+            .collect()
+    }
+
+    fn tet_vertices(&self, t: usize) -> Vec<f32> {
+        let (p, s) = self.tet(t);
+        let g = gradient(p, s);
+        let mut out = Vec::with_capacity(12 * FLOATS_PER_VERTEX);
+        for (face, opposite) in FACES {
+            let v3 = p[opposite];
+            // The three other faces all contain the opposite vertex.
+            let others: Vec<DVec3> = FACES
+                .iter()
+                .filter(|(_, o)| *o != opposite)
+                .map(|(f, _)| normal(p[f[0]], p[f[1]], p[f[2]]))
+                .collect();
+            for &corner in &face {
+                let mut v = vec![p[corner].x, p[corner].y, p[corner].z, s[corner]];
+                v.extend(v3.to_array());
+                for n in &others {
+                    v.extend(n.to_array());
+                }
+                v.extend(g.to_array());
+                out.extend(v.iter().map(|&x| x as f32));
+            }
+        }
+        out
+    }
+
+    /// Number of face vertices [`Prepared::face_vertices`] yields.
+    pub fn vertex_count(&self) -> usize {
+        self.tets.len() * 12
+    }
+}
+
+/// The faithful `(sf, sb)` table: `size`² RGBA8, texel `(i, j)` (i along s = sf, j
+/// along t = sb, row j first) holding the colour of the first isovalue crossed from
+/// `sf = (i + ½)/size` to `sb = (j + ½)/size`, alpha 0 where none is.
+pub fn iso_table(isovalues: &[Isovalue], size: u32) -> Vec<u8> {
+    let mut sorted = isovalues.to_vec();
+    sorted.sort_by(|a, b| a.value.total_cmp(&b.value));
+    let n = size as usize;
+    let centre = |k: usize| (k as f64 + 0.5) / n as f64;
+    let byte = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+    let mut texels = vec![0u8; n * n * 4];
+    for j in 0..n {
+        for i in 0..n {
+            if let Some(k) = first_crossed(&sorted, centre(i), centre(j)) {
+                let c = sorted[k].color;
+                let at = (j * n + i) * 4;
+                texels[at..at + 4].copy_from_slice(&[byte(c[0]), byte(c[1]), byte(c[2]), 255]);
+            }
+        }
+    }
+    texels
+}
+
+/// The precise programs' isovalue list: a `count` x 2 RGBA32F texture, row 0 the
+/// colours, row 1 the values (sorted ascending).
+pub fn iso_list(isovalues: &[Isovalue]) -> Vec<f32> {
+    let mut sorted = isovalues.to_vec();
+    sorted.sort_by(|a, b| a.value.total_cmp(&b.value));
+    let mut texels: Vec<f32> = sorted
+        .iter()
+        .flat_map(|i| i.color.map(|c| c as f32))
+        .collect();
+    texels.extend(sorted.iter().flat_map(|i| [i.value as f32, 0.0, 0.0, 0.0]));
+    texels
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::grid::{generate, Field, GridSpec};
+
+    #[test]
+    fn faces_are_outward_and_counter_clockwise() {
+        let p = [DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z];
+        let centre = (p[0] + p[1] + p[2] + p[3]) / 4.0;
+        for (f, o) in FACES {
+            let n = normal(p[f[0]], p[f[1]], p[f[2]]);
+            assert!(n.dot(p[f[0]] - centre) > 0.0, "face {f:?} points out");
+            assert!(!f.contains(&o));
+        }
+    }
+
+    #[test]
+    fn gradient_of_a_linear_field_is_exact() {
+        let p = [
+            DVec3::new(0.3, -0.2, 0.1),
+            DVec3::new(1.1, 0.0, 0.2),
+            DVec3::new(0.2, 0.9, -0.1),
+            DVec3::new(0.1, 0.3, 1.3),
+        ];
+        let g = DVec3::new(0.7, -1.9, 0.25);
+        let s = p.map(|q| 0.4 + g.dot(q));
+        assert!((gradient(p, s) - g).length() < 1e-12);
+        let flat = [p[0], p[1], p[2], (p[1] + p[2]) / 2.0];
+        assert_eq!(gradient(flat, s), DVec3::ZERO);
+    }
+
+    #[test]
+    fn the_seed_grid_prepares_into_the_object_box() {
+        let mesh = generate(&GridSpec {
+            points: [17, 17, 17],
+            field: Field::Spherical,
+        })
+        .unwrap();
+        let s = crate::mesh::scalars::ScalarSpec::default()
+            .evaluate(&mesh)
+            .unwrap();
+        let p = from_mesh(&mesh, &s.values, s.name, s.range).unwrap();
+        assert_eq!(p.tets.len(), 24_576);
+        assert_eq!(p.vertex_count(), 24_576 * 12);
+        assert!((p.half - DVec3::ONE).length() < 1e-12);
+        let v = p.face_vertices();
+        assert_eq!(v.len(), 24_576 * 12 * FLOATS_PER_VERTEX);
+        // The first vertex: position, scalar, opposite vertex, then unit normals.
+        let n0 = DVec3::new(v[7] as f64, v[8] as f64, v[9] as f64);
+        assert!((n0.length() - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn far_from_the_origin_keeps_millimetres() {
+        // A tetrahedron 1e6 from the origin with millimetre edges: in f32 directly its
+        // corners would collapse (f32 spacing at 1e6 is 0.0625); re-centred in f64 they
+        // keep their shape.
+        let mut mesh = crate::mesh::Mesh::default();
+        let o = 1.0e6;
+        mesh.points = vec![
+            [o, o, o],
+            [o + 0.001, o, o],
+            [o, o + 0.001, o],
+            [o, o, o + 0.001],
+        ];
+        mesh.tets = vec![[0, 1, 2, 3]];
+        let p = from_mesh(&mesh, &[0.0, 1.0, 0.0, 0.0], "s".into(), [0.0, 1.0]).unwrap();
+        let (q, s) = p.tet(0);
+        let g = gradient(q, s);
+        // s = x / 1 mm; the box maps 1 mm to 2 units: the gradient is 0.5 per unit.
+        assert!((g - DVec3::new(0.5, 0.0, 0.0)).length() < 1e-9, "{g}");
+    }
+
+    #[test]
+    fn table_holds_the_first_crossing_and_nothing_elsewhere() {
+        let isos = [
+            Isovalue {
+                value: 0.5,
+                color: [0.0, 1.0, 0.0, 1.0],
+            },
+            Isovalue {
+                value: 0.3,
+                color: [1.0, 0.0, 0.0, 1.0],
+            },
+        ];
+        let t = iso_table(&isos, 10);
+        let at = |i: usize, j: usize| &t[(j * 10 + i) * 4..][..4];
+        assert_eq!(at(1, 8), &[255, 0, 0, 255], "0.15 -> 0.85 crosses 0.3 first");
+        assert_eq!(at(8, 1), &[0, 255, 0, 255], "0.85 -> 0.15 crosses 0.5 first");
+        assert_eq!(at(3, 4), &[0, 0, 0, 0], "0.35 -> 0.45: nothing");
+        assert_eq!(iso_list(&isos)[..4], [1.0, 0.0, 0.0, 1.0], "sorted: 0.3 first");
+    }
+}

@@ -1,0 +1,289 @@
+//! The GL side of cell projection: the face vertices in one buffer (uploaded once), the
+//! isosurface table (faithful) or isovalue list (precise) on unit 0, and the program of
+//! the fidelity and exit variant; every frame is one draw with back-face culling and a
+//! depth test. Changing isovalues or colours rewrites only the table.
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::prepare::{iso_list, iso_table, prepare, Prepared, VERTEX_COMPONENTS};
+use super::{CellprojScene, Exit};
+use crate::camera::Projection;
+use crate::gl::{
+    self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
+    Surface, TexelData, TexelFormat, Texture,
+};
+use crate::programs::{self, ProgramPair};
+use crate::scene::{Fidelity, TechniqueScene};
+use crate::techniques::{Frame, Renderer};
+
+/// Texture unit of the table (faithful) or isovalue list (precise).
+pub const TABLE_UNIT: u32 = 0;
+
+/// Ambient term of the precise shading.
+pub const AMBIENT: f64 = 0.25;
+
+/// The program variants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Variant {
+    /// The seed's programs, exit per fragment.
+    PerFragment,
+    /// The seed's orthographic case, exit per vertex.
+    PerVertex,
+    /// Precise (GLSL), per fragment.
+    Precise,
+}
+
+/// The variant a scene draws with for `projection`: precise for precise fidelity; else
+/// per vertex where the direction is constant (orthographic) unless the scene says
+/// per fragment. Per vertex in perspective is an error (the seed's own caveat).
+pub fn variant(
+    params: &CellprojScene,
+    fidelity: Fidelity,
+    projection: Projection,
+) -> GlResult<Variant> {
+    if fidelity == Fidelity::Precise {
+        return Ok(Variant::Precise);
+    }
+    Ok(match (params.exit, projection) {
+        (Exit::Fragment, _) | (Exit::Auto, Projection::Perspective) => Variant::PerFragment,
+        (Exit::Auto | Exit::Vertex, Projection::Orthographic) => Variant::PerVertex,
+        (Exit::Vertex, Projection::Perspective) => {
+            return Err(GlError::Data(
+                "exit = \"vertex\" needs an orthographic camera: in perspective the ray direction varies over a face, so the exit parameters are not affine (the seed computes them per fragment there)".into(),
+            ))
+        }
+    })
+}
+
+/// The program pair of a variant (precise exists only in GLSL: it loops).
+pub fn program_pair(variant: Variant, kind: ProgramKind) -> GlResult<ProgramPair> {
+    use programs::*;
+    let (vertex, fragment) = match (variant, kind) {
+        (Variant::PerFragment, ProgramKind::Arb) => {
+            (CELLPROJ_PERSPECTIVE_ARBVP, CELLPROJ_PERSPECTIVE_ARBFP)
+        }
+        (Variant::PerFragment, ProgramKind::Glsl) => {
+            (CELLPROJ_PERSPECTIVE_VERT, CELLPROJ_PERSPECTIVE_FRAG)
+        }
+        (Variant::PerVertex, ProgramKind::Arb) => {
+            (CELLPROJ_ORTHOGRAPHIC_ARBVP, CELLPROJ_ORTHOGRAPHIC_ARBFP)
+        }
+        (Variant::PerVertex, ProgramKind::Glsl) => {
+            (CELLPROJ_ORTHOGRAPHIC_VERT, CELLPROJ_ORTHOGRAPHIC_FRAG)
+        }
+        (Variant::Precise, _) => (CELLPROJ_PRECISE_VERT, CELLPROJ_PRECISE_FRAG),
+    };
+    let kind = if variant == Variant::Precise {
+        ProgramKind::Glsl
+    } else {
+        kind
+    };
+    Ok(ProgramPair {
+        kind,
+        vertex,
+        fragment,
+    })
+}
+
+/// The program kind for a scene: precise exists only in GLSL, so `auto` means GLSL
+/// there (an explicit `arb` stays, and is refused by the renderer with the reason).
+pub fn resolve_kind(scene: &crate::scene::Scene, kind: ProgramKind) -> ProgramKind {
+    if scene.fidelity == Fidelity::Precise && scene.programs == crate::gl::ProgramChoice::Auto {
+        ProgramKind::Glsl
+    } else {
+        kind
+    }
+}
+
+/// The eye in object space (perspective) and the unit view direction (both cameras).
+pub fn eye_and_direction(frame: &Frame) -> (DVec3, DVec3) {
+    let inverse = frame.camera.view().inverse();
+    let eye = inverse.transform_point3(DVec3::ZERO);
+    let dir = inverse.transform_vector3(DVec3::NEG_Z).normalize();
+    (eye, dir)
+}
+
+/// The cell-projection renderer.
+pub struct CellprojRenderer {
+    kind: ProgramKind,
+    fidelity: Fidelity,
+    params: CellprojScene,
+    prepared: Prepared,
+    mesh: Mesh,
+    table: Texture,
+    program: Option<(Variant, Program)>,
+}
+
+fn table_texture(gpu: &Gpu, params: &CellprojScene, fidelity: Fidelity) -> GlResult<Texture> {
+    match fidelity {
+        Fidelity::Faithful => {
+            let n = params.table_size;
+            Texture::new(
+                gpu,
+                "cellproj isosurface table (s = sf, t = sb)",
+                Extent::D2(n, n),
+                TexelFormat::Rgba8,
+                Filter::Nearest,
+                TexelData::U8(&iso_table(&params.isovalues, n)),
+            )
+        }
+        Fidelity::Precise => {
+            let count = params.isovalues.len().max(1) as u32;
+            let mut list = iso_list(&params.isovalues);
+            list.resize(count as usize * 8, 0.0);
+            Texture::new(
+                gpu,
+                "cellproj isovalues (row 0 colours, row 1 values)",
+                Extent::D2(count, 2),
+                TexelFormat::Rgba32f,
+                Filter::Nearest,
+                TexelData::F32(&list),
+            )
+        }
+    }
+}
+
+impl CellprojRenderer {
+    /// Load and prepare the scene's mesh (relative paths from `base`), then upload.
+    pub fn new(
+        gpu: &Gpu,
+        kind: ProgramKind,
+        fidelity: Fidelity,
+        params: &CellprojScene,
+        base: &Path,
+    ) -> GlResult<CellprojRenderer> {
+        params
+            .validate()
+            .map_err(|e| GlError::Data(e.to_string()))?;
+        let prepared = prepare(params, base).map_err(GlError::Data)?;
+        CellprojRenderer::from_prepared(gpu, kind, fidelity, params, prepared)
+    }
+
+    /// Upload a mesh prepared elsewhere (tests craft meshes in memory).
+    pub fn from_prepared(
+        gpu: &Gpu,
+        kind: ProgramKind,
+        fidelity: Fidelity,
+        params: &CellprojScene,
+        prepared: Prepared,
+    ) -> GlResult<CellprojRenderer> {
+        if fidelity == Fidelity::Precise && kind == ProgramKind::Arb {
+            return Err(GlError::Unsupported(
+                "precise cell projection exists only in GLSL (it loops over the isovalues; ARB fragment programs have no loops): use --programs glsl or auto".into(),
+            ));
+        }
+        let vertices = prepared.face_vertices();
+        let mesh = Mesh::new(
+            gpu,
+            "cellproj faces (4 per tetrahedron)",
+            &VERTEX_COMPONENTS,
+            &vertices,
+        )?;
+        let table = table_texture(gpu, params, fidelity)?;
+        Ok(CellprojRenderer {
+            kind,
+            fidelity,
+            params: params.clone(),
+            prepared,
+            mesh,
+            table,
+            program: None,
+        })
+    }
+
+    /// The prepared mesh (for references and readouts).
+    pub fn prepared(&self) -> &Prepared {
+        &self.prepared
+    }
+
+    /// The program for `variant`, compiled on first use (a scene switching projection
+    /// compiles the other one once).
+    fn program(&mut self, gpu: &Gpu, variant: Variant) -> GlResult<&Program> {
+        if self.program.as_ref().map(|(v, _)| *v) != Some(variant) {
+            let pair = program_pair(variant, self.kind)?;
+            let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
+            self.program = Some((variant, program));
+        }
+        Ok(&self.program.as_ref().expect("set above").1)
+    }
+}
+
+impl Renderer for CellprojRenderer {
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+        let variant = variant(&self.params, self.fidelity, frame.camera.projection)?;
+        let mvp = frame.camera.view_projection(frame.aspect());
+        let (eye, dir) = eye_and_direction(frame);
+        let perspective = frame.camera.projection == Projection::Perspective;
+        let count = self.params.isovalues.len() as f64;
+        let shading = self.params.shading && self.fidelity == Fidelity::Precise;
+        let program = self.program(gpu, variant)?;
+        program.set_transform(gpu, mvp)?;
+        match variant {
+            Variant::PerFragment => program.set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, 1.0])?,
+            Variant::PerVertex => program.set_vertex_local(gpu, 4, [dir.x, dir.y, dir.z, 0.0])?,
+            Variant::Precise => {
+                let t = mvp.transpose();
+                for (i, row) in [t.x_axis, t.y_axis, t.z_axis, t.w_axis].iter().enumerate() {
+                    program.set_local(gpu, i, row.to_array())?;
+                }
+                let w = if perspective { 1.0 } else { 0.0 };
+                program.set_local(gpu, 4, [eye.x, eye.y, eye.z, w])?;
+                program.set_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
+                let on = if shading { 1.0 } else { 0.0 };
+                program.set_local(gpu, 6, [count, on, AMBIENT, 0.0])?;
+            }
+        }
+        if self.params.isovalues.is_empty() {
+            return Ok(());
+        }
+        let program = &self.program.as_ref().expect("compiled above").1;
+        gl::draw(
+            gpu,
+            surface,
+            &DrawCall {
+                program,
+                mesh: &self.mesh,
+                range: None,
+                textures: &[(TABLE_UNIT, &self.table)],
+                blend: Blend::Replace,
+                depth_test: true,
+                cull_back: true,
+            },
+        )
+    }
+
+    fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()> {
+        let TechniqueScene::Cellproj(new) = technique else {
+            return Err(GlError::Invalid(format!(
+                "cellproj renderer given a {} scene",
+                technique.name()
+            )));
+        };
+        new.validate().map_err(|e| GlError::Data(e.to_string()))?;
+        if new.mesh != self.params.mesh || new.scalars != self.params.scalars {
+            return Err(GlError::Invalid(
+                "a new mesh or scalar needs a new renderer".into(),
+            ));
+        }
+        let table_changed = new.isovalues != self.params.isovalues
+            || new.table_size != self.params.table_size;
+        self.params = (**new).clone();
+        if table_changed {
+            self.table = table_texture(gpu, &self.params, self.fidelity)?;
+        }
+        Ok(())
+    }
+
+    fn program_kind(&self) -> ProgramKind {
+        match self.fidelity {
+            Fidelity::Precise => ProgramKind::Glsl,
+            Fidelity::Faithful => self.kind,
+        }
+    }
+
+    fn needs_depth(&self) -> bool {
+        true
+    }
+}

@@ -1,0 +1,84 @@
+//! The cell-projection editor: isovalues (add, remove, drag the value, pick the colour),
+//! where the exit point is computed, shading and the table size. Each edit rewrites only
+//! the isosurface table on the next frame.
+
+use std::collections::HashMap;
+
+use egui::Rect;
+
+use crate::techniques::cellproj::{CellprojScene, Exit, Isovalue, MAX_ISOVALUES};
+
+/// Draw the editor; true when something changed.
+pub fn editor(
+    ui: &mut egui::Ui,
+    scene: &mut CellprojScene,
+    widgets: &mut HashMap<String, Rect>,
+) -> bool {
+    let mut changed = false;
+    ui.label("Isovalues (normalized scalar, colour)");
+    let mut remove = None;
+    for (i, iso) in scene.isovalues.iter_mut().enumerate() {
+        ui.horizontal(|ui| {
+            let r = ui.add(
+                egui::DragValue::new(&mut iso.value)
+                    .range(0.0..=1.0)
+                    .speed(0.002)
+                    .max_decimals(4),
+            );
+            widgets.insert(format!("Isovalue {}", i + 1), r.rect);
+            changed |= r.changed();
+            let mut c = iso.color.map(|v| v as f32);
+            let r = ui.color_edit_button_rgba_unmultiplied(&mut c);
+            widgets.insert(format!("Isovalue {} colour", i + 1), r.rect);
+            if r.changed() {
+                iso.color = c.map(|v| v as f64);
+                changed = true;
+            }
+            let r = ui.button("Remove");
+            widgets.insert(format!("Remove isovalue {}", i + 1), r.rect);
+            if r.clicked() {
+                remove = Some(i);
+            }
+        });
+    }
+    if let Some(i) = remove {
+        scene.isovalues.remove(i);
+        changed = true;
+    }
+    let r = ui.add_enabled(
+        scene.isovalues.len() < MAX_ISOVALUES,
+        egui::Button::new("Add isovalue"),
+    );
+    widgets.insert("Add isovalue".into(), r.rect);
+    if r.clicked() {
+        let value = scene.isovalues.last().map_or(0.5, |i| (i.value + 0.1) % 1.0);
+        scene.isovalues.push(Isovalue {
+            value,
+            color: [1.0, 1.0, 0.0, 1.0],
+        });
+        changed = true;
+    }
+    ui.separator();
+    ui.horizontal(|ui| {
+        ui.label("Exit point");
+        for (label, exit) in [
+            ("auto", Exit::Auto),
+            ("per vertex", Exit::Vertex),
+            ("per fragment", Exit::Fragment),
+        ] {
+            let r = ui.radio_value(&mut scene.exit, exit, label);
+            widgets.insert(format!("Exit {label}"), r.rect);
+            changed |= r.changed();
+        }
+    });
+    let r = ui.checkbox(&mut scene.shading, "Shading (precise)");
+    widgets.insert("Shading".into(), r.rect);
+    changed |= r.changed();
+    ui.horizontal(|ui| {
+        ui.label("Table size");
+        let r = ui.add(egui::DragValue::new(&mut scene.table_size).range(2..=4096));
+        widgets.insert("Table size".into(), r.rect);
+        changed |= r.changed();
+    });
+    changed
+}
