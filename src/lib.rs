@@ -16,6 +16,7 @@ pub mod image;
 pub mod info;
 pub mod input;
 pub mod png_io;
+pub mod points;
 pub mod programs;
 pub mod render;
 pub mod scene;
