@@ -665,8 +665,8 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
         path: name.to_path_buf(),
         message: what,
     };
-    let mut reader =
-        Reader::new(Cursor::new(bytes)).map_err(|e| decode_error(format!("the header: {e}")))?;
+    let mut reader = guarded(|| Reader::new(Cursor::new(bytes)))
+        .map_err(|e| decode_error(format!("the header: {e}")))?;
     let has_rgb = reader.header().point_format().has_color;
     let mut pd: PointData = PointDataBuilder::new().for_header(reader.header()).build();
     let mut cols = Columns::new(extras.len(), has_rgb);
@@ -674,7 +674,7 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
     let mut done = 0u64;
     while done < count {
         let want = BATCH.min(count - done);
-        let n = reader.fill_points(want, &mut pd).map_err(|e| {
+        let n = guarded(|| reader.fill_points(want, &mut pd)).map_err(|e| {
             decode_error(format!(
                 "decoding points {done}..{} of {count}: {e}",
                 done + want
@@ -725,6 +725,28 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
     })
     .map_err(decode_error)?;
     Ok(LasCloud { cloud, info })
+}
+
+/// Run a `las`/`laz` call, turning a panic into an error message. `laz` asserts on
+/// some corrupt compressed streams (e.g. `assert!(sym < (1 << 16))` in its arithmetic
+/// decoder) where it could return an error; the checks above cannot foresee what an
+/// arithmetic-coded stream decodes to, so this is the last guard: the decoder that
+/// panicked is dropped with the error, never reused.
+fn guarded<T>(f: impl FnOnce() -> las::Result<T>) -> Result<T, String> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+        Ok(result) => result.map_err(|e| e.to_string()),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            Err(format!(
+                "the decoder failed on corrupt data ({})",
+                crate::input::shorten(&what, 80)
+            ))
+        }
+    }
 }
 
 /// Columns gathered batch by batch.
@@ -800,4 +822,4 @@ impl Columns {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -935,4 +935,4 @@ fn ascii_value(token: &[u8], ty: ScalarType) -> Result<f64, String> {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -419,7 +419,6 @@ fn autzen_laz() {
         |b: [[f64; 3]; 2]| (0..6).all(|i| (b[i / 3][i % 3] - expect[i / 3][i % 3]).abs() < 1e-6);
     assert!(close(c.cloud.bounds), "{:?}", c.cloud.bounds);
     assert!(close(c.info.header_bounds), "{:?}", c.info.header_bounds);
-    {}
     let first = c.cloud.original(0).unwrap();
     for (a, v) in [637_177.98, 849_393.95, 411.19].iter().enumerate() {
         assert!((first[a] - v).abs() < 1e-3, "{first:?}");

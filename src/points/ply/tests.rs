@@ -74,7 +74,7 @@ fn header(format: &str) -> String {
     h
 }
 
-fn fixture(encoding: Encoding) -> Vec<u8> {
+pub(crate) fn fixture(encoding: Encoding) -> Vec<u8> {
     let mut out = header(encoding.name()).into_bytes();
     let big = encoding == Encoding::BinaryBigEndian;
     for row in 0..2 {
