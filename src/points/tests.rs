@@ -325,10 +325,14 @@ fn mutate(bytes: &[u8], rng: &mut SplitMix64) -> Vec<u8> {
                 // An extreme 4- or 8-byte value (counts, offsets, lengths).
                 let v: [u8; 8] =
                     [u64::MAX, 1 << 40, 1 << 31, u32::MAX as u64, 0][pick(rng, 5)].to_le_bytes();
-                let n = if rng.next_u64() % 2 == 0 { 4 } else { 8 };
-                for k in 0..n {
+                let n = if rng.next_u64().is_multiple_of(2) {
+                    4
+                } else {
+                    8
+                };
+                for (k, &byte) in v.iter().enumerate().take(n) {
                     if let Some(x) = b.get_mut(at + k) {
-                        *x = v[k];
+                        *x = byte;
                     }
                 }
             }
