@@ -324,7 +324,8 @@ fn parse_chunk(text: &[u8], layout: &Layout) -> Chunk {
     chunk
 }
 
-/// Parse one line into `chunk`; on error the column (characters, 1-based) and message.
+/// Parse one line into `chunk`; on error the column (characters, 1-based) and message
+/// (the chunk is then dropped, so values pushed before the error do not matter).
 fn parse_line(line: &[u8], layout: &Layout, chunk: &mut Chunk) -> Result<(), (usize, String)> {
     let body = line.strip_suffix(b"\n").unwrap_or(line);
     let body = body.strip_suffix(b"\r").unwrap_or(body);
@@ -337,8 +338,6 @@ fn parse_line(line: &[u8], layout: &Layout, chunk: &mut Chunk) -> Result<(), (us
     }
     let count = layout.slots.len();
     let mut position = [0.0f64; 3];
-    let mut ints: Vec<(usize, i32)> = Vec::new();
-    let mut floats: Vec<(usize, f32)> = Vec::new();
     let mut found = 0;
     let mut start = first;
     while start < body.len() {
@@ -391,9 +390,15 @@ fn parse_line(line: &[u8], layout: &Layout, chunk: &mut Chunk) -> Result<(), (us
                         ),
                     ));
                 }
-                ints.push((k, value as i32));
+                if let Values::Int(c) = &mut chunk.columns[k] {
+                    c.push(value as i32);
+                }
             }
-            Slot::Float(k) => floats.push((k, value as f32)),
+            Slot::Float(k) => {
+                if let Values::Float(c) = &mut chunk.columns[k] {
+                    c.push(value as f32);
+                }
+            }
         }
         found += 1;
         start = body[end..]
@@ -408,16 +413,6 @@ fn parse_line(line: &[u8], layout: &Layout, chunk: &mut Chunk) -> Result<(), (us
         ));
     }
     chunk.positions.push(position);
-    for (k, v) in ints {
-        if let Values::Int(c) = &mut chunk.columns[k] {
-            c.push(v);
-        }
-    }
-    for (k, v) in floats {
-        if let Values::Float(c) = &mut chunk.columns[k] {
-            c.push(v);
-        }
-    }
     Ok(())
 }
 
@@ -442,8 +437,9 @@ fn describe_column(index: usize, slot: Slot, layout: &Layout) -> String {
 }
 
 /// The cloud as `.dat` text in `columns`' layout: coordinates from
-/// [`PointCloud::original`], attributes by name, `0` in columns that map nothing or
-/// whose attribute the cloud lacks. For tests and benchmarks of the reader.
+/// [`PointCloud::original`] with as many decimals as the f32 positions resolve
+/// (`scale * 2^-24`), attributes by name, `0` in columns that map nothing or whose
+/// attribute the cloud lacks. For tests and benchmarks of the reader.
 pub fn write(cloud: &PointCloud, columns: &DatColumns) -> Result<String, String> {
     use std::fmt::Write;
     let layout = columns.layout()?;
@@ -452,6 +448,8 @@ pub fn write(cloud: &PointCloud, columns: &DatColumns) -> Result<String, String>
         .iter()
         .map(|(name, _)| cloud.attribute(name).map(|a| &a.values))
         .collect();
+    let step = cloud.scale * 2f64.powi(-24);
+    let decimals = (-step.log10()).ceil().clamp(0.0, 17.0) as usize;
     let mut out = String::new();
     for i in 0..cloud.len() {
         let p = cloud.original(i).unwrap_or([0.0; 3]);
@@ -461,7 +459,7 @@ pub fn write(cloud: &PointCloud, columns: &DatColumns) -> Result<String, String>
             }
             let _ = match *slot {
                 Slot::Unused => write!(out, "0"),
-                Slot::Coord(a) => write!(out, "{}", p[a]),
+                Slot::Coord(a) => write!(out, "{:.*}", decimals, p[a]),
                 Slot::Int(k) | Slot::Float(k) => match sources[k] {
                     Some(Values::Int(v)) => write!(out, "{}", v[i]),
                     Some(Values::Float(v)) => write!(out, "{}", v[i]),

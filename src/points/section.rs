@@ -167,10 +167,13 @@ struct Model {
     faults: Vec<Fault>,
     patches: Vec<Patch>,
     fold_phase: [f64; 3],
-    wave_phase: [f64; 9],
+    /// Sine and cosine of each interface's wave phase.
+    wave_phase: [(f64, f64); 8],
     /// Dominant, secondary and interbed facies of each layer.
     facies: [[i32; 3]; 8],
     channel_phase: [[f64; 2]; 8],
+    /// Reflection coefficient at the base of each layer (from the dominant facies).
+    reflection: [f64; 8],
 }
 
 /// Layer facies: dominant, secondary, thin interbeds (bottom layer first).
@@ -225,20 +228,30 @@ impl Model {
             faults,
             patches,
             fold_phase: std::array::from_fn(|_| rng.range(0.0, tau)),
-            wave_phase: std::array::from_fn(|_| rng.range(0.0, tau)),
+            wave_phase: std::array::from_fn(|_| rng.range(0.0, tau).sin_cos()),
             facies: LAYER_FACIES,
             channel_phase: std::array::from_fn(|_| [rng.range(0.0, tau), rng.range(0.0, tau)]),
+            reflection: std::array::from_fn(|k| {
+                let (below, above) = (LAYER_FACIES[k.max(1) - 1][0], LAYER_FACIES[k][0]);
+                (impedance(above) - impedance(below)) / (impedance(above) + impedance(below))
+            }),
         }
     }
 
-    /// Depth of interface `k` (0 = base, 8 = top of layer 7) at (x, y).
-    fn interface(&self, k: usize, x: f64, y: f64) -> f64 {
+    /// Depths of the interfaces at (x, y): `[k]` is the base of layer `k`. Each is the
+    /// common fold, fading upwards, plus a wave of its own phase (expanded as
+    /// `sin(a + p) = sin a cos p + cos a sin p` so one sine and cosine serve all).
+    fn interfaces(&self, x: f64, y: f64) -> [f64; 8] {
         let tau = std::f64::consts::TAU;
         let fold = 330.0 * (tau * x / 7_000.0 + self.fold_phase[0]).sin()
             + 110.0 * (tau * x / 2_300.0 + self.fold_phase[1]).sin()
             + 50.0 * (tau * y / 3_000.0 + self.fold_phase[2]).sin();
-        let wave = 25.0 * (tau * x / 900.0 + self.wave_phase[k]).sin();
-        -BOX[2] + 500.0 * k as f64 + fold * (1.0 - k as f64 / 12.0) + wave
+        let (sin, cos) = (tau * x / 900.0).sin_cos();
+        std::array::from_fn(|k| {
+            let (sp, cp) = self.wave_phase[k];
+            let wave = 25.0 * (sin * cp + cos * sp);
+            -BOX[2] + 500.0 * k as f64 + fold * (1.0 - k as f64 / 12.0) + wave
+        })
     }
 
     /// Slope of the folding at (x, y) under interface `k`, in degrees.
@@ -298,9 +311,8 @@ fn sample(model: &Model, seed: u64, i: u64) -> Sample {
             nearest = Some((j, d));
         }
     }
-    let layer = (1..8)
-        .take_while(|&k| z0 >= model.interface(k, x, y))
-        .count();
+    let interfaces = model.interfaces(x, y);
+    let layer = (1..8).take_while(|&k| z0 >= interfaces[k]).count();
     let fault_distance = nearest.map_or(f64::INFINITY, |(_, d)| d.abs());
     let fault = match nearest {
         Some((j, d)) if d.abs() <= FAULT_HALF_WIDTH => j as i32,
@@ -312,7 +324,7 @@ fn sample(model: &Model, seed: u64, i: u64) -> Sample {
     let [p0, p1] = model.channel_phase[layer];
     let channel = (tau * x / 1_700.0 + p0).sin() * (tau * y / 1_300.0 + p1).sin()
         + 0.4 * (tau * x / 430.0 + p1).sin();
-    let base = model.interface(layer, x, y);
+    let base = interfaces[layer];
     let bed = (tau * (z0 - base) / 55.0).sin();
     let mut facies = if channel > 0.75 {
         secondary
@@ -345,10 +357,8 @@ fn sample(model: &Model, seed: u64, i: u64) -> Sample {
     let porosity = base_porosity * compaction * noise + damage;
     // Amplitude: Ricker wavelets at the pre-fault interfaces.
     let mut amplitude = 0.0;
-    for k in 1..8 {
-        let (below, above) = (model.facies[k - 1][0], model.facies[k][0]);
-        let r = (impedance(above) - impedance(below)) / (impedance(above) + impedance(below));
-        amplitude += 1.6 * r * ricker((z0 - model.interface(k, x, y)) / 70.0);
+    for (r, z) in model.reflection.iter().zip(interfaces).skip(1) {
+        amplitude += 1.6 * r * ricker((z0 - z) / 70.0);
     }
     amplitude += 0.02 * (rng.next_f64() - 0.5);
     // Joint dip: steep in brittle rock, following faults near them.

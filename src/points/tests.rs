@@ -424,3 +424,54 @@ fn seeded_mutations_never_panic() {
     );
     assert!(outcomes[0] > 2000, "{outcomes:?}");
 }
+
+/// Release timings (best of 3):
+/// `cargo test --release --no-default-features --lib points::tests::timings -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn timings() {
+    fn best<T>(what: &str, mut f: impl FnMut() -> T) -> T {
+        let mut times = Vec::new();
+        let mut out = None;
+        for _ in 0..3 {
+            let t = std::time::Instant::now();
+            out = Some(f());
+            times.push(t.elapsed());
+        }
+        times.sort();
+        eprintln!("{what}: best {:?} (of {times:?})", times[0]);
+        out.unwrap()
+    }
+    let spec = section::SectionSpec::default();
+    let cloud = best("generate 570,000-point section", || {
+        section::generate(&spec).unwrap()
+    });
+    let text = dat::write(&cloud, &dat::DatColumns::default()).unwrap();
+    eprintln!("570,000-line .dat: {} MB", text.len() >> 20);
+    let back = best("parse 570,000-line .dat", || {
+        dat::parse(
+            Path::new("s.dat"),
+            text.as_bytes(),
+            &dat::DatColumns::default(),
+        )
+        .unwrap()
+    });
+    assert_eq!(back.len(), 570_000);
+    if let Some(path) = shared_data("points/autzen_trim.laz") {
+        best("read autzen_trim.laz (110,000 points)", || {
+            lasfile::read(&path).unwrap()
+        });
+    }
+    if let Some(path) = shared_data("points/bunny.ply") {
+        best("read bunny.ply (35,947 vertices)", || {
+            plycloud::read(&path).unwrap()
+        });
+    }
+    let big = section::SectionSpec {
+        points: 10_000_000,
+        seed: 1,
+    };
+    let t = std::time::Instant::now();
+    assert_eq!(section::generate(&big).unwrap().len(), 10_000_000);
+    eprintln!("generate 10,000,000-point section: {:?}", t.elapsed());
+}
