@@ -24,7 +24,7 @@
 //!   the seed reports, and highest along faults as its figure 15 shows.
 //! - **Amplitude**: a synthetic seismic trace: Ricker wavelets at the interfaces (at
 //!   their pre-fault depth) weighted by reflection coefficients of the layers'
-//!   dominant facies, plus noise; about -0.3..0.3.
+//!   dominant facies, a weak ripple from the thin interbeds, and noise; about -0.4..0.3.
 //! - **Joint dip** (degrees, 0..90): near-vertical joints in brittle facies, lower in
 //!   shale and marl, tilted with the bedding, and close to the fault dip within 150 m of
 //!   a fault.
@@ -358,9 +358,9 @@ fn sample(model: &Model, seed: u64, i: u64) -> Sample {
     // Amplitude: Ricker wavelets at the pre-fault interfaces.
     let mut amplitude = 0.0;
     for (r, z) in model.reflection.iter().zip(interfaces).skip(1) {
-        amplitude += 1.6 * r * ricker((z0 - z) / 70.0);
+        amplitude += 1.6 * r * ricker((z0 - z) / 120.0);
     }
-    amplitude += 0.02 * (rng.next_f64() - 0.5);
+    amplitude += 0.04 * bed + 0.02 * (rng.next_f64() - 0.5);
     // Joint dip: steep in brittle rock, following faults near them.
     let bedding = model.bedding_dip(layer, x);
     let mut dip = match rock {

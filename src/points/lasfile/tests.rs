@@ -164,6 +164,11 @@ fn las_1_4_format_7_with_extra_bytes() {
     assert!(!c.info.compressed);
     assert_eq!(c.info.record_length as usize, 36 + EXTRA);
     assert_eq!(c.info.points, 5);
+    // A writer that keeps the legacy count at 0 (as LAS 1.4 allows): the 64-bit one counts.
+    assert_eq!(u64_at(&bytes, 247), 5);
+    let mut zero = bytes.clone();
+    zero[107..111].fill(0);
+    assert_eq!(parse(name(), &zero).unwrap().cloud.len(), 5);
     assert_eq!(
         c.info.extra_bytes,
         [
