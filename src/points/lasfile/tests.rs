@@ -1,3 +1,4 @@
+use super::check::{u32_at, u64_at};
 use super::*;
 use las::point::{Classification, Format};
 use las::{Builder, Color, Point, Transform, Vector, Vlr, Writer};
