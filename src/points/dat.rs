@@ -448,8 +448,7 @@ pub fn write(cloud: &PointCloud, columns: &DatColumns) -> Result<String, String>
         .iter()
         .map(|(name, _)| cloud.attribute(name).map(|a| &a.values))
         .collect();
-    let step = cloud.scale * 2f64.powi(-24);
-    let decimals = (-step.log10()).ceil().clamp(0.0, 17.0) as usize;
+    let decimals = super::decimals_for(cloud.scale * 2f64.powi(-24));
     let mut out = String::new();
     for i in 0..cloud.len() {
         let p = cloud.original(i).unwrap_or([0.0; 3]);

@@ -35,7 +35,7 @@ use check::{check, RECORD_LENGTH};
 use extra::{decode_extra, extra_bytes, extra_type_size, Extra};
 
 use super::progress::Progress;
-use super::{read_file, CloudParts, PointCloud, PointsError, Values};
+use super::{decimals_for, fixed, read_file, CloudParts, PointCloud, PointsError, Values};
 
 /// Header facts of a LAS/LAZ file.
 #[derive(Debug, Clone, PartialEq)]
@@ -64,6 +64,9 @@ impl LasInfo {
     /// The format lines of `arbvis inspect`.
     pub fn describe(&self) -> String {
         let [lo, hi] = self.header_bounds;
+        // Bounds with the decimals of the header's scale factors (0.01 → 2).
+        let d: [usize; 3] = std::array::from_fn(|a| decimals_for(self.scale[a]));
+        let b = |v: f64, a: usize| fixed(v, d[a]);
         format!(
             "format: LAS {}.{}, point format {}, {}, {}-byte records\nheader: {} points, scale {} {} {}, offset {} {} {}, bounds x {} .. {}, y {} .. {}, z {} .. {}\nextra bytes: {}\n",
             self.version.0,
@@ -78,12 +81,12 @@ impl LasInfo {
             self.offset[0],
             self.offset[1],
             self.offset[2],
-            lo[0],
-            hi[0],
-            lo[1],
-            hi[1],
-            lo[2],
-            hi[2],
+            b(lo[0], 0),
+            b(hi[0], 0),
+            b(lo[1], 1),
+            b(hi[1], 1),
+            b(lo[2], 2),
+            b(hi[2], 2),
             if self.extra_bytes.is_empty() {
                 "none".to_string()
             } else {

@@ -336,20 +336,23 @@ impl PointCloud {
     /// Point count, bounds, origin and scale, colours, normals and every attribute's
     /// statistics, one item per line.
     pub fn describe(&self) -> String {
+        // Coordinates with the decimals the f32 positions resolve (scale * 2^-24).
+        let decimals = decimals_for(self.scale * 2f64.powi(-24));
+        let c = |v: f64| fixed(v, decimals);
         let [lo, hi] = self.bounds;
         let mut s = format!(
             "points: {}\nbounds: x {} .. {}, y {} .. {}, z {} .. {}\norigin: {} {} {}, scale {} (positions stored as f32 in [-1, 1]^3)\n",
             self.len(),
-            lo[0],
-            hi[0],
-            lo[1],
-            hi[1],
-            lo[2],
-            hi[2],
-            self.origin[0],
-            self.origin[1],
-            self.origin[2],
-            self.scale
+            c(lo[0]),
+            c(hi[0]),
+            c(lo[1]),
+            c(hi[1]),
+            c(lo[2]),
+            c(hi[2]),
+            c(self.origin[0]),
+            c(self.origin[1]),
+            c(self.origin[2]),
+            c(self.scale)
         );
         if let Some(rgb) = &self.rgb {
             let max = rgb.iter().flatten().copied().max().unwrap_or(0);
@@ -360,13 +363,18 @@ impl PointCloud {
         }
         for a in &self.attributes {
             let st = a.stats;
+            // Float attributes are f32: show the f32 values, not their f64 expansions.
+            let v = |x: f64| match a.values {
+                Values::Int(_) => format!("{x}"),
+                Values::Float(_) => format!("{}", x as f32),
+            };
             s += &format!(
                 "attribute {} ({}): min {} max {} median {}",
                 a.name,
                 a.values.kind(),
-                st.min,
-                st.max,
-                st.median
+                v(st.min),
+                v(st.max),
+                v(st.median)
             );
             if st.non_finite > 0 {
                 s += &format!(", {} NaN or infinite", st.non_finite);
@@ -376,6 +384,25 @@ impl PointCloud {
             }
             s += "\n";
         }
+        s
+    }
+}
+
+/// Decimals that show a step of `step` (0 to 12).
+pub(crate) fn decimals_for(step: f64) -> usize {
+    if step > 0.0 && step.is_finite() {
+        (-step.log10()).ceil().clamp(0.0, 12.0) as usize
+    } else {
+        6
+    }
+}
+
+/// `v` with at most `decimals` decimals, trailing zeros dropped.
+pub(crate) fn fixed(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
         s
     }
 }
