@@ -20,6 +20,8 @@
 //! compressed data and hold at least the declared points, and every LAZ 1.4 chunk's
 //! layer sizes must fit in the file. Points are then decoded in batches of 65,536, so
 //! memory grows only with points actually decoded, and a decoder error names the batch.
+//! (No ratio of points to compressed bytes bounds LAZ safely: a flat grid with constant
+//! attributes, written by `las` itself, packs 72 points into a byte.)
 //! `laz` panics on some corrupt compressed streams; those calls run under
 //! `catch_unwind` and the panic becomes an error (see `guarded`).
 

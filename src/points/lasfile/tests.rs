@@ -241,7 +241,7 @@ fn hostile_headers_are_refused_before_reading() {
     set(&mut b, 247, &(1u64 << 40).to_le_bytes());
     let e = error(&b);
     assert!(
-        e.contains("declares 1099511627776 points, more than the 200000000"),
+        e.contains("declares 1099511627776 points, more than the 100000000"),
         "{e}"
     );
     // A count the data cannot hold.
