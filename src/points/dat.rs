@@ -179,12 +179,14 @@ pub fn parse(name: &Path, bytes: &[u8], columns: &DatColumns) -> Result<PointClo
         .layout()
         .map_err(|m| PointsError::Invalid(format!("{}: {m}", name.display())))?;
     let chunks = split_lines(bytes, chunk_size(bytes.len()));
-    let progress = if bytes.len() as u64 >= super::progress::MIN_POINTS * 16 {
-        let lines: usize = chunks.par_iter().map(|c| count_lines(c)).sum();
-        Progress::new(lines as u64, &format!("reading {}", name.display()))
-    } else {
-        Progress::hidden()
-    };
+    // Lines are only counted for a bar that will be drawn (a point line has 16+ bytes).
+    let progress =
+        if bytes.len() as u64 >= super::progress::MIN_POINTS * 16 && super::progress::enabled() {
+            let lines: usize = chunks.par_iter().map(|c| count_lines(c)).sum();
+            Progress::new(lines as u64, &format!("reading {}", name.display()))
+        } else {
+            Progress::hidden()
+        };
     let parsed: Vec<Chunk> = chunks
         .par_iter()
         .map(|c| {
@@ -422,9 +424,10 @@ fn tokens(text: &[u8]) -> usize {
         .count()
 }
 
-/// 1-based character column of byte `at` of `line`.
+/// 1-based character column of byte `at` of `line` (UTF-8 continuation bytes do not
+/// start a character; counted without copying the line, which may be huge).
 fn column(line: &[u8], at: usize) -> usize {
-    String::from_utf8_lossy(&line[..at]).chars().count() + 1
+    line[..at].iter().filter(|&&b| b & 0xC0 != 0x80).count() + 1
 }
 
 fn describe_column(index: usize, slot: Slot, layout: &Layout) -> String {

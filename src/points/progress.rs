@@ -9,13 +9,18 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 /// Smallest number of points for which a bar is shown.
 pub const MIN_POINTS: u64 = 1_000_000;
 
+/// True when bars can be drawn at all (stderr is a terminal).
+pub fn enabled() -> bool {
+    std::io::stderr().is_terminal()
+}
+
 /// A bar that may not be shown; cleared when dropped.
 pub struct Progress(Option<ProgressBar>);
 
 impl Progress {
     /// A bar for `total` points of work described by `what` (e.g. "reading x.laz").
     pub fn new(total: u64, what: &str) -> Progress {
-        if total < MIN_POINTS || !std::io::stderr().is_terminal() {
+        if total < MIN_POINTS || !enabled() {
             return Progress(None);
         }
         let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
