@@ -351,9 +351,10 @@ fn check_laz(
     }
     let table = table as usize;
     let chunks = u32_at(b, table + 4) as u64;
-    // Each chunk takes at least a byte of the data between its start and the table.
+    // Each chunk takes at least a byte of the data between its start and the table,
+    // but the last may be empty (writers close an empty file with one empty chunk).
     let room = table.saturating_sub(data_start + 8) as u64;
-    if chunks > room {
+    if chunks > room + 1 {
         return Err(fail(
             table,
             format!("the LAZ chunk table lists {chunks} chunks in {room} bytes of data"),
@@ -384,9 +385,19 @@ fn check_laz(
     if compressor == 3 {
         // Each chunk: first point raw, a u32 count, the layer sizes, the layers.
         let mut start = data_start as u64 + 8;
+        // Only the chunks the declared points reach are decoded.
+        let mut covered = 0u64;
         for (k, e) in entries.iter().enumerate() {
-            let sizes_at = start + total + 4;
-            let sizes_end = sizes_at + 4 * layers;
+            if covered >= info.points {
+                break;
+            }
+            covered = covered.saturating_add(if variable {
+                e.point_count
+            } else {
+                chunk_size as u64
+            });
+            let sizes_at = start.saturating_add(total + 4);
+            let sizes_end = sizes_at.saturating_add(4 * layers);
             if sizes_end > b.len() as u64 {
                 return Err(fail(
                     start as usize,
@@ -405,9 +416,6 @@ fn check_laz(
                 ));
             }
             start = start.saturating_add(e.byte_count);
-            if start >= table as u64 {
-                break;
-            }
         }
     }
     Ok(())

@@ -468,3 +468,12 @@ fn autzen_laz() {
     };
     assert_eq!((max(0), max(1), max(2)), (236, 228, 219));
 }
+
+#[test]
+fn empty_files_give_empty_clouds() {
+    for (format, compressed) in [(0, false), (6, false), (3, true), (7, true)] {
+        let c = parse(name(), &fixture(format, 0, compressed)).unwrap();
+        assert!(c.cloud.is_empty(), "format {format}");
+        assert_eq!(c.info.points, 0);
+    }
+}
