@@ -52,7 +52,11 @@ fn extra_vlr() -> Vlr {
 
 fn extra_bytes_of(i: usize) -> Vec<u8> {
     let mut e = Vec::new();
-    let t: i16 = if i == 2 { -32768 } else { 1000 + 7 * i as i16 };
+    let t: i16 = if i == 2 {
+        -32768
+    } else {
+        1000 + 7 * (i % 1000) as i16
+    };
     e.extend(t.to_le_bytes());
     e.push((i as u8).wrapping_add(200));
     e.extend([0xAA, 0xBB]);
