@@ -18,6 +18,7 @@ pub mod input;
 pub mod inspect;
 pub mod mesh;
 pub mod png_io;
+pub mod points;
 pub mod programs;
 pub mod render;
 pub mod scene;

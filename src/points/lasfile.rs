@@ -1,0 +1,293 @@
+//! LAS 1.0-1.4 and LAZ files through the `las` crate (with its `laz` feature): point
+//! formats 0-10, 64-bit point counts, colours, extra bytes.
+//!
+//! What becomes of a point: its coordinates with the header's scale and offset; the
+//! attributes `intensity`, `classification`, `return_number`, `number_of_returns`
+//! (integers); RGB when the format has it (u16 as stored); and every extra-bytes
+//! attribute described by the Extra Bytes VLR (`LASF_Spec` record 4, or an EVLR) by its
+//! name (`name[0]`, `name[1]` for the deprecated 2- and 3-element arrays), with its scale
+//! and offset applied and its no-data value read as NaN; integer ones without scale stay
+//! integers when they fit i32, the others become f32. Undescribed extra bytes are
+//! skipped.
+//!
+//! Hostile files: `las` trusts the header (it sizes buffers from the declared count
+//! and record length, and from EVLR lengths; `laz` sizes its chunk table from the file
+//! and, in LAZ 1.4, each layer from its declared size), so `check.rs` checks the header
+//! itself before calling them: version and format known, header, VLRs and the first
+//! EVLR inside the file, `count × record length` within the bytes after the point
+//! offset for LAS, at most [`MAX_POINTS`](super::MAX_POINTS) points; for LAZ the laszip
+//! VLR's items must match the record length, the chunk table must be smaller than the
+//! compressed data and hold at least the declared points, and every LAZ 1.4 chunk's
+//! layer sizes must fit in the file. Points are then decoded in batches of 65,536, so
+//! memory grows only with points actually decoded, and a decoder error names the batch.
+//! (No ratio of points to compressed bytes bounds LAZ safely: a flat grid with constant
+//! attributes, written by `las` itself, packs 72 points into a byte.)
+//! `laz` panics on some corrupt compressed streams; those calls run under
+//! `catch_unwind` and the panic becomes an error (see `guarded`).
+
+use std::io::Cursor;
+use std::path::Path;
+
+use las::{PointData, PointDataBuilder, Reader};
+
+mod check;
+mod extra;
+
+use check::{check, RECORD_LENGTH};
+use extra::{decode_extra, extra_bytes, extra_type_size, Extra};
+
+use super::progress::Progress;
+use super::{decimals_for, fixed, read_file, CloudParts, PointCloud, PointsError, Values};
+
+/// Header facts of a LAS/LAZ file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LasInfo {
+    /// Version, major and minor.
+    pub version: (u8, u8),
+    /// Point data record format (0-10), without the compression bit.
+    pub point_format: u8,
+    /// True for LAZ.
+    pub compressed: bool,
+    /// Bytes per point record (uncompressed).
+    pub record_length: u16,
+    /// Points declared by the header.
+    pub points: u64,
+    /// Scale factors of x, y, z.
+    pub scale: [f64; 3],
+    /// Offsets of x, y, z.
+    pub offset: [f64; 3],
+    /// Bounds written in the header (min, max).
+    pub header_bounds: [[f64; 3]; 2],
+    /// Names of the extra-bytes attributes read.
+    pub extra_bytes: Vec<String>,
+}
+
+impl LasInfo {
+    /// The format lines of `arbvis inspect`.
+    pub fn describe(&self) -> String {
+        let [lo, hi] = self.header_bounds;
+        // Bounds with the decimals of the header's scale factors (0.01 → 2).
+        let d: [usize; 3] = std::array::from_fn(|a| decimals_for(self.scale[a]));
+        let b = |v: f64, a: usize| fixed(v, d[a]);
+        format!(
+            "format: LAS {}.{}, point format {}, {}, {}-byte records\nheader: {} points, scale {} {} {}, offset {} {} {}, bounds x {} .. {}, y {} .. {}, z {} .. {}\nextra bytes: {}\n",
+            self.version.0,
+            self.version.1,
+            self.point_format,
+            if self.compressed { "compressed (LAZ)" } else { "uncompressed" },
+            self.record_length,
+            self.points,
+            self.scale[0],
+            self.scale[1],
+            self.scale[2],
+            self.offset[0],
+            self.offset[1],
+            self.offset[2],
+            b(lo[0], 0),
+            b(hi[0], 0),
+            b(lo[1], 1),
+            b(hi[1], 1),
+            b(lo[2], 2),
+            b(hi[2], 2),
+            if self.extra_bytes.is_empty() {
+                "none".to_string()
+            } else {
+                self.extra_bytes.join(", ")
+            }
+        )
+    }
+}
+
+/// Points decoded per batch.
+const BATCH: u64 = 65_536;
+
+/// A LAS/LAZ file's cloud and header facts.
+#[derive(Debug, Clone)]
+pub struct LasCloud {
+    /// The points.
+    pub cloud: PointCloud,
+    /// The header.
+    pub info: LasInfo,
+}
+
+/// Read a LAS or LAZ file.
+pub fn read(path: &Path) -> Result<LasCloud, PointsError> {
+    parse_owned(path, read_file(path)?)
+}
+
+/// Parse LAS or LAZ bytes named `name` (copies them: the decoder needs to own its input).
+pub fn parse(name: &Path, bytes: &[u8]) -> Result<LasCloud, PointsError> {
+    parse_owned(name, bytes.to_vec())
+}
+
+/// Parse LAS/LAZ bytes named `name`, taking ownership of them.
+pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, PointsError> {
+    let checked = check(name, &bytes)?;
+    let mut info = checked.info;
+    let base = RECORD_LENGTH[info.point_format as usize] as usize;
+    let record = info.record_length as usize;
+    let extras = extra_bytes(name, &bytes, &checked.vlrs, base, record)?;
+    info.extra_bytes = extras.iter().map(|e| e.name.clone()).collect();
+    let count = info.points;
+    let decode_error = |what: String| PointsError::Decode {
+        path: name.to_path_buf(),
+        message: what,
+    };
+    let mut reader = guarded(|| Reader::new(Cursor::new(bytes)))
+        .map_err(|e| decode_error(format!("the header: {e}")))?;
+    let has_rgb = reader.header().point_format().has_color;
+    let mut pd: PointData = PointDataBuilder::new().for_header(reader.header()).build();
+    let mut cols = Columns::new(extras.len(), has_rgb);
+    let progress = Progress::new(count, &format!("reading {}", name.display()));
+    let mut done = 0u64;
+    while done < count {
+        let want = BATCH.min(count - done);
+        let n = guarded(|| reader.fill_points(want, &mut pd)).map_err(|e| {
+            decode_error(format!(
+                "decoding points {done}..{} of {count}: {e}",
+                done + want
+            ))
+        })?;
+        if n == 0 {
+            return Err(decode_error(format!(
+                "the point data ends after {done} of the {count} points the header declares"
+            )));
+        }
+        cols.append(&pd, &extras, record)
+            .map_err(|_| decode_error(format!("cannot allocate memory for {count} points")))?;
+        done += n;
+        progress.inc(n);
+    }
+    drop(progress);
+    let mut attributes = vec![
+        ("intensity".to_string(), Values::Int(cols.intensity)),
+        (
+            "classification".to_string(),
+            Values::Int(cols.classification),
+        ),
+        ("return_number".to_string(), Values::Int(cols.return_number)),
+        (
+            "number_of_returns".to_string(),
+            Values::Int(cols.number_of_returns),
+        ),
+    ];
+    for (e, values) in extras.iter().zip(cols.extras) {
+        let integral =
+            e.ty <= 6 && e.ty != 5 && e.scale == 1.0 && e.offset == 0.0 && e.no_data.is_none();
+        let mut label = e.name.clone();
+        while attributes.iter().any(|(n, _)| *n == label) {
+            label.push_str("_extra");
+        }
+        let values = if integral {
+            Values::Int(values.iter().map(|&v| v as i32).collect())
+        } else {
+            Values::Float(values.iter().map(|&v| v as f32).collect())
+        };
+        attributes.push((label, values));
+    }
+    let cloud = PointCloud::from_parts(CloudParts {
+        positions: cols.positions,
+        attributes,
+        rgb: has_rgb.then_some(cols.rgb),
+        normals: None,
+    })
+    .map_err(decode_error)?;
+    Ok(LasCloud { cloud, info })
+}
+
+/// Run a `las`/`laz` call, turning a panic into an error message. `laz` asserts on
+/// some corrupt compressed streams (e.g. `assert!(sym < (1 << 16))` in its arithmetic
+/// decoder) where it could return an error; the checks above cannot foresee what an
+/// arithmetic-coded stream decodes to, so this is the last guard: the decoder that
+/// panicked is dropped with the error, never reused.
+fn guarded<T>(f: impl FnOnce() -> las::Result<T>) -> Result<T, String> {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
+        Ok(result) => result.map_err(|e| e.to_string()),
+        Err(panic) => {
+            let what = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            Err(format!(
+                "the decoder failed on corrupt data ({})",
+                crate::input::shorten(&what, 80)
+            ))
+        }
+    }
+}
+
+/// Columns gathered batch by batch.
+struct Columns {
+    positions: Vec<[f64; 3]>,
+    intensity: Vec<i32>,
+    classification: Vec<i32>,
+    return_number: Vec<i32>,
+    number_of_returns: Vec<i32>,
+    rgb: Vec<[u16; 3]>,
+    has_rgb: bool,
+    extras: Vec<Vec<f64>>,
+}
+
+impl Columns {
+    fn new(extras: usize, has_rgb: bool) -> Columns {
+        Columns {
+            positions: Vec::new(),
+            intensity: Vec::new(),
+            classification: Vec::new(),
+            return_number: Vec::new(),
+            number_of_returns: Vec::new(),
+            rgb: Vec::new(),
+            has_rgb,
+            extras: vec![Vec::new(); extras],
+        }
+    }
+
+    fn append(
+        &mut self,
+        pd: &PointData,
+        extras: &[Extra],
+        record: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        let n = pd.len();
+        self.positions.try_reserve(n)?;
+        for v in [
+            &mut self.intensity,
+            &mut self.classification,
+            &mut self.return_number,
+            &mut self.number_of_returns,
+        ] {
+            v.try_reserve(n)?;
+        }
+        self.positions
+            .extend(pd.x().zip(pd.y()).zip(pd.z()).map(|((x, y), z)| [x, y, z]));
+        self.intensity.extend(pd.intensity().map(i32::from));
+        self.classification
+            .extend(pd.classification().map(i32::from));
+        self.return_number.extend(pd.return_number().map(i32::from));
+        self.number_of_returns
+            .extend(pd.number_of_returns().map(i32::from));
+        if self.has_rgb {
+            self.rgb.try_reserve(n)?;
+            if let Some(rgb) = pd.rgb() {
+                self.rgb.extend(rgb.map(|(r, g, b)| [r, g, b]));
+            }
+        }
+        for (e, column) in extras.iter().zip(&mut self.extras) {
+            column.try_reserve(n)?;
+            let size = extra_type_size(e.ty);
+            column.extend(pd.raw_bytes().chunks_exact(record).map(|r| {
+                let v = decode_extra(e.ty, &r[e.at..e.at + size]);
+                if e.no_data == Some(v) {
+                    f64::NAN
+                } else {
+                    v * e.scale + e.offset
+                }
+            }));
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests;

@@ -1,0 +1,422 @@
+//! The checks run on a LAS/LAZ file before the `las` crate reads it: `las` and `laz`
+//! trust the header (buffers sized from the declared count and record length, EVLR
+//! lengths, chunk tables and LAZ 1.4 layer sizes), so each of those is compared with the
+//! bytes the file holds first. Offsets follow the LAS 1.4 R15 specification.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use super::LasInfo;
+use crate::points::{PointsError, MAX_POINTS};
+
+/// Bytes of a point record of each format, without extra bytes.
+pub(super) const RECORD_LENGTH: [u16; 11] = [20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67];
+
+/// A variable length record: where its data is in the file.
+pub(super) struct RawVlr {
+    pub(super) user_id: String,
+    pub(super) record_id: u16,
+    /// Byte offset of the record's header.
+    pub(super) at: usize,
+    /// Its data.
+    pub(super) data: std::ops::Range<usize>,
+}
+
+/// What the checks found in the header.
+pub(super) struct Checked {
+    pub(super) info: LasInfo,
+    pub(super) vlrs: Vec<RawVlr>,
+}
+
+pub(super) fn u16_at(b: &[u8], at: usize) -> u16 {
+    u16::from_le_bytes([b[at], b[at + 1]])
+}
+pub(super) fn u32_at(b: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
+}
+pub(super) fn u64_at(b: &[u8], at: usize) -> u64 {
+    let mut a = [0u8; 8];
+    a.copy_from_slice(&b[at..at + 8]);
+    u64::from_le_bytes(a)
+}
+pub(super) fn f64_at(b: &[u8], at: usize) -> f64 {
+    f64::from_bits(u64_at(b, at))
+}
+pub(super) fn text_at(b: &[u8], range: std::ops::Range<usize>) -> String {
+    let s = &b[range];
+    let end = s.iter().position(|&c| c == 0).unwrap_or(s.len());
+    String::from_utf8_lossy(&s[..end]).trim().to_string()
+}
+
+/// Check the header, VLRs and sizes before the `las` crate reads anything.
+pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
+    let len = b.len();
+    let fail = |at: usize, m: String| PointsError::format(name, at as u64, m);
+    if len < 227 {
+        return Err(fail(
+            len,
+            format!("the file ends inside the LAS header (227 bytes needed, {len} present)"),
+        ));
+    }
+    if &b[0..4] != b"LASF" {
+        return Err(fail(
+            0,
+            format!(
+                "not a LAS file: expected the signature \"LASF\", found {:?}",
+                String::from_utf8_lossy(&b[0..4])
+            ),
+        ));
+    }
+    let version = (b[24], b[25]);
+    if version.0 != 1 || version.1 > 4 {
+        return Err(PointsError::unsupported(
+            name,
+            format!(
+                "LAS version {}.{}: 1.0 to 1.4 are read",
+                version.0, version.1
+            ),
+        ));
+    }
+    let minimum_header = match version.1 {
+        0..=2 => 227,
+        3 => 235,
+        _ => 375,
+    };
+    let header_size = u16_at(b, 94) as usize;
+    if header_size < minimum_header || header_size > len {
+        return Err(fail(
+            94,
+            format!(
+                "header size {header_size}: LAS {}.{} needs at least {minimum_header} and the file has {len} bytes",
+                version.0, version.1
+            ),
+        ));
+    }
+    let offset_to_points = u32_at(b, 96) as usize;
+    if offset_to_points < header_size || offset_to_points > len {
+        return Err(fail(
+            96,
+            format!(
+                "offset to point data {offset_to_points} lies outside {header_size}..{len} (after the header, inside the file)"
+            ),
+        ));
+    }
+    let format_byte = b[104];
+    let compressed = format_byte & 0x80 != 0;
+    let point_format = format_byte & 0x3f;
+    if point_format > 10 {
+        return Err(PointsError::unsupported(
+            name,
+            format!("point data format {format_byte}: formats 0 to 10 are read"),
+        ));
+    }
+    let record_length = u16_at(b, 105);
+    let minimum_record = RECORD_LENGTH[point_format as usize];
+    if record_length < minimum_record {
+        return Err(fail(
+            105,
+            format!(
+                "point record length {record_length} is less than the {minimum_record} bytes of point format {point_format}"
+            ),
+        ));
+    }
+    let legacy_count = u32_at(b, 107) as u64;
+    let points = if legacy_count == 0 && version.1 >= 4 {
+        u64_at(b, 247)
+    } else {
+        legacy_count
+    };
+    let read3 = |at: usize| -> [f64; 3] { std::array::from_fn(|a| f64_at(b, at + 8 * a)) };
+    let scale = read3(131);
+    let offset = read3(155);
+    let bounds = [
+        [f64_at(b, 187), f64_at(b, 203), f64_at(b, 219)],
+        [f64_at(b, 179), f64_at(b, 195), f64_at(b, 211)],
+    ];
+    if scale.iter().chain(&offset).any(|v| !v.is_finite()) {
+        return Err(fail(
+            131,
+            format!("scale {scale:?} and offset {offset:?} must be finite"),
+        ));
+    }
+    if points > MAX_POINTS {
+        return Err(PointsError::unsupported(
+            name,
+            format!(
+                "the header declares {points} points, more than the {MAX_POINTS} this reader loads"
+            ),
+        ));
+    }
+    // VLRs: each inside the file, before the point data.
+    let mut vlrs = Vec::new();
+    let mut at = header_size;
+    for i in 0..u32_at(b, 100) {
+        if at + 54 > offset_to_points {
+            return Err(fail(
+                at,
+                format!("VLR {i} (of {}) starts where its 54-byte header would pass the point data at byte {offset_to_points}", u32_at(b, 100)),
+            ));
+        }
+        let data = at + 54..at + 54 + u16_at(b, at + 20) as usize;
+        if data.end > offset_to_points {
+            return Err(fail(
+                at,
+                format!(
+                    "VLR {i} holds {} bytes and would pass the point data at byte {offset_to_points}",
+                    data.len()
+                ),
+            ));
+        }
+        vlrs.push(RawVlr {
+            user_id: text_at(b, at + 2..at + 18),
+            record_id: u16_at(b, at + 18),
+            at,
+            data: data.clone(),
+        });
+        at = data.end;
+    }
+    // The first EVLR (LAS 1.4), the only one `las` reads.
+    if version.1 >= 4 && u32_at(b, 243) > 0 && u64_at(b, 235) > 0 {
+        let start = u64_at(b, 235);
+        let fits = usize::try_from(start)
+            .ok()
+            .filter(|&s| s >= offset_to_points && s.checked_add(60).is_some_and(|e| e <= len));
+        let Some(start) = fits else {
+            return Err(fail(
+                235,
+                format!("the first EVLR at byte {start} lies outside the data ({offset_to_points}..{len})"),
+            ));
+        };
+        let size = u64_at(b, start + 20);
+        if size > (len - start - 60) as u64 {
+            return Err(fail(
+                start,
+                format!(
+                    "the EVLR declares {size} bytes, but {} remain",
+                    len - start - 60
+                ),
+            ));
+        }
+        vlrs.push(RawVlr {
+            user_id: text_at(b, start + 2..start + 18),
+            record_id: u16_at(b, start + 18),
+            at: start,
+            data: start + 60..start + 60 + size as usize,
+        });
+    }
+    let info = LasInfo {
+        version,
+        point_format,
+        compressed,
+        record_length,
+        points,
+        scale,
+        offset,
+        header_bounds: bounds,
+        extra_bytes: Vec::new(),
+    };
+    if compressed {
+        check_laz(name, b, &info, offset_to_points, &vlrs)?;
+    } else {
+        let need = points.checked_mul(record_length as u64);
+        let have = (len - offset_to_points) as u64;
+        if need.is_none_or(|n| n > have) {
+            return Err(fail(
+                offset_to_points,
+                format!(
+                    "the header declares {points} points of {record_length} bytes, but the {have} bytes after the point offset hold only {}",
+                    have / record_length as u64
+                ),
+            ));
+        }
+    }
+    Ok(Checked { info, vlrs })
+}
+
+/// LAZ: laszip VLR items against the record, chunk table against the data, and LAZ 1.4
+/// layer sizes against the file.
+fn check_laz(
+    name: &Path,
+    b: &[u8],
+    info: &LasInfo,
+    data_start: usize,
+    vlrs: &[RawVlr],
+) -> Result<(), PointsError> {
+    let fail = |at: usize, m: String| PointsError::format(name, at as u64, m);
+    let Some(vlr) = vlrs
+        .iter()
+        .find(|v| v.user_id == "laszip encoded" && v.record_id == 22204)
+    else {
+        return Err(fail(
+            104,
+            "a compressed point format without the laszip VLR (\"laszip encoded\", 22204)".into(),
+        ));
+    };
+    let data = &b[vlr.data.clone()];
+    if data.len() < 34 {
+        return Err(fail(
+            vlr.at,
+            format!(
+                "the laszip VLR holds {} bytes, at least 34 needed",
+                data.len()
+            ),
+        ));
+    }
+    let compressor = u16_at(data, 0);
+    let chunk_size = u32_at(data, 12);
+    let items = u16_at(data, 32) as usize;
+    if data.len() < 34 + 6 * items || items == 0 {
+        return Err(fail(
+            vlr.at,
+            format!(
+                "the laszip VLR lists {items} items in {} bytes ({} needed, at least one item)",
+                data.len(),
+                34 + 6 * items
+            ),
+        ));
+    }
+    let mut total = 0u64;
+    let mut layers = 0u64;
+    for k in 0..items {
+        let (ty, size) = (u16_at(data, 34 + 6 * k), u16_at(data, 36 + 6 * k));
+        // (natural size, layers in LAZ 1.4 chunks); Byte items are any size.
+        let (natural, item_layers) = match ty {
+            0 => (size, 0),
+            6 => (20, 0),
+            7 => (8, 0),
+            8 => (6, 0),
+            9 => (29, 0),
+            10 => (30, 9),
+            11 => (6, 1),
+            12 => (8, 2),
+            13 => (29, 1),
+            14 => (size, size as u64),
+            _ => {
+                return Err(PointsError::unsupported(
+                    name,
+                    format!("LAZ item type {ty}: not a laszip item"),
+                ))
+            }
+        };
+        if size != natural {
+            return Err(fail(
+                vlr.at,
+                format!("LAZ item {k} (type {ty}) declares {size} bytes, the type has {natural}"),
+            ));
+        }
+        total += size as u64;
+        layers += item_layers;
+    }
+    if total != info.record_length as u64 {
+        return Err(fail(
+            vlr.at,
+            format!(
+                "the LAZ items hold {total} bytes, the point records {}",
+                info.record_length
+            ),
+        ));
+    }
+    let laz_vlr =
+        laz::LazVlr::read_from(data).map_err(|e| fail(vlr.at, format!("the laszip VLR: {e}")))?;
+    // The chunk table, located as laz does: offset at the start of the data, else in
+    // the last 8 bytes of the file.
+    if compressor == 1 {
+        return Ok(()); // point-wise: one stream, no table; points are read in batches
+    }
+    if data_start + 8 > b.len() {
+        return Err(fail(
+            data_start,
+            "the file ends before the LAZ chunk table offset".into(),
+        ));
+    }
+    let mut table = u64_at(b, data_start) as i64;
+    if table <= data_start as i64 {
+        table = u64_at(b, b.len() - 8) as i64;
+    }
+    if table <= data_start as i64 {
+        if compressor == 3 {
+            return Err(PointsError::unsupported(
+                name,
+                "a LAZ 1.4 (layered) file without a chunk table",
+            ));
+        }
+        return Ok(());
+    }
+    let table = table as u64;
+    if table.checked_add(8).is_none_or(|e| e > b.len() as u64) {
+        return Err(fail(
+            data_start,
+            format!("the LAZ chunk table offset {table} lies past the end of the file"),
+        ));
+    }
+    let table = table as usize;
+    let chunks = u32_at(b, table + 4) as u64;
+    // Each chunk takes at least a byte of the data between its start and the table,
+    // but the last may be empty (writers close an empty file with one empty chunk).
+    let room = table.saturating_sub(data_start + 8) as u64;
+    if chunks > room + 1 {
+        return Err(fail(
+            table,
+            format!("the LAZ chunk table lists {chunks} chunks in {room} bytes of data"),
+        ));
+    }
+    let mut cursor = Cursor::new(b);
+    cursor.set_position(data_start as u64);
+    let entries = laz::laszip::ChunkTable::read_from(&mut cursor, &laz_vlr)
+        .map_err(|e| fail(table, format!("the LAZ chunk table: {e}")))?;
+    let entries = entries.as_ref();
+    let variable = chunk_size == 0 || chunk_size == u32::MAX;
+    let capacity: u64 = if variable {
+        entries
+            .iter()
+            .fold(0u64, |a, e| a.saturating_add(e.point_count))
+    } else {
+        (entries.len() as u64).saturating_mul(chunk_size as u64)
+    };
+    if info.points > capacity {
+        return Err(fail(
+            table,
+            format!(
+                "the header declares {} points, but the LAZ chunk table holds at most {capacity}",
+                info.points
+            ),
+        ));
+    }
+    if compressor == 3 {
+        // Each chunk: first point raw, a u32 count, the layer sizes, the layers.
+        let mut start = data_start as u64 + 8;
+        // Only the chunks the declared points reach are decoded.
+        let mut covered = 0u64;
+        for (k, e) in entries.iter().enumerate() {
+            if covered >= info.points {
+                break;
+            }
+            covered = covered.saturating_add(if variable {
+                e.point_count
+            } else {
+                chunk_size as u64
+            });
+            let sizes_at = start.saturating_add(total + 4);
+            let sizes_end = sizes_at.saturating_add(4 * layers);
+            if sizes_end > b.len() as u64 {
+                return Err(fail(
+                    start as usize,
+                    format!("LAZ chunk {k} starts too close to the end of the file"),
+                ));
+            }
+            let sum: u64 = (0..layers as usize)
+                .map(|l| u32_at(b, sizes_at as usize + 4 * l) as u64)
+                .sum();
+            if sum > b.len() as u64 - sizes_end {
+                return Err(fail(
+                    sizes_at as usize,
+                    format!(
+                        "LAZ chunk {k} declares layers of {sum} bytes, past the end of the file"
+                    ),
+                ));
+            }
+            start = start.saturating_add(e.byte_count);
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,385 @@
+//! PLY data: binary (either byte order) and ASCII rows read into columns, each row
+//! count checked against the bytes left before anything is allocated.
+
+use std::path::Path;
+
+use super::header::{DeclaredElement, Header};
+use super::{Element, Encoding, Lists, Position, Property, PropertyData, ScalarType};
+use crate::points::progress::Progress;
+use crate::points::PointsError;
+
+/// The elements of ASCII data starting after the header; nothing may follow them.
+pub(super) fn read_ascii(
+    name: &Path,
+    bytes: &[u8],
+    header: &Header,
+) -> Result<Vec<Element>, PointsError> {
+    let mut tokens = Tokens {
+        bytes,
+        pos: header.data,
+        line: header.data_line,
+        line_start: header.data,
+    };
+    let mut elements = Vec::with_capacity(header.elements.len());
+    for e in &header.elements {
+        elements.push(ascii_element(name, e, &mut tokens)?);
+    }
+    tokens.skip_space();
+    if tokens.pos < bytes.len() {
+        let (line, column) = tokens.here();
+        return Err(PointsError::text(
+            name,
+            line,
+            column,
+            "more values than the header declares after the last element",
+        ));
+    }
+    Ok(elements)
+}
+
+/// The elements of binary data starting after the header; nothing may follow them.
+pub(super) fn read_binary(
+    name: &Path,
+    bytes: &[u8],
+    header: &Header,
+) -> Result<Vec<Element>, PointsError> {
+    let big = header.encoding == Encoding::BinaryBigEndian;
+    let mut pos = header.data;
+    let mut elements = Vec::with_capacity(header.elements.len());
+    for e in &header.elements {
+        elements.push(binary_element(name, e, bytes, &mut pos, big)?);
+    }
+    if pos < bytes.len() {
+        return Err(PointsError::format(
+            name,
+            pos as u64,
+            format!(
+                "{} bytes after the last element: the header declares less data than the file holds",
+                bytes.len() - pos
+            ),
+        ));
+    }
+    Ok(elements)
+}
+
+/// Empty columns for `e`, reserved for its rows (the caller checked the count).
+fn columns(name: &Path, e: &DeclaredElement) -> Result<Vec<Property>, PointsError> {
+    let fail = |_| {
+        PointsError::Invalid(format!(
+            "{}: cannot allocate memory for {} rows of element {}",
+            name.display(),
+            e.count,
+            e.name
+        ))
+    };
+    e.properties
+        .iter()
+        .map(|d| {
+            let data = match d.count {
+                None => {
+                    let mut values = Vec::new();
+                    values.try_reserve_exact(e.count).map_err(fail)?;
+                    PropertyData::Scalar { ty: d.ty, values }
+                }
+                Some(count) => {
+                    let mut offsets = Vec::new();
+                    offsets.try_reserve_exact(e.count + 1).map_err(fail)?;
+                    offsets.push(0);
+                    PropertyData::List {
+                        count,
+                        item: d.ty,
+                        lists: Lists {
+                            offsets,
+                            values: Vec::new(),
+                        },
+                    }
+                }
+            };
+            Ok(Property {
+                name: d.name.clone(),
+                data,
+                first_non_finite: None,
+            })
+        })
+        .collect()
+}
+
+fn binary_element(
+    name: &Path,
+    e: &DeclaredElement,
+    bytes: &[u8],
+    pos: &mut usize,
+    big: bool,
+) -> Result<Element, PointsError> {
+    let start = *pos;
+    let min_row: usize = e
+        .properties
+        .iter()
+        .map(|p| p.count.unwrap_or(p.ty).size())
+        .sum();
+    let left = bytes.len() - start;
+    let need = e.count.checked_mul(min_row);
+    if need.is_none_or(|n| n > left) {
+        return Err(PointsError::format(
+            name,
+            start as u64,
+            format!(
+                "element {} declares {} rows of at least {min_row} bytes, but only {left} bytes remain",
+                e.name, e.count
+            ),
+        ));
+    }
+    let mut properties = columns(name, e)?;
+    let count = if min_row == 0 { 0 } else { e.count };
+    let progress = Progress::new(count as u64, &format!("reading {}", name.display()));
+    for row in 0..count {
+        if row % 65_536 == 65_535 {
+            progress.inc(65_536);
+        }
+        for (d, p) in e.properties.iter().zip(properties.iter_mut()) {
+            let at = *pos;
+            let value = |ty: ScalarType, at: usize| -> Result<f64, PointsError> {
+                bytes
+                    .get(at..at + ty.size())
+                    .map(|b| ty.decode(b, big))
+                    .ok_or_else(|| {
+                        PointsError::format(
+                            name,
+                            at as u64,
+                            format!(
+                                "element {} row {row} property {}: the file ends ({} bytes needed, {} left)",
+                                e.name,
+                                d.name,
+                                ty.size(),
+                                bytes.len() - at.min(bytes.len())
+                            ),
+                        )
+                    })
+            };
+            match &mut p.data {
+                PropertyData::Scalar { ty, values } => {
+                    let v = value(*ty, at)?;
+                    *pos += ty.size();
+                    if !v.is_finite() && p.first_non_finite.is_none() {
+                        p.first_non_finite = Some((row, Position::Byte(at as u64)));
+                    }
+                    values.push(v);
+                }
+                PropertyData::List { count, item, lists } => {
+                    let n = value(*count, at)?;
+                    *pos += count.size();
+                    let left = bytes.len() - *pos;
+                    if n < 0.0 || n * item.size() as f64 > left as f64 {
+                        return Err(PointsError::format(
+                            name,
+                            at as u64,
+                            format!(
+                                "element {} row {row} property {}: a list of {n} items of {} bytes, but only {left} bytes remain",
+                                e.name,
+                                d.name,
+                                item.size()
+                            ),
+                        ));
+                    }
+                    for _ in 0..n as usize {
+                        let v = value(*item, *pos)?;
+                        *pos += item.size();
+                        lists.values.push(v);
+                    }
+                    lists.offsets.push(lists.values.len());
+                }
+            }
+        }
+    }
+    Ok(Element {
+        name: e.name.clone(),
+        count: e.count,
+        properties,
+        start: Position::Byte(start as u64),
+    })
+}
+
+/// Whitespace-separated tokens with their line and column.
+struct Tokens<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    line: usize,
+    line_start: usize,
+}
+
+impl<'a> Tokens<'a> {
+    fn skip_space(&mut self) {
+        while let Some(&b) = self.bytes.get(self.pos) {
+            if !b.is_ascii_whitespace() {
+                break;
+            }
+            self.pos += 1;
+            if b == b'\n' {
+                self.line += 1;
+                self.line_start = self.pos;
+            }
+        }
+    }
+
+    fn here(&self) -> (usize, usize) {
+        (self.line, self.pos - self.line_start + 1)
+    }
+
+    /// The next token and its line and column, or `None` at the end.
+    fn next(&mut self) -> Option<(&'a [u8], usize, usize)> {
+        self.skip_space();
+        if self.pos >= self.bytes.len() {
+            return None;
+        }
+        let (line, column) = self.here();
+        let start = self.pos;
+        while self
+            .bytes
+            .get(self.pos)
+            .is_some_and(|b| !b.is_ascii_whitespace())
+        {
+            self.pos += 1;
+        }
+        Some((&self.bytes[start..self.pos], line, column))
+    }
+}
+
+fn ascii_element(
+    name: &Path,
+    e: &DeclaredElement,
+    tokens: &mut Tokens,
+) -> Result<Element, PointsError> {
+    tokens.skip_space();
+    let (line, column) = tokens.here();
+    let values_per_row = e.properties.len();
+    let left = tokens.bytes.len() - tokens.pos;
+    // Each value takes a character and a separator (the very last needs none).
+    let need = e.count.checked_mul(2 * values_per_row);
+    if need.is_none_or(|n| n > left + 1) {
+        return Err(PointsError::text(
+            name,
+            line,
+            column,
+            format!(
+                "element {} declares {} rows of {values_per_row} values, more than the {left} bytes left can hold",
+                e.name, e.count
+            ),
+        ));
+    }
+    let mut properties = columns(name, e)?;
+    let count = if values_per_row == 0 { 0 } else { e.count };
+    let progress = Progress::new(count as u64, &format!("reading {}", name.display()));
+    for row in 0..count {
+        if row % 65_536 == 65_535 {
+            progress.inc(65_536);
+        }
+        for (d, p) in e.properties.iter().zip(properties.iter_mut()) {
+            let at = Where {
+                name,
+                element: &e.name,
+                row,
+                property: &d.name,
+            };
+            match &mut p.data {
+                PropertyData::Scalar { ty, values } => {
+                    let (v, line, column) = at.next(tokens, *ty, "a value")?;
+                    if !v.is_finite() && p.first_non_finite.is_none() {
+                        p.first_non_finite = Some((row, Position::Line { line, column }));
+                    }
+                    values.push(v);
+                }
+                PropertyData::List { count, item, lists } => {
+                    let (n, line, column) = at.next(tokens, *count, "a list length")?;
+                    let left = tokens.bytes.len() - tokens.pos;
+                    if n < 0.0 || n > left as f64 {
+                        return Err(PointsError::text(
+                            name,
+                            line,
+                            column,
+                            format!(
+                                "element {} row {row} property {}: a list of {n} items, but only {left} bytes remain",
+                                e.name, d.name
+                            ),
+                        ));
+                    }
+                    for _ in 0..n as usize {
+                        lists.values.push(at.next(tokens, *item, "a list item")?.0);
+                    }
+                    lists.offsets.push(lists.values.len());
+                }
+            }
+        }
+    }
+    Ok(Element {
+        name: e.name.clone(),
+        count: e.count,
+        properties,
+        start: Position::Line { line, column },
+    })
+}
+
+/// The value being read, for error messages.
+struct Where<'a> {
+    name: &'a Path,
+    element: &'a str,
+    row: usize,
+    property: &'a str,
+}
+
+impl Where<'_> {
+    /// The next token as a value of `ty` with its line and column.
+    fn next(
+        &self,
+        tokens: &mut Tokens,
+        ty: ScalarType,
+        what: &str,
+    ) -> Result<(f64, usize, usize), PointsError> {
+        let Some((token, line, column)) = tokens.next() else {
+            let (line, column) = tokens.here();
+            return Err(PointsError::text(
+                self.name,
+                line,
+                column,
+                format!(
+                    "element {} row {} property {}: the file ends where {what} was expected",
+                    self.element, self.row, self.property
+                ),
+            ));
+        };
+        let v = ascii_value(token, ty).map_err(|m| {
+            PointsError::text(
+                self.name,
+                line,
+                column,
+                format!(
+                    "element {} row {} property {}: {m}",
+                    self.element, self.row, self.property
+                ),
+            )
+        })?;
+        Ok((v, line, column))
+    }
+}
+
+/// A token as a value of `ty`, or what is wrong with it.
+fn ascii_value(token: &[u8], ty: ScalarType) -> Result<f64, String> {
+    let text = std::str::from_utf8(token).unwrap_or("");
+    let shown = || crate::input::shorten(&String::from_utf8_lossy(token), 40);
+    let v = text
+        .parse::<f64>()
+        .map_err(|_| format!("expected a number, found \"{}\"", shown()))?;
+    if ty.is_integer() {
+        let (lo, hi) = ty.range();
+        if v.fract() != 0.0 || !(lo..=hi).contains(&v) {
+            return Err(format!(
+                "expected an integer of {lo}..{hi} ({ty:?}), found \"{}\"",
+                shown()
+            ));
+        }
+        Ok(v)
+    } else if ty == ScalarType::Float {
+        Ok(v as f32 as f64)
+    } else {
+        Ok(v)
+    }
+}

@@ -1,0 +1,243 @@
+//! The PLY header: `ply`, `format`, `comment`, `obj_info`, `element` and `property`
+//! lines up to `end_header`, with line and column in every error.
+
+use std::path::Path;
+
+use super::{Encoding, ScalarType};
+use crate::points::PointsError;
+
+/// A property as declared in the header.
+pub(super) struct Declared {
+    pub(super) name: String,
+    /// `Some(count type)` for lists.
+    pub(super) count: Option<ScalarType>,
+    pub(super) ty: ScalarType,
+}
+
+pub(super) struct DeclaredElement {
+    pub(super) name: String,
+    pub(super) count: usize,
+    pub(super) properties: Vec<Declared>,
+}
+
+pub(super) struct Header {
+    pub(super) encoding: Encoding,
+    pub(super) version: String,
+    pub(super) comments: Vec<String>,
+    pub(super) obj_info: Vec<String>,
+    pub(super) elements: Vec<DeclaredElement>,
+    /// Byte where the data starts.
+    pub(super) data: usize,
+    /// Line where the data starts (for ASCII).
+    pub(super) data_line: usize,
+}
+
+/// Parse the header of `bytes`.
+pub(super) fn parse(name: &Path, bytes: &[u8]) -> Result<Header, PointsError> {
+    let mut header = Header {
+        encoding: Encoding::Ascii,
+        version: String::new(),
+        comments: Vec::new(),
+        obj_info: Vec::new(),
+        elements: Vec::new(),
+        data: 0,
+        data_line: 0,
+    };
+    let mut format_seen = false;
+    let mut pos = 0;
+    let mut number = 0;
+    loop {
+        number += 1;
+        let Some(len) = bytes[pos..].iter().position(|&b| b == b'\n') else {
+            return Err(PointsError::text(
+                name,
+                number,
+                1,
+                if number == 1 {
+                    "not a PLY file: no \"ply\" line".to_string()
+                } else {
+                    "the file ends inside the header: no \"end_header\" line".to_string()
+                },
+            ));
+        };
+        let raw = &bytes[pos..pos + len];
+        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
+        pos += len + 1;
+        let err = |column: usize, message: String| PointsError::text(name, number, column, message);
+        let Ok(line) = std::str::from_utf8(raw) else {
+            return Err(err(1, "the header holds bytes that are not text".into()));
+        };
+        let words: Vec<(usize, &str)> = words(line);
+        let word = |i: usize| words.get(i).map_or("", |w| w.1);
+        let col = |i: usize| words.get(i).map_or(line.chars().count() + 1, |w| w.0);
+        if number == 1 {
+            if line.trim_end() != "ply" {
+                return Err(err(
+                    1,
+                    format!(
+                        "not a PLY file: expected \"ply\" on the first line, found \"{}\"",
+                        crate::input::shorten(line, 40)
+                    ),
+                ));
+            }
+            continue;
+        }
+        match word(0) {
+            "format" => {
+                header.encoding = match word(1) {
+                    "ascii" => Encoding::Ascii,
+                    "binary_little_endian" => Encoding::BinaryLittleEndian,
+                    "binary_big_endian" => Encoding::BinaryBigEndian,
+                    other => {
+                        return Err(err(
+                            col(1),
+                            format!(
+                                "expected ascii, binary_little_endian or binary_big_endian, found \"{}\"",
+                                crate::input::shorten(other, 40)
+                            ),
+                        ))
+                    }
+                };
+                if word(2) != "1.0" {
+                    return Err(err(
+                        col(2),
+                        format!(
+                            "expected format version 1.0, found \"{}\"",
+                            crate::input::shorten(word(2), 40)
+                        ),
+                    ));
+                }
+                header.version = word(2).to_string();
+                format_seen = true;
+            }
+            "comment" => header.comments.push(rest(line, "comment")),
+            "obj_info" => header.obj_info.push(rest(line, "obj_info")),
+            "element" => {
+                let count = word(2).parse::<usize>().map_err(|_| {
+                    err(
+                        col(2),
+                        format!(
+                            "expected the element's row count, found \"{}\"",
+                            crate::input::shorten(word(2), 40)
+                        ),
+                    )
+                })?;
+                if word(1).is_empty() || words.len() != 3 {
+                    return Err(err(1, "expected \"element NAME COUNT\"".into()));
+                }
+                if header.elements.iter().any(|e| e.name == word(1)) {
+                    return Err(err(col(1), format!("element {} is declared twice", word(1))));
+                }
+                header.elements.push(DeclaredElement {
+                    name: word(1).to_string(),
+                    count,
+                    properties: Vec::new(),
+                });
+            }
+            "property" => {
+                let Some(element) = header.elements.last_mut() else {
+                    return Err(err(1, "a property before any element".into()));
+                };
+                let ty = |i: usize| {
+                    ScalarType::from_name(word(i)).ok_or_else(|| {
+                        err(
+                            col(i),
+                            format!(
+                                "expected a PLY type (char, uchar, short, ushort, int, uint, float, double or int8 .. float64), found \"{}\"",
+                                crate::input::shorten(word(i), 40)
+                            ),
+                        )
+                    })
+                };
+                let (declared, n) = if word(1) == "list" {
+                    let count = ty(2)?;
+                    if !count.is_integer() {
+                        return Err(err(
+                            col(2),
+                            format!("a list's length must have an integer type, found {}", word(2)),
+                        ));
+                    }
+                    (
+                        Declared {
+                            name: word(4).to_string(),
+                            count: Some(count),
+                            ty: ty(3)?,
+                        },
+                        5,
+                    )
+                } else {
+                    (
+                        Declared {
+                            name: word(2).to_string(),
+                            count: None,
+                            ty: ty(1)?,
+                        },
+                        3,
+                    )
+                };
+                if words.len() != n {
+                    return Err(err(
+                        1,
+                        "expected \"property TYPE NAME\" or \"property list COUNT_TYPE ITEM_TYPE NAME\"".into(),
+                    ));
+                }
+                if element.properties.iter().any(|p| p.name == declared.name) {
+                    return Err(err(
+                        col(n - 1),
+                        format!(
+                            "property {} of element {} is declared twice",
+                            declared.name, element.name
+                        ),
+                    ));
+                }
+                element.properties.push(declared);
+            }
+            "end_header" => {
+                if !format_seen {
+                    return Err(err(1, "end_header before any format line".into()));
+                }
+                header.data = pos;
+                header.data_line = number + 1;
+                return Ok(header);
+            }
+            "" => return Err(err(1, "an empty line in the header".into())),
+            other => {
+                return Err(err(
+                    1,
+                    format!(
+                        "expected format, comment, obj_info, element, property or end_header, found \"{}\"",
+                        crate::input::shorten(other, 40)
+                    ),
+                ))
+            }
+        }
+    }
+}
+
+/// Words of a header line with their 1-based columns.
+fn words(line: &str) -> Vec<(usize, &str)> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (column, (i, c)) in line.char_indices().enumerate() {
+        match (c.is_whitespace(), start) {
+            (false, None) => start = Some((column + 1, i)),
+            (true, Some((col, s))) => {
+                out.push((col, &line[s..i]));
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some((col, s)) = start {
+        out.push((col, &line[s..]));
+    }
+    out
+}
+
+fn rest(line: &str, keyword: &str) -> String {
+    line.trim_start()
+        .strip_prefix(keyword)
+        .unwrap_or("")
+        .trim_start()
+        .to_string()
+}
