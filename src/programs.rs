@@ -127,7 +127,11 @@ pub fn all_pairs() -> Vec<ProgramPair> {
             CELLPROJ_ORTHOGRAPHIC_VERT,
             CELLPROJ_ORTHOGRAPHIC_FRAG,
         ),
-        (ProgramKind::Glsl, CELLPROJ_PRECISE_VERT, CELLPROJ_PRECISE_FRAG),
+        (
+            ProgramKind::Glsl,
+            CELLPROJ_PRECISE_VERT,
+            CELLPROJ_PRECISE_FRAG,
+        ),
     ];
     for (kind, vertex, fragment) in own_vertex_stage {
         pairs.push(ProgramPair {

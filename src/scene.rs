@@ -284,7 +284,9 @@ impl Scene {
             return Err(FieldError::new("background", "must be finite"));
         }
         match &self.technique {
-            TechniqueScene::Opacity3d(o) => o.validate().map_err(|e| e.within("technique.opacity3d")),
+            TechniqueScene::Opacity3d(o) => {
+                o.validate().map_err(|e| e.within("technique.opacity3d"))
+            }
             TechniqueScene::Cellproj(c) => c.validate().map_err(|e| e.within("technique.cellproj")),
             TechniqueScene::Quad(_) => Ok(()),
         }

@@ -2,10 +2,16 @@
 // arbvis (new): precise cell projection. What changes from the seed's program:
 // - the ray direction is normalized (eye to fragment in perspective, the view
 //   direction in orthographic views);
-// - planes met at grazing angles (|D.N| below 1e-7) and degenerate faces (N = 0) are
-//   skipped instead of divided by, and t starts at 0 (sb = sf) when no plane is ahead;
+// - the exit is the nearest of the planes the ray leaves through (outward normal N with
+//   D.N > 0; the normals are outward), not the nearest positive t: a fragment on an
+//   edge has another plane through it, whose t rounds to +-0, and the seed's test
+//   `t > 0` then takes the entry for the exit and loses the crossing; planes met at
+//   grazing angles (D.N below 1e-7) and degenerate faces (N = 0) are skipped, and t is
+//   0 (sb = sf) when no plane is ahead;
 // - no table: the first isovalue crossed is found exactly, t_iso = t (v - sf)/(sb - sf)
-//   for each isovalue v in (sf, sb] (rising) or [sb, sf) (falling);
+//   for each isovalue v in (sf, sb] (rising) or [sb, sf) (falling), the exit end widened
+//   by 2^-16 so that an isovalue on a shared face, which f32 rounding may leave just
+//   beyond this tetrahedron's exit and which the next one excludes at its entry, is drawn;
 // - depth is written at the crossing, and the colour may be shaded with the gradient.
 // program_local[0..3]: ModelViewProj rows; [4]: eye in object space (xyz), w = 1 for
 // perspective, 0 for orthographic; [5]: view direction (orthographic, unit);
@@ -17,12 +23,12 @@ in float v_sf;
 in vec3 v_pos, v_vertex3, v_gradient;
 flat in vec3 v_normal0, v_normal1, v_normal2;
 out vec4 color;
+const float SLACK = 1.0 / 65536.0;
 
 float exit_along(vec3 D, vec3 aux1, vec3 n, float t) {
     float dn = dot(D, n);
-    if (abs(dn) < 1e-7) return t; // grazing or degenerate: this plane is never ahead
-    float ti = dot(aux1, n) / dn;
-    return ti > 0.0 ? min(t, ti) : t;
+    if (dn < 1e-7) return t; // entering through it, grazing it, or degenerate
+    return min(t, max(dot(aux1, n) / dn, 0.0));
 }
 
 void main() {
@@ -41,7 +47,8 @@ void main() {
     float best = 2.0;
     for (int k = 0; k < count; k++) {
         float v = texelFetch(texture0, ivec2(k, 1), 0).r;
-        bool crossed = (sb > sf && v > sf && v <= sb) || (sb < sf && v >= sb && v < sf);
+        bool crossed = (sb > sf && v > sf && v <= sb + SLACK) ||
+                       (sb < sf && v >= sb - SLACK && v < sf);
         if (crossed) {
             float f = (v - sf) / (sb - sf);
             if (f < best) { best = f; hit = k; }

@@ -42,7 +42,8 @@ pub struct DrawCall<'a> {
     pub program: &'a Program,
     /// The vertices (triangles).
     pub mesh: &'a Mesh,
-    /// First vertex and vertex count; `None` draws all.
+    /// First element and element count (vertices, or indices when the mesh has them);
+    /// `None` draws all.
     pub range: Option<(usize, usize)>,
     /// Textures and the units they go on.
     pub textures: &'a [(u32, &'a Texture)],
@@ -86,11 +87,11 @@ pub fn clear(gpu: &Gpu, surface: Surface<'_>, rgba: [f32; 4]) -> GlResult<()> {
 
 /// Execute `call` on `surface`; the state the draw set is restored afterwards.
 pub fn draw(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<()> {
-    let (first, count) = call.range.unwrap_or((0, call.mesh.vertex_count()));
-    if first + count > call.mesh.vertex_count() {
+    let (first, count) = call.range.unwrap_or((0, call.mesh.draw_count()));
+    if first + count > call.mesh.draw_count() {
         return Err(GlError::Invalid(format!(
-            "draw range {first}+{count} exceeds {} vertices",
-            call.mesh.vertex_count()
+            "draw range {first}+{count} exceeds {} elements",
+            call.mesh.draw_count()
         )));
     }
     let _guard = StateGuard::save(gpu);

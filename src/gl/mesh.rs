@@ -1,6 +1,8 @@
 //! Owned vertex data: one vertex array object over one interleaved f32 buffer, drawn as
-//! triangles. Attribute `i` is generic attribute `i` (ARB `vertex.attrib[i]`, GLSL
-//! `layout(location = i)`); attribute 0 provokes the vertex in the compatibility profile.
+//! triangles, optionally through a u32 index buffer (a subset or an order of the
+//! vertices, replaceable without touching them). Attribute `i` is generic attribute `i`
+//! (ARB `vertex.attrib[i]`, GLSL `layout(location = i)`); attribute 0 provokes the vertex
+//! in the compatibility profile.
 
 use std::sync::Arc;
 
@@ -16,6 +18,8 @@ pub struct Mesh {
     vbo: glow::Buffer,
     floats_per_vertex: usize,
     vertex_count: usize,
+    /// The index buffer and its length, when the mesh draws through indices.
+    indices: Option<(glow::Buffer, usize)>,
     label: String,
 }
 
@@ -61,6 +65,7 @@ impl Mesh {
             vbo,
             floats_per_vertex,
             vertex_count: 0,
+            indices: None,
             label: label.to_string(),
         };
         mesh.upload(vertices)?;
@@ -106,13 +111,68 @@ impl Mesh {
         self.vertex_count
     }
 
-    /// Draw `count` vertices from `first` as triangles (program, target and textures bound).
+    /// Draw through `indices` from now on (each below [`Mesh::vertex_count`]); the
+    /// index buffer is created on first use and replaced after.
+    pub fn set_indices(&mut self, gpu: &Gpu, indices: &[u32]) -> GlResult<()> {
+        if let Some(&bad) = indices.iter().find(|&&i| i as usize >= self.vertex_count) {
+            return Err(GlError::Invalid(format!(
+                "mesh {}: index {bad} beyond its {} vertices",
+                self.label, self.vertex_count
+            )));
+        }
+        let created = self.indices.is_none();
+        // SAFETY: a u32 slice viewed as bytes; bound through this mesh's VAO, whose
+        // binding is restored to none.
+        unsafe {
+            let ebo = match self.indices {
+                Some((ebo, _)) => ebo,
+                None => self.gl.create_buffer().map_err(GlError::Invalid)?,
+            };
+            let bytes =
+                std::slice::from_raw_parts(indices.as_ptr().cast::<u8>(), indices.len() * 4);
+            let prev_vao = self
+                .gl
+                .get_parameter_vertex_array(glow::VERTEX_ARRAY_BINDING);
+            self.gl.bind_vertex_array(Some(self.vao));
+            self.gl.bind_buffer(glow::ELEMENT_ARRAY_BUFFER, Some(ebo));
+            self.gl
+                .buffer_data_u8_slice(glow::ELEMENT_ARRAY_BUFFER, bytes, glow::DYNAMIC_DRAW);
+            self.gl.bind_vertex_array(prev_vao);
+            self.indices = Some((ebo, indices.len()));
+        }
+        if created {
+            gpu.record(
+                "buffer",
+                format!("indices {}", self.label),
+                (indices.len() * 4) as u64,
+            );
+        }
+        crate::gl_check!(gpu)
+    }
+
+    /// Elements a draw walks: the indices when there are some, else the vertices.
+    pub fn draw_count(&self) -> usize {
+        self.indices.map_or(self.vertex_count, |(_, n)| n)
+    }
+
+    /// Draw `count` elements from `first` as triangles (program, target and textures
+    /// bound): vertices, or indices when the mesh has them.
     pub(crate) fn draw_triangles(&self, first: usize, count: usize) {
-        // SAFETY: the range lies within the uploaded vertices (checked by the caller).
+        // SAFETY: the range lies within the elements (checked by the caller); indices
+        // were checked against the vertices when set.
         unsafe {
             self.gl.bind_vertex_array(Some(self.vao));
-            self.gl
-                .draw_arrays(glow::TRIANGLES, first as i32, count as i32);
+            match self.indices {
+                Some(_) => self.gl.draw_elements(
+                    glow::TRIANGLES,
+                    count as i32,
+                    glow::UNSIGNED_INT,
+                    (first * 4) as i32,
+                ),
+                None => self
+                    .gl
+                    .draw_arrays(glow::TRIANGLES, first as i32, count as i32),
+            }
         }
     }
 }
@@ -123,6 +183,9 @@ impl Drop for Mesh {
         unsafe {
             self.gl.delete_vertex_array(self.vao);
             self.gl.delete_buffer(self.vbo);
+            if let Some((ebo, _)) = self.indices {
+                self.gl.delete_buffer(ebo);
+            }
         }
     }
 }

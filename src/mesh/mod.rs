@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 pub const MAX_MESH_BYTES: u64 = 1 << 30;
 
 /// A tetrahedral mesh with named point and cell arrays.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Mesh {
     /// Point coordinates, all finite.
     pub points: Vec<[f64; 3]>,

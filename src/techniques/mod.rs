@@ -3,8 +3,8 @@
 //! of the same maths. The seed techniques (`opacity3d`, `cellproj`, `clip`, `splats`)
 //! slot in beside `quad`, the foundation's demo.
 
-pub mod clip;
 pub mod cellproj;
+pub mod clip;
 pub mod opacity3d;
 pub mod quad;
 pub mod rays;

@@ -51,7 +51,10 @@ pub fn editor(
     );
     widgets.insert("Add isovalue".into(), r.rect);
     if r.clicked() {
-        let value = scene.isovalues.last().map_or(0.5, |i| (i.value + 0.1) % 1.0);
+        let value = scene
+            .isovalues
+            .last()
+            .map_or(0.5, |i| (i.value + 0.1) % 1.0);
         scene.isovalues.push(Isovalue {
             value,
             color: [1.0, 1.0, 0.0, 1.0],

@@ -18,7 +18,14 @@
 //!    [`prepare::iso_table`] builds the `(sf, sb)` table from the isovalues.
 //! 2. [`renderer`] draws every face once with back-face culling (what makes the method
 //!    view independent: no sorting) and a depth test, and discards fragments whose
-//!    table entry is empty.
+//!    table entry is empty. By default only *active* tetrahedra are drawn, those whose
+//!    scalar range `[min, max]` over their corners holds an isovalue: a crossing
+//!    `sf → sb` lies inside that range, so the others could only be discarded. The
+//!    faces stay uploaded once; an index buffer lists the active ones, rebuilt (a scan
+//!    of the per-tetrahedron ranges) when the isovalues change. In faithful mode this
+//!    also drops the table's false crossings in inactive tetrahedra (texel centres are
+//!    up to 1/512 off the exact `sf`, `sb`); `active_only = false` draws every face as
+//!    the seed did.
 //! 3. [`reference`] ray-casts the same mesh in f64 (a bounding-volume hierarchy over the
 //!    tetrahedra) and finds the exact first isovalue crossing along each pixel's ray.
 //!
@@ -43,7 +50,9 @@
 //!   (rising) or `[sb, sf)` (falling). The interval is open at the entry, so a crossing
 //!   exactly on a shared face belongs to exactly one of the two tetrahedra.
 //! - The exit direction of the orthographic variant is the view direction; the seed's Cg
-//!   (`vertex - EyePos`) is the perspective variant.
+//!   (`vertex - EyePos`) is the perspective variant. Used in an orthographic view, the
+//!   per-fragment programs get an eye 10^6 box units back along the view direction, so
+//!   `vertex - EyePos` is the parallel ray to within 10^-6 radians.
 //! - Shading (precise only; the seed drew unlit colours): Lambert with a headlight and
 //!   an ambient term, the normal being the gradient turned toward the viewer.
 //!
@@ -57,6 +66,7 @@
 pub mod prepare;
 pub mod reference;
 pub mod renderer;
+pub mod study;
 
 use serde::{Deserialize, Serialize};
 
@@ -109,6 +119,14 @@ pub struct CellprojScene {
     /// Shade with the gradient as the normal (precise only).
     #[serde(default)]
     pub shading: bool,
+    /// Draw only the tetrahedra whose scalar range holds an isovalue (the others can
+    /// cross nothing); `false` draws every face, as the seed did.
+    #[serde(default = "yes")]
+    pub active_only: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 fn default_table_size() -> u32 {
@@ -125,7 +143,10 @@ impl CellprojScene {
         if self.isovalues.len() > MAX_ISOVALUES {
             return Err(FieldError::new(
                 "isovalues",
-                format!("{} isovalues: at most {MAX_ISOVALUES}", self.isovalues.len()),
+                format!(
+                    "{} isovalues: at most {MAX_ISOVALUES}",
+                    self.isovalues.len()
+                ),
             ));
         }
         for (i, iso) in self.isovalues.iter().enumerate() {
@@ -160,16 +181,26 @@ impl CellprojScene {
 }
 
 /// The first isovalue crossed going from `sf` toward `sb`: in `(sf, sb]` when rising,
-/// `[sb, sf)` when falling, none when equal. `sorted` ascending by value.
-pub fn first_crossed(sorted: &[Isovalue], sf: f64, sb: f64) -> Option<usize> {
+/// `[sb, sf)` when falling, none when equal; the exit end widened by `slack` (an
+/// isovalue on a shared face is computed at the exit of one tetrahedron as `sf + t G·D`,
+/// which rounding may leave just short of it, and it is excluded at the entry of the
+/// next: the slack keeps it from falling between the two). `sorted` ascending.
+pub fn first_crossed(sorted: &[Isovalue], sf: f64, sb: f64, slack: f64) -> Option<usize> {
     if sb > sf {
-        sorted.iter().position(|i| i.value > sf && i.value <= sb)
+        sorted
+            .iter()
+            .position(|i| i.value > sf && i.value <= sb + slack)
     } else if sb < sf {
-        sorted.iter().rposition(|i| i.value >= sb && i.value < sf)
+        sorted
+            .iter()
+            .rposition(|i| i.value >= sb - slack && i.value < sf)
     } else {
         None
     }
 }
+
+/// [`first_crossed`]'s slack in the f64 reference (a few ulps of scalars near 1).
+pub const REFERENCE_SLACK: f64 = 1e-12;
 
 #[cfg(test)]
 mod tests {
@@ -188,17 +219,31 @@ mod tests {
     #[test]
     fn first_crossing_follows_the_ray_and_the_half_open_rule() {
         let s = isos(&[0.3, 0.5, 0.9]);
-        assert_eq!(first_crossed(&s, 0.2, 0.6), Some(0));
-        assert_eq!(first_crossed(&s, 0.6, 0.2), Some(1), "falling: 0.5 first");
-        assert_eq!(first_crossed(&s, 0.31, 0.49), None);
-        assert_eq!(first_crossed(&s, 0.4, 0.4), None, "sf = sb crosses nothing");
+        assert_eq!(first_crossed(&s, 0.2, 0.6, 0.0), Some(0));
+        assert_eq!(
+            first_crossed(&s, 0.6, 0.2, 0.0),
+            Some(1),
+            "falling: 0.5 first"
+        );
+        assert_eq!(first_crossed(&s, 0.31, 0.49, 0.0), None);
+        assert_eq!(
+            first_crossed(&s, 0.4, 0.4, 0.0),
+            None,
+            "sf = sb crosses nothing"
+        );
         // Exactly at a vertex value: counted where the ray leaves, not where it enters,
         // so two tetrahedra sharing the face do not both draw it.
-        assert_eq!(first_crossed(&s, 0.2, 0.3), Some(0));
-        assert_eq!(first_crossed(&s, 0.3, 0.4), None);
-        assert_eq!(first_crossed(&s, 0.4, 0.3), Some(0));
-        assert_eq!(first_crossed(&s, 0.3, 0.2), None);
+        assert_eq!(first_crossed(&s, 0.2, 0.3, 0.0), Some(0));
+        assert_eq!(first_crossed(&s, 0.3, 0.4, 0.0), None);
+        assert_eq!(first_crossed(&s, 0.4, 0.3, 0.0), Some(0));
+        assert_eq!(first_crossed(&s, 0.3, 0.2, 0.0), None);
         // Outside the data range.
-        assert_eq!(first_crossed(&isos(&[1.5]), 0.0, 1.0), None);
+        assert_eq!(first_crossed(&isos(&[1.5]), 0.0, 1.0, 0.0), None);
+        // The slack reaches an isovalue just beyond a rounded exit, never one at the entry.
+        assert_eq!(
+            first_crossed(&s, 0.2, 0.3 - 1e-13, REFERENCE_SLACK),
+            Some(0)
+        );
+        assert_eq!(first_crossed(&s, 0.3, 0.4, REFERENCE_SLACK), None);
     }
 }

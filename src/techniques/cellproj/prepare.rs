@@ -97,11 +97,16 @@ pub fn from_mesh(
     })
 }
 
-/// The gradient of the linear scalar in a tetrahedron (zero when it is flat).
+/// The gradient of the linear scalar in a tetrahedron (zero when it is flat: a
+/// determinant within 1e-12 of its longest edge cubed, the mesh module's flatness).
 pub fn gradient(p: [DVec3; 4], s: [f64; 4]) -> DVec3 {
     let (e1, e2, e3) = (p[1] - p[0], p[2] - p[0], p[3] - p[0]);
     let det = e1.dot(e2.cross(e3));
-    if det.abs() <= 1e-300 || !det.is_finite() {
+    let longest = [e1, e2, e3, p[2] - p[1], p[3] - p[1], p[3] - p[2]]
+        .iter()
+        .map(|e| e.length())
+        .fold(0.0, f64::max);
+    if det.abs() <= 1e-12 * longest.powi(3) || !det.is_finite() {
         return DVec3::ZERO;
     }
     // Solve [e1; e2; e3] g = ds by Cramer's rule with the cofactor vectors.
@@ -158,6 +163,37 @@ impl Prepared {
         out
     }
 
+    /// The scalar range `[min, max]` over each tetrahedron's corners.
+    pub fn ranges(&self) -> Vec<[f64; 2]> {
+        self.tets
+            .iter()
+            .map(|t| {
+                let s = t.map(|v| self.scalars[v as usize]);
+                [
+                    s.iter().copied().fold(f64::INFINITY, f64::min),
+                    s.iter().copied().fold(f64::NEG_INFINITY, f64::max),
+                ]
+            })
+            .collect()
+    }
+
+    /// Vertex indices (12 per tetrahedron, into [`Prepared::face_vertices`]) of the
+    /// tetrahedra whose range, widened by `slack`, holds one of `isovalues`.
+    pub fn active_indices(ranges: &[[f64; 2]], isovalues: &[Isovalue], slack: f64) -> Vec<u32> {
+        let mut values: Vec<f64> = isovalues.iter().map(|i| i.value).collect();
+        values.sort_by(f64::total_cmp);
+        let mut out = Vec::new();
+        for (t, [lo, hi]) in ranges.iter().enumerate() {
+            // The first isovalue at or above lo - slack: active when it is <= hi + slack.
+            let k = values.partition_point(|&v| v < lo - slack);
+            if values.get(k).is_some_and(|&v| v <= hi + slack) {
+                let first = (t * 12) as u32;
+                out.extend(first..first + 12);
+            }
+        }
+        out
+    }
+
     /// Number of face vertices [`Prepared::face_vertices`] yields.
     pub fn vertex_count(&self) -> usize {
         self.tets.len() * 12
@@ -176,7 +212,7 @@ pub fn iso_table(isovalues: &[Isovalue], size: u32) -> Vec<u8> {
     let mut texels = vec![0u8; n * n * 4];
     for j in 0..n {
         for i in 0..n {
-            if let Some(k) = first_crossed(&sorted, centre(i), centre(j)) {
+            if let Some(k) = first_crossed(&sorted, centre(i), centre(j), 0.0) {
                 let c = sorted[k].color;
                 let at = (j * n + i) * 4;
                 texels[at..at + 4].copy_from_slice(&[byte(c[0]), byte(c[1]), byte(c[2]), 255]);
@@ -256,20 +292,40 @@ mod tests {
         // A tetrahedron 1e6 from the origin with millimetre edges: in f32 directly its
         // corners would collapse (f32 spacing at 1e6 is 0.0625); re-centred in f64 they
         // keep their shape.
-        let mut mesh = crate::mesh::Mesh::default();
         let o = 1.0e6;
-        mesh.points = vec![
-            [o, o, o],
-            [o + 0.001, o, o],
-            [o, o + 0.001, o],
-            [o, o, o + 0.001],
-        ];
-        mesh.tets = vec![[0, 1, 2, 3]];
+        let mesh = crate::mesh::Mesh {
+            points: vec![
+                [o, o, o],
+                [o + 0.001, o, o],
+                [o, o + 0.001, o],
+                [o, o, o + 0.001],
+            ],
+            tets: vec![[0, 1, 2, 3]],
+            ..Default::default()
+        };
         let p = from_mesh(&mesh, &[0.0, 1.0, 0.0, 0.0], "s".into(), [0.0, 1.0]).unwrap();
         let (q, s) = p.tet(0);
         let g = gradient(q, s);
         // s = x / 1 mm; the box maps 1 mm to 2 units: the gradient is 0.5 per unit.
         assert!((g - DVec3::new(0.5, 0.0, 0.0)).length() < 1e-9, "{g}");
+    }
+
+    #[test]
+    fn active_tetrahedra_are_those_whose_range_holds_an_isovalue() {
+        let ranges = [[0.0, 0.2], [0.25, 0.35], [0.5, 0.5], [0.6, 1.0]];
+        let iso = |value| Isovalue {
+            value,
+            color: [1.0; 4],
+        };
+        let active = Prepared::active_indices(&ranges, &[iso(0.3), iso(0.5)], 0.0);
+        let tets: Vec<u32> = active.chunks(12).map(|c| c[0] / 12).collect();
+        assert_eq!(tets, vec![1, 2]);
+        assert!(active.chunks(12).all(|c| c[11] == c[0] + 11));
+        assert!(Prepared::active_indices(&ranges, &[iso(0.21)], 0.0).is_empty());
+        assert_eq!(
+            Prepared::active_indices(&ranges, &[iso(0.21)], 0.02).len(),
+            12
+        );
     }
 
     #[test]
@@ -286,9 +342,21 @@ mod tests {
         ];
         let t = iso_table(&isos, 10);
         let at = |i: usize, j: usize| &t[(j * 10 + i) * 4..][..4];
-        assert_eq!(at(1, 8), &[255, 0, 0, 255], "0.15 -> 0.85 crosses 0.3 first");
-        assert_eq!(at(8, 1), &[0, 255, 0, 255], "0.85 -> 0.15 crosses 0.5 first");
+        assert_eq!(
+            at(1, 8),
+            &[255, 0, 0, 255],
+            "0.15 -> 0.85 crosses 0.3 first"
+        );
+        assert_eq!(
+            at(8, 1),
+            &[0, 255, 0, 255],
+            "0.85 -> 0.15 crosses 0.5 first"
+        );
         assert_eq!(at(3, 4), &[0, 0, 0, 0], "0.35 -> 0.45: nothing");
-        assert_eq!(iso_list(&isos)[..4], [1.0, 0.0, 0.0, 1.0], "sorted: 0.3 first");
+        assert_eq!(
+            iso_list(&isos)[..4],
+            [1.0, 0.0, 0.0, 1.0],
+            "sorted: 0.3 first"
+        );
     }
 }

@@ -112,9 +112,15 @@ pub struct CellprojRenderer {
     params: CellprojScene,
     prepared: Prepared,
     mesh: Mesh,
+    ranges: Vec<[f64; 2]>,
     table: Texture,
     program: Option<(Variant, Program)>,
 }
+
+/// Slack of the active test: the precise programs' crossing slack (2^-16) and a margin
+/// for the faithful table's texel-centre rounding (1/512 at 256²) would both be covered
+/// by 1/256; the test only saves work, so erring wide costs a few tetrahedra.
+const ACTIVE_SLACK: f64 = 1.0 / 256.0;
 
 fn table_texture(gpu: &Gpu, params: &CellprojScene, fidelity: Fidelity) -> GlResult<Texture> {
     match fidelity {
@@ -182,15 +188,33 @@ impl CellprojRenderer {
             &vertices,
         )?;
         let table = table_texture(gpu, params, fidelity)?;
-        Ok(CellprojRenderer {
+        let mut renderer = CellprojRenderer {
             kind,
             fidelity,
             params: params.clone(),
+            ranges: prepared.ranges(),
             prepared,
             mesh,
             table,
             program: None,
-        })
+        };
+        renderer.select_active(gpu)?;
+        Ok(renderer)
+    }
+
+    /// List the active tetrahedra in the index buffer (or all, when not culling).
+    fn select_active(&mut self, gpu: &Gpu) -> GlResult<()> {
+        let indices = if self.params.active_only {
+            Prepared::active_indices(&self.ranges, &self.params.isovalues, ACTIVE_SLACK)
+        } else {
+            (0..self.prepared.vertex_count() as u32).collect()
+        };
+        self.mesh.set_indices(gpu, &indices)
+    }
+
+    /// Tetrahedra drawn now.
+    pub fn drawn_tets(&self) -> usize {
+        self.mesh.draw_count() / 12
     }
 
     /// The prepared mesh (for references and readouts).
@@ -221,7 +245,12 @@ impl Renderer for CellprojRenderer {
         let program = self.program(gpu, variant)?;
         program.set_transform(gpu, mvp)?;
         match variant {
-            Variant::PerFragment => program.set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, 1.0])?,
+            Variant::PerFragment => {
+                // The seed's Cg assumes a perspective eye; for a parallel view the eye
+                // goes 10^6 box units back, so `vertex - EyePos` is the view direction.
+                let eye = if perspective { eye } else { -dir * 1.0e6 };
+                program.set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, 1.0])?
+            }
             Variant::PerVertex => program.set_vertex_local(gpu, 4, [dir.x, dir.y, dir.z, 0.0])?,
             Variant::Precise => {
                 let t = mvp.transpose();
@@ -267,11 +296,16 @@ impl Renderer for CellprojRenderer {
                 "a new mesh or scalar needs a new renderer".into(),
             ));
         }
-        let table_changed = new.isovalues != self.params.isovalues
-            || new.table_size != self.params.table_size;
+        let table_changed =
+            new.isovalues != self.params.isovalues || new.table_size != self.params.table_size;
+        let active_changed =
+            new.isovalues != self.params.isovalues || new.active_only != self.params.active_only;
         self.params = (**new).clone();
         if table_changed {
             self.table = table_texture(gpu, &self.params, self.fidelity)?;
+        }
+        if active_changed {
+            self.select_active(gpu)?;
         }
         Ok(())
     }

@@ -1,0 +1,276 @@
+//! The speed/accuracy trade of cell projection, measured: frames per second at the seed's
+//! size (24,576 tetrahedra, 320x240) and up to about a million tetrahedra; the latency
+//! from an isovalue change to the new frame; per-vertex vs per-fragment exit; faithful vs
+//! precise; each setting scored against the f64 reference (fraction of interior pixels
+//! with the right isovalue colour).
+
+use std::time::Instant;
+
+use crate::camera::{Camera, Projection};
+use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target, TargetFormat};
+use crate::mesh::grid::{generate, Field, GridSpec};
+use crate::mesh::scalars::ScalarSpec;
+use crate::scene::{Fidelity, TechniqueScene};
+use crate::techniques::{Frame, Renderer};
+
+use super::prepare::{from_mesh, Prepared};
+use super::reference::{agreement, reference, silhouette_pixels};
+use super::{CellprojRenderer, CellprojScene, Exit, Isovalue};
+
+/// What to sweep.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Grid points per side (the seed: 17; 17 → 24,576 tetrahedra, 56 → 1.0 M).
+    pub grids: Vec<usize>,
+    /// Image size.
+    pub size: [u32; 2],
+    /// Timed frames per setting (median), after one warm-up frame.
+    pub frames: usize,
+    /// Score against the reference (slow for big meshes: only up to `score_up_to` points
+    /// per side).
+    pub score_up_to: usize,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            grids: vec![17, 25, 33, 45, 56],
+            size: [320, 240],
+            frames: 5,
+            score_up_to: 33,
+        }
+    }
+}
+
+/// One measured setting.
+#[derive(Debug, Clone)]
+pub struct Row {
+    /// Tetrahedra drawn.
+    pub tets: usize,
+    /// Setting name.
+    pub setting: String,
+    /// Median milliseconds per frame (clear + draw + finish).
+    pub ms: f64,
+    /// Milliseconds from an isovalue edit to the finished new frame (median).
+    pub edit_ms: f64,
+    /// Fraction of interior pixels agreeing with the reference (NaN when not scored).
+    pub agreement: f64,
+}
+
+/// The seed's isovalues.
+pub fn seed_isovalues() -> Vec<Isovalue> {
+    [
+        (0.3, [1.0, 0.0, 0.0, 1.0]),
+        (0.5, [0.0, 1.0, 0.0, 1.0]),
+        (0.9, [0.0, 0.0, 1.0, 1.0]),
+    ]
+    .map(|(value, color)| Isovalue { value, color })
+    .to_vec()
+}
+
+fn scene_for(points: usize, exit: Exit, active_only: bool) -> CellprojScene {
+    CellprojScene {
+        mesh: crate::mesh::MeshSource::Grid(GridSpec {
+            points: [points; 3],
+            field: Field::Spherical,
+        }),
+        scalars: ScalarSpec::default(),
+        isovalues: seed_isovalues(),
+        exit,
+        table_size: 256,
+        shading: false,
+        active_only,
+    }
+}
+
+/// The study's camera: the demo's rotation.
+pub fn study_camera(projection: Projection) -> Camera {
+    Camera {
+        projection,
+        rotation: [0.2391, 0.3696, 0.0990, 0.8924],
+        zoom: 0.9,
+        ..Camera::default()
+    }
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+/// Time one setting: frames, then isovalue edits (each rewrites the table and draws).
+#[allow(clippy::too_many_arguments)]
+fn measure(
+    headless: &Headless,
+    params: &CellprojScene,
+    prepared: &Prepared,
+    fidelity: Fidelity,
+    kind: ProgramKind,
+    camera: Camera,
+    options: &Options,
+) -> GlResult<(f64, f64, crate::image::Image, Vec<f32>)> {
+    let gpu = headless.gpu();
+    let [w, h] = options.size;
+    let target = Target::with_depth(gpu, w, h, TargetFormat::Rgba8)?;
+    let mut r = CellprojRenderer::from_prepared(gpu, kind, fidelity, params, prepared.clone())?;
+    let frame = Frame {
+        camera,
+        width: w,
+        height: h,
+    };
+    let draw = |r: &mut CellprojRenderer| -> GlResult<f64> {
+        let t0 = Instant::now();
+        target.clear(gpu, [0.0, 0.0, 0.0, 1.0])?;
+        r.draw(gpu, Surface::Target(&target), &frame)?;
+        gpu.finish();
+        Ok(t0.elapsed().as_secs_f64() * 1e3)
+    };
+    draw(&mut r)?;
+    let mut times = Vec::new();
+    for _ in 0..options.frames.max(1) {
+        times.push(draw(&mut r)?);
+    }
+    let mut edits = Vec::new();
+    for i in 0..options.frames.max(1) {
+        let mut edited = params.clone();
+        edited.isovalues[0].value = 0.3 + 0.01 * (i % 5) as f64;
+        let t0 = Instant::now();
+        r.update(gpu, &TechniqueScene::Cellproj(Box::new(edited)))?;
+        draw(&mut r)?;
+        edits.push(t0.elapsed().as_secs_f64() * 1e3);
+    }
+    r.update(gpu, &TechniqueScene::Cellproj(Box::new(params.clone())))?;
+    draw(&mut r)?;
+    let image = target.read(gpu)?;
+    let depth = target.read_depth(gpu)?.unwrap_or_default();
+    Ok((median(times), median(edits), image, depth))
+}
+
+/// Run the sweep; `progress` hears one line per setting.
+pub fn run(
+    headless: &Headless,
+    options: &Options,
+    mut progress: impl FnMut(&str),
+) -> anyhow::Result<Vec<Row>> {
+    let mut rows = Vec::new();
+    let has_arb = headless.gpu().caps().has_arb();
+    for &points in &options.grids {
+        let mesh = generate(&GridSpec {
+            points: [points; 3],
+            field: Field::Spherical,
+        })?;
+        let s = ScalarSpec::default().evaluate(&mesh)?;
+        let prepared = from_mesh(&mesh, &s.values, s.name, s.range).map_err(anyhow::Error::msg)?;
+        let tets = prepared.tets.len();
+        let kind = if has_arb {
+            ProgramKind::Arb
+        } else {
+            ProgramKind::Glsl
+        };
+        use Projection::{Orthographic as Ortho, Perspective as Persp};
+        let (faithful, precise, glsl) = (Fidelity::Faithful, Fidelity::Precise, ProgramKind::Glsl);
+        let settings = [
+            (
+                "seed: faithful per-vertex, all tets (ortho)",
+                faithful,
+                kind,
+                Exit::Vertex,
+                Ortho,
+                false,
+            ),
+            (
+                "seed: faithful per-fragment, all tets (persp)",
+                faithful,
+                kind,
+                Exit::Fragment,
+                Persp,
+                false,
+            ),
+            (
+                "faithful per-vertex (ortho)",
+                faithful,
+                kind,
+                Exit::Vertex,
+                Ortho,
+                true,
+            ),
+            (
+                "faithful per-fragment (ortho)",
+                faithful,
+                kind,
+                Exit::Fragment,
+                Ortho,
+                true,
+            ),
+            (
+                "faithful per-fragment (persp)",
+                faithful,
+                kind,
+                Exit::Fragment,
+                Persp,
+                true,
+            ),
+            ("precise (ortho)", precise, glsl, Exit::Auto, Ortho, true),
+            ("precise (persp)", precise, glsl, Exit::Auto, Persp, true),
+        ];
+        for (name, fidelity, kind, exit, projection, active_only) in settings {
+            let params = scene_for(points, exit, active_only);
+            let camera = study_camera(projection);
+            let (ms, edit_ms, image, depth) = measure(
+                headless, &params, &prepared, fidelity, kind, camera, options,
+            )?;
+            let agreement_fraction = if points <= options.score_up_to {
+                let hits = reference(&prepared, &params.isovalues, &camera, options.size);
+                let silhouette = silhouette_pixels(&prepared, &camera, options.size, 1.5);
+                let sorted = params.sorted_isovalues();
+                agreement(
+                    &image,
+                    Some(&depth),
+                    &hits,
+                    &sorted,
+                    [0.0, 0.0, 0.0, 1.0],
+                    &silhouette,
+                )
+                .interior_fraction()
+            } else {
+                f64::NAN
+            };
+            let row = Row {
+                tets,
+                setting: format!("{name} {}", kind.name()),
+                ms,
+                edit_ms,
+                agreement: agreement_fraction,
+            };
+            progress(&format!(
+                "{:>9} tets  {:<36} {:>8.2} ms ({:>6.1} fps, {:>8.0} tets/s)  edit->frame {:>7.2} ms  agree {:.4}",
+                row.tets,
+                row.setting,
+                row.ms,
+                1e3 / row.ms,
+                row.tets as f64 / row.ms * 1e3,
+                row.edit_ms,
+                row.agreement
+            ));
+            rows.push(row);
+        }
+    }
+    Ok(rows)
+}
+
+/// The rows as CSV.
+pub fn to_csv(rows: &[Row]) -> String {
+    let mut s = String::from("tets,setting,ms_per_frame,fps,edit_to_frame_ms,interior_agreement\n");
+    for r in rows {
+        s += &format!(
+            "{},{},{:.3},{:.1},{:.3},{:.5}\n",
+            r.tets,
+            r.setting,
+            r.ms,
+            1e3 / r.ms,
+            r.edit_ms,
+            r.agreement
+        );
+    }
+    s
+}
