@@ -51,13 +51,24 @@ impl Reader<'_> {
         }
         let at = self.c.pos;
         let b = self.c.take(width, what)?;
-        let mut v = Vec::with_capacity(1);
-        let t = match width {
-            4 => super::read::Num::I32,
-            _ => super::read::Num::U64,
+        let v = if width == 4 {
+            let a = [b[0], b[1], b[2], b[3]];
+            i64::from(if self.big {
+                i32::from_be_bytes(a)
+            } else {
+                i32::from_le_bytes(a)
+            })
+        } else {
+            let mut a = [0u8; 8];
+            a.copy_from_slice(b);
+            let u = if self.big {
+                u64::from_be_bytes(a)
+            } else {
+                u64::from_le_bytes(a)
+            };
+            i64::try_from(u).unwrap_or(i64::MAX)
         };
-        t.decode_int(b, self.big, &mut v);
-        Ok((at, v.first().copied().unwrap_or(0)))
+        Ok((at, v))
     }
 
     /// A non-negative count whose items need at least `min` bytes each (ASCII: `min_text`).
