@@ -118,12 +118,71 @@ impl Reader<'_> {
     }
 }
 
+/// Tag to index: a table indexed by tag while the tags stay compact (gmsh writes 1..n),
+/// a hash map once one does not (sparse tags stay correct, only slower).
+enum TagMap {
+    Dense(Vec<u32>),
+    Sparse(HashMap<i64, u32>),
+}
+
+const NO_INDEX: u32 = u32::MAX;
+
+impl Default for TagMap {
+    fn default() -> Self {
+        TagMap::Dense(Vec::new())
+    }
+}
+
+impl TagMap {
+    /// Map `tag` to `index`; false if the tag is already there. Tags below `room` (a
+    /// bound from counts already checked against the file) may use the table.
+    fn insert(&mut self, tag: i64, index: u32, room: usize) -> bool {
+        if let TagMap::Dense(v) = self {
+            if tag >= 0 && (tag as u64) < room.max(v.len()) as u64 {
+                let t = tag as usize;
+                if t >= v.len() {
+                    v.resize(t + 1, NO_INDEX);
+                }
+                let fresh = v[t] == NO_INDEX;
+                if fresh {
+                    v[t] = index;
+                }
+                return fresh;
+            }
+            let map = v
+                .iter()
+                .enumerate()
+                .filter(|(_, &i)| i != NO_INDEX)
+                .map(|(t, &i)| (t as i64, i))
+                .collect();
+            *self = TagMap::Sparse(map);
+        }
+        match self {
+            TagMap::Sparse(m) => m.insert(tag, index).is_none(),
+            TagMap::Dense(_) => false,
+        }
+    }
+
+    fn get(&self, tag: i64) -> Option<u32> {
+        match self {
+            TagMap::Dense(v) => usize::try_from(tag)
+                .ok()
+                .and_then(|t| v.get(t))
+                .copied()
+                .filter(|&i| i != NO_INDEX),
+            TagMap::Sparse(m) => m.get(&tag).copied(),
+        }
+    }
+}
+
 #[derive(Default)]
 struct State {
     points: Vec<[f64; 3]>,
-    node_index: HashMap<i64, u32>,
+    node_index: TagMap,
+    node_room: usize,
     cells: RawCells,
-    cell_index: HashMap<i64, u32>,
+    cell_index: TagMap,
+    cell_room: usize,
     point_arrays: Vec<DataArray>,
     cell_arrays: Vec<DataArray>,
     have_nodes: bool,
@@ -281,7 +340,7 @@ fn add_node(r: &Reader, st: &mut State, at: usize, tag: i64, p: [f64; 3]) -> Res
         ));
     }
     let index = st.points.len() as u32;
-    if st.node_index.insert(tag, index).is_some() {
+    if !st.node_index.insert(tag, index, st.node_room) {
         return Err(r.err(at, format!("node tag {tag} appears twice")));
     }
     st.points.push(p);
@@ -289,11 +348,9 @@ fn add_node(r: &Reader, st: &mut State, at: usize, tag: i64, p: [f64; 3]) -> Res
 }
 
 fn reserve_nodes(r: &Reader, st: &mut State, n: usize, at: usize) -> Result<(), MeshError> {
+    st.node_room = st.node_room.saturating_add(2 * n + 1024);
     st.points
         .try_reserve_exact(n)
-        .map_err(|_| r.err(at, format!("cannot allocate {n} nodes")))?;
-    st.node_index
-        .try_reserve(n)
         .map_err(|_| r.err(at, format!("cannot allocate {n} nodes")))
 }
 
@@ -381,12 +438,12 @@ fn element(
 ) -> Result<(), MeshError> {
     let kind = gmsh_kind(ty).map_err(|m| r.err(at, format!("element {tag}: {m}")))?;
     let cell = st.cells.kinds.len() as u32;
-    if st.cell_index.insert(tag, cell).is_some() {
+    if !st.cell_index.insert(tag, cell, st.cell_room) {
         return Err(r.err(at, format!("element tag {tag} appears twice")));
     }
     for _ in 0..kind.nodes.unwrap_or(0) {
         let (nat, t) = r.int(width, "a node tag")?;
-        let i = *st.node_index.get(&t).ok_or_else(|| {
+        let i = st.node_index.get(t).ok_or_else(|| {
             r.err(
                 nat,
                 format!(
@@ -408,7 +465,7 @@ fn reserve_cells(r: &Reader, st: &mut State, n: usize, at: usize) -> Result<(), 
     st.cells.kinds.try_reserve_exact(n).map_err(e)?;
     st.cells.at.try_reserve_exact(n).map_err(e)?;
     st.cells.offsets.try_reserve_exact(n + 1).map_err(e)?;
-    st.cell_index.try_reserve(n).map_err(e)?;
+    st.cell_room = st.cell_room.saturating_add(2 * n + 1024);
     if st.cells.offsets.is_empty() {
         st.cells.offsets.push(0);
     }
@@ -565,7 +622,7 @@ fn data(r: &mut Reader, st: &mut State, nodes: bool, at: usize) -> Result<(), Me
         } else {
             &st.cell_index
         };
-        let i = *map.get(&tag).ok_or_else(|| {
+        let i = map.get(tag).ok_or_else(|| {
             r.err(
                 tat,
                 format!(

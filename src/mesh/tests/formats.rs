@@ -319,3 +319,17 @@ fn gmsh_mixed_elements_conform_and_quadratic_tets_use_corners() {
     last.sort_unstable();
     assert_eq!(last, [11, 12, 13, 14]);
 }
+
+#[test]
+fn gmsh_sparse_tags_far_apart() {
+    // Node tag 250 becomes 10^12 (and node 17 becomes -3) everywhere: the tag table
+    // turns into a map, with the same mesh.
+    let text = String::from_utf8(fixtures::msh22(false)).unwrap();
+    let text = text
+        .replace(" 250", " 1000000000000")
+        .replace("\n250 ", "\n1000000000000 ");
+    let text = text.replace(" 17", " -3").replace("\n17 ", "\n-3 ");
+    assert!(text.contains("1000000000000 1.6 1.2 0.9"));
+    let m = ok(text.as_bytes(), "sparse.msh");
+    check_fixture(&m, 0.0, "sparse.msh");
+}
