@@ -51,13 +51,24 @@ impl Reader<'_> {
         }
         let at = self.c.pos;
         let b = self.c.take(width, what)?;
-        let mut v = Vec::with_capacity(1);
-        let t = match width {
-            4 => super::read::Num::I32,
-            _ => super::read::Num::U64,
+        let v = if width == 4 {
+            let a = [b[0], b[1], b[2], b[3]];
+            i64::from(if self.big {
+                i32::from_be_bytes(a)
+            } else {
+                i32::from_le_bytes(a)
+            })
+        } else {
+            let mut a = [0u8; 8];
+            a.copy_from_slice(b);
+            let u = if self.big {
+                u64::from_be_bytes(a)
+            } else {
+                u64::from_le_bytes(a)
+            };
+            i64::try_from(u).unwrap_or(i64::MAX)
         };
-        t.decode_int(b, self.big, &mut v);
-        Ok((at, v.first().copied().unwrap_or(0)))
+        Ok((at, v))
     }
 
     /// A non-negative count whose items need at least `min` bytes each (ASCII: `min_text`).
@@ -107,12 +118,71 @@ impl Reader<'_> {
     }
 }
 
+/// Tag to index: a table indexed by tag while the tags stay compact (gmsh writes 1..n),
+/// a hash map once one does not (sparse tags stay correct, only slower).
+enum TagMap {
+    Dense(Vec<u32>),
+    Sparse(HashMap<i64, u32>),
+}
+
+const NO_INDEX: u32 = u32::MAX;
+
+impl Default for TagMap {
+    fn default() -> Self {
+        TagMap::Dense(Vec::new())
+    }
+}
+
+impl TagMap {
+    /// Map `tag` to `index`; false if the tag is already there. Tags below `room` (a
+    /// bound from counts already checked against the file) may use the table.
+    fn insert(&mut self, tag: i64, index: u32, room: usize) -> bool {
+        if let TagMap::Dense(v) = self {
+            if tag >= 0 && (tag as u64) < room.max(v.len()) as u64 {
+                let t = tag as usize;
+                if t >= v.len() {
+                    v.resize(t + 1, NO_INDEX);
+                }
+                let fresh = v[t] == NO_INDEX;
+                if fresh {
+                    v[t] = index;
+                }
+                return fresh;
+            }
+            let map = v
+                .iter()
+                .enumerate()
+                .filter(|(_, &i)| i != NO_INDEX)
+                .map(|(t, &i)| (t as i64, i))
+                .collect();
+            *self = TagMap::Sparse(map);
+        }
+        match self {
+            TagMap::Sparse(m) => m.insert(tag, index).is_none(),
+            TagMap::Dense(_) => false,
+        }
+    }
+
+    fn get(&self, tag: i64) -> Option<u32> {
+        match self {
+            TagMap::Dense(v) => usize::try_from(tag)
+                .ok()
+                .and_then(|t| v.get(t))
+                .copied()
+                .filter(|&i| i != NO_INDEX),
+            TagMap::Sparse(m) => m.get(&tag).copied(),
+        }
+    }
+}
+
 #[derive(Default)]
 struct State {
     points: Vec<[f64; 3]>,
-    node_index: HashMap<i64, u32>,
+    node_index: TagMap,
+    node_room: usize,
     cells: RawCells,
-    cell_index: HashMap<i64, u32>,
+    cell_index: TagMap,
+    cell_room: usize,
     point_arrays: Vec<DataArray>,
     cell_arrays: Vec<DataArray>,
     have_nodes: bool,
@@ -270,7 +340,7 @@ fn add_node(r: &Reader, st: &mut State, at: usize, tag: i64, p: [f64; 3]) -> Res
         ));
     }
     let index = st.points.len() as u32;
-    if st.node_index.insert(tag, index).is_some() {
+    if !st.node_index.insert(tag, index, st.node_room) {
         return Err(r.err(at, format!("node tag {tag} appears twice")));
     }
     st.points.push(p);
@@ -278,11 +348,9 @@ fn add_node(r: &Reader, st: &mut State, at: usize, tag: i64, p: [f64; 3]) -> Res
 }
 
 fn reserve_nodes(r: &Reader, st: &mut State, n: usize, at: usize) -> Result<(), MeshError> {
+    st.node_room = st.node_room.saturating_add(2 * n + 1024);
     st.points
         .try_reserve_exact(n)
-        .map_err(|_| r.err(at, format!("cannot allocate {n} nodes")))?;
-    st.node_index
-        .try_reserve(n)
         .map_err(|_| r.err(at, format!("cannot allocate {n} nodes")))
 }
 
@@ -370,12 +438,12 @@ fn element(
 ) -> Result<(), MeshError> {
     let kind = gmsh_kind(ty).map_err(|m| r.err(at, format!("element {tag}: {m}")))?;
     let cell = st.cells.kinds.len() as u32;
-    if st.cell_index.insert(tag, cell).is_some() {
+    if !st.cell_index.insert(tag, cell, st.cell_room) {
         return Err(r.err(at, format!("element tag {tag} appears twice")));
     }
     for _ in 0..kind.nodes.unwrap_or(0) {
         let (nat, t) = r.int(width, "a node tag")?;
-        let i = *st.node_index.get(&t).ok_or_else(|| {
+        let i = st.node_index.get(t).ok_or_else(|| {
             r.err(
                 nat,
                 format!(
@@ -397,7 +465,7 @@ fn reserve_cells(r: &Reader, st: &mut State, n: usize, at: usize) -> Result<(), 
     st.cells.kinds.try_reserve_exact(n).map_err(e)?;
     st.cells.at.try_reserve_exact(n).map_err(e)?;
     st.cells.offsets.try_reserve_exact(n + 1).map_err(e)?;
-    st.cell_index.try_reserve(n).map_err(e)?;
+    st.cell_room = st.cell_room.saturating_add(2 * n + 1024);
     if st.cells.offsets.is_empty() {
         st.cells.offsets.push(0);
     }
@@ -554,7 +622,7 @@ fn data(r: &mut Reader, st: &mut State, nodes: bool, at: usize) -> Result<(), Me
         } else {
             &st.cell_index
         };
-        let i = *map.get(&tag).ok_or_else(|| {
+        let i = map.get(tag).ok_or_else(|| {
             r.err(
                 tat,
                 format!(

@@ -619,3 +619,128 @@ pub fn msh41(binary: bool) -> Vec<u8> {
     data_sections(&mut b, binary, &tag);
     b
 }
+
+/// All fixtures, by name.
+pub fn all_fixtures() -> Vec<(String, Vec<u8>)> {
+    let mut v = vec![
+        ("ascii.vtk".to_string(), legacy_ascii()),
+        ("binary.vtk".to_string(), legacy_binary()),
+    ];
+    for (i, (a, b)) in [(false, false), (false, true), (true, false), (true, true)]
+        .into_iter()
+        .enumerate()
+    {
+        v.push((format!("v51-{i}.vtk"), legacy_51(a, b)));
+    }
+    for (i, data) in [
+        VtuData::Ascii,
+        VtuData::Base64,
+        VtuData::AppendedRaw,
+        VtuData::AppendedBase64,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let zlib = data != VtuData::Ascii;
+        v.push((
+            format!("f{i}.vtu"),
+            vtu(Vtu {
+                data,
+                header64: i % 2 == 0,
+                zlib,
+                big: i == 2,
+                joint_base64: i == 3,
+            }),
+        ));
+    }
+    v.push((
+        "raw32.vtu".into(),
+        vtu(Vtu {
+            data: VtuData::AppendedRaw,
+            header64: false,
+            zlib: false,
+            big: false,
+            joint_base64: false,
+        }),
+    ));
+    for (name, b) in [
+        ("a22.msh", msh22(false)),
+        ("b22.msh", msh22(true)),
+        ("a41.msh", msh41(false)),
+        ("b41.msh", msh41(true)),
+    ] {
+        v.push((name.into(), b));
+    }
+    v
+}
+
+/// A small deterministic generator (xorshift64*), so the mutation tests are repeatable.
+pub struct Rng(u64);
+
+impl Rng {
+    /// Seeded (0 is replaced by a fixed odd constant).
+    pub fn new(seed: u64) -> Rng {
+        Rng(if seed == 0 {
+            0x9e37_79b9_7f4a_7c15
+        } else {
+            seed
+        })
+    }
+
+    /// The next 64 random bits.
+    pub fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+
+    /// A number in `0..n` (`n > 0`).
+    pub fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
+
+/// `bytes` with 1 to 3 random edits: a byte flipped, set to a digit, sign, space, line
+/// end or `$`; a cut; an insertion of random bytes or of a long number; a range deleted
+/// or repeated.
+pub fn mutate(bytes: &[u8], rng: &mut Rng) -> Vec<u8> {
+    let mut b = bytes.to_vec();
+    for _ in 0..1 + rng.below(3) {
+        let at = rng.below(b.len() + 1);
+        match rng.below(7) {
+            0 if at < b.len() => b[at] ^= 1 << rng.below(8),
+            1 if at < b.len() => {
+                let set = b"0123456789-+ \n$.eE";
+                b[at] = set[rng.below(set.len())];
+            }
+            2 => b.truncate(at),
+            3 => {
+                let n = 1 + rng.below(8);
+                let junk: Vec<u8> = (0..n).map(|_| rng.next() as u8).collect();
+                b.splice(at..at, junk);
+            }
+            4 => {
+                let digits = [
+                    "4294967296",
+                    "1099511627776",
+                    "18446744073709551615",
+                    "-1",
+                    "9e99",
+                    "nan",
+                ][rng.below(6)];
+                b.splice(at..at, digits.bytes());
+            }
+            5 => {
+                let end = (at + 1 + rng.below(16)).min(b.len());
+                b.drain(at.min(end)..end);
+            }
+            _ => {
+                let end = (at + 1 + rng.below(64)).min(b.len());
+                let piece = b[at.min(end)..end].to_vec();
+                b.splice(at..at, piece);
+            }
+        }
+    }
+    b
+}

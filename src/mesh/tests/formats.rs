@@ -238,3 +238,98 @@ fn vtu_lz4_and_several_pieces_are_refused() {
         .to_string();
     assert!(e.contains("more than one <Piece>"), "{e}");
 }
+
+#[test]
+fn gmsh_mixed_elements_conform_and_quadratic_tets_use_corners() {
+    let nodes = [
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [1.0, 0.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [0.0, 1.0, 1.0],
+        [0.5, 0.5, 1.8],
+        [2.0, 0.0, 0.0],
+        [2.0, 0.0, 1.0],
+        [5.0, 5.0, 5.0],
+        [6.0, 5.0, 5.0],
+        [5.0, 6.0, 5.0],
+        [5.0, 5.0, 6.0],
+    ];
+    let mut s = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n21\n");
+    for (i, p) in nodes.iter().enumerate() {
+        s += &format!("{} {} {} {}\n", i + 1, p[0], p[1], p[2]);
+    }
+    for i in 16..=21 {
+        s += &format!("{i} 5.{i} 5.1 5.2\n"); // edge nodes of the quadratic tetra
+    }
+    s += "$EndNodes\n$Elements\n6\n";
+    s += "1 1 2 0 1 1 2\n"; // line
+    s += "2 2 2 0 1 1 2 3\n"; // triangle
+    s += "3 5 2 0 1 1 2 3 4 5 6 7 8\n"; // hexahedron
+    s += "4 6 2 0 1 2 10 3 6 11 7\n"; // prism sharing the hexahedron's face x = 1
+    s += "5 7 2 0 1 5 6 7 8 9\n"; // pyramid on the hexahedron's top
+    s += "6 11 2 0 1 12 13 14 15 16 17 18 19 20 21\n"; // 10-node tetrahedron
+    s += "$EndElements\n";
+    let m = parse(Path::new("mixed.msh"), s.as_bytes()).unwrap();
+    let cells: Vec<(&str, usize)> = m
+        .info
+        .cells
+        .iter()
+        .map(|c| (c.name.as_str(), c.count))
+        .collect();
+    assert_eq!(
+        cells,
+        [
+            ("VTK_LINE", 1),
+            ("VTK_TRIANGLE", 1),
+            ("VTK_HEXAHEDRON", 1),
+            ("VTK_WEDGE", 1),
+            ("VTK_PYRAMID", 1),
+            ("VTK_QUADRATIC_TETRA", 1)
+        ]
+    );
+    let i = &m.info;
+    assert_eq!(
+        (
+            i.split_cells,
+            i.reduced_to_corners,
+            i.skipped_cells,
+            m.tets.len()
+        ),
+        (3, 1, 2, 6 + 3 + 2 + 1)
+    );
+    assert_eq!(m.source_cell, [2, 2, 2, 2, 2, 2, 3, 3, 3, 4, 4, 5]);
+    let faces = super::real_files::face_counts(&m.tets);
+    // The shared quadrilaterals are cut the same way on both sides: through index 1
+    // (tag 2) on the face x = 1, through index 4 (tag 5) on the top.
+    for f in [[1, 2, 6], [1, 5, 6], [4, 5, 6], [4, 6, 7]] {
+        assert_eq!(faces.get(&f), Some(&2), "{f:?}");
+    }
+    assert!(faces.values().all(|&n| n <= 2));
+    let q = crate::mesh::quality::Quality::of(&m);
+    assert!(
+        (q.total_volume - (1.0 + 0.5 + 0.8 / 3.0 + 1.0 / 6.0)).abs() < 1e-12,
+        "{}",
+        q.total_volume
+    );
+    let mut last = m.tets[11];
+    last.sort_unstable();
+    assert_eq!(last, [11, 12, 13, 14]);
+}
+
+#[test]
+fn gmsh_sparse_tags_far_apart() {
+    // Node tag 250 becomes 10^12 (and node 17 becomes -3) everywhere: the tag table
+    // turns into a map, with the same mesh.
+    let text = String::from_utf8(fixtures::msh22(false)).unwrap();
+    let text = text
+        .replace(" 250", " 1000000000000")
+        .replace("\n250 ", "\n1000000000000 ");
+    let text = text.replace(" 17", " -3").replace("\n17 ", "\n-3 ");
+    assert!(text.contains("1000000000000 1.6 1.2 0.9"));
+    let m = ok(text.as_bytes(), "sparse.msh");
+    check_fixture(&m, 0.0, "sparse.msh");
+}

@@ -5,62 +5,8 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-use super::fixtures::{self, Vtu, VtuData};
+use super::fixtures::{self, all_fixtures, Vtu, VtuData};
 use crate::mesh::parse;
-
-/// All fixtures, by name.
-pub fn all_fixtures() -> Vec<(String, Vec<u8>)> {
-    let mut v = vec![
-        ("ascii.vtk".to_string(), fixtures::legacy_ascii()),
-        ("binary.vtk".to_string(), fixtures::legacy_binary()),
-    ];
-    for (i, (a, b)) in [(false, false), (false, true), (true, false), (true, true)]
-        .into_iter()
-        .enumerate()
-    {
-        v.push((format!("v51-{i}.vtk"), fixtures::legacy_51(a, b)));
-    }
-    for (i, data) in [
-        VtuData::Ascii,
-        VtuData::Base64,
-        VtuData::AppendedRaw,
-        VtuData::AppendedBase64,
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        let zlib = data != VtuData::Ascii;
-        v.push((
-            format!("f{i}.vtu"),
-            fixtures::vtu(Vtu {
-                data,
-                header64: i % 2 == 0,
-                zlib,
-                big: i == 2,
-                joint_base64: i == 3,
-            }),
-        ));
-    }
-    v.push((
-        "raw32.vtu".into(),
-        fixtures::vtu(Vtu {
-            data: VtuData::AppendedRaw,
-            header64: false,
-            zlib: false,
-            big: false,
-            joint_base64: false,
-        }),
-    ));
-    for (name, b) in [
-        ("a22.msh", fixtures::msh22(false)),
-        ("b22.msh", fixtures::msh22(true)),
-        ("a41.msh", fixtures::msh41(false)),
-        ("b41.msh", fixtures::msh41(true)),
-    ] {
-        v.push((name.into(), b));
-    }
-    v
-}
 
 /// `parse` must fail, naming the file and a position, and the message must contain `want`.
 fn fails(name: &str, bytes: &[u8], want: &str) -> String {

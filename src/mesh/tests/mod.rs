@@ -5,6 +5,7 @@ mod fixtures;
 mod formats;
 mod generated;
 mod hostile;
+mod mutation;
 mod real_files;
 
 use std::path::PathBuf;
