@@ -19,6 +19,8 @@
 //! infallible allocation aborts the test with "memory allocation of N bytes failed").
 
 mod common;
+#[path = "../src/mesh/tests/fixtures.rs"]
+mod mesh_fixtures;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
@@ -52,7 +54,7 @@ thread_local! {
 // while the current thread runs a fuzz case.
 unsafe impl GlobalAlloc for Capped {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if CAPPING.with(Cell::get) {
+        if CAPPING.try_with(Cell::get).unwrap_or(false) {
             PEAK_REQUEST.fetch_max(layout.size(), Ordering::Relaxed);
             if layout.size() > ALLOCATION_CAP {
                 return std::ptr::null_mut();
@@ -64,7 +66,7 @@ unsafe impl GlobalAlloc for Capped {
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if CAPPING.with(Cell::get) {
+        if CAPPING.try_with(Cell::get).unwrap_or(false) {
             PEAK_REQUEST.fetch_max(new_size, Ordering::Relaxed);
             if new_size > ALLOCATION_CAP {
                 return std::ptr::null_mut();
@@ -273,6 +275,130 @@ fn scene_corpus() -> Vec<Vec<u8>> {
     corpus
 }
 
+fn mesh_corpus() -> Vec<Vec<u8>> {
+    let mut corpus: Vec<Vec<u8>> = mesh_fixtures::all_fixtures()
+        .into_iter()
+        .map(|(_, b)| b)
+        .collect();
+    for name in ["tetraMesh.vtk", "Tetrahedron.vtu"] {
+        if let Some(p) = common::shared_data(&format!("tets/{name}")) {
+            corpus.push(std::fs::read(p).unwrap());
+        }
+    }
+    corpus
+}
+
+fn dat_corpus() -> Vec<Vec<u8>> {
+    use arbvis::points::{dat, section};
+    let cloud = section::generate(&section::SectionSpec {
+        points: 40,
+        seed: 3,
+    })
+    .unwrap();
+    let text = dat::write(&cloud, &dat::DatColumns::default()).unwrap();
+    vec![format!("# a comment\n{text}").into_bytes()]
+}
+
+fn las_corpus() -> Vec<Vec<u8>> {
+    use las::{Builder, Point, Writer};
+    let mut corpus = Vec::new();
+    for (format, compressed) in [(3, false), (1, true), (6, false)] {
+        let mut b = Builder::from((1, if format >= 6 { 4 } else { 2 }));
+        b.point_format = las::point::Format::new(format).unwrap();
+        b.point_format.is_compressed = compressed;
+        let t = |offset: f64| las::Transform {
+            scale: 0.001,
+            offset,
+        };
+        b.transforms = las::Vector {
+            x: t(500_000.0),
+            y: t(4_000_000.0),
+            z: t(0.0),
+        };
+        let mut w =
+            Writer::new(std::io::Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
+        for i in 0..20 {
+            let f = i as f64;
+            let mut p = Point {
+                x: 500_000.0 + 1.25 * f,
+                y: 4_000_000.0 - 0.5 * f * f,
+                z: 12.0 + f,
+                intensity: 100 * i as u16,
+                ..Default::default()
+            };
+            if w.header().point_format().has_color {
+                p.color = Some(las::Color::new(i * 300, 65535 - i, 7));
+            }
+            if w.header().point_format().has_gps_time {
+                p.gps_time = Some(f);
+            }
+            w.write_point(p).unwrap();
+        }
+        w.close().unwrap();
+        corpus.push(w.into_inner().unwrap().into_inner());
+    }
+    corpus
+}
+
+fn ply_corpus() -> Vec<Vec<u8>> {
+    let header = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\ncomment fuzz\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+        )
+    };
+    let ascii = header("ascii") + "0 0 0 255 0 0\n1 0 0 0 255 0\n0 1.5 0.25 0 0 255\n3 0 1 2\n";
+    let mut binary = header("binary_little_endian").into_bytes();
+    for (x, y, z, c) in [
+        (0f32, 0f32, 0f32, 255u8),
+        (1.0, 0.0, 0.0, 9),
+        (0.0, 1.5, 0.25, 70),
+    ] {
+        for v in [x, y, z] {
+            binary.extend(v.to_le_bytes());
+        }
+        binary.extend([c, 0, 255 - c]);
+    }
+    binary.push(3);
+    for i in [0i32, 1, 2] {
+        binary.extend(i.to_le_bytes());
+    }
+    vec![ascii.into_bytes(), binary]
+}
+
+fn obj_corpus() -> Vec<Vec<u8>> {
+    let mut corpus = vec![b"# a cube\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n".to_vec()];
+    if let Some(p) = common::shared_data("surfaces/cow.obj") {
+        corpus.push(std::fs::read(p).unwrap());
+    }
+    corpus
+}
+
+fn stl_corpus() -> Vec<Vec<u8>> {
+    let tris: [[[f32; 3]; 3]; 4] = [
+        [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]],
+        [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+        [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]],
+        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+    ];
+    let mut binary = vec![b' '; 80];
+    binary.extend((tris.len() as u32).to_le_bytes());
+    let mut ascii = String::from("solid tet\n");
+    for t in &tris {
+        binary.extend([0u8; 12]);
+        ascii += " facet normal 0 0 0\n  outer loop\n";
+        for v in t {
+            for c in v {
+                binary.extend(c.to_le_bytes());
+            }
+            ascii += &format!("   vertex {} {} {}\n", v[0], v[1], v[2]);
+        }
+        binary.extend([0u8; 2]);
+        ascii += "  endloop\n endfacet\n";
+    }
+    ascii += "endsolid tet\n";
+    vec![binary, ascii.into_bytes()]
+}
+
 fn targets() -> Vec<Target> {
     vec![
         Target {
@@ -312,6 +438,55 @@ fn targets() -> Vec<Target> {
                     }
                     let _ = Scene::parse(&scene.to_toml(), "again.toml");
                 }
+            },
+        },
+        Target {
+            name: "mesh",
+            text: false,
+            corpus: mesh_corpus(),
+            run: |b| {
+                let _ = arbvis::mesh::parse(Path::new("fuzz.mesh"), b);
+            },
+        },
+        Target {
+            name: "points-dat",
+            text: true,
+            corpus: dat_corpus(),
+            run: |b| {
+                let columns = arbvis::points::dat::DatColumns::default();
+                let _ = arbvis::points::dat::parse(Path::new("fuzz.dat"), b, &columns);
+            },
+        },
+        Target {
+            name: "points-las",
+            text: false,
+            corpus: las_corpus(),
+            run: |b| {
+                let _ = arbvis::points::lasfile::parse(Path::new("fuzz.laz"), b);
+            },
+        },
+        Target {
+            name: "points-ply",
+            text: false,
+            corpus: ply_corpus(),
+            run: |b| {
+                let _ = arbvis::points::plycloud::parse(Path::new("fuzz.ply"), b);
+            },
+        },
+        Target {
+            name: "surface-obj",
+            text: true,
+            corpus: obj_corpus(),
+            run: |b| {
+                let _ = arbvis::surface::parse(Path::new("fuzz.obj"), b);
+            },
+        },
+        Target {
+            name: "surface-stl",
+            text: false,
+            corpus: stl_corpus(),
+            run: |b| {
+                let _ = arbvis::surface::parse(Path::new("fuzz.stl"), b);
             },
         },
         Target {
@@ -366,7 +541,9 @@ fn run_case(target: &Target, seed: u64, index: usize) {
 fn loaders_and_scenes_survive_mutated_inputs() {
     // Panics are expected and caught: keep their messages off the output.
     let hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(|_| {}));
+    if std::env::var_os("ARBVIS_FUZZ_CASE").is_none() {
+        std::panic::set_hook(Box::new(|_| {}));
+    }
     let targets = targets();
     let result = std::panic::catch_unwind(|| {
         if let Ok(case) = std::env::var("ARBVIS_FUZZ_CASE") {

@@ -24,6 +24,12 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
         path: name.to_path_buf(),
         source,
     })?;
+    // Checked before tobj sees the text: tobj 4.0.5 multiplies indices unchecked
+    // (`vn * 3 + 2`), which overflows on a hostile index.
+    if let Some((position, message)) = locate(&text) {
+        return Err(SurfaceError::format(name, position, message));
+    }
+    let text = geometry_only(&text);
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: false,
@@ -122,6 +128,28 @@ pub(crate) fn weld(vertices: Vec<[f64; 3]>) -> (Vec<[f64; 3]>, Vec<u32>) {
 
 /// The first non-finite vertex or out-of-range face index in OBJ text, with its line and
 /// column (`None` when this scan finds nothing wrong).
+/// The text with what this reader ignores blanked (line numbers kept): texture and
+/// normal lines, and the texture/normal parts of face corners (`f 1/2/3` becomes `f 1`).
+fn geometry_only(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("f") => {
+                out.push('f');
+                for w in words {
+                    out.push(' ');
+                    out.push_str(w.split('/').next().unwrap_or(""));
+                }
+            }
+            Some("vt" | "vn" | "vp" | "l" | "p" | "mtllib" | "usemtl") => {}
+            _ => out.push_str(line),
+        }
+        out.push('\n');
+    }
+    out
+}
+
 fn locate(text: &str) -> Option<(Position, String)> {
     let mut vertex_count: i64 = 0;
     for (l, line) in text.lines().enumerate() {
@@ -155,7 +183,16 @@ fn locate(text: &str) -> Option<(Position, String)> {
                 for word in words {
                     let first = word.split('/').next().unwrap_or("");
                     let Ok(i) = first.parse::<i64>() else {
-                        continue;
+                        return Some((
+                            Position::Line {
+                                line: l + 1,
+                                column: column_of(word),
+                            },
+                            format!(
+                                "face corner {:?}: expected a vertex index",
+                                crate::input::shorten(word, 30)
+                            ),
+                        ));
                     };
                     let resolved = if i < 0 { vertex_count + i + 1 } else { i };
                     if resolved < 1 || resolved > vertex_count {

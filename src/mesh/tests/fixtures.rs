@@ -1,5 +1,5 @@
 //! Small mesh files written byte by byte, one per layout the real files do not cover.
-//! Shared by the unit tests and by `tests/mesh_mutation.rs` (through `#[path]`), so it
+//! Shared by the unit tests and by `tests/fuzz.rs` (through `#[path]`), so it
 //! uses nothing from the crate.
 //!
 //! Every fixture holds the same mesh, chosen not to be friendly: 6 points with uneven
