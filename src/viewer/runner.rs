@@ -45,6 +45,8 @@ pub struct Observed<'a> {
     pub view_px: [u32; 2],
     /// An action of the last frame that failed (screenshot not written, ...).
     pub action_error: Option<String>,
+    /// The interactive quality's name.
+    pub quality: &'static str,
 }
 
 /// Runs a script.
@@ -363,13 +365,14 @@ impl ScriptRunner {
                 if self.frames_in_step > *n {
                     let ms = now.duration_since(t0).as_secs_f64() * 1e3 / *n as f64;
                     println!(
-                        "measure {}: {n} frames, {ms:.1} ms per frame ({:.2} fps), view {}x{}, window {}x{} (script line {})",
+                        "measure {}: {n} frames, {ms:.1} ms per frame ({:.2} fps), view {}x{}, window {}x{}, interactive quality {} (script line {})",
                         mode.name(),
                         1e3 / ms.max(1e-9),
                         o.view_px[0],
                         o.view_px[1],
                         o.window[0],
                         o.window[1],
+                        o.quality,
                         step.line
                     );
                     done = true;

@@ -138,6 +138,7 @@ impl Running {
             window: [size.width, size.height],
             view_px: [self.view_px[2] as u32, self.view_px[3] as u32],
             action_error: self.action_error.take(),
+            quality: self.panel.quality.name(),
         }
     }
 
