@@ -56,6 +56,26 @@ pub fn curve_from_table(table: &ColorTable) -> Vec<[f64; 2]> {
         .collect()
 }
 
+/// Height in texels of a histogram image.
+const HISTOGRAM_ROWS: usize = 64;
+
+/// A histogram of 256 counts as a 256-wide image of grey bars on a clear background
+/// (square-root scale), drawn behind the curve as one texture.
+pub fn histogram_image(counts: &[u32]) -> egui::ColorImage {
+    let top = counts.iter().copied().max().unwrap_or(0).max(1) as f32;
+    let heights: Vec<usize> = counts
+        .iter()
+        .map(|&c| ((c as f32 / top).sqrt() * HISTOGRAM_ROWS as f32).round() as usize)
+        .collect();
+    let mut pixels = vec![Color32::TRANSPARENT; counts.len() * HISTOGRAM_ROWS];
+    for (x, &h) in heights.iter().enumerate() {
+        for y in HISTOGRAM_ROWS - h.min(HISTOGRAM_ROWS)..HISTOGRAM_ROWS {
+            pixels[y * counts.len() + x] = Color32::from_gray(70);
+        }
+    }
+    egui::ColorImage::new([counts.len(), HISTOGRAM_ROWS], pixels)
+}
+
 /// What the editor did this frame.
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
 pub struct CurveEdit {
@@ -64,7 +84,8 @@ pub struct CurveEdit {
 }
 
 /// Draw the editor for `curve` (the scene's alpha points) over `table`'s swatches (the
-/// texture `colours`) and `histogram`; recorded as `label` (the plot area).
+/// texture `colours`) and the `histogram` image ([`histogram_image`]); recorded as
+/// `label` (the plot area).
 #[allow(clippy::too_many_arguments)]
 pub fn editor(
     ui: &mut Ui,
@@ -73,7 +94,7 @@ pub fn editor(
     curve: &mut Vec<[f64; 2]>,
     table: &ColorTable,
     colours: egui::TextureId,
-    histogram: Option<&[u32]>,
+    histogram: Option<egui::TextureId>,
     size: Vec2,
 ) -> CurveEdit {
     let (rect, response) = ui.allocate_exact_size(size, Sense::click_and_drag());
@@ -158,20 +179,12 @@ pub fn editor(
     let painter = ui.painter_at(rect);
     painter.rect_filled(plot, 2.0, Color32::from_gray(24));
     if let Some(h) = histogram {
-        let top = h.iter().copied().max().unwrap_or(0).max(1) as f32;
-        let w = plot.width() / 256.0;
-        for (k, &c) in h.iter().enumerate() {
-            if c == 0 {
-                continue;
-            }
-            let frac = (c as f32 / top).sqrt();
-            let x = plot.left() + k as f32 * w;
-            let bar = Rect::from_min_max(
-                Pos2::new(x, plot.bottom() - frac * plot.height()),
-                Pos2::new(x + w.max(1.0), plot.bottom()),
-            );
-            painter.rect_filled(bar, 0.0, Color32::from_gray(70));
-        }
+        painter.image(
+            h,
+            plot,
+            Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
+            Color32::WHITE,
+        );
     }
     painter.image(
         colours,
@@ -231,6 +244,17 @@ mod tests {
             }
         }
         let seismic = curve_from_table(&ColorTable::builtin("seismic").unwrap());
+        let image = histogram_image(&[0, 4, 1, 16]);
+        assert_eq!(image.size, [4, HISTOGRAM_ROWS]);
+        let column = |x: usize| {
+            (0..HISTOGRAM_ROWS)
+                .filter(|y| image.pixels[y * 4 + x] != Color32::TRANSPARENT)
+                .count()
+        };
+        assert_eq!(
+            [column(0), column(1), column(2), column(3)],
+            [0, 32, 16, 64]
+        );
         assert_eq!(seismic.first(), Some(&[0.0, 1.0]));
         assert_eq!(seismic.last(), Some(&[1.0, 1.0]));
     }

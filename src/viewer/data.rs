@@ -53,6 +53,7 @@ pub struct ViewData {
     /// 256 x 1 texture.
     tables: [Option<(TableSpec, ColorTable, TextureHandle)>; 3],
     sections: [Option<Section>; 3],
+    histograms: [Option<TextureHandle>; 3],
 }
 
 /// Build the scene's renderer with programs of `kind`, keeping its prepared data.
@@ -133,6 +134,17 @@ impl ViewData {
             self.tables[a] = Some((spec.clone(), table, texture));
         }
         self.tables[a].as_ref().map(|(_, t, x)| (t, x))
+    }
+
+    /// Attribute `a`'s histogram as an image (made once).
+    pub fn histogram(&mut self, ctx: &egui::Context, a: usize) -> Option<egui::TextureId> {
+        if self.histograms[a].is_none() {
+            let counts = self.volume.as_ref()?.histograms[a].as_ref()?;
+            let image = super::curve::histogram_image(counts);
+            self.histograms[a] =
+                Some(ctx.load_texture(format!("histogram {a}"), image, TextureOptions::NEAREST));
+        }
+        self.histograms[a].as_ref().map(|t| t.id())
     }
 
     /// The section at `index` along `axis` of attribute `a`, coloured by its table.

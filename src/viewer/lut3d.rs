@@ -145,10 +145,7 @@ pub fn editor(
             ui.label(RichText::new(format!("{role}: {}", attr.attribute.name())).strong());
             ui.label(RichText::new(range).weak());
         });
-        let histogram = data
-            .volume
-            .as_ref()
-            .and_then(|v| v.histograms[a].as_deref());
+        let histogram = data.histogram(&ctx, a);
         let e = curve::editor(
             ui,
             widgets,

@@ -106,7 +106,19 @@ pub fn draw_box(
         }
         let base = corner(half, start);
         let count = ((e1 - e0).length() / 60.0).floor().clamp(2.0, 6.0) as usize;
-        for t in axis.ticks(count) {
+        let ticks = axis.ticks(count);
+        let widest = ticks
+            .iter()
+            .map(|&t| axis.label(t).len())
+            .max()
+            .unwrap_or(0);
+        // The name goes beyond the tick labels (about 6.5 points per character across).
+        let clear = if out.x.abs() > 0.4 {
+            14.0 + 6.5 * widest as f32 * out.x.abs()
+        } else {
+            22.0
+        };
+        for t in ticks {
             let mut q = base;
             q[a] = along(half[a], t, axis.len);
             let s = p.project(q);
@@ -115,7 +127,7 @@ pub fn draw_box(
             painter.text(at, anchor(out), axis.label(t), font.clone(), text);
         }
         painter.text(
-            inside(painter.clip_rect(), mid + out * 26.0),
+            inside(painter.clip_rect(), mid + out * (clear + 4.0)),
             anchor(out),
             &axis.name,
             FontId::proportional(12.0),

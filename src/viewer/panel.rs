@@ -368,7 +368,7 @@ fn sections(ui: &mut egui::Ui, scene: &Scene, data: &mut ViewData, state: &mut P
     });
     let ctx = ui.ctx().clone();
     let column = (ui.available_width() - 16.0) / 3.0;
-    let height = ui.available_height() - 50.0;
+    let height = ui.available_height() - 64.0;
     ui.columns(3, |cols| {
         // Inline, crossline, time slice: fixed axes 2, 1, 0.
         for (col, a) in cols.iter_mut().zip([2usize, 1, 0]) {

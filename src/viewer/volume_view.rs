@@ -181,6 +181,8 @@ impl VolumeView {
             self.building = None;
             return Ok(Pending::Done);
         }
+        // At full interactive quality every frame waits for the whole volume.
+        let sync = sync || (interacting && quality == InteractiveQuality::Full);
         let shown_current = self.shown.as_ref().is_some_and(|p| p.key == *key);
         if (interacting || self.shown.is_none()) && quality != InteractiveQuality::Full && !sync {
             if !shown_current {
