@@ -6,8 +6,8 @@
 //! Decisions: the box is projected with the camera's own matrix for the view's aspect, so
 //! it sits exactly on the volume. Each axis is labelled on the one of its four parallel
 //! edges that lies farthest out from the box's projected centre (a silhouette edge, so
-//! labels fall outside the volume); an axis seen end-on (edge shorter than 24 points) gets
-//! no labels.
+//! labels fall outside the volume) and is not already labelled; an axis seen end-on (edge
+//! shorter than 24 points) gets no labels. Labels are kept 30 points inside the view.
 
 use egui::{Align2, Color32, FontId, Painter, Pos2, Rect, Stroke, Vec2};
 use glam::{DVec3, DVec4};
@@ -84,16 +84,31 @@ pub fn draw_box(
     }
     let font = FontId::proportional(11.0);
     let text = Color32::from_gray(230);
+    let mut labelled: Vec<(Pos2, Pos2)> = Vec::new();
     for (a, axis) in axes.iter().enumerate() {
         let bit = 1 << a;
-        // The outermost of the four edges along this axis.
-        let Some(start) = (0..8).filter(|i| i & bit == 0).max_by(|&i, &j| {
-            let mid =
-                |k: usize| (corners[k] + (corners[k | bit] - corners[k]) * 0.5 - centre).length();
-            mid(i).total_cmp(&mid(j))
-        }) else {
+        // The outermost of the four edges along this axis that does not lie on an edge
+        // already labelled (two axes can project onto one screen line).
+        let mid = |k: usize| corners[k] + (corners[k | bit] - corners[k]) * 0.5;
+        let mut edges: Vec<usize> = (0..8).filter(|i| i & bit == 0).collect();
+        edges.sort_by(|&i, &j| {
+            (mid(j) - centre)
+                .length()
+                .total_cmp(&(mid(i) - centre).length())
+        });
+        let free = |k: usize| {
+            let (p, q) = (corners[k], corners[k | bit]);
+            !labelled.iter().any(|&(a, b): &(Pos2, Pos2)| {
+                let near = |x: Pos2, y: Pos2| x.distance(y) < 12.0;
+                (near(p, a) && near(q, b))
+                    || (near(p, b) && near(q, a))
+                    || near(mid(k), a + (b - a) * 0.5)
+            })
+        };
+        let Some(start) = edges.iter().copied().find(|&k| free(k)) else {
             continue;
         };
+        labelled.push((corners[start], corners[start | bit]));
         let (e0, e1) = (corners[start], corners[start | bit]);
         if (e1 - e0).length() < 24.0 {
             continue;
