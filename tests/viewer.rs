@@ -270,10 +270,7 @@ fn an_idle_viewer_draws_nothing() {
         .map(|l| l.split_whitespace().next().unwrap().parse().unwrap())
         .collect();
     assert_eq!(counts.len(), 2, "{stdout}");
-    assert!(
-        (1..=8).contains(&counts[0]),
-        "refinement after the drag: {stdout}"
-    );
+    assert!(counts[0] >= 1, "no refinement after the drag: {stdout}");
     assert!(counts[1] <= 2, "an idle second drew frames: {stdout}");
     let _ = std::fs::remove_dir_all(&dir);
 }
