@@ -79,8 +79,29 @@ enum Command {
         /// Folder for screenshots (default: current folder).
         #[arg(long, default_value = ".")]
         screenshot_dir: PathBuf,
-        /// Run a script of UI actions, one per line (see `arbvis::viewer::script`), then exit.
-        #[arg(long)]
+        /// Run a script of UI actions, one per line, then exit (an error names the line of a
+        /// step that did not take effect).
+        ///
+        /// Actions (`#` starts a comment; LABEL is a widget's text, e.g. `Save tables`,
+        /// `Lock secondary`, `primary Cr`, `primary table`, `primary alpha`, `slices`,
+        /// `Interactive quality`, `inline section`; FX FY are fractions of the widget from
+        /// its top-left corner, 0..1; DX DY are points):
+        ///   wait N                      let N frames pass
+        ///   click LABEL                 click the widget
+        ///   click-at LABEL FX FY        click at a point of it (adds an alpha-curve point)
+        ///   right-click-at LABEL FX FY  secondary click there (removes a curve point)
+        ///   double-click-at LABEL FX FY double click there (also removes a curve point)
+        ///   drag-on LABEL FX FY DX DY   press there, move by DX DY, release (moves a point)
+        ///   drag DX DY                  drag across the 3D view (turns the camera)
+        ///   scroll DY                   scroll over the 3D view (zoom)
+        ///   set LABEL VALUE             a slider's or number's value, true/false for a check
+        ///                               box, an option's name for a choice
+        ///   key NAME                    press a key: Home (reset camera), F12 (screenshot)
+        ///   resize W H                  resize the window to W x H pixels
+        ///   idle MS                     draw nothing for MS ms; print the frames drawn
+        ///   measure N full|interactive|ui  draw N frames, print the frame rate
+        ///   quit                        close the viewer (implied at the end)
+        #[arg(long, verbatim_doc_comment)]
         script: Option<PathBuf>,
     },
 }

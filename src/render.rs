@@ -62,11 +62,13 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
     let [width, height] = scene.size;
     let t0 = Instant::now();
     let mut renderer = techniques::build(gpu, scene, kind)?;
-    let target = if renderer.needs_depth() {
-        Target::with_depth(gpu, width, height, scene.target_format())?
-    } else {
-        Target::new(gpu, width, height, scene.target_format())?
-    };
+    let target = Target::create(
+        gpu,
+        width,
+        height,
+        scene.target_format(),
+        renderer.needs_depth(),
+    )?;
     gpu.finish();
     let build_time = t0.elapsed();
     let t1 = Instant::now();

@@ -323,7 +323,7 @@ fn las_corpus() -> Vec<Vec<u8>> {
                 x: 500_000.0 + 1.25 * f,
                 y: 4_000_000.0 - 0.5 * f * f,
                 z: 12.0 + f,
-                intensity: 100 * i as u16,
+                intensity: 100 * i,
                 ..Default::default()
             };
             if w.header().point_format().has_color {

@@ -1,5 +1,7 @@
-//! The desktop viewer under Xvfb: one rendered frame, screenshots, and simulated UI
-//! interaction (clicks and a drag injected through egui's input path by `--script`).
+//! The desktop viewer under Xvfb: screenshots equal to offscreen renders of the saved
+//! scene, framing at two window aspects, an idle viewer that draws nothing, every control
+//! of the lut 3D editor reached by `--script` (clicks, drags and values injected through
+//! egui's input path), and script steps that do nothing failing with their line.
 //!
 //! Needs an X server: `DISPLAY`, or `Xvfb` on PATH (started here). Without either the
 //! tests say so and pass, unless `ARBVIS_NO_SKIP=1` (set by `.ci/run`) makes that a failure.
@@ -13,12 +15,12 @@ use common::temp_dir;
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
-use arbvis::gl::Backend;
-use arbvis::gl::TargetFormat;
+use arbvis::gl::{Backend, Surface, Target, TargetFormat};
+use arbvis::image::Image;
 use arbvis::png_io::read_png;
 use arbvis::render::render;
 use arbvis::scene::{Scene, TechniqueScene};
-use arbvis::techniques::opacity3d::Combine;
+use arbvis::techniques::opacity3d::{Combine, Opacity3dScene};
 use arbvis::techniques::quad::{reference_image, QuadScene};
 
 struct Display {
@@ -97,14 +99,15 @@ fn display() -> Option<Display> {
     skip("no DISPLAY and Xvfb did not come up")
 }
 
-/// Run `arbvis view --demo DEMO --size SIZE` with `script`; returns (success, stderr).
-fn run_viewer(
-    display: &Display,
-    dir: &Path,
-    demo: &str,
-    size: &str,
-    script: &str,
-) -> (bool, String) {
+/// What a viewer run left.
+struct Run {
+    ok: bool,
+    stdout: String,
+    stderr: String,
+}
+
+/// Run `arbvis view --demo DEMO --size SIZE` with `script`.
+fn run_viewer(display: &Display, dir: &Path, demo: &str, size: &str, script: &str) -> Run {
     let script_path = dir.join("script.txt");
     std::fs::write(&script_path, script).unwrap();
     let mut child = Command::new(env!("CARGO_BIN_EXE_arbvis"))
@@ -121,10 +124,11 @@ fn run_viewer(
     loop {
         if let Some(status) = child.try_wait().unwrap() {
             let out = child.wait_with_output().unwrap();
-            return (
-                status.success(),
-                String::from_utf8_lossy(&out.stderr).into_owned(),
-            );
+            return Run {
+                ok: status.success(),
+                stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+                stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+            };
         }
         if t0.elapsed() > Duration::from_secs(120) {
             let _ = child.kill();
@@ -135,20 +139,57 @@ fn run_viewer(
 }
 
 /// Run `script` in the viewer on `demo` (one test at a time) and return its screenshot
-/// folder, or `None` when the test is skipped for lack of a display. Fails if the viewer
-/// fails.
-fn run_script(name: &str, demo: &str, size: &str, script: &str) -> Option<PathBuf> {
+/// folder and stdout, or `None` when the test is skipped for lack of a display. Fails if
+/// the viewer fails.
+fn run_script(name: &str, demo: &str, size: &str, script: &str) -> Option<(PathBuf, String)> {
     let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let display = display()?;
     let dir = temp_dir(name);
-    let (ok, stderr) = run_viewer(&display, &dir, demo, size, script);
-    assert!(ok, "viewer failed: {stderr}");
-    Some(dir)
+    let run = run_viewer(&display, &dir, demo, size, script);
+    assert!(run.ok, "viewer failed: {}", run.stderr);
+    Some((dir, run.stdout))
+}
+
+/// Run scripts that must fail; returns each one's stderr (`None`: skipped).
+fn failing_scripts(name: &str, demo: &str, scripts: &[&str]) -> Option<Vec<String>> {
+    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let display = display()?;
+    let dir = temp_dir(name);
+    let errors = scripts
+        .iter()
+        .map(|script| {
+            let run = run_viewer(&display, &dir, demo, "160x160", script);
+            assert!(!run.ok, "script {script:?} should fail: {}", run.stdout);
+            run.stderr
+        })
+        .collect();
+    let _ = std::fs::remove_dir_all(&dir);
+    Some(errors)
+}
+
+fn opacity3d(scene: &Scene) -> &Opacity3dScene {
+    match &scene.technique {
+        TechniqueScene::Opacity3d(o) => o,
+        _ => panic!("saved scene is not opacity3d"),
+    }
+}
+
+/// The screenshot equals an offscreen render of the saved scene at its size, within one
+/// 8-bit level (same driver, same program).
+fn assert_screenshot_is_the_scene(shot: &Image, saved: &Scene) {
+    assert_eq!(
+        saved.size,
+        [shot.width, shot.height],
+        "the saved scene's size is the screenshot's"
+    );
+    let offscreen = saved.picture(&render(saved, Backend::Egl).unwrap().image);
+    let d = shot.compare(&offscreen, common::LEVEL).unwrap();
+    assert!(d.max_abs <= common::LEVEL as f64 * 1.01, "{d:?}");
 }
 
 #[test]
 fn frame_screenshot_and_program_switch() {
-    let Some(dir) = run_script(
+    let Some((dir, _)) = run_script(
         "switch",
         "quad",
         "160x160",
@@ -169,8 +210,7 @@ fn frame_screenshot_and_program_switch() {
     assert_eq!(programs(&glsl_text).as_deref(), Some("glsl"));
 
     // The view is the window minus the side panel; the quad fills it. Both screenshots
-    // match the CPU reference at the view's size within one 8-bit level (the window's
-    // back buffer is 8 bits per channel, as an RGBA8 target).
+    // match the CPU reference at the view's size within one 8-bit level.
     assert_eq!(arb.width, 160, "view width = scene width");
     let want = reference_image(
         &QuadScene::default(),
@@ -186,15 +226,16 @@ fn frame_screenshot_and_program_switch() {
         );
     }
 
-    // "Save scene" wrote a scene that parses and records the switch.
+    // "Save scene" wrote a scene that parses, records the switch and has the view's size.
     let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
     assert_eq!(saved.programs, arbvis::gl::ProgramChoice::Glsl);
+    assert_eq!(saved.size, [glsl.width, glsl.height]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
 fn drag_rotates_the_camera() {
-    let Some(dir) = run_script(
+    let Some((dir, _)) = run_script(
         "drag",
         "quad",
         "160x160",
@@ -212,52 +253,291 @@ fn drag_rotates_the_camera() {
 }
 
 #[test]
-fn script_naming_a_missing_widget_fails_clearly() {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let Some(display) = display() else { return };
-    let dir = temp_dir("missing");
-    let (ok, stderr) = run_viewer(
-        &display,
-        &dir,
-        "quad",
+fn an_idle_viewer_draws_nothing() {
+    // After a drag the volume is refined (the full-quality picture, in parts if slow);
+    // then, with no input, the event loop waits and draws nothing.
+    let Some((dir, stdout)) = run_script(
+        "idle",
+        "v3o2-sum",
         "160x160",
-        "wait 1\nclick No such button\n",
-    );
-    assert!(!ok, "a bad script must fail the viewer");
+        "resize 880 460\nwait 3\ndrag 30 0\nidle 1500\nidle 1000\n",
+    ) else {
+        return;
+    };
+    let counts: Vec<u64> = stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix("idle: "))
+        .map(|l| l.split_whitespace().next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(counts.len(), 2, "{stdout}");
+    assert!(counts[0] >= 1, "no refinement after the drag: {stdout}");
+    assert!(counts[1] <= 2, "an idle second drew frames: {stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The border rows and columns of `img` are all `background`; some pixel inside is not.
+fn assert_framed(img: &Image, background: [u8; 4], what: &str) {
+    let (w, h) = (img.width, img.height);
+    for x in 0..w {
+        for y in [0, h - 1] {
+            assert_eq!(
+                img.pixel_u8(x, y),
+                background,
+                "{what}: ({x}, {y}) on the border"
+            );
+        }
+    }
+    for y in 0..h {
+        for x in [0, w - 1] {
+            assert_eq!(
+                img.pixel_u8(x, y),
+                background,
+                "{what}: ({x}, {y}) on the border"
+            );
+        }
+    }
+    let shown = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|&(x, y)| img.pixel_u8(x, y) != background)
+        .count();
     assert!(
-        stderr.contains("No such button") && stderr.contains("Screenshot"),
-        "{stderr}"
+        shown > (w * h / 20) as usize,
+        "{what}: only {shown} pixels show the volume"
     );
+}
+
+#[test]
+fn the_volume_stays_framed_at_two_window_aspects() {
+    // A tall view and a wide one, each turned by a drag; then Home resets the camera.
+    let Some((dir, _)) = run_script(
+        "framing",
+        "v3o2-sum",
+        "160x160",
+        "resize 880 640\nwait 2\ndrag 50 30\nclick Screenshot\n\
+         resize 1200 460\nwait 2\ndrag -40 60\nclick Screenshot\nclick Save scene\n\
+         key Home\nclick Save scene\n",
+    ) else {
+        return;
+    };
+    let (tall, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
+    let (wide, _) = read_png(&dir.join("arbvis-screenshot-002.png")).unwrap();
+    assert!(tall.height > tall.width, "{}x{}", tall.width, tall.height);
+    assert!(wide.width > wide.height, "{}x{}", wide.width, wide.height);
+    let black = [0, 0, 0, 255];
+    assert_framed(&tall, black, "tall view");
+    assert_framed(&wide, black, "wide view");
+    // Home reset the rotation and framed the volume: a unit cube's bounding sphere fits.
+    let home = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    assert_eq!(home.camera.rotation, [0.0, 0.0, 0.0, 1.0]);
+    let fit = arbvis::viewer::fit_zoom(&home.camera, glam::DVec3::ONE);
+    assert!(
+        (home.camera.zoom - fit).abs() < 1e-12,
+        "{}",
+        home.camera.zoom
+    );
+    assert!((fit - 0.9 / 3f64.sqrt()).abs() < 1e-12, "{fit}");
     let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
-fn lut3d_editor_switches_combination_and_locks_a_table() {
-    let Some(dir) = run_script(
-        "lut3d",
-        "v3o2-sum",
-        "160x400",
-        "wait 2\nclick Product\nwait 2\nclick Lock primary\nwait 2\nclick Screenshot\nwait 1\nclick Save scene\nwait 1\n",
+fn every_lut3d_control_reaches_the_saved_scene() {
+    // The demo: primary seismic [1, 1, 1, 0.8] with alpha [[0, .6], [.35, 0], [.65, 0],
+    // [1, .6]]; secondary magma [1; 4] with alpha [[0, 0], [.6, 0], [1, .8]]; tertiary grey
+    // [.5; 4] with alpha [[0, 0], [1, .1]]; sum, 128 slices.
+    let script = "\
+resize 880 560
+wait 2
+set primary Cr 0.25
+set primary Cg 0.5
+set primary Cb 0.75
+set primary Ca 0.125
+set secondary Cr 0.1
+set secondary Cg 0.2
+set secondary Cb 0.3
+set secondary Ca 0.4
+click Lock tertiary
+set tertiary Cb 0.625
+set secondary table viridis
+click Product
+set slices 48
+click-at primary alpha 0.5 0.25
+drag-on primary alpha 0.65 1 20 -30
+right-click-at primary alpha 0 0.4
+double-click-at secondary alpha 0.6 1
+set Interactive quality quarter
+set Section attribute secondary
+set inline section 10
+click Sections
+click Sections
+measure 2 interactive
+click Screenshot
+click Save scene
+";
+    let Some((dir, stdout)) = run_script("lut3d", "v3o2-sum", "160x160", script) else {
+        return;
+    };
+    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let o = opacity3d(&saved);
+    assert_eq!(o.combine, Combine::Product);
+    assert_eq!(o.slices, 48);
+    assert_eq!(o.primary.coefficients, [0.25, 0.5, 0.75, 0.125]);
+    let secondary = o.secondary.as_ref().unwrap();
+    assert_eq!(secondary.coefficients, [0.1, 0.2, 0.3, 0.4]);
+    assert_eq!(secondary.table.builtin, "viridis");
+    // The lock took Cr (0.5) for all four, then one edit set all four.
+    assert_eq!(o.tertiary.as_ref().unwrap().coefficients, [0.625; 4]);
+    // Primary: a point added at (0.5, 0.75); the point at (0.65, 0) dragged right and up
+    // (20 and 30 points on a plot about 410 x 82 points); (0, 0.6) removed.
+    let alpha = &o.primary.table.alpha;
+    assert_eq!(alpha.len(), 4, "{alpha:?}");
+    assert_eq!(alpha[0], [0.35, 0.0]);
+    assert_eq!(alpha[1], [0.5, 0.75]);
+    assert!(alpha[2][0] > 0.65 && alpha[2][0] < 0.75, "{alpha:?}");
+    assert!(alpha[2][1] > 0.2 && alpha[2][1] < 0.5, "{alpha:?}");
+    assert_eq!(alpha[3], [1.0, 0.6]);
+    // Secondary: the double click removed (0.6, 0).
+    assert_eq!(secondary.table.alpha, vec![[0.0, 0.0], [1.0, 0.8]]);
+    // The interactive quality is a viewer setting (not in the scene): `measure` shows it.
+    assert!(stdout.contains("interactive quality quarter"), "{stdout}");
+    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn save_tables_writes_them_and_the_scene_uses_them() {
+    let Some((dir, _)) = run_script(
+        "tables",
+        "v3o2-product",
+        "160x160",
+        "wait 2\nclick-at primary alpha 0.25 0.5\nclick Save tables\nclick Screenshot\nclick Save scene\nclick Transparent screenshots\nclick Screenshot\n",
     ) else {
         return;
     };
-    // The edits are in the saved scene: product, and the locked primary's four
-    // coefficients made one (the demo's are [1, 1, 1, 0.8]; the lock takes Cr).
     let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
-    let TechniqueScene::Opacity3d(o) = &saved.technique else {
-        panic!("saved scene is not opacity3d");
-    };
-    assert_eq!(o.combine, Combine::Product);
-    assert_eq!(o.primary.coefficients, [1.0; 4]);
-    // And they showed on the next frame: the screenshot equals an offscreen render of the
-    // saved scene at the view's size, within one 8-bit level (same driver, same program,
-    // an 8-bit back buffer as the RGBA8 target).
+    let o = opacity3d(&saved);
+    for (role, attr) in ["primary", "secondary", "tertiary"]
+        .iter()
+        .zip(o.attributes())
+    {
+        let Some(attr) = attr else { continue };
+        let file = dir.join(format!("arbvis-table-{role}.table"));
+        assert!(file.exists(), "{}", file.display());
+        assert_eq!(
+            attr.table.file.as_deref(),
+            Some(std::fs::canonicalize(&file).unwrap().as_path())
+        );
+        assert!(attr.table.alpha.is_empty(), "the curve is in the file");
+    }
+    // The table written holds the edited curve [[0, 0], [0.25, 0.5], [0.55, 0], [0.8, 1]].
+    let table =
+        arbvis::colortable::ColorTable::load(&dir.join("arbvis-table-primary.table")).unwrap();
+    assert_eq!(
+        table.entries[100][3], 67,
+        "(0.55 - 100/255) / 0.3 * 0.5 * 255"
+    );
     let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
-    let mut scene = saved.clone();
-    scene.size = [shot.width, shot.height];
-    scene.programs = arbvis::gl::ProgramChoice::Arb;
-    let offscreen = render(&scene, Backend::Egl).unwrap().image;
-    let d = shot.compare(&offscreen, common::LEVEL).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    // The transparent switch: the second screenshot is the transparent render.
+    let (clear, text) = read_png(&dir.join("arbvis-screenshot-002.png")).unwrap();
+    let scene_text = &text.iter().find(|(k, _)| k == "arbvis:scene").unwrap().1;
+    let mut transparent = Scene::parse(scene_text, "screenshot").unwrap();
+    assert!(transparent.transparent);
+    transparent.base = saved.base.clone();
+    transparent.technique = saved.technique.clone();
+    // As `arbvis render --transparent` writes it: straight colour, coverage alpha.
+    let offscreen = transparent.picture(&render(&transparent, Backend::Egl).unwrap().image);
+    let d = clear.compare(&offscreen, common::LEVEL).unwrap();
     assert!(d.max_abs <= common::LEVEL as f64 * 1.01, "{d:?}");
+    assert!(clear.pixel_u8(0, 0)[3] == 0, "the background is clear");
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn script_steps_that_do_nothing_fail_with_their_line() {
+    let Some(errors) = failing_scripts(
+        "failing",
+        "v3o2-sum",
+        &[
+            "wait 1\nclick No such button\n",
+            "wait 1\n\nset primary Cr 7\n",
+            "wait 1\nset primary table rainbow\n",
+            "wait 1\nset Lock primary maybe\n",
+            // A click on an existing curve point neither adds nor removes one.
+            "wait 1\nclick-at tertiary alpha 1 0.9\n",
+            "wait 1\nwait 1\nkey F5\n",
+            "wait 1\nset slices 2.5\n",
+        ],
+    ) else {
+        return;
+    };
+    let expect = [
+        (
+            "line 2 (click No such button)",
+            "no widget labelled \"No such button\"",
+        ),
+        ("line 3 (set primary Cr 7)", "7 is outside 0..=4"),
+        (
+            "line 2 (set primary table rainbow)",
+            "no option \"rainbow\"",
+        ),
+        ("line 2 (set Lock primary maybe)", "takes true or false"),
+        ("line 2 (click-at tertiary alpha 1 0.9)", "did nothing"),
+        ("line 3 (key F5)", "did nothing"),
+        ("line 2 (set slices 2.5)", "not a whole number"),
+    ];
+    for (e, (line, message)) in errors.iter().zip(expect) {
+        assert!(e.contains(line) && e.contains(message), "{e}");
+    }
+    // The missing widget's error lists the widgets there are.
+    assert!(
+        errors[0].contains("Save tables") && errors[0].contains("Lock secondary"),
+        "{}",
+        errors[0]
+    );
+}
+
+#[test]
+fn drawing_in_parts_equals_one_draw() {
+    // The viewer spreads a slow frame over UI frames with Renderer::draw_part.
+    let mut scene = Scene::demo("v3o2-sum").unwrap();
+    scene.size = [64, 48];
+    if let TechniqueScene::Opacity3d(o) = &mut scene.technique {
+        o.slices = 37;
+    }
+    let headless = common::headless(Backend::Egl);
+    let gpu = headless.gpu();
+    let kind = scene.programs.resolve(gpu);
+    for fidelity in [
+        arbvis::scene::Fidelity::Faithful,
+        arbvis::scene::Fidelity::Precise,
+    ] {
+        scene.fidelity = fidelity;
+        let mut renderer = arbvis::techniques::build(gpu, &scene, kind).unwrap();
+        let frame = arbvis::techniques::Frame {
+            camera: scene.camera,
+            width: 64,
+            height: 48,
+        };
+        let draw = |parts: Option<usize>, renderer: &mut Box<dyn arbvis::techniques::Renderer>| {
+            let t = Target::new(gpu, 64, 48, scene.target_format()).unwrap();
+            t.clear(gpu, scene.background).unwrap();
+            match parts {
+                None => renderer.draw(gpu, Surface::Target(&t), &frame).unwrap(),
+                Some(n) => {
+                    for p in 0..n {
+                        renderer
+                            .draw_part(gpu, Surface::Target(&t), &frame, p, n)
+                            .unwrap();
+                    }
+                }
+            }
+            t.read(gpu).unwrap()
+        };
+        let whole = draw(None, &mut renderer);
+        for parts in [1, 5, 37, 100] {
+            let pieces = draw(Some(parts), &mut renderer);
+            assert_eq!(whole.data, pieces.data, "{fidelity:?} in {parts} parts");
+        }
+    }
 }

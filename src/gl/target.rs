@@ -97,7 +97,8 @@ impl Target {
         Target::create(gpu, width, height, format, true)
     }
 
-    fn create(
+    /// [`Target::new`], or [`Target::with_depth`] when `with_depth`.
+    pub fn create(
         gpu: &Gpu,
         width: u32,
         height: u32,
@@ -284,6 +285,41 @@ impl Target {
             [0, 0, self.width as i32, self.height as i32],
             self.format,
         )
+    }
+}
+
+impl Target {
+    /// Copy the whole target into `[x, y, width, height]` of the window's back buffer
+    /// (`glBlitFramebuffer`): pixel for pixel when the sizes agree, else scaled with
+    /// linear filtering. The viewer keeps its volume image in a target and shows it so.
+    pub fn blit_to_window(&self, gpu: &Gpu, [x, y, w, h]: [i32; 4]) -> GlResult<()> {
+        let _guard = super::state::StateGuard::save(gpu);
+        let (sw, sh) = (self.width as i32, self.height as i32);
+        let filter = if (sw, sh) == (w, h) {
+            glow::NEAREST
+        } else {
+            glow::LINEAR
+        };
+        // SAFETY: plain state calls and a blit between live framebuffers.
+        unsafe {
+            self.gl
+                .bind_framebuffer(glow::READ_FRAMEBUFFER, Some(self.framebuffer));
+            self.gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, None);
+            self.gl.disable(glow::SCISSOR_TEST);
+            self.gl.blit_framebuffer(
+                0,
+                0,
+                sw,
+                sh,
+                x,
+                y,
+                x + w,
+                y + h,
+                glow::COLOR_BUFFER_BIT,
+                filter,
+            );
+        }
+        crate::gl_check!(gpu)
     }
 }
 

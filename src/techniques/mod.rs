@@ -35,6 +35,24 @@ impl Frame {
 pub trait Renderer {
     /// Draw one frame onto `surface` (already cleared by the caller).
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()>;
+    /// Draw part `part` of `parts` of the frame, so that a viewer can spread a slow frame
+    /// over several UI frames: parts `0..parts` drawn in order leave exactly what
+    /// [`Renderer::draw`] leaves. By default part 0 draws everything.
+    fn draw_part(
+        &mut self,
+        gpu: &Gpu,
+        surface: Surface<'_>,
+        frame: &Frame,
+        part: usize,
+        parts: usize,
+    ) -> GlResult<()> {
+        let _ = parts;
+        if part == 0 {
+            self.draw(gpu, surface, frame)
+        } else {
+            Ok(())
+        }
+    }
     /// Take changed parameters (the viewer's editors); resends what changed.
     fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()>;
     /// The program kind in use.

@@ -1,19 +1,12 @@
 //! The cell-projection editor: isovalues (add, remove, drag the value, pick the colour),
-//! where the exit point is computed, shading and the table size. Each edit rewrites only
-//! the isosurface table on the next frame.
+//! where the exit point is computed, shading, active tetrahedra only, and the table size.
+//! Each edit rewrites only the isosurface table (and the active list) on the next frame.
 
-use std::collections::HashMap;
-
-use egui::Rect;
-
+use super::widgets::Widgets;
 use crate::techniques::cellproj::{CellprojScene, Exit, Isovalue, MAX_ISOVALUES};
 
 /// Draw the editor; true when something changed.
-pub fn editor(
-    ui: &mut egui::Ui,
-    scene: &mut CellprojScene,
-    widgets: &mut HashMap<String, Rect>,
-) -> bool {
+pub fn editor(ui: &mut egui::Ui, scene: &mut CellprojScene, w: &mut Widgets) -> bool {
     let mut changed = false;
     ui.label("Isovalues (normalized scalar, colour)");
     let mut remove = None;
@@ -25,18 +18,15 @@ pub fn editor(
                     .speed(0.002)
                     .max_decimals(4),
             );
-            widgets.insert(format!("Isovalue {}", i + 1), r.rect);
-            changed |= r.changed();
+            changed |= w.add(ui, &format!("Isovalue {}", i + 1), &r) && r.changed();
             let mut c = iso.color.map(|v| v as f32);
             let r = ui.color_edit_button_rgba_unmultiplied(&mut c);
-            widgets.insert(format!("Isovalue {} colour", i + 1), r.rect);
-            if r.changed() {
+            if w.add(ui, &format!("Isovalue {} colour", i + 1), &r) && r.changed() {
                 iso.color = c.map(|v| v as f64);
                 changed = true;
             }
             let r = ui.button("Remove");
-            widgets.insert(format!("Remove isovalue {}", i + 1), r.rect);
-            if r.clicked() {
+            if w.add(ui, &format!("Remove isovalue {}", i + 1), &r) && r.clicked() {
                 remove = Some(i);
             }
         });
@@ -49,8 +39,7 @@ pub fn editor(
         scene.isovalues.len() < MAX_ISOVALUES,
         egui::Button::new("Add isovalue"),
     );
-    widgets.insert("Add isovalue".into(), r.rect);
-    if r.clicked() {
+    if w.add(ui, "Add isovalue", &r) && r.clicked() {
         let value = scene
             .isovalues
             .last()
@@ -70,18 +59,17 @@ pub fn editor(
             ("per fragment", Exit::Fragment),
         ] {
             let r = ui.radio_value(&mut scene.exit, exit, label);
-            widgets.insert(format!("Exit {label}"), r.rect);
-            changed |= r.changed();
+            changed |= w.add(ui, &format!("Exit {label}"), &r) && r.changed();
         }
     });
     let r = ui.checkbox(&mut scene.shading, "Shading (precise)");
-    widgets.insert("Shading".into(), r.rect);
-    changed |= r.changed();
+    changed |= w.add(ui, "Shading", &r) && r.changed();
+    let r = ui.checkbox(&mut scene.active_only, "Active tetrahedra only");
+    changed |= w.add(ui, "Active tetrahedra only", &r) && r.changed();
     ui.horizontal(|ui| {
         ui.label("Table size");
         let r = ui.add(egui::DragValue::new(&mut scene.table_size).range(2..=4096));
-        widgets.insert("Table size".into(), r.rect);
-        changed |= r.changed();
+        changed |= w.add(ui, "Table size", &r) && r.changed();
     });
     changed
 }

@@ -1,165 +1,180 @@
-//! The "lut 3D" editor of v3o2 (seed Figure 18): which table goes with the primary,
-//! secondary and tertiary volume, their twelve coefficients (one lock per table edits its
-//! four as one value), sum or product, slice count, fidelity, and each table's alpha
-//! curve. Every edit shows on the next frame (coefficients are resent to
-//! `program.local[1..3]`).
+//! The "lut 3D" editor of v3o2 (seed Figure 18), all of it visible at once: which table
+//! goes with the primary, secondary and tertiary volume and their twelve coefficients in
+//! one grid (a lock per table: when ticked, editing any of its four coefficients sets all
+//! four, as the seed's check boxes do), sum or product, the slice count, and under it one
+//! table editor per attribute (swatches, histogram, alpha curve; see [`super::curve`]).
+//! Every edit shows on the next frame (coefficients are resent to `program.local[1..3]`).
+//!
+//! Labels (for scripts): `Sum`, `Product`, `slices`, `ROLE table`, `Lock ROLE`,
+//! `ROLE Cr` / `Cg` / `Cb` / `Ca`, `ROLE alpha` (the curve), `Save tables`, where ROLE
+//! is `primary`, `secondary` or `tertiary`.
 
-use std::collections::HashMap;
+use egui::{Color32, RichText, Vec2};
 
-use egui::Rect;
-
+use super::curve;
+use super::data::ViewData;
+use super::widgets::Widgets;
 use crate::colortable::BUILTINS;
-use crate::scene::Fidelity;
-use crate::techniques::opacity3d::{Combine, Opacity3dScene, MAX_SLICES};
+use crate::scene::{Scene, TechniqueScene};
+use crate::techniques::opacity3d::{Combine, MAX_SLICES};
+
+/// Width of the editor's panel in points: the grid and curves fit without clipping.
+pub const WIDTH: f32 = 430.0;
+
+/// Names of the three attributes, as labelled in the panel.
+pub const ROLES: [&str; 3] = ["primary", "secondary", "tertiary"];
+
+/// The coefficient names, in `program.local` order.
+pub const COEFFICIENTS: [&str; 4] = ["Cr", "Cg", "Cb", "Ca"];
 
 /// What an edit asks of the viewer.
 #[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
 pub struct Lut3dEdit {
     /// Parameters changed: resend them.
     pub params: bool,
-    /// Fidelity changed: rebuild the renderer.
-    pub fidelity: bool,
     /// Write the three tables as files.
     pub save_tables: bool,
-}
-
-/// Names of the three attributes, as labelled in the panel.
-pub const ROLES: [&str; 3] = ["primary", "secondary", "tertiary"];
-
-fn remember(widgets: &mut HashMap<String, Rect>, label: impl Into<String>, r: &egui::Response) {
-    widgets.insert(label.into(), r.rect);
 }
 
 /// Draw the editor; `locks` is the per-table lock state (UI only).
 pub fn editor(
     ui: &mut egui::Ui,
-    o: &mut Opacity3dScene,
-    fidelity: &mut Fidelity,
+    scene: &mut Scene,
+    data: &mut ViewData,
     locks: &mut [bool; 3],
-    widgets: &mut HashMap<String, Rect>,
+    widgets: &mut Widgets,
 ) -> Lut3dEdit {
     let mut edit = Lut3dEdit::default();
-    ui.label("lut 3D");
+    let ctx = ui.ctx().clone();
+    // Tables first (they borrow the scene immutably).
+    let tables: [Option<(crate::colortable::ColorTable, egui::TextureId)>; 3] =
+        std::array::from_fn(|a| data.table(&ctx, scene, a).map(|(t, x)| (t.clone(), x.id())));
+    let TechniqueScene::Opacity3d(o) = &mut scene.technique else {
+        return edit;
+    };
+    ui.heading("lut 3D");
     ui.horizontal(|ui| {
-        for (c, label) in [(Combine::Sum, "Sum"), (Combine::Product, "Product")] {
-            let r = ui.radio_value(&mut o.combine, c, label);
-            remember(widgets, label, &r);
-            edit.params |= r.changed();
-        }
+        ui.label("combination:");
+        edit.params |= widgets.radio(ui, "Sum", &mut o.combine, Combine::Sum);
+        edit.params |= widgets.radio(ui, "Product", &mut o.combine, Combine::Product);
+        ui.label(match o.combine {
+            Combine::Sum => "(union)",
+            Combine::Product => "(intersection)",
+        });
     });
-    ui.horizontal(|ui| {
-        for (f, label) in [
-            (Fidelity::Faithful, "Faithful"),
-            (Fidelity::Precise, "Precise"),
-        ] {
-            let r = ui.radio_value(fidelity, f, label);
-            remember(widgets, label, &r);
-            edit.fidelity |= r.changed();
-        }
-    });
-    let r = ui.add(
-        egui::Slider::new(&mut o.slices, 1..=MAX_SLICES)
-            .logarithmic(true)
-            .text("slices"),
-    );
-    remember(widgets, "slices", &r);
-    edit.params |= r.changed();
+    edit.params |= widgets.slider(ui, "slices", &mut o.slices, 1..=MAX_SLICES, "slices", true);
+    ui.add_space(4.0);
 
-    for (a, attr) in o.attributes_mut().into_iter().enumerate() {
-        let Some(attr) = attr else {
-            ui.label(format!("{}: none", ROLES[a]));
-            continue;
-        };
-        let role = ROLES[a];
-        egui::CollapsingHeader::new(format!("{role}: {}", attr.attribute.name()))
-            .id_salt(role)
-            .default_open(a == 0)
-            .show(ui, |ui| {
-                let current = attr
+    egui::Grid::new("lut3d coefficients")
+        .num_columns(7)
+        .spacing([6.0, 4.0])
+        .striped(true)
+        .show(ui, |ui| {
+            ui.label("");
+            ui.label("table");
+            ui.label("lock");
+            for c in COEFFICIENTS {
+                ui.label(c);
+            }
+            ui.end_row();
+            for (a, attr) in o.attributes_mut().into_iter().enumerate() {
+                let role = ROLES[a];
+                ui.label(role);
+                let Some(attr) = attr else {
+                    ui.label(RichText::new("none").weak());
+                    ui.end_row();
+                    continue;
+                };
+                let mut name = attr
                     .table
                     .file
                     .as_ref()
-                    .map(|f| f.display().to_string())
+                    .map(|f| format!("file {}", f.display()))
                     .unwrap_or_else(|| attr.table.builtin.clone());
-                let r = egui::ComboBox::from_id_salt(format!("{role} table"))
-                    .selected_text(current)
-                    .show_ui(ui, |ui| {
-                        for name in BUILTINS {
-                            if ui
-                                .selectable_label(
-                                    attr.table.file.is_none() && attr.table.builtin == *name,
-                                    *name,
-                                )
-                                .clicked()
-                            {
-                                attr.table.builtin = name.to_string();
-                                attr.table.file = None;
-                                edit.params = true;
-                            }
-                        }
-                    });
-                remember(widgets, format!("{role} table"), &r.response);
-
-                let r = ui.checkbox(&mut locks[a], "lock");
-                remember(widgets, format!("Lock {role}"), &r);
-                if r.changed() && locks[a] {
-                    let v = attr.coefficients[0];
-                    attr.coefficients = [v; 4];
+                let mut options: Vec<(String, &str)> =
+                    BUILTINS.iter().map(|b| (b.to_string(), *b)).collect();
+                let file_name = name.clone();
+                if attr.table.file.is_some() {
+                    options.push((file_name.clone(), file_name.as_str()));
+                }
+                if widgets.choice(ui, &format!("{role} table"), &mut name, &options, 90.0) {
+                    attr.table.builtin = name.clone();
+                    attr.table.file = None;
                     edit.params = true;
                 }
-                if locks[a] {
-                    let mut v = attr.coefficients[0];
-                    let r = ui.add(egui::Slider::new(&mut v, 0.0..=1.0).text("C (all four)"));
-                    remember(widgets, format!("{role} C"), &r);
-                    if r.changed() {
-                        attr.coefficients = [v; 4];
+                let lock_label = format!("Lock {role}");
+                if widgets.checkbox(ui, &lock_label, &mut locks[a], "") && locks[a] {
+                    attr.coefficients = [attr.coefficients[0]; 4];
+                    edit.params = true;
+                }
+                for (c, name) in COEFFICIENTS.iter().enumerate() {
+                    let mut v = attr.coefficients[c];
+                    let label = format!("{role} {name}");
+                    if widgets.drag_value(ui, &label, &mut v, 0.0..=4.0, 0.005) {
+                        if locks[a] {
+                            attr.coefficients = [v; 4];
+                        } else {
+                            attr.coefficients[c] = v;
+                        }
                         edit.params = true;
                     }
-                } else {
-                    for (c, name) in ["Cr", "Cg", "Cb", "Ca"].iter().enumerate() {
-                        let r = ui.add(
-                            egui::Slider::new(&mut attr.coefficients[c], 0.0..=1.0).text(*name),
-                        );
-                        remember(widgets, format!("{role} {name}"), &r);
-                        edit.params |= r.changed();
-                    }
                 }
+                ui.end_row();
+            }
+        });
+    ui.label(
+        RichText::new("a ticked lock edits the table's four coefficients as one value")
+            .small()
+            .weak(),
+    );
+    ui.separator();
 
-                ui.label("alpha curve (position, alpha)");
-                if attr.table.alpha.is_empty() && ui.button("edit alpha").clicked() {
-                    attr.table.alpha = vec![[0.0, 0.0], [1.0, 1.0]];
-                    edit.params = true;
-                }
-                let mut remove = None;
-                let count = attr.table.alpha.len();
-                for (p, point) in attr.table.alpha.iter_mut().enumerate() {
-                    ui.horizontal(|ui| {
-                        for v in point.iter_mut() {
-                            let r = ui.add(egui::DragValue::new(v).range(0.0..=1.0).speed(0.005));
-                            edit.params |= r.changed();
-                        }
-                        if count > 1 && ui.small_button("x").clicked() {
-                            remove = Some(p);
-                        }
-                    });
-                }
-                if let Some(p) = remove {
-                    attr.table.alpha.remove(p);
-                    edit.params = true;
-                }
-                if !attr.table.alpha.is_empty() {
-                    if ui.button("add point").clicked() {
-                        let last = *attr.table.alpha.last().unwrap_or(&[1.0, 1.0]);
-                        attr.table.alpha.push(last);
-                        edit.params = true;
-                    }
-                    // Keep positions ascending while dragging.
-                    attr.table.alpha.sort_by(|x, y| x[0].total_cmp(&y[0]));
-                }
-            });
+    let width = ui.available_width().min(WIDTH - 20.0);
+    for (a, attr) in o.attributes_mut().into_iter().enumerate() {
+        let (Some(attr), Some((table, texture))) = (attr, &tables[a]) else {
+            continue;
+        };
+        let role = ROLES[a];
+        let range = data
+            .volume
+            .as_ref()
+            .and_then(|v| v.prepared.ranges[a])
+            .map(|(lo, hi)| format!("{} .. {}", short(lo), short(hi)))
+            .unwrap_or_default();
+        ui.horizontal(|ui| {
+            ui.label(RichText::new(format!("{role}: {}", attr.attribute.name())).strong());
+            ui.label(RichText::new(range).weak());
+        });
+        let histogram = data.histogram(&ctx, a);
+        let e = curve::editor(
+            ui,
+            widgets,
+            &format!("{role} alpha"),
+            &mut attr.table.alpha,
+            table,
+            *texture,
+            histogram,
+            Vec2::new(width, 96.0),
+        );
+        edit.params |= e.changed;
+        ui.add_space(6.0);
     }
-    let r = ui.button("Save tables");
-    remember(widgets, "Save tables", &r);
-    edit.save_tables = r.clicked();
+    ui.horizontal(|ui| {
+        edit.save_tables = widgets.button(ui, "Save tables");
+        ui.label(
+            RichText::new("writes arbvis-table-ROLE.table")
+                .small()
+                .color(Color32::GRAY),
+        );
+    });
     edit
+}
+
+/// A value for a range label: integers plainly, others with 4 significant digits.
+pub fn short(v: f64) -> String {
+    if v.fract() == 0.0 && v.abs() < 1e9 {
+        format!("{}", v as i64)
+    } else {
+        format!("{v:.4}")
+    }
 }

@@ -1,17 +1,26 @@
-//! The egui side panel and the GL view area: editors for the scene, program kind,
-//! camera, screenshot and save buttons, FPS. Returns what the user asked for; the
-//! viewer acts on it. Widget rectangles are recorded by label for scripted clicks.
+//! The viewer's layout: controls on the left (programs, fidelity, camera, view options,
+//! screenshot and save), the lut 3D editor on the right (3D opacity), the inline /
+//! crossline / time-slice sections below, and the 3D view in the middle with the box,
+//! axis labels and colour bars drawn over it. Returns what the user asked for; the viewer
+//! acts on it. Every control is recorded by label in [`Widgets`] for scripts.
+//!
+//! Shortcuts: Home resets the camera, F12 takes a screenshot.
 
-use std::collections::HashMap;
+use egui::{Rect, RichText, Sense, Vec2};
 
-use egui::{Rect, Sense};
-
-use crate::camera::{Camera, Projection};
+use super::data::{section_axes, ViewData};
+use super::lut3d;
+use super::overlay::{self, ColourBar, Projector, SECTION_COLOURS};
+use super::volume_view::InteractiveQuality;
+use super::widgets::Widgets;
+use crate::camera::Projection;
 use crate::gl::{Caps, ProgramKind};
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::{Fidelity, Scene, TechniqueScene};
 
-/// Width of the side panel in points.
-pub const PANEL_WIDTH: f32 = 240.0;
+/// Width of the left panel in points.
+pub const PANEL_WIDTH: f32 = 250.0;
+/// Height of the sections panel in points.
+pub const SECTIONS_HEIGHT: f32 = 220.0;
 
 /// What the user asked for this frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -20,7 +29,7 @@ pub enum UiAction {
     SetPrograms(ProgramKind),
     /// Technique parameters changed (resend them).
     ParamsChanged,
-    /// Save the GL view as a PNG.
+    /// Save the 3D view as a PNG.
     Screenshot,
     /// Save the scene as TOML.
     SaveScene,
@@ -28,9 +37,13 @@ pub enum UiAction {
     SetFidelity,
     /// Write the colour tables as table files.
     SaveTables,
+    /// Back to the default camera, framing the volume.
+    ResetCamera,
+    /// Zoom so that the whole volume is in view at any rotation.
+    FitVolume,
 }
 
-/// Pointer input on the GL view, in points.
+/// Pointer input on the 3D view, in points.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct ViewInput {
     /// A drag started here.
@@ -43,99 +56,126 @@ pub struct ViewInput {
     pub scroll: f32,
 }
 
+/// Which sections are shown, of which attribute, where.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SectionsState {
+    /// Shown below the view.
+    pub show: bool,
+    /// Attribute (0 primary, 1 secondary, 2 tertiary).
+    pub attribute: usize,
+    /// Voxel index of the section at each fixed axis (0 time slice, 1 crossline, 2 inline).
+    pub index: [usize; 3],
+}
+
 /// What the panel shows that is not part of the scene.
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct PanelState {
-    /// Frames per second, smoothed.
+    /// UI frames per second, smoothed.
     pub fps: f64,
-    /// Milliseconds per frame, smoothed.
+    /// Milliseconds per UI frame, smoothed.
     pub frame_ms: f64,
+    /// What the volume costs (full and interactive pictures).
+    pub volume_info: String,
     /// The last message (screenshot written, error, ...).
     pub status: String,
     /// Program kind in use.
     pub kind: Option<ProgramKind>,
-    /// Where each labelled widget was drawn last frame (points).
-    pub widgets: HashMap<String, Rect>,
+    /// Every labelled control.
+    pub widgets: Widgets,
     /// The lut 3D editor's lock check boxes.
     pub locks: [bool; 3],
+    /// How the volume is drawn while the user interacts.
+    pub quality: InteractiveQuality,
+    /// The sections.
+    pub sections: SectionsState,
+    /// Draw the box, axis labels and colour bars over the view.
+    pub overlay: bool,
+}
+
+impl Default for PanelState {
+    fn default() -> Self {
+        PanelState {
+            fps: 0.0,
+            frame_ms: 0.0,
+            volume_info: String::new(),
+            status: String::new(),
+            kind: None,
+            widgets: Widgets::default(),
+            locks: [false; 3],
+            quality: InteractiveQuality::default(),
+            sections: SectionsState {
+                show: true,
+                attribute: 0,
+                index: [0; 3],
+            },
+            overlay: true,
+        }
+    }
 }
 
 /// Output of one UI pass.
 pub struct PanelOutput {
     /// Requests, in the order made.
     pub actions: Vec<UiAction>,
-    /// The GL view's rectangle (points).
+    /// The 3D view's rectangle (points).
     pub view: Rect,
     /// Pointer input on the view.
     pub input: ViewInput,
+    /// Something the volume depends on was edited this frame (camera included).
+    pub edited: bool,
 }
 
 /// Build the UI for one frame.
 pub fn show(
     ui: &mut egui::Ui,
     scene: &mut Scene,
+    data: &mut ViewData,
     state: &mut PanelState,
     caps: &Caps,
 ) -> PanelOutput {
     let mut actions = Vec::new();
-    state.widgets.clear();
+    state.widgets.begin_frame();
+    let camera_before = scene.camera;
+    let opacity3d = matches!(scene.technique, TechniqueScene::Opacity3d(_));
+
     egui::Panel::left("controls")
         .exact_size(PANEL_WIDTH)
         .resizable(false)
         .show(ui, |ui| {
-            ui.heading("arbvis");
-            ui.label(format!("{} | {}", caps.renderer, caps.version));
-            ui.label(format!("FPS: {:.1} ({:.2} ms)", state.fps, state.frame_ms));
-            ui.separator();
-
-            ui.label("Programs");
-            ui.horizontal(|ui| {
-                for (kind, label, enabled) in [
-                    (ProgramKind::Arb, "ARB", caps.has_arb()),
-                    (ProgramKind::Glsl, "GLSL", true),
-                ] {
-                    let selected = state.kind == Some(kind);
-                    let r = ui.add_enabled(enabled, egui::RadioButton::new(selected, label));
-                    state.widgets.insert(label.into(), r.rect);
-                    if r.clicked() && !selected {
-                        actions.push(UiAction::SetPrograms(kind));
-                    }
-                }
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                controls(ui, scene, state, caps, &mut actions);
             });
-            ui.separator();
-
-            egui::ScrollArea::vertical()
-                .max_height(ui.available_height() * 0.6)
-                .show(ui, |ui| {
-                    actions.extend(technique_editor(ui, scene, state));
-                });
-            ui.separator();
-
-            camera_editor(ui, &mut scene.camera, &mut state.widgets);
-            ui.separator();
-
-            ui.horizontal(|ui| {
-                for (label, action) in [
-                    ("Screenshot", UiAction::Screenshot),
-                    ("Save scene", UiAction::SaveScene),
-                ] {
-                    let r = ui.button(label);
-                    state.widgets.insert(label.into(), r.rect);
-                    if r.clicked() {
-                        actions.push(action);
-                    }
-                }
-            });
-            if !state.status.is_empty() {
-                ui.label(&state.status);
-            }
         });
+
+    if opacity3d {
+        egui::Panel::right("lut 3D")
+            .exact_size(lut3d::WIDTH)
+            .resizable(false)
+            .show(ui, |ui| {
+                egui::ScrollArea::vertical().show(ui, |ui| {
+                    let e = lut3d::editor(ui, scene, data, &mut state.locks, &mut state.widgets);
+                    if e.params {
+                        actions.push(UiAction::ParamsChanged);
+                    }
+                    if e.save_tables {
+                        actions.push(UiAction::SaveTables);
+                    }
+                });
+            });
+        if state.sections.show && data.volume.is_some() {
+            egui::Panel::bottom("sections")
+                .exact_size(SECTIONS_HEIGHT)
+                .resizable(false)
+                .show(ui, |ui| sections(ui, scene, data, state));
+        }
+    }
 
     let mut input = ViewInput::default();
     let view = egui::CentralPanel::default()
         .frame(egui::Frame::NONE)
         .show(ui, |ui| {
             let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::drag());
+            state.widgets.record(ui, "3D view", rect, true);
             let pos = response.interact_pointer_pos();
             if response.drag_started() {
                 input.drag_start = pos;
@@ -146,78 +186,249 @@ pub fn show(
             if response.hovered() {
                 input.scroll = ui.input(|i| i.smooth_scroll_delta.y);
             }
+            if state.overlay {
+                draw_overlay(ui, rect, scene, data, state);
+            }
             rect
         })
         .inner;
+
+    // Shortcuts (only when no text field has the keyboard).
+    if !ui.ctx().egui_wants_keyboard_input() {
+        use egui::{Key, Modifiers};
+        if ui.input_mut(|i| i.consume_key(Modifiers::NONE, Key::Home)) {
+            actions.push(UiAction::ResetCamera);
+            state.widgets.hit("key Home");
+        }
+        if ui.input_mut(|i| i.consume_key(Modifiers::NONE, Key::F12)) {
+            actions.push(UiAction::Screenshot);
+            state.widgets.hit("key F12");
+        }
+    }
+    let edited = scene.camera != camera_before
+        || actions.iter().any(|a| {
+            matches!(
+                a,
+                UiAction::ParamsChanged | UiAction::ResetCamera | UiAction::FitVolume
+            )
+        });
     PanelOutput {
         actions,
         view,
         input,
+        edited,
     }
 }
 
-fn technique_editor(ui: &mut egui::Ui, scene: &mut Scene, state: &mut PanelState) -> Vec<UiAction> {
-    let mut changed = false;
-    let widgets = &mut state.widgets;
-    match &mut scene.technique {
-        TechniqueScene::Opacity3d(o) => {
-            let edit = super::lut3d::editor(ui, o, &mut scene.fidelity, &mut state.locks, widgets);
-            let mut actions = Vec::new();
-            if edit.fidelity {
+fn controls(
+    ui: &mut egui::Ui,
+    scene: &mut Scene,
+    state: &mut PanelState,
+    caps: &Caps,
+    actions: &mut Vec<UiAction>,
+) {
+    let w = &mut state.widgets;
+    ui.heading("arbvis");
+    ui.label(RichText::new(format!("{} | {}", caps.renderer, caps.version)).small());
+    ui.label(format!(
+        "UI: {:.1} fps ({:.1} ms)",
+        state.fps, state.frame_ms
+    ));
+    if !state.volume_info.is_empty() {
+        ui.label(RichText::new(&state.volume_info).small());
+    }
+    ui.separator();
+
+    ui.horizontal(|ui| {
+        ui.label("Programs");
+        for (kind, label, enabled) in [
+            (ProgramKind::Arb, "ARB", caps.has_arb()),
+            (ProgramKind::Glsl, "GLSL", true),
+        ] {
+            let selected = state.kind == Some(kind);
+            let r = ui.add_enabled(enabled, egui::RadioButton::new(selected, label));
+            if w.add(ui, label, &r) && r.clicked() && !selected {
+                actions.push(UiAction::SetPrograms(kind));
+            }
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.label("Fidelity");
+        for (f, label) in [
+            (Fidelity::Faithful, "Faithful"),
+            (Fidelity::Precise, "Precise"),
+        ] {
+            if w.radio(ui, label, &mut scene.fidelity, f) {
                 actions.push(UiAction::SetFidelity);
-            } else if edit.params {
-                actions.push(UiAction::ParamsChanged);
             }
-            if edit.save_tables {
-                actions.push(UiAction::SaveTables);
-            }
-            return actions;
         }
-        TechniqueScene::Cellproj(c) => {
-            changed = super::isovalues::editor(ui, c, widgets);
-        }
-        TechniqueScene::Quad(q) => {
-            ui.label("Quad colours");
-            for (label, colour) in [("Left", &mut q.left), ("Right", &mut q.right)] {
-                ui.horizontal(|ui| {
-                    ui.label(label);
-                    let mut c = colour.map(|v| v as f32);
-                    let r = ui.color_edit_button_rgba_unmultiplied(&mut c);
-                    widgets.insert(format!("{label} colour"), r.rect);
-                    if r.changed() {
-                        *colour = c.map(|v| v as f64);
-                        changed = true;
-                    }
-                });
-            }
+    });
+    if let TechniqueScene::Cellproj(c) = &mut scene.technique {
+        ui.separator();
+        if super::isovalues::editor(ui, c, w) {
+            actions.push(UiAction::ParamsChanged);
         }
     }
-    if changed {
-        vec![UiAction::ParamsChanged]
-    } else {
-        Vec::new()
+    if let TechniqueScene::Quad(q) = &mut scene.technique {
+        ui.label("Quad colours");
+        for (label, colour) in [("Left", &mut q.left), ("Right", &mut q.right)] {
+            ui.horizontal(|ui| {
+                ui.label(label);
+                let mut c = colour.map(|v| v as f32);
+                let r = ui.color_edit_button_rgba_unmultiplied(&mut c);
+                if w.add(ui, &format!("{label} colour"), &r) && r.changed() {
+                    *colour = c.map(|v| v as f64);
+                    actions.push(UiAction::ParamsChanged);
+                }
+            });
+        }
     }
-}
+    ui.separator();
 
-fn camera_editor(ui: &mut egui::Ui, camera: &mut Camera, widgets: &mut HashMap<String, Rect>) {
-    ui.label("Camera (drag the view to rotate, scroll to zoom)");
+    ui.label("Camera: drag the view to turn, scroll to zoom");
     ui.horizontal(|ui| {
         for (p, label) in [
             (Projection::Orthographic, "Orthographic"),
             (Projection::Perspective, "Perspective"),
         ] {
-            let r = ui.radio_value(&mut camera.projection, p, label);
-            widgets.insert(label.into(), r.rect);
+            w.radio(ui, label, &mut scene.camera.projection, p);
         }
     });
-    ui.add(
-        egui::Slider::new(&mut camera.zoom, 0.1..=10.0)
-            .logarithmic(true)
-            .text("zoom"),
+    w.slider(ui, "zoom", &mut scene.camera.zoom, 0.1..=10.0, "zoom", true);
+    ui.horizontal(|ui| {
+        if w.button(ui, "Reset camera") {
+            actions.push(UiAction::ResetCamera);
+        }
+        if w.button(ui, "Fit volume") {
+            actions.push(UiAction::FitVolume);
+        }
+    });
+    ui.separator();
+
+    ui.horizontal(|ui| {
+        ui.label("Interactive quality");
+        w.choice(
+            ui,
+            "Interactive quality",
+            &mut state.quality,
+            &InteractiveQuality::ALL,
+            80.0,
+        );
+    });
+    ui.label(
+        RichText::new("while dragging or editing: fewer slices and pixels; refined when still")
+            .small()
+            .weak(),
     );
-    let r = ui.button("Reset camera");
-    widgets.insert("Reset camera".into(), r.rect);
-    if r.clicked() {
-        *camera = Camera::default();
+    w.checkbox(
+        ui,
+        "Box and labels",
+        &mut state.overlay,
+        "Box, axis labels, colour bars",
+    );
+    if matches!(scene.technique, TechniqueScene::Opacity3d(_)) {
+        w.checkbox(ui, "Sections", &mut state.sections.show, "Sections");
     }
+    w.checkbox(
+        ui,
+        "Transparent screenshots",
+        &mut scene.transparent,
+        "Transparent screenshots",
+    );
+    ui.separator();
+
+    ui.horizontal(|ui| {
+        if w.button(ui, "Screenshot") {
+            actions.push(UiAction::Screenshot);
+        }
+        if w.button(ui, "Save scene") {
+            actions.push(UiAction::SaveScene);
+        }
+    });
+    if !state.status.is_empty() {
+        ui.label(RichText::new(&state.status).small());
+    }
+}
+
+/// The three sections of one attribute, each with its index slider.
+fn sections(ui: &mut egui::Ui, scene: &Scene, data: &mut ViewData, state: &mut PanelState) {
+    let Some(v) = &data.volume else { return };
+    let axes = v.axes.clone();
+    let dims = v.prepared.dims;
+    let half = v.prepared.half;
+    let present: Vec<(usize, &str)> = (0..3)
+        .filter(|&a| v.prepared.tables[a].is_some())
+        .map(|a| (a, lut3d::ROLES[a]))
+        .collect();
+    let w = &mut state.widgets;
+    ui.horizontal(|ui| {
+        ui.label("Sections of");
+        w.choice(
+            ui,
+            "Section attribute",
+            &mut state.sections.attribute,
+            &present,
+            90.0,
+        );
+        ui.label(RichText::new("in the same table, opaque").small().weak());
+    });
+    let ctx = ui.ctx().clone();
+    let column = (ui.available_width() - 16.0) / 3.0;
+    let height = ui.available_height() - 64.0;
+    ui.columns(3, |cols| {
+        // Inline, crossline, time slice: fixed axes 2, 1, 0.
+        for (col, a) in cols.iter_mut().zip([2usize, 1, 0]) {
+            let index = &mut state.sections.index[a];
+            *index = (*index).min(dims[a] - 1);
+            let label = format!("{} section", axes[a].name);
+            col.horizontal(|ui| {
+                ui.colored_label(SECTION_COLOURS[a], "■");
+                ui.label(format!("{} {}", axes[a].name, axes[a].label(*index)));
+            });
+            col.spacing_mut().slider_width = (column - 60.0).max(40.0);
+            w.slider(col, &label, index, 0..=dims[a] - 1, "", false);
+            let (u, wv) = section_axes(a);
+            let (ex, ey) = (2.0 * half[u] as f32, 2.0 * half[wv] as f32);
+            let s = (column / ex).min(height / ey).max(0.0);
+            if let Some(t) = data.section(&ctx, scene, a, *index, state.sections.attribute) {
+                let size = Vec2::new(ex * s, ey * s);
+                let r = col.add(egui::Image::new((t.id(), size)));
+                r.on_hover_text(format!("{} across, {} down", axes[u].name, axes[wv].name));
+            }
+        }
+    });
+}
+
+fn draw_overlay(ui: &egui::Ui, rect: Rect, scene: &Scene, data: &mut ViewData, state: &PanelState) {
+    let painter = ui.painter_at(rect);
+    let ctx = ui.ctx().clone();
+    let Some(v) = &data.volume else { return };
+    let half = v.prepared.half;
+    let axes = v.axes.clone();
+    let ranges = v.prepared.ranges;
+    let shown = state.sections.show;
+    let sections = [0, 1, 2].map(|a| shown.then_some(state.sections.index[a]));
+    overlay::draw_box(
+        &painter,
+        &Projector::new(&scene.camera, rect),
+        half,
+        &axes,
+        sections,
+    );
+    let mut bars = Vec::new();
+    if let TechniqueScene::Opacity3d(o) = &scene.technique {
+        for (a, attr) in o.attributes().into_iter().enumerate() {
+            let (Some(attr), Some((lo, hi))) = (attr, ranges[a]) else {
+                continue;
+            };
+            if let Some((_, texture)) = data.table(&ctx, scene, a) {
+                bars.push(ColourBar {
+                    title: format!("{}: {}", lut3d::ROLES[a], attr.attribute.name()),
+                    texture: texture.id(),
+                    range: (lut3d::short(lo), lut3d::short(hi)),
+                });
+            }
+        }
+    }
+    overlay::draw_bars(&painter, rect, &bars);
 }

@@ -386,6 +386,15 @@ pub fn read(path: &Path, limits: &Limits) -> Result<Volume, VolumeError> {
     read_from(path, input, gzip, limits)
 }
 
+/// The header alone: its first 348 bytes (inflated when gzip), no voxel read (the viewer
+/// labels its axes in millimetres from it).
+pub fn read_header(path: &Path) -> Result<Header, VolumeError> {
+    let (mut input, _) = open(path)?;
+    let mut h = vec![0u8; HEADER_BYTES];
+    let n = read_full(&mut input, &mut h).map_err(|e| VolumeError::io(path, e))?;
+    parse_header(path, &h[..n])
+}
+
 /// `arbvis inspect`: header facts and value statistics, streamed (the volume is never
 /// held, so a small `.nii.gz` of a huge volume costs one chunk of memory).
 pub fn inspect(path: &Path) -> Result<String, VolumeError> {

@@ -97,6 +97,8 @@ pub struct Opacity3dRenderer {
     neutral: Option<Texture>,
     mesh: Option<Mesh>,
     mesh_key: Option<([u64; 3], usize)>,
+    /// Vertices up to the end of each slice, back to front (for [`Renderer::draw_part`]).
+    slice_ends: Vec<usize>,
     spacing: f64,
 }
 
@@ -184,6 +186,7 @@ impl Opacity3dRenderer {
             neutral: None,
             mesh: None,
             mesh_key: None,
+            slice_ends: Vec::new(),
             spacing: 0.0,
         };
         renderer.build_tables(gpu)?;
@@ -246,6 +249,14 @@ impl Opacity3dRenderer {
         let slices = slice_box(self.prepared.half, dir, self.params.slices);
         let vertices = slices.triangle_vertices();
         self.spacing = slices.spacing;
+        self.slice_ends = slices
+            .polygons
+            .iter()
+            .scan(0, |end, p| {
+                *end += 3 * p.positions.len().saturating_sub(2);
+                Some(*end)
+            })
+            .collect();
         match &mut self.mesh {
             Some(mesh) => mesh.update(gpu, &vertices)?,
             None => {
@@ -257,9 +268,22 @@ impl Opacity3dRenderer {
     }
 }
 
-impl Renderer for Opacity3dRenderer {
-    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+impl Opacity3dRenderer {
+    /// Draw the slices `slices` (indices back to front; the end may run past the last).
+    fn draw_slices(
+        &mut self,
+        gpu: &Gpu,
+        surface: Surface<'_>,
+        frame: &Frame,
+        slices: std::ops::Range<usize>,
+    ) -> GlResult<()> {
         self.update_mesh(gpu, frame)?;
+        let ends = &self.slice_ends;
+        let vertex = |s: usize| match s.checked_sub(1) {
+            Some(i) => ends.get(i).or(ends.last()).copied().unwrap_or(0),
+            None => 0,
+        };
+        let (first, end) = (vertex(slices.start), vertex(slices.end));
         self.program
             .set_transform(gpu, model_view_projection(frame))?;
         let k = correction_exponent(
@@ -287,13 +311,38 @@ impl Renderer for Opacity3dRenderer {
             &DrawCall {
                 program: &self.program,
                 mesh,
-                range: None,
+                range: Some((first, end.saturating_sub(first))),
                 textures: &textures,
                 blend: Blend::Over,
                 depth_test: false,
                 cull_back: false,
             },
         )
+    }
+}
+
+impl Renderer for Opacity3dRenderer {
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+        self.draw_slices(gpu, surface, frame, 0..usize::MAX)
+    }
+
+    /// Part `part` of `parts` is the `part`-th run of consecutive slices, back to front.
+    fn draw_part(
+        &mut self,
+        gpu: &Gpu,
+        surface: Surface<'_>,
+        frame: &Frame,
+        part: usize,
+        parts: usize,
+    ) -> GlResult<()> {
+        self.update_mesh(gpu, frame)?;
+        let n = self.slice_ends.len();
+        let parts = parts.clamp(1, n.max(1));
+        if part >= parts {
+            return Ok(());
+        }
+        let slices = part * n / parts..(part + 1) * n / parts;
+        self.draw_slices(gpu, surface, frame, slices)
     }
 
     fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()> {

@@ -1,0 +1,211 @@
+//! The volume's three axes in the data's own numbers, for the box labels and the
+//! sections: SEG-Y gives inline and crossline numbers from the trace headers and time in
+//! ms from the sample interval; NIfTI gives millimetres from `pixdim`; raw volumes their
+//! scene spacing; the synthetic cube sample / crossline / inline indices.
+//!
+//! Decisions: the primary attribute's source names the axes (all attributes share one
+//! grid). The SEG-Y file is read once more for its headers (the renderer keeps only the
+//! quantized voxels); any failure, or a grid that differs from the rendered one, falls back
+//! to plain `i`, `j`, `k` indices rather than stopping the viewer. Depth-domain SEG-Y is
+//! not told apart from time (the header field that would say so is rarely set): the
+//! vertical axis is labelled `time (ms)`.
+
+use std::path::Path;
+
+use crate::volume::segy::{self, ReadOptions};
+use crate::volume::{nifti_file, Limits, VolumeSource};
+
+/// How an axis numbers its voxels.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Numbers {
+    /// `start + index * step`.
+    Linear {
+        /// Value at index 0.
+        start: f64,
+        /// Change per voxel.
+        step: f64,
+    },
+    /// One number per voxel (SEG-Y inline and crossline numbers).
+    Listed(Vec<f64>),
+}
+
+/// One axis.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    /// What it is (`inline`, `time (ms)`, `i (mm)`, ...).
+    pub name: String,
+    /// Voxel count.
+    pub len: usize,
+    /// Its numbers.
+    pub numbers: Numbers,
+}
+
+impl Axis {
+    /// The number at voxel `index` (clamped into the axis).
+    pub fn value(&self, index: usize) -> f64 {
+        let index = index.min(self.len.saturating_sub(1));
+        match &self.numbers {
+            Numbers::Linear { start, step } => start + index as f64 * step,
+            Numbers::Listed(v) => v.get(index).copied().unwrap_or(index as f64),
+        }
+    }
+
+    /// The number at `index`, written briefly.
+    pub fn label(&self, index: usize) -> String {
+        let v = self.value(index);
+        if v.fract() == 0.0 && v.abs() < 1e9 {
+            format!("{}", v as i64)
+        } else {
+            format!("{v:.1}")
+        }
+    }
+
+    /// About `count` voxel indices spread evenly from the first to the last.
+    pub fn ticks(&self, count: usize) -> Vec<usize> {
+        let last = self.len.saturating_sub(1);
+        let count = count.clamp(2, self.len.max(2));
+        let mut t: Vec<usize> = (0..count)
+            .map(|n| ((n * last) as f64 / (count - 1) as f64).round() as usize)
+            .collect();
+        t.dedup();
+        t
+    }
+}
+
+fn indices(name: &str, len: usize) -> Axis {
+    Axis {
+        name: name.to_string(),
+        len,
+        numbers: Numbers::Linear {
+            start: 0.0,
+            step: 1.0,
+        },
+    }
+}
+
+fn linear(name: &str, len: usize, step: f64) -> Axis {
+    Axis {
+        name: name.to_string(),
+        len,
+        numbers: Numbers::Linear { start: 0.0, step },
+    }
+}
+
+/// The axes of a volume of `dims` read from `source` (relative paths from `base`).
+pub fn describe(source: &VolumeSource, base: &Path, dims: [usize; 3]) -> [Axis; 3] {
+    let plain = || {
+        [
+            indices("i", dims[0]),
+            indices("j", dims[1]),
+            indices("k", dims[2]),
+        ]
+    };
+    match source {
+        VolumeSource::Segy(s) => {
+            let options = ReadOptions {
+                limits: Limits::default(),
+                prestack: s.prestack,
+            };
+            match segy::read(&base.join(&s.path), &options) {
+                Ok(cube) if cube.volume.dims == dims => [
+                    linear("time (ms)", dims[0], cube.interval_us as f64 / 1000.0),
+                    Axis {
+                        name: "crossline".into(),
+                        len: dims[1],
+                        numbers: Numbers::Listed(
+                            cube.crosslines.iter().map(|&v| v as f64).collect(),
+                        ),
+                    },
+                    Axis {
+                        name: "inline".into(),
+                        len: dims[2],
+                        numbers: Numbers::Listed(cube.inlines.iter().map(|&v| v as f64).collect()),
+                    },
+                ],
+                _ => plain(),
+            }
+        }
+        VolumeSource::Nifti(p) => match nifti_file::read_header(&base.join(p)) {
+            Ok(h) if h.dims == dims => {
+                [0, 1, 2].map(|a| linear(["i (mm)", "j (mm)", "k (mm)"][a], dims[a], h.spacing[a]))
+            }
+            _ => plain(),
+        },
+        VolumeSource::Raw(spec) => [0, 1, 2].map(|a| {
+            let s = spec.spacing[a];
+            if s.is_finite() && s > 0.0 && s != 1.0 {
+                linear(["i", "j", "k"][a], dims[a], s)
+            } else {
+                indices(["i", "j", "k"][a], dims[a])
+            }
+        }),
+        VolumeSource::Synthetic(_) => [
+            indices("sample", dims[0]),
+            indices("crossline", dims[1]),
+            indices("inline", dims[2]),
+        ],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn numbers_and_ticks() {
+        let a = Axis {
+            name: "inline".into(),
+            len: 4,
+            numbers: Numbers::Listed(vec![111.0, 112.0, 113.0, 115.0]),
+        };
+        assert_eq!(a.label(3), "115");
+        assert_eq!(a.value(99), 115.0, "clamped");
+        assert_eq!(a.ticks(3), vec![0, 2, 3]);
+        let t = linear("time (ms)", 75, 4.0);
+        assert_eq!(t.label(74), "296");
+        assert_eq!(t.ticks(5), vec![0, 19, 37, 56, 74]);
+        assert_eq!(linear("x", 3, 0.25).label(1), "0.2");
+        assert_eq!(indices("i", 1).ticks(5), vec![0]);
+    }
+
+    #[test]
+    fn synthetic_and_missing_files() {
+        let s = VolumeSource::Synthetic(Default::default());
+        let a = describe(&s, Path::new("."), [64, 32, 16]);
+        assert_eq!(a.map(|a| a.name), ["sample", "crossline", "inline"]);
+        let missing = VolumeSource::Nifti("no/such.nii".into());
+        let a = describe(&missing, Path::new("."), [2, 3, 4]);
+        assert_eq!(a.map(|a| a.name), ["i", "j", "k"], "falls back to indices");
+    }
+
+    #[test]
+    fn segy_axes_from_f3() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/seismic/f3.sgy");
+        if !path.exists() {
+            assert!(
+                std::env::var_os("ARBVIS_NO_SKIP").is_none_or(|v| v != "1"),
+                "ARBVIS_NO_SKIP=1 but {} is missing",
+                path.display()
+            );
+            eprintln!("SKIPPED: {} is missing", path.display());
+            return;
+        }
+        let source = VolumeSource::Segy(segy::SegySource {
+            path,
+            prestack: Default::default(),
+        });
+        let a = describe(&source, Path::new("."), [75, 18, 23]);
+        assert_eq!(a[0].name, "time (ms)");
+        assert_eq!(a[0].label(74), "296", "75 samples at 4 ms");
+        assert_eq!(
+            (a[1].label(0), a[1].label(17)),
+            ("875".into(), "892".into())
+        );
+        assert_eq!(
+            (a[2].label(0), a[2].label(22)),
+            ("111".into(), "133".into())
+        );
+        // A grid that is not the file's falls back to indices.
+        assert_eq!(describe(&source, Path::new("."), [75, 18, 22])[2].name, "k");
+    }
+}

@@ -1,0 +1,191 @@
+//! What the viewer keeps beside the renderer: the prepared (quantized, packed) voxels, the
+//! axes in the data's numbers, a histogram of each attribute's quantized values, the
+//! colour tables as built from the scene (and as egui textures), and the CPU-made section
+//! images (inline, crossline, time slice) of one attribute coloured by its table.
+//!
+//! Decisions: for 3D opacity the viewer prepares the data itself and hands a copy to
+//! [`Opacity3dRenderer::from_prepared`], so switching programs or fidelity re-uploads
+//! without reading files again, and histograms and sections read the same bytes the GPU
+//! samples. Sections show the table's colour opaque (its alpha would hide the section where
+//! the volume is clear); pixels are voxels, stretched to the box's physical aspect.
+
+use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
+
+use super::axes::{self, Axis};
+use crate::colortable::{ColorTable, TableSpec};
+use crate::gl::{GlError, Gpu, ProgramKind};
+use crate::scene::{Scene, TechniqueScene};
+use crate::techniques::opacity3d::prepare::{prepare, Prepared};
+use crate::techniques::opacity3d::Opacity3dRenderer;
+use crate::techniques::{self, Renderer};
+
+/// The two axes a section at fixed `axis` shows: (across, down).
+pub fn section_axes(axis: usize) -> (usize, usize) {
+    match axis {
+        0 => (1, 2), // time slice: crossline across, inline down
+        1 => (2, 0), // crossline section: inline across, time down
+        _ => (1, 0), // inline section: crossline across, time down
+    }
+}
+
+/// The 3D-opacity data behind the panels.
+pub struct Volume3d {
+    /// The voxels as uploaded.
+    pub prepared: Prepared,
+    /// The axes, in the data's numbers.
+    pub axes: [Axis; 3],
+    /// Per attribute, how many voxels hold each quantized value.
+    pub histograms: [Option<Vec<u32>>; 3],
+}
+
+/// One section image and what it shows.
+struct Section {
+    key: (usize, usize, usize, Vec<[u8; 4]>),
+    texture: TextureHandle,
+}
+
+/// Everything the viewer keeps besides the renderer.
+#[derive(Default)]
+pub struct ViewData {
+    /// 3D-opacity data (none for other techniques).
+    pub volume: Option<Volume3d>,
+    /// Per attribute: the spec the table was built from, the table, its colours as a
+    /// 256 x 1 texture.
+    tables: [Option<(TableSpec, ColorTable, TextureHandle)>; 3],
+    sections: [Option<Section>; 3],
+    histograms: [Option<TextureHandle>; 3],
+}
+
+/// Build the scene's renderer with programs of `kind`, keeping its prepared data.
+pub fn build(
+    gpu: &Gpu,
+    scene: &Scene,
+    kind: ProgramKind,
+    data: &mut ViewData,
+) -> Result<Box<dyn Renderer>, GlError> {
+    let TechniqueScene::Opacity3d(params) = &scene.technique else {
+        data.volume = None;
+        return techniques::build(gpu, scene, kind);
+    };
+    if data.volume.is_none() {
+        params
+            .validate()
+            .map_err(|e| GlError::Data(e.to_string()))?;
+        let prepared = prepare(params, &scene.base, &gpu.volume_limits()).map_err(GlError::Data)?;
+        let axes = axes::describe(&params.primary.volume, &scene.base, prepared.dims);
+        let histograms = std::array::from_fn(|a| {
+            prepared.tables[a].as_ref().map(|_| {
+                let mut h = vec![0u32; 256];
+                for v in 0..prepared.packed.len() / 3 {
+                    h[prepared.byte(v, a) as usize] += 1;
+                }
+                h
+            })
+        });
+        data.volume = Some(Volume3d {
+            prepared,
+            axes,
+            histograms,
+        });
+    }
+    let Some(v) = &data.volume else {
+        return Err(GlError::Data("no prepared volume".into()));
+    };
+    let mut prepared = v.prepared.clone();
+    for (a, attr) in params.attributes().into_iter().enumerate() {
+        if let Some(attr) = attr {
+            prepared.tables[a] = Some(attr.table.build(&scene.base).map_err(GlError::Data)?);
+        }
+    }
+    Ok(Box::new(Opacity3dRenderer::from_prepared(
+        gpu,
+        kind,
+        scene.fidelity,
+        params,
+        &scene.base,
+        prepared,
+    )?))
+}
+
+impl ViewData {
+    /// The table of attribute `a` as the scene now names it, and its colour texture
+    /// (rebuilt when the spec changed; `None` for an absent attribute or a table that
+    /// cannot be built).
+    pub fn table(
+        &mut self,
+        ctx: &egui::Context,
+        scene: &Scene,
+        a: usize,
+    ) -> Option<(&ColorTable, &TextureHandle)> {
+        let TechniqueScene::Opacity3d(o) = &scene.technique else {
+            return None;
+        };
+        let spec = &o.attributes()[a]?.table;
+        let stale = self.tables[a].as_ref().is_none_or(|(s, _, _)| s != spec);
+        if stale {
+            let table = spec.build(&scene.base).ok()?;
+            let pixels = table
+                .entries
+                .iter()
+                .map(|e| Color32::from_rgb(e[0], e[1], e[2]))
+                .collect();
+            let image = ColorImage::new([256, 1], pixels);
+            let texture = ctx.load_texture(format!("table {a}"), image, TextureOptions::NEAREST);
+            self.tables[a] = Some((spec.clone(), table, texture));
+        }
+        self.tables[a].as_ref().map(|(_, t, x)| (t, x))
+    }
+
+    /// Attribute `a`'s histogram as an image (made once).
+    pub fn histogram(&mut self, ctx: &egui::Context, a: usize) -> Option<egui::TextureId> {
+        if self.histograms[a].is_none() {
+            let counts = self.volume.as_ref()?.histograms[a].as_ref()?;
+            let image = super::curve::histogram_image(counts);
+            self.histograms[a] =
+                Some(ctx.load_texture(format!("histogram {a}"), image, TextureOptions::NEAREST));
+        }
+        self.histograms[a].as_ref().map(|t| t.id())
+    }
+
+    /// The section at `index` along `axis` of attribute `a`, coloured by its table.
+    pub fn section(
+        &mut self,
+        ctx: &egui::Context,
+        scene: &Scene,
+        axis: usize,
+        index: usize,
+        a: usize,
+    ) -> Option<TextureHandle> {
+        let entries = self.table(ctx, scene, a)?.0.entries.clone();
+        let v = self.volume.as_ref()?;
+        let p = &v.prepared;
+        let index = index.min(p.dims[axis].saturating_sub(1));
+        let key = (axis, index, a, entries);
+        if let Some(s) = &self.sections[axis] {
+            if s.key == key {
+                return Some(s.texture.clone());
+            }
+        }
+        let (u, w) = section_axes(axis);
+        let (nu, nw) = (p.dims[u], p.dims[w]);
+        let mut pixels = Vec::with_capacity(nu * nw);
+        for y in 0..nw {
+            for x in 0..nu {
+                let mut ijk = [0usize; 3];
+                ijk[axis] = index;
+                ijk[u] = x;
+                ijk[w] = y;
+                let voxel = ijk[0] + p.dims[0] * (ijk[1] + p.dims[1] * ijk[2]);
+                let e = key.3[p.byte(voxel, a) as usize];
+                pixels.push(Color32::from_rgb(e[0], e[1], e[2]));
+            }
+        }
+        let image = ColorImage::new([nu, nw], pixels);
+        let texture = ctx.load_texture(format!("section {axis}"), image, TextureOptions::NEAREST);
+        self.sections[axis] = Some(Section {
+            key,
+            texture: texture.clone(),
+        });
+        Some(texture)
+    }
+}

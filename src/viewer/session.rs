@@ -1,0 +1,398 @@
+//! One open viewer window: the renderer, egui, the kept volume picture, the scene being
+//! edited, and what each frame does (UI pass, camera input, actions, volume update,
+//! blit, UI paint).
+
+use std::time::Instant;
+
+use anyhow::anyhow;
+use egui_glow::EguiGlow;
+use glam::{DQuat, DVec2, DVec3};
+use winit::dpi::LogicalSize;
+use winit::event_loop::ActiveEventLoop;
+use winit::window::Window;
+
+use super::data::{self, ViewData};
+use super::lut3d;
+use super::panel::{self, PanelState, UiAction, PANEL_WIDTH, SECTIONS_HEIGHT};
+use super::runner::Observed;
+use super::script::MeasureMode;
+use super::volume_view::{Key, Pending, VolumeView, SETTLE};
+use super::ViewerOptions;
+use crate::camera::{Arcball, Camera, Projection};
+use crate::gl::window::GlWindow;
+use crate::gl::{self, ProgramKind, Surface};
+use crate::png_io;
+use crate::scene::{Scene, TechniqueScene};
+use crate::techniques::{Frame, Renderer};
+
+/// Margin kept around the volume's bounding sphere when framing.
+const FRAME_MARGIN: f64 = 0.9;
+
+/// The largest zoom at which a box of half-extents `half` stays in view at every rotation
+/// (its bounding sphere fits the view's shorter side, with a 10 % margin for labels).
+pub fn fit_zoom(camera: &Camera, half: DVec3) -> f64 {
+    let r = half.length().max(1e-9) / FRAME_MARGIN;
+    match camera.projection {
+        Projection::Orthographic => 1.0 / r,
+        // The eye sits at sqrt(3) / (tan(fov/2) zoom); the sphere fits when r / distance
+        // <= sin(fov/2), the half-angle of the shorter side.
+        Projection::Perspective => {
+            let theta = camera.fov_y_deg.clamp(1.0, 170.0).to_radians() / 2.0;
+            3f64.sqrt() * theta.cos() / r
+        }
+    }
+}
+
+// Fields drop in order: GL objects and egui's before the window's context.
+pub(super) struct Running {
+    renderer: Box<dyn Renderer>,
+    volume: VolumeView,
+    data: ViewData,
+    pub egui: EguiGlow,
+    scene: Scene,
+    panel: PanelState,
+    arcball: Arcball,
+    last_frame: Instant,
+    last_edit: Option<Instant>,
+    dragging: bool,
+    generation: u64,
+    screenshots: u32,
+    view_px: [i32; 4],
+    view_rect: egui::Rect,
+    action_error: Option<String>,
+    pub window: GlWindow,
+}
+
+impl Running {
+    pub fn start(
+        event_loop: &ActiveEventLoop,
+        options: &mut ViewerOptions,
+        repaint: impl Fn(egui::RequestRepaintInfo) + Send + Sync + 'static,
+    ) -> anyhow::Result<Running> {
+        let mut scene = options.scene.clone();
+        let opacity3d = matches!(scene.technique, TechniqueScene::Opacity3d(_));
+        let [w, h] = scene.size.map(|v| v as f64);
+        // Room for the box labels and colour bars around a small volume.
+        let (right, below, min_view) = if opacity3d {
+            (lut3d::WIDTH as f64, SECTIONS_HEIGHT as f64, 420.0)
+        } else {
+            (0.0, 0.0, 0.0)
+        };
+        let attributes = Window::default_attributes()
+            .with_title(format!("arbvis — {}", options.origin))
+            .with_inner_size(LogicalSize::new(
+                PANEL_WIDTH as f64 + w.max(min_view) + right,
+                (h.max(min_view) + below).max(480.0),
+            ));
+        let prefer_egl = std::env::var_os("ARBVIS_PREFER_EGL").is_some_and(|v| v == "1");
+        let window = GlWindow::new(event_loop, attributes, prefer_egl)?;
+        let gpu = window.gpu();
+        let kind = scene.programs.resolve(gpu);
+        let mut data = ViewData::default();
+        let renderer = data::build(gpu, &scene, kind, &mut data)?;
+        let egui = EguiGlow::new(event_loop, gpu.glow().clone(), None, None, false);
+        egui.egui_ctx.set_request_repaint_callback(repaint);
+        let mut panel = PanelState {
+            kind: Some(kind),
+            ..PanelState::default()
+        };
+        if let Some(v) = &data.volume {
+            panel.sections.index = v.prepared.dims.map(|d| d / 2);
+            let fit = fit_zoom(&scene.camera, v.prepared.half);
+            if scene.camera.zoom > fit {
+                panel.status = format!(
+                    "zoom {:.2} -> {fit:.2}: the whole volume in view",
+                    scene.camera.zoom
+                );
+                scene.camera.zoom = fit;
+            }
+        }
+        Ok(Running {
+            renderer,
+            volume: VolumeView::default(),
+            data,
+            egui,
+            scene,
+            panel,
+            arcball: Arcball::default(),
+            last_frame: Instant::now(),
+            last_edit: None,
+            dragging: false,
+            generation: 0,
+            screenshots: 0,
+            view_px: [0, 0, 1, 1],
+            view_rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1.0, 1.0)),
+            action_error: None,
+            window,
+        })
+    }
+
+    /// What a script sees between frames.
+    pub fn observed(&mut self, frames: u64) -> Observed<'_> {
+        let size = self.window.window().inner_size();
+        Observed {
+            widgets: &mut self.panel.widgets,
+            view: self.view_rect,
+            frames,
+            camera: self.scene.camera,
+            window: [size.width, size.height],
+            view_px: [self.view_px[2] as u32, self.view_px[3] as u32],
+            action_error: self.action_error.take(),
+            quality: self.panel.quality.name(),
+        }
+    }
+
+    fn fail_action(&mut self, message: String) {
+        self.panel.status = message.clone();
+        self.action_error = Some(message);
+    }
+
+    /// Draw one frame; returns when the next is due (none: wait for input).
+    pub fn frame(
+        &mut self,
+        options: &ViewerOptions,
+        measure: Option<MeasureMode>,
+    ) -> anyhow::Result<Option<Instant>> {
+        let now = Instant::now();
+        let dt = now.duration_since(self.last_frame).as_secs_f64().max(1e-6);
+        self.last_frame = now;
+        let a = if self.panel.frame_ms == 0.0 { 1.0 } else { 0.2 };
+        self.panel.frame_ms = self.panel.frame_ms * (1.0 - a) + dt * 1e3 * a;
+        self.panel.fps = 1e3 / self.panel.frame_ms.max(1e-6);
+        if matches!(measure, Some(MeasureMode::Full | MeasureMode::Interactive)) {
+            // Turn a little each frame, as a slow drag would.
+            let q = DQuat::from_rotation_y(2f64.to_radians()) * self.scene.camera.quat();
+            self.scene.camera.rotation = q.to_array();
+        }
+
+        let caps = self.window.gpu().caps().clone();
+        let mut out = None;
+        let (scene, data, panel) = (&mut self.scene, &mut self.data, &mut self.panel);
+        self.egui.run(self.window.window(), |ui| {
+            out = Some(panel::show(ui, scene, data, panel, &caps));
+        });
+        let out = out.ok_or_else(|| anyhow!("egui produced no UI"))?;
+        self.view_rect = out.view;
+
+        // Camera from pointer input on the view.
+        let view_size = DVec2::new(out.view.width() as f64, out.view.height() as f64);
+        let local = |p: egui::Pos2| {
+            DVec2::new((p.x - out.view.min.x) as f64, (p.y - out.view.min.y) as f64)
+        };
+        if let Some(p) = out.input.drag_start {
+            self.arcball.begin(&self.scene.camera, local(p), view_size);
+            self.dragging = true;
+        }
+        if let Some(p) = out.input.drag_to {
+            self.arcball
+                .drag(&mut self.scene.camera, local(p), view_size);
+        }
+        if out.input.drag_end {
+            self.arcball.end();
+            self.dragging = false;
+        }
+        if out.input.scroll != 0.0 {
+            let z = self.scene.camera.zoom * (out.input.scroll as f64 / 200.0).exp();
+            self.scene.camera.zoom = z.clamp(0.1, 10.0);
+        }
+
+        let mut screenshot = false;
+        for action in &out.actions {
+            match action {
+                UiAction::SetPrograms(kind) => self.set_programs(*kind),
+                UiAction::ParamsChanged => {
+                    match self
+                        .renderer
+                        .update(self.window.gpu(), &self.scene.technique)
+                    {
+                        Ok(()) => self.generation += 1,
+                        Err(e) => self.fail_action(format!("error: {e}")),
+                    }
+                }
+                UiAction::Screenshot => screenshot = true,
+                UiAction::SaveScene => self.save_scene(options),
+                UiAction::SetFidelity => {
+                    let kind = self.renderer.program_kind();
+                    self.set_programs(kind);
+                }
+                UiAction::SaveTables => self.save_tables(options),
+                UiAction::ResetCamera => {
+                    self.scene.camera = Camera::default();
+                    self.fit();
+                }
+                UiAction::FitVolume => self.fit(),
+            }
+        }
+
+        // The 3D view in window pixels (GL's origin is the bottom left); the scene's size
+        // follows it.
+        let ppp = self.egui.egui_ctx.pixels_per_point();
+        let win = self.window.window().inner_size();
+        let x = (out.view.min.x * ppp).round() as i32;
+        let w = ((out.view.width() * ppp).round() as i32).max(1);
+        let h = ((out.view.height() * ppp).round() as i32).max(1);
+        let y = win.height as i32 - (out.view.max.y * ppp).round() as i32;
+        self.view_px = [x, y, w, h];
+        self.scene.size = [w as u32, h as u32];
+
+        if out.edited || out.input.scroll != 0.0 || out.input.drag_end {
+            self.last_edit = Some(now);
+        }
+        let settling = self
+            .last_edit
+            .is_some_and(|t| now.duration_since(t) < SETTLE);
+        let interacting = self.dragging || settling || measure == Some(MeasureMode::Interactive);
+        let key = Key::of(&self.scene, self.scene.size, self.generation);
+        let gpu = self.window.gpu();
+        let pending = self.volume.update(
+            gpu,
+            self.renderer.as_mut(),
+            &self.scene.technique,
+            &key,
+            interacting,
+            self.panel.quality,
+            measure == Some(MeasureMode::Full),
+        )?;
+        self.panel.volume_info = format!(
+            "volume: {:.0} ms full ({} part{}), {:.0} ms interactive",
+            self.volume.full_ms,
+            self.volume.parts,
+            if self.volume.parts == 1 { "" } else { "s" },
+            self.volume.interactive_ms
+        );
+
+        gl::clear(
+            gpu,
+            Surface::Window([0, 0, win.width as i32, win.height as i32]),
+            [0.1, 0.1, 0.1, 1.0],
+        )?;
+        gl::clear(gpu, Surface::Window(self.view_px), self.scene.background)?;
+        self.volume.show(gpu, self.view_px)?;
+        if screenshot {
+            self.screenshot(options, &key);
+        }
+        self.egui.paint(self.window.window());
+        self.window.swap_buffers()?;
+        Ok(match pending {
+            Pending::Done => None,
+            Pending::Building => Some(Instant::now()),
+            Pending::Refine => Some(self.last_edit.unwrap_or(now) + SETTLE),
+        })
+    }
+
+    /// Zoom so that the whole volume stays in view.
+    fn fit(&mut self) {
+        if let Some(v) = &self.data.volume {
+            self.scene.camera.zoom = fit_zoom(&self.scene.camera, v.prepared.half);
+        }
+    }
+
+    fn set_programs(&mut self, kind: ProgramKind) {
+        match data::build(self.window.gpu(), &self.scene, kind, &mut self.data) {
+            Ok(r) => {
+                self.renderer = r;
+                self.generation += 1;
+                self.panel.kind = Some(kind);
+                self.scene.programs = match kind {
+                    ProgramKind::Arb => crate::gl::ProgramChoice::Arb,
+                    ProgramKind::Glsl => crate::gl::ProgramChoice::Glsl,
+                };
+                self.panel.status = format!("programs: {}", kind.name());
+            }
+            Err(e) => self.fail_action(format!("cannot switch to {}: {e}", kind.name())),
+        }
+    }
+
+    /// The view as a picture: the full-quality volume picture (opaque), or, for a
+    /// transparent scene, the frame drawn again on transparent black (straight colour,
+    /// coverage alpha), exactly as `arbvis render` writes it.
+    fn picture(&mut self, key: &Key) -> anyhow::Result<crate::image::Image> {
+        let gpu = self.window.gpu();
+        if !self.scene.transparent {
+            if let Some(t) = self.volume.full_picture(key) {
+                return Ok(self.scene.picture(&t.read(gpu)?));
+            }
+        }
+        let [w, h] = self.scene.size;
+        let target = gl::Target::create(
+            gpu,
+            w,
+            h,
+            self.scene.target_format(),
+            self.renderer.needs_depth(),
+        )?;
+        target.clear(gpu, self.scene.clear_colour())?;
+        let frame = Frame {
+            camera: self.scene.camera,
+            width: w,
+            height: h,
+        };
+        self.renderer.draw(gpu, Surface::Target(&target), &frame)?;
+        Ok(self.scene.picture(&target.read(gpu)?))
+    }
+
+    fn screenshot(&mut self, options: &ViewerOptions, key: &Key) {
+        let result = self.picture(key).and_then(|image| {
+            self.screenshots += 1;
+            let path = options
+                .screenshot_dir
+                .join(format!("arbvis-screenshot-{:03}.png", self.screenshots));
+            let caps = self.window.gpu().caps();
+            let text = [
+                ("Software", format!("arbvis {}", env!("CARGO_PKG_VERSION"))),
+                ("arbvis:scene-origin", options.origin.clone()),
+                ("arbvis:scene", self.scene.to_toml()),
+                (
+                    "arbvis:programs",
+                    self.renderer.program_kind().name().to_string(),
+                ),
+                (
+                    "arbvis:renderer",
+                    format!("{} | {} | {}", caps.vendor, caps.renderer, caps.version),
+                ),
+            ];
+            png_io::write_png(&path, &image, &text)?;
+            Ok(path)
+        });
+        match result {
+            Ok(p) => self.panel.status = format!("saved {}", p.display()),
+            Err(e) => self.fail_action(format!("screenshot failed: {e}")),
+        }
+    }
+
+    fn save_tables(&mut self, options: &ViewerOptions) {
+        match save_tables(&mut self.scene, &options.screenshot_dir) {
+            Ok(paths) => self.panel.status = format!("saved {}", paths.join(", ")),
+            Err(e) => self.fail_action(format!("cannot save tables: {e}")),
+        }
+    }
+
+    fn save_scene(&mut self, options: &ViewerOptions) {
+        let path = options.screenshot_dir.join("arbvis-scene.toml");
+        let scene = self.scene.with_absolute_paths();
+        match png_io::write_atomic(&path, scene.to_toml().as_bytes()) {
+            Ok(()) => self.panel.status = format!("saved {}", path.display()),
+            Err(e) => self.fail_action(format!("cannot save {}: {e}", path.display())),
+        }
+    }
+}
+
+/// Write each opacity3d table (with its alpha curve applied) as
+/// `arbvis-table-ROLE.table` in `dir`, and point the scene at the files.
+fn save_tables(scene: &mut Scene, dir: &std::path::Path) -> Result<Vec<String>, String> {
+    let base = scene.base.clone();
+    let TechniqueScene::Opacity3d(o) = &mut scene.technique else {
+        return Err("this scene has no colour tables".into());
+    };
+    let mut written = Vec::new();
+    for (role, attr) in lut3d::ROLES.iter().zip(o.attributes_mut()) {
+        let Some(attr) = attr else { continue };
+        let table = attr.table.build(&base)?;
+        let path = dir.join(format!("arbvis-table-{role}.table"));
+        table.save(&path)?;
+        attr.table.file = Some(std::fs::canonicalize(&path).unwrap_or(path.clone()));
+        attr.table.alpha.clear();
+        written.push(path.display().to_string());
+    }
+    Ok(written)
+}
