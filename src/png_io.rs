@@ -93,8 +93,8 @@ fn text_chunk(key: &str, value: &str) -> png::text_metadata::ITXtChunk {
     chunk
 }
 
-/// Read a PNG as an RGBA8 [`Image`] (8-bit RGBA files only, as this crate writes for
-/// RGBA8 targets), with its text chunks.
+/// Read an RGB(A) PNG of 8 or 16 bits per sample as an [`Image`] (RGBA8 or RGBA16F),
+/// with its text chunks.
 pub fn read_png(path: &Path) -> Result<(Image, Vec<(String, String)>), PngError> {
     let name = path.display().to_string();
     let fmt = |message: String| PngError::Format {
@@ -130,23 +130,41 @@ pub fn read_png(path: &Path) -> Result<(Image, Vec<(String, String)>), PngError>
         }
     }
     let (w, h) = (info.width, info.height);
-    let channels = match (info.color_type, info.bit_depth) {
-        (png::ColorType::Rgba, png::BitDepth::Eight) => 4,
-        (png::ColorType::Rgb, png::BitDepth::Eight) => 3,
-        (ct, bd) => return Err(fmt(format!("expected 8-bit RGB(A), found {ct:?} {bd:?}"))),
+    let channels = match info.color_type {
+        png::ColorType::Rgba => 4,
+        png::ColorType::Rgb => 3,
+        ct => return Err(fmt(format!("expected RGB or RGBA, found {ct:?}"))),
     };
-    let mut image = Image::filled(w, h, TargetFormat::Rgba8, [0.0; 4]);
+    // 16-bit files (what float targets are written as) come back as RGBA16F images.
+    let (samples, format): (Vec<f32>, TargetFormat) = match info.bit_depth {
+        png::BitDepth::Eight => (
+            buf[..info.buffer_size()]
+                .iter()
+                .map(|&b| b as f32 / 255.0)
+                .collect(),
+            TargetFormat::Rgba8,
+        ),
+        png::BitDepth::Sixteen => (
+            buf[..info.buffer_size()]
+                .chunks_exact(2)
+                .map(|b| u16::from_be_bytes([b[0], b[1]]) as f32 / 65535.0)
+                .collect(),
+            TargetFormat::Rgba16f,
+        ),
+        bd => {
+            return Err(fmt(format!(
+                "expected 8 or 16 bits per sample, found {bd:?}"
+            )))
+        }
+    };
+    let mut image = Image::filled(w, h, format, [0.0; 4]);
     for (o, px) in image
         .data
         .chunks_exact_mut(4)
-        .zip(buf[..info.buffer_size()].chunks_exact(channels))
+        .zip(samples.chunks_exact(channels))
     {
         for c in 0..4 {
-            o[c] = if c < channels {
-                px[c] as f32 / 255.0
-            } else {
-                1.0
-            };
+            o[c] = if c < channels { px[c] } else { 1.0 };
         }
     }
     Ok((image, text))

@@ -405,6 +405,39 @@ click Save scene
 }
 
 #[test]
+fn the_isovalue_editor_reaches_the_saved_scene() {
+    let script = "\
+resize 900 600
+wait 2
+set Isovalue 1 0.35
+click Remove isovalue 3
+click Add isovalue
+click Precise
+click Shading
+click Screenshot
+click Save scene
+";
+    let Some((dir, _)) = run_script("isovalues", "cellproj-spherical", "160x120", script) else {
+        return;
+    };
+    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let TechniqueScene::Cellproj(c) = &saved.technique else {
+        panic!("saved scene is not cellproj");
+    };
+    let values: Vec<f64> = c.isovalues.iter().map(|i| i.value).collect();
+    // 0.3 set to 0.35, 0.9 removed, one added after 0.5 (at 0.6).
+    assert_eq!(values.len(), 3, "{values:?}");
+    assert_eq!(values[0], 0.35);
+    assert_eq!(values[1], 0.5);
+    assert!((values[2] - 0.6).abs() < 1e-12, "{values:?}");
+    assert!(c.shading);
+    assert_eq!(saved.fidelity, arbvis::scene::Fidelity::Precise);
+    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn save_tables_writes_them_and_the_scene_uses_them() {
     let Some((dir, _)) = run_script(
         "tables",

@@ -76,7 +76,7 @@ pub fn build(gpu: &Gpu, scene: &Scene, kind: ProgramKind) -> GlResult<Box<dyn Re
         )?),
         TechniqueScene::Cellproj(params) => Box::new(cellproj::CellprojRenderer::new(
             gpu,
-            cellproj::renderer::resolve_kind(scene, kind),
+            kind,
             scene.fidelity,
             params,
             &scene.base,

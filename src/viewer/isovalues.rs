@@ -12,13 +12,13 @@ pub fn editor(ui: &mut egui::Ui, scene: &mut CellprojScene, w: &mut Widgets) -> 
     let mut remove = None;
     for (i, iso) in scene.isovalues.iter_mut().enumerate() {
         ui.horizontal(|ui| {
-            let r = ui.add(
-                egui::DragValue::new(&mut iso.value)
-                    .range(0.0..=1.0)
-                    .speed(0.002)
-                    .max_decimals(4),
+            changed |= w.drag_value(
+                ui,
+                &format!("Isovalue {}", i + 1),
+                &mut iso.value,
+                0.0..=1.0,
+                0.002,
             );
-            changed |= w.add(ui, &format!("Isovalue {}", i + 1), &r) && r.changed();
             let mut c = iso.color.map(|v| v as f32);
             let r = ui.color_edit_button_rgba_unmultiplied(&mut c);
             if w.add(ui, &format!("Isovalue {} colour", i + 1), &r) && r.changed() {
@@ -62,14 +62,20 @@ pub fn editor(ui: &mut egui::Ui, scene: &mut CellprojScene, w: &mut Widgets) -> 
             changed |= w.add(ui, &format!("Exit {label}"), &r) && r.changed();
         }
     });
-    let r = ui.checkbox(&mut scene.shading, "Shading (precise)");
-    changed |= w.add(ui, "Shading", &r) && r.changed();
-    let r = ui.checkbox(&mut scene.active_only, "Active tetrahedra only");
-    changed |= w.add(ui, "Active tetrahedra only", &r) && r.changed();
-    ui.horizontal(|ui| {
-        ui.label("Table size");
-        let r = ui.add(egui::DragValue::new(&mut scene.table_size).range(2..=4096));
-        changed |= w.add(ui, "Table size", &r) && r.changed();
-    });
+    changed |= w.checkbox(ui, "Shading", &mut scene.shading, "Shading (precise)");
+    changed |= w.checkbox(
+        ui,
+        "Active tetrahedra only",
+        &mut scene.active_only,
+        "Active tetrahedra only",
+    );
+    changed |= w.slider(
+        ui,
+        "Table size",
+        &mut scene.table_size,
+        2..=4096,
+        "table size",
+        true,
+    );
     changed
 }

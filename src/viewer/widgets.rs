@@ -69,7 +69,12 @@ impl Widgets {
     pub fn add(&mut self, ui: &Ui, label: &str, response: &Response) -> bool {
         self.record(ui, label, response.rect, response.enabled());
         if self.focus.as_deref() == Some(label) && !ui.clip_rect().contains_rect(response.rect) {
-            response.scroll_to_me(Some(egui::Align::Center));
+            // At once: egui's animated scroll moves a few points a frame, too slow for a
+            // script's patience in a short window.
+            response.scroll_to_me_animation(
+                Some(egui::Align::Center),
+                egui::style::ScrollAnimation::none(),
+            );
         }
         let hit = response.clicked()
             || response.changed()

@@ -36,8 +36,9 @@
 //!   the ray direction `vertex - EyePos` un-normalized, `t` starting at 10000.
 //! - `orthographic.*`: the seed's orthographic case: the view direction is constant, so
 //!   each `t_i` is computed per vertex and interpolated (exact: `t_i` is affine on a face).
-//! - `precise.*` (GLSL only: it loops over the isovalues; ARB fragment programs have no
-//!   loops): normalized direction, guarded divisions (grazing rays, degenerate faces),
+//! - `precise.*` (GLSL only: it loops over the isovalues, and ARB fragment programs have
+//!   no loops; precise mode draws with GLSL whatever program kind the scene asks for, and
+//!   says so in the picture's `arbvis:programs`): normalized direction, guarded divisions (grazing rays, degenerate faces),
 //!   the exact crossing `t_iso = t (iso - sf) / (sb - sf)` against each isovalue (no
 //!   table quantization), depth written at the crossing, optional shading.
 //!

@@ -87,16 +87,6 @@ pub fn program_pair(variant: Variant, kind: ProgramKind) -> GlResult<ProgramPair
     })
 }
 
-/// The program kind for a scene: precise exists only in GLSL, so `auto` means GLSL
-/// there (an explicit `arb` stays, and is refused by the renderer with the reason).
-pub fn resolve_kind(scene: &crate::scene::Scene, kind: ProgramKind) -> ProgramKind {
-    if scene.fidelity == Fidelity::Precise && scene.programs == crate::gl::ProgramChoice::Auto {
-        ProgramKind::Glsl
-    } else {
-        kind
-    }
-}
-
 /// The eye in object space (perspective) and the unit view direction (both cameras).
 pub fn eye_and_direction(frame: &Frame) -> (DVec3, DVec3) {
     let inverse = frame.camera.view().inverse();
@@ -175,11 +165,6 @@ impl CellprojRenderer {
         params: &CellprojScene,
         prepared: Prepared,
     ) -> GlResult<CellprojRenderer> {
-        if fidelity == Fidelity::Precise && kind == ProgramKind::Arb {
-            return Err(GlError::Unsupported(
-                "precise cell projection exists only in GLSL (it loops over the isovalues; ARB fragment programs have no loops): use --programs glsl or auto".into(),
-            ));
-        }
         let vertices = prepared.face_vertices();
         let mesh = Mesh::new(
             gpu,
