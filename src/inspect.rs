@@ -6,7 +6,7 @@ use std::io::Read;
 use std::path::Path;
 
 /// What `inspect` reads, for the message about a file it does not.
-pub const READS: &str = "SEG-Y (.sgy, .segy), NIfTI-1 (.nii, .nii.gz)";
+pub const READS: &str = "volumes: SEG-Y (.sgy, .segy), NIfTI-1 (.nii, .nii.gz); tetrahedral meshes: VTK legacy (.vtk), VTK XML (.vtu), gmsh (.msh); point clouds: LAS/LAZ (.las, .laz), PLY (.ply), the seed's text (.dat); surfaces: OBJ (.obj), STL (.stl)";
 
 /// The kinds of file `inspect` knows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -15,6 +15,12 @@ pub enum Kind {
     Segy,
     /// NIfTI-1, plain or gzip.
     Nifti,
+    /// A tetrahedral mesh (VTK legacy or XML, gmsh).
+    Mesh,
+    /// A point cloud (LAS/LAZ, PLY, `.dat`).
+    Points,
+    /// A closed triangle surface (OBJ, STL).
+    Surface,
 }
 
 /// Errors of `inspect`: the reader's own, or a file no reader takes.
@@ -31,6 +37,15 @@ pub enum InspectError {
     /// A volume reader's error.
     #[error(transparent)]
     Volume(#[from] crate::volume::VolumeError),
+    /// A mesh reader's error.
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
+    /// A point-cloud reader's error.
+    #[error(transparent)]
+    Points(#[from] crate::points::PointsError),
+    /// A surface reader's error.
+    #[error(transparent)]
+    Surface(#[from] crate::surface::SurfaceError),
     /// Not a format arbvis reads.
     #[error("{path}: {what}; arbvis inspect reads {READS}")]
     Unknown {
@@ -48,7 +63,27 @@ pub fn kind(path: &Path, head: &[u8]) -> Option<Kind> {
     if ends(".nii") || ends(".nii.gz") || head.get(344..348) == Some(b"n+1\0") {
         return Some(Kind::Nifti);
     }
-    if ends(".sgy") || ends(".segy") || looks_like_segy(head) {
+    if ends(".sgy") || ends(".segy") {
+        return Some(Kind::Segy);
+    }
+    let text = String::from_utf8_lossy(&head[..head.len().min(256)]);
+    let start = text.trim_start();
+    if ends(".vtk")
+        || ends(".vtu")
+        || ends(".msh")
+        || start.starts_with("# vtk DataFile")
+        || start.starts_with("$MeshFormat")
+        || (start.starts_with("<?xml") || start.starts_with("<VTKFile")) && text.contains("VTKFile")
+    {
+        return Some(Kind::Mesh);
+    }
+    if ends(".las") || ends(".laz") || ends(".ply") || ends(".dat") || head.starts_with(b"LASF") {
+        return Some(Kind::Points);
+    }
+    if ends(".obj") || ends(".stl") {
+        return Some(Kind::Surface);
+    }
+    if looks_like_segy(head) {
         return Some(Kind::Segy);
     }
     None
@@ -116,6 +151,16 @@ pub fn inspect(path: &Path) -> Result<String, InspectError> {
     file.take(4096).read_to_end(&mut head).map_err(io)?;
     match kind(path, &head) {
         Some(Kind::Nifti | Kind::Segy) => Ok(crate::volume::inspect(path)?),
+        Some(Kind::Mesh) => Ok(crate::mesh::inspect(path)?),
+        Some(Kind::Points) => Ok(crate::points::inspect(path)?),
+        Some(Kind::Surface) => {
+            let mesh = crate::surface::read(path)?;
+            Ok(format!(
+                "{}\n{}\n",
+                path.display(),
+                crate::surface::describe(&mesh)
+            ))
+        }
         None => Err(InspectError::Unknown {
             path: path.display().to_string(),
             what: looks_like(&head),
@@ -135,7 +180,9 @@ mod tests {
         std::fs::write(&toml, "[package]\nname = \"x\"\n").unwrap();
         let e = inspect(&toml).unwrap_err().to_string();
         assert!(
-            e.contains("text starting with \"[package]\"") && e.contains("SEG-Y (.sgy"),
+            e.contains("text starting with \"[package]\"")
+                && e.contains("SEG-Y (.sgy")
+                && e.contains("gmsh"),
             "{e}"
         );
         let png = dir.join("a.bin");

@@ -288,3 +288,55 @@ fn inspect_prints_what_the_loader_sees() {
         assert!(text.contains(expect), "missing {expect:?} in\n{text}");
     }
 }
+
+#[test]
+fn inspect_reads_meshes_point_clouds_and_surfaces() {
+    for (file, expect) in [
+        (
+            "tets/post.vtk",
+            &["VTK legacy 3.0", "tetrahedra: 8750", "\"Pressure\""][..],
+        ),
+        (
+            "tets/can.vtu",
+            &[
+                "UInt64 headers",
+                "VTK_HEXAHEDRON: 4800",
+                "tetrahedra: 28800",
+            ],
+        ),
+        (
+            "tets/bracket-2.2.msh",
+            &["gmsh MSH 2.2", "tetrahedra: 40710", "\"temperature\""],
+        ),
+        (
+            "points/autzen_trim.laz",
+            &["LAS 1.2", "compressed (LAZ)", "points: 110000"],
+        ),
+        ("points/bunny.ply", &["PLY 1.0 ascii", "points: 35947"]),
+        (
+            "surfaces/cow.obj",
+            &["triangles: 5804", "open edges (one triangle): 0"],
+        ),
+        (
+            "surfaces/42400-IDGH.stl",
+            &["triangles: 11036", "closed: yes"],
+        ),
+    ] {
+        let Some(path) = shared_data(file) else {
+            return;
+        };
+        let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
+            .args(["inspect", path.to_str().unwrap()])
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{file}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for e in expect {
+            assert!(text.contains(e), "{file}: missing {e:?} in\n{text}");
+        }
+    }
+}
