@@ -36,3 +36,36 @@ pub fn format_info(backend: Backend, caps: &Caps) -> String {
     }
     s
 }
+
+/// `arbvis info --json`: the backend and the capabilities, with the fragment and vertex
+/// program limits as nested objects (their fields share names).
+pub fn to_json(backend: Backend, caps: &Caps) -> String {
+    #[derive(serde::Serialize)]
+    struct Info<'a> {
+        backend: &'a str,
+        #[serde(flatten)]
+        caps: &'a Caps,
+    }
+    serde_json::to_string_pretty(&Info {
+        backend: backend.name(),
+        caps,
+    })
+    .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn json_nests_the_limits_and_names_the_backend() {
+        let caps = Caps {
+            renderer: "r".into(),
+            ..Default::default()
+        };
+        let v: serde_json::Value = serde_json::from_str(&to_json(Backend::Osmesa, &caps)).unwrap();
+        assert_eq!(v["backend"], "osmesa");
+        assert!(v["fragment_limits"]["native_instructions"].is_number());
+        assert!(v["vertex_limits"]["local_parameters"].is_number());
+    }
+}

@@ -36,8 +36,8 @@ enum Command {
     Render {
         #[command(flatten)]
         scene: SceneArgs,
-        /// Output PNG (written atomically).
-        #[arg(short, long)]
+        /// Output PNG (written atomically; the name must end in .png).
+        #[arg(short, long, value_parser = png_path)]
         output: PathBuf,
         /// Offscreen backend.
         #[arg(long, value_enum, default_value_t = Backend::Egl)]
@@ -152,20 +152,21 @@ const VTK_MS: f64 = 1260.0;
 struct SceneArgs {
     /// Scene file (TOML).
     scene: Option<PathBuf>,
-    /// A built-in demo instead of a file (e.g. `quad`).
-    #[arg(long, conflicts_with = "scene")]
+    /// A built-in demo instead of a file.
+    #[arg(long, conflicts_with = "scene",
+          value_parser = clap::builder::PossibleValuesParser::new(arbvis::scene::DEMOS.iter().map(|d| d.0)))]
     demo: Option<String>,
     /// Image size, e.g. 512x512.
     #[arg(long, value_parser = parse_size)]
     size: Option<[u32; 2]>,
     /// Program kind: arb, glsl, or auto (ARB where the driver has it).
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, ignore_case = true)]
     programs: Option<ProgramChoice>,
     /// Faithful (original programs, 8-bit) or precise (corrected, float).
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, ignore_case = true)]
     fidelity: Option<Fidelity>,
     /// Colour target precision (default from fidelity).
-    #[arg(long, value_enum)]
+    #[arg(long, value_enum, ignore_case = true)]
     target: Option<TargetFormat>,
     /// Transparent background: straight colour with alpha = coverage (default: opaque,
     /// what the screen shows).
@@ -200,6 +201,20 @@ impl SceneArgs {
     }
 }
 
+/// An output path ending in `.png` (arbvis writes PNG only: a `.jpg` name would hold a
+/// PNG and mislead every program that trusts the extension).
+fn png_path(s: &str) -> Result<PathBuf, String> {
+    let p = PathBuf::from(s);
+    let png = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if png {
+        Ok(p)
+    } else {
+        Err(format!(
+            "{s:?}: arbvis writes PNG images only; name the output *.png"
+        ))
+    }
+}
+
 fn main() -> ExitCode {
     arbvis::png_io::remove_temporaries_on_signals();
     match run(Cli::parse()) {
@@ -217,7 +232,7 @@ fn run(cli: Cli) -> Result<()> {
             let headless = Headless::new(backend)?;
             let caps = headless.gpu().caps();
             if json {
-                println!("{}", serde_json_like(caps));
+                println!("{}", arbvis::info::to_json(backend, caps));
             } else {
                 print!("{}", arbvis::info::format_info(backend, caps));
             }
@@ -307,18 +322,4 @@ fn run(cli: Cli) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// Caps as JSON (flat; no JSON crate needed for this one record).
-fn serde_json_like(caps: &arbvis::gl::Caps) -> String {
-    toml::to_string(caps)
-        .map(|t| {
-            let fields: Vec<String> = t
-                .lines()
-                .filter_map(|l| l.split_once(" = "))
-                .map(|(k, v)| format!("\"{k}\": {v}"))
-                .collect();
-            format!("{{{}}}", fields.join(", "))
-        })
-        .unwrap_or_default()
 }

@@ -108,12 +108,13 @@ fn info_reports_arb_support_and_limits() {
     }
     let json = arbvis(&["info", "--json", "--backend", "osmesa"]);
     let (j, _) = text(&json);
-    assert!(
-        json.status.success()
-            && j.trim_start().starts_with('{')
-            && j.contains("\"arb_fragment_program\""),
-        "{j}"
-    );
+    assert!(json.status.success(), "{j}");
+    // Real JSON, the limits nested (no repeated keys), the backend named.
+    let v: serde_json::Value = serde_json::from_str(&j).unwrap();
+    assert_eq!(v["backend"], "osmesa");
+    assert!(v["arb_fragment_program"].is_boolean());
+    assert!(v["fragment_limits"]["native_tex_indirections"].is_number());
+    assert!(v["vertex_limits"]["native_instructions"].is_number());
 }
 
 #[test]
@@ -234,4 +235,25 @@ fn study_writes_csv_and_plot_and_bench_times() {
         stdout.contains("faithful") && stdout.contains("ms"),
         "{stdout}"
     );
+}
+
+#[test]
+fn flags_take_any_case_and_outputs_must_be_png() {
+    let (out, dir, png) = render_quad("case", "q.png", &["--programs", "ARB", "--size", "16X8"]);
+    assert!(out.status.success(), "{}", text(&out).1);
+    assert!(png.exists());
+    let (out, _, jpg) = render_quad("jpg", "q.jpg", &[]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out).1.contains("writes PNG images only"),
+        "{}",
+        text(&out).1
+    );
+    assert!(!jpg.exists());
+    let help = arbvis(&["render", "--help"]);
+    assert!(
+        text(&help).0.contains("cellproj-spherical"),
+        "--demo help lists the demos"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }
