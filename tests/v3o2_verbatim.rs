@@ -109,6 +109,7 @@ fn hand_computed_sum_pixel(backend: Backend) {
             blend: Blend::Replace,
             depth_test: false,
             cull_back: false,
+            primitive: Default::default(),
         },
     )
     .unwrap();

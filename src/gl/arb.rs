@@ -30,6 +30,12 @@ type ProgramString = unsafe extern "system" fn(u32, u32, i32, *const c_void);
 type ProgramLocal4d = unsafe extern "system" fn(u32, u32, f64, f64, f64, f64);
 type GetProgramiv = unsafe extern "system" fn(u32, u32, *mut i32);
 type GetString = unsafe extern "system" fn(u32) -> *const u8;
+type TexEnvi = unsafe extern "system" fn(u32, u32, i32);
+
+/// `GL_POINT_SPRITE` (compatibility profile).
+pub const POINT_SPRITE: u32 = 0x8861;
+/// `GL_COORD_REPLACE` (compatibility profile).
+pub const COORD_REPLACE: u32 = 0x8862;
 
 /// The ARB program function table.
 #[derive(Clone, Copy)]
@@ -41,6 +47,7 @@ pub struct ArbFns {
     program_local_4d: ProgramLocal4d,
     get_programiv: GetProgramiv,
     get_string: GetString,
+    tex_envi: TexEnvi,
 }
 
 impl std::fmt::Debug for ArbFns {
@@ -71,6 +78,7 @@ impl ArbFns {
             program_local_4d: load!(c"glProgramLocalParameter4dARB", ProgramLocal4d),
             get_programiv: load!(c"glGetProgramivARB", GetProgramiv),
             get_string: load!(c"glGetString", GetString),
+            tex_envi: load!(c"glTexEnvi", TexEnvi),
         })
     }
 
@@ -132,6 +140,14 @@ impl ArbFns {
                 CStr::from_ptr(p.cast()).to_string_lossy().into_owned()
             }
         }
+    }
+
+    /// `glTexEnvi(GL_POINT_SPRITE, GL_COORD_REPLACE, on)` for the active texture unit:
+    /// point sprites hand their coordinates to ARB fragment programs as that unit's
+    /// `fragment.texcoord`.
+    pub(crate) fn coord_replace(&self, on: bool) {
+        // SAFETY: plain values.
+        unsafe { (self.tex_envi)(POINT_SPRITE, COORD_REPLACE, on as i32) };
     }
 
     /// `glGetIntegerv(GL_PROGRAM_ERROR_POSITION_ARB)` through glow.

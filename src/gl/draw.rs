@@ -25,6 +25,23 @@ pub enum Blend {
     Over,
     /// Back-to-front "over" of premultiplied colour: `ONE, ONE_MINUS_SRC_ALPHA`.
     PremultipliedOver,
+    /// Sum: `ONE, ONE` (weighted blended transparency's accumulation).
+    Add,
+    /// Product of transmittances: `ZERO, ONE_MINUS_SRC_ALPHA` on every channel (weighted
+    /// blended transparency's revealage).
+    Reveal,
+}
+
+/// What the vertices make.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Primitive {
+    /// Triangle lists.
+    #[default]
+    Triangles,
+    /// Point sprites: the program sets the size (`gl_PointSize`, ARB `result.pointsize`);
+    /// the fragment gets its position in the sprite (`gl_PointCoord`, or
+    /// `fragment.texcoord[0]` for ARB programs).
+    Points,
 }
 
 /// Where a draw goes.
@@ -53,6 +70,8 @@ pub struct DrawCall<'a> {
     pub depth_test: bool,
     /// Cull back faces (counter-clockwise triangles face the viewer).
     pub cull_back: bool,
+    /// Triangles or point sprites.
+    pub primitive: Primitive,
 }
 
 /// Clear `surface` (only its viewport, for a window) to `rgba`.
@@ -139,14 +158,60 @@ pub fn draw(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<()
                 gl.blend_equation(glow::FUNC_ADD);
                 gl.blend_func(glow::ONE, glow::ONE_MINUS_SRC_ALPHA);
             }
+            Blend::Add => {
+                gl.enable(glow::BLEND);
+                gl.blend_equation(glow::FUNC_ADD);
+                gl.blend_func(glow::ONE, glow::ONE);
+            }
+            Blend::Reveal => {
+                gl.enable(glow::BLEND);
+                gl.blend_equation(glow::FUNC_ADD);
+                gl.blend_func(glow::ZERO, glow::ONE_MINUS_SRC_ALPHA);
+            }
+        }
+        let points = call.primitive == Primitive::Points;
+        for cap in [glow::PROGRAM_POINT_SIZE, super::arb::POINT_SPRITE] {
+            if points {
+                gl.enable(cap);
+            } else {
+                gl.disable(cap);
+            }
         }
     }
     for (unit, texture) in call.textures {
         texture.bind(*unit);
     }
+    let points = call.primitive == Primitive::Points;
+    let coord_replace = |on: bool| {
+        if let (Ok(a), crate::gl::ProgramKind::Arb) = (gpu.arb(), call.program.kind()) {
+            // SAFETY: plain state calls; unit 0 is where ARB programs read the sprite.
+            unsafe {
+                let prev = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
+                gl.active_texture(glow::TEXTURE0);
+                a.coord_replace(on);
+                gl.active_texture(prev);
+            }
+        }
+    };
+    if points {
+        coord_replace(true);
+    }
     call.program.bind();
     if count > 0 {
-        call.mesh.draw_triangles(first, count);
+        let mode = if points {
+            glow::POINTS
+        } else {
+            glow::TRIANGLES
+        };
+        call.mesh.draw_elements(mode, first, count);
+    }
+    if points {
+        coord_replace(false);
+        // SAFETY: plain state calls.
+        unsafe {
+            gl.disable(glow::PROGRAM_POINT_SIZE);
+            gl.disable(super::arb::POINT_SPRITE);
+        }
     }
     for (unit, texture) in call.textures {
         texture.unbind(*unit);

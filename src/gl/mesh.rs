@@ -155,23 +155,21 @@ impl Mesh {
         self.indices.map_or(self.vertex_count, |(_, n)| n)
     }
 
-    /// Draw `count` elements from `first` as triangles (program, target and textures
-    /// bound): vertices, or indices when the mesh has them.
-    pub(crate) fn draw_triangles(&self, first: usize, count: usize) {
+    /// Draw `count` elements from `first` as `mode` (`glow::TRIANGLES` or `glow::POINTS`;
+    /// program, target and textures bound): vertices, or indices when the mesh has them.
+    pub(crate) fn draw_elements(&self, mode: u32, first: usize, count: usize) {
         // SAFETY: the range lies within the elements (checked by the caller); indices
         // were checked against the vertices when set.
         unsafe {
             self.gl.bind_vertex_array(Some(self.vao));
             match self.indices {
                 Some(_) => self.gl.draw_elements(
-                    glow::TRIANGLES,
+                    mode,
                     count as i32,
                     glow::UNSIGNED_INT,
                     (first * 4) as i32,
                 ),
-                None => self
-                    .gl
-                    .draw_arrays(glow::TRIANGLES, first as i32, count as i32),
+                None => self.gl.draw_arrays(mode, first as i32, count as i32),
             }
         }
     }

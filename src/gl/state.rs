@@ -164,6 +164,7 @@ mod tests {
             blend: Blend::Over,
             depth_test: false,
             cull_back: false,
+            primitive: Default::default(),
         };
         draw(gpu, Surface::Target(&target), &call).unwrap();
         target.read(gpu).unwrap();

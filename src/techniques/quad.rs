@@ -107,6 +107,7 @@ impl Renderer for QuadRenderer {
                 blend: Blend::Replace,
                 depth_test: false,
                 cull_back: false,
+                primitive: Default::default(),
             },
         )
     }

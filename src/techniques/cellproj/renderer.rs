@@ -264,6 +264,7 @@ impl Renderer for CellprojRenderer {
                 blend: Blend::Replace,
                 depth_test: true,
                 cull_back: true,
+                primitive: Default::default(),
             },
         )
     }

@@ -316,6 +316,7 @@ impl Opacity3dRenderer {
                 blend: Blend::Over,
                 depth_test: false,
                 cull_back: false,
+                primitive: Default::default(),
             },
         )
     }
