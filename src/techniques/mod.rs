@@ -8,6 +8,7 @@ pub mod cellproj;
 pub mod opacity3d;
 pub mod quad;
 pub mod rays;
+pub mod splats;
 
 use crate::camera::Camera;
 use crate::gl::{GlResult, Gpu, ProgramKind, Surface};
