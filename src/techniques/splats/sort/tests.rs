@@ -169,6 +169,35 @@ fn radix_parallel_path_and_digit_widths_agree() {
 }
 
 #[test]
+fn radix_handles_skewed_and_narrow_keys() {
+    // A dense cluster and two far outliers: nearly everything in one top bucket,
+    // finished by LSD passes over the low bits.
+    let mut positions: Vec<[f32; 3]> = random_cloud(PARALLEL_MIN + 5000, 6)
+        .iter()
+        .map(|p| p.map(|c| c * 1e-3))
+        .collect();
+    positions[17] = [50.0, 0.0, 0.0];
+    positions[40_000] = [-50.0, 1.0, 0.0];
+    // Keys a few hundred ulps apart: the top digit alone sorts them.
+    let mut r = SplitMix64::new(2);
+    let narrow: Vec<[f32; 3]> = (0..5000)
+        .map(|_| [0.0, 0.0, 0.5 + (r.next_u64() % 300) as f32 * 2f32.powi(-24)])
+        .collect();
+    for (cloud, view) in [
+        (&positions, View::Eye([0.0, 0.0, 0.0])),
+        (&positions, View::Along([1.0, 0.0, 0.0])),
+        (&narrow, View::Along([0.0, 0.0, 1.0])),
+    ] {
+        let keys = keys_order(cloud, view);
+        for bits in [4, 11] {
+            let mut out = Vec::new();
+            radix_with(cloud, view, &mut RadixScratch::default(), &mut out, bits);
+            assert_same(&out, &keys, &format!("{bits} bits, {view:?}"));
+        }
+    }
+}
+
+#[test]
 fn zero_one_and_coincident_points() {
     let view = View::Eye([0.0, 0.0, 5.0]);
     for method in SortMethod::ALL {
@@ -282,6 +311,54 @@ fn time_methods_reports_every_row() {
     })
     .unwrap();
     let rows = time_methods(&cloud, &Camera::default(), 2);
-    assert_eq!(rows.len(), 7);
+    assert_eq!(rows.len(), 8);
     assert!(rows[0].0.starts_with("seed"));
+}
+
+/// Release timings for the report, not a timed test:
+/// `ARBVIS_SORT_POINTS=570000,10000000 cargo test --release --no-default-features --lib
+/// splats_timings -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn splats_timings() {
+    use crate::points::section::{generate, SectionSpec};
+    use crate::techniques::splats::normals;
+    let counts = std::env::var("ARBVIS_SORT_POINTS").unwrap_or_else(|_| "570000".into());
+    let camera = Camera {
+        projection: Projection::Perspective,
+        rotation: glam::DQuat::from_euler(glam::EulerRot::YXZ, 0.7, -0.4, 0.0).to_array(),
+        ..Camera::default()
+    };
+    for points in counts.split(',').filter_map(|s| s.trim().parse().ok()) {
+        let cloud = generate(&SectionSpec { points, seed: 1 }).unwrap();
+        let runs = if points > 2_000_000 { 5 } else { 21 };
+        println!(
+            "{points} points, {} threads, median of {runs}:",
+            rayon::current_num_threads()
+        );
+        for (name, time) in time_methods(&cloud, &camera, runs) {
+            println!("  {:>10.3} ms  {name}", time.as_secs_f64() * 1e3);
+        }
+        let ortho = Camera {
+            projection: Projection::Orthographic,
+            ..camera
+        };
+        let rows = time_methods(&cloud, &ortho, runs);
+        println!(
+            "  {:>10.3} ms  radix (buffers reused), orthographic",
+            rows[5].1.as_secs_f64() * 1e3
+        );
+        if points <= 2_000_000 {
+            for per_layer in [true, false] {
+                let start = Instant::now();
+                let report = normals::estimate_cloud(&cloud, normals::DEFAULT_K, per_layer);
+                println!(
+                    "  {:>10.3} ms  normals k=16 ({} groups, {} fallbacks)",
+                    start.elapsed().as_secs_f64() * 1e3,
+                    report.groups,
+                    report.collinear + report.coincident + report.too_few
+                );
+            }
+        }
+    }
 }
