@@ -295,3 +295,58 @@ fn orientation_faces_the_eye() {
     // Edge-on: kept.
     assert_eq!(orient_toward(n, p, DVec3::new(0.5, 4.0, 0.0)), n);
 }
+
+#[test]
+fn bunny_normals_follow_its_surface() {
+    // The Stanford bunny's vertices, against the area-weighted normals of its faces.
+    let Some(path) = crate::points::shared_data("points/bunny.ply") else {
+        return;
+    };
+    let ply = crate::points::ply::read(&path).unwrap();
+    let cloud = crate::points::plycloud::cloud(&path, &ply).unwrap();
+    assert_eq!(cloud.len(), 35_947);
+    let faces = ply.element("face").and_then(|f| f.face_indices()).unwrap();
+    let mut truth = vec![DVec3::ZERO; cloud.len()];
+    for face in faces.iter() {
+        let v: Vec<usize> = face.iter().map(|&i| i as usize).collect();
+        let p = |i: usize| n64(&cloud.positions[v[i]]);
+        for t in 1..v.len() - 1 {
+            let n = (p(t) - p(0)).cross(p(t + 1) - p(0));
+            for i in [0, t, t + 1] {
+                truth[v[i]] += n;
+            }
+        }
+    }
+    let report = estimate_cloud(&cloud, DEFAULT_K, true);
+    assert_eq!(
+        (
+            report.groups,
+            report.collinear,
+            report.coincident,
+            report.too_few
+        ),
+        (1, 0, 0, 0)
+    );
+    let mut angles: Vec<f64> = truth
+        .iter()
+        .zip(&report.normals)
+        .filter(|(t, _)| t.length() > 0.0)
+        .map(|(t, n)| axis_angle(n64(n), *t))
+        .collect();
+    angles.sort_by(f64::total_cmp);
+    let at = |q: f64| angles[(q * (angles.len() - 1) as f64) as usize];
+    eprintln!(
+        "bunny: {} vertices with faces; median {:.2}°, 90% {:.2}°, 99% {:.2}°",
+        angles.len(),
+        at(0.5),
+        at(0.9),
+        at(0.99)
+    );
+    assert!(angles.len() > 34_800);
+    assert!(
+        at(0.5) < 5.0 && at(0.9) < 15.0,
+        "median {}°, 90% {}°",
+        at(0.5),
+        at(0.9)
+    );
+}

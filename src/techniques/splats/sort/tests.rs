@@ -362,3 +362,41 @@ fn splats_timings() {
         }
     }
 }
+
+#[test]
+fn lidar_tile_orders_agree() {
+    // 110,000 lidar returns quantized to centimetres: plenty of exact ties.
+    let Some(path) = crate::points::shared_data("points/autzen_trim.laz") else {
+        return;
+    };
+    let cloud = crate::points::lasfile::read(&path).unwrap().cloud;
+    assert_eq!(cloud.len(), 110_000);
+    let positions = &cloud.positions;
+    for view in [
+        View::Along([0.0, 0.0, -1.0]),
+        View::Along([0.6, -0.3, -0.74]),
+        View::Eye([0.2, -2.5, 1.5]),
+        View::Eye([0.0, 0.0, 0.0]),
+    ] {
+        let keys = keys_order(positions, view);
+        assert_back_to_front(&keys, positions, |p| view.key(p));
+        assert_same(
+            &back_to_front(SortMethod::Radix, positions, view),
+            &keys,
+            "radix",
+        );
+        let seed = back_to_front(SortMethod::Seed, positions, view);
+        assert_back_to_front(&seed, positions, |p| view.seed_key(p));
+        if let View::Along(_) = view {
+            assert_same(&seed, &keys, "seed");
+        }
+    }
+    let down = View::Along([0.0, 0.0, -1.0]);
+    let order = keys_order(positions, down);
+    let ties = order
+        .windows(2)
+        .filter(|w| down.key(&positions[w[0] as usize]) == down.key(&positions[w[1] as usize]))
+        .count();
+    eprintln!("autzen: {ties} ties seen from above");
+    assert!(ties > 50_000, "{ties}");
+}
