@@ -21,13 +21,13 @@
 //!   them per layer; here k nearest neighbours (kiddo's k-d tree) and PCA, one tree
 //!   per layer id, in parallel; flipped toward the eye at draw time
 //!   ([`normals::orient_toward`]).
-//! - **Reference** ([`reference`]): the f64 compositing of the same splats (GL's point
+//! - **Reference** ([`reference`](mod@reference)): the f64 compositing of the same splats (GL's point
 //!   clipping, size clamping and point-sprite coverage; the seed's footprints as
 //!   written beside precise ones) that the renderer is scored against.
 //!
 //! The seed's footprint formulas, as written, are 0 (smoothstep) or at their lowest
 //! (Gaussian) at the splat centre and largest on the rim, the reverse of the splats it
-//! describes; [`reference`]'s doc gives the details and the precise versions.
+//! describes; [`reference`](mod@reference)'s doc gives the details and the precise versions.
 
 pub mod normals;
 pub mod reference;

@@ -26,9 +26,8 @@
 //! `std::sort` was not, so the seed's tie order was unspecified), [`SortMethod::Keys`]
 //! on comparing the index after the key, [`SortMethod::Radix`] on its scatter being
 //! stable over pairs laid out in index order (and on pairs being unique where it uses
-//! a comparison sort). So all three give identical orders
-//! whenever their keys agree (always for Keys and Radix; for Seed, except for the
-//! square-root rounding above).
+//! a comparison sort). So all three give identical orders whenever their keys agree
+//! (always for Keys and Radix; for Seed, except for the square-root rounding above).
 //!
 //! # The methods
 //!
@@ -39,18 +38,19 @@
 //!   sort starts from the previous frame's order, as the seed's vector did.
 //! - [`SortMethod::Keys`]: one key per point computed in parallel, then a parallel
 //!   sort of (key, index) pairs (rayon's `par_sort_unstable_by`, ties by index).
-//! - [`SortMethod::Radix`]: keys mapped to u32 so that integer order is the float order
-//!   (flip all bits of negatives, the sign bit of positives), reversed for farthest
-//!   first, offset by the smallest key so only the bits that vary are sorted, packed
-//!   with the index into u64. One most-significant-digit pass on the top
-//!   [`RADIX_BITS`] bits splits the array into one chunk per thread: per-chunk
-//!   histograms in parallel, then each chunk scatters into its own disjoint ranges of
-//!   the output (split with `split_at_mut`, no `unsafe`). The 2048 buckets are then
-//!   independent and small enough for the cache: each is finished by LSD passes on the
-//!   remaining bits, buckets in parallel. Small inputs run on one thread.
-//!   [`RadixScratch`] keeps the buffers between frames (fresh pages cost about as much
-//!   as the sort). A full LSD sort (three passes of 11 bits over the whole array) took
-//!   6.2 ms for 570k points here; this layout halves the passes over memory.
+//! - [`SortMethod::Radix`] (in `sort/radix.rs`): keys mapped to u32 so that integer
+//!   order is the float order (flip all bits of negatives, the sign bit of positives),
+//!   reversed for farthest first, offset by the smallest key so only the bits that vary
+//!   are sorted, packed with the index into u64. One most-significant-digit pass on the
+//!   top [`RADIX_BITS`] bits, split into one chunk per thread: per-chunk histograms in
+//!   parallel, then each chunk scatters into its own disjoint ranges of the output
+//!   (split with `split_at_mut`, no `unsafe`). The 2048 buckets are then independent
+//!   and small enough for the cache: each is finished by LSD passes of up to 8 bits
+//!   into a per-task buffer, the last pass writing indices straight into the order,
+//!   buckets in parallel. Small inputs run on one thread. [`RadixScratch`] keeps the
+//!   buffers between frames (fresh pages cost about a tenth of the sort). Three full
+//!   LSD passes of 11 bits over the whole array were memory-bound (6.2 ms for 570k
+//!   points here); this layout does about half the memory traffic (4.5-4.7 ms).
 //!
 //! [`SortCache`] returns the previous order untouched when the view did not change (same
 //! bits) and the point count is the same; call [`SortCache::invalidate`] when the
@@ -67,6 +67,11 @@ use rayon::prelude::*;
 
 use crate::camera::{Camera, Projection};
 use crate::points::{PointCloud, Values, AMPLITUDE, FACIES, FAULT, JOINT_DIP, LAYER, POROSITY};
+
+mod radix;
+pub use radix::{radix_order_into, RadixScratch, RADIX_BITS};
+#[cfg(test)]
+use radix::{radix_with, PARALLEL_MIN};
 
 /// Where the splats are seen from, in the cloud's coordinates.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -139,19 +144,6 @@ fn canonical(k: f32) -> f32 {
     }
 }
 
-/// The u32 whose integer order is the reverse of `k`'s float order (for a canonical
-/// key: no NaN, no -0), so that ascending radix order is farthest first.
-#[inline]
-fn descending_bits(k: f32) -> u32 {
-    let b = k.to_bits();
-    let ascending = if b & 0x8000_0000 != 0 {
-        !b
-    } else {
-        b | 0x8000_0000
-    };
-    !ascending
-}
-
 /// The sorting methods.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -160,7 +152,7 @@ pub enum SortMethod {
     Seed,
     /// One key per point, a parallel sort of (key, index) pairs.
     Keys,
-    /// A parallel LSD radix sort of (key bits, index) pairs.
+    /// A parallel radix sort of (key bits, index) pairs.
     Radix,
 }
 
@@ -290,222 +282,6 @@ pub fn keys_order(positions: &[[f32; 3]], view: View) -> Vec<u32> {
     // (faster) sort gives the one stable result.
     pairs.par_sort_unstable_by(|a, b| b.0.total_cmp(&a.0).then(a.1.cmp(&b.1)));
     pairs.into_par_iter().map(|(_, i)| i).collect()
-}
-
-/// Bits of the first (most significant) radix digit: 2048 buckets.
-pub const RADIX_BITS: u32 = 11;
-
-/// Below this many points the radix sort runs on one thread.
-const PARALLEL_MIN: usize = 1 << 16;
-
-/// Buckets up to this size are finished with a comparison sort.
-const SMALL_BUCKET: usize = 48;
-
-/// Buffers kept between radix sorts.
-#[derive(Debug, Default, Clone)]
-pub struct RadixScratch {
-    a: Vec<u64>,
-    b: Vec<u64>,
-}
-
-/// The radix sort into `out` (cleared first), reusing `scratch`.
-pub fn radix_order_into(
-    positions: &[[f32; 3]],
-    view: View,
-    scratch: &mut RadixScratch,
-    out: &mut Vec<u32>,
-) {
-    radix_with(positions, view, scratch, out, RADIX_BITS);
-}
-
-/// `slice` cut into consecutive parts of the given sizes.
-fn split_sizes<T>(mut rest: &mut [T], sizes: impl Iterator<Item = usize>) -> Vec<&mut [T]> {
-    let mut parts = Vec::new();
-    for size in sizes {
-        let (part, tail) = std::mem::take(&mut rest).split_at_mut(size);
-        parts.push(part);
-        rest = tail;
-    }
-    parts
-}
-
-/// The radix sort with a first digit of `top_bits` bits. Pairs are `key << 32 | index`
-/// with `key` the descending bits less the smallest one, so only `bits` bits vary:
-/// 1. one most-significant-digit pass on the top `top_bits` of them: per-chunk
-///    histograms, then every chunk scatters into its own ranges (stable);
-/// 2. each bucket, now independent and small enough for the cache, is sorted on the
-///    remaining low bits by LSD passes of up to 8 bits between its range of the output
-///    and the same range of the input buffer (a comparison sort below
-///    [`SMALL_BUCKET`]: pairs are unique, so any correct sort is the stable order),
-///    buckets in parallel, and writes its indices straight into `out`.
-fn radix_with(
-    positions: &[[f32; 3]],
-    view: View,
-    scratch: &mut RadixScratch,
-    out: &mut Vec<u32>,
-    top_bits: u32,
-) {
-    out.clear();
-    let n = positions.len();
-    if n == 0 || too_many(n) {
-        return;
-    }
-    let chunks = if n < PARALLEL_MIN {
-        1
-    } else {
-        rayon::current_num_threads().max(1)
-    };
-    let chunk_len = n.div_ceil(chunks);
-    let RadixScratch { a, b } = scratch;
-    a.resize(n, 0);
-    b.resize(n, 0);
-    out.resize(n, 0);
-    let (lo, hi) = a
-        .par_chunks_mut(chunk_len)
-        .zip(positions.par_chunks(chunk_len))
-        .enumerate()
-        .map(|(c, (slots, points))| match view {
-            // One loop per kind, so the view is not matched per point.
-            View::Eye(_) => fill_pairs(slots, points, c * chunk_len, |p| view.key(p)),
-            View::Along(_) => fill_pairs(slots, points, c * chunk_len, |p| view.key(p)),
-        })
-        .reduce(|| (u32::MAX, 0), |x, y| (x.0.min(y.0), x.1.max(y.1)));
-    let bits = 32 - (hi - lo).leading_zeros();
-    if bits == 0 {
-        // All keys equal: index order.
-        out.par_iter_mut()
-            .enumerate()
-            .for_each(|(i, o)| *o = i as u32);
-        return;
-    }
-    let top = top_bits.clamp(1, 16).min(bits);
-    let low_bits = bits - top;
-    let radix = 1usize << top;
-    let digit = move |v: u64| (((v >> 32) as u32 - lo) >> low_bits) as usize;
-    let counts: Vec<Vec<usize>> = a
-        .par_chunks(chunk_len)
-        .map(|chunk| {
-            let mut count = vec![0usize; radix];
-            for &v in chunk {
-                count[digit(v)] += 1;
-            }
-            count
-        })
-        .collect();
-    // Ranges of `b` ordered by digit, then chunk: each chunk writes only its own.
-    let sizes = (0..radix).flat_map(|d| counts.iter().map(move |count| count[d]));
-    let mut ranges: Vec<Vec<&mut [u64]>> = (0..counts.len())
-        .map(|_| Vec::with_capacity(radix))
-        .collect();
-    for (k, range) in split_sizes(b, sizes).into_iter().enumerate() {
-        ranges[k % counts.len()].push(range);
-    }
-    a.par_chunks(chunk_len)
-        .zip(ranges.into_par_iter())
-        .for_each(|(chunk, ranges)| {
-            let mut slots: Vec<_> = ranges.into_iter().map(|r| r.iter_mut()).collect();
-            for &v in chunk {
-                // Never `None`: the ranges were sized by this chunk's own counts.
-                if let Some(slot) = slots[digit(v)].next() {
-                    *slot = v;
-                }
-            }
-        });
-    let buckets = (0..radix).map(|d| counts.iter().map(|count| count[d]).sum::<usize>());
-    let buckets: Vec<usize> = buckets.collect();
-    split_sizes(b, buckets.iter().copied())
-        .into_par_iter()
-        .zip(split_sizes(out, buckets.iter().copied()))
-        .for_each_init(
-            || (vec![0u32; 1024], Vec::new()),
-            |(hist, spare), (data, out)| {
-                // A per-task buffer that stays in the cache, not a cold range of `a`.
-                spare.resize(spare.len().max(data.len()), 0);
-                sort_bucket(data, &mut spare[..data.len()], out, hist, lo, low_bits)
-            },
-        );
-}
-
-/// Fill `slots` with `key bits << 32 | index` (indices from `first`); the range of the
-/// key bits.
-#[inline]
-fn fill_pairs(
-    slots: &mut [u64],
-    points: &[[f32; 3]],
-    first: usize,
-    key: impl Fn(&[f32; 3]) -> f32,
-) -> (u32, u32) {
-    let (mut lo, mut hi) = (u32::MAX, 0u32);
-    for (j, (slot, p)) in slots.iter_mut().zip(points).enumerate() {
-        let k = descending_bits(key(p));
-        lo = lo.min(k);
-        hi = hi.max(k);
-        *slot = (k as u64) << 32 | (first + j) as u64;
-    }
-    (lo, hi)
-}
-
-/// Sort one bucket on its low `bits` key bits (see [`radix_with`]) and write its
-/// indices into `out`; `hist` is a reusable buffer of at least 1024 counters.
-fn sort_bucket(
-    data: &mut [u64],
-    spare: &mut [u64],
-    out: &mut [u32],
-    hist: &mut [u32],
-    lo: u32,
-    bits: u32,
-) {
-    if bits == 0 || data.len() <= SMALL_BUCKET {
-        // Equal keys are already in index order; unique pairs sort to the stable order.
-        if bits != 0 {
-            data.sort_unstable();
-        }
-        for (o, v) in out.iter_mut().zip(data.iter()) {
-            *o = *v as u32;
-        }
-        return;
-    }
-    // Up to 4 passes of up to 8 bits; one sweep counts the digits of all of them.
-    let passes = bits.div_ceil(8);
-    let width = bits.div_ceil(passes);
-    let radix = 1usize << width;
-    let mask = (1u32 << width) - 1;
-    let key = |v: u64| (v >> 32) as u32 - lo;
-    let hist = &mut hist[..passes as usize * radix];
-    hist.fill(0);
-    for (p, h) in hist.chunks_exact_mut(radix).enumerate() {
-        let shift = p as u32 * width;
-        for &v in data.iter() {
-            h[((key(v) >> shift) & mask) as usize] += 1;
-        }
-    }
-    for h in hist.chunks_exact_mut(radix) {
-        let mut sum = 0;
-        for c in h.iter_mut() {
-            let count = *c;
-            *c = sum;
-            sum += count;
-        }
-    }
-    let (mut src, mut dst) = (data, spare);
-    for (p, h) in hist.chunks_exact_mut(radix).enumerate() {
-        let shift = p as u32 * width;
-        if p as u32 + 1 == passes {
-            // The last pass writes the indices straight into `out`.
-            for &v in src.iter() {
-                let d = ((key(v) >> shift) & mask) as usize;
-                out[h[d] as usize] = v as u32;
-                h[d] += 1;
-            }
-        } else {
-            for &v in src.iter() {
-                let d = ((key(v) >> shift) & mask) as usize;
-                dst[h[d] as usize] = v;
-                h[d] += 1;
-            }
-            std::mem::swap(&mut src, &mut dst);
-        }
-    }
 }
 
 /// A sorter that keeps its buffers (and, for the seed's method, its structs) between
