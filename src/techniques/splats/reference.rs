@@ -161,7 +161,11 @@ pub fn view_direction(camera: &Camera) -> DVec3 {
 
 /// A splat's size in pixels (see the module doc), unclamped NaN when undefined.
 pub fn splat_size(params: &SplatParams, camera: &Camera, p: DVec3) -> f64 {
-    let size = match eye_position(camera) {
+    size_from(params, eye_position(camera), p)
+}
+
+fn size_from(params: &SplatParams, eye: Option<DVec3>, p: DVec3) -> f64 {
+    let size = match eye {
         Some(eye) => params.point_size / p.distance(eye) * params.factor,
         None => params.point_size * params.factor,
     };
@@ -208,36 +212,50 @@ struct Screen {
     depth: f64,
 }
 
-fn project(
-    scene: &SplatScene,
-    camera: &Camera,
-    size: [u32; 2],
-    mvp: &DMat4,
-    i: usize,
-) -> Option<Screen> {
-    let p = scene.position(i);
-    let c = *mvp * DVec4::new(p.x, p.y, p.z, 1.0);
-    // Written so that NaN fails every test.
-    let inside = c.w > 0.0 && c.x.abs() <= c.w && c.y.abs() <= c.w && c.z.abs() <= c.w;
-    let s = splat_size(&scene.params, camera, p);
-    let drawn = s > 0.0;
-    if !inside || !drawn {
-        return None;
+/// The camera's matrices and eye, computed once per image.
+struct Projector {
+    mvp: DMat4,
+    view: DMat4,
+    eye: Option<DVec3>,
+    size: [f64; 2],
+}
+
+impl Projector {
+    fn new(camera: &Camera, size: [u32; 2]) -> Projector {
+        Projector {
+            mvp: camera.view_projection(size[0] as f64 / size[1].max(1) as f64),
+            view: camera.view(),
+            eye: eye_position(camera),
+            size: [size[0] as f64, size[1] as f64],
+        }
     }
-    let eye_z = (camera.view() * DVec4::new(p.x, p.y, p.z, 1.0)).z;
-    let rgba = scene.rgba[i];
-    Some(Screen {
-        x: (c.x / c.w + 1.0) / 2.0 * size[0] as f64,
-        y: (c.y / c.w + 1.0) / 2.0 * size[1] as f64,
-        size: s,
-        rgb: [0, 1, 2].map(|k| clamp01(rgba[k])),
-        alpha: rgba[3],
-        z: match camera.projection {
-            Projection::Perspective => -eye_z,
-            Projection::Orthographic => 2.0 - eye_z,
-        },
-        depth: (c.z / c.w + 1.0) / 2.0,
-    })
+
+    /// Splat `i` on screen, or `None` when GL would not draw it.
+    fn project(&self, scene: &SplatScene, i: usize) -> Option<Screen> {
+        let p = scene.position(i);
+        let c = self.mvp * DVec4::new(p.x, p.y, p.z, 1.0);
+        // Written so that NaN fails every test.
+        let inside = c.w > 0.0 && c.x.abs() <= c.w && c.y.abs() <= c.w && c.z.abs() <= c.w;
+        let s = size_from(&scene.params, self.eye, p);
+        let drawn = s > 0.0;
+        if !inside || !drawn {
+            return None;
+        }
+        let eye_z = (self.view * DVec4::new(p.x, p.y, p.z, 1.0)).z;
+        let rgba = scene.rgba[i];
+        Some(Screen {
+            x: (c.x / c.w + 1.0) / 2.0 * self.size[0],
+            y: (c.y / c.w + 1.0) / 2.0 * self.size[1],
+            size: s,
+            rgb: [0, 1, 2].map(|k| clamp01(rgba[k])),
+            alpha: rgba[3],
+            z: match self.eye {
+                Some(_) => -eye_z,
+                None => 2.0 - eye_z,
+            },
+            depth: (c.z / c.w + 1.0) / 2.0,
+        })
+    }
 }
 
 /// Clamp to [0, 1] with NaN → 0.
@@ -365,10 +383,10 @@ fn screen_splats(
     camera: &Camera,
     size: [u32; 2],
 ) -> Vec<Screen> {
-    let mvp = camera.view_projection(size[0] as f64 / size[1].max(1) as f64);
+    let projector = Projector::new(camera, size);
     indices
         .filter(|&i| i < scene.len())
-        .filter_map(|i| project(scene, camera, size, &mvp, i))
+        .filter_map(|i| projector.project(scene, i))
         .collect()
 }
 
