@@ -211,6 +211,13 @@ fn degenerate_inputs_fall_back() {
     // Coincident points.
     let r = estimate(&vec![[0.1f32, 0.2, 0.3]; 100], LayerIds::None, 16);
     assert_eq!((r.coincident, r.normals[50]), (100, [0.0, 0.0, 1.0]));
+    // Many of them (a tree of one position), and half a cloud stacked on one point.
+    let r = estimate(&vec![[0.5f32, -0.5, 0.0]; 60_000], LayerIds::None, 16);
+    assert_eq!(r.coincident, 60_000);
+    let mut stacked = plane(20_000, DVec3::ZERO, DVec3::new(0.0, 1.0, 1.0), 2.0, 0.0, 3);
+    stacked.extend(vec![[0.25f32, 0.0, 0.0]; 20_000]);
+    let r = estimate(&stacked, LayerIds::None, 16);
+    assert_eq!(r.coincident, 20_000);
     // Collinear points along a tilted line: the perpendicular closest to +Z.
     let dir = DVec3::new(0.6, 0.0, 0.8);
     let line: Vec<[f32; 3]> = (0..50)
