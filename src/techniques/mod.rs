@@ -8,6 +8,7 @@ pub mod clip;
 pub mod opacity3d;
 pub mod quad;
 pub mod rays;
+pub mod splats;
 
 use crate::camera::Camera;
 use crate::gl::{GlResult, Gpu, ProgramKind, Surface};

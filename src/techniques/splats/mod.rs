@@ -1,0 +1,34 @@
+//! Point-based rendering of geological sections (seed 004): every point a `GL_POINT`
+//! splat sized by its distance to the eye, its alpha falling off from the centre,
+//! blended back to front over the others.
+//!
+//! # How it works (the CPU part)
+//!
+//! - **Order** ([`sort`]): transparent splats need back-to-front order (the depth test
+//!   would discard what should blend), so each frame the camera moved the points are
+//!   sorted by their distance to the eye (orthographic: depth along the view). The
+//!   seed sorted its point structs with `std::sort` and a comparator computing both
+//!   distances (~35 ms for 570k points), then re-uploaded the whole buffer; kept here
+//!   as [`sort::SortMethod::Seed`], the baseline. The fast paths compute one key per
+//!   point and sort (key, index) pairs ([`sort::SortMethod::Keys`]) or radix-sort them
+//!   in parallel ([`sort::SortMethod::Radix`]), yielding an index buffer to upload
+//!   instead of the points; [`sort::SortCache`] skips the sort when the camera did not
+//!   move. All methods are stable (ties in index order) and agree.
+//! - **Order-independent alternative**: weighted blended OIT (McGuire & Bavoil 2013)
+//!   needs no sort; [`reference::weighted_blended`] composites it on the CPU so its
+//!   error against exact order ([`reference::rmse_rgb`]) can be measured.
+//! - **Normals** ([`normals`]) for Phong lighting: the seed had CloudCompare estimate
+//!   them per layer; here k nearest neighbours (kiddo's k-d tree) and PCA, one tree
+//!   per layer id, in parallel; flipped toward the eye at draw time
+//!   ([`normals::orient_toward`]).
+//! - **Reference** ([`reference`](mod@reference)): the f64 compositing of the same splats (GL's point
+//!   clipping, size clamping and point-sprite coverage; the seed's footprints as
+//!   written beside precise ones) that the renderer is scored against.
+//!
+//! The seed's footprint formulas, as written, are 0 (smoothstep) or at their lowest
+//! (Gaussian) at the splat centre and largest on the rim, the reverse of the splats it
+//! describes; [`reference`](mod@reference)'s doc gives the details and the precise versions.
+
+pub mod normals;
+pub mod reference;
+pub mod sort;
