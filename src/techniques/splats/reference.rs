@@ -21,9 +21,9 @@
 //!    the inscribed circle; fragments with `n_dist > 1` are discarded. Alpha is the
 //!    point's alpha times the [`Footprint`] at `n_dist`; colour and alpha are clamped
 //!    to [0, 1] (a fixed-point target clamps them) and a NaN alpha counts as 0.
-//! 5. Blending: `glBlendFunc(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA)` on all four
-//!    channels, so the alpha channel gets `a² + dst.a (1 - a)` (a quirk of the seed's
-//!    non-separate blend; compare colours, not alpha).
+//! 5. Blending: colour `SRC_ALPHA, ONE_MINUS_SRC_ALPHA` as the seed's `glBlendFunc`;
+//!    alpha `ONE, ONE_MINUS_SRC_ALPHA` (arbvis's `Blend::Over`), so the alpha channel is
+//!    coverage, `a + dst.a (1 - a)`.
 //!
 //! # The seed's footprints and their quirks
 //!
@@ -371,7 +371,7 @@ pub fn composite_in_order(
             for (d, c) in dst.iter_mut().zip(s.rgb) {
                 *d = c * a + *d * (1.0 - a);
             }
-            dst[3] = a * a + dst[3] * (1.0 - a);
+            dst[3] = a + dst[3] * (1.0 - a);
         },
     );
     to_image(size, pixels)

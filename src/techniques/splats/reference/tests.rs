@@ -37,7 +37,7 @@ fn over(dst: [f64; 4], c: [f64; 3], a: f64) -> [f64; 4] {
         c[0] * a + dst[0] * (1.0 - a),
         c[1] * a + dst[1] * (1.0 - a),
         c[2] * a + dst[2] * (1.0 - a),
-        a * a + dst[3] * (1.0 - a),
+        a + dst[3] * (1.0 - a),
     ]
 }
 
@@ -64,7 +64,7 @@ fn one_splat_by_hand() {
         let a = 0.8 * smoothstep(0.0, 1.0, 1.0 - n_dist);
         f32s(over(BG, [1.0, 0.5, 0.25], a))
     };
-    assert_eq!(image.pixel(4, 4), f32s([0.8, 0.4, 0.22, 0.84]));
+    assert_eq!(image.pixel(4, 4), f32s([0.8, 0.4, 0.22, 1.0]));
     assert_eq!(image.pixel(5, 4), expect(0.4));
     assert_eq!(image.pixel(4, 2), expect(0.8));
     assert_eq!(image.pixel(6, 5), expect(2.0 * 5f64.sqrt() / 5.0));
@@ -95,7 +95,7 @@ fn two_overlapping_splats_in_both_orders() {
     assert_eq!(exact_order(&positions, &camera), vec![1, 0]);
     let exact = composite(&s, &camera, [9, 9]);
     let blue_then_red = over(over(black, [0.0, 0.0, 1.0], 0.3), [1.0, 0.0, 0.0], 0.6);
-    assert_eq!(blue_then_red, [0.6, 0.0, 0.3 * 0.4, 0.36 + 0.09 * 0.4]);
+    assert_eq!(blue_then_red, [0.6, 0.0, 0.3 * 0.4, 0.6 + 0.3 * 0.4]);
     assert_eq!(exact.pixel(4, 4), f32s(blue_then_red));
     assert_eq!(composite_in_order(&s, &[1, 0], &camera, [9, 9]), exact);
     let wrong = composite_in_order(&s, &[0, 1], &camera, [9, 9]);
