@@ -60,6 +60,13 @@ pub const CELLPROJ_PRECISE_VERT: ProgramText = program!("cellproj/precise.vert")
 /// Precise cell projection: fragment stage (exact crossing, guarded exit, depth, shading).
 pub const CELLPROJ_PRECISE_FRAG: ProgramText = program!("cellproj/precise.frag");
 
+/// Splats: the vertex stage (the seed's size rule, per-point Phong).
+pub const SPLATS_VERT: ProgramText = program!("splats/splat.vert");
+/// Splats: the seed's fragment functions as written.
+pub const SPLATS_SEED_FRAG: ProgramText = program!("splats/seed.frag");
+/// Splats: the corrected fragment stage.
+pub const SPLATS_PRECISE_FRAG: ProgramText = program!("splats/precise.frag");
+
 /// A vertex + fragment pair of one kind.
 #[derive(Debug, Clone)]
 pub struct ProgramPair {
@@ -170,5 +177,8 @@ pub fn all_texts() -> Vec<ProgramText> {
         CELLPROJ_ORTHOGRAPHIC_FRAG,
         CELLPROJ_PRECISE_VERT,
         CELLPROJ_PRECISE_FRAG,
+        SPLATS_VERT,
+        SPLATS_SEED_FRAG,
+        SPLATS_PRECISE_FRAG,
     ]
 }

@@ -11,6 +11,7 @@ use crate::gl::{ProgramChoice, TargetFormat};
 use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::quad::QuadScene;
+use crate::techniques::splats::SplatsScene;
 
 /// Faithful (the original programs, 8-bit targets, original formulas) or precise
 /// (corrected maths, float targets). DESIGN.md §3.
@@ -52,6 +53,8 @@ pub enum TechniqueScene {
     Opacity3d(Box<Opacity3dScene>),
     /// Isosurfaces of tetrahedral meshes by cell projection.
     Cellproj(Box<CellprojScene>),
+    /// Point-based rendering of geological sections as splats.
+    Splats(Box<SplatsScene>),
 }
 
 impl TechniqueScene {
@@ -61,6 +64,7 @@ impl TechniqueScene {
             TechniqueScene::Quad(_) => "quad",
             TechniqueScene::Opacity3d(_) => "opacity3d",
             TechniqueScene::Cellproj(_) => "cellproj",
+            TechniqueScene::Splats(_) => "splats",
         }
     }
 }
@@ -162,6 +166,10 @@ pub const DEMOS: &[(&str, &str)] = &[
         "cellproj-spherical",
         include_str!("../scenes/demo/cellproj-spherical.toml"),
     ),
+    (
+        "splats-section",
+        include_str!("../scenes/demo/splats-section.toml"),
+    ),
 ];
 
 impl Scene {
@@ -240,6 +248,11 @@ impl Scene {
                     *p = base.join(&*p);
                 }
             }
+            TechniqueScene::Splats(s) => {
+                if let Some(p) = s.cloud.path_mut() {
+                    *p = base.join(&*p);
+                }
+            }
             TechniqueScene::Quad(_) => {}
         }
         scene.base = base;
@@ -288,6 +301,7 @@ impl Scene {
                 o.validate().map_err(|e| e.within("technique.opacity3d"))
             }
             TechniqueScene::Cellproj(c) => c.validate().map_err(|e| e.within("technique.cellproj")),
+            TechniqueScene::Splats(s) => s.validate().map_err(|e| e.within("technique.splats")),
             TechniqueScene::Quad(_) => Ok(()),
         }
     }

@@ -150,6 +150,14 @@ impl Mesh {
         crate::gl_check!(gpu)
     }
 
+    /// Draw the vertices in order again (the index buffer is deleted).
+    pub fn clear_indices(&mut self) {
+        if let Some((ebo, _)) = self.indices.take() {
+            // SAFETY: deleted once; the VAO is not drawn through it any more.
+            unsafe { self.gl.delete_buffer(ebo) };
+        }
+    }
+
     /// Elements a draw walks: the indices when there are some, else the vertices.
     pub fn draw_count(&self) -> usize {
         self.indices.map_or(self.vertex_count, |(_, n)| n)

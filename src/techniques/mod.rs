@@ -75,6 +75,12 @@ pub fn build(gpu: &Gpu, scene: &Scene, kind: ProgramKind) -> GlResult<Box<dyn Re
             params,
             &scene.base,
         )?),
+        TechniqueScene::Splats(params) => Box::new(splats::SplatsRenderer::new(
+            gpu,
+            scene.fidelity,
+            params,
+            &scene.base,
+        )?),
         TechniqueScene::Cellproj(params) => Box::new(cellproj::CellprojRenderer::new(
             gpu,
             kind,

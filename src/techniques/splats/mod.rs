@@ -30,5 +30,11 @@
 //! describes; [`reference`](mod@reference)'s doc gives the details and the precise versions.
 
 pub mod normals;
+pub mod prepare;
 pub mod reference;
+pub mod renderer;
+pub mod scene;
 pub mod sort;
+
+pub use renderer::SplatsRenderer;
+pub use scene::SplatsScene;

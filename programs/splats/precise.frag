@@ -1,0 +1,43 @@
+#version 330
+// arbvis (new): seed 004's fragment shader corrected: the property normalized as
+// (value - min) / (max - min), clamped, 0 for an empty range; the footprints fall off
+// from the centre (smoothstep(0, 1, 1 - n_dist), exp(-n_dist^2 / (2 width)), a width of 0
+// giving a single opaque pixel at the centre). Uniforms as seed.frag.
+uniform vec4 program_local[5];
+in vec3 v_color;
+in float v_value;
+in vec2 v_light;
+out vec4 FragColor;
+const float PI = 3.14159265358979;
+
+float normalized(float value, float min_value, float max_value) {
+    if (!(max_value > min_value) || isnan(value)) return 0.0;
+    return clamp((value - min_value) / (max_value - min_value), 0.0, 1.0);
+}
+
+void main() {
+    float n_dist = 2.0 * length(gl_PointCoord - vec2(0.5));
+    if (n_dist > 1.0) discard;
+    float min_value = program_local[0].y;
+    float max_value = program_local[0].z;
+    float n = normalized(v_value, min_value, max_value);
+    vec3 color = v_color;
+    if (program_local[0].x > 0.5) {
+        vec3 pct = vec3(smoothstep(0.0, 1.0, n), sin(n * PI), sqrt(n));
+        color = mix(program_local[1].rgb, program_local[2].rgb, pct);
+    }
+    color = color * v_light.x + v_light.y;
+    float alpha;
+    if (program_local[3].x > 0.5) {
+        float w = program_local[3].y;
+        alpha = w > 0.0 ? exp(-n_dist * n_dist / (2.0 * w)) : (n_dist == 0.0 ? 1.0 : 0.0);
+    } else {
+        alpha = smoothstep(0.0, 1.0, 1.0 - n_dist);
+    }
+    if (program_local[0].w > 0.5) {
+        float t = program_local[4].x;
+        float r = program_local[4].y;
+        alpha *= (v_value >= t - r && v_value <= t + r) ? smoothstep(0.0, 1.0, n) : 0.0;
+    }
+    FragColor = vec4(color, clamp(alpha, 0.0, 1.0));
+}

@@ -1,0 +1,287 @@
+//! The GL side of the splats: the point vertices uploaded once, an index buffer holding
+//! the back-to-front order of the visible points (rewritten only when the camera moved),
+//! or, for the seed's method, the whole vertex buffer re-uploaded in sorted order; one
+//! draw of point sprites blended `SRC_ALPHA, ONE_MINUS_SRC_ALPHA` without depth test.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use super::prepare::{
+    from_cloud, normals_for, prepare, Prepared, COLOR_A, COLOR_B, PHONG, VERTEX_COMPONENTS,
+};
+use super::scene::{ColourMode, Kernel, Mode, SortChoice, SplatsScene};
+use super::sort::{seed_order, SeedPoint, SortCache, SortMethod, View};
+use crate::camera::Projection;
+use crate::gl::{
+    self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind, Surface,
+};
+use crate::points::PointCloud;
+use crate::programs::{self, ProgramPair};
+use crate::scene::{Fidelity, TechniqueScene};
+use crate::techniques::{Frame, Renderer};
+
+/// The program pair of a fidelity (GLSL; see the module doc of [`super`] for ARB).
+pub fn program_pair(fidelity: Fidelity) -> ProgramPair {
+    ProgramPair {
+        kind: ProgramKind::Glsl,
+        vertex: programs::SPLATS_VERT,
+        fragment: match fidelity {
+            Fidelity::Faithful => programs::SPLATS_SEED_FRAG,
+            Fidelity::Precise => programs::SPLATS_PRECISE_FRAG,
+        },
+    }
+}
+
+/// The splat renderer.
+pub struct SplatsRenderer {
+    fidelity: Fidelity,
+    base: PathBuf,
+    cloud: PointCloud,
+    normals: Option<(Vec<[f32; 3]>, usize)>,
+    params: SplatsScene,
+    prepared: Prepared,
+    mesh: Mesh,
+    program: Program,
+    cache: Option<SortCache>,
+    seed_points: Vec<SeedPoint>,
+    /// The view the current order was made for.
+    ordered_for: Option<[u64; 4]>,
+    /// Time of the last sort (and upload), for the bench and the viewer.
+    pub last_sort: Duration,
+}
+
+fn view_bits(view: View) -> [u64; 4] {
+    match view {
+        View::Eye(e) => [
+            0,
+            e[0].to_bits() as u64,
+            e[1].to_bits() as u64,
+            e[2].to_bits() as u64,
+        ],
+        View::Along(d) => [
+            1,
+            d[0].to_bits() as u64,
+            d[1].to_bits() as u64,
+            d[2].to_bits() as u64,
+        ],
+    }
+}
+
+impl SplatsRenderer {
+    /// Load and prepare the scene's cloud (relative paths from `base`), then upload.
+    pub fn new(
+        gpu: &Gpu,
+        fidelity: Fidelity,
+        params: &SplatsScene,
+        base: &Path,
+    ) -> GlResult<SplatsRenderer> {
+        params
+            .validate()
+            .map_err(|e| GlError::Data(e.to_string()))?;
+        let (cloud, prepared) = prepare(params, base).map_err(GlError::Data)?;
+        SplatsRenderer::from_prepared(gpu, fidelity, params, base, cloud, prepared)
+    }
+
+    /// Upload a cloud prepared elsewhere.
+    pub fn from_prepared(
+        gpu: &Gpu,
+        fidelity: Fidelity,
+        params: &SplatsScene,
+        base: &Path,
+        cloud: PointCloud,
+        prepared: Prepared,
+    ) -> GlResult<SplatsRenderer> {
+        if params.sort == SortChoice::Oit {
+            return Err(GlError::Unsupported(
+                "sort = \"oit\" (weighted blended transparency) is measured on the CPU only (splats::reference::weighted_blended); the renderer draws sorted splats".into(),
+            ));
+        }
+        let pair = program_pair(fidelity);
+        let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
+        let mesh = Mesh::new(
+            gpu,
+            "splats points",
+            &VERTEX_COMPONENTS,
+            &prepared.vertices(None),
+        )?;
+        let normals = (params.lighting && params.mode == Mode::Surface)
+            .then(|| (prepared.normals.clone(), prepared.normal_fallbacks));
+        let mut r = SplatsRenderer {
+            fidelity,
+            base: base.to_path_buf(),
+            cloud,
+            normals,
+            params: params.clone(),
+            prepared,
+            mesh,
+            program,
+            cache: None,
+            seed_points: Vec::new(),
+            ordered_for: None,
+            last_sort: Duration::ZERO,
+        };
+        r.install(gpu)?;
+        Ok(r)
+    }
+
+    /// Set up the ordering of the current `prepared` and `params`, and the constants.
+    fn install(&mut self, gpu: &Gpu) -> GlResult<()> {
+        self.cache = match self.params.sort {
+            SortChoice::Keys => Some(SortCache::new(SortMethod::Keys)),
+            SortChoice::Radix => Some(SortCache::new(SortMethod::Radix)),
+            SortChoice::Seed | SortChoice::None | SortChoice::Oit => None,
+        };
+        self.seed_points = if self.params.sort == SortChoice::Seed {
+            SeedPoint::from_positions(&self.prepared.positions)
+        } else {
+            Vec::new()
+        };
+        self.ordered_for = None;
+        self.mesh.clear_indices();
+        self.mesh.update(gpu, &self.prepared.vertices(None))?;
+        if self.params.sort == SortChoice::None {
+            let visible: Vec<u32> = self.visible(0..self.prepared.len() as u32);
+            self.mesh.set_indices(gpu, &visible)?;
+        }
+        self.send_constants(gpu)
+    }
+
+    /// The prepared cloud.
+    pub fn prepared(&self) -> &Prepared {
+        &self.prepared
+    }
+
+    fn visible(&self, order: impl IntoIterator<Item = u32>) -> Vec<u32> {
+        order
+            .into_iter()
+            .filter(|&i| self.prepared.visible[i as usize])
+            .collect()
+    }
+
+    /// Put the points in back-to-front order for `view` (nothing when it did not move).
+    fn order(&mut self, gpu: &Gpu, view: View) -> GlResult<()> {
+        let bits = view_bits(view);
+        if self.ordered_for == Some(bits) || self.params.sort == SortChoice::None {
+            return Ok(());
+        }
+        let t0 = Instant::now();
+        if self.params.sort == SortChoice::Seed {
+            // The seed's way: the structs sorted with a distance comparator, the whole
+            // buffer re-uploaded in that order (hidden points left out).
+            let order = seed_order(&mut self.seed_points, view);
+            let order = self.visible(order);
+            let vertices = self.prepared.vertices(Some(&order));
+            self.mesh.update(gpu, &vertices)?;
+        } else if let Some(cache) = &mut self.cache {
+            let order: Vec<u32> = cache.order(&self.prepared.positions, view).to_vec();
+            let order = self.visible(order);
+            self.mesh.set_indices(gpu, &order)?;
+        }
+        self.last_sort = t0.elapsed();
+        self.ordered_for = Some(bits);
+        Ok(())
+    }
+
+    fn send_constants(&self, gpu: &Gpu) -> GlResult<()> {
+        let p = &self.params;
+        let colour = if p.colour == ColourMode::Property {
+            1.0
+        } else {
+            0.0
+        };
+        let volume = if p.mode == Mode::Volume { 1.0 } else { 0.0 };
+        let [lo, hi] = self.prepared.range;
+        let prog = &self.program;
+        prog.set_local(gpu, 0, [colour, lo, hi, volume])?;
+        prog.set_local(gpu, 1, [COLOR_A[0], COLOR_A[1], COLOR_A[2], 1.0])?;
+        prog.set_local(gpu, 2, [COLOR_B[0], COLOR_B[1], COLOR_B[2], 1.0])?;
+        let kernel = if p.kernel == Kernel::Gaussian {
+            1.0
+        } else {
+            0.0
+        };
+        prog.set_local(gpu, 3, [kernel, p.gauss_width, 0.0, 0.0])?;
+        prog.set_local(gpu, 4, [p.volume.threshold, p.volume.range, 0.0, 0.0])?;
+        let lighting = if p.lighting && p.mode == Mode::Surface {
+            1.0
+        } else {
+            0.0
+        };
+        prog.set_vertex_local(gpu, 6, [p.point_size, p.factor, lighting, 0.0])?;
+        prog.set_vertex_local(gpu, 7, PHONG)?;
+        Ok(())
+    }
+}
+
+impl Renderer for SplatsRenderer {
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+        let camera = &frame.camera;
+        let view = View::of_camera(camera);
+        self.order(gpu, view)?;
+        self.program
+            .set_transform(gpu, camera.view_projection(frame.aspect()))?;
+        let inverse = camera.view().inverse();
+        let eye = inverse.transform_point3(glam::DVec3::ZERO);
+        let dir = inverse.transform_vector3(glam::DVec3::NEG_Z).normalize();
+        let perspective = if camera.projection == Projection::Perspective {
+            1.0
+        } else {
+            0.0
+        };
+        self.program
+            .set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, perspective])?;
+        self.program
+            .set_vertex_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
+        gl::draw(
+            gpu,
+            surface,
+            &DrawCall {
+                program: &self.program,
+                mesh: &self.mesh,
+                range: None,
+                textures: &[],
+                blend: Blend::Over,
+                depth_test: false,
+                cull_back: false,
+                primitive: Primitive::Points,
+            },
+        )
+    }
+
+    fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()> {
+        let TechniqueScene::Splats(new) = technique else {
+            return Err(GlError::Invalid(format!(
+                "splats renderer given a {} scene",
+                technique.name()
+            )));
+        };
+        new.validate().map_err(|e| GlError::Data(e.to_string()))?;
+        let p = &self.params;
+        if new.cloud != p.cloud {
+            *self = SplatsRenderer::new(gpu, self.fidelity, new, &self.base.clone())?;
+            return Ok(());
+        }
+        let lit = |s: &SplatsScene| (s.lighting && s.mode == Mode::Surface, s.normals_k);
+        if lit(new) != lit(p) {
+            self.normals = normals_for(&self.cloud, new);
+        }
+        let rebuild = new.colour != p.colour
+            || new.property != p.property
+            || new.faults_white != p.faults_white
+            || new.hide_layers != p.hide_layers
+            || new.hide_undefined != p.hide_undefined
+            || lit(new) != lit(p)
+            || new.sort != p.sort;
+        self.params = (**new).clone();
+        if rebuild {
+            self.prepared =
+                from_cloud(&self.cloud, new, self.normals.clone()).map_err(GlError::Data)?;
+            return self.install(gpu);
+        }
+        self.send_constants(gpu)
+    }
+
+    fn program_kind(&self) -> ProgramKind {
+        ProgramKind::Glsl
+    }
+}

@@ -1,0 +1,199 @@
+//! `[technique.splats]`: which cloud, how its points are coloured, hidden, sized, shaded,
+//! ordered, and whether a property is shown as a volume.
+
+use serde::{Deserialize, Serialize};
+
+use crate::points::PointSource;
+use crate::scene::FieldError;
+
+/// What colours a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ColourMode {
+    /// The facies dictionary (`-999`, undefined, in grey).
+    #[default]
+    Facies,
+    /// One colour per layer id.
+    Layer,
+    /// The property gradient scale (the seed's `gradient_scale` in the fragment program).
+    Property,
+    /// The file's RGB (LAS, PLY).
+    Rgb,
+    /// LAS intensity, as grey.
+    Intensity,
+    /// LAS classification, one colour per class.
+    Classification,
+}
+
+/// How a splat's alpha falls off from its centre.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kernel {
+    /// `smoothstep` (faithful: of `n_dist` as the seed wrote it; precise: of `1 - n_dist`).
+    Smoothstep,
+    /// A Gaussian (faithful: the seed's `gauss(n_dist, 1.0, width)`; precise:
+    /// `exp(-n_dist^2 / (2 width))`).
+    #[default]
+    Gaussian,
+}
+
+/// How points are put in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SortChoice {
+    /// The seed's way: sort the point structs with a comparator computing both distances,
+    /// then re-upload the whole buffer.
+    Seed,
+    /// One key per point, (key, index) pairs sorted; an index buffer uploaded.
+    Keys,
+    /// Parallel radix sort of (key, index); an index buffer uploaded.
+    #[default]
+    Radix,
+    /// File order (wrong where splats overlap: for comparison).
+    None,
+    /// Weighted blended order-independent transparency (McGuire & Bavoil 2013): no
+    /// order, an approximation of it.
+    Oit,
+}
+
+/// Surface or volume rendering.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// Splats composing the section's surfaces (lit with normals when asked).
+    #[default]
+    Surface,
+    /// A property as density through a transfer function: points outside
+    /// `threshold ± range` get alpha 0, inside `smoothstep(0, 1, normalized value)`.
+    Volume,
+}
+
+/// The transfer function of volume mode.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct VolumeSpec {
+    /// Centre of the shown values, in the property's own units.
+    pub threshold: f64,
+    /// Half-width of the shown values.
+    pub range: f64,
+}
+
+impl Default for VolumeSpec {
+    /// Porosity's densest band as the seed reports it (0.0-0.012).
+    fn default() -> Self {
+        VolumeSpec {
+            threshold: 0.006,
+            range: 0.006,
+        }
+    }
+}
+
+/// `[technique.splats]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SplatsScene {
+    /// The point cloud.
+    pub cloud: PointSource,
+    /// Surface or volume.
+    #[serde(default)]
+    pub mode: Mode,
+    /// What colours the points.
+    #[serde(default)]
+    pub colour: ColourMode,
+    /// The property of `colour = "property"` and of volume mode.
+    #[serde(default = "porosity")]
+    pub property: String,
+    /// Faults (fault id >= 0) drawn white.
+    #[serde(default)]
+    pub faults_white: bool,
+    /// Layer ids not drawn.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub hide_layers: Vec<i32>,
+    /// Points of undefined facies (-999) not drawn.
+    #[serde(default)]
+    pub hide_undefined: bool,
+    /// The seed's `pointSize`.
+    #[serde(default = "default_point_size")]
+    pub point_size: f64,
+    /// The seed's `factor` (`gl_PointSize = pointSize / distance * factor`).
+    #[serde(default = "one")]
+    pub factor: f64,
+    /// Alpha fall-off.
+    #[serde(default)]
+    pub kernel: Kernel,
+    /// Width of the Gaussian (the seed's `gauss_factor`, a variance).
+    #[serde(default = "default_gauss_width")]
+    pub gauss_width: f64,
+    /// Phong lighting with normals estimated per layer (k nearest neighbours, PCA).
+    #[serde(default)]
+    pub lighting: bool,
+    /// Neighbours per normal.
+    #[serde(default = "default_k")]
+    pub normals_k: usize,
+    /// Ordering.
+    #[serde(default)]
+    pub sort: SortChoice,
+    /// Volume mode's transfer function.
+    #[serde(default)]
+    pub volume: VolumeSpec,
+}
+
+fn porosity() -> String {
+    crate::points::POROSITY.into()
+}
+fn default_point_size() -> f64 {
+    10.0
+}
+fn one() -> f64 {
+    1.0
+}
+fn default_gauss_width() -> f64 {
+    0.2
+}
+fn default_k() -> usize {
+    16
+}
+
+/// Largest point size asked for (GL clamps to its own range, 255 on llvmpipe).
+pub const MAX_POINT_SIZE: f64 = 4096.0;
+
+impl SplatsScene {
+    /// Check values that parse but cannot render; the error names the key.
+    pub fn validate(&self) -> Result<(), FieldError> {
+        let positive = |key: &str, v: f64, max: f64| {
+            if v.is_finite() && v > 0.0 && v <= max {
+                Ok(())
+            } else {
+                Err(FieldError::new(
+                    key,
+                    format!("{v}: must be positive and at most {max}"),
+                ))
+            }
+        };
+        positive("point_size", self.point_size, MAX_POINT_SIZE)?;
+        positive("factor", self.factor, 1e6)?;
+        if !(self.gauss_width.is_finite() && self.gauss_width >= 0.0) {
+            return Err(FieldError::new(
+                "gauss_width",
+                format!("{}: must be finite and not negative", self.gauss_width),
+            ));
+        }
+        if !(3..=256).contains(&self.normals_k) {
+            return Err(FieldError::new(
+                "normals_k",
+                format!("{}: must be 3..=256", self.normals_k),
+            ));
+        }
+        let v = self.volume;
+        if !(v.threshold.is_finite() && v.range.is_finite() && v.range >= 0.0) {
+            return Err(FieldError::new(
+                "volume",
+                format!(
+                    "threshold {} range {}: finite, range not negative",
+                    v.threshold, v.range
+                ),
+            ));
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,370 @@
+//! Splats end to end: GPU vs the f64 compositing reference (same footprints, same
+//! order), every sort method drawing the same picture, the seed's formulas as written vs
+//! corrected, hidden layers, lighting, volume mode, the extremes, and what gets built.
+
+mod common;
+
+use arbvis::camera::{Camera, Projection};
+use arbvis::gl::{Backend, Headless, Surface, Target, TargetFormat};
+use arbvis::image::Image;
+use arbvis::points::section::{generate, SectionSpec};
+use arbvis::points::PointCloud;
+use arbvis::render::render_on;
+use arbvis::scene::{Fidelity, Scene, TechniqueScene};
+use arbvis::techniques::splats::prepare::{footprint, from_cloud, normals_for, point_rgba};
+use arbvis::techniques::splats::reference::{
+    composite, eye_position, view_direction, SplatParams, SplatScene,
+};
+use arbvis::techniques::splats::scene::{ColourMode, Kernel, Mode, SortChoice};
+use arbvis::techniques::splats::{SplatsRenderer, SplatsScene};
+use arbvis::techniques::{Frame, Renderer};
+use common::headless;
+
+const BACKGROUND: [f32; 4] = [0.1, 0.1, 0.15, 1.0];
+const SIZE: [u32; 2] = [96, 72];
+
+fn cloud(points: usize) -> PointCloud {
+    generate(&SectionSpec { points, seed: 7 }).unwrap()
+}
+
+fn params(text: &str) -> SplatsScene {
+    toml::from_str(&format!(
+        "cloud = {{ section = {{ points = 1500, seed = 7 }} }}\n{text}"
+    ))
+    .unwrap()
+}
+
+fn camera(projection: Projection) -> Camera {
+    Camera {
+        projection,
+        rotation: [-0.5703, -0.1422, -0.1957, 0.785],
+        zoom: 1.6,
+        ..Camera::default()
+    }
+}
+
+/// Draw `cloud` with `params` into a float target (no 8-bit blending drift).
+fn draw(
+    h: &Headless,
+    cloud: &PointCloud,
+    params: &SplatsScene,
+    fidelity: Fidelity,
+    camera: Camera,
+) -> Image {
+    let gpu = h.gpu();
+    let normals = normals_for(cloud, params);
+    let prepared = from_cloud(cloud, params, normals).unwrap();
+    let mut r = SplatsRenderer::from_prepared(
+        gpu,
+        fidelity,
+        params,
+        std::path::Path::new("."),
+        cloud.clone(),
+        prepared,
+    )
+    .unwrap();
+    let target = Target::new(gpu, SIZE[0], SIZE[1], TargetFormat::Rgba32f).unwrap();
+    target.clear(gpu, BACKGROUND).unwrap();
+    let frame = Frame {
+        camera,
+        width: SIZE[0],
+        height: SIZE[1],
+    };
+    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
+    target.read(gpu).unwrap()
+}
+
+/// The f64 reference of the same splats.
+fn reference(
+    cloud: &PointCloud,
+    params: &SplatsScene,
+    fidelity: Fidelity,
+    camera: &Camera,
+) -> Image {
+    let normals = normals_for(cloud, params);
+    let prepared = from_cloud(cloud, params, normals).unwrap();
+    let rgba = point_rgba(
+        &prepared,
+        params,
+        fidelity,
+        eye_position(camera),
+        view_direction(camera),
+    );
+    let scene = SplatScene {
+        positions: &prepared.positions,
+        rgba: &rgba,
+        params: SplatParams {
+            point_size: params.point_size,
+            factor: params.factor,
+            footprint: footprint(params, fidelity),
+            size_range: [1.0, 255.0],
+        },
+        background: BACKGROUND.map(f64::from),
+    };
+    composite(&scene, camera, SIZE)
+}
+
+fn rgb_only(image: &Image) -> Image {
+    let mut out = image.clone();
+    out.data.chunks_exact_mut(4).for_each(|p| p[3] = 1.0);
+    out
+}
+
+#[test]
+fn gpu_matches_the_f64_reference() {
+    let h = headless(Backend::Egl);
+    let c = cloud(1500);
+    for (fidelity, text) in [
+        (
+            Fidelity::Precise,
+            "kernel = \"gaussian\"\ngauss_width = 0.15\npoint_size = 7.0",
+        ),
+        (
+            Fidelity::Precise,
+            "kernel = \"smoothstep\"\ncolour = \"property\"\npoint_size = 6.0",
+        ),
+        (
+            Fidelity::Faithful,
+            "kernel = \"gaussian\"\ngauss_width = 0.3\npoint_size = 7.0\ncolour = \"layer\"",
+        ),
+        (
+            Fidelity::Faithful,
+            "kernel = \"smoothstep\"\nfaults_white = true\npoint_size = 5.0",
+        ),
+        (Fidelity::Precise, "lighting = true\npoint_size = 6.0"),
+        (
+            Fidelity::Precise,
+            "mode = \"volume\"\ncolour = \"property\"\npoint_size = 9.0",
+        ),
+    ] {
+        for projection in [Projection::Orthographic, Projection::Perspective] {
+            let p = params(text);
+            let cam = camera(projection);
+            let gpu = rgb_only(&draw(&h, &c, &p, fidelity, cam));
+            let cpu = rgb_only(&reference(&c, &p, fidelity, &cam));
+            let d = gpu.compare(&cpu, 0.0).unwrap();
+            let mut errs: Vec<f32> = gpu
+                .data
+                .iter()
+                .zip(&cpu.data)
+                .map(|(a, b)| (a - b).abs())
+                .collect();
+            errs.sort_by(f32::total_cmp);
+            let q = |f: f64| errs[((errs.len() - 1) as f64 * f) as usize];
+            eprintln!(
+                "{fidelity:?} {projection:?} [{}]: rmse {:.5} max {:.4} p99 {:.5} p999 {:.5}",
+                text.replace('\n', " "),
+                d.rmse,
+                d.max_abs,
+                q(0.99),
+                q(0.999)
+            );
+            // Orthographic views agree to 2e-3 everywhere (measured: exact but for f32
+            // rounding). In perspective the size is pointSize / distance * factor in f32
+            // against f64, so a pixel centre on a splat's rim (n_dist = 1) can fall on
+            // either side: such flips cost the rim's alpha, up to 0.73 with the seed's
+            // rim-heavy Gaussian. 99.9 % of values agree within 2e-3 (measured 7e-4).
+            let bound = if projection == Projection::Orthographic {
+                2e-3
+            } else {
+                0.75
+            };
+            assert!(
+                q(0.999) < 2e-3 && d.max_abs < bound,
+                "{fidelity:?} {projection:?} [{text}]: {d:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn every_sort_method_draws_the_same_picture_and_order_matters() {
+    let h = headless(Backend::Egl);
+    let c = cloud(1500);
+    let cam = camera(Projection::Perspective);
+    let pictures: Vec<Image> = ["radix", "keys", "seed"]
+        .iter()
+        .map(|m| {
+            draw(
+                &h,
+                &c,
+                &params(&format!("sort = \"{m}\"\npoint_size = 8.0")),
+                Fidelity::Precise,
+                cam,
+            )
+        })
+        .collect();
+    for (i, p) in pictures.iter().enumerate().skip(1) {
+        let d = p.compare(&pictures[0], 0.0).unwrap();
+        // Same order, same fragments: bit-identical.
+        assert_eq!(d.max_abs, 0.0, "method {i}: {d:?}");
+    }
+    let unsorted = draw(
+        &h,
+        &c,
+        &params("sort = \"none\"\npoint_size = 8.0"),
+        Fidelity::Precise,
+        cam,
+    );
+    let d = unsorted.compare(&pictures[0], 0.0).unwrap();
+    assert!(
+        d.max_abs > 0.05,
+        "file order is visibly wrong where splats overlap: {d:?}"
+    );
+}
+
+#[test]
+fn the_seed_footprints_as_written_differ_from_the_corrected_ones() {
+    // The seed's smoothstep(0, 1, n_dist) is 0 at the centre: a lone splat is a ring.
+    let h = headless(Backend::Egl);
+    let mut one = cloud(1);
+    one.positions = vec![[0.0, 0.0, 0.0]];
+    let p = params("kernel = \"smoothstep\"\npoint_size = 21.0\ncolour = \"layer\"");
+    let cam = Camera::default();
+    for (fidelity, centre_alpha_is_high) in [(Fidelity::Faithful, false), (Fidelity::Precise, true)]
+    {
+        let img = draw(&h, &one, &p, fidelity, cam);
+        let centre = img.pixel(SIZE[0] / 2, SIZE[1] / 2);
+        let rim = img.pixel(SIZE[0] / 2 + 8, SIZE[1] / 2);
+        let dist = |px: [f32; 4]| (0..3).map(|i| (px[i] - BACKGROUND[i]).abs()).sum::<f32>();
+        assert_eq!(
+            dist(centre) > dist(rim),
+            centre_alpha_is_high,
+            "{fidelity:?}: centre {centre:?} rim {rim:?}"
+        );
+    }
+}
+
+#[test]
+fn hidden_layers_and_undefined_facies_are_not_drawn() {
+    let h = headless(Backend::Egl);
+    let c = cloud(3000);
+    let cam = camera(Projection::Orthographic);
+    let all = draw(&h, &c, &params("point_size = 4.0"), Fidelity::Precise, cam);
+    let hidden_text = "point_size = 4.0\nhide_layers = [0, 1, 2, 3, 4, 5, 6, 7]";
+    let none = draw(&h, &c, &params(hidden_text), Fidelity::Precise, cam);
+    assert!(
+        none.data.chunks_exact(4).all(|p| p[..3] == BACKGROUND[..3]),
+        "every layer hidden"
+    );
+    let some = draw(
+        &h,
+        &c,
+        &params("point_size = 4.0\nhide_layers = [7]\nhide_undefined = true"),
+        Fidelity::Precise,
+        cam,
+    );
+    let lit = |img: &Image| {
+        img.data
+            .chunks_exact(4)
+            .filter(|p| p[..3] != BACKGROUND[..3])
+            .count()
+    };
+    assert!(lit(&some) < lit(&all) && lit(&some) > 0);
+    // The reference agrees on which points are left out.
+    let p = params("point_size = 4.0\nhide_layers = [7]\nhide_undefined = true");
+    let d = rgb_only(&some)
+        .compare(&rgb_only(&reference(&c, &p, Fidelity::Precise, &cam)), 0.0)
+        .unwrap();
+    assert!(d.rmse < 2e-3, "{d:?}");
+}
+
+#[test]
+fn extremes_stay_finite() {
+    let h = headless(Backend::Egl);
+    let cam = camera(Projection::Perspective);
+    // No points, and one point.
+    for n in [0usize, 1] {
+        let mut c = cloud(1);
+        c.positions.truncate(n);
+        for a in &mut c.attributes {
+            match &mut a.values {
+                arbvis::points::Values::Int(v) => v.truncate(n),
+                arbvis::points::Values::Float(v) => v.truncate(n),
+            }
+        }
+        let img = draw(&h, &c, &params(""), Fidelity::Precise, cam);
+        assert!(img.data.iter().all(|v| v.is_finite()), "{n} points");
+    }
+    // Coincident points: a stable order gives the same picture every time.
+    let mut c = cloud(50);
+    c.positions.iter_mut().for_each(|p| *p = [0.1, 0.0, 0.0]);
+    let a = draw(&h, &c, &params("point_size = 12.0"), Fidelity::Precise, cam);
+    let b = draw(&h, &c, &params("point_size = 12.0"), Fidelity::Precise, cam);
+    assert_eq!(a.compare(&b, 0.0).unwrap().max_abs, 0.0);
+    // The camera inside the cloud (points behind it are not drawn), a zero Gaussian
+    // width, and a property of zero range (the seed's division gives NaN: alpha 0).
+    let c = cloud(1500);
+    let inside = Camera {
+        projection: Projection::Perspective,
+        zoom: 12.0,
+        ..Camera::default()
+    };
+    for (text, fidelity) in [
+        ("point_size = 30.0", Fidelity::Precise),
+        ("gauss_width = 0.0", Fidelity::Precise),
+        ("gauss_width = 0.0", Fidelity::Faithful),
+    ] {
+        let img = draw(&h, &c, &params(text), fidelity, inside);
+        assert!(
+            img.data.iter().all(|v| v.is_finite()),
+            "{text} {fidelity:?}"
+        );
+    }
+    let mut flat = cloud(400);
+    for a in &mut flat.attributes {
+        if a.name == "porosity" {
+            if let arbvis::points::Values::Float(v) = &mut a.values {
+                v.iter_mut().for_each(|x| *x = 0.004);
+            }
+        }
+    }
+    // Precise normalizes a zero range to 0: finite. The seed's `value / (max - min)` is
+    // infinite there and its gradient's sin() NaN, as written: the faithful colours are
+    // NaN in a float target, and 0 in a fixed-point one (as the reference clamps them).
+    let p = params(
+        "colour = \"property\"\nmode = \"volume\"\nvolume = { threshold = 0.004, range = 0.001 }",
+    );
+    let img = draw(&h, &flat, &p, Fidelity::Precise, cam);
+    assert!(img.data.iter().all(|v| v.is_finite()));
+    let faithful = draw(&h, &flat, &p, Fidelity::Faithful, cam);
+    let expected = reference(&flat, &p, Fidelity::Faithful, &cam);
+    let nan = |img: &Image| img.data.iter().filter(|v| v.is_nan()).count();
+    assert!(nan(&faithful) > 0 && nan(&expected) == 0);
+}
+
+#[test]
+fn the_demo_builds_what_it_draws() {
+    let h = headless(Backend::Egl);
+    let mut scene = Scene::demo("splats-section").unwrap();
+    scene.size = [160, 90];
+    if let TechniqueScene::Splats(s) = &mut scene.technique {
+        s.cloud = arbvis::points::PointSource::Section(SectionSpec {
+            points: 20_000,
+            seed: 1,
+        });
+    }
+    let r = render_on(&h, &scene).unwrap();
+    let kinds: Vec<&str> = r.resources.iter().map(|r| r.kind).collect();
+    // The index buffer of the order comes with the first frame.
+    assert_eq!(
+        kinds,
+        ["program", "buffer", "framebuffer", "buffer"],
+        "{:?}",
+        r.resources
+    );
+    assert_eq!(r.resources[1].bytes, 20_000 * 10 * 4, "10 floats per point");
+    let lit = r
+        .image
+        .data
+        .chunks_exact(4)
+        .filter(|p| p[..3] != [1.0, 1.0, 1.0])
+        .count();
+    assert!(lit > 160 * 90 / 10, "the section is drawn: {lit} pixels");
+    let _ = (
+        ColourMode::Facies,
+        Kernel::Gaussian,
+        Mode::Surface,
+        SortChoice::Radix,
+    );
+}
