@@ -387,3 +387,30 @@ fn mesh_scenes_render_and_agree_with_the_reference() {
         assert!(a.interior_fraction() >= bar, "{file}: {a:?}");
     }
 }
+
+#[test]
+fn point_cloud_scenes_render() {
+    let h = headless(Backend::Egl);
+    for (file, data) in [
+        ("autzen", "points/autzen_trim.laz"),
+        ("bunny", "points/bunny.ply"),
+    ] {
+        if shared_data(data).is_none() {
+            return;
+        }
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/data/{file}.toml"));
+        let mut scene = Scene::load(&path).unwrap();
+        scene.size = [160, 120];
+        let r = render_on(&h, &scene).unwrap();
+        let bg = scene.background;
+        let lit = r
+            .image
+            .data
+            .chunks_exact(4)
+            .filter(|p| (0..3).any(|c| (p[c] - bg[c]).abs() > 0.05))
+            .count();
+        // The cloud covers a good part of the picture, in colours (autzen's 8-bit RGB in
+        // 16-bit fields once came out black).
+        assert!(lit > 160 * 120 / 10, "{file}: {lit} pixels drawn");
+    }
+}

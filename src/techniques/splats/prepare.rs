@@ -120,6 +120,12 @@ pub fn from_cloud(
         [0.0, 0.0]
     };
     let grey = [0.6f32; 3];
+    // LAS stores colour in 16 bits, but many writers put 8-bit values there (autzen's
+    // largest is 236): scale by 255 when nothing exceeds it, as PDAL and CloudCompare do.
+    let rgb_scale = match &cloud.rgb {
+        Some(rgb) if rgb.iter().flatten().all(|&v| v <= 255) => 255.0,
+        _ => 65535.0,
+    };
     let colours: Vec<[f32; 3]> = (0..n)
         .map(|i| {
             let base = match scene.colour {
@@ -130,7 +136,7 @@ pub fn from_cloud(
                 ColourMode::Rgb => cloud
                     .rgb
                     .as_ref()
-                    .map_or(grey, |rgb| rgb[i].map(|v| v as f32 / 65535.0)),
+                    .map_or(grey, |rgb| rgb[i].map(|v| v as f32 / rgb_scale)),
                 ColourMode::Intensity => cloud.ints("intensity").map_or(grey, |v| {
                     let max = cloud
                         .attribute("intensity")
@@ -357,6 +363,19 @@ mod tests {
         assert!(p.range[0] >= 0.0 && p.range[1] > p.range[0]);
         assert_eq!(p.vertices(None).len(), 2000 * FLOATS_PER_VERTEX);
         assert!(matches!(s.cloud, PointSource::Section(_)));
+    }
+
+    #[test]
+    fn eight_bit_colours_in_sixteen_bit_fields_are_scaled_by_255() {
+        let mut cloud = generate(&SectionSpec { points: 3, seed: 5 }).unwrap();
+        let mut s = scene();
+        s.colour = ColourMode::Rgb;
+        cloud.rgb = Some(vec![[255, 0, 51], [0, 0, 0], [236, 84, 102]]);
+        let p = from_cloud(&cloud, &s, None).unwrap();
+        assert_eq!(p.colours[0], [1.0, 0.0, 0.2]);
+        cloud.rgb = Some(vec![[65535, 0, 13107], [256, 0, 0], [0, 0, 0]]);
+        let p = from_cloud(&cloud, &s, None).unwrap();
+        assert_eq!(p.colours[0], [1.0, 0.0, 0.2]);
     }
 
     #[test]
