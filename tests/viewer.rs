@@ -110,8 +110,16 @@ struct Run {
 fn run_viewer(display: &Display, dir: &Path, demo: &str, size: &str, script: &str) -> Run {
     let script_path = dir.join("script.txt");
     std::fs::write(&script_path, script).unwrap();
+    // A demo's name, or a scene file.
+    let source: Vec<&str> = if demo.ends_with(".toml") {
+        vec![demo]
+    } else {
+        vec!["--demo", demo]
+    };
     let mut child = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args(["view", "--demo", demo, "--size", size, "--screenshot-dir"])
+        .arg("view")
+        .args(source)
+        .args(["--size", size, "--screenshot-dir"])
         .arg(dir)
         .arg("--script")
         .arg(&script_path)
@@ -434,6 +442,51 @@ click Save scene
     assert_eq!(saved.fidelity, arbvis::scene::Fidelity::Precise);
     let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
     assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_splat_editor_reaches_the_saved_scene() {
+    let dir = temp_dir("splat-scene");
+    let scene = dir.join("splats.toml");
+    std::fs::write(
+        &scene,
+        "fidelity = \"precise\"\nbackground = [1.0, 1.0, 1.0, 1.0]\n[camera]\nprojection = \"perspective\"\nrotation = [-0.5703, -0.1422, -0.1957, 0.785]\nzoom = 1.5\n[technique.splats]\ncloud = { section = { points = 20000, seed = 3 } }\n",
+    )
+    .unwrap();
+    let script = "\
+resize 900 640
+wait 2
+click Layer 7
+click Faults in white
+set Colour layer
+set Point size 6
+click Sort seed
+click Volume mode
+set Threshold 0.01
+click Screenshot
+click Save scene
+";
+    let Some((out, _)) = run_script("splats", scene.to_str().unwrap(), "200x150", script) else {
+        return;
+    };
+    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let TechniqueScene::Splats(s) = &saved.technique else {
+        panic!("saved scene is not splats");
+    };
+    assert_eq!(s.hide_layers, vec![7]);
+    assert!(s.faults_white);
+    assert_eq!(
+        s.colour,
+        arbvis::techniques::splats::scene::ColourMode::Layer
+    );
+    assert_eq!(s.point_size, 6.0);
+    assert_eq!(s.sort, arbvis::techniques::splats::scene::SortChoice::Seed);
+    assert_eq!(s.mode, arbvis::techniques::splats::scene::Mode::Volume);
+    assert_eq!(s.volume.threshold, 0.01);
+    let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

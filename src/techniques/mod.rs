@@ -62,6 +62,10 @@ pub trait Renderer {
     fn needs_depth(&self) -> bool {
         false
     }
+    /// A line for the viewer about the last frame's CPU work (e.g. the sort time).
+    fn status(&self) -> Option<String> {
+        None
+    }
 }
 
 /// Build the renderer a scene names, with programs of `kind`; nothing else is created.

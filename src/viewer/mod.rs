@@ -28,6 +28,7 @@ pub mod panel;
 pub mod runner;
 pub mod script;
 mod session;
+pub mod splats;
 pub mod volume_view;
 pub mod widgets;
 

@@ -263,6 +263,12 @@ fn controls(
             }
         }
     });
+    if let TechniqueScene::Splats(sp) = &mut scene.technique {
+        ui.separator();
+        if super::splats::editor(ui, sp, w) {
+            actions.push(UiAction::ParamsChanged);
+        }
+    }
     if let TechniqueScene::Cellproj(c) = &mut scene.technique {
         ui.separator();
         if super::isovalues::editor(ui, c, w) {

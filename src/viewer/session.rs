@@ -254,11 +254,14 @@ impl Running {
             measure == Some(MeasureMode::Full),
         )?;
         self.panel.volume_info = format!(
-            "volume: {:.0} ms full ({} part{}), {:.0} ms interactive",
+            "picture: {:.0} ms full ({} part{}), {:.0} ms interactive{}",
             self.volume.full_ms,
             self.volume.parts,
             if self.volume.parts == 1 { "" } else { "s" },
-            self.volume.interactive_ms
+            self.volume.interactive_ms,
+            self.renderer
+                .status()
+                .map_or(String::new(), |s| format!("\n{s}"))
         );
 
         gl::clear(

@@ -284,4 +284,14 @@ impl Renderer for SplatsRenderer {
     fn program_kind(&self) -> ProgramKind {
         ProgramKind::Glsl
     }
+
+    fn status(&self) -> Option<String> {
+        let drawn = self.prepared.visible.iter().filter(|v| **v).count();
+        Some(format!(
+            "{drawn} of {} points drawn; last sort ({:?}): {:.1} ms",
+            self.prepared.len(),
+            self.params.sort,
+            self.last_sort.as_secs_f64() * 1e3
+        ))
+    }
 }

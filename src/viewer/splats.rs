@@ -1,0 +1,139 @@
+//! The splat editor: layers shown or hidden, colour mode, faults and undefined facies,
+//! point size and factor, kernel and its width, lighting (per-layer normals), sort
+//! method, and volume mode's transfer function. The frame and sort times show in the
+//! panel's status line.
+
+use super::widgets::Widgets;
+use crate::techniques::splats::scene::{ColourMode, Kernel, Mode, SortChoice};
+use crate::techniques::splats::SplatsScene;
+
+/// Layer ids with a toggle (the seed's sections have layers 0..7).
+pub const LAYERS: i32 = 8;
+
+/// Draw the editor; true when something changed.
+pub fn editor(ui: &mut egui::Ui, scene: &mut SplatsScene, w: &mut Widgets) -> bool {
+    let mut changed = false;
+    ui.label("Layers shown");
+    ui.horizontal_wrapped(|ui| {
+        for layer in 0..LAYERS {
+            let mut shown = !scene.hide_layers.contains(&layer);
+            let label = format!("Layer {layer}");
+            if w.checkbox(ui, &label, &mut shown, &layer.to_string()) {
+                scene.hide_layers.retain(|&l| l != layer);
+                if !shown {
+                    scene.hide_layers.push(layer);
+                    scene.hide_layers.sort_unstable();
+                }
+                changed = true;
+            }
+        }
+    });
+    changed |= w.checkbox(
+        ui,
+        "Hide undefined facies",
+        &mut scene.hide_undefined,
+        "Hide undefined facies (-999)",
+    );
+    changed |= w.checkbox(
+        ui,
+        "Faults in white",
+        &mut scene.faults_white,
+        "Faults in white",
+    );
+    changed |= w.choice(
+        ui,
+        "Colour",
+        &mut scene.colour,
+        &[
+            (ColourMode::Facies, "facies"),
+            (ColourMode::Layer, "layer"),
+            (ColourMode::Property, "property"),
+            (ColourMode::Rgb, "rgb"),
+            (ColourMode::Intensity, "intensity"),
+            (ColourMode::Classification, "classification"),
+        ],
+        140.0,
+    );
+    let mut property = scene.property.clone();
+    if w.choice(
+        ui,
+        "Property",
+        &mut property,
+        &[
+            ("porosity".to_string(), "porosity"),
+            ("amplitude".to_string(), "amplitude"),
+            ("joint_dip".to_string(), "joint_dip"),
+        ],
+        140.0,
+    ) {
+        scene.property = property;
+        changed = true;
+    }
+    ui.separator();
+    changed |= w.slider(
+        ui,
+        "Point size",
+        &mut scene.point_size,
+        1.0..=64.0,
+        "point size",
+        true,
+    );
+    changed |= w.slider(ui, "Factor", &mut scene.factor, 0.1..=10.0, "factor", true);
+    ui.horizontal(|ui| {
+        ui.label("Kernel");
+        for (k, label) in [
+            (Kernel::Gaussian, "Gaussian"),
+            (Kernel::Smoothstep, "smoothstep"),
+        ] {
+            changed |= w.radio(ui, label, &mut scene.kernel, k);
+        }
+    });
+    changed |= w.slider(
+        ui,
+        "Gaussian width",
+        &mut scene.gauss_width,
+        0.0..=2.0,
+        "width",
+        false,
+    );
+    changed |= w.checkbox(
+        ui,
+        "Lighting",
+        &mut scene.lighting,
+        "Lighting (normals per layer)",
+    );
+    ui.horizontal(|ui| {
+        ui.label("Sort");
+        for (s, label) in [
+            (SortChoice::Radix, "radix"),
+            (SortChoice::Keys, "keys"),
+            (SortChoice::Seed, "seed"),
+            (SortChoice::None, "none"),
+        ] {
+            let r = ui.radio_value(&mut scene.sort, s, label);
+            changed |= w.add(ui, &format!("Sort {label}"), &r) && r.changed();
+        }
+    });
+    ui.separator();
+    let mut volume = scene.mode == Mode::Volume;
+    if w.checkbox(
+        ui,
+        "Volume mode",
+        &mut volume,
+        "Volume mode (property as density)",
+    ) {
+        scene.mode = if volume { Mode::Volume } else { Mode::Surface };
+        changed = true;
+    }
+    ui.add_enabled_ui(volume, |ui| {
+        changed |= w.drag_value(
+            ui,
+            "Threshold",
+            &mut scene.volume.threshold,
+            -1e9..=1e9,
+            0.0005,
+        );
+        changed |= w.drag_value(ui, "Range", &mut scene.volume.range, 0.0..=1e9, 0.0005);
+    });
+    changed
+}
