@@ -18,6 +18,8 @@ pub enum TexelFormat {
     Rgba32f,
     /// 1 x f32.
     R32f,
+    /// 1 x u8 (normalized; the era's LUMINANCE8).
+    R8,
     /// 3 x f16, filled from u8 data (normalized k/255, converted by GL): filtering in
     /// float instead of 8-bit arithmetic, at 6 bytes per texel.
     Rgb16f,
@@ -33,6 +35,7 @@ impl TexelFormat {
             TexelFormat::Rgba8 => 4,
             TexelFormat::Rgba32f => 16,
             TexelFormat::R32f => 4,
+            TexelFormat::R8 => 1,
             TexelFormat::Rgb16f => 6,
             TexelFormat::Rgba32fFromU8 => 16,
         }
@@ -57,6 +60,7 @@ impl TexelFormat {
             TexelFormat::Rgba8 => (glow::RGBA8, glow::RGBA, glow::UNSIGNED_BYTE),
             TexelFormat::Rgba32f => (glow::RGBA32F, glow::RGBA, glow::FLOAT),
             TexelFormat::R32f => (glow::R32F, glow::RED, glow::FLOAT),
+            TexelFormat::R8 => (glow::R8, glow::RED, glow::UNSIGNED_BYTE),
             TexelFormat::Rgb16f => (glow::RGB16F, glow::RGB, glow::UNSIGNED_BYTE),
             TexelFormat::Rgba32fFromU8 => (glow::RGBA32F, glow::RGBA, glow::UNSIGNED_BYTE),
         }
@@ -68,6 +72,7 @@ impl TexelFormat {
             TexelFormat::Rgba8 => "RGBA8",
             TexelFormat::Rgba32f => "RGBA32F",
             TexelFormat::R32f => "R32F",
+            TexelFormat::R8 => "R8",
             TexelFormat::Rgb16f => "RGB16F",
             TexelFormat::Rgba32fFromU8 => "RGBA32F",
         }

@@ -56,6 +56,7 @@ pub mod mask_field;
 pub mod mesh_field;
 pub mod multires;
 pub mod shape;
+pub mod stage;
 #[cfg(test)]
 mod tests;
 pub mod texture;
