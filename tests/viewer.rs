@@ -28,11 +28,15 @@ struct Display {
     _server: Option<KillOnDrop>,
 }
 
-struct KillOnDrop(Child);
+/// An Xvfb on display `.1`, killed when dropped. SIGKILL leaves its lock file and
+/// socket behind, which would make the display look taken to the next test: remove them.
+struct KillOnDrop(Child, u32);
 impl Drop for KillOnDrop {
     fn drop(&mut self) {
         let _ = self.0.kill();
         let _ = self.0.wait();
+        let _ = std::fs::remove_file(format!("/tmp/.X{}-lock", self.1));
+        let _ = std::fs::remove_file(format!("/tmp/.X11-unix/X{}", self.1));
     }
 }
 
@@ -58,13 +62,13 @@ fn display() -> Option<Display> {
     }
     // Display numbers per test process and per test, so nothing collides.
     let base = 100 + (std::process::id() % 200) * 8;
-    for _ in 0..8 {
+    for _ in 0..16 {
         let n = base + NEXT_DISPLAY.fetch_add(1, std::sync::atomic::Ordering::SeqCst) % 8;
-        if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
-            || Path::new(&format!("/tmp/.X{n}-lock")).exists()
-        {
+        if display_taken(n) {
             continue;
         }
+        // A socket left by a dead server would pass the readiness check below at once.
+        let _ = std::fs::remove_file(format!("/tmp/.X11-unix/X{n}"));
         let child = match Command::new("Xvfb")
             .args([
                 format!(":{n}"),
@@ -78,7 +82,7 @@ fn display() -> Option<Display> {
             .stderr(Stdio::null())
             .spawn()
         {
-            Ok(c) => KillOnDrop(c),
+            Ok(c) => KillOnDrop(c, n),
             Err(e) => {
                 return skip(&format!(
                     "no DISPLAY and Xvfb cannot start ({e}); install xvfb"
@@ -97,6 +101,16 @@ fn display() -> Option<Display> {
         }
     }
     skip("no DISPLAY and Xvfb did not come up")
+}
+
+/// Whether display `n` belongs to a live X server: its lock file names a running process.
+/// A lock left by a killed server does not count (Xvfb replaces a stale lock itself);
+/// neither does a socket without a lock.
+fn display_taken(n: u32) -> bool {
+    match std::fs::read_to_string(format!("/tmp/.X{n}-lock")) {
+        Ok(pid) => Path::new(&format!("/proc/{}", pid.trim())).exists(),
+        Err(_) => false,
+    }
 }
 
 /// What a viewer run left.
