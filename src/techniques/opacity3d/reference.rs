@@ -251,6 +251,55 @@ pub fn emulate_faithful(
     })
 }
 
+/// CPU mirror of precise slicing: the GPU's slice planes and sample points, each sample
+/// classified exactly as [`reference`] does and composited far to near in f64 with the
+/// opacity of its slab. GPU against this isolates the arithmetic (storage of the levels,
+/// filtering, f32) from the discretization, which [`reference`] measures.
+pub fn emulate_precise(
+    prepared: &Prepared,
+    params: &Opacity3dScene,
+    camera: &Camera,
+    size: [u32; 2],
+    background: [f64; 4],
+) -> Image {
+    let half = prepared.half;
+    let reference = prepared.reference_spacing();
+    let n = (camera.quat().inverse() * DVec3::Z).normalize();
+    let extent = (half * n.abs()).element_sum();
+    let count = params.slices;
+    let spacing = 2.0 * extent / count as f64;
+    trace_pixels(camera, size, TargetFormat::Rgba32f, |origin, dir| {
+        let mut dst = background;
+        let along = dir.dot(n);
+        if along.abs() < 1e-300 {
+            return dst;
+        }
+        for i in 0..count {
+            let depth = -extent + (i as f64 + 0.5) * spacing;
+            let p = origin + dir * ((depth - origin.dot(n)) / along);
+            if (p.abs() - half).max_element() > 1e-9 {
+                continue;
+            }
+            let tc = (p + half) / (2.0 * half);
+            let c = classify(
+                prepared,
+                params,
+                tc,
+                Addressing::TexelCentre,
+                1.0 / 3.0,
+                Filtering::Exact,
+            )
+            .map(|v| v.clamp(0.0, 1.0));
+            let a = 1.0 - (1.0 - c[3]).powf(spacing / reference);
+            for ch in 0..3 {
+                dst[ch] = c[ch] * a + dst[ch] * (1.0 - a);
+            }
+            dst[3] = a + dst[3] * (1.0 - a);
+        }
+        dst
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

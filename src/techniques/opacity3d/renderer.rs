@@ -101,12 +101,13 @@ pub struct Opacity3dRenderer {
 }
 
 /// Texel formats of the packed volume and the tables: 8-bit when faithful (filtering in
-/// 8-bit arithmetic, as the original hardware); float when precise (the same 8-bit values,
-/// filtered in float).
+/// 8-bit arithmetic, as the original hardware); when precise the same 8-bit values as
+/// 16-bit unorm (k·257/65535 = k/255 exactly, so a level's texel-centre lookup lands on
+/// its entry; half floats put it up to 0.06 texel off) and f32 tables, filtered in float.
 pub fn texel_formats(fidelity: Fidelity) -> (TexelFormat, TexelFormat) {
     match fidelity {
         Fidelity::Faithful => (TexelFormat::Rgb8, TexelFormat::Rgba8),
-        Fidelity::Precise => (TexelFormat::Rgb16f, TexelFormat::Rgba32fFromU8),
+        Fidelity::Precise => (TexelFormat::Rgb16FromU8, TexelFormat::Rgba32fFromU8),
     }
 }
 
