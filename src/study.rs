@@ -133,6 +133,7 @@ fn measure(
         params(scene),
         &scene.base,
         prepared.clone(),
+        scene.camera.projection,
     )?;
     let frame = Frame {
         camera: scene.camera,

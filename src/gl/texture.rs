@@ -30,6 +30,8 @@ pub enum TexelFormat {
     Rg16FromU8,
     /// 3 x 16-bit unorm from u8 data (see [`TexelFormat::R16FromU8`]).
     Rgb16FromU8,
+    /// 1 x u8 (flags, masks).
+    R8,
 }
 
 impl TexelFormat {
@@ -45,6 +47,7 @@ impl TexelFormat {
             TexelFormat::R16FromU8 => 2,
             TexelFormat::Rg16FromU8 => 4,
             TexelFormat::Rgb16FromU8 => 6,
+            TexelFormat::R8 => 1,
         }
     }
 
@@ -75,6 +78,7 @@ impl TexelFormat {
             TexelFormat::R16FromU8 => (glow::R16, glow::RED, glow::UNSIGNED_BYTE),
             TexelFormat::Rg16FromU8 => (glow::RG16, glow::RG, glow::UNSIGNED_BYTE),
             TexelFormat::Rgb16FromU8 => (glow::RGB16, glow::RGB, glow::UNSIGNED_BYTE),
+            TexelFormat::R8 => (glow::R8, glow::RED, glow::UNSIGNED_BYTE),
         }
     }
 
@@ -89,6 +93,7 @@ impl TexelFormat {
             TexelFormat::R16FromU8 => "R16",
             TexelFormat::Rg16FromU8 => "RG16",
             TexelFormat::Rgb16FromU8 => "RGB16",
+            TexelFormat::R8 => "R8",
         }
     }
 }

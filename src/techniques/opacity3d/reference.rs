@@ -177,7 +177,9 @@ pub fn reference(
             return dst;
         };
         let length = (exit - enter) * dir.length();
-        let steps = ((length / reference * oversample).ceil() as usize).max(1);
+        // A chord within 1e-4 step of a whole number of steps takes that number (the ray
+        // caster rounds alike), so that f32 and f64 agree on ties such as axis views.
+        let steps = ((length / reference * oversample - 1e-4).ceil() as usize).max(1);
         let exponent = length / steps as f64 / reference;
         // Far to near.
         for s in (0..steps).rev() {
@@ -251,10 +253,25 @@ pub fn emulate_faithful(
     })
 }
 
+/// Length of ray a precise slicing sample at `p` stands for, on a ray of unit direction
+/// `dir` whose samples lie `2 half_step` apart: half a step each side, or, where the
+/// neighbouring sample would lie outside the box `[-half, half]`, all the way to the face
+/// where the ray enters or leaves. The slabs of one ray so tile its chord exactly (the
+/// program templates compute the same in f32).
+pub fn slab_length(p: DVec3, dir: DVec3, half: DVec3, half_step: f64) -> f64 {
+    let q = DVec3::select(dir.cmplt(DVec3::ZERO), -p, p);
+    let inv = DVec3::ONE / dir.abs().max(DVec3::splat(1e-20));
+    let back = ((half + q) * inv).min_element();
+    let fwd = ((half - q) * inv).min_element();
+    let end = |d: f64| if d < 2.0 * half_step { d } else { half_step };
+    end(back) + end(fwd)
+}
+
 /// CPU mirror of precise slicing: the GPU's slice planes and sample points, each sample
-/// classified exactly as [`reference`] does and composited far to near in f64 with the
-/// opacity of its slab. GPU against this isolates the arithmetic (storage of the levels,
-/// filtering, f32) from the discretization, which [`reference`] measures.
+/// classified exactly as [`reference`] does, given the opacity of its slab
+/// ([`slab_length`]) and composited far to near in f64. GPU against this isolates the
+/// arithmetic (storage of the levels, filtering, f32) from the discretization, which
+/// [`reference`] measures.
 pub fn emulate_precise(
     prepared: &Prepared,
     params: &Opacity3dScene,
@@ -264,6 +281,7 @@ pub fn emulate_precise(
 ) -> Image {
     let half = prepared.half;
     let reference = prepared.reference_spacing();
+    let corrected = super::renderer::corrected(params, crate::scene::Fidelity::Precise);
     let n = (camera.quat().inverse() * DVec3::Z).normalize();
     let extent = (half * n.abs()).element_sum();
     let count = params.slices;
@@ -274,6 +292,8 @@ pub fn emulate_precise(
         if along.abs() < 1e-300 {
             return dst;
         }
+        let unit = dir.normalize();
+        let half_step = spacing / 2.0 / unit.dot(n).abs();
         for i in 0..count {
             let depth = -extent + (i as f64 + 0.5) * spacing;
             let p = origin + dir * ((depth - origin.dot(n)) / along);
@@ -290,7 +310,11 @@ pub fn emulate_precise(
                 Filtering::Exact,
             )
             .map(|v| v.clamp(0.0, 1.0));
-            let a = 1.0 - (1.0 - c[3]).powf(spacing / reference);
+            let a = if corrected {
+                1.0 - (1.0 - c[3]).powf(slab_length(p, unit, half, half_step) / reference)
+            } else {
+                c[3]
+            };
             for ch in 0..3 {
                 dst[ch] = c[ch] * a + dst[ch] * (1.0 - a);
             }
@@ -303,6 +327,29 @@ pub fn emulate_precise(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn slabs_tile_the_chord() {
+        // A ray along x through a box of half 1: chord 2, samples 0.3 apart.
+        let half = DVec3::ONE;
+        let dir = DVec3::X;
+        let hs = 0.15;
+        let xs: Vec<f64> = (0..7).map(|i| -0.95 + 0.3 * i as f64).collect();
+        let total: f64 = xs
+            .iter()
+            .map(|&x| slab_length(DVec3::new(x, 0.2, -0.4), dir, half, hs))
+            .sum();
+        assert!((total - 2.0).abs() < 1e-12, "{total}");
+        // The first sample stands for the 0.05 before it and half a step after.
+        let first = slab_length(DVec3::new(-0.95, 0.2, -0.4), dir, half, hs);
+        assert!((first - 0.2).abs() < 1e-12, "{first}");
+        // A diagonal ray leaves through the nearest face: the end slab stops there.
+        let d = DVec3::new(1.0, 1.0, 0.0).normalize();
+        let p = DVec3::new(0.0, 0.9, 0.0);
+        let to_face = 0.1 * 2f64.sqrt();
+        let h = slab_length(p, d, half, 0.5);
+        assert!((h - (0.5 + to_face)).abs() < 1e-12, "{h}");
+    }
 
     #[test]
     fn original_addressing_with_nearest_reads_entry_k() {

@@ -1,0 +1,84 @@
+#version 330
+// arbvis (new): v3o2's 3D opacity in precise mode as a single-pass ray caster (GLSL only:
+// ARB fragment programs have no loops). Drawn on the box's far faces, one fragment per
+// pixel; tags and channel placeholders as in slice_precise.frag.
+//  - exact ray-box entry per pixel; the chord is cut into N = ceil(L / step) equal steps,
+//    sampled at their midpoints (the reference's own rule), so no partial slab;
+//  - each step's exact opacity a' = 1 - (1 - a)^(h / reference);
+//  - the same classification as slice_precise (texel-centre lookup, exact 1/3, clamp);
+//  - front to back, stopping once the accumulated alpha reaches local[9].w;
+//  - empty-space skipping: texture5 holds, per brick, 1 where some sample can have
+//    alpha > 0 (levels over the brick and one voxel around it against the tables'
+//    alpha), so samples in an empty brick are skipped without changing the result.
+// Locals: 1..3 coefficients; 4 = (1/reference or 0, step length, 0 or 1, 0); 5 = lookup;
+// 6 = box size; 7 = box half size; 8 = orthographic: the ray direction (unit) /
+// perspective: the eye; 9 = (bricks per unit texture coordinate, stop alpha).
+// Output: premultiplied colour and coverage, blended ONE, ONE_MINUS_SRC_ALPHA.
+in vec4 v_texcoord0;
+uniform sampler3D texture0;
+uniform sampler2D texture2;
+uniform sampler2D texture3;  // [secondary]
+uniform sampler2D texture4;  // [tertiary]
+uniform sampler3D texture5;  // [skip]
+uniform vec4 program_local[10];
+out vec4 frag_color;
+
+vec4 classify(vec3 tc) {
+    vec4 lookup = program_local[5];
+    vec4 coord = textureLod(texture0, tc, 0.0) * lookup.x + lookup.y;
+    vec4 lut = textureLod(texture2, vec2(coord.@1, 0.5), 0.0);
+    vec4 col = program_local[1] * lut;
+    lut = textureLod(texture3, vec2(coord.@2, 0.5), 0.0);  // [secondary]
+    col = program_local[2] * lut + col;  // [sum secondary]
+    col = col * (program_local[2] * lut);  // [product secondary]
+    lut = textureLod(texture4, vec2(coord.@3, 0.5), 0.0);  // [tertiary]
+    col = program_local[3] * lut + col;  // [sum tertiary]
+    col = col * (program_local[3] * lut);  // [product tertiary]
+    col = col * lookup.z;  // [sum]
+    return clamp(col, 0.0, 1.0);
+}
+
+void main() {
+    vec4 correction = program_local[4];
+    vec3 size = program_local[6].xyz;
+    vec3 half_size = program_local[7].xyz;
+    vec3 p_exit = v_texcoord0.xyz * size - half_size;
+    vec3 dir = program_local[8].xyz;  // [orthographic]
+    vec3 dir = normalize(p_exit - program_local[8].xyz);  // [perspective]
+    // Back from the exit to the entry: the nearest face behind, per axis.
+    vec3 q = mix(p_exit, -p_exit, lessThan(dir, vec3(0.0)));
+    vec3 back3 = (half_size + q) / max(abs(dir), vec3(1e-20));
+    float chord = min(min(back3.x, back3.y), back3.z);
+    chord = min(chord, length(p_exit - program_local[8].xyz));  // [perspective]
+    int steps = max(1, int(ceil(chord / correction.y - 1e-4)));
+    float h = chord / float(steps);
+    float k = h * correction.x + correction.z;
+    // Sample j sits at texture coordinate start + delta * j.
+    vec3 delta = dir * h / size;
+    vec3 start = (p_exit - dir * chord + half_size) / size + 0.5 * delta;
+    vec3 bricks = program_local[9].xyz;  // [skip]
+    ivec3 last = textureSize(texture5, 0) - 1;  // [skip]
+    vec3 safe = mix(delta, vec3(1e-30), equal(delta, vec3(0.0)));  // [skip]
+    float stop = program_local[9].w;
+    vec4 acc = vec4(0.0);
+    int j = 0;
+    while (j < steps && acc.a < stop) {
+        int end = steps;
+        vec3 cell = floor((start + delta * float(j)) * bricks);  // [skip]
+        // First sample past this brick along each axis (a little early is harmless).
+        vec3 lo = cell / bricks;  // [skip]
+        vec3 hi = (cell + 1.0) / bricks;  // [skip]
+        vec3 bound = (mix(lo, hi, greaterThan(delta, vec3(0.0))) - start) / safe;  // [skip]
+        bound = mix(bound, vec3(1e30), equal(delta, vec3(0.0)));  // [skip]
+        float first = ceil(min(min(bound.x, bound.y), bound.z) - 1e-3);  // [skip]
+        end = int(clamp(first, float(j + 1), float(steps)));  // [skip]
+        bool empty = texelFetch(texture5, clamp(ivec3(cell), ivec3(0), last), 0).r == 0.0;  // [skip]
+        if (empty) { j = end; continue; }  // [skip]
+        for (; j < end && acc.a < stop; j++) {
+            vec4 col = classify(start + delta * float(j));
+            float a = 1.0 - pow(1.0 - col.a, k);
+            acc += (1.0 - acc.a) * vec4(col.rgb * a, a);
+        }
+    }
+    frag_color = acc;
+}
