@@ -52,11 +52,48 @@ enum Command {
         /// A `.sgy`/`.segy` or `.nii`/`.nii.gz` file.
         file: PathBuf,
     },
-    /// Time v3o2's 3D opacity on a synthetic volume³ x 3 attributes at size² (faithful and
-    /// precise, ARB and GLSL, over slice counts); no scoring.
+    /// Time a scene offscreen: clear + draw + finish per frame, the first frame apart,
+    /// settings interleaved over rounds. For 3D opacity: sweep faithful / precise slice
+    /// counts and ray-caster steps, score against the f64 reference (RGB), and export what
+    /// a peer needs (benches/peers/vtk_volume.py).
     Bench {
         #[command(flatten)]
-        sweep: SweepArgs,
+        scene: SceneArgs,
+        /// Timed frames per setting and round.
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+        /// Passes over all settings (interleaved).
+        #[arg(long, default_value_t = 1)]
+        rounds: usize,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+        /// Score against the f64 reference (3D opacity; RMSE and largest error over RGB).
+        #[arg(long)]
+        score: bool,
+        /// Reference steps per voxel.
+        #[arg(long, default_value_t = 16.0)]
+        oversample: f64,
+        /// Faithful slicing at these slice counts, e.g. 128,256.
+        #[arg(long, value_delimiter = ',')]
+        faithful: Vec<usize>,
+        /// Precise slicing at these slice counts.
+        #[arg(long, value_delimiter = ',')]
+        precise: Vec<usize>,
+        /// The precise ray caster at these steps per voxel, e.g. 0.5,1,2 (pre-integrated
+        /// for one attribute).
+        #[arg(long, value_delimiter = ',')]
+        raycast: Vec<f64>,
+        /// The precise ray caster with point sampling at these steps per voxel.
+        #[arg(long, value_delimiter = ',')]
+        raycast_point: Vec<f64>,
+        /// Write the levels, tables, camera (and with --score the reference) for a peer
+        /// into this folder; the reference is reused from it when the scene matches.
+        #[arg(long)]
+        export: Option<PathBuf>,
+        /// Offscreen backend.
+        #[arg(long, value_enum, default_value_t = Backend::Egl)]
+        backend: Backend,
     },
     /// The speed-for-accuracy study of 3D opacity: every slice count, target precision,
     /// opacity correction on/off and program kind, timed and scored against the f64
@@ -234,11 +271,48 @@ fn run(cli: Cli) -> Result<()> {
                 );
             }
         }
-        Command::Bench { sweep } => {
-            let headless = Headless::new(sweep.backend)?;
-            println!("{}", headless.gpu().caps().renderer);
-            let options = sweep.options(false, false)?;
-            arbvis::study::run(&headless, &options, |line| println!("{line}"))?;
+        Command::Bench {
+            scene,
+            frames,
+            rounds,
+            json,
+            score,
+            oversample,
+            faithful,
+            precise,
+            raycast,
+            raycast_point,
+            export,
+            backend,
+        } => {
+            if frames == 0 || rounds == 0 {
+                bail!("--frames and --rounds must be at least 1");
+            }
+            if !(oversample.is_finite() && oversample > 0.0 && oversample <= 1024.0) {
+                bail!("--oversample {oversample}: must be above 0 and at most 1024");
+            }
+            let (scene, origin) = scene.load()?;
+            let headless = Headless::new(backend)?;
+            let options = arbvis::study::bench::BenchOptions {
+                frames,
+                rounds,
+                score,
+                oversample,
+                faithful,
+                precise,
+                raycast,
+                raycast_point,
+                export,
+            };
+            let report = arbvis::study::bench::run(&headless, &scene, &origin, &options, |line| {
+                eprintln!("{line}")
+            })
+            .with_context(|| format!("benchmarking {origin}"))?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else {
+                print!("{}", arbvis::study::bench::to_text(&report));
+            }
         }
         Command::Study {
             sweep,

@@ -225,13 +225,65 @@ fn study_writes_csv_and_plot_and_bench_times() {
     let (plot, _) = read_png(&dir.join("opacity3d.png")).unwrap();
     assert_eq!((plot.width, plot.height), (1100, 700));
     assert!(stdout.contains("wrote"), "{stdout}");
+    // bench times any scene; for 3D opacity it sweeps, scores and exports for a peer.
+    let export = dir.join("peer");
     let bench = arbvis(&[
-        "bench", "--volume", "8", "--size", "16", "--slices", "4", "--frames", "1",
+        "bench",
+        "--demo",
+        "v3o2-product",
+        "--size",
+        "16x12",
+        "--faithful",
+        "4",
+        "--precise",
+        "4,8",
+        "--raycast",
+        "0.5",
+        "--frames",
+        "2",
+        "--rounds",
+        "2",
+        "--score",
+        "--oversample",
+        "2",
+        "--json",
+        "--export",
+        export.to_str().unwrap(),
     ]);
     let (stdout, stderr) = text(&bench);
     assert!(bench.status.success(), "{stderr}");
+    for key in [
+        "\"faithful slicing 4\"",
+        "\"precise slicing 8\"",
+        "\"raycast 0.5 step/voxel\"",
+        "\"median_ms\"",
+        "\"rmse\"",
+    ] {
+        assert!(stdout.contains(key), "{key} in {stdout}");
+    }
+    for file in [
+        "scene.json",
+        "levels_primary.u8",
+        "table_primary.u8",
+        "reference.f32",
+    ] {
+        assert!(export.join(file).is_file(), "{file}");
+    }
+    // 16 x 12 pixels, RGB f32.
+    assert_eq!(
+        std::fs::metadata(export.join("reference.f32"))
+            .unwrap()
+            .len(),
+        16 * 12 * 12
+    );
+    let quad = arbvis(&["bench", "--demo", "quad", "--size", "8x8", "--frames", "1"]);
+    let (stdout, stderr) = text(&quad);
+    assert!(quad.status.success(), "{stderr}");
     assert!(
-        stdout.contains("faithful") && stdout.contains("ms"),
+        stdout.contains("quad") && stdout.contains("median"),
         "{stdout}"
     );
+    let bad = arbvis(&["bench", "--demo", "quad", "--score"]);
+    assert!(!bad.status.success());
+    assert!(text(&bad).1.contains("3D-opacity"), "{}", text(&bad).1);
 }

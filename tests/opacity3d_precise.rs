@@ -11,8 +11,9 @@ use arbvis::gl::{Backend, Filter, Headless, ProgramChoice};
 use arbvis::image::Image;
 use arbvis::render::render_on;
 use arbvis::scene::{Scene, TechniqueScene};
+use arbvis::techniques::opacity3d::mirror::{emulate_precise, emulate_preintegrated};
 use arbvis::techniques::opacity3d::prepare::prepare;
-use arbvis::techniques::opacity3d::reference::{emulate_precise, reference};
+use arbvis::techniques::opacity3d::reference::reference;
 use arbvis::techniques::opacity3d::{Opacity3dScene, Raycast};
 use arbvis::volume::synthetic::SplitMix;
 use common::{headless, temp_dir};
@@ -211,11 +212,23 @@ fn precise_slicing_matches_its_cpu_mirror_in_every_view() {
     }
 }
 
+/// Point-sampling ray caster settings.
 fn raycast(steps_per_voxel: f64, termination: f64, brick: usize) -> Option<Raycast> {
     Some(Raycast {
         steps_per_voxel,
         termination,
         brick,
+        preintegrate: false,
+    })
+}
+
+/// Pre-integrating ray caster settings (no termination).
+fn preintegrating(steps_per_voxel: f64) -> Option<Raycast> {
+    Some(Raycast {
+        steps_per_voxel,
+        termination: 0.0,
+        brick: 0,
+        preintegrate: true,
     })
 }
 
@@ -394,4 +407,56 @@ fn precise_builds_one_channel_per_attribute_and_the_ray_caster_its_bricks() {
         .expect("ARB cannot ray cast")
         .to_string();
     assert!(e.contains("GLSL only"), "{e}");
+}
+
+/// The pre-integrated ray caster (one attribute) against its CPU mirror (the same table,
+/// samples and partial last step: measured at most 8.1e-5) and the reference: on random
+/// data with random tables, where a table's detail dominates, it has 2 to 3 times less
+/// error than point sampling at every step (measured RMSE 4.5e-3 against 1.25e-2 at 0.5
+/// step/voxel, sum, axis-aligned), and its error falls with the step.
+#[test]
+fn preintegration_matches_its_mirror_and_beats_point_sampling_on_sharp_tables() {
+    let h = headless(Backend::Egl);
+    for (view, combine) in [(0, "sum"), (1, "product"), (2, "sum")] {
+        let (name, camera) = views()[view];
+        {
+            let (mut scene, dir) = random_scene("preint", 9, [7, 5, 6], 1, combine);
+            scene.camera = camera;
+            let reference = reference_of(&scene, &dir, 64.0);
+            let prepared = prepare(params(&scene), &dir, &Default::default()).unwrap();
+            let mut errors = Vec::new();
+            for steps in [0.5, 2.0] {
+                params_mut(&mut scene).raycast = preintegrating(steps);
+                let gpu = render(&h, &scene);
+                let p = params(&scene);
+                let table = arbvis::techniques::opacity3d::preint::preintegrate(
+                    prepared.tables[0].as_ref().unwrap(),
+                    p.primary.coefficients,
+                    p.combine,
+                    p.table_filter,
+                    1.0 / steps,
+                );
+                let mirror = emulate_preintegrated(
+                    &prepared,
+                    p,
+                    &scene.camera,
+                    scene.size,
+                    scene.background.map(|v| v as f64),
+                    steps,
+                    &table,
+                );
+                let what = format!("{name}, {combine}, {steps} step/voxel");
+                assert!(rgb_error(&gpu, &mirror).0 < 2e-4, "{what}");
+                let pre = rgb_error(&gpu, &reference).1;
+                params_mut(&mut scene).raycast = raycast(steps, 0.0, 0);
+                let point = rgb_error(&render(&h, &scene), &reference).1;
+                assert!(pre < 0.75 * point, "{what}: {pre:.2e} against {point:.2e}");
+                errors.push(pre);
+            }
+            assert!(
+                errors.windows(2).all(|w| w[1] < w[0]),
+                "{name} {combine}: {errors:?}"
+            );
+        }
+    }
 }

@@ -1,15 +1,19 @@
 #version 330
 // arbvis (new): v3o2's 3D opacity in precise mode as a single-pass ray caster (GLSL only:
 // ARB fragment programs have no loops). Drawn on the box's far faces, one fragment per
-// pixel; tags and channel placeholders as in slice_precise.frag.
-//  - exact ray-box entry per pixel; the chord is cut into N = ceil(L / step) equal steps,
-//    sampled at their midpoints (the reference's own rule), so no partial slab;
-//  - each step's exact opacity a' = 1 - (1 - a)^(h / reference);
-//  - the same classification as slice_precise (texel-centre lookup, exact 1/3, clamp);
+// pixel; tags and channel placeholders as in slice_precise.frag ("!tag": kept when the
+// scene lacks the tag).
+//  - exact ray-box entry per pixel;
+//  - point sampling (several attributes): the chord is cut into N = ceil(L / step) equal
+//    steps sampled at their midpoints (the reference's own rule), each with its exact
+//    opacity a' = 1 - (1 - a)^(h / reference) and the classification of slice_precise;
+//  - pre-integrated (one attribute, tag preint): samples at both ends of each full step,
+//    the step's premultiplied colour and opacity read from the 256 x 256 table on unit 6
+//    (front value, back value), and the partial last step by its midpoint;
 //  - front to back, stopping once the accumulated alpha reaches local[9].w;
-//  - empty-space skipping: texture5 holds, per brick, 1 where some sample can have
-//    alpha > 0 (levels over the brick and one voxel around it against the tables'
-//    alpha), so samples in an empty brick are skipped without changing the result.
+//  - empty-space skipping (tag skip, point sampling only): texture5 holds, per brick, 1
+//    where some sample can have alpha > 0 (levels over the brick and one voxel around it
+//    against the tables' alpha), so samples in an empty brick are skipped exactly.
 // Locals: 1..3 coefficients; 4 = (1/reference or 0, step length, 0 or 1, 0); 5 = lookup;
 // 6 = box size; 7 = box half size; 8 = orthographic: the ray direction (unit) /
 // perspective: the eye; 9 = (bricks per unit texture coordinate, stop alpha).
@@ -20,6 +24,7 @@ uniform sampler2D texture2;
 uniform sampler2D texture3;  // [secondary]
 uniform sampler2D texture4;  // [tertiary]
 uniform sampler3D texture5;  // [skip]
+uniform sampler2D texture6;  // [preint]
 uniform vec4 program_local[10];
 out vec4 frag_color;
 
@@ -40,6 +45,7 @@ vec4 classify(vec3 tc) {
 
 void main() {
     vec4 correction = program_local[4];
+    vec4 lookup = program_local[5];  // [preint]
     vec3 size = program_local[6].xyz;
     vec3 half_size = program_local[7].xyz;
     vec3 p_exit = v_texcoord0.xyz * size - half_size;
@@ -50,20 +56,20 @@ void main() {
     vec3 back3 = (half_size + q) / max(abs(dir), vec3(1e-20));
     float chord = min(min(back3.x, back3.y), back3.z);
     chord = min(chord, length(p_exit - program_local[8].xyz));  // [perspective]
-    int steps = max(1, int(ceil(chord / correction.y - 1e-4)));
-    float h = chord / float(steps);
-    float k = h * correction.x + correction.z;
+    float stop = program_local[9].w;
+    vec4 acc = vec4(0.0);
+    int steps = max(1, int(ceil(chord / correction.y - 1e-4)));  // [!preint]
+    float h = chord / float(steps);  // [!preint]
+    float k = h * correction.x + correction.z;  // [!preint]
     // Sample j sits at texture coordinate start + delta * j.
-    vec3 delta = dir * h / size;
-    vec3 start = (p_exit - dir * chord + half_size) / size + 0.5 * delta;
+    vec3 delta = dir * h / size;  // [!preint]
+    vec3 start = (p_exit - dir * chord + half_size) / size + 0.5 * delta;  // [!preint]
     vec3 bricks = program_local[9].xyz;  // [skip]
     ivec3 last = textureSize(texture5, 0) - 1;  // [skip]
     vec3 safe = mix(delta, vec3(1e-30), equal(delta, vec3(0.0)));  // [skip]
-    float stop = program_local[9].w;
-    vec4 acc = vec4(0.0);
-    int j = 0;
-    while (j < steps && acc.a < stop) {
-        int end = steps;
+    int j = 0;  // [!preint]
+    while (j < steps && acc.a < stop) {  // [!preint]
+        int end = steps;  // [!preint]
         vec3 cell = floor((start + delta * float(j)) * bricks);  // [skip]
         // First sample past this brick along each axis (a little early is harmless).
         vec3 lo = cell / bricks;  // [skip]
@@ -74,11 +80,29 @@ void main() {
         end = int(clamp(first, float(j + 1), float(steps)));  // [skip]
         bool empty = texelFetch(texture5, clamp(ivec3(cell), ivec3(0), last), 0).r == 0.0;  // [skip]
         if (empty) { j = end; continue; }  // [skip]
-        for (; j < end && acc.a < stop; j++) {
-            vec4 col = classify(start + delta * float(j));
-            float a = 1.0 - pow(1.0 - col.a, k);
-            acc += (1.0 - acc.a) * vec4(col.rgb * a, a);
-        }
-    }
+        for (; j < end && acc.a < stop; j++) {  // [!preint]
+            vec4 col = classify(start + delta * float(j));  // [!preint]
+            float a = 1.0 - pow(1.0 - col.a, k);  // [!preint]
+            acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [!preint]
+        }  // [!preint]
+    }  // [!preint]
+    // Pre-integrated: full steps of exactly the step length from the entry, then the rest.
+    float h = correction.y;  // [preint]
+    float full = floor(chord / h + 1e-4);  // [preint]
+    float rest = max(chord - full * h, 0.0);  // [preint]
+    vec3 delta = dir * h / size;  // [preint]
+    vec3 start = (p_exit - dir * chord + half_size) / size;  // [preint]
+    float front = textureLod(texture0, start, 0.0).r * lookup.x + lookup.y;  // [preint]
+    int steps = int(full);  // [preint]
+    for (int j = 1; j <= steps && acc.a < stop; j++) {  // [preint]
+        float back = textureLod(texture0, start + delta * float(j), 0.0).r * lookup.x + lookup.y;  // [preint]
+        acc += (1.0 - acc.a) * textureLod(texture6, vec2(front, back), 0.0);  // [preint]
+        front = back;  // [preint]
+    }  // [preint]
+    if (rest > 1e-4 * h && acc.a < stop) {  // [preint]
+        vec4 col = classify(start + delta * (full + 0.5 * rest / h));  // [preint]
+        float a = 1.0 - pow(1.0 - col.a, rest * correction.x + correction.z);  // [preint]
+        acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [preint]
+    }  // [preint]
     frag_color = acc;
 }

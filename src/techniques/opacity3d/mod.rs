@@ -45,6 +45,8 @@
 //! volumes of different grids (an error naming both).
 
 pub mod bricks;
+pub mod mirror;
+pub mod preint;
 pub mod prepare;
 pub mod programs;
 pub mod reference;
@@ -145,8 +147,17 @@ pub struct Raycast {
     /// A ray stops once its alpha reaches `1 - termination` (0: never); what it leaves out
     /// is at most that much of what lies behind.
     pub termination: f64,
-    /// Voxels per side of the bricks of empty-space skipping (0: no skipping).
+    /// Voxels per side of the bricks of empty-space skipping (0: no skipping; point
+    /// sampling only). Off by default: on the bench scenes few bricks are empty and the
+    /// per-brick bookkeeping made frames 1.6x slower (205 against 325 ms, 256² of the
+    /// 256³ cube on llvmpipe).
     pub brick: usize,
+    /// Pre-integrated classification for a one-attribute scene ([`preint`]); ignored
+    /// with several attributes or without opacity correction. Off by default: it wins
+    /// where the table has more detail than the data (2 to 3 times less error on random
+    /// tables), but on the bench scene's smooth table the data's own curvature dominates
+    /// and point sampling reached lower error per millisecond.
+    pub preintegrate: bool,
 }
 
 impl Default for Raycast {
@@ -154,7 +165,8 @@ impl Default for Raycast {
         Raycast {
             steps_per_voxel: 1.0,
             termination: 1.0 / 1024.0,
-            brick: 8,
+            brick: 0,
+            preintegrate: false,
         }
     }
 }

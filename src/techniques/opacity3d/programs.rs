@@ -4,12 +4,13 @@
 //!
 //! A template line that ends in a comment holding a bracketed list of tags (`# [sum
 //! secondary]` in ARB, `// [sum secondary]` in GLSL) is kept only when the scene has every
-//! tag, and the comment is dropped; `@1 @2 @3` become the channel letter of the primary,
+//! tag (and none written `!tag`), and the comment is dropped; `@1 @2 @3` become the channel letter of the primary,
 //! secondary and tertiary attribute in the precise volume, which holds the present
 //! attributes only, in that order (one attribute: `r`). So a one-attribute scene's
 //! program fetches one table, and the ARB and GLSL texts of a scene come from the same
 //! lines. Tags: `sum` / `product`, `secondary`, `tertiary`, `orthographic` /
-//! `perspective`, `skip` (the ray caster's empty-space skipping).
+//! `perspective`, `skip` (the ray caster's empty-space skipping), `preint` (its
+//! pre-integrated classification).
 //!
 //! Which paths exist in which language: faithful slicing (verbatim ARB, GLSL port),
 //! precise slicing (ARB and GLSL), the precise ray caster (GLSL only: ARB fragment
@@ -33,6 +34,8 @@ pub struct Variant {
     pub projection: Projection,
     /// Ray caster only: empty-space skipping.
     pub skip: bool,
+    /// Ray caster only: pre-integrated classification (one attribute).
+    pub preint: bool,
 }
 
 impl Variant {
@@ -54,6 +57,9 @@ impl Variant {
         });
         if self.skip {
             tags.push("skip");
+        }
+        if self.preint {
+            tags.push("preint");
         }
         tags
     }
@@ -87,7 +93,13 @@ pub fn specialize(template: &ProgramText, tags: &[&str], channels: [char; 3]) ->
             None => (line, ""),
         };
         let (kept, body) = match line_tags(body) {
-            Some((code, wanted)) => (wanted.iter().all(|t| tags.contains(t)), code),
+            Some((code, wanted)) => (
+                wanted.iter().all(|t| match t.strip_prefix('!') {
+                    Some(absent) => !tags.contains(&absent),
+                    None => tags.contains(t),
+                }),
+                code,
+            ),
             None => (true, body),
         };
         if kept {
@@ -148,18 +160,22 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
             [true, false, true],
         ] {
             for projection in [Projection::Orthographic, Projection::Perspective] {
-                for skip in [false, true] {
+                for (skip, preint) in [(false, false), (true, false), (false, true)] {
                     let v = Variant {
                         combine,
                         present,
                         projection,
                         skip,
+                        preint,
                     };
-                    if !skip {
+                    if !(skip || preint) {
                         pairs.push(slicing_pair(ProgramKind::Arb, v));
                         pairs.push(slicing_pair(ProgramKind::Glsl, v));
                     }
-                    pairs.push(raycast_pair(v));
+                    // Pre-integration is for one attribute.
+                    if !preint || present == [true, false, false] {
+                        pairs.push(raycast_pair(v));
+                    }
                 }
             }
         }
@@ -177,6 +193,7 @@ mod tests {
             present,
             projection: Projection::Orthographic,
             skip: false,
+            preint: false,
         }
     }
 
@@ -241,8 +258,9 @@ mod tests {
         );
         assert_eq!(line_tags("vec4 v = a[2];"), None);
         assert_eq!(line_tags("PARAM m[4] = { program.local[0..3] };"), None);
-        let t = ProgramText::embedded("t", "a\nb # [x]\nc // [x y]\nd");
-        assert_eq!(specialize(&t, &["x"], ['r'; 3]).text, "a\nb\nd");
-        assert_eq!(specialize(&t, &["x", "y"], ['r'; 3]).text, "a\nb\nc\nd");
+        let t = ProgramText::embedded("t", "a\nb # [x]\nc // [x y]\nd // [!y]\ne");
+        assert_eq!(specialize(&t, &["x"], ['r'; 3]).text, "a\nb\nd\ne");
+        assert_eq!(specialize(&t, &["x", "y"], ['r'; 3]).text, "a\nb\nc\ne");
+        assert_eq!(specialize(&t, &[], ['r'; 3]).text, "a\nd\ne");
     }
 }

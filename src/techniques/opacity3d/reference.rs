@@ -8,6 +8,7 @@
 //!   ([`Prepared::reference_spacing`]), so a step `h` has `1 - (1 - a)^(h / ref)`. The
 //!   integral is taken by the midpoint rule with `oversample` steps per reference spacing,
 //!   far to near, over the background.
+//! - [`super::mirror`] holds the CPU mirrors of the precise paths.
 //! - [`emulate_faithful`]: an independent emulation of the faithful 8-bit pipeline: the
 //!   same slices as the GPU (planes perpendicular to the view axis at layer centres),
 //!   trilinear fetch with 8-bit filtering arithmetic ([`Filtering::Unorm8`]), the original table addressing (`coord = v` into 256 texels), the
@@ -253,103 +254,9 @@ pub fn emulate_faithful(
     })
 }
 
-/// Length of ray a precise slicing sample at `p` stands for, on a ray of unit direction
-/// `dir` whose samples lie `2 half_step` apart: half a step each side, or, where the
-/// neighbouring sample would lie outside the box `[-half, half]`, all the way to the face
-/// where the ray enters or leaves. The slabs of one ray so tile its chord exactly (the
-/// program templates compute the same in f32).
-pub fn slab_length(p: DVec3, dir: DVec3, half: DVec3, half_step: f64) -> f64 {
-    let q = DVec3::select(dir.cmplt(DVec3::ZERO), -p, p);
-    let inv = DVec3::ONE / dir.abs().max(DVec3::splat(1e-20));
-    let back = ((half + q) * inv).min_element();
-    let fwd = ((half - q) * inv).min_element();
-    let end = |d: f64| if d < 2.0 * half_step { d } else { half_step };
-    end(back) + end(fwd)
-}
-
-/// CPU mirror of precise slicing: the GPU's slice planes and sample points, each sample
-/// classified exactly as [`reference`] does, given the opacity of its slab
-/// ([`slab_length`]) and composited far to near in f64. GPU against this isolates the
-/// arithmetic (storage of the levels, filtering, f32) from the discretization, which
-/// [`reference`] measures.
-pub fn emulate_precise(
-    prepared: &Prepared,
-    params: &Opacity3dScene,
-    camera: &Camera,
-    size: [u32; 2],
-    background: [f64; 4],
-) -> Image {
-    let half = prepared.half;
-    let reference = prepared.reference_spacing();
-    let corrected = super::renderer::corrected(params, crate::scene::Fidelity::Precise);
-    let n = (camera.quat().inverse() * DVec3::Z).normalize();
-    let extent = (half * n.abs()).element_sum();
-    let count = params.slices;
-    let spacing = 2.0 * extent / count as f64;
-    trace_pixels(camera, size, TargetFormat::Rgba32f, |origin, dir| {
-        let mut dst = background;
-        let along = dir.dot(n);
-        if along.abs() < 1e-300 {
-            return dst;
-        }
-        let unit = dir.normalize();
-        let half_step = spacing / 2.0 / unit.dot(n).abs();
-        for i in 0..count {
-            let depth = -extent + (i as f64 + 0.5) * spacing;
-            let p = origin + dir * ((depth - origin.dot(n)) / along);
-            if (p.abs() - half).max_element() > 1e-9 {
-                continue;
-            }
-            let tc = (p + half) / (2.0 * half);
-            let c = classify(
-                prepared,
-                params,
-                tc,
-                Addressing::TexelCentre,
-                1.0 / 3.0,
-                Filtering::Exact,
-            )
-            .map(|v| v.clamp(0.0, 1.0));
-            let a = if corrected {
-                1.0 - (1.0 - c[3]).powf(slab_length(p, unit, half, half_step) / reference)
-            } else {
-                c[3]
-            };
-            for ch in 0..3 {
-                dst[ch] = c[ch] * a + dst[ch] * (1.0 - a);
-            }
-            dst[3] = a + dst[3] * (1.0 - a);
-        }
-        dst
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn slabs_tile_the_chord() {
-        // A ray along x through a box of half 1: chord 2, samples 0.3 apart.
-        let half = DVec3::ONE;
-        let dir = DVec3::X;
-        let hs = 0.15;
-        let xs: Vec<f64> = (0..7).map(|i| -0.95 + 0.3 * i as f64).collect();
-        let total: f64 = xs
-            .iter()
-            .map(|&x| slab_length(DVec3::new(x, 0.2, -0.4), dir, half, hs))
-            .sum();
-        assert!((total - 2.0).abs() < 1e-12, "{total}");
-        // The first sample stands for the 0.05 before it and half a step after.
-        let first = slab_length(DVec3::new(-0.95, 0.2, -0.4), dir, half, hs);
-        assert!((first - 0.2).abs() < 1e-12, "{first}");
-        // A diagonal ray leaves through the nearest face: the end slab stops there.
-        let d = DVec3::new(1.0, 1.0, 0.0).normalize();
-        let p = DVec3::new(0.0, 0.9, 0.0);
-        let to_face = 0.1 * 2f64.sqrt();
-        let h = slab_length(p, d, half, 0.5);
-        assert!((h - (0.5 + to_face)).abs() < 1e-12, "{h}");
-    }
 
     #[test]
     fn original_addressing_with_nearest_reads_entry_k() {

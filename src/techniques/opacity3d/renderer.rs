@@ -33,6 +33,8 @@ pub const VOLUME_UNIT: u32 = 0;
 pub const TABLE_UNITS: [u32; 3] = [2, 3, 4];
 /// Unit of the ray caster's brick occupancy.
 pub const BRICK_UNIT: u32 = 5;
+/// Unit of the ray caster's pre-integration table.
+pub const PREINT_UNIT: u32 = 6;
 
 /// How a scene is drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -50,6 +52,15 @@ pub fn path(params: &Opacity3dScene, fidelity: Fidelity) -> Path3d {
     } else {
         Path3d::Slicing
     }
+}
+
+/// Whether the ray caster pre-integrates: one attribute, opacity correction on, and
+/// `raycast.preintegrate`.
+pub fn preintegrated(params: &Opacity3dScene, fidelity: Fidelity, attributes: usize) -> bool {
+    path(params, fidelity) == Path3d::Raycast
+        && attributes == 1
+        && corrected(params, fidelity)
+        && params.raycast.is_some_and(|r| r.preintegrate)
 }
 
 /// The program kind a scene draws with: the ray caster is GLSL only, so `auto` gives GLSL
@@ -180,6 +191,7 @@ pub struct Opacity3dRenderer {
     tables: [Option<Texture>; 3],
     neutral: Option<Texture>,
     bricks: Option<(Bricks, Texture)>,
+    preint: Option<Texture>,
     mesh: Option<Mesh>,
     mesh_key: Option<([u64; 3], usize)>,
     spacing: f64,
@@ -272,12 +284,14 @@ impl Opacity3dRenderer {
             tables: [None, None, None],
             neutral: None,
             bricks: None,
+            preint: None,
             mesh: None,
             mesh_key: None,
             spacing: 0.0,
         };
         renderer.build_tables(gpu)?;
         renderer.build_bricks(gpu)?;
+        renderer.build_preint(gpu)?;
         renderer.send_constants(gpu)?;
         Ok(renderer)
     }
@@ -326,10 +340,40 @@ impl Opacity3dRenderer {
         Ok(())
     }
 
+    /// The ray caster's pre-integration table for the current table and step.
+    fn build_preint(&mut self, gpu: &Gpu) -> GlResult<()> {
+        let (Some(r), Some(table), true) = (
+            &self.params.raycast,
+            &self.prepared.tables[0],
+            preintegrated(&self.params, self.fidelity, self.prepared.count()),
+        ) else {
+            self.preint = None;
+            return Ok(());
+        };
+        let data = super::preint::preintegrate(
+            table,
+            coefficients(&self.params)[0],
+            self.params.combine,
+            self.params.table_filter,
+            1.0 / r.steps_per_voxel,
+        );
+        let n = super::preint::SIZE as u32;
+        self.preint = Some(Texture::new(
+            gpu,
+            "opacity3d pre-integration table (front x back)",
+            Extent::D2(n, n),
+            TexelFormat::Rgba32f,
+            Filter::Linear,
+            TexelData::F32(&data),
+        )?);
+        Ok(())
+    }
+
     /// The ray caster's bricks and their occupancy for the current tables.
     fn build_bricks(&mut self, gpu: &Gpu) -> GlResult<()> {
+        let preint = preintegrated(&self.params, self.fidelity, self.prepared.count());
         let size = match (&self.params.raycast, self.path()) {
-            (Some(r), Path3d::Raycast) if r.brick > 0 => r.brick,
+            (Some(r), Path3d::Raycast) if r.brick > 0 && !preint => r.brick,
             _ => {
                 self.bricks = None;
                 return Ok(());
@@ -446,11 +490,13 @@ fn make_program(
     prepared: &Prepared,
     projection: Projection,
 ) -> GlResult<Program> {
+    let preint = preintegrated(params, fidelity, prepared.count());
     let variant = Variant {
         combine: params.combine,
         present: prepared.present(),
         projection,
-        skip: params.raycast.is_some_and(|r| r.brick > 0),
+        skip: params.raycast.is_some_and(|r| r.brick > 0) && !preint,
+        preint,
     };
     let pair = match (fidelity, path(params, fidelity)) {
         (Fidelity::Faithful, _) => faithful_pair(kind, params.combine),
@@ -499,6 +545,9 @@ impl Renderer for Opacity3dRenderer {
         }
         if let Some((_, t)) = &self.bricks {
             textures.push((BRICK_UNIT, t));
+        }
+        if let Some(t) = &self.preint {
+            textures.push((PREINT_UNIT, t));
         }
         let Some(mesh) = &self.mesh else {
             return Ok(());
@@ -550,7 +599,15 @@ impl Renderer for Opacity3dRenderer {
             )?;
             return Ok(());
         }
-        let shape = |p: &Opacity3dScene| (p.combine, p.raycast.map(|r| r.brick > 0));
+        let count = self.prepared.count();
+        let fidelity = self.fidelity;
+        let shape = |p: &Opacity3dScene| {
+            (
+                p.combine,
+                p.raycast.map(|r| r.brick > 0),
+                preintegrated(p, fidelity, count),
+            )
+        };
         if shape(&old) != shape(new) {
             self.program = make_program(
                 gpu,
@@ -577,6 +634,19 @@ impl Renderer for Opacity3dRenderer {
             self.build_tables(gpu)?;
         }
         self.build_bricks(gpu)?;
+        let preint_input = |p: &Opacity3dScene| {
+            (
+                preintegrated(p, fidelity, count),
+                p.raycast.map(|r| r.steps_per_voxel),
+                p.primary.table.clone(),
+                p.primary.coefficients,
+                p.combine,
+                p.table_filter,
+            )
+        };
+        if preint_input(&old) != preint_input(new) {
+            self.build_preint(gpu)?;
+        }
         self.send_constants(gpu)
     }
 

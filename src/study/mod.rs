@@ -5,6 +5,9 @@
 //! precise — timed over several frames (median), and scored against the f64 reference
 //! integral (RGB: max abs, RMSE, PSNR). `study` writes CSV and a plot (error against time).
 
+pub mod bench;
+pub mod export;
+
 use std::path::Path;
 use std::time::Instant;
 
