@@ -87,6 +87,9 @@ enum Command {
         /// The precise ray caster with point sampling at these steps per voxel.
         #[arg(long, value_delimiter = ',')]
         raycast_point: Vec<f64>,
+        /// Ray-caster settings offset their steps per pixel (see raycast.jitter).
+        #[arg(long)]
+        jitter: bool,
         /// Write the levels, tables, camera (and with --score the reference) for a peer
         /// into this folder; the reference is reused from it when the scene matches.
         #[arg(long)]
@@ -282,6 +285,7 @@ fn run(cli: Cli) -> Result<()> {
             precise,
             raycast,
             raycast_point,
+            jitter,
             export,
             backend,
         } => {
@@ -302,6 +306,7 @@ fn run(cli: Cli) -> Result<()> {
                 precise,
                 raycast,
                 raycast_point,
+                jitter,
                 export,
             };
             let report = arbvis::study::bench::run(&headless, &scene, &origin, &options, |line| {

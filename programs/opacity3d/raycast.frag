@@ -4,9 +4,11 @@
 // pixel; tags and channel placeholders as in slice_precise.frag ("!tag": kept when the
 // scene lacks the tag).
 //  - exact ray-box entry per pixel;
-//  - point sampling (several attributes): the chord is cut into N = ceil(L / step) equal
-//    steps sampled at their midpoints (the reference's own rule), each with its exact
-//    opacity a' = 1 - (1 - a)^(h / reference) and the classification of slice_precise;
+//  - point sampling: the chord is cut into N = ceil(L / step) equal steps sampled at
+//    their midpoints (the reference's own rule), or with jitter into steps of the step
+//    length after a first one of a per-pixel fraction of it; each sample with the exact
+//    opacity of its step a' = 1 - (1 - a)^(h / reference) and slice_precise's
+//    classification;
 //  - pre-integrated (one attribute, tag preint): samples at both ends of each full step,
 //    the step's premultiplied colour and opacity read from the 256 x 256 table on unit 6
 //    (front value, back value), and the partial last step by its midpoint;
@@ -25,6 +27,7 @@ uniform sampler2D texture3;  // [secondary]
 uniform sampler2D texture4;  // [tertiary]
 uniform sampler3D texture5;  // [skip]
 uniform sampler2D texture6;  // [preint]
+uniform sampler2D texture6;  // [baked]
 uniform vec4 program_local[10];
 out vec4 frag_color;
 
@@ -58,18 +61,18 @@ void main() {
     chord = min(chord, length(p_exit - program_local[8].xyz));  // [perspective]
     float stop = program_local[9].w;
     vec4 acc = vec4(0.0);
-    int steps = max(1, int(ceil(chord / correction.y - 1e-4)));  // [!preint]
-    float h = chord / float(steps);  // [!preint]
-    float k = h * correction.x + correction.z;  // [!preint]
+    int steps = max(1, int(ceil(chord / correction.y - 1e-4)));  // [!preint !jitter]
+    float h = chord / float(steps);  // [!preint !jitter]
+    float k = h * correction.x + correction.z;  // [!preint !jitter]
     // Sample j sits at texture coordinate start + delta * j.
-    vec3 delta = dir * h / size;  // [!preint]
-    vec3 start = (p_exit - dir * chord + half_size) / size + 0.5 * delta;  // [!preint]
+    vec3 delta = dir * h / size;  // [!preint !jitter]
+    vec3 start = (p_exit - dir * chord + half_size) / size + 0.5 * delta;  // [!preint !jitter]
     vec3 bricks = program_local[9].xyz;  // [skip]
     ivec3 last = textureSize(texture5, 0) - 1;  // [skip]
     vec3 safe = mix(delta, vec3(1e-30), equal(delta, vec3(0.0)));  // [skip]
-    int j = 0;  // [!preint]
-    while (j < steps && acc.a < stop) {  // [!preint]
-        int end = steps;  // [!preint]
+    int j = 0;  // [!preint !jitter]
+    while (j < steps && acc.a < stop) {  // [!preint !jitter]
+        int end = steps;  // [!preint !jitter]
         vec3 cell = floor((start + delta * float(j)) * bricks);  // [skip]
         // First sample past this brick along each axis (a little early is harmless).
         vec3 lo = cell / bricks;  // [skip]
@@ -80,12 +83,44 @@ void main() {
         end = int(clamp(first, float(j + 1), float(steps)));  // [skip]
         bool empty = texelFetch(texture5, clamp(ivec3(cell), ivec3(0), last), 0).r == 0.0;  // [skip]
         if (empty) { j = end; continue; }  // [skip]
-        for (; j < end && acc.a < stop; j++) {  // [!preint]
-            vec4 col = classify(start + delta * float(j));  // [!preint]
-            float a = 1.0 - pow(1.0 - col.a, k);  // [!preint]
-            acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [!preint]
-        }  // [!preint]
-    }  // [!preint]
+        for (; j < end && acc.a < stop; j++) {  // [!preint !jitter]
+            vec4 col = classify(start + delta * float(j));  // [!preint !jitter]
+            float a = 1.0 - pow(1.0 - col.a, k);  // [!preint !jitter]
+            acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [!preint !jitter]
+        }  // [!preint !jitter]
+    }  // [!preint !jitter]
+    // Jitter: steps of the step length h, the first one ending at u h with u in (0, 1]
+    // per pixel, so that steps whose length divides the voxel spacing do not sample every
+    // ray at the same place in its cells; the first and last steps by their midpoints with
+    // their own opacity. Baked (one attribute): full steps read colour and opacity for h
+    // from a 4081-entry table (16 per level) on unit 6, premultiplied, without pow.
+    float h = correction.y;  // [jitter]
+    float u = 1.0 - fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));  // [jitter]
+    vec3 entry = (p_exit - dir * chord + half_size) / size;  // [jitter]
+    vec3 along = dir / size;  // [jitter]
+    float first = min(u * h, chord);  // [jitter]
+    vec4 col = classify(entry + along * (0.5 * first));  // [jitter]
+    float a = 1.0 - pow(1.0 - col.a, first * correction.x + correction.z);  // [jitter]
+    acc = vec4(col.rgb * a, a);  // [jitter]
+    int full = int(max(floor((chord - first) / h + 1e-4), 0.0));  // [jitter]
+    vec3 start = entry + along * (first + 0.5 * h);  // [jitter]
+    vec3 delta = along * h;  // [jitter]
+    float k = h * correction.x + correction.z;  // [jitter !baked]
+    for (int j = 0; j < full && acc.a < stop; j++) {  // [jitter]
+        vec3 tc = start + delta * float(j);  // [jitter]
+        vec4 col = classify(tc);  // [jitter !baked]
+        float a = 1.0 - pow(1.0 - col.a, k);  // [jitter !baked]
+        acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [jitter !baked]
+        float v = textureLod(texture0, tc, 0.0).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
+        acc += (1.0 - acc.a) * textureLod(texture6, vec2(v, 0.5), 0.0);  // [baked]
+    }  // [jitter]
+    float done = min(first + float(full) * h, chord);  // [jitter]
+    float rest = chord - done;  // [jitter]
+    if (rest > 1e-4 * h && acc.a < stop) {  // [jitter]
+        vec4 col = classify(entry + along * (done + 0.5 * rest));  // [jitter]
+        float a = 1.0 - pow(1.0 - col.a, rest * correction.x + correction.z);  // [jitter]
+        acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [jitter]
+    }  // [jitter]
     // Pre-integrated: full steps of exactly the step length from the entry, then the rest.
     float h = correction.y;  // [preint]
     float full = floor(chord / h + 1e-4);  // [preint]

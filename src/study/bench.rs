@@ -47,6 +47,8 @@ pub struct BenchOptions {
     pub raycast: Vec<f64>,
     /// The precise ray caster, point sampling, at these steps per voxel.
     pub raycast_point: Vec<f64>,
+    /// Ray-caster settings jitter their steps per pixel.
+    pub jitter: bool,
     /// Folder for the data a peer needs (levels, tables, camera, reference).
     pub export: Option<PathBuf>,
 }
@@ -62,6 +64,7 @@ impl Default for BenchOptions {
             precise: Vec::new(),
             raycast: Vec::new(),
             raycast_point: Vec::new(),
+            jitter: false,
             export: None,
         }
     }
@@ -135,6 +138,7 @@ pub fn settings(scene: &Scene, options: &BenchOptions) -> Result<Vec<Setting>> {
             let r = Raycast {
                 steps_per_voxel: steps,
                 preintegrate,
+                jitter: options.jitter,
                 ..base.raycast.unwrap_or_default()
             };
             let mut probe = scene.clone();
@@ -158,9 +162,11 @@ fn raycast_name(r: &Raycast, scene: &Scene) -> String {
         }
         _ => false,
     };
+    let jitter = r.jitter && !pre;
     format!(
-        "raycast{} {} step/voxel",
+        "raycast{}{} {} step/voxel",
         if pre { " pre-int" } else { "" },
+        if jitter { " jitter" } else { "" },
         r.steps_per_voxel
     )
 }

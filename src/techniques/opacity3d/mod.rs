@@ -158,15 +158,26 @@ pub struct Raycast {
     /// tables), but on the bench scene's smooth table the data's own curvature dominates
     /// and point sampling reached lower error per millisecond.
     pub preintegrate: bool,
+    /// Offset each pixel's steps by a per-pixel fraction of a step (point sampling, no
+    /// skipping): where the step divides the voxel spacing (axis-aligned views at 0.5, 1,
+    /// 2 steps/voxel) every ray otherwise samples its cells at the same place, and the
+    /// error of those settings rises above that of fewer steps.
+    pub jitter: bool,
+    /// With jitter and one attribute: full steps read their colour and opacity from a
+    /// table baked for the step (no `pow` per sample), where that table is within 1e-5 of
+    /// the exact model ([`preint::baked`]).
+    pub bake: bool,
 }
 
 impl Default for Raycast {
     fn default() -> Self {
         Raycast {
             steps_per_voxel: 1.0,
-            termination: 1.0 / 1024.0,
+            termination: 1.0 / 4096.0,
             brick: 0,
             preintegrate: false,
+            jitter: true,
+            bake: true,
         }
     }
 }

@@ -47,6 +47,51 @@ pub fn classify_value(
     std::array::from_fn(|c| (coefficients[c] * lut[c] * scale).clamp(0.0, 1.0))
 }
 
+/// Entries of the baked table: 16 per level, so that every level is an entry.
+pub const BAKED: usize = 255 * 16 + 1;
+
+/// Largest error the baked table may leave (else the ray caster keeps `pow`).
+pub const BAKED_TOLERANCE: f64 = 1e-5;
+
+/// The ray caster's baked table for one attribute and steps of `exponent` reference
+/// spacings: `BAKED` entries over [0, 1], each the classification at its value with the
+/// exact opacity of one step, premultiplied; and the largest difference between its
+/// linear interpolation and the exact model (alpha interpolated, then corrected), taken
+/// at the midpoints and quarter points between entries. The model is smooth between
+/// levels, its curvature `exponent (exponent - 1) Δalpha² (1 - alpha)^(exponent - 2)`
+/// for an alpha step Δalpha between neighbouring entries: a table whose alpha moves by
+/// 0.1 between entries keeps the error under [`BAKED_TOLERANCE`] (1.5 steps per voxel
+/// or fewer), one that jumps from 0 to 0.9 does not (tested).
+pub fn baked(
+    table: &ColorTable,
+    coefficients: [f64; 4],
+    combine: Combine,
+    filter: Filter,
+    exponent: f64,
+) -> (Vec<f32>, f64) {
+    let exact = |v: f64| {
+        let c = classify_value(table, coefficients, combine, filter, v);
+        let a = 1.0 - (1.0 - c[3]).powf(exponent);
+        [c[0] * a, c[1] * a, c[2] * a, a]
+    };
+    let step = 1.0 / (BAKED - 1) as f64;
+    let entries: Vec<[f64; 4]> = (0..BAKED).map(|m| exact(m as f64 * step)).collect();
+    let worst = entries
+        .windows(2)
+        .enumerate()
+        .flat_map(|(m, pair)| {
+            [0.25, 0.5, 0.75].map(|w| {
+                let e = exact((m as f64 + w) * step);
+                (0..4)
+                    .map(|c| (pair[0][c] + (pair[1][c] - pair[0][c]) * w - e[c]).abs())
+                    .fold(0.0, f64::max)
+            })
+        })
+        .fold(0.0, f64::max);
+    let data = entries.iter().flat_map(|e| e.map(|x| x as f32)).collect();
+    (data, worst)
+}
+
 /// Substeps per level a segment is integrated with.
 const SUB: usize = 4;
 
@@ -143,6 +188,53 @@ mod tests {
         );
         assert!(e[3] as f64 > lo && (e[3] as f64) < hi, "{e:?}");
         assert!(e.iter().take(3).all(|&c| c <= e[3] + 1e-7), "{e:?}");
+    }
+
+    /// The largest interpolation error over 20,000 values.
+    fn dense_error(t: &ColorTable, c: [f64; 4], exponent: f64, b: &[f32]) -> f64 {
+        let mut worst = 0f64;
+        for s in 0..20_000 {
+            let v = (s as f64 + 0.37) / 20_000.0;
+            let x = v * (BAKED - 1) as f64;
+            let (i, w) = (x.floor() as usize, x.fract());
+            let g = classify_value(t, c, Combine::Product, Filter::Linear, v);
+            let a = 1.0 - (1.0 - g[3]).powf(exponent);
+            let exact = [g[0] * a, g[1] * a, g[2] * a, a];
+            for ch in 0..4 {
+                let lo = b[i * 4 + ch] as f64;
+                let hi = b[(i + 1).min(BAKED - 1) * 4 + ch] as f64;
+                worst = worst.max((lo + (hi - lo) * w - exact[ch]).abs());
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn the_baked_table_knows_its_own_error() {
+        let c = [1.0, 0.8, 1.0, 1.0];
+        // Alpha jumping between 0 and `top` at every entry: the steepest table there is.
+        for (top, usable) in [(25u8, true), (229, false)] {
+            let mut t = ramp();
+            for (k, e) in t.entries.iter_mut().enumerate() {
+                e[3] = if k % 2 == 0 { 0 } else { top };
+            }
+            for exponent in [0.25, 0.5, 1.0, 1.5] {
+                let (b, worst) = baked(&t, c, Combine::Product, Filter::Linear, exponent);
+                let dense = dense_error(&t, c, exponent, &b);
+                // The estimate holds what 20,000 values find (f32 storage aside).
+                assert!(
+                    dense <= worst * 1.05 + 2e-7,
+                    "{top} {exponent}: {dense} > {worst}"
+                );
+                // At exponent 1 there is no correction: only the premultiplication bends.
+                let expected = usable || exponent == 1.0;
+                assert_eq!(
+                    worst < BAKED_TOLERANCE,
+                    expected,
+                    "{top} {exponent}: {worst}"
+                );
+            }
+        }
     }
 
     #[test]

@@ -10,7 +10,8 @@
 //! program fetches one table, and the ARB and GLSL texts of a scene come from the same
 //! lines. Tags: `sum` / `product`, `secondary`, `tertiary`, `orthographic` /
 //! `perspective`, `skip` (the ray caster's empty-space skipping), `preint` (its
-//! pre-integrated classification).
+//! pre-integrated classification), `jitter` (its per-pixel step offset), `baked` (its
+//! one-attribute table of step colour and opacity).
 //!
 //! Which paths exist in which language: faithful slicing (verbatim ARB, GLSL port),
 //! precise slicing (ARB and GLSL), the precise ray caster (GLSL only: ARB fragment
@@ -36,6 +37,10 @@ pub struct Variant {
     pub skip: bool,
     /// Ray caster only: pre-integrated classification (one attribute).
     pub preint: bool,
+    /// Ray caster only: per-pixel offset of the steps (point sampling).
+    pub jitter: bool,
+    /// Ray caster only, with jitter: one attribute's steps from the baked table.
+    pub baked: bool,
 }
 
 impl Variant {
@@ -60,6 +65,12 @@ impl Variant {
         }
         if self.preint {
             tags.push("preint");
+        }
+        if self.jitter {
+            tags.push("jitter");
+        }
+        if self.baked {
+            tags.push("baked");
         }
         tags
     }
@@ -160,20 +171,28 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
             [true, false, true],
         ] {
             for projection in [Projection::Orthographic, Projection::Perspective] {
-                for (skip, preint) in [(false, false), (true, false), (false, true)] {
+                for (skip, preint, jitter, baked) in [
+                    (false, false, false, false),
+                    (true, false, false, false),
+                    (false, true, false, false),
+                    (false, false, true, false),
+                    (false, false, true, true),
+                ] {
                     let v = Variant {
                         combine,
                         present,
                         projection,
                         skip,
                         preint,
+                        jitter,
+                        baked,
                     };
-                    if !(skip || preint) {
+                    if !(skip || preint || jitter) {
                         pairs.push(slicing_pair(ProgramKind::Arb, v));
                         pairs.push(slicing_pair(ProgramKind::Glsl, v));
                     }
-                    // Pre-integration is for one attribute.
-                    if !preint || present == [true, false, false] {
+                    // Pre-integration and the baked table are for one attribute.
+                    if !(preint || baked) || present == [true, false, false] {
                         pairs.push(raycast_pair(v));
                     }
                 }
@@ -194,6 +213,8 @@ mod tests {
             projection: Projection::Orthographic,
             skip: false,
             preint: false,
+            jitter: false,
+            baked: false,
         }
     }
 

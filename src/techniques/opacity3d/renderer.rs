@@ -63,6 +63,43 @@ pub fn preintegrated(params: &Opacity3dScene, fidelity: Fidelity, attributes: us
         && params.raycast.is_some_and(|r| r.preintegrate)
 }
 
+/// The ray caster's table on unit 6, if its scene uses one.
+pub enum StepTable {
+    /// None: point sampling with `pow`, or slicing.
+    None,
+    /// Pre-integration, `SIZE²` RGBA ([`super::preint::preintegrate`]).
+    Preint(Vec<f32>),
+    /// One attribute, jittered steps: colour and opacity of a step, `BAKED` RGBA
+    /// ([`super::preint::baked`]), used only within its tolerance.
+    Baked(Vec<f32>),
+}
+
+/// The table a ray-casting scene needs (one attribute only).
+pub fn step_table(params: &Opacity3dScene, fidelity: Fidelity, prepared: &Prepared) -> StepTable {
+    let (Some(r), Some(table)) = (&params.raycast, &prepared.tables[0]) else {
+        return StepTable::None;
+    };
+    let one = prepared.count() == 1;
+    if path(params, fidelity) != Path3d::Raycast || !one || !corrected(params, fidelity) {
+        return StepTable::None;
+    }
+    let c = coefficients(params)[0];
+    let (combine, filter, exponent) =
+        (params.combine, params.table_filter, 1.0 / r.steps_per_voxel);
+    if r.preintegrate {
+        StepTable::Preint(super::preint::preintegrate(
+            table, c, combine, filter, exponent,
+        ))
+    } else if r.jitter && r.bake {
+        match super::preint::baked(table, c, combine, filter, exponent) {
+            (data, worst) if worst < super::preint::BAKED_TOLERANCE => StepTable::Baked(data),
+            _ => StepTable::None,
+        }
+    } else {
+        StepTable::None
+    }
+}
+
 /// The program kind a scene draws with: the ray caster is GLSL only, so `auto` gives GLSL
 /// there; an explicit `arb` stays (and the renderer says why it cannot).
 pub fn resolve_kind(scene: &Scene, kind: ProgramKind) -> ProgramKind {
@@ -192,6 +229,7 @@ pub struct Opacity3dRenderer {
     neutral: Option<Texture>,
     bricks: Option<(Bricks, Texture)>,
     preint: Option<Texture>,
+    baked: bool,
     mesh: Option<Mesh>,
     mesh_key: Option<([u64; 3], usize)>,
     spacing: f64,
@@ -252,7 +290,9 @@ impl Opacity3dRenderer {
                 "volume {ni}x{nj}x{nk} exceeds GL_MAX_3D_TEXTURE_SIZE {max}"
             )));
         }
-        let program = make_program(gpu, kind, fidelity, params, &prepared, projection)?;
+        let table = step_table(params, fidelity, &prepared);
+        let baked = matches!(table, StepTable::Baked(_));
+        let program = make_program(gpu, kind, fidelity, params, &prepared, projection, baked)?;
         let extent = Extent::D3(ni as u32, nj as u32, nk as u32);
         let volume = match fidelity {
             Fidelity::Faithful => Texture::new(
@@ -285,13 +325,14 @@ impl Opacity3dRenderer {
             neutral: None,
             bricks: None,
             preint: None,
+            baked,
             mesh: None,
             mesh_key: None,
             spacing: 0.0,
         };
         renderer.build_tables(gpu)?;
         renderer.build_bricks(gpu)?;
-        renderer.build_preint(gpu)?;
+        renderer.upload_step_table(gpu, table)?;
         renderer.send_constants(gpu)?;
         Ok(renderer)
     }
@@ -340,28 +381,31 @@ impl Opacity3dRenderer {
         Ok(())
     }
 
-    /// The ray caster's pre-integration table for the current table and step.
-    fn build_preint(&mut self, gpu: &Gpu) -> GlResult<()> {
-        let (Some(r), Some(table), true) = (
-            &self.params.raycast,
-            &self.prepared.tables[0],
-            preintegrated(&self.params, self.fidelity, self.prepared.count()),
-        ) else {
-            self.preint = None;
-            return Ok(());
+    /// The ray caster's table on unit 6 (pre-integration or baked), or none.
+    fn upload_step_table(&mut self, gpu: &Gpu, table: StepTable) -> GlResult<()> {
+        let (label, extent, data) = match table {
+            StepTable::None => {
+                self.preint = None;
+                return Ok(());
+            }
+            StepTable::Preint(data) => {
+                let n = super::preint::SIZE as u32;
+                (
+                    "opacity3d pre-integration table (front x back)",
+                    Extent::D2(n, n),
+                    data,
+                )
+            }
+            StepTable::Baked(data) => (
+                "opacity3d baked step table (colour and opacity of a step)",
+                Extent::D2(super::preint::BAKED as u32, 1),
+                data,
+            ),
         };
-        let data = super::preint::preintegrate(
-            table,
-            coefficients(&self.params)[0],
-            self.params.combine,
-            self.params.table_filter,
-            1.0 / r.steps_per_voxel,
-        );
-        let n = super::preint::SIZE as u32;
         self.preint = Some(Texture::new(
             gpu,
-            "opacity3d pre-integration table (front x back)",
-            Extent::D2(n, n),
+            label,
+            extent,
             TexelFormat::Rgba32f,
             Filter::Linear,
             TexelData::F32(&data),
@@ -373,7 +417,7 @@ impl Opacity3dRenderer {
     fn build_bricks(&mut self, gpu: &Gpu) -> GlResult<()> {
         let preint = preintegrated(&self.params, self.fidelity, self.prepared.count());
         let size = match (&self.params.raycast, self.path()) {
-            (Some(r), Path3d::Raycast) if r.brick > 0 && !preint => r.brick,
+            (Some(r), Path3d::Raycast) if r.brick > 0 && !preint && !r.jitter => r.brick,
             _ => {
                 self.bricks = None;
                 return Ok(());
@@ -489,14 +533,17 @@ fn make_program(
     params: &Opacity3dScene,
     prepared: &Prepared,
     projection: Projection,
+    baked: bool,
 ) -> GlResult<Program> {
     let preint = preintegrated(params, fidelity, prepared.count());
     let variant = Variant {
         combine: params.combine,
         present: prepared.present(),
         projection,
-        skip: params.raycast.is_some_and(|r| r.brick > 0) && !preint,
+        skip: params.raycast.is_some_and(|r| r.brick > 0 && !r.jitter) && !preint,
         preint,
+        jitter: params.raycast.is_some_and(|r| r.jitter) && !preint,
+        baked,
     };
     let pair = match (fidelity, path(params, fidelity)) {
         (Fidelity::Faithful, _) => faithful_pair(kind, params.combine),
@@ -526,6 +573,7 @@ impl Renderer for Opacity3dRenderer {
                 &self.params,
                 &self.prepared,
                 projection,
+                self.baked,
             )?;
             self.projection = projection;
             self.send_constants(gpu)?;
@@ -599,27 +647,6 @@ impl Renderer for Opacity3dRenderer {
             )?;
             return Ok(());
         }
-        let count = self.prepared.count();
-        let fidelity = self.fidelity;
-        let shape = |p: &Opacity3dScene| {
-            (
-                p.combine,
-                p.raycast.map(|r| r.brick > 0),
-                preintegrated(p, fidelity, count),
-            )
-        };
-        if shape(&old) != shape(new) {
-            self.program = make_program(
-                gpu,
-                self.kind,
-                self.fidelity,
-                new,
-                &self.prepared,
-                self.projection,
-            )?;
-            self.mesh_key = None;
-            self.mesh = None;
-        }
         let tables = |p: &Opacity3dScene| p.attributes().map(|a| a.map(|a| a.table.clone()));
         if tables(&old) != tables(new)
             || old.table_filter != new.table_filter
@@ -634,19 +661,29 @@ impl Renderer for Opacity3dRenderer {
             self.build_tables(gpu)?;
         }
         self.build_bricks(gpu)?;
-        let preint_input = |p: &Opacity3dScene| {
+        let table = step_table(new, self.fidelity, &self.prepared);
+        let baked = matches!(table, StepTable::Baked(_));
+        let shape = |p: &Opacity3dScene| {
             (
-                preintegrated(p, fidelity, count),
-                p.raycast.map(|r| r.steps_per_voxel),
-                p.primary.table.clone(),
-                p.primary.coefficients,
                 p.combine,
-                p.table_filter,
+                p.raycast.map(|r| (r.brick > 0, r.jitter, r.preintegrate)),
             )
         };
-        if preint_input(&old) != preint_input(new) {
-            self.build_preint(gpu)?;
+        if shape(&old) != shape(new) || baked != self.baked {
+            self.baked = baked;
+            self.program = make_program(
+                gpu,
+                self.kind,
+                self.fidelity,
+                new,
+                &self.prepared,
+                self.projection,
+                baked,
+            )?;
+            self.mesh_key = None;
+            self.mesh = None;
         }
+        self.upload_step_table(gpu, table)?;
         self.send_constants(gpu)
     }
 
