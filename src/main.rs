@@ -80,16 +80,17 @@ enum Command {
         /// Precise slicing at these slice counts.
         #[arg(long, value_delimiter = ',')]
         precise: Vec<usize>,
-        /// The precise ray caster at these steps per voxel, e.g. 0.5,1,2 (pre-integrated
-        /// for one attribute).
+        /// The precise ray caster at these steps per voxel, e.g. 0.5,1,2 (the scene's
+        /// [technique.opacity3d.raycast] options, else the defaults).
         #[arg(long, value_delimiter = ',')]
         raycast: Vec<f64>,
-        /// The precise ray caster with point sampling at these steps per voxel.
+        /// The pre-integrated ray caster (one attribute) at these steps per voxel.
         #[arg(long, value_delimiter = ',')]
-        raycast_point: Vec<f64>,
-        /// Ray-caster settings offset their steps per pixel (see raycast.jitter).
-        #[arg(long)]
-        jitter: bool,
+        raycast_preint: Vec<f64>,
+        /// How to look at the scene: its own camera, or an axis-aligned, rotated or
+        /// perspective view.
+        #[arg(long, value_enum, default_value_t = arbvis::study::bench::View::File)]
+        view: arbvis::study::bench::View,
         /// Write the levels, tables, camera (and with --score the reference) for a peer
         /// into this folder; the reference is reused from it when the scene matches.
         #[arg(long)]
@@ -284,8 +285,8 @@ fn run(cli: Cli) -> Result<()> {
             faithful,
             precise,
             raycast,
-            raycast_point,
-            jitter,
+            raycast_preint,
+            view,
             export,
             backend,
         } => {
@@ -296,6 +297,8 @@ fn run(cli: Cli) -> Result<()> {
                 bail!("--oversample {oversample}: must be above 0 and at most 1024");
             }
             let (scene, origin) = scene.load()?;
+            let scene = view.apply(&scene);
+            let origin = format!("{origin} ({} view)", view.name());
             let headless = Headless::new(backend)?;
             let options = arbvis::study::bench::BenchOptions {
                 frames,
@@ -305,8 +308,7 @@ fn run(cli: Cli) -> Result<()> {
                 faithful,
                 precise,
                 raycast,
-                raycast_point,
-                jitter,
+                raycast_preint,
                 export,
             };
             let report = arbvis::study::bench::run(&headless, &scene, &origin, &options, |line| {

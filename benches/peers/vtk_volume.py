@@ -48,7 +48,8 @@ from vtk.util import numpy_support  # noqa: E402
 def arbvis_bench(args, extra, score):
     """Run `arbvis bench` once and return its JSON report."""
     cmd = [args.arbvis, "bench", args.scene, "--json", "--frames", str(args.frames),
-           "--export", args.export, "--oversample", str(args.oversample)] + extra
+           "--export", args.export, "--oversample", str(args.oversample),
+           "--view", args.view] + extra
     if score:
         cmd.append("--score")
     out = subprocess.run(cmd, check=True, capture_output=True, text=True)
@@ -181,6 +182,13 @@ def main():
     p.add_argument("--faithful", default="")
     p.add_argument("--precise", default="")
     p.add_argument("--raycast", default="")
+    p.add_argument("--raycast-preint", default="")
+    p.add_argument("--view", default="file", help="file, axis, rotated or perspective "
+                   "(arbvis bench --view)")
+    p.add_argument("--only-vtk", default=None, metavar="TYPE:SD",
+                   help="render only VTK at this setting (e.g. float32:2) from the export "
+                   "folder, --frames frames, and print the median: for timing whole "
+                   "processes")
     p.add_argument("--sample-distances", default="2,1,0.5,0.25",
                    help="VTK sample distances in voxels (reference spacings)")
     p.add_argument("--types", default="float32,uint8")
@@ -191,12 +199,22 @@ def main():
     p.add_argument("--json", default=None, help="write every measurement here")
     args = p.parse_args()
     name = os.path.splitext(os.path.basename(args.scene))[0]
-    args.export = args.export or os.path.join(root, "target", f"peer-{name}")
+    args.export = args.export or os.path.join(root, "target", f"peer-{name}-{args.view}")
+    if args.only_vtk:
+        t, sd = args.only_vtk.split(":")
+        scene, _ = load_export(args.export)
+        scene["folder"] = args.export
+        peer = VtkPeer(scene, t)
+        peer.set_sample_distance(float(sd))
+        peer.frame()
+        times = [peer.frame() for _ in range(args.frames)]
+        print(f"VTK {t} sd {sd}: median {statistics.median(times):.1f} ms")
+        return
 
     extra = []
-    for flag in ("faithful", "precise", "raycast"):
+    for flag in ("faithful", "precise", "raycast", "raycast_preint"):
         if getattr(args, flag):
-            extra += [f"--{flag}", getattr(args, flag)]
+            extra += ["--" + flag.replace("_", "-"), getattr(args, flag)]
     if args.size:
         extra += ["--size", args.size]
     # The first run scores (and computes or reads the cached reference) and exports.

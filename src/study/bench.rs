@@ -43,12 +43,11 @@ pub struct BenchOptions {
     pub faithful: Vec<usize>,
     /// Precise slicing at these slice counts.
     pub precise: Vec<usize>,
-    /// The precise ray caster at these steps per voxel (pre-integrated where it can be).
+    /// The precise ray caster at these steps per voxel (the scene's ray-caster options,
+    /// else the defaults).
     pub raycast: Vec<f64>,
-    /// The precise ray caster, point sampling, at these steps per voxel.
-    pub raycast_point: Vec<f64>,
-    /// Ray-caster settings jitter their steps per pixel.
-    pub jitter: bool,
+    /// The pre-integrated ray caster at these steps per voxel.
+    pub raycast_preint: Vec<f64>,
     /// Folder for the data a peer needs (levels, tables, camera, reference).
     pub export: Option<PathBuf>,
 }
@@ -63,10 +62,63 @@ impl Default for BenchOptions {
             faithful: Vec::new(),
             precise: Vec::new(),
             raycast: Vec::new(),
-            raycast_point: Vec::new(),
-            jitter: false,
+            raycast_preint: Vec::new(),
             export: None,
         }
+    }
+}
+
+/// A view of a scene for benches and studies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum View {
+    /// The scene file's own camera.
+    #[default]
+    File,
+    /// Orthographic, looking down the k axis (identity rotation).
+    Axis,
+    /// Orthographic at the `v3o2-sum` demo's rotation, zoom 0.8.
+    Rotated,
+    /// The same rotation in perspective (30 degrees vertical field of view), zoom 0.8.
+    Perspective,
+}
+
+impl View {
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            View::File => "file",
+            View::Axis => "axis",
+            View::Rotated => "rotated",
+            View::Perspective => "perspective",
+        }
+    }
+
+    /// `scene` seen this way.
+    pub fn apply(self, scene: &Scene) -> Scene {
+        use crate::camera::{Camera, Projection};
+        let rotated = [0.326506, -0.092296, -0.701057, 0.627211];
+        let mut s = scene.clone();
+        match self {
+            View::File => {}
+            View::Axis => s.camera = Camera::default(),
+            View::Rotated => {
+                s.camera = Camera {
+                    rotation: rotated,
+                    zoom: 0.8,
+                    ..Camera::default()
+                }
+            }
+            View::Perspective => {
+                s.camera = Camera {
+                    projection: Projection::Perspective,
+                    rotation: rotated,
+                    zoom: 0.8,
+                    ..Camera::default()
+                }
+            }
+        }
+        s
     }
 }
 
@@ -85,10 +137,10 @@ pub fn settings(scene: &Scene, options: &BenchOptions) -> Result<Vec<Setting>> {
     let sweeping = !(options.faithful.is_empty()
         && options.precise.is_empty()
         && options.raycast.is_empty()
-        && options.raycast_point.is_empty());
+        && options.raycast_preint.is_empty());
     let TechniqueScene::Opacity3d(base) = &scene.technique else {
         if sweeping {
-            bail!("--faithful, --precise and --raycast[-point] sweep 3D-opacity scenes only");
+            bail!("--faithful, --precise and --raycast[-preint] sweep 3D-opacity scenes only");
         }
         return Ok(vec![Setting {
             name: format!("{} {}", scene.technique.name(), scene.fidelity.name()),
@@ -133,13 +185,16 @@ pub fn settings(scene: &Scene, options: &BenchOptions) -> Result<Vec<Setting>> {
             p.raycast = None;
         })?;
     }
-    for (list, preintegrate) in [(&options.raycast, true), (&options.raycast_point, false)] {
+    let own = base.raycast.unwrap_or_default();
+    for (list, preintegrate) in [
+        (&options.raycast, own.preintegrate),
+        (&options.raycast_preint, true),
+    ] {
         for &steps in list {
             let r = Raycast {
                 steps_per_voxel: steps,
                 preintegrate,
-                jitter: options.jitter,
-                ..base.raycast.unwrap_or_default()
+                ..own
             };
             let mut probe = scene.clone();
             probe.fidelity = Fidelity::Precise;
@@ -162,11 +217,11 @@ fn raycast_name(r: &Raycast, scene: &Scene) -> String {
         }
         _ => false,
     };
-    let jitter = r.jitter && !pre;
+    let exact = !r.jitter && !pre;
     format!(
         "raycast{}{} {} step/voxel",
         if pre { " pre-int" } else { "" },
-        if jitter { " jitter" } else { "" },
+        if exact { " exact-steps" } else { "" },
         r.steps_per_voxel
     )
 }
@@ -585,6 +640,7 @@ mod tests {
             faithful: vec![64],
             precise: vec![128, 256],
             raycast: vec![0.5],
+            raycast_preint: vec![2.0],
             ..Default::default()
         };
         let s = settings(&scene, &options).unwrap();
@@ -595,7 +651,8 @@ mod tests {
                 "faithful slicing 64",
                 "precise slicing 128",
                 "precise slicing 256",
-                "raycast pre-int 0.5 step/voxel"
+                "raycast 0.5 step/voxel",
+                "raycast pre-int 2 step/voxel"
             ]
         );
         assert_eq!(s[0].scene.fidelity, Fidelity::Faithful);
