@@ -91,6 +91,10 @@ enum Command {
         /// perspective view.
         #[arg(long, value_enum, default_value_t = arbvis::study::bench::View::File)]
         view: arbvis::study::bench::View,
+        /// Also time probe programs on the scene's slices: rasterization and blending, one
+        /// 2D fetch (fill rate), the 3D fetch, dependent table fetches, RGBA8 / RGBA32F.
+        #[arg(long)]
+        breakdown: bool,
         /// Write the levels, tables, camera (and with --score the reference) for a peer
         /// into this folder; the reference is reused from it when the scene matches.
         #[arg(long)]
@@ -287,6 +291,7 @@ fn run(cli: Cli) -> Result<()> {
             raycast,
             raycast_preint,
             view,
+            breakdown,
             export,
             backend,
         } => {
@@ -310,6 +315,7 @@ fn run(cli: Cli) -> Result<()> {
                 raycast,
                 raycast_preint,
                 export,
+                breakdown,
             };
             let report = arbvis::study::bench::run(&headless, &scene, &origin, &options, |line| {
                 eprintln!("{line}")

@@ -32,6 +32,8 @@ pub const OPACITY3D_SLICE_PRECISE_ARBFP: ProgramText = program!("opacity3d/slice
 pub const OPACITY3D_SLICE_PRECISE_FRAG: ProgramText = program!("opacity3d/slice_precise.frag");
 /// Precise single-pass ray caster (new, GLSL only), a template like the slicing one.
 pub const OPACITY3D_RAYCAST_FRAG: ProgramText = program!("opacity3d/raycast.frag");
+/// The probes of `arbvis bench --breakdown` (new, GLSL), a template.
+pub const OPACITY3D_PROBE_FRAG: ProgramText = program!("opacity3d/probe.frag");
 
 /// The seed's Cg vertex program (reference text, not compiled).
 pub const CELLPROJ_SEED_VERTEX_CG: ProgramText = program!("cellproj/seed_vertex.cg");
@@ -148,6 +150,7 @@ pub fn all_texts() -> Vec<ProgramText> {
         OPACITY3D_SLICE_PRECISE_ARBFP,
         OPACITY3D_SLICE_PRECISE_FRAG,
         OPACITY3D_RAYCAST_FRAG,
+        OPACITY3D_PROBE_FRAG,
         CELLPROJ_SEED_VERTEX_CG,
         CELLPROJ_SEED_FRAGMENT_CG,
         CELLPROJ_PERSPECTIVE_ARBVP,

@@ -50,6 +50,8 @@ pub struct BenchOptions {
     pub raycast_preint: Vec<f64>,
     /// Folder for the data a peer needs (levels, tables, camera, reference).
     pub export: Option<PathBuf>,
+    /// Also time the probes of [`super::breakdown`] on the scene's slices.
+    pub breakdown: bool,
 }
 
 impl Default for BenchOptions {
@@ -64,6 +66,7 @@ impl Default for BenchOptions {
             raycast: Vec::new(),
             raycast_preint: Vec::new(),
             export: None,
+            breakdown: false,
         }
     }
 }
@@ -440,9 +443,19 @@ pub fn run(
             ));
         }
     }
+    let mut results: Vec<Measured> = results.into_iter().flatten().collect();
+    if let (true, Some(prepared)) = (options.breakdown, &prepared) {
+        results.extend(super::breakdown::run(
+            headless,
+            scene,
+            prepared,
+            options.frames,
+            options.rounds,
+            &mut progress,
+        )?);
+    }
     let settings = results
         .into_iter()
-        .flatten()
         .map(|mut m| {
             m.median_ms = median(&m.frames_ms);
             m.min_ms = m.frames_ms.iter().copied().fold(f64::INFINITY, f64::min);
@@ -462,6 +475,29 @@ pub fn run(
         reference_s,
         settings,
     })
+}
+
+impl Measured {
+    /// A probe of [`super::breakdown`] (GLSL, on `slices` slices).
+    pub fn probe(name: String, target: TargetFormat, slices: usize, first: f64) -> Measured {
+        Measured {
+            name,
+            technique: "opacity3d".into(),
+            fidelity: String::new(),
+            path: "probe".into(),
+            slices: Some(slices),
+            steps_per_voxel: None,
+            programs: ProgramKind::Glsl.name().into(),
+            target: target.name().into(),
+            first_ms: first,
+            frames_ms: Vec::new(),
+            median_ms: f64::NAN,
+            min_ms: f64::NAN,
+            max_ms: f64::NAN,
+            rmse: None,
+            max_abs: None,
+        }
+    }
 }
 
 fn new_measured(setting: &Setting, s: &Scene, kind: ProgramKind, first: f64) -> Measured {
@@ -597,13 +633,13 @@ pub fn to_text(report: &Report) -> String {
         report.rounds
     );
     s += &format!(
-        "{:<30} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
+        "{:<52} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9}\n",
         "setting", "first ms", "median", "min", "max", "RMSE", "max err"
     );
     for m in &report.settings {
         let score = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.5}"));
         s += &format!(
-            "{:<30} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>9} {:>9}\n",
+            "{:<52} {:>9.1} {:>9.1} {:>9.1} {:>9.1} {:>9} {:>9}\n",
             m.name,
             m.first_ms,
             m.median_ms,

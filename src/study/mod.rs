@@ -6,6 +6,7 @@
 //! integral (RGB: max abs, RMSE, PSNR). `study` writes CSV and a plot (error against time).
 
 pub mod bench;
+pub mod breakdown;
 pub mod export;
 
 use std::path::Path;

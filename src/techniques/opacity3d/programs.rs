@@ -199,6 +199,16 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
             }
         }
     }
+    for tags in [
+        &[][..],
+        &["fetch2d"],
+        &["fetch3d"],
+        &["fetch3d", "table1"],
+        &["fetch3d", "table3"],
+    ] {
+        let probe = specialize(&programs::OPACITY3D_PROBE_FRAG, tags, ['g', 'b', 'r']);
+        pairs.push(with_transform(ProgramKind::Glsl, &probe, &probe));
+    }
     pairs
 }
 
