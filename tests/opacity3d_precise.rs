@@ -375,7 +375,8 @@ fn precise_error_falls_at_second_order_and_monotonically() {
 
 #[test]
 fn precise_builds_one_channel_per_attribute_and_the_ray_caster_its_bricks() {
-    for (attributes, bytes) in [(1, 2), (2, 4), (3, 6)] {
+    // One attribute as f32 (4 bytes), two and three as 16-bit unorm.
+    for (attributes, bytes) in [(1, 4), (2, 4), (3, 6)] {
         let (mut scene, _dir) = random_scene("resources", 1, [4, 3, 2], attributes, "product");
         let r = render_on(&headless(Backend::Egl), &scene).unwrap();
         let volume = r

@@ -27,7 +27,7 @@ uniform sampler2D texture3;  // [secondary]
 uniform sampler2D texture4;  // [tertiary]
 uniform sampler3D texture5;  // [skip]
 uniform sampler2D texture6;  // [preint]
-uniform sampler2D texture6;  // [baked]
+uniform sampler1D texture6;  // [baked]
 uniform vec4 program_local[10];
 out vec4 frag_color;
 
@@ -112,7 +112,7 @@ void main() {
         float a = 1.0 - pow(1.0 - col.a, k);  // [jitter !baked]
         acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [jitter !baked]
         float v = textureLod(texture0, tc, 0.0).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
-        acc += (1.0 - acc.a) * textureLod(texture6, vec2(v, 0.5), 0.0);  // [baked]
+        acc += (1.0 - acc.a) * textureLod(texture6, v, 0.0);  // [baked]
     }  // [jitter]
     float done = min(first + float(full) * h, chord);  // [jitter]
     float rest = chord - done;  // [jitter]

@@ -32,6 +32,9 @@ pub enum TexelFormat {
     Rgb16FromU8,
     /// 1 x u8 (flags, masks).
     R8,
+    /// 1 x f32 filled from u8 data (k/255 converted by GL): twice the bytes of
+    /// [`TexelFormat::R16FromU8`], the same values, and faster to filter on llvmpipe.
+    R32fFromU8,
 }
 
 impl TexelFormat {
@@ -48,6 +51,7 @@ impl TexelFormat {
             TexelFormat::Rg16FromU8 => 4,
             TexelFormat::Rgb16FromU8 => 6,
             TexelFormat::R8 => 1,
+            TexelFormat::R32fFromU8 => 4,
         }
     }
 
@@ -59,6 +63,7 @@ impl TexelFormat {
             TexelFormat::R16FromU8 => 1,
             TexelFormat::Rg16FromU8 => 2,
             TexelFormat::Rgb16FromU8 => 3,
+            TexelFormat::R32fFromU8 => 1,
             other => other.bytes(),
         }
     }
@@ -79,6 +84,7 @@ impl TexelFormat {
             TexelFormat::Rg16FromU8 => (glow::RG16, glow::RG, glow::UNSIGNED_BYTE),
             TexelFormat::Rgb16FromU8 => (glow::RGB16, glow::RGB, glow::UNSIGNED_BYTE),
             TexelFormat::R8 => (glow::R8, glow::RED, glow::UNSIGNED_BYTE),
+            TexelFormat::R32fFromU8 => (glow::R32F, glow::RED, glow::UNSIGNED_BYTE),
         }
     }
 
@@ -94,6 +100,7 @@ impl TexelFormat {
             TexelFormat::Rg16FromU8 => "RG16",
             TexelFormat::Rgb16FromU8 => "RGB16",
             TexelFormat::R8 => "R8",
+            TexelFormat::R32fFromU8 => "R32F",
         }
     }
 }
