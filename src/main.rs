@@ -105,10 +105,15 @@ enum Command {
     },
     /// The speed-for-accuracy study of 3D opacity: every slice count, target precision,
     /// opacity correction on/off and program kind, timed and scored against the f64
-    /// reference; writes OUT/opacity3d.csv and OUT/opacity3d.png.
+    /// reference; writes OUT/opacity3d.csv and OUT/opacity3d.png. With --from, the trade
+    /// against VTK instead, from runs of benches/peers/vtk_volume.py --json: a plot per
+    /// run, OUT/study.csv and the README-ready OUT/study.md.
     Study {
         #[command(flatten)]
         sweep: SweepArgs,
+        /// Peer-script runs (JSON) to plot and tabulate instead of sweeping.
+        #[arg(long, num_args = 1..)]
+        from: Vec<PathBuf>,
         /// Reference steps per voxel.
         #[arg(long, default_value_t = 4.0)]
         oversample: f64,
@@ -327,10 +332,15 @@ fn run(cli: Cli) -> Result<()> {
                 print!("{}", arbvis::study::bench::to_text(&report));
             }
         }
+        Command::Study { from, out, .. } if !from.is_empty() => {
+            print!("{}", arbvis::study::peers::study(&from, &out)?);
+            println!("wrote {}", out.join("study.md").display());
+        }
         Command::Study {
             sweep,
             oversample,
             out,
+            ..
         } => {
             let headless = Headless::new(sweep.backend)?;
             let caps = headless.gpu().caps().clone();

@@ -287,3 +287,40 @@ fn study_writes_csv_and_plot_and_bench_times() {
     assert!(!bad.status.success());
     assert!(text(&bad).1.contains("3D-opacity"), "{}", text(&bad).1);
 }
+
+#[test]
+fn study_from_peer_runs_writes_plots_and_the_readme_table() {
+    let dir = temp_dir("study-from");
+    let run = r#"{"arbvis": {"scene": "s", "renderer": "llvmpipe", "version": "4.5",
+        "size": [8, 8], "settings": []},
+      "arbvis_frames": {
+        "precise slicing 128": {"rmse": 0.004, "max_abs": 0.1, "frames_ms": [10]},
+        "raycast 0.5 step/voxel": {"rmse": 0.002, "max_abs": 0.1, "frames_ms": [5]}},
+      "vtk": [{"type": "float32", "sample_distance": 2.0, "first_ms": 1, "frames_ms": [12],
+               "rmse": 0.003, "max_abs": 0.1}],
+      "vtk_version": "9.7.2"}"#;
+    std::fs::write(dir.join("cube-axis.json"), run).unwrap();
+    let out = dir.join("out");
+    let study = arbvis(&[
+        "study",
+        "--from",
+        dir.join("cube-axis.json").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&study);
+    assert!(study.status.success(), "{stderr}");
+    assert!(stdout.contains("2.40x"), "{stdout}");
+    assert!(out.join("cube-axis.png").is_file() && out.join("study.csv").is_file());
+    // A broken run names the file and the position.
+    std::fs::write(dir.join("broken.json"), "{\"arbvis\": 3").unwrap();
+    let bad = arbvis(&[
+        "study",
+        "--from",
+        dir.join("broken.json").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!bad.status.success());
+    assert!(text(&bad).1.contains("broken.json:1:"), "{}", text(&bad).1);
+}
