@@ -52,18 +52,68 @@ enum Command {
         /// A `.sgy`/`.segy` or `.nii`/`.nii.gz` file.
         file: PathBuf,
     },
-    /// Time v3o2's 3D opacity on a synthetic volume³ x 3 attributes at size² (faithful and
-    /// precise, ARB and GLSL, over slice counts); no scoring.
+    /// Time a scene offscreen: clear + draw + finish per frame, the first frame apart,
+    /// settings interleaved over rounds. For 3D opacity: sweep faithful / precise slice
+    /// counts and ray-caster steps, score against the f64 reference (RGB), and export what
+    /// a peer needs (benches/peers/vtk_volume.py).
     Bench {
         #[command(flatten)]
-        sweep: SweepArgs,
+        scene: SceneArgs,
+        /// Timed frames per setting and round.
+        #[arg(long, default_value_t = 5)]
+        frames: usize,
+        /// Passes over all settings (interleaved).
+        #[arg(long, default_value_t = 1)]
+        rounds: usize,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+        /// Score against the f64 reference (3D opacity; RMSE and largest error over RGB).
+        #[arg(long)]
+        score: bool,
+        /// Reference steps per voxel.
+        #[arg(long, default_value_t = 16.0)]
+        oversample: f64,
+        /// Faithful slicing at these slice counts, e.g. 128,256.
+        #[arg(long, value_delimiter = ',')]
+        faithful: Vec<usize>,
+        /// Precise slicing at these slice counts.
+        #[arg(long, value_delimiter = ',')]
+        precise: Vec<usize>,
+        /// The precise ray caster at these steps per voxel, e.g. 0.5,1,2 (the scene's
+        /// [technique.opacity3d.raycast] options, else the defaults).
+        #[arg(long, value_delimiter = ',')]
+        raycast: Vec<f64>,
+        /// The pre-integrated ray caster (one attribute) at these steps per voxel.
+        #[arg(long, value_delimiter = ',')]
+        raycast_preint: Vec<f64>,
+        /// How to look at the scene: its own camera, or an axis-aligned, rotated or
+        /// perspective view.
+        #[arg(long, value_enum, default_value_t = arbvis::study::bench::View::File)]
+        view: arbvis::study::bench::View,
+        /// Also time probe programs on the scene's slices: rasterization and blending, one
+        /// 2D fetch (fill rate), the 3D fetch, dependent table fetches, RGBA8 / RGBA32F.
+        #[arg(long)]
+        breakdown: bool,
+        /// Write the levels, tables, camera (and with --score the reference) for a peer
+        /// into this folder; the reference is reused from it when the scene matches.
+        #[arg(long)]
+        export: Option<PathBuf>,
+        /// Offscreen backend.
+        #[arg(long, value_enum, default_value_t = Backend::Egl)]
+        backend: Backend,
     },
     /// The speed-for-accuracy study of 3D opacity: every slice count, target precision,
     /// opacity correction on/off and program kind, timed and scored against the f64
-    /// reference; writes OUT/opacity3d.csv and OUT/opacity3d.png.
+    /// reference; writes OUT/opacity3d.csv and OUT/opacity3d.png. With --from, the trade
+    /// against VTK instead, from runs of benches/peers/vtk_volume.py --json: a plot per
+    /// run, OUT/study.csv and the README-ready OUT/study.md.
     Study {
         #[command(flatten)]
         sweep: SweepArgs,
+        /// Peer-script runs (JSON) to plot and tabulate instead of sweeping.
+        #[arg(long, num_args = 1..)]
+        from: Vec<PathBuf>,
         /// Reference steps per voxel.
         #[arg(long, default_value_t = 4.0)]
         oversample: f64,
@@ -270,16 +320,63 @@ fn run(cli: Cli) -> Result<()> {
                 );
             }
         }
-        Command::Bench { sweep } => {
-            let headless = Headless::new(sweep.backend)?;
-            println!("{}", headless.gpu().caps().renderer);
-            let options = sweep.options(false, false)?;
-            arbvis::study::run(&headless, &options, |line| println!("{line}"))?;
+        Command::Bench {
+            scene,
+            frames,
+            rounds,
+            json,
+            score,
+            oversample,
+            faithful,
+            precise,
+            raycast,
+            raycast_preint,
+            view,
+            breakdown,
+            export,
+            backend,
+        } => {
+            if frames == 0 || rounds == 0 {
+                bail!("--frames and --rounds must be at least 1");
+            }
+            if !(oversample.is_finite() && oversample > 0.0 && oversample <= 1024.0) {
+                bail!("--oversample {oversample}: must be above 0 and at most 1024");
+            }
+            let (scene, origin) = scene.load()?;
+            let scene = view.apply(&scene);
+            let origin = format!("{origin} ({} view)", view.name());
+            let headless = Headless::new(backend)?;
+            let options = arbvis::study::bench::BenchOptions {
+                frames,
+                rounds,
+                score,
+                oversample,
+                faithful,
+                precise,
+                raycast,
+                raycast_preint,
+                export,
+                breakdown,
+            };
+            let report = arbvis::study::bench::run(&headless, &scene, &origin, &options, |line| {
+                eprintln!("{line}")
+            })
+            .with_context(|| format!("benchmarking {origin}"))?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report)?);
+            } else {
+                print!("{}", arbvis::study::bench::to_text(&report));
+            }
+        }
+        Command::Study { from, out, .. } if !from.is_empty() => {
+            print!("{}", arbvis::study::peers::study(&from, &out)?);
+            println!("wrote {}", out.join("study.md").display());
         }
         Command::Study {
             sweep,
             oversample,
             out,
+            ..
         } => {
             let headless = Headless::new(sweep.backend)?;
             let caps = headless.gpu().caps().clone();

@@ -25,15 +25,15 @@ pub const OPACITY3D_SUM_FRAG: ProgramText = program!("opacity3d/sum.frag");
 /// GLSL port of the product program.
 pub const OPACITY3D_PRODUCT_FRAG: ProgramText = program!("opacity3d/product.frag");
 
-/// Precise sum (new): texel-centre lookup, clamp, opacity correction.
-pub const OPACITY3D_SUM_PRECISE_ARBFP: ProgramText = program!("opacity3d/sum_precise.arbfp");
-/// GLSL twin of [`OPACITY3D_SUM_PRECISE_ARBFP`].
-pub const OPACITY3D_SUM_PRECISE_FRAG: ProgramText = program!("opacity3d/sum_precise.frag");
-/// Precise product (new).
-pub const OPACITY3D_PRODUCT_PRECISE_ARBFP: ProgramText =
-    program!("opacity3d/product_precise.arbfp");
-/// GLSL twin of [`OPACITY3D_PRODUCT_PRECISE_ARBFP`].
-pub const OPACITY3D_PRODUCT_PRECISE_FRAG: ProgramText = program!("opacity3d/product_precise.frag");
+/// Precise slicing (new), a template: specialized per scene by
+/// `techniques::opacity3d::programs` (tags and channel placeholders).
+pub const OPACITY3D_SLICE_PRECISE_ARBFP: ProgramText = program!("opacity3d/slice_precise.arbfp");
+/// GLSL twin of [`OPACITY3D_SLICE_PRECISE_ARBFP`] (the same tags).
+pub const OPACITY3D_SLICE_PRECISE_FRAG: ProgramText = program!("opacity3d/slice_precise.frag");
+/// Precise single-pass ray caster (new, GLSL only), a template like the slicing one.
+pub const OPACITY3D_RAYCAST_FRAG: ProgramText = program!("opacity3d/raycast.frag");
+/// The probes of `arbvis bench --breakdown` (new, GLSL), a template.
+pub const OPACITY3D_PROBE_FRAG: ProgramText = program!("opacity3d/probe.frag");
 
 /// The seed's Cg vertex program (reference text, not compiled).
 pub const CELLPROJ_SEED_VERTEX_CG: ProgramText = program!("cellproj/seed_vertex.cg");
@@ -101,11 +101,6 @@ pub fn all_pairs() -> Vec<ProgramPair> {
         (QUAD_ARBFP, QUAD_FRAG),
         (OPACITY3D_SUM_ARBFP, OPACITY3D_SUM_FRAG),
         (OPACITY3D_PRODUCT_ARBFP, OPACITY3D_PRODUCT_FRAG),
-        (OPACITY3D_SUM_PRECISE_ARBFP, OPACITY3D_SUM_PRECISE_FRAG),
-        (
-            OPACITY3D_PRODUCT_PRECISE_ARBFP,
-            OPACITY3D_PRODUCT_PRECISE_FRAG,
-        ),
     ];
     let mut pairs = Vec::new();
     for (arb, glsl) in &fragments {
@@ -147,6 +142,8 @@ pub fn all_pairs() -> Vec<ProgramPair> {
             fragment,
         });
     }
+    // Templates compile only specialized: every specialization of opacity3d's.
+    pairs.extend(crate::techniques::opacity3d::programs::all_precise_pairs());
     pairs
 }
 
@@ -161,10 +158,10 @@ pub fn all_texts() -> Vec<ProgramText> {
         OPACITY3D_PRODUCT_ARBFP,
         OPACITY3D_SUM_FRAG,
         OPACITY3D_PRODUCT_FRAG,
-        OPACITY3D_SUM_PRECISE_ARBFP,
-        OPACITY3D_SUM_PRECISE_FRAG,
-        OPACITY3D_PRODUCT_PRECISE_ARBFP,
-        OPACITY3D_PRODUCT_PRECISE_FRAG,
+        OPACITY3D_SLICE_PRECISE_ARBFP,
+        OPACITY3D_SLICE_PRECISE_FRAG,
+        OPACITY3D_RAYCAST_FRAG,
+        OPACITY3D_PROBE_FRAG,
         CELLPROJ_SEED_VERTEX_CG,
         CELLPROJ_SEED_FRAGMENT_CG,
         CELLPROJ_PERSPECTIVE_ARBVP,

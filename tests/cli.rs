@@ -226,15 +226,104 @@ fn study_writes_csv_and_plot_and_bench_times() {
     let (plot, _) = read_png(&dir.join("opacity3d.png")).unwrap();
     assert_eq!((plot.width, plot.height), (1100, 700));
     assert!(stdout.contains("wrote"), "{stdout}");
+    // bench times any scene; for 3D opacity it sweeps, scores and exports for a peer.
+    let export = dir.join("peer");
     let bench = arbvis(&[
-        "bench", "--volume", "8", "--size", "16", "--slices", "4", "--frames", "1",
+        "bench",
+        "--demo",
+        "v3o2-product",
+        "--size",
+        "16x12",
+        "--faithful",
+        "4",
+        "--precise",
+        "4,8",
+        "--raycast",
+        "0.5",
+        "--frames",
+        "2",
+        "--rounds",
+        "2",
+        "--score",
+        "--oversample",
+        "2",
+        "--json",
+        "--export",
+        export.to_str().unwrap(),
     ]);
     let (stdout, stderr) = text(&bench);
     assert!(bench.status.success(), "{stderr}");
+    for key in [
+        "\"faithful slicing 4\"",
+        "\"precise slicing 8\"",
+        "\"raycast 0.5 step/voxel\"",
+        "\"median_ms\"",
+        "\"rmse\"",
+    ] {
+        assert!(stdout.contains(key), "{key} in {stdout}");
+    }
+    for file in [
+        "scene.json",
+        "levels_primary.u8",
+        "table_primary.u8",
+        "reference.f32",
+    ] {
+        assert!(export.join(file).is_file(), "{file}");
+    }
+    // 16 x 12 pixels, RGB f32.
+    assert_eq!(
+        std::fs::metadata(export.join("reference.f32"))
+            .unwrap()
+            .len(),
+        16 * 12 * 12
+    );
+    let quad = arbvis(&["bench", "--demo", "quad", "--size", "8x8", "--frames", "1"]);
+    let (stdout, stderr) = text(&quad);
+    assert!(quad.status.success(), "{stderr}");
     assert!(
-        stdout.contains("faithful") && stdout.contains("ms"),
+        stdout.contains("quad") && stdout.contains("median"),
         "{stdout}"
     );
+    let bad = arbvis(&["bench", "--demo", "quad", "--score"]);
+    assert!(!bad.status.success());
+    assert!(text(&bad).1.contains("3D-opacity"), "{}", text(&bad).1);
+}
+
+#[test]
+fn study_from_peer_runs_writes_plots_and_the_readme_table() {
+    let dir = temp_dir("study-from");
+    let run = r#"{"arbvis": {"scene": "s", "renderer": "llvmpipe", "version": "4.5",
+        "size": [8, 8], "settings": []},
+      "arbvis_frames": {
+        "precise slicing 128": {"rmse": 0.004, "max_abs": 0.1, "frames_ms": [10]},
+        "raycast 0.5 step/voxel": {"rmse": 0.002, "max_abs": 0.1, "frames_ms": [5]}},
+      "vtk": [{"type": "float32", "sample_distance": 2.0, "first_ms": 1, "frames_ms": [12],
+               "rmse": 0.003, "max_abs": 0.1}],
+      "vtk_version": "9.7.2"}"#;
+    std::fs::write(dir.join("cube-axis.json"), run).unwrap();
+    let out = dir.join("out");
+    let study = arbvis(&[
+        "study",
+        "--from",
+        dir.join("cube-axis.json").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&study);
+    assert!(study.status.success(), "{stderr}");
+    assert!(stdout.contains("2.40x"), "{stdout}");
+    assert!(out.join("cube-axis.png").is_file() && out.join("study.csv").is_file());
+    // A broken run names the file and the position.
+    std::fs::write(dir.join("broken.json"), "{\"arbvis\": 3").unwrap();
+    let bad = arbvis(&[
+        "study",
+        "--from",
+        dir.join("broken.json").to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!bad.status.success());
+    assert!(text(&bad).1.contains("broken.json:1:"), "{}", text(&bad).1);
 }
 
 #[test]

@@ -25,6 +25,16 @@ pub enum TexelFormat {
     Rgb16f,
     /// 4 x f32, filled from u8 data (normalized k/255, converted by GL).
     Rgba32fFromU8,
+    /// 1 x 16-bit unorm, filled from u8 data: GL stores k as k·257, which reads back as
+    /// k·257/65535 = k/255 exactly (where half floats are 2^-11 off), filtered in float.
+    R16FromU8,
+    /// 2 x 16-bit unorm from u8 data (see [`TexelFormat::R16FromU8`]).
+    Rg16FromU8,
+    /// 3 x 16-bit unorm from u8 data (see [`TexelFormat::R16FromU8`]).
+    Rgb16FromU8,
+    /// 1 x f32 filled from u8 data (k/255 converted by GL): twice the bytes of
+    /// [`TexelFormat::R16FromU8`], the same values, and faster to filter on llvmpipe.
+    R32fFromU8,
 }
 
 impl TexelFormat {
@@ -38,6 +48,10 @@ impl TexelFormat {
             TexelFormat::R8 => 1,
             TexelFormat::Rgb16f => 6,
             TexelFormat::Rgba32fFromU8 => 16,
+            TexelFormat::R16FromU8 => 2,
+            TexelFormat::Rg16FromU8 => 4,
+            TexelFormat::Rgb16FromU8 => 6,
+            TexelFormat::R32fFromU8 => 4,
         }
     }
 
@@ -46,6 +60,10 @@ impl TexelFormat {
         match self {
             TexelFormat::Rgb16f => 3,
             TexelFormat::Rgba32fFromU8 => 4,
+            TexelFormat::R16FromU8 => 1,
+            TexelFormat::Rg16FromU8 => 2,
+            TexelFormat::Rgb16FromU8 => 3,
+            TexelFormat::R32fFromU8 => 1,
             other => other.bytes(),
         }
     }
@@ -63,6 +81,10 @@ impl TexelFormat {
             TexelFormat::R8 => (glow::R8, glow::RED, glow::UNSIGNED_BYTE),
             TexelFormat::Rgb16f => (glow::RGB16F, glow::RGB, glow::UNSIGNED_BYTE),
             TexelFormat::Rgba32fFromU8 => (glow::RGBA32F, glow::RGBA, glow::UNSIGNED_BYTE),
+            TexelFormat::R16FromU8 => (glow::R16, glow::RED, glow::UNSIGNED_BYTE),
+            TexelFormat::Rg16FromU8 => (glow::RG16, glow::RG, glow::UNSIGNED_BYTE),
+            TexelFormat::Rgb16FromU8 => (glow::RGB16, glow::RGB, glow::UNSIGNED_BYTE),
+            TexelFormat::R32fFromU8 => (glow::R32F, glow::RED, glow::UNSIGNED_BYTE),
         }
     }
 
@@ -75,6 +97,10 @@ impl TexelFormat {
             TexelFormat::R8 => "R8",
             TexelFormat::Rgb16f => "RGB16F",
             TexelFormat::Rgba32fFromU8 => "RGBA32F",
+            TexelFormat::R16FromU8 => "R16",
+            TexelFormat::Rg16FromU8 => "RG16",
+            TexelFormat::Rgb16FromU8 => "RGB16",
+            TexelFormat::R32fFromU8 => "R32F",
         }
     }
 }

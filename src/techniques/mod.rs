@@ -74,10 +74,11 @@ pub fn build(gpu: &Gpu, scene: &Scene, kind: ProgramKind) -> GlResult<Box<dyn Re
         TechniqueScene::Quad(params) => Box::new(quad::QuadRenderer::new(gpu, kind, params)?),
         TechniqueScene::Opacity3d(params) => Box::new(opacity3d::Opacity3dRenderer::new(
             gpu,
-            kind,
+            opacity3d::renderer::resolve_kind(scene, kind),
             scene.fidelity,
             params,
             &scene.base,
+            scene.camera.projection,
         )?),
         TechniqueScene::Splats(params) => Box::new(splats::SplatsRenderer::new(
             gpu,

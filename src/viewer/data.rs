@@ -104,6 +104,7 @@ pub fn build(
         params,
         &scene.base,
         prepared,
+        scene.camera.projection,
     )?))
 }
 

@@ -41,6 +41,24 @@ impl Prepared {
         self.tables.iter().filter(|t| t.is_some()).count()
     }
 
+    /// Which attributes are present (primary, secondary, tertiary).
+    pub fn present(&self) -> [bool; 3] {
+        self.tables.each_ref().map(Option::is_some)
+    }
+
+    /// The present attributes' levels only, interleaved in attribute order (the precise
+    /// volume: one channel per attribute the scene has).
+    pub fn present_levels(&self) -> Vec<u8> {
+        let channels: Vec<usize> = (0..3)
+            .filter(|&a| self.tables[a].is_some())
+            .map(|a| CHANNEL[a])
+            .collect();
+        self.packed
+            .chunks_exact(3)
+            .flat_map(|texel| channels.iter().map(move |&c| texel[c]))
+            .collect()
+    }
+
     /// Object-space spacing that table alphas are defined for (precise mode's opacity
     /// correction): one voxel along the longest axis.
     pub fn reference_spacing(&self) -> f64 {
@@ -157,6 +175,20 @@ mod tests {
         assert_eq!(p, vec![30, 10, 20, 31, 11, 21]);
         let two = pack([Some(&[10]), Some(&[20]), None], 1);
         assert_eq!(two, vec![0, 10, 20], "2D opacity leaves R at 0");
+    }
+
+    #[test]
+    fn present_levels_keep_the_present_attributes_in_order() {
+        let grey = ColorTable::builtin("grey").unwrap();
+        let prepared = Prepared {
+            dims: [2, 1, 1],
+            half: DVec3::ONE,
+            packed: pack([Some(&[10, 11]), None, Some(&[30, 31])], 2),
+            tables: [Some(grey.clone()), None, Some(grey)],
+            ranges: [None; 3],
+        };
+        assert_eq!(prepared.present(), [true, false, true]);
+        assert_eq!(prepared.present_levels(), vec![10, 30, 11, 31]);
     }
 
     #[test]

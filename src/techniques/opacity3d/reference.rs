@@ -8,6 +8,9 @@
 //!   ([`Prepared::reference_spacing`]), so a step `h` has `1 - (1 - a)^(h / ref)`. The
 //!   integral is taken by the midpoint rule with `oversample` steps per reference spacing,
 //!   far to near, over the background.
+//! - [`super::mirror`] holds the CPU mirrors of the precise paths.
+//! - [`emulate_faithful_llvmpipe`]: the same pipeline bit for bit as llvmpipe computes
+//!   it (f32 program, llvmpipe's 8-bit blend), where filtering arithmetic is not involved.
 //! - [`emulate_faithful`]: an independent emulation of the faithful 8-bit pipeline: the
 //!   same slices as the GPU (planes perpendicular to the view axis at layer centres),
 //!   trilinear fetch with 8-bit filtering arithmetic ([`Filtering::Unorm8`]), the original table addressing (`coord = v` into 256 texels), the
@@ -177,7 +180,9 @@ pub fn reference(
             return dst;
         };
         let length = (exit - enter) * dir.length();
-        let steps = ((length / reference * oversample).ceil() as usize).max(1);
+        // A chord within 1e-4 step of a whole number of steps takes that number (the ray
+        // caster rounds alike), so that f32 and f64 agree on ties such as axis views.
+        let steps = ((length / reference * oversample - 1e-4).ceil() as usize).max(1);
         let exponent = length / steps as f64 / reference;
         // Far to near.
         for s in (0..steps).rev() {
@@ -251,9 +256,155 @@ pub fn emulate_faithful(
     })
 }
 
+/// The two emulations of the faithful pipeline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Model {
+    /// Any 8-bit hardware: exact arithmetic rounded where 8-bit storage rounds
+    /// ([`emulate_faithful`]).
+    Generic,
+    /// Mesa's llvmpipe, bit for bit where no filtering arithmetic is involved
+    /// ([`emulate_faithful_llvmpipe`]).
+    Llvmpipe,
+}
+
+/// `x · y / 255` as llvmpipe's 8-bit blend computes it: `p = x y`, then
+/// `(p + (p >> 8) + 128) >> 8`, which is `round(p / 255)` except for 24 of the 65536
+/// products (e.g. 152 · 229 / 255 = 136.5 gives 136).
+pub fn llvmpipe_mul8(x: u32, y: u32) -> u32 {
+    let p = x * y;
+    (p + (p >> 8) + 128) >> 8
+}
+
+/// The faithful pipeline as llvmpipe computes it: texels convert to `k · f32(1/255)`, the
+/// verbatim program runs in f32 (the coefficients as f32, `0.3333` as f32, each `MUL` and
+/// `MAD` rounded to f32), the colour converts to 8 bits as `rint(f32(x · 255))` after
+/// clamping, and each blend product is [`llvmpipe_mul8`], the two added with saturation
+/// (alpha: `ONE, ONE_MINUS_SRC_ALPHA`). Linear filtering still goes through the generic
+/// 8-bit model ([`Filtering::Unorm8`]), whose rounding order is not llvmpipe's.
+pub fn emulate_faithful_llvmpipe(
+    prepared: &Prepared,
+    params: &Opacity3dScene,
+    camera: &Camera,
+    size: [u32; 2],
+    background: [f64; 4],
+) -> Image {
+    let half = prepared.half;
+    let n = (camera.quat().inverse() * DVec3::Z).normalize();
+    let extent = (half * n.abs()).element_sum();
+    let count = params.slices;
+    let spacing = 2.0 * extent / count as f64;
+    let unit = 1.0f32 / 255.0;
+    let to8 = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round_ties_even() as u32;
+    let coeff = coefficients(params).map(|c| c.map(|x| x as f32));
+    // A texel value (a multiple of 1/255 from the 8-bit models) as llvmpipe's float.
+    let texel = |v: f64| (v * 255.0).round() as f32 * unit;
+    trace_pixels(camera, size, TargetFormat::Rgba8, |origin, dir| {
+        let mut dst = background.map(|v| to8(v as f32));
+        let along = dir.dot(n);
+        if along.abs() < 1e-300 {
+            return dst.map(|v| v as f64 / 255.0);
+        }
+        for i in 0..count {
+            let depth = -extent + (i as f64 + 0.5) * spacing;
+            let p = origin + dir * ((depth - origin.dot(n)) / along);
+            if (p.abs() - half).max_element() > 1e-9 {
+                continue;
+            }
+            let tc = (p + half) / (2.0 * half);
+            let v = sample(prepared, tc, params.volume_filter, Filtering::Unorm8).map(texel);
+            let lut = |a: usize| -> [f32; 4] {
+                match &prepared.tables[a] {
+                    Some(t) => lookup_f32(t, v[a], params.table_filter).map(texel),
+                    // The 1x1 white table of an absent attribute in a product; in a
+                    // sum its coefficients are 0 and texture 0 reads black.
+                    None => match params.combine {
+                        Combine::Sum => [0.0; 4],
+                        Combine::Product => [1.0; 4],
+                    },
+                }
+            };
+            let [l1, l2, l3] = [lut(0), lut(1), lut(2)];
+            let src: [f32; 4] = std::array::from_fn(|c| match params.combine {
+                Combine::Sum => {
+                    let t = coeff[0][c] * l1[c];
+                    let t = coeff[1][c] * l2[c] + t;
+                    let t = coeff[2][c] * l3[c] + t;
+                    t * 0.3333f32
+                }
+                Combine::Product => {
+                    let (t1, t2, t3) = (
+                        coeff[0][c] * l1[c],
+                        coeff[1][c] * l2[c],
+                        coeff[2][c] * l3[c],
+                    );
+                    (t2 * t1) * t3
+                }
+            });
+            let src = src.map(to8);
+            let a = src[3];
+            for ch in 0..3 {
+                dst[ch] = (llvmpipe_mul8(src[ch], a) + llvmpipe_mul8(dst[ch], 255 - a)).min(255);
+            }
+            dst[3] = (llvmpipe_mul8(a, 255) + llvmpipe_mul8(dst[3], 255 - a)).min(255);
+        }
+        dst.map(|v| v as f64 / 255.0)
+    })
+}
+
+/// A table lookup with the original addressing for an f32 value, as llvmpipe does it:
+/// nearest reads entry `floor(v · 256)` computed in f32 (clamped); linear goes through
+/// the generic 8-bit model.
+fn lookup_f32(table: &ColorTable, v: f32, filter: Filter) -> [f64; 4] {
+    match filter {
+        Filter::Nearest => {
+            let k = ((v * 256.0).floor() as i64).clamp(0, 255) as usize;
+            table.entries[k].map(|c| c as f64 / 255.0)
+        }
+        Filter::Linear => lookup(
+            table,
+            v as f64,
+            filter,
+            Addressing::Original,
+            Filtering::Unorm8,
+        ),
+    }
+}
+
+/// The faithful emulation of `model`.
+pub fn emulate_faithful_with(
+    model: Model,
+    prepared: &Prepared,
+    params: &Opacity3dScene,
+    camera: &Camera,
+    size: [u32; 2],
+    background: [f64; 4],
+) -> Image {
+    match model {
+        Model::Generic => emulate_faithful(prepared, params, camera, size, background),
+        Model::Llvmpipe => emulate_faithful_llvmpipe(prepared, params, camera, size, background),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn llvmpipe_mul8_is_not_always_round_p_over_255() {
+        let mut differ = 0;
+        for x in 0..=255u32 {
+            for y in 0..=255u32 {
+                let rounded = ((x * y) as f64 / 255.0).round() as u32;
+                let l = llvmpipe_mul8(x, y);
+                assert!(l.abs_diff(rounded) <= 1, "{x} {y}");
+                differ += (l != rounded) as u32;
+            }
+            // Multiplying by 255 (a factor ONE) is exact.
+            assert_eq!(llvmpipe_mul8(x, 255), x);
+        }
+        assert_eq!(differ, 24);
+        assert_eq!(llvmpipe_mul8(152, 229), 136);
+    }
 
     #[test]
     fn original_addressing_with_nearest_reads_entry_k() {

@@ -5,6 +5,11 @@
 //! precise — timed over several frames (median), and scored against the f64 reference
 //! integral (RGB: max abs, RMSE, PSNR). `study` writes CSV and a plot (error against time).
 
+pub mod bench;
+pub mod breakdown;
+pub mod export;
+pub mod peers;
+
 use std::path::Path;
 use std::time::Instant;
 
@@ -133,6 +138,7 @@ fn measure(
         params(scene),
         &scene.base,
         prepared.clone(),
+        scene.camera.projection,
     )?;
     let frame = Frame {
         camera: scene.camera,
@@ -364,6 +370,95 @@ pub fn plot(rows: &[Row], path: &Path, title: &str, vtk_ms: f64) -> anyhow::Resu
                 vtk_ms
             ))
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK));
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 13))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()?;
+        root.present()?;
+    }
+    let data: Vec<f32> = buffer
+        .chunks_exact(3)
+        .flat_map(|p| [p[0], p[1], p[2], 255].map(|v| v as f32 / 255.0))
+        .collect();
+    let image = Image {
+        width: w,
+        height: h,
+        format: TargetFormat::Rgba8,
+        data,
+    };
+    crate::png_io::write_png(path, &image, &[("Software", "arbvis study".into())])?;
+    Ok(())
+}
+
+/// Plot named lines of (ms, RMSE) points on log axes (a line and dots per series).
+pub fn plot_lines(
+    lines: &[(String, Vec<(f64, f64)>)],
+    path: &Path,
+    title: &str,
+) -> anyhow::Result<()> {
+    use plotters::prelude::*;
+    plotters::style::register_font(
+        "sans-serif",
+        FontStyle::Normal,
+        epaint_default_fonts::UBUNTU_LIGHT,
+    )
+    .map_err(|_| anyhow::anyhow!("the plot font did not load"))?;
+    let (w, h) = (1100u32, 700u32);
+    let mut buffer = vec![0u8; (w * h * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let finite = |v: f64| v.is_finite() && v > 0.0;
+        let points: Vec<(f64, f64)> = lines
+            .iter()
+            .flat_map(|(_, p)| p.iter().copied())
+            .filter(|&(x, y)| finite(x) && finite(y))
+            .collect();
+        if points.is_empty() {
+            anyhow::bail!("nothing to plot");
+        }
+        let fold = |f: fn(f64, f64) -> f64, init: f64, pick: fn(&(f64, f64)) -> f64| {
+            points.iter().map(pick).fold(init, f)
+        };
+        let (x0, x1) = (
+            fold(f64::min, f64::INFINITY, |p| p.0) * 0.8,
+            fold(f64::max, 0.0, |p| p.0) * 1.25,
+        );
+        let (y0, y1) = (
+            fold(f64::min, f64::INFINITY, |p| p.1) * 0.8,
+            fold(f64::max, 0.0, |p| p.1) * 1.25,
+        );
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
+        chart
+            .configure_mesh()
+            .x_desc("time per frame (ms, log)")
+            .y_desc("RMSE of RGB against the f64 reference (log)")
+            .label_style(("sans-serif", 14))
+            .draw()?;
+        for (n, (name, pts)) in lines.iter().enumerate() {
+            let colour = Palette99::pick(n).to_rgba();
+            let mut pts: Vec<(f64, f64)> = pts
+                .iter()
+                .copied()
+                .filter(|&(x, y)| finite(x) && finite(y))
+                .collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            chart
+                .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
+                .label(name.as_str())
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
+                });
+            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
+        }
         chart
             .configure_series_labels()
             .background_style(WHITE.mix(0.85))

@@ -1,0 +1,13 @@
+#!/usr/bin/env bash
+# Renders the README's pictures with arbvis itself (opaque PNGs, as a browser shows them).
+# Run from the repository root: bash docs/pictures.sh
+set -euo pipefail
+cargo build --release --no-default-features --quiet
+arbvis=target/release/arbvis
+out=docs/pictures
+mkdir -p "$out"
+for demo in v3o2-sum v3o2-product cellproj-planar cellproj-spherical clip-sphere clip-mesh; do
+  "$arbvis" render --demo "$demo" -o "$out/$demo.png"
+done
+"$arbvis" render --demo cellproj-spherical --fidelity precise -o "$out/cellproj-spherical-precise.png"
+"$arbvis" render --demo splats-section --size 1200x675 -o "$out/splats-section.png"
