@@ -66,6 +66,16 @@ pub const SPLATS_VERT: ProgramText = program!("splats/splat.vert");
 pub const SPLATS_SEED_FRAG: ProgramText = program!("splats/seed.frag");
 /// Splats: the corrected fragment stage.
 pub const SPLATS_PRECISE_FRAG: ProgramText = program!("splats/precise.frag");
+/// ARB twin of [`SPLATS_VERT`] (`result.pointsize`, the `if`s as selects).
+pub const SPLATS_ARBVP: ProgramText = program!("splats/splat.arbvp");
+/// ARB twin of [`SPLATS_SEED_FRAG`] (the sprite coordinate as `fragment.texcoord[0]`).
+pub const SPLATS_SEED_ARBFP: ProgramText = program!("splats/seed.arbfp");
+/// ARB twin of [`SPLATS_PRECISE_FRAG`].
+pub const SPLATS_PRECISE_ARBFP: ProgramText = program!("splats/precise.arbfp");
+/// Weighted blended OIT's composite of the splats (ARB, over the common transform).
+pub const SPLATS_OIT_COMPOSITE_ARBFP: ProgramText = program!("splats/oit_composite.arbfp");
+/// GLSL twin of [`SPLATS_OIT_COMPOSITE_ARBFP`].
+pub const SPLATS_OIT_COMPOSITE_FRAG: ProgramText = program!("splats/oit_composite.frag");
 
 /// A vertex + fragment pair of one kind.
 #[derive(Debug, Clone)]
@@ -101,6 +111,7 @@ pub fn all_pairs() -> Vec<ProgramPair> {
         (QUAD_ARBFP, QUAD_FRAG),
         (OPACITY3D_SUM_ARBFP, OPACITY3D_SUM_FRAG),
         (OPACITY3D_PRODUCT_ARBFP, OPACITY3D_PRODUCT_FRAG),
+        (SPLATS_OIT_COMPOSITE_ARBFP, SPLATS_OIT_COMPOSITE_FRAG),
     ];
     let mut pairs = Vec::new();
     for (arb, glsl) in &fragments {
@@ -134,6 +145,10 @@ pub fn all_pairs() -> Vec<ProgramPair> {
             CELLPROJ_PRECISE_VERT,
             CELLPROJ_PRECISE_FRAG,
         ),
+        (ProgramKind::Arb, SPLATS_ARBVP, SPLATS_SEED_ARBFP),
+        (ProgramKind::Arb, SPLATS_ARBVP, SPLATS_PRECISE_ARBFP),
+        (ProgramKind::Glsl, SPLATS_VERT, SPLATS_SEED_FRAG),
+        (ProgramKind::Glsl, SPLATS_VERT, SPLATS_PRECISE_FRAG),
     ];
     for (kind, vertex, fragment) in own_vertex_stage {
         pairs.push(ProgramPair {
@@ -177,5 +192,10 @@ pub fn all_texts() -> Vec<ProgramText> {
         SPLATS_VERT,
         SPLATS_SEED_FRAG,
         SPLATS_PRECISE_FRAG,
+        SPLATS_ARBVP,
+        SPLATS_SEED_ARBFP,
+        SPLATS_PRECISE_ARBFP,
+        SPLATS_OIT_COMPOSITE_ARBFP,
+        SPLATS_OIT_COMPOSITE_FRAG,
     ]
 }

@@ -2,11 +2,12 @@
 // arbvis (new): seed 004's fragment shader corrected: the property normalized as
 // (value - min) / (max - min), clamped, 0 for an empty range; the footprints fall off
 // from the centre (smoothstep(0, 1, 1 - n_dist), exp(-n_dist^2 / (2 width)), a width of 0
-// giving a single opaque pixel at the centre). Uniforms as seed.frag.
-uniform vec4 program_local[5];
+// giving a single opaque pixel at the centre). Uniforms as seed.frag. ARB twin: precise.arbfp.
+uniform vec4 program_local[6];
 in vec3 v_color;
 in float v_value;
 in vec2 v_light;
+in float v_z;
 out vec4 FragColor;
 const float PI = 3.14159265358979;
 
@@ -39,5 +40,16 @@ void main() {
         float r = program_local[4].y;
         alpha *= (v_value >= t - r && v_value <= t + r) ? smoothstep(0.0, 1.0, n) : 0.0;
     }
-    FragColor = vec4(color, clamp(alpha, 0.0, 1.0));
+    alpha = clamp(alpha, 0.0, 1.0);
+    // arbvis: program_local[5].x > 0.5 is weighted blended OIT's accumulation pass
+    // (McGuire & Bavoil 2013, eq. 7 weight; splats::oit): (clamp(color) a w, a w).
+    if (program_local[5].x > 0.5) {
+        float z5 = v_z / 5.0;
+        float z200 = v_z / 200.0;
+        float z2 = z200 * z200;
+        float w = alpha * clamp(10.0 / (1e-5 + z5 * z5 + z2 * z2 * z2), 1e-2, 3e3);
+        FragColor = vec4(clamp(color, 0.0, 1.0) * alpha * w, alpha * w);
+    } else {
+        FragColor = vec4(color, alpha);
+    }
 }

@@ -5,11 +5,13 @@
 // `minView <= value <= maxView`, which the text leaves implicit), with arbvis's uniforms:
 // program_local[0]: (colour from: 0 point colour / 1 gradient_scale, min, max, volume)
 // [1]: colorA, [2]: colorB, [3]: (kernel: 0 smoothstep / 1 gauss, gauss_factor)
-// [4]: (threshold, range).
-uniform vec4 program_local[5];
+// [4]: (threshold, range); [5]: (output: 0 blended splat / 1 OIT accumulation).
+// ARB twin: seed.arbfp.
+uniform vec4 program_local[6];
 in vec3 v_color;
 in float v_value;
 in vec2 v_light;
+in float v_z;
 out vec4 FragColor;
 const float PI = 3.14159265358979;
 
@@ -58,5 +60,16 @@ void main() {
     }
     if (program_local[0].w > 0.5) alpha *= TransferFunction(v_value, max_value, min_value);
     if (isnan(alpha)) alpha = 0.0;
-    FragColor = vec4(color, clamp(alpha, 0.0, 1.0));
+    alpha = clamp(alpha, 0.0, 1.0);
+    // arbvis: program_local[5].x > 0.5 is weighted blended OIT's accumulation pass
+    // (McGuire & Bavoil 2013, eq. 7 weight; splats::oit): (clamp(color) a w, a w).
+    if (program_local[5].x > 0.5) {
+        float z5 = v_z / 5.0;
+        float z200 = v_z / 200.0;
+        float z2 = z200 * z200;
+        float w = alpha * clamp(10.0 / (1e-5 + z5 * z5 + z2 * z2 * z2), 1e-2, 3e3);
+        FragColor = vec4(clamp(color, 0.0, 1.0) * alpha * w, alpha * w);
+    } else {
+        FragColor = vec4(color, alpha);
+    }
 }

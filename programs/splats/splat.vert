@@ -6,15 +6,18 @@
 // are flipped) is computed per point: v_light = (ambient + diffuse term, specular term).
 // vertex_local[0..3]: ModelViewProj rows; [4]: cameraPos (xyz), w = 1 perspective;
 // [5]: view direction (orthographic); [6]: (pointSize, factor, lighting on, 0);
-// [7]: Phong (ambient, diffuse, specular, shininess).
+// [7]: Phong (ambient, diffuse, specular, shininess); [8]: the row giving weighted blended
+// OIT's view distance z (dot(vertex_local[8], p), see splats::oit).
+// ARB twin: splat.arbvp.
 layout(location = 0) in vec3 aPos;
 layout(location = 1) in vec3 aColor;
 layout(location = 2) in float aValue;
 layout(location = 3) in vec3 aNormal;
-uniform vec4 vertex_local[8];
+uniform vec4 vertex_local[9];
 out vec3 v_color;
 out float v_value;
 out vec2 v_light;
+out float v_z;
 void main() {
     vec4 p = vec4(aPos, 1.0);
     gl_Position = vec4(dot(vertex_local[0], p), dot(vertex_local[1], p),
@@ -31,6 +34,7 @@ void main() {
     }
     v_color = aColor;
     v_value = aValue;
+    v_z = dot(vertex_local[8], p);
     v_light = vec2(1.0, 0.0);
     if (vertex_local[6].z > 0.5) {
         vec3 v = normalize(perspective ? cameraPos - aPos : -vertex_local[5].xyz);

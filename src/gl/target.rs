@@ -1,5 +1,7 @@
 //! Offscreen render targets: a framebuffer object with one colour texture in RGBA8,
-//! RGBA16F or RGBA32F, read back into an [`Image`].
+//! RGBA16F or RGBA32F, read back into an [`Image`]. The colour is an owned [`Texture`]
+//! ([`Target::color`]), so that a later draw can read what an earlier one rendered
+//! (weighted blended transparency's composite does).
 
 use std::sync::Arc;
 
@@ -7,6 +9,7 @@ use glow::HasContext;
 
 use super::error::{GlError, GlResult};
 use super::gpu::Gpu;
+use super::texture::{TexelFormat, Texture};
 use crate::image::Image;
 
 /// Colour-target precision; faithful mode draws into RGBA8 as the original did.
@@ -60,21 +63,22 @@ impl TargetFormat {
         }
     }
 
-    fn internal(self) -> u32 {
+    /// The texel format of a target's colour texture.
+    pub fn texel(self) -> TexelFormat {
         match self {
-            TargetFormat::Rgba8 => glow::RGBA8,
-            TargetFormat::Rgba16f => glow::RGBA16F,
-            TargetFormat::Rgba32f => glow::RGBA32F,
+            TargetFormat::Rgba8 => TexelFormat::Rgba8,
+            TargetFormat::Rgba16f => TexelFormat::Rgba16f,
+            TargetFormat::Rgba32f => TexelFormat::Rgba32f,
         }
     }
 }
 
 /// An owned framebuffer with one colour texture and, when asked for, a 24-bit depth
-/// buffer; deleted on Drop.
+/// buffer; deleted on Drop (the framebuffer first, then the texture it held).
 pub struct Target {
     gl: Arc<glow::Context>,
     framebuffer: glow::Framebuffer,
-    color: glow::Texture,
+    color: Texture,
     depth: Option<glow::Renderbuffer>,
     width: u32,
     height: u32,
@@ -111,42 +115,28 @@ impl Target {
             )));
         }
         let gl = gpu.glow().clone();
-        // SAFETY: fresh objects; the previous framebuffer and texture bindings are restored.
-        let (framebuffer, color, depth, status) = unsafe {
+        let color = Texture::render_target(gpu, width, height, format.texel())?;
+        // SAFETY: fresh objects; the previous framebuffer binding is restored.
+        let (framebuffer, depth, status) = unsafe {
             let prev_fb = gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING);
-            let prev_active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
-            gl.active_texture(glow::TEXTURE0);
-            let prev_tex = gl.get_parameter_texture(glow::TEXTURE_BINDING_2D);
-            let color = gl.create_texture().map_err(GlError::Invalid)?;
-            gl.bind_texture(glow::TEXTURE_2D, Some(color));
-            gl.tex_storage_2d(
-                glow::TEXTURE_2D,
-                1,
-                format.internal(),
-                width as i32,
-                height as i32,
-            );
-            gl.tex_parameter_i32(
-                glow::TEXTURE_2D,
-                glow::TEXTURE_MIN_FILTER,
-                glow::NEAREST as i32,
-            );
-            gl.tex_parameter_i32(
-                glow::TEXTURE_2D,
-                glow::TEXTURE_MAG_FILTER,
-                glow::NEAREST as i32,
-            );
             let framebuffer = gl.create_framebuffer().map_err(GlError::Invalid)?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
             gl.framebuffer_texture_2d(
                 glow::FRAMEBUFFER,
                 glow::COLOR_ATTACHMENT0,
                 glow::TEXTURE_2D,
-                Some(color),
+                Some(color.raw()),
                 0,
             );
             let depth = if with_depth {
-                let rb = gl.create_renderbuffer().map_err(GlError::Invalid)?;
+                let rb = match gl.create_renderbuffer() {
+                    Ok(rb) => rb,
+                    Err(e) => {
+                        gl.bind_framebuffer(glow::FRAMEBUFFER, prev_fb);
+                        gl.delete_framebuffer(framebuffer);
+                        return Err(GlError::Invalid(e));
+                    }
+                };
                 gl.bind_renderbuffer(glow::RENDERBUFFER, Some(rb));
                 gl.renderbuffer_storage(
                     glow::RENDERBUFFER,
@@ -170,9 +160,7 @@ impl Target {
             gl.clear_depth_f64(1.0);
             gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
             gl.bind_framebuffer(glow::FRAMEBUFFER, prev_fb);
-            gl.bind_texture(glow::TEXTURE_2D, prev_tex);
-            gl.active_texture(prev_active);
-            (framebuffer, color, depth, status)
+            (framebuffer, depth, status)
         };
         let target = Target {
             gl,
@@ -215,6 +203,11 @@ impl Target {
     /// Colour precision.
     pub fn format(&self) -> TargetFormat {
         self.format
+    }
+
+    /// The colour texture, to be read by a later draw (not while drawing into it).
+    pub fn color(&self) -> &Texture {
+        &self.color
     }
 
     /// Whether it has a depth buffer.
@@ -381,7 +374,6 @@ impl Drop for Target {
         // SAFETY: deleted once, on the context that created them.
         unsafe {
             self.gl.delete_framebuffer(self.framebuffer);
-            self.gl.delete_texture(self.color);
             if let Some(rb) = self.depth {
                 self.gl.delete_renderbuffer(rb);
             }

@@ -35,6 +35,8 @@ pub enum TexelFormat {
     /// 1 x f32 filled from u8 data (k/255 converted by GL): twice the bytes of
     /// [`TexelFormat::R16FromU8`], the same values, and faster to filter on llvmpipe.
     R32fFromU8,
+    /// 4 x f16, filled from f32 data (a render target's colour).
+    Rgba16f,
 }
 
 impl TexelFormat {
@@ -52,6 +54,7 @@ impl TexelFormat {
             TexelFormat::Rg16FromU8 => 4,
             TexelFormat::Rgb16FromU8 => 6,
             TexelFormat::R32fFromU8 => 4,
+            TexelFormat::Rgba16f => 8,
         }
     }
 
@@ -64,12 +67,16 @@ impl TexelFormat {
             TexelFormat::Rg16FromU8 => 2,
             TexelFormat::Rgb16FromU8 => 3,
             TexelFormat::R32fFromU8 => 1,
+            TexelFormat::Rgba16f => 16,
             other => other.bytes(),
         }
     }
 
     fn float_source(self) -> bool {
-        matches!(self, TexelFormat::Rgba32f | TexelFormat::R32f)
+        matches!(
+            self,
+            TexelFormat::Rgba32f | TexelFormat::R32f | TexelFormat::Rgba16f
+        )
     }
 
     fn gl(self) -> (u32, u32, u32) {
@@ -85,6 +92,7 @@ impl TexelFormat {
             TexelFormat::Rg16FromU8 => (glow::RG16, glow::RG, glow::UNSIGNED_BYTE),
             TexelFormat::Rgb16FromU8 => (glow::RGB16, glow::RGB, glow::UNSIGNED_BYTE),
             TexelFormat::R32fFromU8 => (glow::R32F, glow::RED, glow::UNSIGNED_BYTE),
+            TexelFormat::Rgba16f => (glow::RGBA16F, glow::RGBA, glow::FLOAT),
         }
     }
 
@@ -101,6 +109,7 @@ impl TexelFormat {
             TexelFormat::Rg16FromU8 => "RG16",
             TexelFormat::Rgb16FromU8 => "RGB16",
             TexelFormat::R32fFromU8 => "R32F",
+            TexelFormat::Rgba16f => "RGBA16F",
         }
     }
 }
@@ -264,6 +273,53 @@ impl Texture {
             (extent.texels() * format.bytes()) as u64,
         );
         Ok(texture)
+    }
+
+    /// An uninitialized `width` x `height` 2D texture of `format` (immutable storage,
+    /// nearest filtering, clamp to edge) to render into: a [`super::Target`]'s colour,
+    /// which records it among the resources (this does not).
+    pub(crate) fn render_target(
+        gpu: &Gpu,
+        width: u32,
+        height: u32,
+        format: TexelFormat,
+    ) -> GlResult<Texture> {
+        let gl = gpu.glow().clone();
+        let (internal, _, _) = format.gl();
+        // SAFETY: a fresh texture, bound to unit 0's 2D target only while being set up;
+        // the previous binding and active unit are restored.
+        let raw = unsafe {
+            let prev_active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
+            gl.active_texture(glow::TEXTURE0);
+            let prev = gl.get_parameter_texture(glow::TEXTURE_BINDING_2D);
+            let raw = gl.create_texture().map_err(GlError::Invalid)?;
+            gl.bind_texture(glow::TEXTURE_2D, Some(raw));
+            gl.tex_storage_2d(glow::TEXTURE_2D, 1, internal, width as i32, height as i32);
+            for (name, value) in [
+                (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
+                (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
+                (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
+                (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
+            ] {
+                gl.tex_parameter_i32(glow::TEXTURE_2D, name, value as i32);
+            }
+            gl.bind_texture(glow::TEXTURE_2D, prev);
+            gl.active_texture(prev_active);
+            raw
+        };
+        let texture = Texture {
+            gl,
+            raw,
+            extent: Extent::D2(width, height),
+            format,
+        };
+        crate::gl_check!(gpu)?;
+        Ok(texture)
+    }
+
+    /// The GL name (to attach to a framebuffer).
+    pub(crate) fn raw(&self) -> glow::Texture {
+        self.raw
     }
 
     /// Replace all texels (same size and format).

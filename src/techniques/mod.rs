@@ -82,6 +82,7 @@ pub fn build(gpu: &Gpu, scene: &Scene, kind: ProgramKind) -> GlResult<Box<dyn Re
         )?),
         TechniqueScene::Splats(params) => Box::new(splats::SplatsRenderer::new(
             gpu,
+            kind,
             scene.fidelity,
             params,
             &scene.base,

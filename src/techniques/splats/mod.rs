@@ -15,8 +15,9 @@
 //!   instead of the points; [`sort::SortCache`] skips the sort when the camera did not
 //!   move. All methods are stable (ties in index order) and agree.
 //! - **Order-independent alternative**: weighted blended OIT (McGuire & Bavoil 2013)
-//!   needs no sort; [`reference::weighted_blended`] composites it on the CPU so its
-//!   error against exact order ([`reference::rmse_rgb`]) can be measured.
+//!   needs no sort; [`oit`] draws it on the GPU (two float targets and a composite),
+//!   [`reference::weighted_blended`] composites it on the CPU so its error against
+//!   exact order ([`reference::rmse_rgb`]) can be measured.
 //! - **Normals** ([`normals`]) for Phong lighting: the seed had CloudCompare estimate
 //!   them per layer; here k nearest neighbours (kiddo's k-d tree) and PCA, one tree
 //!   per layer id, in parallel; flipped toward the eye at draw time
@@ -30,6 +31,7 @@
 //! describes; [`reference`](mod@reference)'s doc gives the details and the precise versions.
 
 pub mod normals;
+pub mod oit;
 pub mod prepare;
 pub mod reference;
 pub mod renderer;

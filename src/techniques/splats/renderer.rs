@@ -2,10 +2,16 @@
 //! the back-to-front order of the visible points (rewritten only when the camera moved),
 //! or, for the seed's method, the whole vertex buffer re-uploaded in sorted order; one
 //! draw of point sprites blended `SRC_ALPHA, ONE_MINUS_SRC_ALPHA` without depth test.
+//! `sort = "oit"` draws the visible points in file order through [`OitPass`] instead.
+//!
+//! Programs: ARB (`splats/splat.arbvp` with `seed.arbfp` or `precise.arbfp`) or their
+//! GLSL twins, as the scene's `programs` resolves; point sprites work under both (the
+//! ARB fragment programs read the sprite coordinate from `fragment.texcoord[0]`).
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use super::oit::{z_row, OitPass};
 use super::prepare::{
     from_cloud, normals_for, prepare, Prepared, COLOR_A, COLOR_B, PHONG, VERTEX_COMPONENTS,
 };
@@ -20,20 +26,25 @@ use crate::programs::{self, ProgramPair};
 use crate::scene::{Fidelity, TechniqueScene};
 use crate::techniques::{Frame, Renderer};
 
-/// The program pair of a fidelity (GLSL; see the module doc of [`super`] for ARB).
-pub fn program_pair(fidelity: Fidelity) -> ProgramPair {
+/// The program pair of a fidelity and kind.
+pub fn program_pair(fidelity: Fidelity, kind: ProgramKind) -> ProgramPair {
+    use programs::*;
+    let (vertex, fragment) = match (kind, fidelity) {
+        (ProgramKind::Arb, Fidelity::Faithful) => (SPLATS_ARBVP, SPLATS_SEED_ARBFP),
+        (ProgramKind::Arb, Fidelity::Precise) => (SPLATS_ARBVP, SPLATS_PRECISE_ARBFP),
+        (ProgramKind::Glsl, Fidelity::Faithful) => (SPLATS_VERT, SPLATS_SEED_FRAG),
+        (ProgramKind::Glsl, Fidelity::Precise) => (SPLATS_VERT, SPLATS_PRECISE_FRAG),
+    };
     ProgramPair {
-        kind: ProgramKind::Glsl,
-        vertex: programs::SPLATS_VERT,
-        fragment: match fidelity {
-            Fidelity::Faithful => programs::SPLATS_SEED_FRAG,
-            Fidelity::Precise => programs::SPLATS_PRECISE_FRAG,
-        },
+        kind,
+        vertex,
+        fragment,
     }
 }
 
 /// The splat renderer.
 pub struct SplatsRenderer {
+    kind: ProgramKind,
     fidelity: Fidelity,
     base: PathBuf,
     cloud: PointCloud,
@@ -44,6 +55,8 @@ pub struct SplatsRenderer {
     program: Program,
     cache: Option<SortCache>,
     seed_points: Vec<SeedPoint>,
+    /// `sort = "oit"`'s targets and composite, made at the first frame's size.
+    oit: Option<OitPass>,
     /// The view the current order was made for.
     ordered_for: Option<[u64; 4]>,
     /// Time of the last sort (and upload), for the bench and the viewer.
@@ -68,9 +81,11 @@ fn view_bits(view: View) -> [u64; 4] {
 }
 
 impl SplatsRenderer {
-    /// Load and prepare the scene's cloud (relative paths from `base`), then upload.
+    /// Load and prepare the scene's cloud (relative paths from `base`), then upload;
+    /// programs of `kind`.
     pub fn new(
         gpu: &Gpu,
+        kind: ProgramKind,
         fidelity: Fidelity,
         params: &SplatsScene,
         base: &Path,
@@ -79,24 +94,20 @@ impl SplatsRenderer {
             .validate()
             .map_err(|e| GlError::Data(e.to_string()))?;
         let (cloud, prepared) = prepare(params, base).map_err(GlError::Data)?;
-        SplatsRenderer::from_prepared(gpu, fidelity, params, base, cloud, prepared)
+        SplatsRenderer::from_prepared(gpu, kind, fidelity, params, base, cloud, prepared)
     }
 
     /// Upload a cloud prepared elsewhere.
     pub fn from_prepared(
         gpu: &Gpu,
+        kind: ProgramKind,
         fidelity: Fidelity,
         params: &SplatsScene,
         base: &Path,
         cloud: PointCloud,
         prepared: Prepared,
     ) -> GlResult<SplatsRenderer> {
-        if params.sort == SortChoice::Oit {
-            return Err(GlError::Unsupported(
-                "sort = \"oit\" (weighted blended transparency) is measured on the CPU only (splats::reference::weighted_blended); the renderer draws sorted splats".into(),
-            ));
-        }
-        let pair = program_pair(fidelity);
+        let pair = program_pair(fidelity, kind);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         let mesh = Mesh::new(
             gpu,
@@ -107,6 +118,7 @@ impl SplatsRenderer {
         let normals = (params.lighting && params.mode == Mode::Surface)
             .then(|| (prepared.normals.clone(), prepared.normal_fallbacks));
         let mut r = SplatsRenderer {
+            kind,
             fidelity,
             base: base.to_path_buf(),
             cloud,
@@ -117,6 +129,7 @@ impl SplatsRenderer {
             program,
             cache: None,
             seed_points: Vec::new(),
+            oit: None,
             ordered_for: None,
             last_sort: Duration::ZERO,
         };
@@ -137,9 +150,12 @@ impl SplatsRenderer {
             Vec::new()
         };
         self.ordered_for = None;
+        if self.params.sort != SortChoice::Oit {
+            self.oit = None;
+        }
         self.mesh.clear_indices();
         self.mesh.update(gpu, &self.prepared.vertices(None))?;
-        if self.params.sort == SortChoice::None {
+        if matches!(self.params.sort, SortChoice::None | SortChoice::Oit) {
             let visible: Vec<u32> = self.visible(0..self.prepared.len() as u32);
             self.mesh.set_indices(gpu, &visible)?;
         }
@@ -161,7 +177,8 @@ impl SplatsRenderer {
     /// Put the points in back-to-front order for `view` (nothing when it did not move).
     fn order(&mut self, gpu: &Gpu, view: View) -> GlResult<()> {
         let bits = view_bits(view);
-        if self.ordered_for == Some(bits) || self.params.sort == SortChoice::None {
+        let unordered = matches!(self.params.sort, SortChoice::None | SortChoice::Oit);
+        if self.ordered_for == Some(bits) || unordered {
             return Ok(());
         }
         let t0 = Instant::now();
@@ -202,6 +219,7 @@ impl SplatsRenderer {
         };
         prog.set_local(gpu, 3, [kernel, p.gauss_width, 0.0, 0.0])?;
         prog.set_local(gpu, 4, [p.volume.threshold, p.volume.range, 0.0, 0.0])?;
+        prog.set_local(gpu, 5, [0.0; 4])?;
         let lighting = if p.lighting && p.mode == Mode::Surface {
             1.0
         } else {
@@ -232,6 +250,18 @@ impl Renderer for SplatsRenderer {
             .set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, perspective])?;
         self.program
             .set_vertex_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
+        self.program
+            .set_vertex_local(gpu, 8, z_row(camera).to_array())?;
+        if self.params.sort == SortChoice::Oit {
+            let (w, h) = (frame.width, frame.height);
+            if !self.oit.as_ref().is_some_and(|o| o.fits(w, h)) {
+                self.oit = None;
+                self.oit = Some(OitPass::new(gpu, self.kind, w, h)?);
+            }
+            if let Some(oit) = &self.oit {
+                return oit.draw(gpu, &self.program, &self.mesh, surface);
+            }
+        }
         gl::draw(
             gpu,
             surface,
@@ -258,7 +288,7 @@ impl Renderer for SplatsRenderer {
         new.validate().map_err(|e| GlError::Data(e.to_string()))?;
         let p = &self.params;
         if new.cloud != p.cloud {
-            *self = SplatsRenderer::new(gpu, self.fidelity, new, &self.base.clone())?;
+            *self = SplatsRenderer::new(gpu, self.kind, self.fidelity, new, &self.base.clone())?;
             return Ok(());
         }
         let lit = |s: &SplatsScene| (s.lighting && s.mode == Mode::Surface, s.normals_k);
@@ -282,11 +312,17 @@ impl Renderer for SplatsRenderer {
     }
 
     fn program_kind(&self) -> ProgramKind {
-        ProgramKind::Glsl
+        self.program.kind()
     }
 
     fn status(&self) -> Option<String> {
         let drawn = self.prepared.visible.iter().filter(|v| **v).count();
+        if self.params.sort == SortChoice::Oit {
+            return Some(format!(
+                "{drawn} of {} points drawn; weighted blended OIT (no sort)",
+                self.prepared.len()
+            ));
+        }
         Some(format!(
             "{drawn} of {} points drawn; last sort ({:?}): {:.1} ms",
             self.prepared.len(),
