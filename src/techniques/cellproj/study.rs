@@ -80,6 +80,8 @@ fn scene_for(points: usize, exit: Exit, active_only: bool) -> CellprojScene {
         table_size: 256,
         shading: false,
         active_only,
+        order: Default::default(),
+        depth: Default::default(),
     }
 }
 
