@@ -185,42 +185,6 @@ impl Default for Raycast {
 /// Most samples per voxel the ray caster accepts.
 pub const MAX_STEPS_PER_VOXEL: f64 = 1024.0;
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn with_raycast(text: &str) -> Result<(), FieldError> {
-        let scene = crate::scene::Scene::demo("v3o2-sum").unwrap();
-        let crate::scene::TechniqueScene::Opacity3d(mut params) = scene.technique else {
-            unreachable!()
-        };
-        params.raycast =
-            Some(toml::from_str(text).map_err(|e| FieldError::new("toml", e.to_string()))?);
-        params.validate()
-    }
-
-    #[test]
-    fn raycast_options_are_checked() {
-        assert!(with_raycast("").is_ok());
-        assert!(with_raycast("steps_per_voxel = 0.25\ntermination = 0.0\nbrick = 0").is_ok());
-        for (text, key) in [
-            ("steps_per_voxel = 0.0", "raycast.steps_per_voxel"),
-            ("steps_per_voxel = nan", "raycast.steps_per_voxel"),
-            ("steps_per_voxel = 1e9", "raycast.steps_per_voxel"),
-            ("termination = 1.0", "raycast.termination"),
-            ("termination = -0.1", "raycast.termination"),
-            ("brick = 1000", "raycast.brick"),
-        ] {
-            let e = with_raycast(text).unwrap_err();
-            assert_eq!(e.key, key, "{text}");
-        }
-        assert!(
-            with_raycast("bricks = 4").is_err(),
-            "unknown keys are errors"
-        );
-    }
-}
-
 fn default_slices() -> usize {
     256
 }
@@ -312,3 +276,39 @@ impl Opacity3dScene {
 
 /// The attributes' names in scenes, in texture order.
 pub const ATTRIBUTE_NAMES: [&str; 3] = ["primary", "secondary", "tertiary"];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with_raycast(text: &str) -> Result<(), FieldError> {
+        let scene = crate::scene::Scene::demo("v3o2-sum").unwrap();
+        let crate::scene::TechniqueScene::Opacity3d(mut params) = scene.technique else {
+            unreachable!()
+        };
+        params.raycast =
+            Some(toml::from_str(text).map_err(|e| FieldError::new("toml", e.to_string()))?);
+        params.validate()
+    }
+
+    #[test]
+    fn raycast_options_are_checked() {
+        assert!(with_raycast("").is_ok());
+        assert!(with_raycast("steps_per_voxel = 0.25\ntermination = 0.0\nbrick = 0").is_ok());
+        for (text, key) in [
+            ("steps_per_voxel = 0.0", "raycast.steps_per_voxel"),
+            ("steps_per_voxel = nan", "raycast.steps_per_voxel"),
+            ("steps_per_voxel = 1e9", "raycast.steps_per_voxel"),
+            ("termination = 1.0", "raycast.termination"),
+            ("termination = -0.1", "raycast.termination"),
+            ("brick = 1000", "raycast.brick"),
+        ] {
+            let e = with_raycast(text).unwrap_err();
+            assert_eq!(e.key, key, "{text}");
+        }
+        assert!(
+            with_raycast("bricks = 4").is_err(),
+            "unknown keys are errors"
+        );
+    }
+}
