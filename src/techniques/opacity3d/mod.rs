@@ -58,6 +58,7 @@ use serde::{Deserialize, Serialize};
 use crate::colortable::TableSpec;
 use crate::gl::Filter;
 use crate::scene::FieldError;
+use crate::techniques::clip::ClipSpec;
 use crate::volume::attributes::Attribute;
 use crate::volume::quantize::Quantization;
 use crate::volume::VolumeSource;
@@ -135,6 +136,10 @@ pub struct Opacity3dScene {
     /// absent, precise mode slices. Faithful mode always slices.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub raycast: Option<Raycast>,
+    /// A clip object (`[technique.opacity3d.clip]`, seed 002): only what lies inside it
+    /// (outside with `invert`) is drawn.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub clip: Option<ClipSpec>,
 }
 
 /// `[technique.opacity3d.raycast]`: how the precise ray caster samples.
@@ -184,42 +189,6 @@ impl Default for Raycast {
 
 /// Most samples per voxel the ray caster accepts.
 pub const MAX_STEPS_PER_VOXEL: f64 = 1024.0;
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn with_raycast(text: &str) -> Result<(), FieldError> {
-        let scene = crate::scene::Scene::demo("v3o2-sum").unwrap();
-        let crate::scene::TechniqueScene::Opacity3d(mut params) = scene.technique else {
-            unreachable!()
-        };
-        params.raycast =
-            Some(toml::from_str(text).map_err(|e| FieldError::new("toml", e.to_string()))?);
-        params.validate()
-    }
-
-    #[test]
-    fn raycast_options_are_checked() {
-        assert!(with_raycast("").is_ok());
-        assert!(with_raycast("steps_per_voxel = 0.25\ntermination = 0.0\nbrick = 0").is_ok());
-        for (text, key) in [
-            ("steps_per_voxel = 0.0", "raycast.steps_per_voxel"),
-            ("steps_per_voxel = nan", "raycast.steps_per_voxel"),
-            ("steps_per_voxel = 1e9", "raycast.steps_per_voxel"),
-            ("termination = 1.0", "raycast.termination"),
-            ("termination = -0.1", "raycast.termination"),
-            ("brick = 1000", "raycast.brick"),
-        ] {
-            let e = with_raycast(text).unwrap_err();
-            assert_eq!(e.key, key, "{text}");
-        }
-        assert!(
-            with_raycast("bricks = 4").is_err(),
-            "unknown keys are errors"
-        );
-    }
-}
 
 fn default_slices() -> usize {
     256
@@ -290,6 +259,9 @@ impl Opacity3dScene {
                 ));
             }
         }
+        if let Some(clip) = &self.clip {
+            clip.validate().map_err(|e| e.within("clip"))?;
+        }
         for (name, a) in ATTRIBUTE_NAMES.iter().zip(self.attributes()) {
             if let Some(a) = a {
                 if a.coefficients.iter().any(|c| !c.is_finite() || *c < 0.0) {
@@ -312,3 +284,39 @@ impl Opacity3dScene {
 
 /// The attributes' names in scenes, in texture order.
 pub const ATTRIBUTE_NAMES: [&str; 3] = ["primary", "secondary", "tertiary"];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn with_raycast(text: &str) -> Result<(), FieldError> {
+        let scene = crate::scene::Scene::demo("v3o2-sum").unwrap();
+        let crate::scene::TechniqueScene::Opacity3d(mut params) = scene.technique else {
+            unreachable!()
+        };
+        params.raycast =
+            Some(toml::from_str(text).map_err(|e| FieldError::new("toml", e.to_string()))?);
+        params.validate()
+    }
+
+    #[test]
+    fn raycast_options_are_checked() {
+        assert!(with_raycast("").is_ok());
+        assert!(with_raycast("steps_per_voxel = 0.25\ntermination = 0.0\nbrick = 0").is_ok());
+        for (text, key) in [
+            ("steps_per_voxel = 0.0", "raycast.steps_per_voxel"),
+            ("steps_per_voxel = nan", "raycast.steps_per_voxel"),
+            ("steps_per_voxel = 1e9", "raycast.steps_per_voxel"),
+            ("termination = 1.0", "raycast.termination"),
+            ("termination = -0.1", "raycast.termination"),
+            ("brick = 1000", "raycast.brick"),
+        ] {
+            let e = with_raycast(text).unwrap_err();
+            assert_eq!(e.key, key, "{text}");
+        }
+        assert!(
+            with_raycast("bricks = 4").is_err(),
+            "unknown keys are errors"
+        );
+    }
+}
