@@ -170,6 +170,11 @@ pub const DEMOS: &[(&str, &str)] = &[
         "splats-section",
         include_str!("../scenes/demo/splats-section.toml"),
     ),
+    (
+        "clip-sphere",
+        include_str!("../scenes/demo/clip-sphere.toml"),
+    ),
+    ("clip-mesh", include_str!("../scenes/demo/clip-mesh.toml")),
 ];
 
 impl Scene {

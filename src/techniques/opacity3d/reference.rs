@@ -186,7 +186,7 @@ pub fn reference(
     )
 }
 
-/// [`reference`] where only samples at object-space points `keep` accepts contribute
+/// [`reference()`] where only samples at object-space points `keep` accepts contribute
 /// (a clip's [`crate::techniques::clip::shape::Shape::inside`]).
 pub fn reference_clipped(
     prepared: &Prepared,
