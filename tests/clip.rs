@@ -570,40 +570,64 @@ fn update_rebuilds_the_clip() {
     }
 }
 
-/// The data scene: the F3 crop clipped by the STL part (skipped without
-/// ../shared/data). ARB and GLSL within one 8-bit level (tests/opacity3d.rs's bound);
-/// the clip draws a part of what the unclipped scene draws: some pixels lit, fewer than
-/// unclipped, and none lit where the unclipped scene shows background.
+/// The data scenes (skipped without ../shared/data): the F3 crop clipped by the STL
+/// part, the ICBM template cut by a half-space. ARB and GLSL within one 8-bit level
+/// (tests/opacity3d.rs's bound); the clip draws a part of what the unclipped scene draws:
+/// some pixels lit, fewer than unclipped (the F3 part) or no more (the brain's cut keeps
+/// its silhouette), and none lit where the unclipped scene shows background.
 #[test]
-fn the_f3_crop_clipped_by_an_stl_part() {
-    let (Some(_), Some(_)) = (
-        common::shared_data("seismic/f3.sgy"),
-        common::shared_data("surfaces/42400-IDGH.stl"),
-    ) else {
-        return;
-    };
+fn data_scenes_with_clips() {
     let h = headless(Backend::Egl);
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut scene = Scene::load(&root.join("scenes/data/f3-clip.toml")).unwrap();
-    scene.size = [96, 96];
-    let mut plain = scene.clone();
-    params_mut(&mut plain).clip = None;
-    scene.programs = arbvis::gl::ProgramChoice::Arb;
-    let arb = render(&h, &scene);
-    scene.programs = arbvis::gl::ProgramChoice::Glsl;
-    let glsl = render(&h, &scene);
-    let d = arb.compare(&glsl, LEVEL).unwrap();
-    assert!(d.max_abs <= LEVEL as f64 * 1.01, "{d:?}");
-    let unclipped = render(&h, &plain);
-    let lit = |img: &Image, i: usize| img.data[4 * i..4 * i + 3].iter().any(|&v| v > 2.0 * LEVEL);
-    let n = 96 * 96;
-    let clipped = (0..n).filter(|&i| lit(&arb, i)).count();
-    let full = (0..n).filter(|&i| lit(&unclipped, i)).count();
-    assert!(
-        clipped > n / 20 && clipped < full * 3 / 4,
-        "{clipped} of {full} lit"
-    );
-    assert!((0..n).all(|i| lit(&unclipped, i) || !lit(&arb, i)));
+    for (file, data) in [
+        (
+            "f3-clip",
+            &["seismic/f3.sgy", "surfaces/42400-IDGH.stl"][..],
+        ),
+        (
+            "icbm152-clip",
+            &[
+                "volumes/mni_icbm152_t1_tal_nlin_sym_09a_converted.nii.gz",
+                "volumes/mni_icbm152_gm_tal_nlin_sym_09a_converted.nii.gz",
+                "volumes/mni_icbm152_wm_tal_nlin_sym_09a_converted.nii.gz",
+            ][..],
+        ),
+    ] {
+        if data.iter().any(|d| common::shared_data(d).is_none()) {
+            continue;
+        }
+        let mut scene = Scene::load(&root.join(format!("scenes/data/{file}.toml"))).unwrap();
+        scene.size = [96, 96];
+        let mut plain = scene.clone();
+        params_mut(&mut plain).clip = None;
+        scene.programs = arbvis::gl::ProgramChoice::Arb;
+        let arb = render(&h, &scene);
+        scene.programs = arbvis::gl::ProgramChoice::Glsl;
+        let glsl = render(&h, &scene);
+        let d = arb.compare(&glsl, LEVEL).unwrap();
+        assert!(d.max_abs <= LEVEL as f64 * 1.01, "{file}: {d:?}");
+        let unclipped = render(&h, &plain);
+        assert!(
+            arb.compare(&unclipped, 0.0).unwrap().max_abs > 0.05,
+            "{file}: no cut"
+        );
+        let lit =
+            |img: &Image, i: usize| img.data[4 * i..4 * i + 3].iter().any(|&v| v > 2.0 * LEVEL);
+        let n = 96 * 96;
+        let clipped = (0..n).filter(|&i| lit(&arb, i)).count();
+        let full = (0..n).filter(|&i| lit(&unclipped, i)).count();
+        assert!(
+            clipped > n / 20 && clipped <= full,
+            "{file}: {clipped} of {full} lit"
+        );
+        if file == "f3-clip" {
+            assert!(clipped < full * 3 / 4, "{file}: {clipped} of {full} lit");
+        }
+        assert!(
+            (0..n).all(|i| lit(&unclipped, i) || !lit(&arb, i)),
+            "{file}"
+        );
+    }
 }
 
 /// `arbvis bench --score` on a clipped scene scores against the clipped reference: the
