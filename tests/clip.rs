@@ -666,3 +666,45 @@ fn bench_scores_a_clipped_scene_against_the_clipped_reference() {
     let rmse = json["settings"][0]["rmse"].as_f64().unwrap();
     assert!(rmse < 5e-3, "{stdout}");
 }
+
+/// Pre-integration and the baked step table read whole steps without `classify`, where
+/// the ray caster's clip test sits, so a clip turns them off: with a clip, asking for
+/// them draws exactly what point sampling draws (one attribute, where they would
+/// otherwise be used).
+#[test]
+fn whole_step_tables_are_off_with_a_clip() {
+    let h = headless(Backend::Egl);
+    let raycast = |preintegrate: bool, jitter: bool, bake: bool| {
+        Some(Raycast {
+            steps_per_voxel: 1.0,
+            termination: 0.0,
+            brick: 0,
+            preintegrate,
+            jitter,
+            bake,
+        })
+    };
+    for (asked, plain) in [
+        (raycast(true, false, false), raycast(false, false, false)),
+        (raycast(false, true, true), raycast(false, true, false)),
+    ] {
+        use arbvis::techniques::opacity3d::renderer::{step_table, StepTable};
+        let clip = format!("shape = {CARVED}");
+        // Without the clip this scene does use the table asked for.
+        let mut unclipped = scene("precise", "glsl", None);
+        params_mut(&mut unclipped).raycast = asked;
+        let prepared = prepare(params(&unclipped), &unclipped.base, &Default::default()).unwrap();
+        let used = step_table(params(&unclipped), Fidelity::Precise, &prepared);
+        assert!(!matches!(used, StepTable::None), "{asked:?}");
+        let clipped = with("precise", "glsl", asked, &clip);
+        let off = step_table(params(&clipped), Fidelity::Precise, &prepared);
+        assert!(matches!(off, StepTable::None), "{asked:?}");
+        let a = render(&h, &clipped);
+        let b = render(&h, &with("precise", "glsl", plain, &clip));
+        assert_eq!(a.compare(&b, 0.0).unwrap().max_abs, 0.0, "{asked:?}");
+        assert!(
+            render(&h, &unclipped).compare(&a, 0.0).unwrap().max_abs > 0.05,
+            "{asked:?}: the clip shows"
+        );
+    }
+}
