@@ -2,7 +2,8 @@
 //! Luo, Xue, Long and Wu, ~2010): a distance-field clip texture (Weiskopf et al. 2003)
 //! compressed into an INDEX-DATA pair — a low-resolution INDEX with one texel per block
 //! saying outside / inside / boundary, and a DATA texture holding only the boundary
-//! blocks at full resolution. This module is the CPU part; the GL renderer builds on it.
+//! blocks at full resolution. This module is the CPU part and the GPU stage ([`stage`]);
+//! 3D opacity draws through it ([`crate::techniques::opacity3d::clipping`]).
 //!
 //! # How it works
 //! 1. [`ClipSpec`] (scene, checked by [`scene`]) → [`shape::Shape`]: analytic shapes,
