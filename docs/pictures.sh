@@ -2,7 +2,7 @@
 # Renders the README's pictures with arbvis itself (opaque PNGs, as a browser shows them).
 # Run from the repository root: bash docs/pictures.sh
 set -euo pipefail
-cargo build --release --no-default-features --quiet
+cargo build --release --quiet
 arbvis=target/release/arbvis
 out=docs/pictures
 mkdir -p "$out"
@@ -11,3 +11,9 @@ for demo in v3o2-sum v3o2-product cellproj-planar cellproj-spherical clip-sphere
 done
 "$arbvis" render --demo cellproj-spherical --fidelity precise -o "$out/cellproj-spherical-precise.png"
 "$arbvis" render --demo splats-section --size 1200x675 -o "$out/splats-section.png"
+# Real data (from ../shared/data, which a user's clone may not have).
+if [ -d ../shared/data ]; then
+  for s in f3 icbm152 post autzen bunny; do
+    "$arbvis" render "scenes/data/$s.toml" -o "$out/data-$s.png"
+  done
+fi

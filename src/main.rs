@@ -46,10 +46,12 @@ enum Command {
         #[arg(long)]
         stats: bool,
     },
-    /// Print what the loaders see in a file (SEG-Y, NIfTI): format, dimensions,
-    /// inline/crossline/offset/sample ranges, sample type, byte order, value statistics.
+    /// Print what the loaders see in a file: volumes (SEG-Y, NIfTI: dimensions, ranges,
+    /// sample type, byte order, statistics), meshes (VTK legacy, .vtu, gmsh: points, cells
+    /// by type, bounds, arrays, flat tetrahedra), point clouds (.dat, LAS/LAZ, PLY: count,
+    /// bounds, attributes) and surfaces (OBJ, STL).
     Inspect {
-        /// A `.sgy`/`.segy` or `.nii`/`.nii.gz` file.
+        /// A volume, mesh, point cloud or surface file.
         file: PathBuf,
     },
     /// Time a scene offscreen: clear + draw + finish per frame, the first frame apart,
@@ -114,6 +116,13 @@ enum Command {
         /// Peer-script runs (JSON) to plot and tabulate instead of sweeping.
         #[arg(long, num_args = 1..)]
         from: Vec<PathBuf>,
+        /// The technique whose trade to sweep.
+        #[arg(long, value_enum, ignore_case = true, default_value_t = StudyTechnique::Opacity3d)]
+        technique: StudyTechnique,
+        /// Cell projection: grid points per side of the generated meshes (17: the seed's
+        /// 24,576 tetrahedra; 56: about a million).
+        #[arg(long, value_delimiter = ',', default_values_t = [17, 25, 33, 45, 56])]
+        grids: Vec<usize>,
         /// Reference steps per voxel.
         #[arg(long, default_value_t = 4.0)]
         oversample: f64,
@@ -154,6 +163,16 @@ enum Command {
         #[arg(long, verbatim_doc_comment)]
         script: Option<PathBuf>,
     },
+}
+
+/// Techniques with a trade study.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum StudyTechnique {
+    /// v3o2's 3D opacity: slice counts, targets, opacity correction, program kinds.
+    Opacity3d,
+    /// Cell projection: mesh sizes, exit per vertex / per fragment, faithful / precise,
+    /// mesh / view order, isovalue-edit latency.
+    Cellproj,
 }
 
 /// The sizes a bench or study sweeps.
@@ -371,6 +390,32 @@ fn run(cli: Cli) -> Result<()> {
         Command::Study { from, out, .. } if !from.is_empty() => {
             print!("{}", arbvis::study::peers::study(&from, &out)?);
             println!("wrote {}", out.join("study.md").display());
+        }
+        Command::Study {
+            sweep,
+            technique: StudyTechnique::Cellproj,
+            grids,
+            out,
+            ..
+        } => {
+            let headless = Headless::new(sweep.backend)?;
+            let options = arbvis::techniques::cellproj::study::Options {
+                grids,
+                frames: sweep.frames.max(1),
+                ..Default::default()
+            };
+            if options.grids.iter().any(|&g| !(2..=128).contains(&g)) {
+                bail!("--grids: each must be 2..=128 points per side");
+            }
+            let rows = arbvis::techniques::cellproj::study::run(&headless, &options, |line| {
+                eprintln!("{line}")
+            })?;
+            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+            let csv = out.join("cellproj.csv");
+            let text = arbvis::techniques::cellproj::study::to_csv(&rows);
+            arbvis::png_io::write_atomic(&csv, text.as_bytes())
+                .with_context(|| format!("writing {}", csv.display()))?;
+            println!("wrote {}", csv.display());
         }
         Command::Study {
             sweep,

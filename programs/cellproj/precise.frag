@@ -12,7 +12,10 @@
 //   for each isovalue v in (sf, sb] (rising) or [sb, sf) (falling), the exit end widened
 //   by 2^-16 so that an isovalue on a shared face, which f32 rounding may leave just
 //   beyond this tetrahedron's exit and which the next one excludes at its entry, is drawn;
-// - depth is written at the crossing, and the colour may be shaded with the gradient.
+// - depth is written at the crossing (unless ENTRY_DEPTH is defined: then the entry
+//   face's depth stays, which orders the tetrahedra along a ray just as well and lets
+//   the depth test run before this program), and the colour may be shaded with the
+//   gradient.
 // program_local[0..3]: ModelViewProj rows; [4]: eye in object space (xyz), w = 1 for
 // perspective, 0 for orthographic; [5]: view direction (orthographic, unit);
 // [6]: x = isovalue count, y = shading on (1) / off (0), z = ambient term.
@@ -56,10 +59,12 @@ void main() {
     }
     if (hit < 0) discard;
     vec4 c = texelFetch(texture0, ivec2(hit, 0), 0);
+#ifndef ENTRY_DEPTH
     vec3 p = v_pos + D * (t * best);
     vec4 clip = vec4(dot(program_local[0], vec4(p, 1.0)), dot(program_local[1], vec4(p, 1.0)),
                      dot(program_local[2], vec4(p, 1.0)), dot(program_local[3], vec4(p, 1.0)));
     gl_FragDepth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);
+#endif
     if (program_local[6].y > 0.5) {
         vec3 g = v_gradient;
         float len = length(g);

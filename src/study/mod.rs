@@ -303,12 +303,7 @@ pub fn to_csv(rows: &[Row]) -> String {
 /// with the VTK GPU ray caster's time on this machine kind as a vertical line.
 pub fn plot(rows: &[Row], path: &Path, title: &str, vtk_ms: f64) -> anyhow::Result<()> {
     use plotters::prelude::*;
-    plotters::style::register_font(
-        "sans-serif",
-        FontStyle::Normal,
-        epaint_default_fonts::UBUNTU_LIGHT,
-    )
-    .map_err(|_| anyhow::anyhow!("the plot font did not load"))?;
+    register_plot_font()?;
     let (w, h) = (1100u32, 700u32);
     let mut buffer = vec![0u8; (w * h * 3) as usize];
     {
@@ -379,18 +374,7 @@ pub fn plot(rows: &[Row], path: &Path, title: &str, vtk_ms: f64) -> anyhow::Resu
             .draw()?;
         root.present()?;
     }
-    let data: Vec<f32> = buffer
-        .chunks_exact(3)
-        .flat_map(|p| [p[0], p[1], p[2], 255].map(|v| v as f32 / 255.0))
-        .collect();
-    let image = Image {
-        width: w,
-        height: h,
-        format: TargetFormat::Rgba8,
-        data,
-    };
-    crate::png_io::write_png(path, &image, &[("Software", "arbvis study".into())])?;
-    Ok(())
+    save_plot(&buffer, w, h, path)
 }
 
 /// Plot named lines of (ms, RMSE) points on log axes (a line and dots per series).
@@ -400,12 +384,7 @@ pub fn plot_lines(
     title: &str,
 ) -> anyhow::Result<()> {
     use plotters::prelude::*;
-    plotters::style::register_font(
-        "sans-serif",
-        FontStyle::Normal,
-        epaint_default_fonts::UBUNTU_LIGHT,
-    )
-    .map_err(|_| anyhow::anyhow!("the plot font did not load"))?;
+    register_plot_font()?;
     let (w, h) = (1100u32, 700u32);
     let mut buffer = vec![0u8; (w * h * 3) as usize];
     {
@@ -468,6 +447,21 @@ pub fn plot_lines(
             .draw()?;
         root.present()?;
     }
+    save_plot(&buffer, w, h, path)
+}
+
+/// The plots' font (egui's, already a dependency), registered with plotters.
+fn register_plot_font() -> anyhow::Result<()> {
+    plotters::style::register_font(
+        "sans-serif",
+        plotters::style::FontStyle::Normal,
+        epaint_default_fonts::UBUNTU_LIGHT,
+    )
+    .map_err(|_| anyhow::anyhow!("the plot font did not load"))
+}
+
+/// Write a plotters RGB buffer as an opaque PNG.
+fn save_plot(buffer: &[u8], w: u32, h: u32, path: &Path) -> anyhow::Result<()> {
     let data: Vec<f32> = buffer
         .chunks_exact(3)
         .flat_map(|p| [p[0], p[1], p[2], 255].map(|v| v as f32 / 255.0))

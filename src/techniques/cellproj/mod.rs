@@ -100,6 +100,36 @@ pub enum Exit {
     Fragment,
 }
 
+/// The order the faces are drawn in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Order {
+    /// The mesh's order, uploaded once, the same for every view (the seed's
+    /// view-independent draw; isovalue edits rewrite an index list).
+    #[default]
+    Mesh,
+    /// Per view: the active tetrahedra front to back (by centroid), only their faces
+    /// that can face the viewer, copied into one vertex buffer. The depth test then
+    /// rejects hidden fragments before their program runs, and half the vertices are
+    /// never processed; the picture is the same, but every change of view rebuilds the
+    /// buffer (a sort and a copy on the CPU).
+    View,
+}
+
+/// What the precise programs write to the depth buffer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Depth {
+    /// The depth of the isovalue crossing (exact; the program writes `gl_FragDepth`,
+    /// which makes the rasterizer test depth after the program, for every fragment).
+    #[default]
+    Crossing,
+    /// The depth of the entry face, as rasterized. The colours are the same: in a mesh of
+    /// non-overlapping tetrahedra a ray meets them one after another, so the nearest
+    /// entry holds the nearest crossing. The depth test can then run before the program.
+    Entry,
+}
+
 /// `[technique.cellproj]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -124,6 +154,12 @@ pub struct CellprojScene {
     /// cross nothing); `false` draws every face, as the seed did.
     #[serde(default = "yes")]
     pub active_only: bool,
+    /// Face order: the mesh's (view independent) or front to back per view.
+    #[serde(default)]
+    pub order: Order,
+    /// Depth written by the precise programs.
+    #[serde(default)]
+    pub depth: Depth,
 }
 
 fn yes() -> bool {

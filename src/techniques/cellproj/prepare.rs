@@ -25,6 +25,21 @@ pub const FACES: [([usize; 3], usize); 4] = [
     ([0, 2, 1], 3),
 ];
 
+/// Where the viewer is, in object space, for ordering and culling faces on the CPU.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Viewer {
+    /// A parallel view along this unit direction (into the scene).
+    Parallel(DVec3),
+    /// A perspective eye at this point.
+    Eye(DVec3),
+}
+
+/// Cosine between a face's outward normal and the direction from the viewer up to which
+/// [`Prepared::view_faces`] keeps the face (0 would keep exactly the front faces).
+/// Culling happens in the GL from window coordinates in f32 (a few 1e-5 pixels off); a
+/// face turned 1e-3 away projects to 1/1000 of its area, far beyond that.
+pub const FACING_MARGIN: f64 = 1e-3;
+
 /// A mesh ready to draw and to trace.
 #[derive(Debug, Clone)]
 pub struct Prepared {
@@ -177,9 +192,8 @@ impl Prepared {
             .collect()
     }
 
-    /// Vertex indices (12 per tetrahedron, into [`Prepared::face_vertices`]) of the
-    /// tetrahedra whose range, widened by `slack`, holds one of `isovalues`.
-    pub fn active_indices(ranges: &[[f64; 2]], isovalues: &[Isovalue], slack: f64) -> Vec<u32> {
+    /// The tetrahedra whose range, widened by `slack`, holds one of `isovalues`.
+    pub fn active_tets(ranges: &[[f64; 2]], isovalues: &[Isovalue], slack: f64) -> Vec<u32> {
         let mut values: Vec<f64> = isovalues.iter().map(|i| i.value).collect();
         values.sort_by(f64::total_cmp);
         let mut out = Vec::new();
@@ -187,8 +201,68 @@ impl Prepared {
             // The first isovalue at or above lo - slack: active when it is <= hi + slack.
             let k = values.partition_point(|&v| v < lo - slack);
             if values.get(k).is_some_and(|&v| v <= hi + slack) {
-                let first = (t * 12) as u32;
-                out.extend(first..first + 12);
+                out.push(t as u32);
+            }
+        }
+        out
+    }
+
+    /// Vertex indices (12 per tetrahedron, into [`Prepared::face_vertices`]) of the
+    /// [`Prepared::active_tets`].
+    pub fn active_indices(ranges: &[[f64; 2]], isovalues: &[Isovalue], slack: f64) -> Vec<u32> {
+        Self::active_tets(ranges, isovalues, slack)
+            .into_iter()
+            .flat_map(|t| t * 12..t * 12 + 12)
+            .collect()
+    }
+
+    /// The centroid of tetrahedron `t`.
+    pub fn centroid(&self, t: usize) -> DVec3 {
+        let (p, _) = self.tet(t);
+        (p[0] + p[1] + p[2] + p[3]) / 4.0
+    }
+
+    /// The vertex data of `tets` (slices of `faces`, [`Prepared::face_vertices`]) for one
+    /// view: the tetrahedra front to back by centroid, and of each only the faces that
+    /// may face `viewer` (outward normal at most [`FACING_MARGIN`] away from the
+    /// viewer's side: what back-face culling would drop, with a margin for the GL's f32
+    /// rounding of nearly edge-on faces, which are kept). In parallel.
+    pub fn view_faces(&self, faces: &[f32], tets: &[u32], viewer: Viewer) -> Vec<f32> {
+        // Sort keys and the faces to keep (bit k for face k), in parallel; then one
+        // sequential copy of whole faces.
+        let mut keyed: Vec<(f64, u32, u8)> = tets
+            .par_iter()
+            .map(|&t| {
+                let (p, _) = self.tet(t as usize);
+                let c = (p[0] + p[1] + p[2] + p[3]) / 4.0;
+                let key = match viewer {
+                    Viewer::Parallel(d) => c.dot(d),
+                    Viewer::Eye(e) => (c - e).length_squared(),
+                };
+                let mut keep = 0u8;
+                for (k, (f, _)) in FACES.iter().enumerate() {
+                    let n = (p[f[1]] - p[f[0]]).cross(p[f[2]] - p[f[0]]);
+                    let toward = match viewer {
+                        Viewer::Parallel(d) => d,
+                        Viewer::Eye(e) => (p[f[0]] - e).normalize_or_zero(),
+                    };
+                    if n.dot(toward) < FACING_MARGIN * n.length() || n == DVec3::ZERO {
+                        keep |= 1 << k;
+                    }
+                }
+                (key, t, keep)
+            })
+            .collect();
+        keyed.par_sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let face_floats = 3 * FLOATS_PER_VERTEX;
+        let kept: usize = keyed.iter().map(|k| k.2.count_ones() as usize).sum();
+        let mut out = Vec::with_capacity(kept * face_floats);
+        for &(_, t, keep) in &keyed {
+            for k in 0..4 {
+                if keep & (1 << k) != 0 {
+                    let at = (t as usize * 4 + k) * face_floats;
+                    out.extend_from_slice(&faces[at..at + face_floats]);
+                }
             }
         }
         out

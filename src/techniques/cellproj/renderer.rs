@@ -7,12 +7,12 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::prepare::{iso_list, iso_table, prepare, Prepared, VERTEX_COMPONENTS};
-use super::{CellprojScene, Exit};
+use super::prepare::{iso_list, iso_table, prepare, Prepared, Viewer, VERTEX_COMPONENTS};
+use super::{CellprojScene, Depth, Exit, Order};
 use crate::camera::Projection;
 use crate::gl::{
     self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
-    Surface, TexelData, TexelFormat, Texture,
+    ProgramText, Surface, TexelData, TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
 use crate::scene::{Fidelity, TechniqueScene};
@@ -57,6 +57,16 @@ pub fn variant(
     })
 }
 
+/// The precise fragment program writing the entry depth: `precise.frag` with
+/// `ENTRY_DEPTH` defined, which leaves out its `gl_FragDepth`.
+pub fn entry_depth_fragment(fragment: &ProgramText) -> ProgramText {
+    let text = fragment.text.replacen('\n', "\n#define ENTRY_DEPTH\n", 1);
+    ProgramText {
+        name: format!("{} (ENTRY_DEPTH)", fragment.name).into(),
+        text: text.into(),
+    }
+}
+
 /// The program pair of a variant (precise exists only in GLSL: it loops).
 pub fn program_pair(variant: Variant, kind: ProgramKind) -> GlResult<ProgramPair> {
     use programs::*;
@@ -95,16 +105,33 @@ pub fn eye_and_direction(frame: &Frame) -> (DVec3, DVec3) {
     (eye, dir)
 }
 
+/// The viewer of a frame, in object space (what [`Order::View`] sorts and culls for).
+pub fn viewer(frame: &Frame) -> Viewer {
+    let (eye, dir) = eye_and_direction(frame);
+    match frame.camera.projection {
+        Projection::Orthographic => Viewer::Parallel(dir),
+        Projection::Perspective => Viewer::Eye(eye),
+    }
+}
+
 /// The cell-projection renderer.
 pub struct CellprojRenderer {
     kind: ProgramKind,
     fidelity: Fidelity,
     params: CellprojScene,
     prepared: Prepared,
+    /// [`Order::Mesh`]: every face, drawn through an index list of the active ones;
+    /// [`Order::View`]: the active faces of one view, in order.
     mesh: Mesh,
+    /// The face vertices on the CPU, kept for [`Order::View`] rebuilds.
+    faces: Option<Vec<f32>>,
+    /// The tetrahedra drawn (active, or all).
+    drawn: Vec<u32>,
+    /// The viewer [`Order::View`]'s buffer was built for (`None`: rebuild).
+    built_for: Option<Viewer>,
     ranges: Vec<[f64; 2]>,
     table: Texture,
-    program: Option<(Variant, Program)>,
+    program: Option<(Variant, Depth, Program)>,
 }
 
 /// Slack of the active test: the precise programs' crossing slack (2^-16) and a margin
@@ -141,6 +168,19 @@ fn table_texture(gpu: &Gpu, params: &CellprojScene, fidelity: Fidelity) -> GlRes
     }
 }
 
+/// The GL mesh of an order, and the CPU copy of the faces [`Order::View`] keeps.
+fn face_mesh(gpu: &Gpu, prepared: &Prepared, order: Order) -> GlResult<(Mesh, Option<Vec<f32>>)> {
+    let vertices = prepared.face_vertices();
+    let label = "cellproj faces (4 per tetrahedron)";
+    Ok(match order {
+        Order::Mesh => (Mesh::new(gpu, label, &VERTEX_COMPONENTS, &vertices)?, None),
+        Order::View => (
+            Mesh::new(gpu, label, &VERTEX_COMPONENTS, &[])?,
+            Some(vertices),
+        ),
+    })
+}
+
 impl CellprojRenderer {
     /// Load and prepare the scene's mesh (relative paths from `base`), then upload.
     pub fn new(
@@ -165,13 +205,7 @@ impl CellprojRenderer {
         params: &CellprojScene,
         prepared: Prepared,
     ) -> GlResult<CellprojRenderer> {
-        let vertices = prepared.face_vertices();
-        let mesh = Mesh::new(
-            gpu,
-            "cellproj faces (4 per tetrahedron)",
-            &VERTEX_COMPONENTS,
-            &vertices,
-        )?;
+        let (mesh, faces) = face_mesh(gpu, &prepared, params.order)?;
         let table = table_texture(gpu, params, fidelity)?;
         let mut renderer = CellprojRenderer {
             kind,
@@ -180,6 +214,9 @@ impl CellprojRenderer {
             ranges: prepared.ranges(),
             prepared,
             mesh,
+            faces,
+            drawn: Vec::new(),
+            built_for: None,
             table,
             program: None,
         };
@@ -187,19 +224,49 @@ impl CellprojRenderer {
         Ok(renderer)
     }
 
-    /// List the active tetrahedra in the index buffer (or all, when not culling).
+    /// Choose the tetrahedra to draw (the active ones, or all): an index list for
+    /// [`Order::Mesh`]; for [`Order::View`] the next draw rebuilds its buffer.
     fn select_active(&mut self, gpu: &Gpu) -> GlResult<()> {
-        let indices = if self.params.active_only {
-            Prepared::active_indices(&self.ranges, &self.params.isovalues, ACTIVE_SLACK)
+        self.drawn = if self.params.active_only {
+            Prepared::active_tets(&self.ranges, &self.params.isovalues, ACTIVE_SLACK)
         } else {
-            (0..self.prepared.vertex_count() as u32).collect()
+            (0..self.prepared.tets.len() as u32).collect()
         };
-        self.mesh.set_indices(gpu, &indices)
+        self.built_for = None;
+        if self.params.order == Order::Mesh {
+            let indices: Vec<u32> = self
+                .drawn
+                .iter()
+                .flat_map(|&t| t * 12..t * 12 + 12)
+                .collect();
+            self.mesh.set_indices(gpu, &indices)?;
+        }
+        Ok(())
+    }
+
+    /// For [`Order::View`], rebuild the face buffer when the viewer moved.
+    fn build_view(&mut self, gpu: &Gpu, frame: &Frame) -> GlResult<()> {
+        let Some(faces) = &self.faces else {
+            return Ok(());
+        };
+        let viewer = viewer(frame);
+        if self.built_for != Some(viewer) {
+            let data = self.prepared.view_faces(faces, &self.drawn, viewer);
+            self.mesh.update(gpu, &data)?;
+            self.built_for = Some(viewer);
+        }
+        Ok(())
     }
 
     /// Tetrahedra drawn now.
     pub fn drawn_tets(&self) -> usize {
-        self.mesh.draw_count() / 12
+        self.drawn.len()
+    }
+
+    /// Vertices the last draw sent (12 per tetrahedron in mesh order; in view order
+    /// only the faces that may face the viewer).
+    pub fn drawn_vertices(&self) -> usize {
+        self.mesh.draw_count()
     }
 
     /// The prepared mesh (for references and readouts).
@@ -210,12 +277,18 @@ impl CellprojRenderer {
     /// The program for `variant`, compiled on first use (a scene switching projection
     /// compiles the other one once).
     fn program(&mut self, gpu: &Gpu, variant: Variant) -> GlResult<&Program> {
-        if self.program.as_ref().map(|(v, _)| *v) != Some(variant) {
+        let depth = self.params.depth;
+        if self.program.as_ref().map(|(v, d, _)| (*v, *d)) != Some((variant, depth)) {
             let pair = program_pair(variant, self.kind)?;
-            let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
-            self.program = Some((variant, program));
+            let fragment = if variant == Variant::Precise && depth == Depth::Entry {
+                entry_depth_fragment(&pair.fragment)
+            } else {
+                pair.fragment
+            };
+            let program = Program::new(gpu, pair.kind, &pair.vertex, &fragment)?;
+            self.program = Some((variant, depth, program));
         }
-        Ok(&self.program.as_ref().expect("set above").1)
+        Ok(&self.program.as_ref().expect("set above").2)
     }
 }
 
@@ -252,7 +325,8 @@ impl Renderer for CellprojRenderer {
         if self.params.isovalues.is_empty() {
             return Ok(());
         }
-        let program = &self.program.as_ref().expect("compiled above").1;
+        self.build_view(gpu, frame)?;
+        let program = &self.program.as_ref().expect("compiled above").2;
         gl::draw(
             gpu,
             surface,
@@ -286,11 +360,15 @@ impl Renderer for CellprojRenderer {
             new.isovalues != self.params.isovalues || new.table_size != self.params.table_size;
         let active_changed =
             new.isovalues != self.params.isovalues || new.active_only != self.params.active_only;
+        let order_changed = new.order != self.params.order;
         self.params = (**new).clone();
+        if order_changed {
+            (self.mesh, self.faces) = face_mesh(gpu, &self.prepared, self.params.order)?;
+        }
         if table_changed {
             self.table = table_texture(gpu, &self.params, self.fidelity)?;
         }
-        if active_changed {
+        if active_changed || order_changed {
             self.select_active(gpu)?;
         }
         Ok(())

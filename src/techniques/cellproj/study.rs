@@ -80,6 +80,8 @@ fn scene_for(points: usize, exit: Exit, active_only: bool) -> CellprojScene {
         table_size: 256,
         shading: false,
         active_only,
+        order: Default::default(),
+        depth: Default::default(),
     }
 }
 
@@ -177,6 +179,7 @@ pub fn run(
                 Exit::Vertex,
                 Ortho,
                 false,
+                false,
             ),
             (
                 "seed: faithful per-fragment, all tets (persp)",
@@ -184,6 +187,7 @@ pub fn run(
                 kind,
                 Exit::Fragment,
                 Persp,
+                false,
                 false,
             ),
             (
@@ -193,6 +197,7 @@ pub fn run(
                 Exit::Vertex,
                 Ortho,
                 true,
+                false,
             ),
             (
                 "faithful per-fragment (ortho)",
@@ -201,6 +206,7 @@ pub fn run(
                 Exit::Fragment,
                 Ortho,
                 true,
+                false,
             ),
             (
                 "faithful per-fragment (persp)",
@@ -209,12 +215,53 @@ pub fn run(
                 Exit::Fragment,
                 Persp,
                 true,
+                false,
             ),
-            ("precise (ortho)", precise, glsl, Exit::Auto, Ortho, true),
-            ("precise (persp)", precise, glsl, Exit::Auto, Persp, true),
+            (
+                "precise (ortho)",
+                precise,
+                glsl,
+                Exit::Auto,
+                Ortho,
+                true,
+                false,
+            ),
+            (
+                "precise (persp)",
+                precise,
+                glsl,
+                Exit::Auto,
+                Persp,
+                true,
+                false,
+            ),
+            // Front to back per view, back faces dropped, entry depth (the camera
+            // is still: the per-view rebuild happens once, before the timed frames).
+            (
+                "faithful per-vertex, view order (ortho)",
+                faithful,
+                kind,
+                Exit::Vertex,
+                Ortho,
+                true,
+                true,
+            ),
+            (
+                "precise, view order (ortho)",
+                precise,
+                glsl,
+                Exit::Auto,
+                Ortho,
+                true,
+                true,
+            ),
         ];
-        for (name, fidelity, kind, exit, projection, active_only) in settings {
-            let params = scene_for(points, exit, active_only);
+        for (name, fidelity, kind, exit, projection, active_only, view_order) in settings {
+            let mut params = scene_for(points, exit, active_only);
+            if view_order {
+                params.order = super::Order::View;
+                params.depth = super::Depth::Entry;
+            }
             let camera = study_camera(projection);
             let (ms, edit_ms, image, depth) = measure(
                 headless, &params, &prepared, fidelity, kind, camera, options,
@@ -258,14 +305,14 @@ pub fn run(
     Ok(rows)
 }
 
-/// The rows as CSV.
+/// The rows as CSV (the setting quoted: names hold commas).
 pub fn to_csv(rows: &[Row]) -> String {
     let mut s = String::from("tets,setting,ms_per_frame,fps,edit_to_frame_ms,interior_agreement\n");
     for r in rows {
         s += &format!(
-            "{},{},{:.3},{:.1},{:.3},{:.5}\n",
+            "{},\"{}\",{:.3},{:.1},{:.3},{:.5}\n",
             r.tets,
-            r.setting,
+            r.setting.replace('"', "'"),
             r.ms,
             1e3 / r.ms,
             r.edit_ms,
