@@ -708,3 +708,28 @@ fn whole_step_tables_are_off_with_a_clip() {
         );
     }
 }
+
+/// Empty-space skipping stays exact with a clip (a skipped brick has nothing to clip):
+/// bricks of 1, 2 and 3 voxels draw what no skipping draws, to f32 rounding (the bound
+/// of tests/opacity3d_precise.rs, 1e-6).
+#[test]
+fn empty_space_skipping_with_a_clip() {
+    let h = headless(Backend::Egl);
+    let clip = format!("shape = {CARVED}");
+    let skipping = |brick: usize| {
+        let mut s = with("precise", "glsl", point_sampling(2.0), &clip);
+        if let Some(r) = &mut params_mut(&mut s).raycast {
+            r.brick = brick;
+        }
+        // A table clear below the middle so that some bricks are empty.
+        params_mut(&mut s).primary.table =
+            toml::from_str("builtin = \"viridis\"\nalpha = [[0.0, 0.0], [0.5, 0.0], [1.0, 0.7]]")
+                .unwrap();
+        render(&h, &s)
+    };
+    let plain = skipping(0);
+    for brick in [1, 2, 3] {
+        let (max, _, _) = rgb_error(&skipping(brick), &plain, 0.0);
+        assert!(max < 1e-6, "brick {brick}: {max:.2e}");
+    }
+}
