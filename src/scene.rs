@@ -170,6 +170,11 @@ pub const DEMOS: &[(&str, &str)] = &[
         "splats-section",
         include_str!("../scenes/demo/splats-section.toml"),
     ),
+    (
+        "clip-sphere",
+        include_str!("../scenes/demo/clip-sphere.toml"),
+    ),
+    ("clip-mesh", include_str!("../scenes/demo/clip-mesh.toml")),
 ];
 
 impl Scene {
@@ -227,7 +232,7 @@ impl Scene {
         toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot serialize: {e}\n"))
     }
 
-    /// A copy whose relative data paths (volumes, table files) are made absolute against
+    /// A copy whose relative data paths (volumes, table files, clip meshes and masks) are made absolute against
     /// [`Scene::base`], so it can be saved anywhere.
     pub fn with_absolute_paths(&self) -> Scene {
         let mut scene = self.clone();
@@ -241,6 +246,9 @@ impl Scene {
                     if let Some(f) = &mut attr.table.file {
                         *f = base.join(&*f);
                     }
+                }
+                if let Some(clip) = &mut o.clip {
+                    clip.shape.for_each_path(&mut |p| *p = base.join(&*p));
                 }
             }
             TechniqueScene::Cellproj(c) => {

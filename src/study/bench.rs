@@ -23,7 +23,7 @@ use crate::gl::{Headless, ProgramKind, Surface, Target, TargetFormat};
 use crate::image::Image;
 use crate::scene::{Fidelity, Scene, TechniqueScene};
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
-use crate::techniques::opacity3d::reference::reference;
+use crate::techniques::opacity3d::reference::reference_clipped;
 use crate::techniques::opacity3d::renderer::{path, preintegrated, resolve_kind, Path3d};
 use crate::techniques::opacity3d::{Opacity3dRenderer, Raycast};
 use crate::techniques::{self, Frame, Renderer};
@@ -575,13 +575,22 @@ fn reference_rgb(
         bail!("--score needs a 3D-opacity scene");
     };
     let t0 = Instant::now();
-    let image = reference(
+    // A clipped scene is scored against the integral inside the analytic clip object.
+    let clip = match &params.clip {
+        Some(clip) => Some(
+            clip.shape(&scene.base, prepared.half.to_array())
+                .context("building the clip shape for the reference")?,
+        ),
+        None => None,
+    };
+    let image = reference_clipped(
         prepared,
         params,
         &scene.camera,
         scene.size,
         scene.background.map(|v| v as f64),
         options.oversample,
+        |x| clip.as_ref().is_none_or(|c| c.inside(x)),
     );
     let seconds = t0.elapsed().as_secs_f64();
     progress(&format!(

@@ -2,12 +2,13 @@
 //! Luo, Xue, Long and Wu, ~2010): a distance-field clip texture (Weiskopf et al. 2003)
 //! compressed into an INDEX-DATA pair — a low-resolution INDEX with one texel per block
 //! saying outside / inside / boundary, and a DATA texture holding only the boundary
-//! blocks at full resolution. This module is the CPU part; the GL renderer builds on it.
+//! blocks at full resolution. This module is the CPU part and the GPU stage ([`stage`]);
+//! 3D opacity draws through it ([`crate::techniques::opacity3d::clipping`]).
 //!
 //! # How it works
-//! 1. [`ClipSpec`] (scene) → [`shape::Shape`]: analytic shapes, CSG, triangle meshes
-//!    ([`mesh_field`], from [`crate::surface`]) and voxel masks ([`mask_field`]), in the
-//!    volume's object space (the box `[-half, half]`, longest side `[-1, 1]`).
+//! 1. [`ClipSpec`] (scene, checked by [`scene`]) → [`shape::Shape`]: analytic shapes,
+//!    CSG, triangle meshes ([`mesh_field`], from [`crate::surface`] or generated in
+//!    code) and voxel masks ([`mask_field`]), in the volume's object space (the box `[-half, half]`, longest side `[-1, 1]`).
 //! 2. [`texture::ClipTexture::build`]: the clip distance of every voxel centre, mapped to
 //!    `clamp(0.5 + 0.5 d / diag, 0, 1)` (boundary at 0.5, clamped beyond one voxel
 //!    diagonal), in parallel, timed.
@@ -55,6 +56,7 @@
 pub mod mask_field;
 pub mod mesh_field;
 pub mod multires;
+pub mod scene;
 pub mod shape;
 pub mod stage;
 #[cfg(test)]
@@ -141,6 +143,22 @@ pub enum ShapeSpec {
         #[serde(default)]
         rotation: [f64; 3],
     },
+    /// A closed triangle mesh generated in code (no file): a torus around its own z
+    /// axis, placed by `center + R v` ([`scene::torus`]).
+    TorusMesh {
+        /// Centre.
+        center: [f64; 3],
+        /// Radius of the ring (to the tube's centre).
+        major_radius: f64,
+        /// Radius of the tube (below `major_radius`).
+        minor_radius: f64,
+        /// Euler degrees.
+        #[serde(default)]
+        rotation: [f64; 3],
+        /// Segments around the ring and around the tube.
+        #[serde(default = "torus_segments")]
+        segments: [usize; 2],
+    },
     /// A volume thresholded: `value >= threshold` is inside.
     Mask {
         /// The mask volume (stretched over the clipped volume's box).
@@ -158,6 +176,10 @@ pub enum ShapeSpec {
 
 fn one() -> f64 {
     1.0
+}
+
+fn torus_segments() -> [usize; 2] {
+    [48, 24]
 }
 
 /// Deepest CSG nesting accepted.
@@ -301,6 +323,24 @@ impl ShapeSpec {
                     &mesh,
                     v(*position),
                     DVec3::splat(*scale),
+                    rotation_from_degrees(*rotation),
+                )))
+            }
+            ShapeSpec::TorusMesh {
+                center,
+                major_radius,
+                minor_radius,
+                rotation,
+                segments,
+            } => {
+                if let Err(e) = self.validate() {
+                    return Err(ClipError::Invalid(e.to_string()));
+                }
+                let mesh = scene::torus(*major_radius, *minor_radius, *segments)?;
+                Shape::Mesh(Box::new(mesh_field::MeshShape::new(
+                    &mesh,
+                    v(*center),
+                    DVec3::ONE,
                     rotation_from_degrees(*rotation),
                 )))
             }

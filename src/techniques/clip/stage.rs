@@ -254,13 +254,31 @@ pub fn compose_arb(text: &str, prologue: &str) -> Result<String, String> {
 /// statement of `main` discarding where `clip_value(coord) < 0.5`, and its
 /// `program_local` array widened to hold the clip's constants.
 pub fn compose_glsl(text: &str, function: &str, coord: &str) -> Result<String, String> {
+    compose_glsl_at(
+        text,
+        function,
+        "void main()",
+        &format!("if (clip_value({coord}) < 0.5) discard;"),
+    )
+}
+
+/// The GLSL program `text` with `function` inserted before the function whose header
+/// starts with `signature`, `statement` made the first statement of that function (e.g.
+/// a ray caster's `if (clip_value(tc) < 0.5) return vec4(0.0);` in its per-sample
+/// function), and `program_local` widened to hold the clip's constants.
+pub fn compose_glsl_at(
+    text: &str,
+    function: &str,
+    signature: &str,
+    statement: &str,
+) -> Result<String, String> {
     let main = text
-        .find("void main()")
-        .ok_or_else(|| "no `void main()` in the GLSL text".to_string())?;
+        .find(signature)
+        .ok_or_else(|| format!("no `{signature}` in the GLSL text"))?;
     let open = text[main..]
         .find('{')
         .map(|o| main + o + 1)
-        .ok_or_else(|| "`main` has no body".to_string())?;
+        .ok_or_else(|| format!("`{signature}` has no body"))?;
     let locals = format!("uniform vec4 program_local[{}];", crate::gl::MAX_LOCALS);
     let mut head = text[..main].to_string();
     match head.find("uniform vec4 program_local[") {
@@ -271,7 +289,7 @@ pub fn compose_glsl(text: &str, function: &str, coord: &str) -> Result<String, S
         None => head.push_str(&format!("{locals}\n")),
     }
     Ok(format!(
-        "{head}{function}{}\n    if (clip_value({coord}) < 0.5) discard;{}",
+        "{head}{function}{}\n    {statement}{}",
         &text[main..open],
         &text[open..]
     ))
@@ -301,5 +319,24 @@ mod tests {
         let m = out.find("void main()").unwrap();
         let d = out.find("if (clip_value(v.xyz) < 0.5) discard;").unwrap();
         assert!(f < m && m < d && d < out.find("x();").unwrap(), "{out}");
+    }
+
+    #[test]
+    fn a_ray_caster_gets_the_test_in_its_per_sample_function() {
+        let text = "#version 330\nuniform vec4 program_local[10];\nvec4 classify(vec3 tc) {\n    return vec4(1.0);\n}\nvoid main() {\n    frag_color = classify(vec3(0.5));\n}\n";
+        let out = compose_glsl_at(
+            text,
+            "float clip_value(vec3 p) { return 1.0; }\n",
+            "vec4 classify(vec3 tc)",
+            "if (clip_value(tc) < 0.5) return vec4(0.0);",
+        )
+        .unwrap();
+        let f = out.find("float clip_value").unwrap();
+        let c =
+            out.find("vec4 classify(vec3 tc) {\n    if (clip_value(tc) < 0.5) return vec4(0.0);");
+        assert!(c.is_some_and(|c| f < c), "{out}");
+        assert!(!out.contains("discard"), "{out}");
+        assert!(out.contains("program_local[16]"), "{out}");
+        assert!(compose_glsl_at(text, "", "vec4 shade(", "").is_err());
     }
 }

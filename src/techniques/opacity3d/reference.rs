@@ -8,6 +8,9 @@
 //!   ([`Prepared::reference_spacing`]), so a step `h` has `1 - (1 - a)^(h / ref)`. The
 //!   integral is taken by the midpoint rule with `oversample` steps per reference spacing,
 //!   far to near, over the background.
+//!   With a clip, [`reference_clipped`] takes the analytic predicate
+//!   ([`crate::techniques::clip::shape::Shape::inside`], `invert` applied): a sample
+//!   outside the clip contributes nothing.
 //! - [`super::mirror`] holds the CPU mirrors of the precise paths.
 //! - [`emulate_faithful_llvmpipe`]: the same pipeline bit for bit as llvmpipe computes
 //!   it (f32 program, llvmpipe's 8-bit blend), where filtering arithmetic is not involved.
@@ -172,6 +175,28 @@ pub fn reference(
     background: [f64; 4],
     oversample: f64,
 ) -> Image {
+    reference_clipped(
+        prepared,
+        params,
+        camera,
+        size,
+        background,
+        oversample,
+        |_| true,
+    )
+}
+
+/// [`reference()`] where only samples at object-space points `keep` accepts contribute
+/// (a clip's [`crate::techniques::clip::shape::Shape::inside`]).
+pub fn reference_clipped(
+    prepared: &Prepared,
+    params: &Opacity3dScene,
+    camera: &Camera,
+    size: [u32; 2],
+    background: [f64; 4],
+    oversample: f64,
+    keep: impl Fn(DVec3) -> bool + Sync,
+) -> Image {
     let reference = prepared.reference_spacing();
     let half = prepared.half;
     trace_pixels(camera, size, TargetFormat::Rgba32f, |origin, dir| {
@@ -187,7 +212,11 @@ pub fn reference(
         // Far to near.
         for s in (0..steps).rev() {
             let t = enter + (exit - enter) * (s as f64 + 0.5) / steps as f64;
-            let tc = (origin + dir * t + half) / (2.0 * half);
+            let x = origin + dir * t;
+            if !keep(x) {
+                continue;
+            }
+            let tc = (x + half) / (2.0 * half);
             let c = classify(
                 prepared,
                 params,

@@ -7,12 +7,16 @@
 //!   unorm: k/255 exactly either way);
 //! - precise ray casting (GLSL): the box's far faces, one fragment per pixel marching its
 //!   ray, with the brick occupancy of empty-space skipping on unit 5.
+//!
+//! With a clip ([`super::clipping`]) every program has the clip test composed in and the
+//! clip's textures sit on units 7 and 8.
 
 use std::path::{Path, PathBuf};
 
 use glam::{DMat4, DVec3};
 
 use super::bricks::Bricks;
+use super::clipping::{self, Clip};
 use super::prepare::{prepare, Prepared};
 use super::programs::{raycast_pair, slicing_pair, Variant};
 use super::slicing::slice_box;
@@ -25,6 +29,7 @@ use crate::gl::{
 };
 use crate::programs;
 use crate::scene::{Fidelity, Scene, TechniqueScene};
+use crate::techniques::clip::stage as clipping_stage;
 use crate::techniques::{Frame, Renderer};
 
 /// Texture unit of the packed volume and of the three tables (unit 1 is v3o2's
@@ -55,11 +60,13 @@ pub fn path(params: &Opacity3dScene, fidelity: Fidelity) -> Path3d {
     }
 }
 
-/// Whether the ray caster pre-integrates: one attribute, opacity correction on, and
-/// `raycast.preintegrate`.
+/// Whether the ray caster pre-integrates: one attribute, opacity correction on,
+/// `raycast.preintegrate`
+/// and no clip (whole steps would skip the per-sample clip test).
 pub fn preintegrated(params: &Opacity3dScene, fidelity: Fidelity, attributes: usize) -> bool {
     path(params, fidelity) == Path3d::Raycast
         && attributes == 1
+        && params.clip.is_none()
         && corrected(params, fidelity)
         && params.raycast.is_some_and(|r| r.preintegrate)
 }
@@ -75,11 +82,15 @@ pub enum StepTable {
     Baked(Vec<f32>),
 }
 
-/// The table a ray-casting scene needs (one attribute only).
+/// The table a ray-casting scene needs (one attribute only, no clip: a clipped scene
+/// point-samples through the clip test).
 pub fn step_table(params: &Opacity3dScene, fidelity: Fidelity, prepared: &Prepared) -> StepTable {
     let (Some(r), Some(table)) = (&params.raycast, &prepared.tables[0]) else {
         return StepTable::None;
     };
+    if params.clip.is_some() {
+        return StepTable::None;
+    }
     let one = prepared.count() == 1;
     if path(params, fidelity) != Path3d::Raycast || !one || !corrected(params, fidelity) {
         return StepTable::None;
@@ -238,6 +249,7 @@ pub struct Opacity3dRenderer {
     /// Vertices up to the end of each slice, back to front (for [`Renderer::draw_part`]).
     slice_ends: Vec<usize>,
     spacing: f64,
+    clip: Option<Clip>,
 }
 
 fn table_texture(
@@ -297,7 +309,14 @@ impl Opacity3dRenderer {
         }
         let table = step_table(params, fidelity, &prepared);
         let baked = matches!(table, StepTable::Baked(_));
-        let program = make_program(gpu, kind, fidelity, params, &prepared, projection, baked)?;
+        let clip = match &params.clip {
+            Some(spec) => Some(clipping::build(gpu, spec, base, &prepared, fidelity)?),
+            None => None,
+        };
+        let stage = clip.as_ref().map(|c| &c.stage);
+        let program = make_program(
+            gpu, kind, fidelity, params, &prepared, projection, baked, stage,
+        )?;
         let extent = Extent::D3(ni as u32, nj as u32, nk as u32);
         let volume = match fidelity {
             Fidelity::Faithful => Texture::new(
@@ -335,6 +354,7 @@ impl Opacity3dRenderer {
             mesh_key: None,
             slice_ends: Vec::new(),
             spacing: 0.0,
+            clip,
         };
         renderer.build_tables(gpu)?;
         renderer.build_bricks(gpu)?;
@@ -346,6 +366,11 @@ impl Opacity3dRenderer {
     /// The prepared data (for references and the viewer's readouts).
     pub fn prepared(&self) -> &Prepared {
         &self.prepared
+    }
+
+    /// The clip, if the scene has one (its f64 shape is the reference's predicate).
+    pub fn clip(&self) -> Option<&Clip> {
+        self.clip.as_ref()
     }
 
     /// The path this renderer draws with.
@@ -451,6 +476,9 @@ impl Opacity3dRenderer {
         for (i, c) in coefficients(&self.params).iter().enumerate() {
             self.program.set_local(gpu, i + 1, *c)?;
         }
+        if let Some(clip) = &self.clip {
+            clip.stage.send(gpu, &self.program)?;
+        }
         if self.fidelity == Fidelity::Precise {
             let p = &self.program;
             p.set_local(gpu, 5, [255.0 / 256.0, 0.5 / 256.0, 1.0 / 3.0, 0.0])?;
@@ -542,7 +570,8 @@ impl Opacity3dRenderer {
     }
 }
 
-/// The program for a fidelity, path and projection.
+/// The program for a fidelity, path and projection, with `clip`'s test composed in.
+#[allow(clippy::too_many_arguments)]
 fn make_program(
     gpu: &Gpu,
     kind: ProgramKind,
@@ -551,6 +580,7 @@ fn make_program(
     prepared: &Prepared,
     projection: Projection,
     baked: bool,
+    clip: Option<&clipping_stage::ClipStage>,
 ) -> GlResult<Program> {
     let preint = preintegrated(params, fidelity, prepared.count());
     let variant = Variant {
@@ -576,6 +606,10 @@ fn make_program(
             raycast_pair(variant)
         }
     };
+    let pair = match clip {
+        Some(stage) => clipping::compose(pair, stage, path(params, fidelity))?,
+        None => pair,
+    };
     Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)
 }
 
@@ -599,6 +633,7 @@ impl Opacity3dRenderer {
                 &self.prepared,
                 projection,
                 self.baked,
+                self.clip.as_ref().map(|c| &c.stage),
             )?;
             self.projection = projection;
             self.send_constants(gpu)?;
@@ -627,6 +662,9 @@ impl Opacity3dRenderer {
         }
         if let Some(t) = &self.preint {
             textures.push((PREINT_UNIT, t));
+        }
+        if let Some(clip) = &self.clip {
+            textures.extend(clip.stage.textures());
         }
         let Some(mesh) = &self.mesh else {
             return Ok(());
@@ -718,6 +756,19 @@ impl Renderer for Opacity3dRenderer {
             self.build_tables(gpu)?;
         }
         self.build_bricks(gpu)?;
+        let clip_changed = old.clip != new.clip;
+        if clip_changed {
+            self.clip = match &new.clip {
+                Some(spec) => Some(clipping::build(
+                    gpu,
+                    spec,
+                    &self.base,
+                    &self.prepared,
+                    self.fidelity,
+                )?),
+                None => None,
+            };
+        }
         let table = step_table(new, self.fidelity, &self.prepared);
         let baked = matches!(table, StepTable::Baked(_));
         let shape = |p: &Opacity3dScene| {
@@ -726,7 +777,7 @@ impl Renderer for Opacity3dRenderer {
                 p.raycast.map(|r| (r.brick > 0, r.jitter, r.preintegrate)),
             )
         };
-        if shape(&old) != shape(new) || baked != self.baked {
+        if shape(&old) != shape(new) || baked != self.baked || clip_changed {
             self.baked = baked;
             self.program = make_program(
                 gpu,
@@ -736,6 +787,7 @@ impl Renderer for Opacity3dRenderer {
                 &self.prepared,
                 self.projection,
                 baked,
+                self.clip.as_ref().map(|c| &c.stage),
             )?;
             self.mesh_key = None;
             self.mesh = None;
