@@ -18,9 +18,8 @@
 //!   (`arbvis inspect`-style text by [`describe`]).
 //! - STL has no shared vertices: equal positions (bit for bit, after -0 = +0) are welded so
 //!   that the edge counts mean something. OBJ and indexed input keep their indices.
-//! - PLY: the PLY reader (`crate::points::ply`, another branch) yields vertices and face
-//!   lists; `TriangleMesh::from_indexed(name, vertices, faces)` is where they plug in.
-//!   [`read`] does not dispatch `.ply` yet and says so.
+//! - PLY: the point clouds' PLY reader (`crate::points::ply`, ASCII and binary, bounded)
+//!   yields the vertices and face lists, which [`TriangleMesh::from_indexed`] checks.
 
 pub mod obj;
 pub mod stl;
@@ -91,6 +90,9 @@ pub enum SurfaceError {
         /// What was expected and what was found.
         message: String,
     },
+    /// A PLY file the PLY reader refused (its error names the file and byte).
+    #[error(transparent)]
+    Ply(#[from] crate::points::PointsError),
     /// The format is not one this module reads.
     #[error("{path}: {message}")]
     Unsupported {
@@ -212,20 +214,54 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
     match ext.as_str() {
         "obj" => obj::parse(name, bytes),
         "stl" => stl::parse(name, bytes),
-        "ply" => Err(SurfaceError::Unsupported {
-            path: name.to_path_buf(),
-            message: "PLY surfaces are read by crate::points::ply (not in this build); \
-                      feed its faces to TriangleMesh::from_indexed"
-                .into(),
-        }),
+        "ply" => parse_ply(name, bytes),
         _ => Err(SurfaceError::Unsupported {
             path: name.to_path_buf(),
             message: format!(
-                "unknown surface extension {:?}: expected .obj or .stl",
+                "unknown surface extension {:?}: expected .obj, .stl or .ply",
                 crate::input::shorten(&ext, 20)
             ),
         }),
     }
+}
+
+/// A PLY surface: its `vertex` element's x, y, z and its `face` element's index lists
+/// (`vertex_indices` or `vertex_index`), read by [`crate::points::ply`] and checked by
+/// [`TriangleMesh::from_indexed`] (indices in range, polygons split as fans).
+fn parse_ply(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
+    let ply = crate::points::ply::parse(name, bytes)?;
+    let missing = |what: &str| SurfaceError::Unsupported {
+        path: name.to_path_buf(),
+        message: format!("a PLY surface needs {what}"),
+    };
+    let vertex = ply
+        .element("vertex")
+        .ok_or_else(|| missing("a vertex element"))?;
+    let axis = |a: &str| {
+        vertex
+            .scalar(a)
+            .ok_or_else(|| missing(&format!("vertex property {a}")))
+    };
+    let (x, y, z) = (axis("x")?, axis("y")?, axis("z")?);
+    let vertices: Vec<[f64; 3]> = (0..x.len()).map(|i| [x[i], y[i], z[i]]).collect();
+    let faces = ply
+        .element("face")
+        .and_then(|f| f.face_indices())
+        .ok_or_else(|| missing("a face element with a vertex_indices list"))?;
+    // Indices arrive as f64 (the PLY reader's one numeric type): non-integers and
+    // negatives become u32::MAX, which from_indexed reports as out of range.
+    let polygons = faces.iter().map(|f| {
+        f.iter()
+            .map(|&i| {
+                if i >= 0.0 && i.fract() == 0.0 && i < u32::MAX as f64 {
+                    i as u32
+                } else {
+                    u32::MAX
+                }
+            })
+            .collect::<Vec<u32>>()
+    });
+    TriangleMesh::from_indexed(name, vertices, polygons)
 }
 
 /// Read a surface file (regular files of at most [`MAX_SURFACE_BYTES`]).
@@ -290,12 +326,52 @@ mod tests {
     #[test]
     fn parse_dispatches_by_extension() {
         let e = parse(Path::new("x.ply"), b"ply\n").unwrap_err().to_string();
-        assert!(e.contains("TriangleMesh::from_indexed"), "{e}");
+        assert!(e.contains("x.ply"), "{e}");
         let e = parse(Path::new("x.off"), b"OFF\n").unwrap_err().to_string();
-        assert!(e.contains("expected .obj or .stl"), "{e}");
+        assert!(e.contains("expected .obj, .stl or .ply"), "{e}");
         let e = read(Path::new("/")).unwrap_err().to_string();
         assert!(e.contains("directory"), "{e}");
         let m = parse(Path::new("X.OBJ"), b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();
         assert_eq!(m.bounds(), ([0.0; 3], [1.0, 1.0, 0.0]));
+    }
+
+    #[test]
+    fn ply_surfaces_are_read_and_checked() {
+        // A tetrahedron in ASCII PLY, one face a quad split as a fan (5 triangles).
+        let ascii = "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n\
+                     property float z\nelement face 4\nproperty list uchar int vertex_indices\n\
+                     end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n0.5 0.5 1\n\
+                     4 0 3 2 1\n3 0 1 4\n3 1 2 4\n3 2 3 4\n";
+        let m = parse(Path::new("t.ply"), ascii.as_bytes()).unwrap();
+        assert_eq!(m.vertices.len(), 5);
+        assert_eq!(m.triangles.len(), 5);
+        assert_eq!(m.triangles[0], [0, 3, 2]);
+        assert_eq!(m.triangles[1], [0, 2, 1]);
+        // An index out of range names the polygon; a missing face element is said.
+        let bad = ascii.replace("3 2 3 4", "3 2 3 9");
+        let e = parse(Path::new("t.ply"), bad.as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("t.ply") && e.contains('9'), "{e}");
+        let cloud = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+                     property float z\nend_header\n0 0 0\n";
+        let e = parse(Path::new("c.ply"), cloud.as_bytes())
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("c.ply") && e.contains("face element"), "{e}");
+        // The PLY reader's own errors pass through with their byte.
+        let e = parse(Path::new("x.ply"), b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nend_header\n\0")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("x.ply") && e.contains("byte"), "{e}");
+    }
+
+    #[test]
+    fn the_bunny_is_a_ply_surface() {
+        let Some(path) = crate::points::shared_data("points/bunny.ply") else {
+            return;
+        };
+        let m = read(&path).unwrap();
+        assert_eq!((m.vertices.len(), m.triangles.len()), (35_947, 69_451));
     }
 }
