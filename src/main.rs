@@ -123,6 +123,12 @@ enum Command {
         /// 24,576 tetrahedra; 56: about a million).
         #[arg(long, value_delimiter = ',', default_values_t = [17, 25, 33, 45, 56])]
         grids: Vec<usize>,
+        /// Clipping: clip grid sides of the texture sweep.
+        #[arg(long, value_delimiter = ',', default_values_t = [256, 512])]
+        clip_sizes: Vec<usize>,
+        /// Clipping: block sides B.
+        #[arg(long, value_delimiter = ',', default_values_t = [4, 8, 16, 32])]
+        blocks: Vec<usize>,
         /// Reference steps per voxel.
         #[arg(long, default_value_t = 4.0)]
         oversample: f64,
@@ -173,6 +179,9 @@ enum StudyTechnique {
     /// Cell projection: mesh sizes, exit per vertex / per fragment, faithful / precise,
     /// mesh / view order, isovalue-edit latency.
     Cellproj,
+    /// Volume clipping: clip grid sizes, shapes and block sizes (bytes, ratio, build
+    /// time), and frame times with no clip, the single texture and INDEX-DATA.
+    Clip,
 }
 
 /// The sizes a bench or study sweeps.
@@ -390,6 +399,41 @@ fn run(cli: Cli) -> Result<()> {
         Command::Study { from, out, .. } if !from.is_empty() => {
             print!("{}", arbvis::study::peers::study(&from, &out)?);
             println!("wrote {}", out.join("study.md").display());
+        }
+        Command::Study {
+            sweep,
+            technique: StudyTechnique::Clip,
+            clip_sizes,
+            blocks,
+            out,
+            ..
+        } => {
+            if clip_sizes.iter().any(|&n| !(1..=2048).contains(&n))
+                || blocks.iter().any(|&b| !(1..=256).contains(&b))
+            {
+                bail!("--clip-sizes must be 1..=2048 and --blocks 1..=256");
+            }
+            let options = arbvis::techniques::clip::study::Options {
+                sizes: clip_sizes,
+                blocks,
+                frame_volume: sweep.volume,
+                image: sweep.size,
+                frames: sweep.frames.max(1),
+            };
+            let headless = Headless::new(sweep.backend)?;
+            let max = headless.gpu().caps().max_3d_texture_size.max(1) as usize;
+            let study =
+                arbvis::techniques::clip::study::textures(&options, max, |l| eprintln!("{l}"))?;
+            let frames =
+                arbvis::techniques::clip::study::frames(&headless, &options, |l| eprintln!("{l}"))?;
+            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+            let (textures, times) = arbvis::techniques::clip::study::to_csv(&study, &frames);
+            for (name, text) in [("clip-textures.csv", textures), ("clip-frames.csv", times)] {
+                let path = out.join(name);
+                arbvis::png_io::write_atomic(&path, text.as_bytes())
+                    .with_context(|| format!("writing {}", path.display()))?;
+                println!("wrote {}", path.display());
+            }
         }
         Command::Study {
             sweep,

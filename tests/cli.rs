@@ -388,3 +388,46 @@ fn study_of_cell_projection_writes_its_sweep() {
     assert!(!bad.status.success());
     assert!(text(&bad).1.contains("--grids"), "{}", text(&bad).1);
 }
+
+#[test]
+fn study_of_clipping_writes_its_sweeps() {
+    // A 24³ clip grid, B = 4 and 8, frames of a 16³ volume at 32²: the 256³ and
+    // 512³ are a benchmark.
+    let dir = temp_dir("study-clip");
+    let out = arbvis(&[
+        "study",
+        "--technique",
+        "clip",
+        "--clip-sizes",
+        "24",
+        "--blocks",
+        "4,8",
+        "--volume",
+        "16",
+        "--size",
+        "32",
+        "--frames",
+        "1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let (_, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let textures = std::fs::read_to_string(dir.join("clip-textures.csv")).unwrap();
+    // Per shape (sphere, torus, and the cow where ../shared is present): single + 2 B.
+    let shapes = textures.lines().skip(1).count() / 3;
+    assert!((2..=3).contains(&shapes), "{textures}");
+    for line in textures.lines().skip(1) {
+        let ratio: f64 = line.rsplit(',').nth(1).unwrap().parse().unwrap();
+        assert!(ratio > 0.0 && ratio.is_finite(), "{line}");
+    }
+    let frames = std::fs::read_to_string(dir.join("clip-frames.csv")).unwrap();
+    let rows: Vec<&str> = frames.lines().skip(1).collect();
+    assert_eq!(rows.len(), 4, "{frames}");
+    for row in &rows[2..] {
+        // INDEX-DATA keeps what the single texture keeps (the keep/discard decision is
+        // the same at every point, clip/mod.rs): the bound is 1/255; measured 0.
+        let levels: f64 = row.rsplit(',').next().unwrap().parse().unwrap();
+        assert!(levels <= 1.0, "{row}");
+    }
+}
