@@ -129,6 +129,12 @@ enum Command {
         /// Clipping: block sides B.
         #[arg(long, value_delimiter = ',', default_values_t = [4, 8, 16, 32])]
         blocks: Vec<usize>,
+        /// Splats: cloud sizes of the sort timings.
+        #[arg(long, value_delimiter = ',', default_values_t = [570_000, 10_000_000])]
+        points: Vec<usize>,
+        /// Splats: cloud size and image of the frame times.
+        #[arg(long, default_value_t = 570_000)]
+        frame_points: usize,
         /// Reference steps per voxel.
         #[arg(long, default_value_t = 4.0)]
         oversample: f64,
@@ -182,6 +188,9 @@ enum StudyTechnique {
     /// Volume clipping: clip grid sizes, shapes and block sizes (bytes, ratio, build
     /// time), and frame times with no clip, the single texture and INDEX-DATA.
     Clip,
+    /// Splats: every sort method at each cloud size, and frame times per sort choice
+    /// while the camera turns.
+    Splats,
 }
 
 /// The sizes a bench or study sweeps.
@@ -399,6 +408,42 @@ fn run(cli: Cli) -> Result<()> {
         Command::Study { from, out, .. } if !from.is_empty() => {
             print!("{}", arbvis::study::peers::study(&from, &out)?);
             println!("wrote {}", out.join("study.md").display());
+        }
+        Command::Study {
+            sweep,
+            technique: StudyTechnique::Splats,
+            points,
+            frame_points,
+            out,
+            ..
+        } => {
+            let most = arbvis::points::MAX_POINTS as usize;
+            if points
+                .iter()
+                .chain([&frame_points])
+                .any(|&n| n == 0 || n > most)
+            {
+                bail!("--points and --frame-points must be 1..={most}");
+            }
+            let options = arbvis::techniques::splats::study::Options {
+                points,
+                frame_points,
+                runs: sweep.frames.max(1),
+                ..Default::default()
+            };
+            let sorts = arbvis::techniques::splats::study::sorts(&options, |l| eprintln!("{l}"))?;
+            let headless = Headless::new(sweep.backend)?;
+            let frames = arbvis::techniques::splats::study::frames(&headless, &options, |l| {
+                eprintln!("{l}")
+            })?;
+            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+            let (s, f) = arbvis::techniques::splats::study::to_csv(&sorts, &frames);
+            for (name, text) in [("splats-sorts.csv", s), ("splats-frames.csv", f)] {
+                let path = out.join(name);
+                arbvis::png_io::write_atomic(&path, text.as_bytes())
+                    .with_context(|| format!("writing {}", path.display()))?;
+                println!("wrote {}", path.display());
+            }
         }
         Command::Study {
             sweep,

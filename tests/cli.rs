@@ -432,3 +432,42 @@ fn study_of_clipping_writes_its_sweeps() {
         assert!(levels <= 1.0, "{row}");
     }
 }
+
+#[test]
+fn study_of_splats_writes_its_sweeps() {
+    // 3,000 points (at the demo's 1600x900): the seed's 570k and 10 M are a benchmark.
+    let dir = temp_dir("study-splats");
+    let out = arbvis(&[
+        "study",
+        "--technique",
+        "splats",
+        "--points",
+        "3000",
+        "--frame-points",
+        "3000",
+        "--frames",
+        "1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let (_, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    let sorts = std::fs::read_to_string(dir.join("splats-sorts.csv")).unwrap();
+    assert!(
+        sorts.contains("seed comparator") && sorts.contains("radix"),
+        "{sorts}"
+    );
+    let frames = std::fs::read_to_string(dir.join("splats-frames.csv")).unwrap();
+    let names: Vec<&str> = frames
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap())
+        .collect();
+    assert_eq!(names, ["seed", "keys", "radix", "none", "oit"], "{frames}");
+    for line in frames.lines().skip(1) {
+        let ms: f64 = line.split(',').nth(1).unwrap().parse().unwrap();
+        assert!(ms > 0.0 && ms.is_finite(), "{line}");
+    }
+    let bad = arbvis(&["study", "--technique", "splats", "--points", "0"]);
+    assert!(!bad.status.success() && text(&bad).1.contains("--points"));
+}

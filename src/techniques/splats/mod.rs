@@ -37,6 +37,7 @@ pub mod reference;
 pub mod renderer;
 pub mod scene;
 pub mod sort;
+pub mod study;
 
 pub use renderer::SplatsRenderer;
 pub use scene::SplatsScene;
