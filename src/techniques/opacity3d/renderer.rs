@@ -30,6 +30,7 @@ use crate::gl::{
 use crate::programs;
 use crate::scene::{Fidelity, Scene, TechniqueScene};
 use crate::techniques::clip::stage as clipping_stage;
+use crate::techniques::clip::stats::ClipStats;
 use crate::techniques::{Frame, Renderer};
 
 /// Texture unit of the packed volume and of the three tables (unit 1 is v3o2's
@@ -798,5 +799,9 @@ impl Renderer for Opacity3dRenderer {
 
     fn program_kind(&self) -> ProgramKind {
         self.program.kind()
+    }
+
+    fn clip_stats(&self) -> Option<ClipStats> {
+        self.clip.as_ref().map(|c| c.stats)
     }
 }
