@@ -1,7 +1,9 @@
 //! The desktop viewer under Xvfb: screenshots equal to offscreen renders of the saved
 //! scene, framing at two window aspects, an idle viewer that draws nothing, every control
 //! of the lut 3D editor reached by `--script` (clicks, drags and values injected through
-//! egui's input path), and script steps that do nothing failing with their line.
+//! egui's input path), the isovalue, splat and clip editors reaching the saved scene (the
+//! clip's cost line read with `print`), and script steps that do nothing failing with
+//! their line.
 //!
 //! Needs an X server: `DISPLAY`, or `Xvfb` on PATH (started here). Without either the
 //! tests say so and pass, unless `ARBVIS_NO_SKIP=1` (set by `.ci/run`) makes that a failure.
@@ -609,6 +611,49 @@ click Save scene
 }
 
 #[test]
+fn a_clip_the_editor_cannot_edit_is_kept() {
+    // The clip-sphere demo with a CSG clip: shown read-only, and chosen again after a
+    // sphere was tried.
+    let dir = temp_dir("clip-csg-scene");
+    let scene = dir.join("csg.toml");
+    let demo = include_str!("../scenes/demo/clip-sphere.toml");
+    let csg = "shape = { difference = [{ sphere = { center = [0.0, 0.0, 0.0], radius = 0.9 } }, { box = { center = [0.5, 0.5, 0.5], half_size = [0.5, 0.5, 0.5] } }] }";
+    let text = demo.replace(
+        "shape = { sphere = { center = [-1.0, 1.0, 1.0], radius = 1.45 } }",
+        csg,
+    );
+    assert_ne!(text, demo);
+    std::fs::write(&scene, &text).unwrap();
+    let script = "\
+resize 1000 720
+wait 2
+print Clip shape details
+set Clip shape sphere
+set Clip radius 0.3
+set Clip shape scene-difference
+set Clip block 16
+click Save scene
+";
+    let Some((out, stdout)) = run_script("clip-csg", scene.to_str().unwrap(), "160x160", script)
+    else {
+        return;
+    };
+    assert!(
+        stdout.contains("print Clip shape details: difference (read-only)"),
+        "{stdout}"
+    );
+    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let clip = opacity3d(&saved).clip.clone().unwrap();
+    let original = Scene::load(&scene).unwrap();
+    let mut want = opacity3d(&original).clip.clone().unwrap();
+    assert_eq!(want.shape.kind(), "difference");
+    want.block = 16;
+    assert_eq!(clip, want);
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn save_tables_writes_them_and_the_scene_uses_them() {
     let Some((dir, _)) = run_script(
         "tables",
@@ -674,6 +719,8 @@ fn script_steps_that_do_nothing_fail_with_their_line() {
             // No clip in this demo: the section opens, the clip is added, B is disabled
             // once INDEX-DATA is off.
             "wait 1\nclick Clip\nclick Clip enabled\nset Clip multires false\nset Clip block 16\n",
+            // A half-space's normal cannot become zero.
+            "wait 1\nclick Clip\nclick Clip enabled\nset Clip shape half-space\nset Clip normal z 0\n",
         ],
     ) else {
         return;
@@ -693,6 +740,10 @@ fn script_steps_that_do_nothing_fail_with_their_line() {
         ("line 3 (key F5)", "did nothing"),
         ("line 2 (set slices 2.5)", "not a whole number"),
         ("line 5 (set Clip block 16)", "Clip block is disabled"),
+        (
+            "line 5 (set Clip normal z 0)",
+            "the clip normal must not be zero",
+        ),
     ];
     for (e, (line, message)) in errors.iter().zip(expect) {
         assert!(e.contains(line) && e.contains(message), "{e}");
