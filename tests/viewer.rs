@@ -1,7 +1,9 @@
 //! The desktop viewer under Xvfb: screenshots equal to offscreen renders of the saved
 //! scene, framing at two window aspects, an idle viewer that draws nothing, every control
 //! of the lut 3D editor reached by `--script` (clicks, drags and values injected through
-//! egui's input path), and script steps that do nothing failing with their line.
+//! egui's input path), the isovalue, splat and clip editors reaching the saved scene (the
+//! clip's cost line read with `print`), and script steps that do nothing failing with
+//! their line.
 //!
 //! Needs an X server: `DISPLAY`, or `Xvfb` on PATH (started here). Without either the
 //! tests say so and pass, unless `ARBVIS_NO_SKIP=1` (set by `.ci/run`) makes that a failure.
@@ -20,6 +22,8 @@ use arbvis::image::Image;
 use arbvis::png_io::read_png;
 use arbvis::render::render;
 use arbvis::scene::{Scene, TechniqueScene};
+use arbvis::techniques::clip::stats::ClipStats;
+use arbvis::techniques::clip::{ClipSpec, ShapeSpec};
 use arbvis::techniques::opacity3d::{Combine, Opacity3dScene};
 use arbvis::techniques::quad::{reference_image, QuadScene};
 
@@ -504,6 +508,151 @@ click Save scene
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// What a script's `print Clip stats` steps wrote (`print LABEL: TEXT (script line N)`).
+fn clip_stats_lines(stdout: &str) -> Vec<&str> {
+    stdout
+        .lines()
+        .filter_map(|l| l.strip_prefix("print Clip stats: "))
+        .filter_map(|l| l.rsplit_once(" (script line ").map(|(text, _)| text))
+        .collect()
+}
+
+#[test]
+fn the_clip_editor_reaches_the_saved_scene() {
+    // The demo: an inverted sphere at [-1, 1, 1], radius 1.45, B = 8, INDEX-DATA. The
+    // clip is switched off and on again (restored), made a torus, moved, resized and
+    // turned, no longer inverted, B = 16, then the single texture.
+    let script = "\
+resize 1000 720
+wait 2
+print Clip stats
+click Clip enabled
+click Clip enabled
+set Clip shape torus-mesh
+set Clip minor radius 0.2
+set Clip major radius 0.7
+set Clip x 0.25
+set Clip y -0.5
+set Clip z 0
+set Clip rotation x 30
+set Clip invert false
+set Clip block 16
+print Clip stats
+set Clip multires false
+print Clip stats
+click Screenshot
+click Save scene
+";
+    let Some((dir, stdout)) = run_script("clip", "clip-sphere", "200x200", script) else {
+        return;
+    };
+    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let clip = opacity3d(&saved)
+        .clip
+        .clone()
+        .expect("the saved scene has a clip");
+    let mut want = ClipSpec {
+        shape: ShapeSpec::TorusMesh {
+            center: [0.25, -0.5, 0.0],
+            major_radius: 0.7,
+            minor_radius: 0.2,
+            rotation: [30.0, 0.0, 0.0],
+            segments: [48, 24],
+        },
+        invert: false,
+        block: 16,
+        multires: false,
+        resolution: None,
+    };
+    assert_eq!(clip, want);
+    let text = std::fs::read_to_string(dir.join("arbvis-scene.toml")).unwrap();
+    assert!(text.contains("[technique.opacity3d.clip]"), "{text}");
+
+    // The stats line after each rebuild: the demo's (B = 8: INDEX 8^3 x 16 bytes), the
+    // torus at B = 16 (INDEX 4^3 x 16 bytes) and the single texture (64^3 x 1 byte,
+    // faithful).
+    let lines = clip_stats_lines(&stdout);
+    assert_eq!(lines.len(), 3, "{stdout}");
+    assert!(
+        lines[0].starts_with("INDEX-DATA (B = 8): built in "),
+        "{}",
+        lines[0]
+    );
+    assert!(
+        lines[0].contains("ms; INDEX 8.0 KiB + DATA "),
+        "{}",
+        lines[0]
+    );
+    assert!(
+        lines[1].starts_with("INDEX-DATA (B = 16): built in "),
+        "{}",
+        lines[1]
+    );
+    assert_eq!(
+        lines[2].split_once(" ms; ").unwrap().1,
+        "256.0 KiB, ratio 1 (uncompressed)",
+        "{}",
+        lines[2]
+    );
+    // The torus's bytes and ratio equal a CPU build of the same clip over the demo's
+    // 64^3 volume (its box [-1, 1]^3).
+    want.multires = true;
+    let built = want.build(Path::new("."), [64; 3], [1.0; 3], 2048).unwrap();
+    let stats = ClipStats::of(&built, arbvis::scene::Fidelity::Faithful, 0.0);
+    assert_eq!(
+        lines[1].split_once(" ms; ").unwrap().1,
+        stats.line().split_once(" ms; ").unwrap().1
+    );
+    assert!(stats.ratio > 0.0 && stats.ratio < 1.0, "{stats:?}");
+
+    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn a_clip_the_editor_cannot_edit_is_kept() {
+    // The clip-sphere demo with a CSG clip: shown read-only, and chosen again after a
+    // sphere was tried.
+    let dir = temp_dir("clip-csg-scene");
+    let scene = dir.join("csg.toml");
+    let demo = include_str!("../scenes/demo/clip-sphere.toml");
+    let csg = "shape = { difference = [{ sphere = { center = [0.0, 0.0, 0.0], radius = 0.9 } }, { box = { center = [0.5, 0.5, 0.5], half_size = [0.5, 0.5, 0.5] } }] }";
+    let text = demo.replace(
+        "shape = { sphere = { center = [-1.0, 1.0, 1.0], radius = 1.45 } }",
+        csg,
+    );
+    assert_ne!(text, demo);
+    std::fs::write(&scene, &text).unwrap();
+    let script = "\
+resize 1000 720
+wait 2
+print Clip shape details
+set Clip shape sphere
+set Clip radius 0.3
+set Clip shape scene-difference
+set Clip block 16
+click Save scene
+";
+    let Some((out, stdout)) = run_script("clip-csg", scene.to_str().unwrap(), "160x160", script)
+    else {
+        return;
+    };
+    assert!(
+        stdout.contains("print Clip shape details: difference (read-only)"),
+        "{stdout}"
+    );
+    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let clip = opacity3d(&saved).clip.clone().unwrap();
+    let original = Scene::load(&scene).unwrap();
+    let mut want = opacity3d(&original).clip.clone().unwrap();
+    assert_eq!(want.shape.kind(), "difference");
+    want.block = 16;
+    assert_eq!(clip, want);
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn save_tables_writes_them_and_the_scene_uses_them() {
     let Some((dir, _)) = run_script(
@@ -567,6 +716,11 @@ fn script_steps_that_do_nothing_fail_with_their_line() {
             "wait 1\nclick-at tertiary alpha 1 0.9\n",
             "wait 1\nwait 1\nkey F5\n",
             "wait 1\nset slices 2.5\n",
+            // No clip in this demo: the section opens, the clip is added, B is disabled
+            // once INDEX-DATA is off.
+            "wait 1\nclick Clip\nclick Clip enabled\nset Clip multires false\nset Clip block 16\n",
+            // A half-space's normal cannot become zero.
+            "wait 1\nclick Clip\nclick Clip enabled\nset Clip shape half-space\nset Clip normal z 0\n",
         ],
     ) else {
         return;
@@ -585,6 +739,11 @@ fn script_steps_that_do_nothing_fail_with_their_line() {
         ("line 2 (click-at tertiary alpha 1 0.9)", "did nothing"),
         ("line 3 (key F5)", "did nothing"),
         ("line 2 (set slices 2.5)", "not a whole number"),
+        ("line 5 (set Clip block 16)", "Clip block is disabled"),
+        (
+            "line 5 (set Clip normal z 0)",
+            "the clip normal must not be zero",
+        ),
     ];
     for (e, (line, message)) in errors.iter().zip(expect) {
         assert!(e.contains(line) && e.contains(message), "{e}");

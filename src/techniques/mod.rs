@@ -66,6 +66,11 @@ pub trait Renderer {
     fn status(&self) -> Option<String> {
         None
     }
+    /// The clip's last build time and texture memory, for a technique drawn through a
+    /// clip object (3D opacity with `[technique.opacity3d.clip]`); `None` without one.
+    fn clip_stats(&self) -> Option<clip::stats::ClipStats> {
+        None
+    }
 }
 
 /// Build the renderer a scene names, with programs of `kind`; nothing else is created.

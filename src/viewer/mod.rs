@@ -19,6 +19,7 @@
 //! scene's zoom is only lowered, never raised.
 
 pub mod axes;
+pub mod clip;
 pub mod curve;
 pub mod data;
 pub mod isovalues;

@@ -1,8 +1,8 @@
-//! The viewer's layout: controls on the left (programs, fidelity, camera, view options,
-//! screenshot and save), the lut 3D editor on the right (3D opacity), the inline /
-//! crossline / time-slice sections below, and the 3D view in the middle with the box,
-//! axis labels and colour bars drawn over it. Returns what the user asked for; the viewer
-//! acts on it. Every control is recorded by label in [`Widgets`] for scripts.
+//! The viewer's layout: controls on the left (programs, fidelity, the technique's editor
+//! or, for 3D opacity, the clip editor, camera, view options, screenshot and save), the
+//! lut 3D editor on the right (3D opacity), the inline / crossline / time-slice sections
+//! below, and the 3D view in the middle with the box, axis labels and colour bars drawn
+//! over it. Returns what the user asked for; the viewer acts on it. Every control is recorded by label in [`Widgets`] for scripts.
 //!
 //! Shortcuts: Home resets the camera, F12 takes a screenshot.
 
@@ -90,6 +90,8 @@ pub struct PanelState {
     pub sections: SectionsState,
     /// Draw the box, axis labels and colour bars over the view.
     pub overlay: bool,
+    /// The clip editor's state (3D opacity).
+    pub clip: super::clip::ClipEditor,
 }
 
 impl Default for PanelState {
@@ -109,6 +111,7 @@ impl Default for PanelState {
                 index: [0; 3],
             },
             overlay: true,
+            clip: super::clip::ClipEditor::default(),
         }
     }
 }
@@ -266,6 +269,12 @@ fn controls(
     if let TechniqueScene::Splats(sp) = &mut scene.technique {
         ui.separator();
         if super::splats::editor(ui, sp, w) {
+            actions.push(UiAction::ParamsChanged);
+        }
+    }
+    if let TechniqueScene::Opacity3d(o) = &mut scene.technique {
+        ui.separator();
+        if super::clip::editor(ui, o, &mut state.clip, w) {
             actions.push(UiAction::ParamsChanged);
         }
     }

@@ -359,6 +359,16 @@ impl ScriptRunner {
                 );
                 done = true;
             }
+            Action::Print(label) => match o.widgets.text_of(label) {
+                Some(text) => {
+                    println!("print {label}: {text} (script line {})", step.line);
+                    done = true;
+                }
+                None if self.frames_in_step > PATIENCE => {
+                    return Err(self.error(&step, format!("no text labelled {label:?}")))
+                }
+                None => {}
+            },
             Action::Measure(n, mode) => {
                 let now = Instant::now();
                 let t0 = *self.started.get_or_insert(now);

@@ -21,6 +21,8 @@
 //! resize 1280 800                 # resize the window (pixels)
 //! idle 1000                       # ask for no frame for 1000 ms; prints to stdout how many
 //!                                 #     frames were drawn meanwhile (0 when the viewer waits)
+//! print Clip stats                # print a labelled text line to stdout as `print LABEL:
+//!                                 #     TEXT` (the clip editor's build time and memory)
 //! measure 20 full                 # draw 20 frames, printing frames per second to stdout:
 //!                                 #     `full` (the volume redrawn at full quality each
 //!                                 #     frame), `interactive` (at the interactive quality, as
@@ -80,6 +82,8 @@ pub enum Action {
     Idle(u64),
     /// Draw this many frames in a mode and print the frame rate.
     Measure(u32, MeasureMode),
+    /// Print what the labelled text line shows.
+    Print(String),
     /// Close the viewer.
     Quit,
 }
@@ -161,7 +165,7 @@ pub enum ScriptError {
 }
 
 /// Every action word, for errors.
-const WORDS: &str = "wait, click, click-at, right-click-at, double-click-at, drag-on, drag, scroll, set, key, resize, idle, measure, quit";
+const WORDS: &str = "wait, click, click-at, right-click-at, double-click-at, drag-on, drag, scroll, set, key, resize, idle, measure, print, quit";
 
 impl Script {
     /// Read a script file.
@@ -353,6 +357,8 @@ fn parse_action(line: &str) -> Result<Action, String> {
             };
             Action::Measure(n, mode)
         }
+        "print" if !rest.is_empty() => Action::Print(rest.to_string()),
+        "print" => return Err("print needs a text label".into()),
         "quit" => Action::Quit,
         other => {
             return Err(format!(
@@ -393,7 +399,8 @@ mod tests {
                 "click-at primary alpha 0.25 0.75\nright-click-at primary alpha 0 1\n\
                  double-click-at x 1 0\ndrag-on secondary alpha 0.5 0.5 -30 12.5\n\
                  scroll -120\nset primary Cr 0.25\nset primary table magma\n\
-                 key Home\nresize 1280 800\nidle 1000\nmeasure 20 interactive\n"
+                 key Home\nresize 1280 800\nidle 1000\nmeasure 20 interactive\n\
+                 print Clip stats\n"
             ),
             vec![
                 Action::Click {
@@ -429,6 +436,7 @@ mod tests {
                 Action::Resize(1280, 800),
                 Action::Idle(1000),
                 Action::Measure(20, MeasureMode::Interactive),
+                Action::Print("Clip stats".into()),
             ]
         );
     }
@@ -463,6 +471,7 @@ mod tests {
             "measure 0 full",
             "measure 10 fast",
             "scroll inf",
+            "print",
         ] {
             let e = Script::parse(&format!("wait 1\n{bad}\n"), "s").unwrap_err();
             assert!(e.to_string().starts_with("s:2: "), "{bad}: {e}");

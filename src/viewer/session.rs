@@ -224,6 +224,9 @@ impl Running {
             }
         }
 
+        // Read each frame (a copy): the clip's cost after any rebuild above.
+        self.panel.clip.stats = self.renderer.clip_stats();
+
         // The 3D view in window pixels (GL's origin is the bottom left); the scene's size
         // follows it.
         let ppp = self.egui.egui_ctx.pixels_per_point();

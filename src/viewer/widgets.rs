@@ -38,6 +38,7 @@ pub struct SetRequest {
 #[derive(Debug, Default)]
 pub struct Widgets {
     seen: HashMap<String, Seen>,
+    texts: HashMap<String, String>,
     /// Labels whose widget responded (clicked, changed, edited) since the script last
     /// cleared them.
     pub hits: HashSet<String>,
@@ -51,6 +52,19 @@ impl Widgets {
     /// Forget last frame's rectangles (hits, focus and set persist).
     pub fn begin_frame(&mut self) {
         self.seen.clear();
+        self.texts.clear();
+    }
+
+    /// The text a [`Widgets::text`] label showed last frame (a script's `print`).
+    pub fn text_of(&self, label: &str) -> Option<&str> {
+        self.texts.get(label).map(String::as_str)
+    }
+
+    /// A small text line, recorded as `label` with what it says (for `print`).
+    pub fn text(&mut self, ui: &mut Ui, label: &str, text: &str) {
+        let r = ui.label(egui::RichText::new(text).small());
+        self.record(ui, label, r.rect, true);
+        self.texts.insert(label.to_string(), text.to_string());
     }
 
     /// Where `label` was drawn last.

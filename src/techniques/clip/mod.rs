@@ -59,6 +59,7 @@ pub mod multires;
 pub mod scene;
 pub mod shape;
 pub mod stage;
+pub mod stats;
 pub mod study;
 #[cfg(test)]
 mod tests;

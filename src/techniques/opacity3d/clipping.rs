@@ -35,6 +35,7 @@
 
 use std::borrow::Cow;
 use std::path::Path;
+use std::time::Instant;
 
 use super::prepare::Prepared;
 use super::renderer::Path3d;
@@ -42,6 +43,7 @@ use crate::gl::{GlError, GlResult, Gpu, ProgramKind, ProgramText};
 use crate::programs::ProgramPair;
 use crate::scene::Fidelity;
 use crate::techniques::clip::stage::{compose_arb, compose_glsl, compose_glsl_at, ClipStage};
+use crate::techniques::clip::stats::ClipStats;
 use crate::techniques::clip::{ClipSpec, ClipTextures};
 
 /// Where 3D opacity's programs read the sample's volume coordinate.
@@ -60,10 +62,13 @@ pub struct Clip {
     pub textures: ClipTextures,
     /// The uploaded textures and constants.
     pub stage: ClipStage,
+    /// What the build took and what the upload costs (the viewer's clip editor).
+    pub stats: ClipStats,
 }
 
 /// Build `spec`'s textures over `prepared`'s box (files relative to `base`) and upload
-/// them for `fidelity`; INDEX-DATA when `spec.multires`, else the single texture.
+/// them for `fidelity`; INDEX-DATA when `spec.multires`, else the single texture. The
+/// build is timed (CPU textures and upload) into [`Clip::stats`].
 pub fn build(
     gpu: &Gpu,
     spec: &ClipSpec,
@@ -71,15 +76,18 @@ pub fn build(
     prepared: &Prepared,
     fidelity: Fidelity,
 ) -> GlResult<Clip> {
+    let start = Instant::now();
     let max = gpu.caps().max_3d_texture_size.max(1) as usize;
     let textures = spec
         .build(base, prepared.dims, prepared.half.to_array(), max)
         .map_err(|e| GlError::Data(format!("clip: {e}")))?;
     let stage = ClipStage::new(gpu, &textures, fidelity)?;
+    let stats = ClipStats::of(&textures, fidelity, start.elapsed().as_secs_f64());
     Ok(Clip {
         spec: spec.clone(),
         textures,
         stage,
+        stats,
     })
 }
 

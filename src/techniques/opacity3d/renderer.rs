@@ -30,6 +30,7 @@ use crate::gl::{
 use crate::programs;
 use crate::scene::{Fidelity, Scene, TechniqueScene};
 use crate::techniques::clip::stage as clipping_stage;
+use crate::techniques::clip::stats::ClipStats;
 use crate::techniques::{Frame, Renderer};
 
 /// Texture unit of the packed volume and of the three tables (unit 1 is v3o2's
@@ -758,16 +759,21 @@ impl Renderer for Opacity3dRenderer {
         self.build_bricks(gpu)?;
         let clip_changed = old.clip != new.clip;
         if clip_changed {
-            self.clip = match &new.clip {
-                Some(spec) => Some(clipping::build(
-                    gpu,
-                    spec,
-                    &self.base,
-                    &self.prepared,
-                    self.fidelity,
-                )?),
-                None => None,
+            let built = match &new.clip {
+                Some(spec) => {
+                    clipping::build(gpu, spec, &self.base, &self.prepared, self.fidelity).map(Some)
+                }
+                None => Ok(None),
             };
+            match built {
+                Ok(clip) => self.clip = clip,
+                Err(e) => {
+                    // Keep the clip drawn with and remember it, so the next update with the
+                    // new clip tries again.
+                    self.params.clip = old.clip.clone();
+                    return Err(e);
+                }
+            }
         }
         let table = step_table(new, self.fidelity, &self.prepared);
         let baked = matches!(table, StepTable::Baked(_));
@@ -798,5 +804,9 @@ impl Renderer for Opacity3dRenderer {
 
     fn program_kind(&self) -> ProgramKind {
         self.program.kind()
+    }
+
+    fn clip_stats(&self) -> Option<ClipStats> {
+        self.clip.as_ref().map(|c| c.stats)
     }
 }
