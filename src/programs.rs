@@ -105,6 +105,20 @@ pub fn with_transform(kind: ProgramKind, arb: &ProgramText, glsl: &ProgramText) 
     }
 }
 
+/// Clip prologue (seed 002), single resolution: inserted after a host's `!!ARBfp1.0`.
+pub const CLIP_SINGLE_ARBFP: ProgramText = program!("clip/single.arbfp");
+/// Clip prologue, INDEX-DATA with the seed's coordinate formula (faithful).
+pub const CLIP_MULTIRES_SLOT_CENTRE_ARBFP: ProgramText =
+    program!("clip/multires_slot_centre.arbfp");
+/// Clip prologue, INDEX-DATA with one MAD (precise).
+pub const CLIP_MULTIRES_OFFSET_ARBFP: ProgramText = program!("clip/multires_offset.arbfp");
+/// GLSL `clip_value(p)` twin of [`CLIP_SINGLE_ARBFP`].
+pub const CLIP_SINGLE_GLSL: ProgramText = program!("clip/single.glsl");
+/// GLSL twin of [`CLIP_MULTIRES_SLOT_CENTRE_ARBFP`].
+pub const CLIP_MULTIRES_SLOT_CENTRE_GLSL: ProgramText = program!("clip/multires_slot_centre.glsl");
+/// GLSL twin of [`CLIP_MULTIRES_OFFSET_ARBFP`].
+pub const CLIP_MULTIRES_OFFSET_GLSL: ProgramText = program!("clip/multires_offset.glsl");
+
 /// Every pair the techniques can draw with, both kinds (the compile-everything test).
 pub fn all_pairs() -> Vec<ProgramPair> {
     let fragments = [
@@ -159,6 +173,8 @@ pub fn all_pairs() -> Vec<ProgramPair> {
     }
     // Templates compile only specialized: every specialization of opacity3d's.
     pairs.extend(crate::techniques::opacity3d::programs::all_precise_pairs());
+    // The clip's prologues and functions, composed with the verbatim v3o2 programs.
+    pairs.extend(crate::techniques::opacity3d::clipping::all_clip_pairs());
     pairs
 }
 
@@ -197,5 +213,11 @@ pub fn all_texts() -> Vec<ProgramText> {
         SPLATS_PRECISE_ARBFP,
         SPLATS_OIT_COMPOSITE_ARBFP,
         SPLATS_OIT_COMPOSITE_FRAG,
+        CLIP_SINGLE_ARBFP,
+        CLIP_MULTIRES_SLOT_CENTRE_ARBFP,
+        CLIP_MULTIRES_OFFSET_ARBFP,
+        CLIP_SINGLE_GLSL,
+        CLIP_MULTIRES_SLOT_CENTRE_GLSL,
+        CLIP_MULTIRES_OFFSET_GLSL,
     ]
 }

@@ -26,7 +26,29 @@ use super::multires::{IndexEncoding, MultiRes};
 use super::texture::ClipTexture;
 use super::ClipTextures;
 use crate::gl::{Extent, Filter, GlResult, Gpu, Program, TexelData, TexelFormat, Texture};
+use crate::programs;
 use crate::scene::Fidelity;
+
+/// The ARB clip prologue of `lookup` (`programs/clip/*.arbfp`, units 7/8 and locals
+/// 10-13 written there), reading the host program's volume coordinate `coord`.
+pub fn arb_prologue(lookup: Lookup, coord: &str) -> String {
+    let text = match lookup {
+        Lookup::Single => programs::CLIP_SINGLE_ARBFP,
+        Lookup::Multires(IndexEncoding::SlotCentre) => programs::CLIP_MULTIRES_SLOT_CENTRE_ARBFP,
+        Lookup::Multires(IndexEncoding::Offset) => programs::CLIP_MULTIRES_OFFSET_ARBFP,
+    };
+    text.text.replace("@COORD@", coord)
+}
+
+/// The GLSL `clip_value(p)` of `lookup` (`programs/clip/*.glsl`).
+pub fn glsl_function(lookup: Lookup) -> String {
+    let text = match lookup {
+        Lookup::Single => programs::CLIP_SINGLE_GLSL,
+        Lookup::Multires(IndexEncoding::SlotCentre) => programs::CLIP_MULTIRES_SLOT_CENTRE_GLSL,
+        Lookup::Multires(IndexEncoding::Offset) => programs::CLIP_MULTIRES_OFFSET_GLSL,
+    };
+    text.text.to_string()
+}
 
 /// Unit of the single-resolution texture, or of the INDEX.
 pub const INDEX_UNIT: u32 = 7;
@@ -174,69 +196,13 @@ impl ClipStage {
 
     /// The ARB prologue (reads `coord`, e.g. `fragment.texcoord[0]`).
     pub fn arb_prologue(&self, coord: &str) -> String {
-        let (i, d) = (INDEX_UNIT, DATA_UNIT);
-        let l = |k: usize| format!("program.local[{}]", FIRST_LOCAL + k);
-        match self.lookup {
-            Lookup::Single => format!(
-                "# arbvis clip (single resolution): keep where the clip texture is >= 0.5\n\
-                 TEMP clip_v;\n\
-                 TEX clip_v, {coord}, texture[{i}], 3D;\n\
-                 ADD clip_v, clip_v.x, -0.5;\n\
-                 KIL clip_v;\n"
-            ),
-            Lookup::Multires(encoding) => {
-                let data_coord = match encoding {
-                    IndexEncoding::Offset => format!("MAD clip_d, {coord}, {}, clip_i;\n", l(1)),
-                    IndexEncoding::SlotCentre => format!(
-                        "MUL clip_b, {coord}, {};\nFLR clip_b, clip_b;\nADD clip_b, clip_b, 0.5;\nMUL clip_b, clip_b, {};\nSUB clip_b, {coord}, clip_b;\nMAD clip_d, clip_b, {}, clip_i;\n",
-                        l(2),
-                        l(3),
-                        l(1)
-                    ),
-                };
-                format!(
-                    "# arbvis clip (INDEX-DATA, {encoding:?}): INDEX alpha 0 discards, 1 keeps, 0.5 reads DATA\n\
-                     TEMP clip_p, clip_i, clip_b, clip_d;\n\
-                     MUL clip_p, {coord}, {};\n\
-                     TEX clip_i, clip_p, texture[{i}], 3D;\n\
-                     {data_coord}\
-                     TEX clip_d, clip_d, texture[{d}], 3D;\n\
-                     ADD clip_b.x, clip_i.w, -0.5;\n\
-                     ABS clip_b.x, clip_b.x;\n\
-                     ADD clip_b.x, clip_b.x, -0.25;\n\
-                     CMP clip_d.x, clip_b.x, clip_d.x, clip_i.w;\n\
-                     ADD clip_d, clip_d.x, -0.5;\n\
-                     KIL clip_d;\n",
-                    l(0)
-                )
-            }
-        }
+        arb_prologue(self.lookup, coord)
     }
 
-    /// The GLSL `clip_value(vec3 p)` function and its samplers (uses `program_local`).
+    /// The GLSL `clip_value(p)` function of this stage's lookup
+    /// (`programs/clip/*.glsl`).
     pub fn glsl_function(&self) -> String {
-        let (i, d) = (INDEX_UNIT, DATA_UNIT);
-        let l = |k: usize| format!("program_local[{}].xyz", FIRST_LOCAL + k);
-        match self.lookup {
-            Lookup::Single => format!(
-                "// arbvis clip (single resolution)\nuniform sampler3D texture{i};\nfloat clip_value(vec3 p) {{ return texture(texture{i}, p).r; }}\n"
-            ),
-            Lookup::Multires(encoding) => {
-                let coord = match encoding {
-                    IndexEncoding::Offset => format!("p * {} + idx.xyz", l(1)),
-                    IndexEncoding::SlotCentre => format!(
-                        "idx.xyz + (p - (floor(p * {}) + 0.5) * {}) * {}",
-                        l(2),
-                        l(3),
-                        l(1)
-                    ),
-                };
-                format!(
-                    "// arbvis clip (INDEX-DATA, {encoding:?})\nuniform sampler3D texture{i};\nuniform sampler3D texture{d};\nfloat clip_value(vec3 p) {{\n    vec4 idx = texture(texture{i}, p * {});\n    if (abs(idx.w - 0.5) >= 0.25) return idx.w;\n    return texture(texture{d}, {coord}).r;\n}}\n",
-                    l(0)
-                )
-            }
-        }
+        glsl_function(self.lookup)
     }
 }
 

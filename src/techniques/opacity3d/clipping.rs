@@ -42,7 +42,10 @@ use super::renderer::Path3d;
 use crate::gl::{GlError, GlResult, Gpu, ProgramKind, ProgramText};
 use crate::programs::ProgramPair;
 use crate::scene::Fidelity;
-use crate::techniques::clip::stage::{compose_arb, compose_glsl, compose_glsl_at, ClipStage};
+use crate::techniques::clip::multires::IndexEncoding;
+use crate::techniques::clip::stage::{
+    arb_prologue, compose_arb, compose_glsl, compose_glsl_at, glsl_function, ClipStage, Lookup,
+};
 use crate::techniques::clip::stats::ClipStats;
 use crate::techniques::clip::{ClipSpec, ClipTextures};
 
@@ -114,4 +117,38 @@ pub fn compose(pair: ProgramPair, stage: &ClipStage, path: Path3d) -> GlResult<P
         },
         ..pair
     })
+}
+
+/// The verbatim v3o2 pairs (sum, product; ARB and GLSL) composed with every clip lookup,
+/// for the compile-everything test (`programs/clip/` holds fragments, not programs).
+pub fn all_clip_pairs() -> Vec<ProgramPair> {
+    use super::renderer::faithful_pair;
+    use super::Combine;
+    let lookups = [
+        Lookup::Single,
+        Lookup::Multires(IndexEncoding::SlotCentre),
+        Lookup::Multires(IndexEncoding::Offset),
+    ];
+    let mut out = Vec::new();
+    for combine in [Combine::Sum, Combine::Product] {
+        for kind in [ProgramKind::Arb, ProgramKind::Glsl] {
+            let pair = faithful_pair(kind, combine);
+            for lookup in lookups {
+                let text = &pair.fragment.text;
+                let composed = match kind {
+                    ProgramKind::Arb => compose_arb(text, &arb_prologue(lookup, ARB_COORD)),
+                    ProgramKind::Glsl => compose_glsl(text, &glsl_function(lookup), GLSL_COORD),
+                }
+                .expect("the verbatim programs take the clip");
+                out.push(ProgramPair {
+                    fragment: ProgramText {
+                        name: Cow::Owned(format!("{} + clip {lookup:?}", pair.fragment.name)),
+                        text: Cow::Owned(composed),
+                    },
+                    ..pair.clone()
+                });
+            }
+        }
+    }
+    out
 }
