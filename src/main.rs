@@ -1,7 +1,7 @@
 //! The `arbvis` command line.
 #![forbid(unsafe_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
@@ -175,6 +175,18 @@ enum Command {
         #[arg(long, verbatim_doc_comment)]
         script: Option<PathBuf>,
     },
+}
+
+/// Write a study's files into `out` (created if missing), atomically, saying so.
+fn write_study<const N: usize>(out: &Path, files: [(&str, String); N]) -> Result<()> {
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    for (name, text) in files {
+        let path = out.join(name);
+        arbvis::png_io::write_atomic(&path, text.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
 }
 
 /// Techniques with a trade study.
@@ -436,14 +448,8 @@ fn run(cli: Cli) -> Result<()> {
             let frames = arbvis::techniques::splats::study::frames(&headless, &options, |l| {
                 eprintln!("{l}")
             })?;
-            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
             let (s, f) = arbvis::techniques::splats::study::to_csv(&sorts, &frames);
-            for (name, text) in [("splats-sorts.csv", s), ("splats-frames.csv", f)] {
-                let path = out.join(name);
-                arbvis::png_io::write_atomic(&path, text.as_bytes())
-                    .with_context(|| format!("writing {}", path.display()))?;
-                println!("wrote {}", path.display());
-            }
+            write_study(&out, [("splats-sorts.csv", s), ("splats-frames.csv", f)])?;
         }
         Command::Study {
             sweep,
@@ -471,14 +477,11 @@ fn run(cli: Cli) -> Result<()> {
                 arbvis::techniques::clip::study::textures(&options, max, |l| eprintln!("{l}"))?;
             let frames =
                 arbvis::techniques::clip::study::frames(&headless, &options, |l| eprintln!("{l}"))?;
-            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
             let (textures, times) = arbvis::techniques::clip::study::to_csv(&study, &frames);
-            for (name, text) in [("clip-textures.csv", textures), ("clip-frames.csv", times)] {
-                let path = out.join(name);
-                arbvis::png_io::write_atomic(&path, text.as_bytes())
-                    .with_context(|| format!("writing {}", path.display()))?;
-                println!("wrote {}", path.display());
-            }
+            write_study(
+                &out,
+                [("clip-textures.csv", textures), ("clip-frames.csv", times)],
+            )?;
         }
         Command::Study {
             sweep,
@@ -499,12 +502,8 @@ fn run(cli: Cli) -> Result<()> {
             let rows = arbvis::techniques::cellproj::study::run(&headless, &options, |line| {
                 eprintln!("{line}")
             })?;
-            std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
-            let csv = out.join("cellproj.csv");
             let text = arbvis::techniques::cellproj::study::to_csv(&rows);
-            arbvis::png_io::write_atomic(&csv, text.as_bytes())
-                .with_context(|| format!("writing {}", csv.display()))?;
-            println!("wrote {}", csv.display());
+            write_study(&out, [("cellproj.csv", text)])?;
         }
         Command::Study {
             sweep,
