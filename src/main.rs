@@ -168,6 +168,7 @@ enum Command {
         ///   set LABEL VALUE             a slider's or number's value, true/false for a check
         ///                               box, an option's name for a choice
         ///   key NAME                    press a key: Home (reset camera), F12 (screenshot)
+        ///   print LABEL                 print a labelled text line (e.g. `Clip stats`)
         ///   resize W H                  resize the window to W x H pixels
         ///   idle MS                     draw nothing for MS ms; print the frames drawn
         ///   measure N full|interactive|ui  draw N frames, print the frame rate
@@ -463,6 +464,16 @@ fn run(cli: Cli) -> Result<()> {
                 || blocks.iter().any(|&b| !(1..=256).contains(&b))
             {
                 bail!("--clip-sizes must be 1..=2048 and --blocks 1..=256");
+            }
+            // Checked before any work: a block larger than a grid fails only at that grid.
+            let smallest = clip_sizes.iter().chain([&sweep.volume]).min().copied();
+            if let (Some(b), Some(n)) = (blocks.iter().max(), smallest) {
+                if *b > n {
+                    bail!(
+                        "--blocks {b} is larger than the smallest grid ({n}: --clip-sizes or \
+                         --volume); blocks must fit in every grid"
+                    );
+                }
             }
             let options = arbvis::techniques::clip::study::Options {
                 sizes: clip_sizes,

@@ -190,7 +190,8 @@ impl Scene {
                 message: parse_message(text, start, e.message()),
             }
         })?;
-        scene.validate().map_err(|e| {
+        let checked = longer_arrays(text, &scene).map_or_else(|| scene.validate(), Err);
+        checked.map_err(|e| {
             let (line, column) = key_position(text, &e.key);
             SceneError::Invalid {
                 path: origin.to_string(),
@@ -357,6 +358,46 @@ impl std::fmt::Display for FieldError {
 
 /// Line and column of the dotted `key` in `text`, or of its longest prefix that the text
 /// spells out (a value left at its default has no position of its own).
+/// An array in the scene text with more values than its field holds (`size = [32, 32,
+/// 5]`, a quaternion where Euler degrees are read): the TOML reader fills fixed-size
+/// fields from the first values and drops the rest without a word, so the parsed scene,
+/// written back, is compared with the text and the first longer array is an error.
+fn longer_arrays(text: &str, scene: &Scene) -> Option<FieldError> {
+    let original: toml::Table = text.parse().ok()?;
+    let parsed = toml::Value::try_from(scene).ok()?;
+    compare_lengths(&toml::Value::Table(original), &parsed, "")
+}
+
+fn compare_lengths(original: &toml::Value, parsed: &toml::Value, key: &str) -> Option<FieldError> {
+    use toml::Value::{Array, Table};
+    match (original, parsed) {
+        (Array(a), Array(b)) => {
+            if a.len() > b.len() {
+                return Some(FieldError::new(
+                    key,
+                    format!(
+                        "{} values where {} are read (the rest would be ignored)",
+                        a.len(),
+                        b.len()
+                    ),
+                ));
+            }
+            a.iter()
+                .zip(b)
+                .find_map(|(x, y)| compare_lengths(x, y, key))
+        }
+        (Table(a), Table(b)) => a.iter().find_map(|(k, v)| {
+            let sub = if key.is_empty() {
+                k.clone()
+            } else {
+                format!("{key}.{k}")
+            };
+            b.get(k).and_then(|w| compare_lengths(v, w, &sub))
+        }),
+        _ => None,
+    }
+}
+
 fn key_position(text: &str, key: &str) -> (usize, usize) {
     use toml::de::{DeTable, DeValue};
     let Ok(root) = DeTable::parse(text) else {
@@ -422,6 +463,34 @@ pub fn parse_size(s: &str) -> Result<[u32; 2], String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn arrays_longer_than_their_field_are_errors() {
+        let (_, base) = DEMOS.iter().find(|(n, _)| *n == "clip-sphere").unwrap();
+        for (from, to, key) in [
+            ("size = [256, 256]", "size = [256, 256, 5]", "size"),
+            (
+                "rotation = [0.326506, -0.092296, -0.701057, 0.627211]",
+                "rotation = [0.326506, -0.092296, -0.701057, 0.627211, 1.0]",
+                "camera.rotation",
+            ),
+            (
+                "coefficients = [1.0, 1.0, 1.0, 0.8]",
+                "coefficients = [1.0, 1.0, 1.0, 0.8, 2.0]",
+                "technique.opacity3d.primary.coefficients",
+            ),
+        ] {
+            assert!(base.contains(from), "{from} not in\n{base}");
+            let text = base.replacen(from, to, 1);
+            let e = Scene::parse(&text, "s.toml").unwrap_err().to_string();
+            assert!(e.contains(key) && e.contains("values where"), "{e}");
+            assert!(e.starts_with("s.toml:"), "{e}");
+        }
+        // Every demo and data scene, written back, has nothing longer than it reads.
+        for (name, _) in DEMOS {
+            Scene::parse(&Scene::demo(name).unwrap().to_toml(), name).unwrap();
+        }
+    }
 
     #[test]
     fn every_demo_parses() {
