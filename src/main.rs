@@ -53,6 +53,10 @@ enum Command {
     Inspect {
         /// A volume, mesh, point cloud or surface file.
         file: PathBuf,
+        /// Also read and inspect it this many more times and print the median time (what
+        /// loading the file costs).
+        #[arg(long, value_name = "RUNS")]
+        time: Option<usize>,
     },
     /// Time a scene offscreen: clear + draw + finish per frame, the first frame apart,
     /// settings interleaved over rounds. For 3D opacity: sweep faithful / precise slice
@@ -540,8 +544,22 @@ fn run(cli: Cli) -> Result<()> {
             print!("{}", arbvis::study::summary(&rows, VTK_MS));
             println!("wrote {} and {}", csv.display(), png.display());
         }
-        Command::Inspect { file } => {
+        Command::Inspect { file, time } => {
             print!("{}", arbvis::inspect::inspect(&file)?);
+            if let Some(runs) = time.filter(|&r| r > 0) {
+                let mut ms: Vec<f64> = (0..runs.min(1000))
+                    .map(|_| {
+                        let t = std::time::Instant::now();
+                        arbvis::inspect::inspect(&file).map(|_| t.elapsed().as_secs_f64() * 1e3)
+                    })
+                    .collect::<Result<_, _>>()?;
+                ms.sort_by(f64::total_cmp);
+                println!(
+                    "read and inspected in {:.2} ms (median of {})",
+                    ms[ms.len() / 2],
+                    ms.len()
+                );
+            }
         }
         #[cfg(feature = "viewer")]
         Command::View {

@@ -471,3 +471,19 @@ fn study_of_splats_writes_its_sweeps() {
     let bad = arbvis(&["study", "--technique", "splats", "--points", "0"]);
     assert!(!bad.status.success() && text(&bad).1.contains("--points"));
 }
+
+#[test]
+fn inspect_times_loading_when_asked() {
+    let dir = temp_dir("inspect-time");
+    let stl = dir.join("t.stl");
+    std::fs::write(
+        &stl,
+        "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n",
+    )
+    .unwrap();
+    let out = arbvis(&["inspect", stl.to_str().unwrap(), "--time", "3"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stdout.contains("triangles: 1"), "{stdout}");
+    assert!(stdout.contains("ms (median of 3)"), "{stdout}");
+}

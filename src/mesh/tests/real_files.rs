@@ -253,33 +253,3 @@ fn inspect_reports_what_was_read() {
         assert!(s.contains(want), "missing {want:?} in\n{s}");
     }
 }
-
-/// Load times of the real files (run with `cargo test --release -- --ignored load_times
-/// --nocapture`; the report quotes them).
-#[test]
-#[ignore]
-fn load_times() {
-    for f in [
-        "post.vtk",
-        "tetraMesh.vtk",
-        "Tetrahedron.vtu",
-        "can.vtu",
-        "bracket-2.2.msh",
-        "bracket-4.1.msh",
-        "bracket-4.1-binary.msh",
-    ] {
-        let Some(p) = shared(&format!("tets/{f}")) else {
-            return;
-        };
-        let bytes = std::fs::read(&p).unwrap();
-        let t = std::time::Instant::now();
-        let runs = 5;
-        for _ in 0..runs {
-            crate::mesh::parse(&p, &bytes).unwrap();
-        }
-        println!(
-            "{f}: {:.2} ms",
-            t.elapsed().as_secs_f64() * 1000.0 / runs as f64
-        );
-    }
-}

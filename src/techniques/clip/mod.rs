@@ -44,7 +44,7 @@
 //! meshes: NaN or empty are errors with position, open ones are decided by the winding
 //! number.
 //!
-//! # Measured (release, 2-core machine, `tests::build_times`)
+//! # Measured (release, 2-core machine; `arbvis study --technique clip` measures them again)
 //! Texture + INDEX-DATA (B = 8) build, seconds (shared machine, ±30 %): sphere 128³
 //! 0.03 + 0.01, 256³ 0.21 + 0.08, 512³ 2.2 + 0.6; 42400-IDGH.stl (11,036 triangles) 128³
 //! 0.09 + 0.01, 256³ 0.33 + 0.07; cow.obj (5,804 triangles) 256³ 0.23 + 0.07. Compression ratio of a sphere of radius 0.35 N at 256³, B = 8,

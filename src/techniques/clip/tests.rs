@@ -286,38 +286,29 @@ fn index_encodings_give_the_same_coordinate() {
     }
 }
 
+/// The issue's sphere (radius 0.35 N) at 128³ (256³ and 512³ are in `arbvis study
+/// --technique clip`): the ratio the seed's method reaches and how it depends on B.
 #[test]
-#[ignore = "256³, about a second in release; run with --release -- --ignored"]
 fn compression_ratio_of_the_issue_sphere() {
-    let n = 256;
+    let n = 128;
     let grid = ClipGrid::new([n; 3], [1.0; 3]).unwrap();
     // Radius 0.35 N voxels = 0.35 * 2 in object units.
     let tex = ClipTexture::build(&sphere([0.0; 3], 0.7), &grid);
-    let mr = MultiRes::build(&tex, 8, 2048).unwrap();
-    let r = mr.compression_ratio(TexelFormat::Rgba32F, TexelFormat::R8, TexelFormat::R8);
-    eprintln!(
-        "sphere r = 0.35 N, 256³, B = 8: {} of {} blocks boundary, DATA {:?}, ratio {r:.4} (RGBA16 INDEX: {:.4}); built in {:.3} s + {:.3} s",
-        mr.slots,
-        mr.classes.len(),
-        mr.data_dims,
-        mr.compression_ratio(TexelFormat::Rgba16, TexelFormat::R8, TexelFormat::R8),
-        tex.build_seconds,
-        mr.build_seconds
-    );
-    assert!(r < 0.2, "{r}");
-    for block in [4, 6, 8, 10, 12, 16, 32] {
-        let mr = MultiRes::build(&tex, block, 2048).unwrap();
-        let used = mr.slots * (block + 2).pow(3);
-        eprintln!(
-            "B = {block:2}: {:5} boundary of {:6} blocks, DATA {:?} ({used} texels in use), ratio INDEX RGBA32F {:.4}, RGBA16 {:.4}, RGBA8 {:.4}",
-            mr.slots,
-            mr.classes.len(),
-            mr.data_dims,
-            mr.compression_ratio(TexelFormat::Rgba32F, TexelFormat::R8, TexelFormat::R8),
-            mr.compression_ratio(TexelFormat::Rgba16, TexelFormat::R8, TexelFormat::R8),
-            mr.compression_ratio(TexelFormat::Rgba8, TexelFormat::R8, TexelFormat::R8),
-        );
-    }
+    let ratio = |b: usize| {
+        MultiRes::build(&tex, b, 2048).unwrap().compression_ratio(
+            TexelFormat::Rgba32F,
+            TexelFormat::R8,
+            TexelFormat::R8,
+        )
+    };
+    let r: Vec<f64> = [4, 8, 16, 32].map(ratio).to_vec();
+    eprintln!("sphere r = 0.35 N, 128³, B = 4/8/16/32: {r:.4?}");
+    // The surface's blocks, extended to (B+2)³, against N³: about 6 (B+2)³ / (B² N) of
+    // the sphere's surface, so the ratio halves when N doubles (0.195 at 256³). At 128³
+    // the best block is 8 and the ratio is 0.379; the bounds leave room for the
+    // rounding of which blocks the boundary touches, not for a change of method.
+    assert!((0.33..0.45).contains(&r[1]), "{r:?}");
+    assert!(r[1] < r[0] && r[1] < r[2] && r[2] < r[3], "{r:?}");
 }
 
 /// A closed box mesh `[x0, x1] x [y0, y1] x [z0, z1]`, outward.
@@ -703,38 +694,4 @@ fn bad_clip_meshes_give_clear_errors() {
     assert!(e("empty.obj").contains("no faces"));
     assert!(e("empty.stl").contains("too short"), "{}", e("empty.stl"));
     let _ = std::fs::remove_dir_all(&dir);
-}
-
-#[test]
-#[ignore = "timings; run with --release -- --ignored --nocapture"]
-fn build_times() {
-    let time = |what: &str, shape: &Shape, n: usize| {
-        let grid = ClipGrid::new([n; 3], [1.0; 3]).unwrap();
-        let tex = ClipTexture::build(shape, &grid);
-        let mr = MultiRes::build(&tex, 8, 2048).unwrap();
-        eprintln!(
-            "{what} {n}³: texture {:.3} s, INDEX-DATA {:.3} s, {} boundary blocks, ratio {:.4}",
-            tex.build_seconds,
-            mr.build_seconds,
-            mr.slots,
-            mr.compression_ratio(TexelFormat::Rgba32F, TexelFormat::R8, TexelFormat::R8)
-        );
-    };
-    for n in [128, 256, 384, 512] {
-        time("sphere r = 0.35 N", &sphere([0.0; 3], 0.7), n);
-    }
-    if let Some(path) = shared("surfaces/42400-IDGH.stl") {
-        let part = crate::surface::read(&path).unwrap();
-        let shape = Shape::Mesh(Box::new(fit(&part, [1.0; 3])));
-        for n in [128, 256] {
-            time("42400-IDGH.stl", &shape, n);
-        }
-    }
-    if let Some(path) = shared("surfaces/cow.obj") {
-        let cow = crate::surface::read(&path).unwrap();
-        let shape = Shape::Mesh(Box::new(fit(&cow, [1.0; 3])));
-        for n in [128, 256] {
-            time("cow.obj", &shape, n);
-        }
-    }
 }

@@ -3,7 +3,9 @@
 //! ([`super::sort::time_methods`]: the seed's comparator sort of structs, keys, the
 //! parallel radix sort, a cache hit), and the frame time of the `splats-section` demo with
 //! each sort method while the camera turns 1° per frame (so every frame sorts and uploads,
-//! as a user's drag does), with the sort's share of it.
+//! as a user's drag does), with the sort's share of it. For clouds up to 2 M points also
+//! the f64 references' time and weighted blended OIT's error against exact order, and the
+//! normals' estimation time.
 
 use std::time::Instant;
 
@@ -12,7 +14,7 @@ use super::sort::time_methods;
 use crate::camera::{Camera, Projection};
 use crate::gl::{Headless, Surface, Target};
 use crate::points::section::{generate, SectionSpec};
-use crate::points::PointSource;
+use crate::points::{PointCloud, PointSource};
 use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::{self, Frame};
 
@@ -72,20 +74,68 @@ pub fn sorts(options: &Options, mut progress: impl FnMut(&str)) -> anyhow::Resul
     let mut rows = Vec::new();
     for &points in &options.points {
         let cloud = generate(&SectionSpec { points, seed: 1 })?;
+        let mut push = |method: String, ms: f64| {
+            progress(&format!("{points:>9} points  {ms:>9.2} ms  {method}"));
+            rows.push(SortRow { points, method, ms });
+        };
         for (method, time) in time_methods(&cloud, &camera, options.runs) {
-            let row = SortRow {
-                points,
-                method: method.to_string(),
-                ms: time.as_secs_f64() * 1e3,
-            };
-            progress(&format!(
-                "{:>9} points  {:>9.2} ms  {}",
-                row.points, row.ms, row.method
-            ));
-            rows.push(row);
+            push(method.to_string(), time.as_secs_f64() * 1e3);
+        }
+        if points <= 2_000_000 {
+            for (method, ms) in accuracy(&cloud, &camera, options.size) {
+                push(method, ms);
+            }
         }
     }
     Ok(rows)
+}
+
+/// Beside the sorts: the f64 references at `size` (exact compositing, and weighted
+/// blended OIT with its RMSE against exact order, McGuire & Bavoil's eq. 7 weight) and
+/// per-layer normals (k = 16), each timed once.
+fn accuracy(cloud: &PointCloud, camera: &Camera, size: [u32; 2]) -> Vec<(String, f64)> {
+    use super::reference::{self, Footprint, SplatParams, SplatScene};
+    let facies = cloud.ints(crate::points::FACIES).unwrap_or(&[]);
+    let rgba: Vec<[f64; 4]> = (0..cloud.len())
+        .map(|i| {
+            let f = facies.get(i).copied().unwrap_or(0);
+            let c = crate::points::section::facies_colour(f).map(|c| c as f64 / 255.0);
+            [c[0], c[1], c[2], 0.6]
+        })
+        .collect();
+    let scene = SplatScene {
+        positions: &cloud.positions,
+        rgba: &rgba,
+        params: SplatParams {
+            point_size: 20.0,
+            footprint: Footprint::Smoothstep,
+            ..SplatParams::default()
+        },
+        background: [0.0, 0.0, 0.0, 1.0],
+    };
+    let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+    let t = Instant::now();
+    let exact = reference::composite(&scene, camera, size);
+    let exact_ms = ms(t);
+    let t = Instant::now();
+    let oit = reference::weighted_blended(&scene, reference::OitWeight::Eq7, camera, size);
+    let oit_ms = ms(t);
+    let rmse = reference::rmse_rgb(&exact, &oit).unwrap_or(f64::NAN);
+    let t = Instant::now();
+    super::normals::estimate_cloud(cloud, super::normals::DEFAULT_K, true);
+    let normals_ms = ms(t);
+    let [w, h] = size;
+    vec![
+        (
+            format!("f64 exact compositing at {w}x{h} (reference)"),
+            exact_ms,
+        ),
+        (
+            format!("f64 weighted blended OIT at {w}x{h}: RMSE {rmse:.4} against exact order"),
+            oit_ms,
+        ),
+        ("normals, k = 16 per layer (kiddo + PCA)".into(), normals_ms),
+    ]
 }
 
 /// The frame timings (GPU) of the `splats-section` demo at `options.frame_points`, one
