@@ -352,20 +352,10 @@ fn study_of_cell_projection_writes_its_sweep() {
     // Two tiny grids (48 and 384 tetrahedra): the full sweep (up to a million) is a
     // benchmark. Every setting is timed, the edit latency measured and, for meshes this
     // small, scored against the f64 reference.
-    let dir = temp_dir("study-cellproj");
-    let out = arbvis(&[
-        "study",
-        "--technique",
-        "cellproj",
-        "--grids",
-        "3,5",
-        "--frames",
-        "1",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    let (_, stderr) = text(&out);
-    assert!(out.status.success(), "{stderr}");
+    let dir = study(
+        "study-cellproj",
+        &["--technique", "cellproj", "--grids", "3,5", "--frames", "1"],
+    );
     let csv = std::fs::read_to_string(dir.join("cellproj.csv")).unwrap();
     // 9 settings per grid (the seed's two, three faithful, two precise, two view-ordered).
     assert_eq!(csv.lines().count(), 1 + 2 * 9, "{csv}");
@@ -393,26 +383,23 @@ fn study_of_cell_projection_writes_its_sweep() {
 fn study_of_clipping_writes_its_sweeps() {
     // A 24³ clip grid, B = 4 and 8, frames of a 16³ volume at 32²: the 256³ and
     // 512³ are a benchmark.
-    let dir = temp_dir("study-clip");
-    let out = arbvis(&[
-        "study",
-        "--technique",
-        "clip",
-        "--clip-sizes",
-        "24",
-        "--blocks",
-        "4,8",
-        "--volume",
-        "16",
-        "--size",
-        "32",
-        "--frames",
-        "1",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    let (_, stderr) = text(&out);
-    assert!(out.status.success(), "{stderr}");
+    let dir = study(
+        "study-clip",
+        &[
+            "--technique",
+            "clip",
+            "--clip-sizes",
+            "24",
+            "--blocks",
+            "4,8",
+            "--volume",
+            "16",
+            "--size",
+            "32",
+            "--frames",
+            "1",
+        ],
+    );
     let textures = std::fs::read_to_string(dir.join("clip-textures.csv")).unwrap();
     // Per shape (sphere, torus, and the cow where ../shared is present): single + 2 B.
     let shapes = textures.lines().skip(1).count() / 3;
@@ -436,22 +423,19 @@ fn study_of_clipping_writes_its_sweeps() {
 #[test]
 fn study_of_splats_writes_its_sweeps() {
     // 3,000 points (at the demo's 1600x900): the seed's 570k and 10 M are a benchmark.
-    let dir = temp_dir("study-splats");
-    let out = arbvis(&[
-        "study",
-        "--technique",
-        "splats",
-        "--points",
-        "3000",
-        "--frame-points",
-        "3000",
-        "--frames",
-        "1",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
-    let (_, stderr) = text(&out);
-    assert!(out.status.success(), "{stderr}");
+    let dir = study(
+        "study-splats",
+        &[
+            "--technique",
+            "splats",
+            "--points",
+            "3000",
+            "--frame-points",
+            "3000",
+            "--frames",
+            "1",
+        ],
+    );
     let sorts = std::fs::read_to_string(dir.join("splats-sorts.csv")).unwrap();
     assert!(
         sorts.contains("seed comparator") && sorts.contains("radix"),
@@ -486,4 +470,16 @@ fn inspect_times_loading_when_asked() {
     assert!(out.status.success(), "{stderr}");
     assert!(stdout.contains("triangles: 1"), "{stdout}");
     assert!(stdout.contains("ms (median of 3)"), "{stdout}");
+}
+
+/// Run `arbvis study ARGS --out DIR` in a fresh folder named `name`; fails the test if
+/// the study fails; returns the folder.
+fn study(name: &str, args: &[&str]) -> std::path::PathBuf {
+    let dir = temp_dir(name);
+    let mut all = vec!["study"];
+    all.extend_from_slice(args);
+    all.extend(["--out", dir.to_str().unwrap()]);
+    let out = arbvis(&all);
+    assert!(out.status.success(), "{}", text(&out).1);
+    dir
 }
