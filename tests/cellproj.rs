@@ -116,25 +116,29 @@ fn score(
 
 const SIZE: [u32; 2] = [160, 120];
 
+/// The seed's mesh and isovalues on `field`, drawn from the rotated camera in
+/// `projection` and scored against the f64 reference.
+fn seed_agreement(
+    h: &Headless,
+    field: Field,
+    projection: Projection,
+    fidelity: Fidelity,
+    kind: ProgramKind,
+) -> Agreement {
+    let isos = seed_isovalues();
+    let p = params(field, isos.clone());
+    let prepared = seed_mesh(field);
+    let cam = camera(projection);
+    let (image, depth) = draw(h, &p, prepared.clone(), fidelity, kind, cam, SIZE);
+    score(&prepared, &isos, &image, &depth, &cam, SIZE)
+}
+
 #[test]
 fn precise_agrees_with_the_reference_on_both_seed_fields() {
     let h = headless(Backend::Egl);
     for field in [Field::Oblique, Field::Spherical, Field::Planar] {
         for projection in [Projection::Orthographic, Projection::Perspective] {
-            let isos = seed_isovalues();
-            let p = params(field, isos.clone());
-            let prepared = seed_mesh(field);
-            let cam = camera(projection);
-            let (image, depth) = draw(
-                &h,
-                &p,
-                prepared.clone(),
-                Fidelity::Precise,
-                ProgramKind::Glsl,
-                cam,
-                SIZE,
-            );
-            let a = score(&prepared, &isos, &image, &depth, &cam, SIZE);
+            let a = seed_agreement(&h, field, projection, Fidelity::Precise, ProgramKind::Glsl);
             // The bar is 99 % of interior pixels; measured on llvmpipe: every
             // one. 99.9 % leaves room for another driver's f32 rounding.
             eprintln!("{field:?} {projection:?}: {a:?}");
@@ -155,20 +159,7 @@ fn faithful_agrees_with_the_reference_within_its_table_quantization() {
     let h = headless(Backend::Egl);
     for field in [Field::Oblique, Field::Spherical] {
         for projection in [Projection::Orthographic, Projection::Perspective] {
-            let isos = seed_isovalues();
-            let p = params(field, isos.clone());
-            let prepared = seed_mesh(field);
-            let cam = camera(projection);
-            let (image, depth) = draw(
-                &h,
-                &p,
-                prepared.clone(),
-                Fidelity::Faithful,
-                ProgramKind::Arb,
-                cam,
-                SIZE,
-            );
-            let a = score(&prepared, &isos, &image, &depth, &cam, SIZE);
+            let a = seed_agreement(&h, field, projection, Fidelity::Faithful, ProgramKind::Arb);
             // The 256² table decides crossings at texel centres: pixels whose ray passes
             // within 1/256 of an isovalue inside a tetrahedron may flip. Measured above
             // 99.3-99.9 % on these fields.
