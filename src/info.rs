@@ -22,6 +22,7 @@ pub fn format_info(backend: Backend, caps: &Caps) -> String {
     );
     s += &format!("texture image units:     {}\n", caps.max_texture_units);
     s += &format!("max 3D texture size:     {}\n", caps.max_3d_texture_size);
+    s += &format!("max 2D texture size:     {}\n", caps.max_texture_size);
     for (name, l, frag) in [
         ("fragment", caps.fragment_limits, true),
         ("vertex", caps.vertex_limits, false),

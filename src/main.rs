@@ -101,6 +101,10 @@ enum Command {
         /// 2D fetch (fill rate), the 3D fetch, dependent table fetches, RGBA8 / RGBA32F.
         #[arg(long)]
         breakdown: bool,
+        /// Turn the camera this many degrees about the vertical axis before every frame,
+        /// so each frame pays for a moving view (the splats' sort and tile lists).
+        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+        turn: f64,
         /// Write the levels, tables, camera (and with --score the reference) for a peer
         /// into this folder; the reference is reused from it when the scene matches.
         #[arg(long)]
@@ -387,11 +391,15 @@ fn run(cli: Cli) -> Result<()> {
             raycast_preint,
             view,
             breakdown,
+            turn,
             export,
             backend,
         } => {
             if frames == 0 || rounds == 0 {
                 bail!("--frames and --rounds must be at least 1");
+            }
+            if !(turn.is_finite() && turn.abs() <= 360.0) {
+                bail!("--turn {turn}: degrees, at most 360 either way");
             }
             if !(oversample.is_finite() && oversample > 0.0 && oversample <= 1024.0) {
                 bail!("--oversample {oversample}: must be above 0 and at most 1024");
@@ -411,6 +419,7 @@ fn run(cli: Cli) -> Result<()> {
                 raycast_preint,
                 export,
                 breakdown,
+                turn,
             };
             let report = arbvis::study::bench::run(&headless, &scene, &origin, &options, |line| {
                 eprintln!("{line}")

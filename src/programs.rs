@@ -76,6 +76,9 @@ pub const SPLATS_PRECISE_ARBFP: ProgramText = program!("splats/precise.arbfp");
 pub const SPLATS_OIT_COMPOSITE_ARBFP: ProgramText = program!("splats/oit_composite.arbfp");
 /// GLSL twin of [`SPLATS_OIT_COMPOSITE_ARBFP`].
 pub const SPLATS_OIT_COMPOSITE_FRAG: ProgramText = program!("splats/oit_composite.frag");
+/// Splats composited per pixel from tile lists (GLSL only: ARB fragment programs have
+/// no loops), over the common transform.
+pub const SPLATS_TILES_FRAG: ProgramText = program!("splats/tiles.frag");
 
 /// A vertex + fragment pair of one kind.
 #[derive(Debug, Clone)]
@@ -163,6 +166,7 @@ pub fn all_pairs() -> Vec<ProgramPair> {
         (ProgramKind::Arb, SPLATS_ARBVP, SPLATS_PRECISE_ARBFP),
         (ProgramKind::Glsl, SPLATS_VERT, SPLATS_SEED_FRAG),
         (ProgramKind::Glsl, SPLATS_VERT, SPLATS_PRECISE_FRAG),
+        (ProgramKind::Glsl, TRANSFORM_VERT, SPLATS_TILES_FRAG),
     ];
     for (kind, vertex, fragment) in own_vertex_stage {
         pairs.push(ProgramPair {
@@ -213,6 +217,7 @@ pub fn all_texts() -> Vec<ProgramText> {
         SPLATS_PRECISE_ARBFP,
         SPLATS_OIT_COMPOSITE_ARBFP,
         SPLATS_OIT_COMPOSITE_FRAG,
+        SPLATS_TILES_FRAG,
         CLIP_SINGLE_ARBFP,
         CLIP_MULTIRES_SLOT_CENTRE_ARBFP,
         CLIP_MULTIRES_OFFSET_ARBFP,

@@ -310,7 +310,11 @@ impl Scene {
                 o.validate().map_err(|e| e.within("technique.opacity3d"))
             }
             TechniqueScene::Cellproj(c) => c.validate().map_err(|e| e.within("technique.cellproj")),
-            TechniqueScene::Splats(s) => s.validate().map_err(|e| e.within("technique.splats")),
+            TechniqueScene::Splats(s) => {
+                s.validate().map_err(|e| e.within("technique.splats"))?;
+                s.draw_allowed(self.fidelity, self.programs)
+                    .map_err(|e| e.within("technique.splats"))
+            }
             TechniqueScene::Quad(_) => Ok(()),
         }
     }

@@ -5,140 +5,15 @@
 mod common;
 
 use arbvis::camera::{Camera, Projection};
-use arbvis::gl::{Backend, Headless, ProgramChoice, ProgramKind, Surface, Target, TargetFormat};
+use arbvis::gl::{Backend, ProgramChoice, ProgramKind};
 use arbvis::image::Image;
-use arbvis::points::section::{generate, SectionSpec};
-use arbvis::points::PointCloud;
+use arbvis::points::section::SectionSpec;
 use arbvis::render::render_on;
 use arbvis::scene::{Fidelity, Scene, TechniqueScene};
-use arbvis::techniques::splats::oit::OIT_WEIGHT;
-use arbvis::techniques::splats::prepare::{footprint, from_cloud, normals_for, point_rgba};
-use arbvis::techniques::splats::reference::{
-    composite, eye_position, rmse_rgb, view_direction, weighted_blended, SplatParams, SplatScene,
-};
+use arbvis::techniques::splats::reference::rmse_rgb;
 use arbvis::techniques::splats::scene::{ColourMode, Kernel, Mode, SortChoice};
-use arbvis::techniques::splats::{SplatsRenderer, SplatsScene};
-use arbvis::techniques::{Frame, Renderer};
 use common::headless;
-
-const BACKGROUND: [f32; 4] = [0.1, 0.1, 0.15, 1.0];
-const SIZE: [u32; 2] = [96, 72];
-
-fn cloud(points: usize) -> PointCloud {
-    generate(&SectionSpec { points, seed: 7 }).unwrap()
-}
-
-fn params(text: &str) -> SplatsScene {
-    toml::from_str(&format!(
-        "cloud = {{ section = {{ points = 1500, seed = 7 }} }}\n{text}"
-    ))
-    .unwrap()
-}
-
-fn camera(projection: Projection) -> Camera {
-    Camera {
-        projection,
-        rotation: [-0.5703, -0.1422, -0.1957, 0.785],
-        zoom: 1.6,
-        ..Camera::default()
-    }
-}
-
-/// Draw `cloud` with `params` into a float target (no 8-bit blending drift), GLSL.
-fn draw(
-    h: &Headless,
-    cloud: &PointCloud,
-    params: &SplatsScene,
-    fidelity: Fidelity,
-    camera: Camera,
-) -> Image {
-    draw_with(h, ProgramKind::Glsl, cloud, params, fidelity, camera)
-}
-
-/// [`draw`] with programs of `kind`.
-fn draw_with(
-    h: &Headless,
-    kind: ProgramKind,
-    cloud: &PointCloud,
-    params: &SplatsScene,
-    fidelity: Fidelity,
-    camera: Camera,
-) -> Image {
-    let gpu = h.gpu();
-    let normals = normals_for(cloud, params);
-    let prepared = from_cloud(cloud, params, normals).unwrap();
-    let mut r = SplatsRenderer::from_prepared(
-        gpu,
-        kind,
-        fidelity,
-        params,
-        std::path::Path::new("."),
-        cloud.clone(),
-        prepared,
-    )
-    .unwrap();
-    let target = Target::new(gpu, SIZE[0], SIZE[1], TargetFormat::Rgba32f).unwrap();
-    target.clear(gpu, BACKGROUND).unwrap();
-    let frame = Frame {
-        camera,
-        width: SIZE[0],
-        height: SIZE[1],
-    };
-    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
-    assert_eq!(r.program_kind(), kind);
-    target.read(gpu).unwrap()
-}
-
-/// The f64 reference of the same splats.
-fn reference(
-    cloud: &PointCloud,
-    params: &SplatsScene,
-    fidelity: Fidelity,
-    camera: &Camera,
-) -> Image {
-    reference_of(cloud, params, fidelity, camera, false)
-}
-
-/// The f64 reference, in exact order or weighted blended (the GPU's weight).
-fn reference_of(
-    cloud: &PointCloud,
-    params: &SplatsScene,
-    fidelity: Fidelity,
-    camera: &Camera,
-    oit: bool,
-) -> Image {
-    let normals = normals_for(cloud, params);
-    let prepared = from_cloud(cloud, params, normals).unwrap();
-    let rgba = point_rgba(
-        &prepared,
-        params,
-        fidelity,
-        eye_position(camera),
-        view_direction(camera),
-    );
-    let scene = SplatScene {
-        positions: &prepared.positions,
-        rgba: &rgba,
-        params: SplatParams {
-            point_size: params.point_size,
-            factor: params.factor,
-            footprint: footprint(params, fidelity),
-            size_range: [1.0, 255.0],
-        },
-        background: BACKGROUND.map(f64::from),
-    };
-    if oit {
-        weighted_blended(&scene, OIT_WEIGHT, camera, SIZE)
-    } else {
-        composite(&scene, camera, SIZE)
-    }
-}
-
-fn rgb_only(image: &Image) -> Image {
-    let mut out = image.clone();
-    out.data.chunks_exact_mut(4).for_each(|p| p[3] = 1.0);
-    out
-}
+use common::splats::*;
 
 #[test]
 fn gpu_matches_the_f64_reference() {

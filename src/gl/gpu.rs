@@ -73,6 +73,8 @@ pub struct Caps {
     pub max_texture_units: i32,
     /// `GL_MAX_3D_TEXTURE_SIZE`.
     pub max_3d_texture_size: i32,
+    /// `GL_MAX_TEXTURE_SIZE` (2D).
+    pub max_texture_size: i32,
 }
 
 impl Caps {
@@ -246,6 +248,7 @@ fn query_caps(gl: &glow::Context, arb_fns: Option<&ArbFns>) -> Caps {
             vertex_limits: limits(arb::VERTEX_PROGRAM, arb_vertex_program),
             max_texture_units: gl.get_parameter_i32(glow::MAX_TEXTURE_IMAGE_UNITS),
             max_3d_texture_size: gl.get_parameter_i32(glow::MAX_3D_TEXTURE_SIZE),
+            max_texture_size: gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE),
         };
         // Queries of absent enums may have queued errors; they say nothing about later calls.
         while gl.get_error() != glow::NO_ERROR {}

@@ -37,6 +37,13 @@ pub enum TexelFormat {
     R32fFromU8,
     /// 4 x f16, filled from f32 data (a render target's colour).
     Rgba16f,
+    /// 4 x u32, unnormalized (`usampler`, `texelFetch` only), filled from the u32s'
+    /// native bytes: records whose words a program reinterprets (`uintBitsToFloat`).
+    Rgba32ui,
+    /// 1 x u32, unnormalized (see [`TexelFormat::Rgba32ui`]).
+    R32ui,
+    /// 2 x u32, unnormalized (see [`TexelFormat::Rgba32ui`]).
+    Rg32ui,
 }
 
 impl TexelFormat {
@@ -55,6 +62,9 @@ impl TexelFormat {
             TexelFormat::Rgb16FromU8 => 6,
             TexelFormat::R32fFromU8 => 4,
             TexelFormat::Rgba16f => 8,
+            TexelFormat::Rgba32ui => 16,
+            TexelFormat::R32ui => 4,
+            TexelFormat::Rg32ui => 8,
         }
     }
 
@@ -72,11 +82,12 @@ impl TexelFormat {
         }
     }
 
-    fn float_source(self) -> bool {
-        matches!(
-            self,
-            TexelFormat::Rgba32f | TexelFormat::R32f | TexelFormat::Rgba16f
-        )
+    fn source_kind(self) -> SourceKind {
+        match self {
+            TexelFormat::Rgba32f | TexelFormat::R32f | TexelFormat::Rgba16f => SourceKind::F32,
+            TexelFormat::Rgba32ui | TexelFormat::R32ui | TexelFormat::Rg32ui => SourceKind::U32,
+            _ => SourceKind::U8,
+        }
     }
 
     fn gl(self) -> (u32, u32, u32) {
@@ -93,6 +104,9 @@ impl TexelFormat {
             TexelFormat::Rgb16FromU8 => (glow::RGB16, glow::RGB, glow::UNSIGNED_BYTE),
             TexelFormat::R32fFromU8 => (glow::R32F, glow::RED, glow::UNSIGNED_BYTE),
             TexelFormat::Rgba16f => (glow::RGBA16F, glow::RGBA, glow::FLOAT),
+            TexelFormat::Rgba32ui => (glow::RGBA32UI, glow::RGBA_INTEGER, glow::UNSIGNED_INT),
+            TexelFormat::R32ui => (glow::R32UI, glow::RED_INTEGER, glow::UNSIGNED_INT),
+            TexelFormat::Rg32ui => (glow::RG32UI, glow::RG_INTEGER, glow::UNSIGNED_INT),
         }
     }
 
@@ -110,6 +124,9 @@ impl TexelFormat {
             TexelFormat::Rgb16FromU8 => "RGB16",
             TexelFormat::R32fFromU8 => "R32F",
             TexelFormat::Rgba16f => "RGBA16F",
+            TexelFormat::Rgba32ui => "RGBA32UI",
+            TexelFormat::R32ui => "R32UI",
+            TexelFormat::Rg32ui => "RG32UI",
         }
     }
 }
@@ -132,6 +149,37 @@ pub enum TexelData<'a> {
     U8(&'a [u8]),
     /// Floats for float formats.
     F32(&'a [f32]),
+    /// Words for the unsigned integer formats.
+    U32(&'a [u32]),
+}
+
+impl<'a> TexelData<'a> {
+    /// The bytes handed to GL, and which kind of source they are.
+    fn bytes(self) -> (&'a [u8], SourceKind) {
+        match self {
+            TexelData::U8(d) => (d, SourceKind::U8),
+            TexelData::F32(d) => (bytes_of(d), SourceKind::F32),
+            TexelData::U32(d) => (bytes_of(d), SourceKind::U32),
+        }
+    }
+}
+
+/// What a format's source data is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum SourceKind {
+    U8,
+    F32,
+    U32,
+}
+
+impl SourceKind {
+    fn name(self) -> &'static str {
+        match self {
+            SourceKind::U8 => "u8",
+            SourceKind::F32 => "f32",
+            SourceKind::U32 => "u32",
+        }
+    }
 }
 
 /// Texture dimensionality and size.
@@ -181,25 +229,19 @@ impl Texture {
         data: TexelData<'_>,
     ) -> GlResult<Texture> {
         let expected = extent.texels() * format.source_bytes();
-        let (given, float_data) = match data {
-            TexelData::U8(d) => (d.len(), false),
-            TexelData::F32(d) => (d.len() * 4, true),
-        };
-        let float_format = format.float_source();
-        if given != expected || float_data != float_format {
+        let (bytes, kind) = data.bytes();
+        if bytes.len() != expected || kind != format.source_kind() {
             return Err(GlError::Invalid(format!(
-                "texture {label}: {extent:?} {} needs {expected} bytes of {} data, got {given} bytes",
+                "texture {label}: {extent:?} {} needs {expected} bytes of {} data, got {} bytes of {}",
                 format.name(),
-                if float_format { "f32" } else { "u8" }
+                format.source_kind().name(),
+                bytes.len(),
+                kind.name()
             )));
         }
         let gl = gpu.glow().clone();
         let target = extent.target();
         let (internal, fmt, ty) = format.gl();
-        let bytes: &[u8] = match data {
-            TexelData::U8(d) => d,
-            TexelData::F32(d) => bytemuck_f32(d),
-        };
         let gl_filter = match filter {
             Filter::Nearest => glow::NEAREST,
             Filter::Linear => glow::LINEAR,
@@ -359,6 +401,55 @@ impl Texture {
         crate::gl_check!(gpu)
     }
 
+    /// Replace the first texels of a 2D texture, row after row, with `data` (whole
+    /// texels of its format; the last row may be partial): what a texture used as a
+    /// growing array needs each frame.
+    pub fn update_texels(&self, gpu: &Gpu, data: TexelData<'_>) -> GlResult<()> {
+        let Extent::D2(w, h) = self.extent else {
+            return Err(GlError::Invalid(format!(
+                "update_texels on a {:?} texture",
+                self.extent
+            )));
+        };
+        let (bytes, kind) = data.bytes();
+        let texel = self.format.source_bytes();
+        let row = w as usize * texel;
+        let fits = bytes.len() <= row * h as usize;
+        if kind != self.format.source_kind() || bytes.len() % texel != 0 || !fits {
+            return Err(GlError::Invalid(format!(
+                "texture update: {} bytes of {} are not whole {texel}-byte texels of {} within {w} x {h}",
+                bytes.len(),
+                kind.name(),
+                self.format.source_kind().name()
+            )));
+        }
+        let (whole, part) = bytes.split_at(bytes.len() / row * row);
+        let (_, fmt, ty) = self.format.gl();
+        let gl = &self.gl;
+        // SAFETY: sizes checked above (whole rows, then one partial row below them);
+        // unit 0's binding is restored.
+        unsafe {
+            let prev_active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
+            gl.active_texture(glow::TEXTURE0);
+            gl.bind_texture(glow::TEXTURE_2D, Some(self.raw));
+            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
+            let rows = (whole.len() / row) as i32;
+            for (y, height, width, src) in [
+                (0, rows, w as i32, whole),
+                (rows, 1, (part.len() / texel) as i32, part),
+            ] {
+                if src.is_empty() {
+                    continue;
+                }
+                let src = glow::PixelUnpackData::Slice(Some(src));
+                gl.tex_sub_image_2d(glow::TEXTURE_2D, 0, 0, y, width, height, fmt, ty, src);
+            }
+            gl.bind_texture(glow::TEXTURE_2D, None);
+            gl.active_texture(prev_active);
+        }
+        crate::gl_check!(gpu)
+    }
+
     /// Size and dimensionality.
     pub fn extent(&self) -> Extent {
         self.extent
@@ -390,7 +481,14 @@ impl Drop for Texture {
     }
 }
 
-fn bytemuck_f32(d: &[f32]) -> &[u8] {
-    // SAFETY: f32 has no invalid bit patterns and u8 has alignment 1.
+/// Plain numbers (`f32`, `u32`: every bit pattern valid, no padding) as bytes.
+fn bytes_of<T: PlainNumber>(d: &[T]) -> &[u8] {
+    // SAFETY: T is f32 or u32 (sealed below): no padding, every byte initialized, and u8
+    // has alignment 1.
     unsafe { std::slice::from_raw_parts(d.as_ptr().cast(), std::mem::size_of_val(d)) }
 }
+
+/// The element types [`bytes_of`] accepts.
+trait PlainNumber: Copy {}
+impl PlainNumber for f32 {}
+impl PlainNumber for u32 {}

@@ -52,6 +52,9 @@ pub struct BenchOptions {
     pub export: Option<PathBuf>,
     /// Also time the probes of [`super::breakdown`] on the scene's slices.
     pub breakdown: bool,
+    /// Degrees the camera turns about the vertical axis before every frame (0: still),
+    /// so that every frame pays for what a moving view costs (the splats' sort).
+    pub turn: f64,
 }
 
 impl Default for BenchOptions {
@@ -67,6 +70,7 @@ impl Default for BenchOptions {
             raycast_preint: Vec::new(),
             export: None,
             breakdown: false,
+            turn: 0.0,
         }
     }
 }
@@ -405,7 +409,12 @@ pub fn run(
                     slots.last_mut().expect("just pushed")
                 }
             };
+            let mut frame = frame;
+            let turn = glam::DQuat::from_rotation_y(options.turn.to_radians());
             let mut one = || -> Result<f64> {
+                if options.turn != 0.0 {
+                    frame.camera.rotation = (frame.camera.quat() * turn).to_array();
+                }
                 let t0 = Instant::now();
                 slot.target.clear(gpu, s.clear_colour())?;
                 slot.renderer

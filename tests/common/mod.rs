@@ -1,6 +1,8 @@
 //! Shared test harness: contexts, pixel probes with bit-depth tolerances, golden images.
 #![allow(dead_code)]
 
+pub mod splats;
+
 use std::path::{Path, PathBuf};
 
 use arbvis::gl::{Backend, Headless};

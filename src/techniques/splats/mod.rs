@@ -38,6 +38,8 @@ pub mod renderer;
 pub mod scene;
 pub mod sort;
 pub mod study;
+pub mod tiled;
+pub mod tiles;
 
 pub use renderer::SplatsRenderer;
 pub use scene::SplatsScene;

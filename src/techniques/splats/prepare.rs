@@ -304,26 +304,36 @@ pub fn point_rgba(
     view_dir: DVec3,
 ) -> Vec<[f64; 4]> {
     (0..prepared.len())
-        .map(|i| {
-            let value = prepared.values[i] as f64;
-            let mut c = match scene.colour {
-                ColourMode::Property => gradient_scale(value, prepared.range, fidelity),
-                _ => prepared.colours[i].map(f64::from),
-            };
-            if scene.lighting && scene.mode == Mode::Surface {
-                let p = DVec3::from_array(prepared.positions[i].map(f64::from));
-                let to_viewer = eye.map_or(-view_dir, |e| e - p);
-                let n = DVec3::from_array(prepared.normals[i].map(f64::from));
-                c = lit(c, n, to_viewer);
-            }
-            let a = match scene.mode {
-                Mode::Surface => 1.0,
-                Mode::Volume => transfer(value, prepared.range, scene, fidelity),
-            };
-            let a = if prepared.visible[i] { a } else { 0.0 };
-            [c[0], c[1], c[2], a]
-        })
+        .map(|i| rgba_of(prepared, scene, fidelity, eye, view_dir, i))
         .collect()
+}
+
+/// Point `i`'s RGBA (see [`point_rgba`]).
+pub fn rgba_of(
+    prepared: &Prepared,
+    scene: &SplatsScene,
+    fidelity: Fidelity,
+    eye: Option<DVec3>,
+    view_dir: DVec3,
+    i: usize,
+) -> [f64; 4] {
+    let value = prepared.values[i] as f64;
+    let mut c = match scene.colour {
+        ColourMode::Property => gradient_scale(value, prepared.range, fidelity),
+        _ => prepared.colours[i].map(f64::from),
+    };
+    if scene.lighting && scene.mode == Mode::Surface {
+        let p = DVec3::from_array(prepared.positions[i].map(f64::from));
+        let to_viewer = eye.map_or(-view_dir, |e| e - p);
+        let n = DVec3::from_array(prepared.normals[i].map(f64::from));
+        c = lit(c, n, to_viewer);
+    }
+    let a = match scene.mode {
+        Mode::Surface => 1.0,
+        Mode::Volume => transfer(value, prepared.range, scene, fidelity),
+    };
+    let a = if prepared.visible[i] { a } else { 0.0 };
+    [c[0], c[1], c[2], a]
 }
 
 #[cfg(test)]

@@ -212,8 +212,8 @@ struct Screen {
     depth: f64,
 }
 
-/// The camera's matrices and eye, computed once per image.
-struct Projector {
+/// Where GL draws a point: the camera's matrices and eye, computed once per image.
+pub struct Projector {
     mvp: DMat4,
     view: DMat4,
     eye: Option<DVec3>,
@@ -221,7 +221,8 @@ struct Projector {
 }
 
 impl Projector {
-    fn new(camera: &Camera, size: [u32; 2]) -> Projector {
+    /// The projector of `camera` onto a `size` image.
+    pub fn new(camera: &Camera, size: [u32; 2]) -> Projector {
         Projector {
             mvp: camera.view_projection(size[0] as f64 / size[1].max(1) as f64),
             view: camera.view(),
@@ -230,23 +231,33 @@ impl Projector {
         }
     }
 
-    /// Splat `i` on screen, or `None` when GL would not draw it.
-    fn project(&self, scene: &SplatScene, i: usize) -> Option<Screen> {
-        let p = scene.position(i);
+    /// Window position (x, y: GL's, y up) and size in pixels of the splat at `p`, with
+    /// its clip position; `None` when GL would not draw it (steps 1 and 2 of the module
+    /// doc).
+    pub fn place(&self, params: &SplatParams, p: DVec3) -> Option<([f64; 3], DVec4)> {
         let c = self.mvp * DVec4::new(p.x, p.y, p.z, 1.0);
         // Written so that NaN fails every test.
         let inside = c.w > 0.0 && c.x.abs() <= c.w && c.y.abs() <= c.w && c.z.abs() <= c.w;
-        let s = size_from(&scene.params, self.eye, p);
+        let s = size_from(params, self.eye, p);
         let drawn = s > 0.0;
         if !inside || !drawn {
             return None;
         }
+        let x = (c.x / c.w + 1.0) / 2.0 * self.size[0];
+        let y = (c.y / c.w + 1.0) / 2.0 * self.size[1];
+        Some(([x, y, s], c))
+    }
+
+    /// Splat `i` on screen, or `None` when GL would not draw it.
+    fn project(&self, scene: &SplatScene, i: usize) -> Option<Screen> {
+        let p = scene.position(i);
+        let ([x, y, size], c) = self.place(&scene.params, p)?;
         let eye_z = (self.view * DVec4::new(p.x, p.y, p.z, 1.0)).z;
         let rgba = scene.rgba[i];
         Some(Screen {
-            x: (c.x / c.w + 1.0) / 2.0 * self.size[0],
-            y: (c.y / c.w + 1.0) / 2.0 * self.size[1],
-            size: s,
+            x,
+            y,
+            size,
             rgb: [0, 1, 2].map(|k| clamp01(rgba[k])),
             alpha: rgba[3],
             z: match self.eye {
@@ -268,7 +279,7 @@ fn clamp01(v: f64) -> f64 {
 }
 
 /// Pixel index range `[lo, hi)` whose centres `k + 0.5` lie in `[c - h, c + h)`.
-fn covered(c: f64, h: f64, limit: u32) -> (i64, i64) {
+pub fn covered(c: f64, h: f64, limit: u32) -> (i64, i64) {
     let lo = (c - h - 0.5).ceil().max(0.0);
     let hi = (c + h - 0.5).ceil().min(limit as f64);
     (lo as i64, hi as i64)

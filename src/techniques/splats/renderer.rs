@@ -15,8 +15,14 @@ use super::oit::{z_row, OitPass};
 use super::prepare::{
     from_cloud, normals_for, prepare, Prepared, COLOR_A, COLOR_B, PHONG, VERTEX_COMPONENTS,
 };
-use super::scene::{ColourMode, Kernel, Mode, SortChoice, SplatsScene};
+use super::reference::{eye_position, view_direction, SplatParams};
+use super::scene::{ColourMode, DrawChoice, Kernel, Mode, SortChoice, SplatsScene};
 use super::sort::{seed_order, SeedPoint, SortCache, SortMethod, View};
+use super::tiled::TilePass;
+use super::tiles::{
+    place_splats, point_colours, spatial_order, Binner, SpatialPoints, TooManyEntries,
+    DEFAULT_MAX_ENTRIES,
+};
 use crate::camera::Projection;
 use crate::gl::{
     self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind, Surface,
@@ -59,8 +65,28 @@ pub struct SplatsRenderer {
     oit: Option<OitPass>,
     /// The view the current order was made for.
     ordered_for: Option<[u64; 4]>,
+    /// `draw = "tiles"`: the gather pass and what its textures hold.
+    tiles: Option<TileState>,
     /// Time of the last sort (and upload), for the bench and the viewer.
     pub last_sort: Duration,
+    /// Time of the last placing, binning and upload of tile lists.
+    pub last_bin: Duration,
+}
+
+/// The tile pass and the frame its uploads were made for.
+struct TileState {
+    pass: TilePass,
+    /// The visible points in spatial order.
+    points: SpatialPoints,
+    /// The lists' buffers, kept from frame to frame.
+    binner: Binner,
+    /// Camera matrix, size and order of the uploaded lists.
+    lists_for: Option<(Vec<u64>, [u32; 2])>,
+    /// The view the uploaded colours were lit for (`Some` of anything when unlit).
+    colours_for: Option<[u64; 4]>,
+    /// Entries of the uploaded lists, or the entries a frame needed past the bound (it
+    /// was drawn as points).
+    entries: Result<usize, TooManyEntries>,
 }
 
 fn view_bits(view: View) -> [u64; 4] {
@@ -107,6 +133,9 @@ impl SplatsRenderer {
         cloud: PointCloud,
         prepared: Prepared,
     ) -> GlResult<SplatsRenderer> {
+        params
+            .draw_allowed(fidelity, crate::gl::ProgramChoice::Auto)
+            .map_err(|e| GlError::Data(e.to_string()))?;
         let pair = program_pair(fidelity, kind);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         let mesh = Mesh::new(
@@ -131,7 +160,9 @@ impl SplatsRenderer {
             seed_points: Vec::new(),
             oit: None,
             ordered_for: None,
+            tiles: None,
             last_sort: Duration::ZERO,
+            last_bin: Duration::ZERO,
         };
         r.install(gpu)?;
         Ok(r)
@@ -153,6 +184,20 @@ impl SplatsRenderer {
         if self.params.sort != SortChoice::Oit {
             self.oit = None;
         }
+        self.tiles = match (self.params.draw, self.tiles.take()) {
+            (DrawChoice::Points, _) => None,
+            (DrawChoice::Tiles, kept) => Some(TileState {
+                pass: match kept {
+                    Some(t) => t.pass,
+                    None => TilePass::new(gpu)?,
+                },
+                points: spatial_order(&self.prepared.positions, &self.prepared.visible),
+                binner: Binner::default(),
+                lists_for: None,
+                colours_for: None,
+                entries: Ok(0),
+            }),
+        };
         self.mesh.clear_indices();
         self.mesh.update(gpu, &self.prepared.vertices(None))?;
         if matches!(self.params.sort, SortChoice::None | SortChoice::Oit) {
@@ -199,6 +244,67 @@ impl SplatsRenderer {
         Ok(())
     }
 
+    /// The splat rules of the precise programs, for placing tiles.
+    fn splat_params(&self) -> SplatParams {
+        SplatParams {
+            point_size: self.params.point_size,
+            factor: self.params.factor,
+            footprint: super::prepare::footprint(&self.params, self.fidelity),
+            size_range: [1.0, 255.0],
+        }
+    }
+
+    /// Bring the tile pass's colours and lists up to `frame` (nothing that did not
+    /// change); `false` when the lists would exceed their bound.
+    fn prepare_tiles(&mut self, gpu: &Gpu, frame: &Frame) -> GlResult<bool> {
+        let camera = &frame.camera;
+        let size = [frame.width, frame.height];
+        let lit = self.params.lighting && self.params.mode == Mode::Surface;
+        let view = if lit {
+            view_bits(View::of_camera(camera))
+        } else {
+            [0; 4]
+        };
+        let matrix: Vec<u64> = camera
+            .view_projection(frame.aspect())
+            .to_cols_array()
+            .iter()
+            .map(|v| v.to_bits())
+            .collect();
+        let params = self.splat_params();
+        let Some(state) = &mut self.tiles else {
+            return Ok(false);
+        };
+        let t0 = Instant::now();
+        if state.colours_for != Some(view) {
+            let colours = point_colours(
+                &self.prepared,
+                &self.params,
+                eye_position(camera),
+                view_direction(camera),
+            );
+            state.pass.set_colours(gpu, &colours)?;
+            state.colours_for = Some(view);
+        }
+        let key = Some((matrix, size));
+        if state.lists_for != key {
+            let placed = place_splats(&state.points, camera, size, self.params.tile, &params);
+            let ordered = self.params.sort != SortChoice::None;
+            let binned = state.binner.bin(&placed, DEFAULT_MAX_ENTRIES, ordered);
+            state.entries = match binned {
+                Ok(()) => {
+                    let lists = &state.binner.lists;
+                    state.pass.set_lists(gpu, lists)?;
+                    Ok(lists.entries.len())
+                }
+                Err(too_many) => Err(too_many),
+            };
+            state.lists_for = key;
+            self.last_bin = t0.elapsed();
+        }
+        Ok(state.entries.is_ok())
+    }
+
     fn send_constants(&self, gpu: &Gpu) -> GlResult<()> {
         let p = &self.params;
         let colour = if p.colour == ColourMode::Property {
@@ -233,6 +339,19 @@ impl SplatsRenderer {
 
 impl Renderer for SplatsRenderer {
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+        if self.tiles.is_some() && self.prepare_tiles(gpu, frame)? {
+            if let Some(state) = &self.tiles {
+                let gaussian = if self.params.kernel == Kernel::Gaussian {
+                    1.0
+                } else {
+                    0.0
+                };
+                return state
+                    .pass
+                    .draw(gpu, surface, [gaussian, self.params.gauss_width]);
+            }
+        }
+        // Points (also a tiles frame past the bound on list entries).
         let camera = &frame.camera;
         let view = View::of_camera(camera);
         self.order(gpu, view)?;
@@ -301,7 +420,9 @@ impl Renderer for SplatsRenderer {
             || new.hide_layers != p.hide_layers
             || new.hide_undefined != p.hide_undefined
             || lit(new) != lit(p)
-            || new.sort != p.sort;
+            || new.sort != p.sort
+            || new.draw != p.draw
+            || new.tile != p.tile;
         self.params = (**new).clone();
         if rebuild {
             self.prepared =
@@ -323,8 +444,24 @@ impl Renderer for SplatsRenderer {
                 self.prepared.len()
             ));
         }
+        let tiles = match &self.tiles {
+            None => String::new(),
+            Some(TileState {
+                entries: Ok(n), ..
+            }) => format!(
+                "; tiles of {} px: {n} list entries, last lists {:.1} ms",
+                self.params.tile,
+                self.last_bin.as_secs_f64() * 1e3
+            ),
+            Some(TileState {
+                entries: Err(TooManyEntries(n)),
+                ..
+            }) => format!(
+                "; tiles would need {n} list entries (more than {DEFAULT_MAX_ENTRIES}): drawn as points"
+            ),
+        };
         Some(format!(
-            "{drawn} of {} points drawn; last sort ({:?}): {:.1} ms",
+            "{drawn} of {} points drawn; last sort ({:?}): {:.1} ms{tiles}",
             self.prepared.len(),
             self.params.sort,
             self.last_sort.as_secs_f64() * 1e3

@@ -3,8 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::gl::ProgramChoice;
 use crate::points::PointSource;
-use crate::scene::FieldError;
+use crate::scene::{Fidelity, FieldError};
 
 /// What colours a point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -54,6 +55,19 @@ pub enum SortChoice {
     /// Weighted blended order-independent transparency (McGuire & Bavoil 2013): no
     /// order, an approximation of it.
     Oit,
+}
+
+/// How the splats reach the pixels.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum DrawChoice {
+    /// One `GL_POINT` sprite per splat, blended in order (the seed's way).
+    #[default]
+    Points,
+    /// Precise only: per-tile lists built on the CPU in order, composited per pixel by a
+    /// GLSL gather program (`splats::tiles`); the same picture, without the per-point
+    /// cost of `GL_POINTS` on software drivers.
+    Tiles,
 }
 
 /// Surface or volume rendering.
@@ -133,6 +147,12 @@ pub struct SplatsScene {
     /// Ordering.
     #[serde(default)]
     pub sort: SortChoice,
+    /// Points or tiles.
+    #[serde(default)]
+    pub draw: DrawChoice,
+    /// Tile side in pixels (`draw = "tiles"`).
+    #[serde(default = "default_tile")]
+    pub tile: u32,
     /// Volume mode's transfer function.
     #[serde(default)]
     pub volume: VolumeSpec,
@@ -153,11 +173,41 @@ fn default_gauss_width() -> f64 {
 fn default_k() -> usize {
     16
 }
+fn default_tile() -> u32 {
+    super::tiles::DEFAULT_TILE
+}
 
 /// Largest point size asked for (GL clamps to its own range, 255 on llvmpipe).
 pub const MAX_POINT_SIZE: f64 = 4096.0;
 
 impl SplatsScene {
+    /// `draw = "tiles"` is precise and GLSL only: faithful mode runs the seed's programs
+    /// as `GL_POINTS`, and ARB fragment programs have no loops to walk a tile's list.
+    pub fn draw_allowed(
+        &self,
+        fidelity: Fidelity,
+        programs: ProgramChoice,
+    ) -> Result<(), FieldError> {
+        if self.draw != DrawChoice::Tiles {
+            return Ok(());
+        }
+        if fidelity == Fidelity::Faithful {
+            return Err(FieldError::new(
+                "draw",
+                "\"tiles\" composites the precise footprints; faithful mode draws the seed's \
+                 programs as points: use fidelity = \"precise\" or draw = \"points\"",
+            ));
+        }
+        if programs == ProgramChoice::Arb {
+            return Err(FieldError::new(
+                "draw",
+                "\"tiles\" needs a GLSL program (ARB fragment programs have no loops): use \
+                 programs = \"glsl\" or \"auto\", or draw = \"points\"",
+            ));
+        }
+        Ok(())
+    }
+
     /// Check values that parse but cannot render; the error names the key.
     pub fn validate(&self) -> Result<(), FieldError> {
         let positive = |key: &str, v: f64, max: f64| {
@@ -182,6 +232,18 @@ impl SplatsScene {
             return Err(FieldError::new(
                 "normals_k",
                 format!("{}: must be 3..=256", self.normals_k),
+            ));
+        }
+        if !(1..=256).contains(&self.tile) {
+            return Err(FieldError::new(
+                "tile",
+                format!("{}: must be 1..=256 pixels", self.tile),
+            ));
+        }
+        if self.draw == DrawChoice::Tiles && self.sort == SortChoice::Oit {
+            return Err(FieldError::new(
+                "draw",
+                "\"tiles\" composites in the sort's order; sort = \"oit\" has none",
             ));
         }
         let v = self.volume;

@@ -1,0 +1,157 @@
+//! The GL half of `draw = "tiles"`: the [`super::tiles`] lists and the point colours
+//! in three textures, composited by `splats/tiles.frag` over one full-screen quad,
+//! blended `ONE, ONE_MINUS_SRC_ALPHA` over the cleared target. GLSL only (ARB fragment
+//! programs have no loops). All textures are freed on Drop.
+
+use glam::DMat4;
+
+use super::tiles::TileLists;
+use crate::gl::{
+    self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Primitive, Program,
+    ProgramKind, Surface, TexelData, TexelFormat, Texture,
+};
+use crate::programs;
+use crate::techniques::quad::quad_vertices;
+
+/// Texels per row of the array textures (`ROW` in `tiles.frag`).
+pub const ROW: usize = 4096;
+
+/// The gather program, its quad, and the textures of the current lists and colours.
+pub struct TilePass {
+    program: Program,
+    quad: Mesh,
+    offsets: Option<Texture>,
+    entries: Option<Texture>,
+    colours: Option<Texture>,
+    /// Tile side and tiles across of the lists uploaded last.
+    tile: u32,
+    across: u32,
+}
+
+/// A 2D array texture of at least `texels` texels of `format`, `ROW` wide: `current`
+/// when it is big enough, else a new one with a quarter to spare (zero-filled).
+fn array_texture(
+    gpu: &Gpu,
+    current: Option<Texture>,
+    label: &str,
+    format: TexelFormat,
+    texels: usize,
+) -> GlResult<Texture> {
+    let rows = texels.div_ceil(ROW).max(1);
+    if let Some(t) = current {
+        if let Extent::D2(_, h) = t.extent() {
+            if h as usize >= rows {
+                return Ok(t);
+            }
+        }
+    }
+    let max = gpu.caps().max_texture_size.max(1) as usize;
+    if rows > max {
+        return Err(GlError::Data(format!(
+            "{label}: {texels} texels need {rows} rows of {ROW}, more than this driver's \
+             {max} (GL_MAX_TEXTURE_SIZE)"
+        )));
+    }
+    let rows = (rows + rows / 4).min(max);
+    let extent = Extent::D2(ROW as u32, rows as u32);
+    let words = ROW * rows * format.bytes() / 4;
+    let data = match format {
+        TexelFormat::Rgba32f => TexelData::F32(&vec![0.0; words]),
+        _ => TexelData::U32(&vec![0; words]),
+    };
+    // The old texture is dropped (freed) before the new one is filled.
+    Texture::new(gpu, label, extent, format, Filter::Nearest, data)
+}
+
+impl TilePass {
+    /// The program and quad; textures come with the first lists and colours.
+    pub fn new(gpu: &Gpu) -> GlResult<TilePass> {
+        let program = Program::new(
+            gpu,
+            ProgramKind::Glsl,
+            &programs::TRANSFORM_VERT,
+            &programs::SPLATS_TILES_FRAG,
+        )?;
+        program.set_transform(gpu, DMat4::IDENTITY)?;
+        let quad = Mesh::new(gpu, "splats tiles quad", &[4, 4], &quad_vertices())?;
+        Ok(TilePass {
+            program,
+            quad,
+            offsets: None,
+            entries: None,
+            colours: None,
+            tile: 1,
+            across: 0,
+        })
+    }
+
+    /// Upload every point's RGBA (by point index).
+    pub fn set_colours(&mut self, gpu: &Gpu, colours: &[[f32; 4]]) -> GlResult<()> {
+        let t = array_texture(
+            gpu,
+            self.colours.take(),
+            "splat colours",
+            TexelFormat::Rgba32f,
+            colours.len(),
+        )?;
+        t.update_texels(gpu, TexelData::F32(colours.as_flattened()))?;
+        self.colours = Some(t);
+        Ok(())
+    }
+
+    /// Upload the lists of a frame.
+    pub fn set_lists(&mut self, gpu: &Gpu, lists: &TileLists) -> GlResult<()> {
+        let offsets = array_texture(
+            gpu,
+            self.offsets.take(),
+            "splat tile offsets",
+            TexelFormat::R32ui,
+            lists.offsets.len(),
+        )?;
+        offsets.update_texels(gpu, TexelData::U32(&lists.offsets))?;
+        self.offsets = Some(offsets);
+        let entries = array_texture(
+            gpu,
+            self.entries.take(),
+            "splat tile lists",
+            TexelFormat::Rgba32ui,
+            lists.entries.len(),
+        )?;
+        entries.update_texels(gpu, TexelData::U32(lists.entries.as_flattened()))?;
+        self.entries = Some(entries);
+        self.tile = lists.tile;
+        self.across = lists.tiles[0];
+        Ok(())
+    }
+
+    /// Composite the uploaded lists onto `surface` (the frame the lists were made for);
+    /// `kernel` is (1 Gaussian / 0 smoothstep, the Gaussian's width).
+    pub fn draw(&self, gpu: &Gpu, surface: Surface<'_>, kernel: [f64; 2]) -> GlResult<()> {
+        let (Some(offsets), Some(entries), Some(colours)) =
+            (&self.offsets, &self.entries, &self.colours)
+        else {
+            return Err(GlError::Invalid(
+                "splat tiles drawn before lists and colours were uploaded".into(),
+            ));
+        };
+        self.program.set_local(
+            gpu,
+            0,
+            [self.tile as f64, self.across as f64, kernel[0], kernel[1]],
+        )?;
+        gl::draw(
+            gpu,
+            surface,
+            &DrawCall {
+                program: &self.program,
+                mesh: &self.quad,
+                range: None,
+                textures: &[(0, offsets), (1, entries), (2, colours)],
+                blend: Blend::PremultipliedOver,
+                depth_test: false,
+                cull_back: false,
+                primitive: Primitive::Triangles,
+            },
+        )
+    }
+}
