@@ -151,7 +151,7 @@ fn lists_and_lit_colours_follow_the_camera() {
     let again = frame(&mut r, &h, &target, turned);
     assert_eq!(again.compare(&b, 0.0).unwrap().max_abs, 0.0);
     assert_eq!(r.status().unwrap(), status);
-    assert!(status.contains("tiles of 2 px"), "{status}");
+    assert!(status.contains("as tiles of 2 px"), "{status}");
 }
 
 #[test]
@@ -229,4 +229,25 @@ fn tiles_are_precise_and_glsl_and_need_an_order() {
     }
     assert!(scene("fidelity = \"precise\"", "draw = \"tiles\"").is_ok());
     assert!(scene("fidelity = \"faithful\"", "draw = \"points\"").is_ok());
+}
+
+#[test]
+fn edits_reach_the_tiles() {
+    // Point size, kernel and the transfer function change what the lists and colours
+    // hold without rebuilding the renderer: the edited renderer draws what a new one does.
+    let h = headless(Backend::Egl);
+    let cam = camera(Projection::Perspective);
+    let base = "mode = \"volume\"\ncolour = \"property\"\npoint_size = 6.0";
+    let edited = "mode = \"volume\"\ncolour = \"property\"\npoint_size = 11.0\n\
+                  kernel = \"smoothstep\"\nvolume = { threshold = 0.004, range = 0.003 }";
+    let (mut r, target) = renderer(&h, base);
+    let before = frame(&mut r, &h, &target, cam);
+    let new = arbvis::scene::TechniqueScene::Splats(Box::new(params(&tiles(edited))));
+    r.update(h.gpu(), &new).unwrap();
+    let after = frame(&mut r, &h, &target, cam);
+    let (mut fresh, fresh_target) = renderer(&h, edited);
+    let expected = frame(&mut fresh, &h, &fresh_target, cam);
+    assert_eq!(after.compare(&expected, 0.0).unwrap().max_abs, 0.0);
+    let changed = before.compare(&after, 0.0).unwrap();
+    assert!(changed.pixels_over > 100, "{changed:?}");
 }

@@ -480,6 +480,8 @@ click Faults in white
 set Colour layer
 set Point size 6
 click Sort seed
+click Draw tiles
+set Tile size 3
 click Volume mode
 set Threshold 0.01
 click Screenshot
@@ -500,6 +502,8 @@ click Save scene
     );
     assert_eq!(s.point_size, 6.0);
     assert_eq!(s.sort, arbvis::techniques::splats::scene::SortChoice::Seed);
+    assert_eq!(s.draw, arbvis::techniques::splats::scene::DrawChoice::Tiles);
+    assert_eq!(s.tile, 3);
     assert_eq!(s.mode, arbvis::techniques::splats::scene::Mode::Volume);
     assert_eq!(s.volume.threshold, 0.01);
     let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();

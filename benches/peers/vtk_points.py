@@ -3,22 +3,25 @@
 
     pip install vtk numpy
     cargo build --release
-    python3 benches/peers/vtk_points.py --points 570000 --pixels 1.3 --rounds 3
+    python3 benches/peers/vtk_points.py --points 570000 --pixels 1.3 --rounds 3 --turn 1
 
 1. A cloud of `--points` points shaped like the seed's section (8 folded layers in a
    4 x 1 x 1 box, a colour per layer, seeded) is written once as a binary little-endian PLY
    (x, y, z as float, red, green, blue as uchar) that both systems read.
-2. arbvis draws it from a scene (`cloud = { ply = ... }`, colour = "rgb", orthographic,
+2. arbvis draws it from two scenes (`cloud = { ply = ... }`, colour = "rgb", orthographic,
    looking down -y onto the section's face, splats of `--pixels` pixels: in orthographic
-   views gl_PointSize = point_size x factor, sorted back to front by the radix sort); VTK
+   views gl_PointSize = point_size x factor): `draw = "points"` (GL_POINTS sorted back to
+   front by the radix sort) and `draw = "tiles"` (per-tile lists composited per pixel); VTK
    draws it with vtkPointGaussianMapper (the default Gaussian splat, opacity on, sorted by
    nothing), parallel projection, the same view direction, its scale factor set so a splat
    is `--pixels` pixels across at the window's size, and the same 1600x900 size.
-3. Both are timed per frame (arbvis: `arbvis bench SCENE --json`, clear + draw + finish;
+3. All are timed per frame (arbvis: `arbvis bench SCENE --json`, clear + draw + finish;
    VTK: Render + WaitForCompletion), first frame apart, alternating round by round; the
-   script prints the medians and their ratio. The camera stays still in both, so arbvis's
-   per-frame sort runs once: its cost at 570k points (about 3-5 ms) is reported by
-   `arbvis bench` as the sort time and is small beside a frame.
+   script prints the medians and their ratios. With `--turn DEG` the camera turns DEG
+   degrees about the vertical axis before every frame in both (arbvis `bench --turn`, VTK
+   `Azimuth`), so every arbvis frame pays for its order (the sort, or the tile lists);
+   VTK's mapper does not sort, so turning costs it nothing. Without it the camera stays
+   still and arbvis orders once.
 """
 
 import argparse
@@ -59,7 +62,7 @@ def write_cloud(path, n, seed):
         f.write(rec.tobytes())
 
 
-def arbvis_scene(path, ply, size, pixels):
+def arbvis_scene(path, ply, size, pixels, draw):
     # Looking along +y with z up (VTK's camera below): a quarter turn about x, the sign
     # checked by rendering both (--png).
     q = [-np.sin(np.pi / 4), 0.0, 0.0, np.cos(np.pi / 4)]
@@ -81,11 +84,13 @@ point_size = {pixels}
 factor = 1.0
 kernel = "gaussian"
 sort = "radix"
+draw = "{draw}"
 """)
 
 
-def arbvis_frames(binary, scene, frames):
-    out = subprocess.run([binary, "bench", scene, "--json", "--frames", str(frames)],
+def arbvis_frames(binary, scene, frames, turn):
+    out = subprocess.run([binary, "bench", scene, "--json", "--frames", str(frames),
+                          "--turn", str(turn)],
                          check=True, capture_output=True, text=True)
     j = json.loads(out.stdout)
     s = j["settings"][0]
@@ -134,9 +139,12 @@ class VtkScene:
         w.SetInputConnection(grab.GetOutputPort())
         w.Write()
 
-    def frames(self, n):
+    def frames(self, n, turn):
         out = []
+        cam = self.ren.GetActiveCamera()
         for _ in range(n):
+            if turn:
+                cam.Azimuth(turn)
             t0 = time.perf_counter()
             self.win.Render()
             self.win.WaitForCompletion()
@@ -154,6 +162,8 @@ def main():
     p.add_argument("--frames", type=int, default=5)
     p.add_argument("--rounds", type=int, default=3)
     p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--turn", type=float, default=0.0,
+                   help="degrees the camera turns before every frame (both systems)")
     p.add_argument("--dir", default="/tmp/arbvis-vtk-points")
     p.add_argument("--json", default=None)
     p.add_argument("--png", default=None, help="write VTK's frame here (to compare coverage "
@@ -164,28 +174,35 @@ def main():
     ply = os.path.join(a.dir, f"section-{a.points}-{a.seed}.ply")
     if not os.path.exists(ply):
         write_cloud(ply, a.points, a.seed)
-    scene = os.path.join(a.dir, "splats.toml")
-    arbvis_scene(scene, ply, size, a.pixels)
+    scenes = {}
+    for draw in ("points", "tiles"):
+        scenes[draw] = os.path.join(a.dir, f"splats-{draw}.toml")
+        arbvis_scene(scenes[draw], ply, size, a.pixels, draw)
     v = VtkScene(ply, size, a.pixels)
     if a.png:
         v.save_png(a.png)
-    arb, vtk_ms = [], []
+    arb = {draw: [] for draw in scenes}
+    vtk_ms = []
     renderer = ""
     for r in range(a.rounds):
-        ms, renderer = arbvis_frames(a.arbvis, scene, a.frames)
-        arb += ms
-        vtk_ms += v.frames(a.frames)
+        for draw, scene in scenes.items():
+            ms, renderer = arbvis_frames(a.arbvis, scene, a.frames, a.turn)
+            arb[draw] += ms
+        vtk_ms += v.frames(a.frames, a.turn)
         print(f"round {r + 1} of {a.rounds} done", flush=True)
-    ma, mv = statistics.median(arb), statistics.median(vtk_ms)
+    mv = statistics.median(vtk_ms)
     print(f"{v.n} points at {size[0]}x{size[1]}, {a.pixels}-pixel splats, {renderer}; "
-          f"VTK {vtk.vtkVersion.GetVTKVersion()}")
-    print(f"arbvis splats (radix-sorted, Gaussian): median {ma:8.1f} ms/frame")
-    print(f"VTK point Gaussian mapper:              median {mv:8.1f} ms/frame")
-    print(f"arbvis is {mv / ma:.1f}x faster")
+          f"VTK {vtk.vtkVersion.GetVTKVersion()}; camera turning {a.turn} degrees per frame")
+    for draw, ms in arb.items():
+        m = statistics.median(ms)
+        print(f"arbvis splats, draw = {draw:<6} (Gaussian): median {m:8.1f} ms/frame, "
+              f"{mv / m:5.1f}x faster than VTK")
+    print(f"VTK point Gaussian mapper:                median {mv:8.1f} ms/frame")
     if a.json:
         with open(a.json, "w") as f:
-            json.dump({"points": v.n, "size": size, "pixels": a.pixels, "renderer": renderer,
-                       "arbvis_ms": arb, "vtk_ms": vtk_ms}, f, indent=1)
+            json.dump({"points": v.n, "size": size, "pixels": a.pixels, "turn": a.turn,
+                       "renderer": renderer, "arbvis_ms": arb["points"],
+                       "arbvis_tiles_ms": arb["tiles"], "vtk_ms": vtk_ms}, f, indent=1)
 
 
 if __name__ == "__main__":

@@ -13,11 +13,11 @@
 // texture1: list entries (RGBA32UI: window x, y and size as f32 bits, point index);
 // texture2: point colours (RGBA32F by point index).
 // program_local[0]: (tile size in pixels, tiles across, kernel: 1 Gaussian / 0 smoothstep,
-// Gaussian width).
+// Gaussian width); [1].xy: the viewport's corner in window coordinates (0 offscreen).
 uniform usampler2D texture0;
 uniform usampler2D texture1;
 uniform sampler2D texture2;
-uniform vec4 program_local[1];
+uniform vec4 program_local[2];
 out vec4 FragColor;
 
 const int ROW = 4096;
@@ -38,7 +38,8 @@ float footprint(float n_dist) {
 void main() {
     int tile_size = int(program_local[0].x);
     int across = int(program_local[0].y);
-    ivec2 pixel = ivec2(gl_FragCoord.xy);
+    vec2 centre = gl_FragCoord.xy - program_local[1].xy;
+    ivec2 pixel = ivec2(centre);
     uint tile = uint((pixel.y / tile_size) * across + pixel.x / tile_size);
     uint first = texelFetch(texture0, at(tile), 0).r;
     uint last = texelFetch(texture0, at(tile + 1u), 0).r;
@@ -46,7 +47,7 @@ void main() {
     float transmittance = 1.0;
     for (uint k = last; k > first && transmittance >= FLOOR; k--) {
         uvec4 e = texelFetch(texture1, at(k - 1u), 0);
-        vec2 d = gl_FragCoord.xy - vec2(uintBitsToFloat(e.x), uintBitsToFloat(e.y));
+        vec2 d = centre - vec2(uintBitsToFloat(e.x), uintBitsToFloat(e.y));
         float half_size = 0.5 * uintBitsToFloat(e.z);
         if (any(lessThan(d, vec2(-half_size))) || any(greaterThanEqual(d, vec2(half_size))))
             continue;

@@ -262,13 +262,20 @@ fn controls(
             (Fidelity::Precise, "Precise"),
         ] {
             if w.radio(ui, label, &mut scene.fidelity, f) {
+                // Tiles are precise only: faithful draws the seed's points.
+                if let TechniqueScene::Splats(sp) = &mut scene.technique {
+                    if f == Fidelity::Faithful {
+                        sp.draw = crate::techniques::splats::scene::DrawChoice::Points;
+                    }
+                }
                 actions.push(UiAction::SetFidelity);
             }
         }
     });
+    let fidelity = scene.fidelity;
     if let TechniqueScene::Splats(sp) = &mut scene.technique {
         ui.separator();
-        if super::splats::editor(ui, sp, w) {
+        if super::splats::editor(ui, sp, fidelity, w) {
             actions.push(UiAction::ParamsChanged);
         }
     }

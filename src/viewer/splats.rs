@@ -1,17 +1,23 @@
 //! The splat editor: layers shown or hidden, colour mode, faults and undefined facies,
 //! point size and factor, kernel and its width, lighting (per-layer normals), sort
-//! method, and volume mode's transfer function. The frame and sort times show in the
-//! panel's status line.
+//! method, points or tiles (precise only) and the tile size, and volume mode's transfer
+//! function. The frame, sort and tile-list times show in the panel's status line.
 
 use super::widgets::Widgets;
-use crate::techniques::splats::scene::{ColourMode, Kernel, Mode, SortChoice};
+use crate::scene::Fidelity;
+use crate::techniques::splats::scene::{ColourMode, DrawChoice, Kernel, Mode, SortChoice};
 use crate::techniques::splats::SplatsScene;
 
 /// Layer ids with a toggle (the seed's sections have layers 0..7).
 pub const LAYERS: i32 = 8;
 
-/// Draw the editor; true when something changed.
-pub fn editor(ui: &mut egui::Ui, scene: &mut SplatsScene, w: &mut Widgets) -> bool {
+/// Draw the editor for a scene of `fidelity`; true when something changed.
+pub fn editor(
+    ui: &mut egui::Ui,
+    scene: &mut SplatsScene,
+    fidelity: Fidelity,
+    w: &mut Widgets,
+) -> bool {
     let mut changed = false;
     ui.label("Layers shown");
     ui.horizontal_wrapped(|ui| {
@@ -113,6 +119,17 @@ pub fn editor(ui: &mut egui::Ui, scene: &mut SplatsScene, w: &mut Widgets) -> bo
             let r = ui.radio_value(&mut scene.sort, s, label);
             changed |= w.add(ui, &format!("Sort {label}"), &r) && r.changed();
         }
+    });
+    // Tiles composite the precise footprints: faithful mode draws the seed's points.
+    ui.add_enabled_ui(fidelity == Fidelity::Precise, |ui| {
+        ui.horizontal(|ui| {
+            ui.label("Draw");
+            for (d, label) in [(DrawChoice::Points, "points"), (DrawChoice::Tiles, "tiles")] {
+                let r = ui.radio_value(&mut scene.draw, d, label);
+                changed |= w.add(ui, &format!("Draw {label}"), &r) && r.changed();
+            }
+        });
+        changed |= w.slider(ui, "Tile size", &mut scene.tile, 1..=16, "tile (px)", false);
     });
     ui.separator();
     let mut volume = scene.mode == Mode::Volume;

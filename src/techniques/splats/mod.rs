@@ -22,6 +22,11 @@
 //!   them per layer; here k nearest neighbours (kiddo's k-d tree) and PCA, one tree
 //!   per layer id, in parallel; flipped toward the eye at draw time
 //!   ([`normals::orient_toward`]).
+//! - **Tiles** ([`tiles`], [`tiled`]): `draw = "tiles"` (precise, GLSL) builds, per
+//!   frame the camera moved, a back-to-front list of splats per screen tile in parallel
+//!   on the CPU and composites each pixel from its tile's list in one gather pass: the
+//!   same splats without the per-point setup cost of `GL_POINTS` on software drivers
+//!   (README, "Splats": 11.8x VTK's point Gaussian mapper where points reach 3.3x).
 //! - **Reference** ([`reference`](mod@reference)): the f64 compositing of the same splats (GL's point
 //!   clipping, size clamping and point-sprite coverage; the seed's footprints as
 //!   written beside precise ones) that the renderer is scored against.

@@ -405,6 +405,8 @@ impl Renderer for SplatsRenderer {
             )));
         };
         new.validate().map_err(|e| GlError::Data(e.to_string()))?;
+        new.draw_allowed(self.fidelity, crate::gl::ProgramChoice::Auto)
+            .map_err(|e| GlError::Data(e.to_string()))?;
         let p = &self.params;
         if new.cloud != p.cloud {
             *self = SplatsRenderer::new(gpu, self.kind, self.fidelity, new, &self.base.clone())?;
@@ -429,6 +431,11 @@ impl Renderer for SplatsRenderer {
                 from_cloud(&self.cloud, new, self.normals.clone()).map_err(GlError::Data)?;
             return self.install(gpu);
         }
+        // Tiles bake sizes into the lists and the transfer function into the colours.
+        if let Some(state) = &mut self.tiles {
+            state.lists_for = None;
+            state.colours_for = None;
+        }
         self.send_constants(gpu)
     }
 
@@ -444,12 +451,17 @@ impl Renderer for SplatsRenderer {
                 self.prepared.len()
             ));
         }
-        let tiles = match &self.tiles {
-            None => String::new(),
-            Some(TileState {
-                entries: Ok(n), ..
-            }) => format!(
-                "; tiles of {} px: {n} list entries, last lists {:.1} ms",
+        let points = format!("{drawn} of {} points drawn", self.prepared.len());
+        let sort = format!(
+            "last sort ({:?}): {:.1} ms",
+            self.params.sort,
+            self.last_sort.as_secs_f64() * 1e3
+        );
+        Some(match &self.tiles {
+            None => format!("{points}; {sort}"),
+            Some(TileState { entries: Ok(n), .. }) => format!(
+                "{points} as tiles of {} px: {n} list entries, placed, binned and ordered \
+                 per tile: last lists {:.1} ms",
                 self.params.tile,
                 self.last_bin.as_secs_f64() * 1e3
             ),
@@ -457,14 +469,9 @@ impl Renderer for SplatsRenderer {
                 entries: Err(TooManyEntries(n)),
                 ..
             }) => format!(
-                "; tiles would need {n} list entries (more than {DEFAULT_MAX_ENTRIES}): drawn as points"
+                "{points}; tiles would need {n} list entries (more than \
+                 {DEFAULT_MAX_ENTRIES}): drawn as points; {sort}"
             ),
-        };
-        Some(format!(
-            "{drawn} of {} points drawn; last sort ({:?}): {:.1} ms{tiles}",
-            self.prepared.len(),
-            self.params.sort,
-            self.last_sort.as_secs_f64() * 1e3
-        ))
+        })
     }
 }

@@ -3,19 +3,21 @@
 //! ([`super::sort::time_methods`]: the seed's comparator sort of structs, keys, the
 //! parallel radix sort, a cache hit), and the frame time of the `splats-section` demo with
 //! each sort method while the camera turns 1° per frame (so every frame sorts and uploads,
-//! as a user's drag does), with the sort's share of it. For clouds up to 2 M points also
-//! the f64 references' time and weighted blended OIT's error against exact order, and the
-//! normals' estimation time.
+//! as a user's drag does), with the sort's share of it; then the same demo in precise
+//! mode drawn as points and as tiles (`draw = "tiles"`, each tile size), where the
+//! order's share is the tile lists' time. For clouds up to 2 M points also the f64
+//! references' time and weighted blended OIT's error against exact order, and the normals'
+//! estimation time.
 
 use std::time::Instant;
 
-use super::scene::SortChoice;
+use super::scene::{DrawChoice, SortChoice};
 use super::sort::time_methods;
 use crate::camera::{Camera, Projection};
 use crate::gl::{Headless, Surface, Target};
 use crate::points::section::{generate, SectionSpec};
 use crate::points::{PointCloud, PointSource};
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::{Fidelity, Scene, TechniqueScene};
 use crate::techniques::{self, Frame};
 
 /// What to sweep.
@@ -56,11 +58,12 @@ pub struct SortRow {
 /// One frame timing.
 #[derive(Debug, Clone)]
 pub struct FrameRow {
-    /// Sort choice.
+    /// What was drawn: the sort choice, with the fidelity and draw where not the demo's.
     pub sort: String,
-    /// Median milliseconds per frame (sort + upload + clear + draw + finish).
+    /// Median milliseconds per frame (order + upload + clear + draw + finish).
     pub ms: f64,
-    /// Median milliseconds of the sort and upload within it.
+    /// Median milliseconds of the order (the sort, or the tile lists) and upload within
+    /// it.
     pub sort_ms: f64,
 }
 
@@ -139,7 +142,8 @@ fn accuracy(cloud: &PointCloud, camera: &Camera, size: [u32; 2]) -> Vec<(String,
 }
 
 /// The frame timings (GPU) of the `splats-section` demo at `options.frame_points`, one
-/// per sort choice, the camera turning 1° about the vertical axis each frame.
+/// per sort choice, then precise points and tiles (tile sides 1 to 4), the camera turning
+/// 1° about the vertical axis each frame.
 pub fn frames(
     headless: &Headless,
     options: &Options,
@@ -155,23 +159,54 @@ pub fn frames(
         points: options.frame_points,
         seed: 1,
     });
-    let base = params.clone();
-    let kind = scene.programs.resolve(gpu);
-    let mut renderer = techniques::build(gpu, &scene, kind)?;
-    let [w, h] = scene.size;
-    let target = Target::create(gpu, w, h, scene.target_format(), renderer.needs_depth())?;
-    let mut rows = Vec::new();
-    for sort in [
+    let base = (**params).clone();
+    let mut settings: Vec<(String, Fidelity, super::SplatsScene)> = [
         SortChoice::Seed,
         SortChoice::Keys,
         SortChoice::Radix,
         SortChoice::None,
         SortChoice::Oit,
-    ] {
-        let mut p = base.clone();
-        p.sort = sort;
-        renderer.update(gpu, &TechniqueScene::Splats(p))?;
-        let (mut times, mut sort_times) = (Vec::new(), Vec::new());
+    ]
+    .into_iter()
+    .map(|sort| {
+        let p = super::SplatsScene {
+            sort,
+            ..base.clone()
+        };
+        (format!("{sort:?}").to_lowercase(), scene.fidelity, p)
+    })
+    .collect();
+    settings.push(("radix (precise)".into(), Fidelity::Precise, base.clone()));
+    for tile in [1, 2, 3, 4] {
+        let p = super::SplatsScene {
+            draw: DrawChoice::Tiles,
+            tile,
+            ..base.clone()
+        };
+        settings.push((format!("tiles {tile}px (precise)"), Fidelity::Precise, p));
+    }
+    let [w, h] = scene.size;
+    let mut rows = Vec::new();
+    let mut built: Option<(Fidelity, Box<dyn techniques::Renderer>)> = None;
+    for (name, fidelity, p) in settings {
+        let renderer = match &mut built {
+            Some((f, r)) if *f == fidelity => {
+                r.update(gpu, &TechniqueScene::Splats(Box::new(p)))?;
+                r
+            }
+            _ => {
+                let mut s = scene.clone();
+                s.fidelity = fidelity;
+                s.technique = TechniqueScene::Splats(Box::new(p));
+                let kind = s.programs.resolve(gpu);
+                &mut built
+                    .insert((fidelity, techniques::build(gpu, &s, kind)?))
+                    .1
+            }
+        };
+        let format = scene.target.unwrap_or(fidelity.default_target());
+        let target = Target::create(gpu, w, h, format, renderer.needs_depth())?;
+        let (mut times, mut order_times) = (Vec::new(), Vec::new());
         let mut camera = scene.camera;
         for i in 0..=options.runs.max(1) {
             let turn = glam::DQuat::from_rotation_y(1f64.to_radians());
@@ -187,22 +222,16 @@ pub fn frames(
             gpu.finish();
             if i > 0 {
                 times.push(t0.elapsed().as_secs_f64() * 1e3);
-                // File order and OIT do not sort (the status keeps the last sort's time).
-                let sorted = !matches!(sort, SortChoice::None | SortChoice::Oit);
-                sort_times.push(if sorted {
-                    sort_ms(renderer.status().as_deref())
-                } else {
-                    0.0
-                });
+                order_times.push(order_ms(renderer.status().as_deref()));
             }
         }
         let row = FrameRow {
-            sort: format!("{sort:?}").to_lowercase(),
+            sort: name,
             ms: median(&mut times),
-            sort_ms: median(&mut sort_times),
+            sort_ms: median(&mut order_times),
         };
         progress(&format!(
-            "{:<6} {:>9.1} ms/frame, of which sort and upload {:>7.1} ms",
+            "{:<26} {:>9.1} ms/frame, of which order and upload {:>7.1} ms",
             row.sort, row.ms, row.sort_ms
         ));
         rows.push(row);
@@ -210,13 +239,19 @@ pub fn frames(
     Ok(rows)
 }
 
-/// The sort time the renderer's status line reports (`... last sort (Radix): 3.2 ms`),
-/// 0 where it reports none (OIT).
-fn sort_ms(status: Option<&str>) -> f64 {
-    status
-        .and_then(|s| s.rsplit_once("): "))
-        .and_then(|(_, t)| t.trim_end_matches(" ms").parse().ok())
-        .unwrap_or(0.0)
+/// The order's time in the renderer's status line: `last lists 21.3 ms` (tiles), else
+/// `last sort (Radix): 3.2 ms`; 0 where it reports neither (OIT, file order).
+fn order_ms(status: Option<&str>) -> f64 {
+    let Some(s) = status else { return 0.0 };
+    let after = |marker: &str| {
+        let rest = &s[s.find(marker)? + marker.len()..];
+        let number = rest.split(" ms").next()?;
+        number.trim().parse().ok()
+    };
+    if s.contains("OIT") || s.contains("(None)") {
+        return 0.0;
+    }
+    after("last lists ").or_else(|| after("): ")).unwrap_or(0.0)
 }
 
 fn median(v: &mut [f64]) -> f64 {
@@ -230,7 +265,7 @@ pub fn to_csv(sorts: &[SortRow], frames: &[FrameRow]) -> (String, String) {
     for r in sorts {
         s += &format!("{},\"{}\",{:.3}\n", r.points, r.method, r.ms);
     }
-    let mut f = String::from("sort,ms_per_frame,sort_and_upload_ms\n");
+    let mut f = String::from("drawn,ms_per_frame,order_and_upload_ms\n");
     for r in frames {
         f += &format!("{},{:.3},{:.3}\n", r.sort, r.ms, r.sort_ms);
     }
@@ -240,10 +275,15 @@ pub fn to_csv(sorts: &[SortRow], frames: &[FrameRow]) -> (String, String) {
 #[cfg(test)]
 mod tests {
     #[test]
-    fn the_status_line_gives_the_sort_time() {
+    fn the_status_line_gives_the_order_time() {
         let s = "570000 of 570000 points drawn; last sort (Radix): 3.2 ms";
-        assert_eq!(super::sort_ms(Some(s)), 3.2);
-        assert_eq!(super::sort_ms(Some("weighted blended OIT (no sort)")), 0.0);
-        assert_eq!(super::sort_ms(None), 0.0);
+        assert_eq!(super::order_ms(Some(s)), 3.2);
+        let tiles = "570000 of 570000 points drawn as tiles of 2 px: 774448 list entries, \
+                     placed, binned and ordered per tile: last lists 21.3 ms";
+        assert_eq!(super::order_ms(Some(tiles)), 21.3);
+        assert_eq!(super::order_ms(Some("weighted blended OIT (no sort)")), 0.0);
+        let none = "570000 of 570000 points drawn; last sort (None): 0.0 ms";
+        assert_eq!(super::order_ms(Some(none)), 0.0);
+        assert_eq!(super::order_ms(None), 0.0);
     }
 }

@@ -139,6 +139,13 @@ impl TilePass {
             0,
             [self.tile as f64, self.across as f64, kernel[0], kernel[1]],
         )?;
+        // Window coordinates count from the window's corner; the lists from the view's.
+        let origin = match surface {
+            Surface::Target(_) => [0, 0],
+            Surface::Window([x, y, _, _]) => [x, y],
+        };
+        self.program
+            .set_local(gpu, 1, [origin[0] as f64, origin[1] as f64, 0.0, 0.0])?;
         gl::draw(
             gpu,
             surface,

@@ -12,19 +12,21 @@
 //!
 //! # How
 //!
-//! 1. [`place_splats`]: each visible point, in file order, placed where GL draws it, in
-//!    f32 as the vertex program computes it: clip position by the camera's matrix,
-//!    points outside the clip volume (or at or behind the eye) dropped, size by the
-//!    seed's rule clamped to `[1, 255]`, window position; with its depth key
-//!    ([`View::key`], the sorts' key: larger is farther).
+//! 0. [`spatial_order`] (once per scene): the visible points in Morton order, so that
+//!    what follows reads and writes memory mostly in order whatever the file's order.
+//! 1. [`place_splats`]: each point placed where GL draws it, in f32 as the vertex
+//!    program computes it: clip position by the camera's matrix, points outside the
+//!    clip volume (or at or behind the eye) dropped, size by the seed's rule clamped to
+//!    `[1, 255]` (llvmpipe's point size range), window position; with its depth key
+//!    ([`View::key`], the sorts' key: larger is farther), the tiles it touches, and the
+//!    bands of tile rows it reaches.
 //! 2. [`bin`]: the screen cut into square tiles of `tile` pixels; each splat is listed
 //!    in every tile its covered pixels touch (the reference's half-open square, widened
 //!    by [`MARGIN`] pixels so rounding cannot miss a pixel: the program decides coverage
-//!    exactly). Bands of tile rows, one per thread and balanced by their entries, each
-//!    count then fill their own part of one array in file order, then sort each tile's
-//!    list back to front by key (stable: ties stay in index order, the rule of every
-//!    sort method). No global sort is needed: within a tile this is the global order.
-//!    `ordered = false` keeps file order (as `sort = "none"`).
+//!    exactly). Bands of tile rows, several per thread, each count then fill their own
+//!    part of one array, then sort each tile's list back to front by key, ties by point
+//!    index (the rule of every sort method). No global sort is needed: within a tile
+//!    this is the global order. `ordered = false` gives index order (`sort = "none"`).
 //! 3. [`point_colours`]: each point's RGBA (the precise programs' colour, lighting and
 //!    transfer alpha, [`rgba_of`]) in f32, recomputed only when lighting makes it
 //!    depend on the view.
@@ -47,8 +49,9 @@ use crate::scene::Fidelity;
 /// positions is far below it; the program's exact test decides).
 pub const MARGIN: f32 = 1.0 / 64.0;
 
-/// Default tile side in pixels (the fastest of 1, 2, 3, 4 and 8 for 1.3-pixel splats at
-/// 1600x900 on llvmpipe; README, "Splats").
+/// Default tile side in pixels: for 1.3-pixel splats at 1600x900 on llvmpipe, the camera
+/// turning, tiles of 1, 2, 3, 4 and 8 pixels took 75, 75, 95, 106 and over 137 ms per
+/// frame; 2 lists a quarter fewer entries than 1.
 pub const DEFAULT_TILE: u32 = 2;
 
 /// Default bound on list entries (16 M entries, 256 MiB).
@@ -416,9 +419,10 @@ impl Binner {
                 keys[*c] = part.keys[k];
                 *c += 1;
             });
+            let mut scratch = Vec::new();
             for w in in_band.windows(2) {
                 let [a, b] = [w[0], w[1]].map(|o| o as usize - band.start);
-                back_to_front(&mut entries[a..b], &mut keys[a..b], ordered);
+                back_to_front(&mut entries[a..b], &mut keys[a..b], ordered, &mut scratch);
             }
         });
         self.lists.tile = placed.tile.max(1);
@@ -473,20 +477,29 @@ fn for_each_tile(
 
 /// Sort one tile's list back to front: by key, largest (farthest) first, ties by point
 /// index (the sorts' rule); by point index alone when not `ordered` (file order).
-fn back_to_front(entries: &mut [[u32; 4]], keys: &mut [f32], ordered: bool) {
-    let before = |(ka, a): (f32, u32), (kb, b): (f32, u32)| {
-        let by_key = if ordered {
-            kb.total_cmp(&ka)
-        } else {
-            std::cmp::Ordering::Equal
-        };
-        by_key.then(a.cmp(&b))
+/// `scratch` is reused from tile to tile (no allocation per tile).
+fn back_to_front(
+    entries: &mut [[u32; 4]],
+    keys: &mut [f32],
+    ordered: bool,
+    scratch: &mut Vec<(u32, u32, [u32; 4])>,
+) {
+    // One integer per key that orders as the key does, largest first (flip the bits of
+    // the positive floats, all bits of the negative ones).
+    let rank = |k: f32| -> u32 {
+        if !ordered {
+            return 0;
+        }
+        let b = k.to_bits();
+        let ascending = if b >> 31 == 1 { !b } else { b | 1 << 31 };
+        !ascending
     };
-    if entries.len() <= 32 {
+    if entries.len() <= 16 {
         for i in 1..entries.len() {
             let (e, k) = (entries[i], keys[i]);
+            let key = (rank(k), e[3]);
             let mut j = i;
-            while j > 0 && before((k, e[3]), (keys[j - 1], entries[j - 1][3])).is_lt() {
+            while j > 0 && key < (rank(keys[j - 1]), entries[j - 1][3]) {
                 entries[j] = entries[j - 1];
                 keys[j] = keys[j - 1];
                 j -= 1;
@@ -496,12 +509,16 @@ fn back_to_front(entries: &mut [[u32; 4]], keys: &mut [f32], ordered: bool) {
         }
         return;
     }
-    let mut order: Vec<usize> = (0..entries.len()).collect();
-    order.sort_unstable_by(|&a, &b| before((keys[a], entries[a][3]), (keys[b], entries[b][3])));
-    let sorted: Vec<([u32; 4], f32)> = order.iter().map(|&i| (entries[i], keys[i])).collect();
-    for (i, (e, k)) in sorted.into_iter().enumerate() {
-        entries[i] = e;
-        keys[i] = k;
+    scratch.clear();
+    scratch.extend(
+        entries
+            .iter()
+            .zip(keys.iter())
+            .map(|(e, &k)| (rank(k), e[3], *e)),
+    );
+    scratch.sort_unstable_by_key(|&(r, point, _)| (r, point));
+    for (slot, &(_, _, e)) in entries.iter_mut().zip(scratch.iter()) {
+        *slot = e;
     }
 }
 
