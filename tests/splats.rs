@@ -48,14 +48,8 @@ fn gpu_matches_the_f64_reference() {
             let gpu = rgb_only(&draw(&h, &c, &p, fidelity, cam));
             let cpu = rgb_only(&reference(&c, &p, fidelity, &cam));
             let d = gpu.compare(&cpu, 0.0).unwrap();
-            let mut errs: Vec<f32> = gpu
-                .data
-                .iter()
-                .zip(&cpu.data)
-                .map(|(a, b)| (a - b).abs())
-                .collect();
-            errs.sort_by(f32::total_cmp);
-            let q = |f: f64| errs[((errs.len() - 1) as f64 * f) as usize];
+            let errs = errors(&gpu, &cpu);
+            let q = |f: f64| quantile(&errs, f);
             eprintln!(
                 "{fidelity:?} {projection:?} [{}]: rmse {:.5} max {:.4} p99 {:.5} p999 {:.5}",
                 text.replace('\n', " "),

@@ -29,22 +29,6 @@ fn tiles(text: &str) -> String {
     format!("{text}\ndraw = \"tiles\"")
 }
 
-/// Per-value absolute errors, sorted, and the largest.
-fn errors(a: &Image, b: &Image) -> Vec<f32> {
-    let mut e: Vec<f32> = a
-        .data
-        .iter()
-        .zip(&b.data)
-        .map(|(x, y)| (x - y).abs())
-        .collect();
-    e.sort_by(f32::total_cmp);
-    e
-}
-
-fn quantile(sorted: &[f32], q: f64) -> f32 {
-    sorted[((sorted.len() - 1) as f64 * q) as usize]
-}
-
 #[test]
 fn tiles_match_the_f64_reference_and_the_points() {
     let h = headless(Backend::Egl);

@@ -134,3 +134,20 @@ pub fn rgb_only(image: &Image) -> Image {
     out.data.chunks_exact_mut(4).for_each(|p| p[3] = 1.0);
     out
 }
+
+/// Per-value absolute differences of two images, sorted (the last is the largest).
+pub fn errors(a: &Image, b: &Image) -> Vec<f32> {
+    let mut e: Vec<f32> = a
+        .data
+        .iter()
+        .zip(&b.data)
+        .map(|(x, y)| (x - y).abs())
+        .collect();
+    e.sort_by(f32::total_cmp);
+    e
+}
+
+/// The `q` quantile of sorted values.
+pub fn quantile(sorted: &[f32], q: f64) -> f32 {
+    sorted[((sorted.len() - 1) as f64 * q) as usize]
+}

@@ -148,6 +148,17 @@ impl Default for SplatParams {
     }
 }
 
+impl SplatParams {
+    /// Splats of `point_size` (factor 1, GL's default size range) with `footprint`.
+    pub fn sized(footprint: Footprint, point_size: f64) -> SplatParams {
+        SplatParams {
+            point_size,
+            footprint,
+            ..SplatParams::default()
+        }
+    }
+}
+
 /// The eye in object space (perspective), `R⁻¹ (0, 0, d)`.
 pub fn eye_position(camera: &Camera) -> Option<DVec3> {
     (camera.projection == Projection::Perspective)

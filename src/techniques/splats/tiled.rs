@@ -63,6 +63,26 @@ fn array_texture(
     Texture::new(gpu, label, extent, format, Filter::Nearest, data)
 }
 
+/// Put `data` (whole texels of `format`) into `slot`'s array texture, grown as needed.
+fn upload(
+    gpu: &Gpu,
+    slot: &mut Option<Texture>,
+    label: &str,
+    format: TexelFormat,
+    data: TexelData<'_>,
+) -> GlResult<()> {
+    let words = match data {
+        TexelData::U8(d) => d.len() / 4,
+        TexelData::F32(d) => d.len(),
+        TexelData::U32(d) => d.len(),
+    };
+    let texels = words * 4 / format.bytes();
+    let t = array_texture(gpu, slot.take(), label, format, texels)?;
+    t.update_texels(gpu, data)?;
+    *slot = Some(t);
+    Ok(())
+}
+
 impl TilePass {
     /// The program and quad; textures come with the first lists and colours.
     pub fn new(gpu: &Gpu) -> GlResult<TilePass> {
@@ -87,38 +107,34 @@ impl TilePass {
 
     /// Upload every point's RGBA (by point index).
     pub fn set_colours(&mut self, gpu: &Gpu, colours: &[[f32; 4]]) -> GlResult<()> {
-        let t = array_texture(
+        let data = TexelData::F32(colours.as_flattened());
+        upload(
             gpu,
-            self.colours.take(),
+            &mut self.colours,
             "splat colours",
             TexelFormat::Rgba32f,
-            colours.len(),
-        )?;
-        t.update_texels(gpu, TexelData::F32(colours.as_flattened()))?;
-        self.colours = Some(t);
-        Ok(())
+            data,
+        )
     }
 
     /// Upload the lists of a frame.
     pub fn set_lists(&mut self, gpu: &Gpu, lists: &TileLists) -> GlResult<()> {
-        let offsets = array_texture(
+        let data = TexelData::U32(&lists.offsets);
+        upload(
             gpu,
-            self.offsets.take(),
+            &mut self.offsets,
             "splat tile offsets",
             TexelFormat::R32ui,
-            lists.offsets.len(),
+            data,
         )?;
-        offsets.update_texels(gpu, TexelData::U32(&lists.offsets))?;
-        self.offsets = Some(offsets);
-        let entries = array_texture(
+        let data = TexelData::U32(lists.entries.as_flattened());
+        upload(
             gpu,
-            self.entries.take(),
+            &mut self.entries,
             "splat tile lists",
             TexelFormat::Rgba32ui,
-            lists.entries.len(),
+            data,
         )?;
-        entries.update_texels(gpu, TexelData::U32(lists.entries.as_flattened()))?;
-        self.entries = Some(entries);
         self.tile = lists.tile;
         self.across = lists.tiles[0];
         Ok(())

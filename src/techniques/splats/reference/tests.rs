@@ -5,12 +5,7 @@ use crate::techniques::splats::sort::{keys_order, View};
 const BG: [f64; 4] = [0.0, 0.0, 0.1, 1.0];
 
 fn params(footprint: Footprint, point_size: f64) -> SplatParams {
-    SplatParams {
-        point_size,
-        factor: 1.0,
-        footprint,
-        size_range: [1.0, 255.0],
-    }
+    SplatParams::sized(footprint, point_size)
 }
 
 fn scene<'a>(

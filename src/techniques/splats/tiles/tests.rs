@@ -32,12 +32,7 @@ fn camera(projection: Projection) -> Camera {
 }
 
 fn params(footprint: Footprint, point_size: f64) -> SplatParams {
-    SplatParams {
-        point_size,
-        factor: 1.0,
-        footprint,
-        size_range: [1.0, 255.0],
-    }
+    SplatParams::sized(footprint, point_size)
 }
 
 fn all(positions: &[[f32; 3]]) -> SpatialPoints {
