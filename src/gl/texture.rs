@@ -317,6 +317,24 @@ impl Texture {
         Ok(texture)
     }
 
+    /// An uninitialized `width` x `height` 2D texture of `format` to fill later
+    /// ([`Texture::update_texels`]): no copy of zeros in memory first.
+    pub fn empty_2d(
+        gpu: &Gpu,
+        label: &str,
+        width: u32,
+        height: u32,
+        format: TexelFormat,
+    ) -> GlResult<Texture> {
+        let texture = Texture::render_target(gpu, width, height, format)?;
+        gpu.record(
+            "texture",
+            format!("{label} {:?} {}", texture.extent, format.name()),
+            (width as u64) * (height as u64) * format.bytes() as u64,
+        );
+        Ok(texture)
+    }
+
     /// An uninitialized `width` x `height` 2D texture of `format` (immutable storage,
     /// nearest filtering, clamp to edge) to render into: a [`super::Target`]'s colour,
     /// which records it among the resources (this does not).
@@ -376,7 +394,8 @@ impl Texture {
         let (internal, fmt, ty) = self.format.gl();
         let gl = &self.gl;
         let target = self.extent.target();
-        // SAFETY: size checked; unit 0's binding is restored.
+        // SAFETY: size checked; the texture is bound on unit 0 only while filled (unbound
+        // after), and the active unit is restored.
         unsafe {
             let prev_active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
             gl.active_texture(glow::TEXTURE0);
@@ -426,8 +445,9 @@ impl Texture {
         let (whole, part) = bytes.split_at(bytes.len() / row * row);
         let (_, fmt, ty) = self.format.gl();
         let gl = &self.gl;
-        // SAFETY: sizes checked above (whole rows, then one partial row below them);
-        // unit 0's binding is restored.
+        // SAFETY: sizes checked above (whole rows, then one partial row below them); the
+        // texture is bound on unit 0 only while filled (unbound after), and the active
+        // unit is restored.
         unsafe {
             let prev_active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
             gl.active_texture(glow::TEXTURE0);

@@ -7,8 +7,8 @@ use glam::DMat4;
 
 use super::tiles::TileLists;
 use crate::gl::{
-    self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Primitive, Program,
-    ProgramKind, Surface, TexelData, TexelFormat, Texture,
+    self, Blend, DrawCall, Extent, GlError, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind,
+    Surface, TexelData, TexelFormat, Texture,
 };
 use crate::programs;
 use crate::techniques::quad::quad_vertices;
@@ -29,7 +29,8 @@ pub struct TilePass {
 }
 
 /// A 2D array texture of at least `texels` texels of `format`, `ROW` wide: `current`
-/// when it is big enough, else a new one with a quarter to spare (zero-filled).
+/// when it is big enough, else a new one with a quarter to spare (uninitialized: only
+/// what is uploaded is read).
 fn array_texture(
     gpu: &Gpu,
     current: Option<Texture>,
@@ -53,14 +54,8 @@ fn array_texture(
         )));
     }
     let rows = (rows + rows / 4).min(max);
-    let extent = Extent::D2(ROW as u32, rows as u32);
-    let words = ROW * rows * format.bytes() / 4;
-    let data = match format {
-        TexelFormat::Rgba32f => TexelData::F32(&vec![0.0; words]),
-        _ => TexelData::U32(&vec![0; words]),
-    };
-    // The old texture is dropped (freed) before the new one is filled.
-    Texture::new(gpu, label, extent, format, Filter::Nearest, data)
+    // The old texture is dropped (freed) before the new one is made.
+    Texture::empty_2d(gpu, label, ROW as u32, rows as u32, format)
 }
 
 /// Put `data` (whole texels of `format`) into `slot`'s array texture, grown as needed.

@@ -205,6 +205,8 @@ struct PlacedPart {
     rects: Vec<[u32; 4]>,
     /// Per band, the splats (indices into this part) that reach it, in order.
     bands: Vec<Vec<u32>>,
+    /// List entries these splats make (the tiles of their rects).
+    entries: u64,
 }
 
 impl Placed {
@@ -262,7 +264,10 @@ pub fn place_splats(
                 splats: Vec::with_capacity(n),
                 keys: Vec::with_capacity(n),
                 rects: Vec::with_capacity(n),
-                bands: vec![Vec::with_capacity(2 * n / band_count.max(1) + 16); band_count],
+                bands: (0..band_count)
+                    .map(|_| Vec::with_capacity(2 * n / band_count.max(1) + 16))
+                    .collect(),
+                entries: 0,
             };
             for (p, &i) in chunk.iter().zip(index) {
                 let q = Vec3::from_array(*p);
@@ -275,6 +280,8 @@ pub fn place_splats(
                     Some(e) => point_size / q.distance(e) * factor,
                     None => point_size * factor,
                 };
+                // The reference's rule: a NaN size draws nothing, others are clamped.
+                let s = if s.is_nan() { s } else { s.max(lo).min(hi) };
                 let drawn = s > 0.0;
                 if !inside || !drawn {
                     continue;
@@ -283,10 +290,11 @@ pub fn place_splats(
                 let splat = ScreenSplat {
                     x: (ndc.x + 1.0) / 2.0 * w,
                     y: (ndc.y + 1.0) / 2.0 * h,
-                    size: s.max(lo).min(hi),
+                    size: s,
                     point: i,
                 };
                 let rect = splat.tiles(size, tile);
+                part.entries += (rect[1] - rect[0]) as u64 * (rect[3] - rect[2]) as u64;
                 let k = part.splats.len() as u32;
                 if rect[2] < rect[3] {
                     let first = (rect[2] / band_rows) as usize;
@@ -376,6 +384,12 @@ impl Binner {
         let tiles = placed.tiles();
         let across = tiles[0] as usize;
         let bands = placed.bands();
+        // The bound first: a close-up of large splats must not count billions of entries
+        // to learn that it is drawn as points.
+        let needed: u64 = placed.parts.iter().map(|p| p.entries).sum();
+        if needed > max_entries.min(u32::MAX as usize) as u64 {
+            return Err(TooManyEntries(needed));
+        }
         // Count per tile, each band its own rows.
         self.counts.clear();
         self.counts.resize(across * tiles[1] as usize, 0);
@@ -386,10 +400,6 @@ impl Binner {
                 let counts = band.part;
                 for_each_tile(placed, rows, across, |_, _, t| counts[t] += 1);
             });
-        let needed: u64 = self.counts.iter().map(|&c| c as u64).sum();
-        if needed > max_entries.min(u32::MAX as usize) as u64 {
-            return Err(TooManyEntries(needed));
-        }
         let offsets = &mut self.lists.offsets;
         offsets.clear();
         let mut total = 0u32;
