@@ -217,6 +217,20 @@ fn lists_are_bounded_and_empty_inputs_give_empty_lists() {
     assert!(lists.entries.is_empty() && lists.offsets.iter().all(|&o| o == 0));
     let hidden = spatial_order(&positions, &vec![false; positions.len()]);
     assert!(hidden.positions.is_empty() && hidden.index.is_empty());
+    // Points at NaN or infinity are ordered (anywhere) and never placed.
+    let mut odd = positions.clone();
+    odd[0] = [f32::NAN, 0.0, 0.0];
+    odd[1] = [f32::INFINITY, 0.0, 0.0];
+    odd[2] = [0.0, f32::NEG_INFINITY, f32::NAN];
+    let spatial = all(&odd);
+    assert_eq!(spatial.index.len(), odd.len());
+    let small = params(Footprint::Disc, 3.0);
+    let placed = place_splats(&spatial, &cam, SIZE, 4, &small);
+    assert!(placed
+        .splats()
+        .all(|s| s.point > 2 && s.x.is_finite() && s.y.is_finite()));
+    assert!(placed.splats().count() > 40);
+    assert!(bin(&placed, DEFAULT_MAX_ENTRIES, true).is_ok());
     for size in [[0, 0], [0, 5], [9, 0]] {
         let placed = place_splats(&all(&positions), &cam, size, 4, &big);
         let lists = bin(&placed, 10, true).unwrap();
