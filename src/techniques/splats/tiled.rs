@@ -1,5 +1,6 @@
 //! The GL half of `draw = "tiles"`: the [`super::tiles`] lists and the point colours
-//! in three textures, composited by `splats/tiles.frag` over one full-screen quad,
+//! in three textures, composited by `splats/tiles.frag` over the blocks of tiles that
+//! hold any splat (quads of whole pixels; the rest of the view would add nothing),
 //! blended `ONE, ONE_MINUS_SRC_ALPHA` over the cleared target. GLSL only (ARB fragment
 //! programs have no loops). All textures are freed on Drop.
 
@@ -11,15 +12,18 @@ use crate::gl::{
     Surface, TexelData, TexelFormat, Texture,
 };
 use crate::programs;
-use crate::techniques::quad::quad_vertices;
 
 /// Texels per row of the array textures (`ROW` in `tiles.frag`).
 pub const ROW: usize = 4096;
 
-/// The gather program, its quad, and the textures of the current lists and colours.
+/// Tiles per side of the blocks the gather is drawn over.
+const BLOCK: u32 = 8;
+
+/// The gather program, the quads of the occupied blocks, and the textures of the
+/// current lists and colours.
 pub struct TilePass {
     program: Program,
-    quad: Mesh,
+    blocks: Mesh,
     offsets: Option<Texture>,
     entries: Option<Texture>,
     colours: Option<Texture>,
@@ -58,6 +62,21 @@ fn array_texture(
     Texture::empty_2d(gpu, label, ROW as u32, rows as u32, format)
 }
 
+/// Two triangles per occupied rectangle of `lists`, in normalized device coordinates
+/// (position x, y, 0, 1 then an unused texture coordinate), for the identity transform.
+fn block_vertices(lists: &TileLists) -> Vec<f32> {
+    let [w, h] = lists.size.map(|v| v.max(1) as f32);
+    let mut v = Vec::new();
+    for [x0, y0, x1, y1] in lists.occupied(BLOCK) {
+        let (a, b) = (x0 as f32 / w * 2.0 - 1.0, x1 as f32 / w * 2.0 - 1.0);
+        let (c, d) = (y0 as f32 / h * 2.0 - 1.0, y1 as f32 / h * 2.0 - 1.0);
+        for (x, y) in [(a, c), (b, c), (b, d), (a, c), (b, d), (a, d)] {
+            v.extend_from_slice(&[x, y, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0]);
+        }
+    }
+    v
+}
+
 /// Put `data` (whole texels of `format`) into `slot`'s array texture, grown as needed.
 fn upload(
     gpu: &Gpu,
@@ -79,7 +98,7 @@ fn upload(
 }
 
 impl TilePass {
-    /// The program and quad; textures come with the first lists and colours.
+    /// The program; the blocks and textures come with the first lists and colours.
     pub fn new(gpu: &Gpu) -> GlResult<TilePass> {
         let program = Program::new(
             gpu,
@@ -88,10 +107,10 @@ impl TilePass {
             &programs::SPLATS_TILES_FRAG,
         )?;
         program.set_transform(gpu, DMat4::IDENTITY)?;
-        let quad = Mesh::new(gpu, "splats tiles quad", &[4, 4], &quad_vertices())?;
+        let blocks = Mesh::new(gpu, "splats tile blocks", &[4, 4], &[])?;
         Ok(TilePass {
             program,
-            quad,
+            blocks,
             offsets: None,
             entries: None,
             colours: None,
@@ -130,6 +149,7 @@ impl TilePass {
             TexelFormat::Rgba32ui,
             data,
         )?;
+        self.blocks.update(gpu, &block_vertices(lists))?;
         self.tile = lists.tile;
         self.across = lists.tiles[0];
         Ok(())
@@ -145,6 +165,9 @@ impl TilePass {
                 "splat tiles drawn before lists and colours were uploaded".into(),
             ));
         };
+        if self.blocks.vertex_count() == 0 {
+            return Ok(());
+        }
         self.program.set_local(
             gpu,
             0,
@@ -162,7 +185,7 @@ impl TilePass {
             surface,
             &DrawCall {
                 program: &self.program,
-                mesh: &self.quad,
+                mesh: &self.blocks,
                 range: None,
                 textures: &[(0, offsets), (1, entries), (2, colours)],
                 blend: Blend::PremultipliedOver,

@@ -321,6 +321,8 @@ pub fn place_splats(
 /// Per-tile lists of splats, back to front.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct TileLists {
+    /// Image size in pixels.
+    pub size: [u32; 2],
     /// Tile side in pixels.
     pub tile: u32,
     /// Tiles across and up.
@@ -333,6 +335,43 @@ pub struct TileLists {
 }
 
 impl TileLists {
+    /// Pixel rectangles `[x0, y0, x1, y1)` covering every tile that holds an entry: the
+    /// blocks of `block` x `block` tiles with any, runs along a row merged. Pixels outside
+    /// them have empty lists, so the gather need not run there.
+    pub fn occupied(&self, block: u32) -> Vec<[u32; 4]> {
+        let block = block.max(1);
+        let [across, up] = self.tiles;
+        let empty = |tx: u32, ty: u32| {
+            let t = (ty * across + tx) as usize;
+            self.offsets[t] == self.offsets[t + 1]
+        };
+        let pixel = |t: u32, limit: u32| (t * self.tile).min(limit);
+        let mut rects: Vec<[u32; 4]> = Vec::new();
+        for by in (0..up).step_by(block as usize) {
+            let rows = by..(by + block).min(up);
+            let mut run: Option<u32> = None;
+            for bx in (0..across).step_by(block as usize).chain([across]) {
+                let cols = bx..(bx + block).min(across);
+                let any =
+                    bx < across && rows.clone().any(|ty| cols.clone().any(|tx| !empty(tx, ty)));
+                match (any, run) {
+                    (true, None) => run = Some(bx),
+                    (false, Some(start)) => {
+                        rects.push([
+                            pixel(start, self.size[0]),
+                            pixel(rows.start, self.size[1]),
+                            pixel(bx, self.size[0]),
+                            pixel(rows.end, self.size[1]),
+                        ]);
+                        run = None;
+                    }
+                    _ => {}
+                }
+            }
+        }
+        rects
+    }
+
     /// The entries of tile (`tx`, `ty`), back to front.
     pub fn list(&self, tx: u32, ty: u32) -> &[[u32; 4]] {
         let t = (ty * self.tiles[0] + tx) as usize;
@@ -435,6 +474,7 @@ impl Binner {
                 back_to_front(&mut entries[a..b], &mut keys[a..b], ordered, &mut scratch);
             }
         });
+        self.lists.size = placed.size;
         self.lists.tile = placed.tile.max(1);
         self.lists.tiles = tiles;
         Ok(())

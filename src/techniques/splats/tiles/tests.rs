@@ -241,3 +241,49 @@ fn lists_are_bounded_and_empty_inputs_give_empty_lists() {
         );
     }
 }
+
+#[test]
+fn occupied_blocks_cover_every_listed_tile_and_skip_empty_ones() {
+    // A sparse cloud: 30 small splats on the odd-sized image.
+    let (positions, _) = random_cloud(30, 17);
+    let cam = camera(Projection::Orthographic);
+    for (tile, block) in [(1, 1), (2, 3), (4, 2), (5, 2)] {
+        let lists = lists_of(&positions, &cam, &params(Footprint::Disc, 2.0), tile);
+        let rects = lists.occupied(block);
+        let inside = |x: u32, y: u32| {
+            rects
+                .iter()
+                .filter(|r| r[0] <= x && x < r[2] && r[1] <= y && y < r[3])
+                .count()
+        };
+        let mut covered = 0;
+        for y in 0..SIZE[1] {
+            for x in 0..SIZE[0] {
+                let n = inside(x, y);
+                assert!(n <= 1, "pixel ({x}, {y}) in {n} rectangles");
+                covered += n;
+                if !lists.list(x / tile, y / tile).is_empty() {
+                    assert_eq!(n, 1, "tile {tile} block {block}: pixel ({x}, {y}) left out");
+                }
+            }
+        }
+        // Every rectangle holds a listed tile; sparse splats leave most pixels out.
+        for r in &rects {
+            assert!(r[0] < r[2] && r[1] < r[3] && r[2] <= SIZE[0] && r[3] <= SIZE[1]);
+            let listed = (r[1]..r[3])
+                .any(|y| (r[0]..r[2]).any(|x| !lists.list(x / tile, y / tile).is_empty()));
+            assert!(listed, "{r:?} holds no splat");
+        }
+        assert!(
+            covered < (SIZE[0] * SIZE[1]) as usize,
+            "tile {tile} block {block}"
+        );
+    }
+    // Nothing listed: no rectangles.
+    let none = bin(
+        &place_splats(&all(&[]), &cam, SIZE, 2, &params(Footprint::Disc, 2.0)),
+        10,
+        true,
+    );
+    assert!(none.unwrap().occupied(4).is_empty());
+}
