@@ -51,14 +51,9 @@ fn main() -> anyhow::Result<()> {
             gpu,
             Surface::Target(&target),
             &DrawCall {
-                program: &program,
-                mesh: &mesh,
-                range: None,
-                textures: &[],
                 blend: Blend::Over,
-                depth_test: false,
-                cull_back: false,
                 primitive: Primitive::Points,
+                ..DrawCall::new(&program, &mesh)
             },
         )?;
         gpu.finish();

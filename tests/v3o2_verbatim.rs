@@ -5,7 +5,7 @@
 mod common;
 
 use arbvis::gl::{
-    draw, Backend, Blend, DrawCall, Extent, Filter, Mesh, Program, ProgramKind, Surface, Target,
+    draw, Backend, DrawCall, Extent, Filter, Mesh, Program, ProgramKind, Surface, Target,
     TargetFormat, TexelData, TexelFormat, Texture,
 };
 use arbvis::programs;
@@ -102,14 +102,9 @@ fn hand_computed_sum_pixel(backend: Backend) {
         gpu,
         Surface::Target(&target),
         &DrawCall {
-            program: &program,
-            mesh: &mesh,
-            range: None,
             textures: &[(0, &vol), (2, &lut1), (3, &lut2), (4, &lut3)],
-            blend: Blend::Replace,
-            depth_test: false,
-            cull_back: false,
             primitive: Default::default(),
+            ..DrawCall::new(&program, &mesh)
         },
     )
     .unwrap();

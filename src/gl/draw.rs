@@ -74,6 +74,23 @@ pub struct DrawCall<'a> {
     pub primitive: Primitive,
 }
 
+impl<'a> DrawCall<'a> {
+    /// All of `mesh` as triangles with `program`: no textures, no blending, no depth
+    /// test, no culling; change what differs with struct update syntax.
+    pub fn new(program: &'a Program, mesh: &'a Mesh) -> DrawCall<'a> {
+        DrawCall {
+            program,
+            mesh,
+            range: None,
+            textures: &[],
+            blend: Blend::Replace,
+            depth_test: false,
+            cull_back: false,
+            primitive: Primitive::Triangles,
+        }
+    }
+}
+
 /// Clear `surface` (only its viewport, for a window) to `rgba`.
 pub fn clear(gpu: &Gpu, surface: Surface<'_>, rgba: [f32; 4]) -> GlResult<()> {
     let _guard = StateGuard::save(gpu);

@@ -157,14 +157,9 @@ mod tests {
         .unwrap();
         target.clear(gpu, [0.0; 4]).unwrap();
         let call = DrawCall {
-            program: &program,
-            mesh: &mesh,
-            range: None,
-            textures: &[],
             blend: Blend::Over,
-            depth_test: false,
-            cull_back: false,
             primitive: Default::default(),
+            ..DrawCall::new(&program, &mesh)
         };
         draw(gpu, Surface::Target(&target), &call).unwrap();
         target.read(gpu).unwrap();

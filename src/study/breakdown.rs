@@ -153,14 +153,10 @@ pub fn run(
                     gpu,
                     Surface::Target(target),
                     &DrawCall {
-                        program: &programs_of[i],
-                        mesh: &mesh,
-                        range: None,
                         textures: &textures,
                         blend: p.blend,
-                        depth_test: false,
-                        cull_back: false,
                         primitive: Default::default(),
+                        ..DrawCall::new(&programs_of[i], &mesh)
                     },
                 )?;
                 gpu.finish();

@@ -13,9 +13,7 @@ use glam::{DMat4, DVec3};
 use serde::{Deserialize, Serialize};
 
 use super::{Frame, Renderer};
-use crate::gl::{
-    self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface,
-};
+use crate::gl::{self, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface};
 use crate::image::Image;
 use crate::programs;
 use crate::scene::TechniqueScene;
@@ -96,20 +94,7 @@ impl QuadRenderer {
 impl Renderer for QuadRenderer {
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
         self.program.set_transform(gpu, transform(frame))?;
-        gl::draw(
-            gpu,
-            surface,
-            &DrawCall {
-                program: &self.program,
-                mesh: &self.mesh,
-                range: None,
-                textures: &[],
-                blend: Blend::Replace,
-                depth_test: false,
-                cull_back: false,
-                primitive: Default::default(),
-            },
-        )
+        gl::draw(gpu, surface, &DrawCall::new(&self.program, &self.mesh))
     }
 
     fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()> {

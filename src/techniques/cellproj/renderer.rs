@@ -11,7 +11,7 @@ use super::prepare::{iso_list, iso_table, prepare, Prepared, Viewer, VERTEX_COMP
 use super::{CellprojScene, Depth, Exit, Order};
 use crate::camera::Projection;
 use crate::gl::{
-    self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
+    self, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
     ProgramText, Surface, TexelData, TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
@@ -331,14 +331,11 @@ impl Renderer for CellprojRenderer {
             gpu,
             surface,
             &DrawCall {
-                program,
-                mesh: &self.mesh,
-                range: None,
                 textures: &[(TABLE_UNIT, &self.table)],
-                blend: Blend::Replace,
                 depth_test: true,
                 cull_back: true,
                 primitive: Default::default(),
+                ..DrawCall::new(program, &self.mesh)
             },
         )
     }

@@ -675,8 +675,6 @@ impl Opacity3dRenderer {
             gpu,
             surface,
             &DrawCall {
-                program: &self.program,
-                mesh,
                 range: (!raycast).then_some((first, end.saturating_sub(first))),
                 textures: &textures,
                 blend: if raycast {
@@ -684,9 +682,9 @@ impl Opacity3dRenderer {
                 } else {
                     Blend::Over
                 },
-                depth_test: false,
                 cull_back: raycast,
                 primitive: Default::default(),
+                ..DrawCall::new(&self.program, mesh)
             },
         )
     }

@@ -93,14 +93,9 @@ impl OitPass {
         self.accum.clear(gpu, [0.0; 4])?;
         self.reveal.clear(gpu, [1.0; 4])?;
         let splats = |blend: Blend| DrawCall {
-            program,
-            mesh,
-            range: None,
-            textures: &[],
             blend,
-            depth_test: false,
-            cull_back: false,
             primitive: Primitive::Points,
+            ..DrawCall::new(program, mesh)
         };
         program.set_local(gpu, 5, [1.0, 0.0, 0.0, 0.0])?;
         let drawn = gl::draw(gpu, Surface::Target(&self.accum), &splats(Blend::Add));
@@ -111,14 +106,9 @@ impl OitPass {
             gpu,
             surface,
             &DrawCall {
-                program: &self.composite,
-                mesh: &self.quad,
-                range: None,
                 textures: &[(0, self.accum.color()), (1, self.reveal.color())],
                 blend: Blend::Over,
-                depth_test: false,
-                cull_back: false,
-                primitive: Primitive::Triangles,
+                ..DrawCall::new(&self.composite, &self.quad)
             },
         )
     }

@@ -385,14 +385,9 @@ impl Renderer for SplatsRenderer {
             gpu,
             surface,
             &DrawCall {
-                program: &self.program,
-                mesh: &self.mesh,
-                range: None,
-                textures: &[],
                 blend: Blend::Over,
-                depth_test: false,
-                cull_back: false,
                 primitive: Primitive::Points,
+                ..DrawCall::new(&self.program, &self.mesh)
             },
         )
     }

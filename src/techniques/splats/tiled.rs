@@ -8,8 +8,8 @@ use glam::DMat4;
 
 use super::tiles::TileLists;
 use crate::gl::{
-    self, Blend, DrawCall, Extent, GlError, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind,
-    Surface, TexelData, TexelFormat, Texture,
+    self, Blend, DrawCall, Extent, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface,
+    TexelData, TexelFormat, Texture,
 };
 use crate::programs;
 
@@ -184,14 +184,9 @@ impl TilePass {
             gpu,
             surface,
             &DrawCall {
-                program: &self.program,
-                mesh: &self.blocks,
-                range: None,
                 textures: &[(0, offsets), (1, entries), (2, colours)],
                 blend: Blend::PremultipliedOver,
-                depth_test: false,
-                cull_back: false,
-                primitive: Primitive::Triangles,
+                ..DrawCall::new(&self.program, &self.blocks)
             },
         )
     }
