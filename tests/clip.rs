@@ -10,12 +10,13 @@ use std::path::{Path, PathBuf};
 use arbvis::gl::{Backend, Headless, ProgramKind};
 use arbvis::image::Image;
 use arbvis::render::render_on;
-use arbvis::scene::{Fidelity, Scene, SceneError, TechniqueScene};
+use arbvis::scene::{Fidelity, Scene, SceneError};
 use arbvis::techniques::clip::ClipSpec;
 use arbvis::techniques::opacity3d::prepare::prepare;
 use arbvis::techniques::opacity3d::reference::reference_clipped;
-use arbvis::techniques::opacity3d::{Opacity3dScene, Raycast};
+use arbvis::techniques::opacity3d::Raycast;
 use common::{headless, temp_dir, LEVEL};
+use common::{opacity3d as params, opacity3d_mut as params_mut};
 
 /// A rotated box less an off-centre sphere: no symmetry of the view or the volume maps
 /// it onto itself.
@@ -35,20 +36,6 @@ fn scene(fidelity: &str, programs: &str, clip: Option<&str>) -> Scene {
         text += &format!("[technique.opacity3d.clip]\n{clip}\n");
     }
     Scene::parse(&text, "clip test").unwrap_or_else(|e| panic!("{e}\n{text}"))
-}
-
-fn params(scene: &Scene) -> &Opacity3dScene {
-    match &scene.technique {
-        TechniqueScene::Opacity3d(p) => p,
-        _ => panic!("not an opacity3d scene"),
-    }
-}
-
-fn params_mut(scene: &mut Scene) -> &mut Opacity3dScene {
-    match &mut scene.technique {
-        TechniqueScene::Opacity3d(p) => p,
-        _ => panic!("not an opacity3d scene"),
-    }
 }
 
 fn clip_mut(scene: &mut Scene) -> &mut ClipSpec {

@@ -9,13 +9,13 @@ use std::path::{Path, PathBuf};
 use arbvis::gl::{Backend, Filter, Headless, ProgramChoice, ProgramKind, TargetFormat};
 use arbvis::image::Image;
 use arbvis::render::{render_on, Rendered};
-use arbvis::scene::{Fidelity, Scene, TechniqueScene};
+use arbvis::scene::{Fidelity, Scene};
 use arbvis::techniques::opacity3d::prepare::prepare;
 use arbvis::techniques::opacity3d::reference::{
     emulate_faithful, emulate_faithful_llvmpipe, reference,
 };
-use arbvis::techniques::opacity3d::Opacity3dScene;
 use common::{headless, temp_dir, LEVEL};
+use common::{opacity3d as params, opacity3d_mut as params_mut};
 
 /// Write `n³` u8 samples from `f(i, j, k)` as a raw file.
 fn write_raw(dir: &Path, file: &str, n: usize, f: impl Fn(usize, usize, usize) -> u8) {
@@ -52,20 +52,6 @@ fn raw_scene(
     let mut scene = Scene::parse(&text, "test").unwrap();
     scene.base = dir.to_path_buf();
     scene
-}
-
-fn params(scene: &Scene) -> &Opacity3dScene {
-    match &scene.technique {
-        TechniqueScene::Opacity3d(p) => p,
-        _ => panic!("not an opacity3d scene"),
-    }
-}
-
-fn params_mut(scene: &mut Scene) -> &mut Opacity3dScene {
-    match &mut scene.technique {
-        TechniqueScene::Opacity3d(p) => p,
-        _ => panic!("not an opacity3d scene"),
-    }
 }
 
 fn render(h: &Headless, scene: &Scene) -> Rendered {

@@ -10,13 +10,14 @@ use arbvis::camera::{Camera, Projection};
 use arbvis::gl::{Backend, Filter, Headless, ProgramChoice};
 use arbvis::image::Image;
 use arbvis::render::render_on;
-use arbvis::scene::{Scene, TechniqueScene};
+use arbvis::scene::Scene;
 use arbvis::techniques::opacity3d::mirror::{emulate_precise, emulate_preintegrated};
 use arbvis::techniques::opacity3d::prepare::prepare;
 use arbvis::techniques::opacity3d::reference::reference;
-use arbvis::techniques::opacity3d::{Opacity3dScene, Raycast};
+use arbvis::techniques::opacity3d::Raycast;
 use arbvis::volume::synthetic::SplitMix;
 use common::{headless, temp_dir};
+use common::{opacity3d as params, opacity3d_mut as params_mut};
 
 /// Random bytes from a seeded generator.
 fn random_bytes(seed: u64, n: usize, range: std::ops::RangeInclusive<u8>) -> Vec<u8> {
@@ -82,20 +83,6 @@ fn random_scene(
     let mut scene = Scene::parse(&text, name).unwrap();
     scene.base = dir.clone();
     (scene, dir)
-}
-
-fn params(scene: &Scene) -> &Opacity3dScene {
-    match &scene.technique {
-        TechniqueScene::Opacity3d(p) => p,
-        _ => panic!("not an opacity3d scene"),
-    }
-}
-
-fn params_mut(scene: &mut Scene) -> &mut Opacity3dScene {
-    match &mut scene.technique {
-        TechniqueScene::Opacity3d(p) => p,
-        _ => panic!("not an opacity3d scene"),
-    }
 }
 
 /// Largest RGB difference and RMSE over RGB between `a` and `b`.

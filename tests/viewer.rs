@@ -13,7 +13,7 @@ mod common;
 
 use std::path::{Path, PathBuf};
 
-use common::temp_dir;
+use common::{opacity3d, temp_dir};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -24,7 +24,7 @@ use arbvis::render::render;
 use arbvis::scene::{Scene, TechniqueScene};
 use arbvis::techniques::clip::stats::ClipStats;
 use arbvis::techniques::clip::{ClipSpec, ShapeSpec};
-use arbvis::techniques::opacity3d::{Combine, Opacity3dScene};
+use arbvis::techniques::opacity3d::Combine;
 use arbvis::techniques::quad::{reference_image, QuadScene};
 
 struct Display {
@@ -191,13 +191,6 @@ fn failing_scripts(name: &str, demo: &str, scripts: &[&str]) -> Option<Vec<Strin
         .collect();
     let _ = std::fs::remove_dir_all(&dir);
     Some(errors)
-}
-
-fn opacity3d(scene: &Scene) -> &Opacity3dScene {
-    match &scene.technique {
-        TechniqueScene::Opacity3d(o) => o,
-        _ => panic!("saved scene is not opacity3d"),
-    }
 }
 
 /// The screenshot equals an offscreen render of the saved scene at its size, within one

@@ -84,26 +84,28 @@ pub const FACIES_TABLE: [(i32, &str, [u8; 3]); 7] = [
     (6, "marl", [176, 204, 178]),
 ];
 
-/// Colour of facies `id`: from [`FACIES_TABLE`], or for ids it lacks a colour of a
-/// fixed 12-colour palette picked by the id (so files with other ids still show them).
+/// Twelve distinct colours (ColorBrewer's Set3), for ids without colours of their own.
+pub const PALETTE: [[u8; 3]; 12] = [
+    [141, 211, 199],
+    [255, 255, 179],
+    [190, 186, 218],
+    [251, 128, 114],
+    [128, 177, 211],
+    [253, 180, 98],
+    [179, 222, 105],
+    [252, 205, 229],
+    [217, 217, 217],
+    [188, 128, 189],
+    [204, 235, 197],
+    [255, 237, 111],
+];
+
+/// Colour of facies `id`: from [`FACIES_TABLE`], or for ids it lacks a colour of
+/// [`PALETTE`] picked by the id (so files with other ids still show them).
 pub fn facies_colour(id: i32) -> [u8; 3] {
     if let Some((_, _, rgb)) = FACIES_TABLE.iter().find(|(f, _, _)| *f == id) {
         return *rgb;
     }
-    const PALETTE: [[u8; 3]; 12] = [
-        [141, 211, 199],
-        [255, 255, 179],
-        [190, 186, 218],
-        [251, 128, 114],
-        [128, 177, 211],
-        [253, 180, 98],
-        [179, 222, 105],
-        [252, 205, 229],
-        [217, 217, 217],
-        [188, 128, 189],
-        [204, 235, 197],
-        [255, 237, 111],
-    ];
     PALETTE[id.rem_euclid(PALETTE.len() as i32) as usize]
 }
 

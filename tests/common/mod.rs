@@ -8,6 +8,8 @@ use std::path::{Path, PathBuf};
 use arbvis::gl::{Backend, Headless};
 use arbvis::image::Image;
 use arbvis::png_io::{read_png, write_png};
+use arbvis::scene::{Scene, TechniqueScene};
+use arbvis::techniques::opacity3d::Opacity3dScene;
 
 /// One step of an 8-bit channel.
 pub const LEVEL: f32 = 1.0 / 255.0;
@@ -140,4 +142,20 @@ pub fn temp_dir(name: &str) -> std::path::PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// The 3D-opacity parameters of `scene` (a test's own scene: anything else is a bug).
+pub fn opacity3d(scene: &Scene) -> &Opacity3dScene {
+    match &scene.technique {
+        TechniqueScene::Opacity3d(p) => p,
+        _ => panic!("not an opacity3d scene"),
+    }
+}
+
+/// [`opacity3d`], to change.
+pub fn opacity3d_mut(scene: &mut Scene) -> &mut Opacity3dScene {
+    match &mut scene.technique {
+        TechniqueScene::Opacity3d(p) => p,
+        _ => panic!("not an opacity3d scene"),
+    }
 }

@@ -21,12 +21,7 @@ pub fn check_fixture(m: &Mesh, tol: f64, what: &str) {
     assert_eq!(m.info.flipped, 1, "{what}");
     assert_eq!(m.info.skipped_cells, 2, "{what}");
     assert_eq!(m.info.split_cells, 0, "{what}");
-    let cells: Vec<(&str, usize)> = m
-        .info
-        .cells
-        .iter()
-        .map(|c| (c.name.as_str(), c.count))
-        .collect();
+    let cells = cell_counts(m);
     assert_eq!(
         cells,
         [("VTK_TETRA", 3), ("VTK_TRIANGLE", 1), ("VTK_VERTEX", 1)],
@@ -274,12 +269,7 @@ fn gmsh_mixed_elements_conform_and_quadratic_tets_use_corners() {
     s += "6 11 2 0 1 12 13 14 15 16 17 18 19 20 21\n"; // 10-node tetrahedron
     s += "$EndElements\n";
     let m = parse(Path::new("mixed.msh"), s.as_bytes()).unwrap();
-    let cells: Vec<(&str, usize)> = m
-        .info
-        .cells
-        .iter()
-        .map(|c| (c.name.as_str(), c.count))
-        .collect();
+    let cells = cell_counts(&m);
     assert_eq!(
         cells,
         [
@@ -332,4 +322,13 @@ fn gmsh_sparse_tags_far_apart() {
     assert!(text.contains("1000000000000 1.6 1.2 0.9"));
     let m = ok(text.as_bytes(), "sparse.msh");
     check_fixture(&m, 0.0, "sparse.msh");
+}
+
+/// (VTK cell type name, count) of each cell kind a mesh was read with.
+fn cell_counts(m: &crate::mesh::Mesh) -> Vec<(&str, usize)> {
+    m.info
+        .cells
+        .iter()
+        .map(|c| (c.name.as_str(), c.count))
+        .collect()
 }

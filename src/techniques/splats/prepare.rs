@@ -8,7 +8,7 @@ use glam::DVec3;
 
 use super::normals::{estimate_cloud, DEFAULT_K};
 use super::scene::{ColourMode, Kernel, Mode, SplatsScene};
-use crate::points::section::facies_colour;
+use crate::points::section::{facies_colour, PALETTE};
 use crate::points::{PointCloud, FACIES, FAULT, LAYER, UNDEFINED_FACIES};
 use crate::scene::Fidelity;
 
@@ -23,17 +23,9 @@ pub const COLOR_A: [f64; 3] = [0.05, 0.10, 0.45];
 /// See [`COLOR_A`].
 pub const COLOR_B: [f64; 3] = [1.0, 0.85, 0.25];
 
-/// One colour per layer id (0..7 in the seed's sections; ids wrap around beyond).
-pub const LAYER_COLOURS: [[u8; 3]; 8] = [
-    [141, 211, 199],
-    [255, 255, 179],
-    [190, 186, 218],
-    [251, 128, 114],
-    [128, 177, 211],
-    [253, 180, 98],
-    [179, 222, 105],
-    [252, 205, 229],
-];
+/// Layer colours: the first 8 of [`crate::points::section::PALETTE`] (layer ids 0..7 in
+/// the seed's sections; ids wrap around beyond).
+pub const LAYERS_IN_PALETTE: i32 = 8;
 
 /// A cloud ready to draw.
 #[derive(Debug, Clone)]
@@ -131,7 +123,7 @@ pub fn from_cloud(
             let base = match scene.colour {
                 ColourMode::Facies => facies.map_or(grey, |f| byte_colour(facies_colour(f[i]))),
                 ColourMode::Layer => layers.map_or(grey, |l| {
-                    byte_colour(LAYER_COLOURS[l[i].rem_euclid(8) as usize])
+                    byte_colour(PALETTE[l[i].rem_euclid(LAYERS_IN_PALETTE) as usize])
                 }),
                 ColourMode::Rgb => cloud
                     .rgb
