@@ -97,6 +97,25 @@ fn draw(
     (image, depth)
 }
 
+/// [`draw`] in precise mode with GLSL (the only precise programs).
+fn draw_precise(
+    h: &Headless,
+    params: &CellprojScene,
+    prepared: Prepared,
+    camera: Camera,
+    size: [u32; 2],
+) -> (Image, Vec<f32>) {
+    draw(
+        h,
+        params,
+        prepared,
+        Fidelity::Precise,
+        ProgramKind::Glsl,
+        camera,
+        size,
+    )
+}
+
 fn score(
     prepared: &Prepared,
     isovalues: &[Isovalue],
@@ -217,15 +236,7 @@ fn isovalues_exactly_at_vertex_values_are_drawn_whole_in_precise_mode() {
     let p = params(Field::Planar, isos.clone());
     let prepared = seed_mesh(Field::Planar);
     let cam = camera(Projection::Orthographic);
-    let (image, depth) = draw(
-        &h,
-        &p,
-        prepared.clone(),
-        Fidelity::Precise,
-        ProgramKind::Glsl,
-        cam,
-        SIZE,
-    );
+    let (image, depth) = draw_precise(&h, &p, prepared.clone(), cam, SIZE);
     let a = score(&prepared, &isos, &image, &depth, &cam, SIZE);
     assert!(a.interior_fraction() >= 0.995, "{a:?}");
 }
@@ -247,18 +258,7 @@ fn far_from_the_origin_the_picture_is_the_same() {
     }
     let far = prepared_of(&mesh);
     let cam = camera(Projection::Perspective);
-    let draw_one = |prepared| {
-        draw(
-            &h,
-            &p,
-            prepared,
-            Fidelity::Precise,
-            ProgramKind::Glsl,
-            cam,
-            SIZE,
-        )
-        .0
-    };
+    let draw_one = |prepared| draw_precise(&h, &p, prepared, cam, SIZE).0;
     let d = draw_one(near).compare(&draw_one(far), 0.0).unwrap();
     assert_eq!(d.pixels_over, 0, "{d:?}");
 }
@@ -366,15 +366,7 @@ fn extremes_give_finite_documented_pictures() {
     let isos = seed_isovalues();
     let p = params(Field::Oblique, isos.clone());
     let prepared = seed_mesh(Field::Oblique);
-    let (image, depth) = draw(
-        &h,
-        &p,
-        prepared.clone(),
-        Fidelity::Precise,
-        ProgramKind::Glsl,
-        axis,
-        SIZE,
-    );
+    let (image, depth) = draw_precise(&h, &p, prepared.clone(), axis, SIZE);
     let a = score(&prepared, &isos, &image, &depth, &axis, SIZE);
     assert!(a.interior_fraction() >= 0.99, "axis view: {a:?}");
     assert!(image.data.iter().all(|v| v.is_finite()));
@@ -407,15 +399,7 @@ fn flat_and_sliver_tetrahedra_are_counted_and_harmless() {
     let h = headless(Backend::Egl);
     let isos = seed_isovalues();
     let params = params(Field::Spherical, isos);
-    let (image, _) = draw(
-        &h,
-        &params,
-        p,
-        Fidelity::Precise,
-        ProgramKind::Glsl,
-        camera(Projection::Perspective),
-        [64, 48],
-    );
+    let (image, _) = draw_precise(&h, &params, p, camera(Projection::Perspective), [64, 48]);
     assert!(image.data.iter().all(|v| v.is_finite()));
 }
 
