@@ -11,7 +11,7 @@
 use glam::DVec3;
 
 use super::prepare::Prepared;
-use super::reference::{classify, sample, Addressing, Filtering};
+use super::reference::{classify, sample, Addressing, Filtering, ViewSlices};
 use super::Opacity3dScene;
 use crate::camera::Camera;
 use crate::gl::TargetFormat;
@@ -47,25 +47,12 @@ pub fn emulate_precise(
     let half = prepared.half;
     let reference = prepared.reference_spacing();
     let corrected = super::renderer::corrected(params, crate::scene::Fidelity::Precise);
-    let n = (camera.quat().inverse() * DVec3::Z).normalize();
-    let extent = (half * n.abs()).element_sum();
-    let count = params.slices;
-    let spacing = 2.0 * extent / count as f64;
+    let slices = ViewSlices::new(half, camera, params.slices);
     trace_pixels(camera, size, TargetFormat::Rgba32f, |origin, dir| {
         let mut dst = background;
-        let along = dir.dot(n);
-        if along.abs() < 1e-300 {
-            return dst;
-        }
         let unit = dir.normalize();
-        let half_step = spacing / 2.0 / unit.dot(n).abs();
-        for i in 0..count {
-            let depth = -extent + (i as f64 + 0.5) * spacing;
-            let p = origin + dir * ((depth - origin.dot(n)) / along);
-            if (p.abs() - half).max_element() > 1e-9 {
-                continue;
-            }
-            let tc = (p + half) / (2.0 * half);
+        let half_step = slices.spacing() / 2.0 / unit.dot(slices.normal()).abs();
+        for (p, tc) in slices.crossings(origin, dir) {
             let c = classify(
                 prepared,
                 params,

@@ -236,6 +236,59 @@ pub fn reference_clipped(
     })
 }
 
+/// The `count` view-aligned slices the renderer draws through a box of half-size `half`
+/// (evenly spaced along the view direction over the box's extent, each at the centre of
+/// its slab), and where a ray crosses them: what the CPU mirrors of slicing share.
+pub(crate) struct ViewSlices {
+    half: DVec3,
+    normal: DVec3,
+    extent: f64,
+    spacing: f64,
+    count: usize,
+}
+
+impl ViewSlices {
+    /// The slices of `camera`'s view.
+    pub(crate) fn new(half: DVec3, camera: &Camera, count: usize) -> ViewSlices {
+        let normal = (camera.quat().inverse() * DVec3::Z).normalize();
+        let extent = (half * normal.abs()).element_sum();
+        ViewSlices {
+            half,
+            normal,
+            extent,
+            spacing: 2.0 * extent / count as f64,
+            count,
+        }
+    }
+
+    /// The slices' normal (toward the viewer).
+    pub(crate) fn normal(&self) -> DVec3 {
+        self.normal
+    }
+
+    /// Distance between neighbouring slices.
+    pub(crate) fn spacing(&self) -> f64 {
+        self.spacing
+    }
+
+    /// Where the ray `origin + t dir` crosses each slice inside the box, back to front:
+    /// the point and its texture coordinate (none for a ray along the slices).
+    pub(crate) fn crossings(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+    ) -> impl Iterator<Item = (DVec3, DVec3)> + '_ {
+        let along = dir.dot(self.normal);
+        let count = if along.abs() < 1e-300 { 0 } else { self.count };
+        (0..count).filter_map(move |i| {
+            let depth = -self.extent + (i as f64 + 0.5) * self.spacing;
+            let p = origin + dir * ((depth - origin.dot(self.normal)) / along);
+            let inside = (p.abs() - self.half).max_element() <= 1e-9;
+            inside.then(|| (p, (p + self.half) / (2.0 * self.half)))
+        })
+    }
+}
+
 /// Independent emulation of the faithful pipeline into an 8-bit target (see the module
 /// doc); values are multiples of 1/255.
 pub fn emulate_faithful(
@@ -245,27 +298,13 @@ pub fn emulate_faithful(
     size: [u32; 2],
     background: [f64; 4],
 ) -> Image {
-    let half = prepared.half;
-    let n = (camera.quat().inverse() * DVec3::Z).normalize();
-    let extent = (half * n.abs()).element_sum();
-    let count = params.slices;
-    let spacing = 2.0 * extent / count as f64;
+    let slices = ViewSlices::new(prepared.half, camera, params.slices);
     let to8 = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round();
     // 8-bit blending: each product rounded on its own, then summed.
     let mul = |x: f64, y: f64| (x * y / 255.0).round();
     trace_pixels(camera, size, TargetFormat::Rgba8, |origin, dir| {
         let mut dst = background.map(to8);
-        let along = dir.dot(n);
-        if along.abs() < 1e-300 {
-            return dst.map(|v| v / 255.0);
-        }
-        for i in 0..count {
-            let depth = -extent + (i as f64 + 0.5) * spacing;
-            let p = origin + dir * ((depth - origin.dot(n)) / along);
-            if (p.abs() - half).max_element() > 1e-9 {
-                continue;
-            }
-            let tc = (p + half) / (2.0 * half);
+        for (_, tc) in slices.crossings(origin, dir) {
             let src = classify(
                 prepared,
                 params,
@@ -317,11 +356,7 @@ pub fn emulate_faithful_llvmpipe(
     size: [u32; 2],
     background: [f64; 4],
 ) -> Image {
-    let half = prepared.half;
-    let n = (camera.quat().inverse() * DVec3::Z).normalize();
-    let extent = (half * n.abs()).element_sum();
-    let count = params.slices;
-    let spacing = 2.0 * extent / count as f64;
+    let slices = ViewSlices::new(prepared.half, camera, params.slices);
     let unit = 1.0f32 / 255.0;
     let to8 = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round_ties_even() as u32;
     let coeff = coefficients(params).map(|c| c.map(|x| x as f32));
@@ -329,17 +364,7 @@ pub fn emulate_faithful_llvmpipe(
     let texel = |v: f64| (v * 255.0).round() as f32 * unit;
     trace_pixels(camera, size, TargetFormat::Rgba8, |origin, dir| {
         let mut dst = background.map(|v| to8(v as f32));
-        let along = dir.dot(n);
-        if along.abs() < 1e-300 {
-            return dst.map(|v| v as f64 / 255.0);
-        }
-        for i in 0..count {
-            let depth = -extent + (i as f64 + 0.5) * spacing;
-            let p = origin + dir * ((depth - origin.dot(n)) / along);
-            if (p.abs() - half).max_element() > 1e-9 {
-                continue;
-            }
-            let tc = (p + half) / (2.0 * half);
+        for (_, tc) in slices.crossings(origin, dir) {
             let v = sample(prepared, tc, params.volume_filter, Filtering::Unorm8).map(texel);
             let lut = |a: usize| -> [f32; 4] {
                 match &prepared.tables[a] {
