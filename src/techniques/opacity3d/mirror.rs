@@ -11,7 +11,7 @@
 use glam::DVec3;
 
 use super::prepare::Prepared;
-use super::reference::{classify, sample, Addressing, Filtering, ViewSlices};
+use super::reference::{exact_rgba, over, sample, Filtering, ViewSlices};
 use super::Opacity3dScene;
 use crate::camera::Camera;
 use crate::gl::TargetFormat;
@@ -53,24 +53,13 @@ pub fn emulate_precise(
         let unit = dir.normalize();
         let half_step = slices.spacing() / 2.0 / unit.dot(slices.normal()).abs();
         for (p, tc) in slices.crossings(origin, dir) {
-            let c = classify(
-                prepared,
-                params,
-                tc,
-                Addressing::TexelCentre,
-                1.0 / 3.0,
-                Filtering::Exact,
-            )
-            .map(|v| v.clamp(0.0, 1.0));
+            let c = exact_rgba(prepared, params, tc);
             let a = if corrected {
                 1.0 - (1.0 - c[3]).powf(slab_length(p, unit, half, half_step) / reference)
             } else {
                 c[3]
             };
-            for ch in 0..3 {
-                dst[ch] = c[ch] * a + dst[ch] * (1.0 - a);
-            }
-            dst[3] = a + dst[3] * (1.0 - a);
+            over(&mut dst, c, a);
         }
         dst
     })
@@ -137,15 +126,7 @@ pub fn emulate_preintegrated(
             front = back;
         }
         if rest > 1e-4 * h {
-            let c = classify(
-                prepared,
-                params,
-                tc(full * h + rest / 2.0),
-                Addressing::TexelCentre,
-                1.0 / 3.0,
-                Filtering::Exact,
-            )
-            .map(|v| v.clamp(0.0, 1.0));
+            let c = exact_rgba(prepared, params, tc(full * h + rest / 2.0));
             let a = 1.0 - (1.0 - c[3]).powf(rest / reference);
             let w = (1.0 - acc[3]) * a;
             for ch in 0..3 {

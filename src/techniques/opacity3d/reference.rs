@@ -165,6 +165,29 @@ pub fn classify(
     out
 }
 
+/// The exact model's colour at texture coordinate `tc` (texel-centre addressing, the
+/// sum's 1/3 exact, no 8-bit rounding), clamped to [0, 1] as a target would.
+pub fn exact_rgba(prepared: &Prepared, params: &Opacity3dScene, tc: DVec3) -> [f64; 4] {
+    classify(
+        prepared,
+        params,
+        tc,
+        Addressing::TexelCentre,
+        1.0 / 3.0,
+        Filtering::Exact,
+    )
+    .map(|v| v.clamp(0.0, 1.0))
+}
+
+/// Blend colour `c` of alpha `a` over `dst` as the renderer blends: `SRC_ALPHA,
+/// ONE_MINUS_SRC_ALPHA` for colour, `ONE, ONE_MINUS_SRC_ALPHA` for alpha.
+pub fn over(dst: &mut [f64; 4], c: [f64; 4], a: f64) {
+    for ch in 0..3 {
+        dst[ch] = c[ch] * a + dst[ch] * (1.0 - a);
+    }
+    dst[3] = a + dst[3] * (1.0 - a);
+}
+
 /// The f64 reference image (see the module doc); `oversample` steps per reference
 /// spacing (8 or more keeps the quadrature error far below 8-bit steps).
 pub fn reference(
@@ -217,20 +240,9 @@ pub fn reference_clipped(
                 continue;
             }
             let tc = (x + half) / (2.0 * half);
-            let c = classify(
-                prepared,
-                params,
-                tc,
-                Addressing::TexelCentre,
-                1.0 / 3.0,
-                Filtering::Exact,
-            )
-            .map(|v| v.clamp(0.0, 1.0));
+            let c = exact_rgba(prepared, params, tc);
             let a = 1.0 - (1.0 - c[3]).powf(exponent);
-            for ch in 0..3 {
-                dst[ch] = c[ch] * a + dst[ch] * (1.0 - a);
-            }
-            dst[3] = a + dst[3] * (1.0 - a);
+            over(&mut dst, c, a);
         }
         dst
     })
