@@ -302,86 +302,31 @@ pub fn to_csv(rows: &[Row]) -> String {
 /// Plot RMSE against time per frame, one line per setting through its slice counts,
 /// with the VTK GPU ray caster's time on this machine kind as a vertical line.
 pub fn plot(rows: &[Row], path: &Path, title: &str, vtk_ms: f64) -> anyhow::Result<()> {
-    use plotters::prelude::*;
-    register_plot_font()?;
-    let (w, h) = (1100u32, 700u32);
-    let mut buffer = vec![0u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let finite = |v: f64| v.is_finite() && v > 0.0;
-        let xs: Vec<f64> = rows.iter().map(|r| r.ms).filter(|v| finite(*v)).collect();
-        let ys: Vec<f64> = rows.iter().map(|r| r.rmse).filter(|v| finite(*v)).collect();
-        let (x0, x1) = (
-            xs.iter().copied().fold(f64::INFINITY, f64::min).min(vtk_ms) * 0.8,
-            xs.iter().copied().fold(0.0, f64::max).max(vtk_ms) * 1.25,
-        );
-        let (y0, y1) = (
-            ys.iter().copied().fold(f64::INFINITY, f64::min) * 0.8,
-            ys.iter().copied().fold(0.0, f64::max) * 1.25,
-        );
-        if !(finite(x0) && finite(y0)) {
-            anyhow::bail!("nothing to plot");
-        }
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
-        chart
-            .configure_mesh()
-            .x_desc("time per frame (ms, log)")
-            .y_desc("RMSE of RGB against the f64 reference (log)")
-            .label_style(("sans-serif", 14))
-            .draw()?;
-        let mut series: Vec<String> = rows.iter().map(Row::series).collect();
-        series.dedup();
-        series.sort();
-        series.dedup();
-        for (n, name) in series.iter().enumerate() {
-            let colour = Palette99::pick(n).to_rgba();
-            let mut points: Vec<(f64, f64)> = rows
+    let mut series: Vec<String> = rows.iter().map(Row::series).collect();
+    series.sort();
+    series.dedup();
+    let lines: Vec<(String, Vec<(f64, f64)>)> = series
+        .into_iter()
+        .map(|name| {
+            let points = rows
                 .iter()
-                .filter(|r| &r.series() == name && finite(r.ms) && finite(r.rmse))
+                .filter(|r| r.series() == name)
                 .map(|r| (r.ms, r.rmse))
                 .collect();
-            points.sort_by(|a, b| a.0.total_cmp(&b.0));
-            chart
-                .draw_series(LineSeries::new(points.clone(), colour.stroke_width(2)))?
-                .label(name.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
-                });
-            chart.draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
-        }
-        chart
-            .draw_series(LineSeries::new(
-                vec![(vtk_ms, y0), (vtk_ms, y1)],
-                BLACK.stroke_width(1),
-            ))?
-            .label(format!(
-                "VTK 9.7 GPU ray caster, 3 components ({:.0} ms)",
-                vtk_ms
-            ))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK));
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()?;
-        root.present()?;
-    }
-    save_plot(&buffer, w, h, path)
+            (name, points)
+        })
+        .collect();
+    let vtk = format!("VTK 9.7 GPU ray caster, 3 components ({vtk_ms:.0} ms)");
+    plot_lines(&lines, path, title, Some((vtk_ms, vtk.as_str())))
 }
 
-/// Plot named lines of (ms, RMSE) points on log axes (a line and dots per series).
+/// Plot named lines of (ms, RMSE) points on log axes (a line and dots per series), and
+/// where given a vertical line at a time with its label.
 pub fn plot_lines(
     lines: &[(String, Vec<(f64, f64)>)],
     path: &Path,
     title: &str,
+    vertical: Option<(f64, &str)>,
 ) -> anyhow::Result<()> {
     use plotters::prelude::*;
     register_plot_font()?;
@@ -399,19 +344,19 @@ pub fn plot_lines(
         if points.is_empty() {
             anyhow::bail!("nothing to plot");
         }
-        let fold = |f: fn(f64, f64) -> f64, init: f64, pick: fn(&(f64, f64)) -> f64| {
-            points.iter().map(pick).fold(init, f)
-        };
-        let (x0, x1) = (
-            fold(f64::min, f64::INFINITY, |p| p.0) * 0.8,
-            fold(f64::max, 0.0, |p| p.0) * 1.25,
-        );
-        let (y0, y1) = (
-            fold(f64::min, f64::INFINITY, |p| p.1) * 0.8,
-            fold(f64::max, 0.0, |p| p.1) * 1.25,
-        );
+        let xs = points
+            .iter()
+            .map(|p| p.0)
+            .chain(vertical.map(|v| v.0).filter(|&x| finite(x)));
+        let (x0, x1) = xs.fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
+            (lo.min(x), hi.max(x))
+        });
+        let (y0, y1) = points.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
+            (lo.min(p.1), hi.max(p.1))
+        });
+        let (x0, x1, y0, y1) = (x0 * 0.8, x1 * 1.25, y0 * 0.8, y1 * 1.25);
         let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
+            .caption(title, ("sans-serif", 22))
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(70)
@@ -437,6 +382,15 @@ pub fn plot_lines(
                     PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
                 });
             chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
+        }
+        if let Some((x, label)) = vertical.filter(|v| finite(v.0)) {
+            chart
+                .draw_series(LineSeries::new(
+                    vec![(x, y0), (x, y1)],
+                    BLACK.stroke_width(1),
+                ))?
+                .label(label)
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK));
         }
         chart
             .configure_series_labels()

@@ -232,7 +232,7 @@ pub fn study(runs: &[PathBuf], out: &Path) -> Result<String> {
             "{name}: {} at {}x{}, {}",
             run.arbvis.scene, run.arbvis.size[0], run.arbvis.size[1], run.arbvis.renderer
         );
-        super::plot_lines(&lines, &out.join(format!("{name}.png")), &title)?;
+        super::plot_lines(&lines, &out.join(format!("{name}.png")), &title, None)?;
     }
     crate::png_io::write_atomic(&out.join("study.csv"), csv.as_bytes())?;
     crate::png_io::write_atomic(&out.join("study.md"), md.as_bytes())?;
