@@ -13,6 +13,7 @@
 //! colour channels of every pixel. The reference (see `opacity3d::reference`) is cached
 //! in the export folder, keyed by the scene text, size and oversampling.
 
+use super::median;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -304,16 +305,6 @@ pub fn rgb_error(image: &Image, rgb: &[f32]) -> (f64, f64) {
     }
     let n = (rgb.len() / 3 * 3).max(1);
     (max, (sum / n as f64).sqrt())
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    match s.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => s[n / 2],
-        n => (s[n / 2 - 1] + s[n / 2]) / 2.0,
-    }
 }
 
 /// Which renderer a setting draws with (one per fidelity, path, programs and target).

@@ -404,6 +404,17 @@ pub fn plot_lines(
     save_plot(&buffer, w, h, path)
 }
 
+/// The median of `v` (the mean of the middle two for an even count; NaN when empty).
+pub fn median(v: &[f64]) -> f64 {
+    let mut s = v.to_vec();
+    s.sort_by(f64::total_cmp);
+    match s.len() {
+        0 => f64::NAN,
+        n if n % 2 == 1 => s[n / 2],
+        n => (s[n / 2 - 1] + s[n / 2]) / 2.0,
+    }
+}
+
 /// The plots' font (egui's, already a dependency), registered with plotters.
 fn register_plot_font() -> anyhow::Result<()> {
     plotters::style::register_font(

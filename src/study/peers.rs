@@ -11,6 +11,7 @@
 //! steps per voxel) and the work it needs for RMSE 1/255 and 1e-3 (log-log interpolation
 //! between the settings that bracket it). `study.csv` holds every point.
 
+use super::median;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -59,16 +60,6 @@ struct Point {
     ms: f64,
     rmse: f64,
     name: String,
-}
-
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    match s.len() {
-        0 => f64::NAN,
-        n if n % 2 == 1 => s[n / 2],
-        n => (s[n / 2 - 1] + s[n / 2]) / 2.0,
-    }
 }
 
 /// The series of a run, by name, each sorted by work.

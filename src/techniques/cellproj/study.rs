@@ -4,6 +4,7 @@
 //! precise; each setting scored against the f64 reference (fraction of interior pixels
 //! with the right isovalue colour).
 
+use crate::study::median;
 use std::time::Instant;
 
 use crate::camera::{Camera, Projection};
@@ -95,11 +96,6 @@ pub fn study_camera(projection: Projection) -> Camera {
     }
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
-}
-
 /// Time one setting: frames, then isovalue edits (each rewrites the table and draws).
 #[allow(clippy::too_many_arguments)]
 fn measure(
@@ -145,7 +141,7 @@ fn measure(
     draw(&mut r)?;
     let image = target.read(gpu)?;
     let depth = target.read_depth(gpu)?.unwrap_or_default();
-    Ok((median(times), median(edits), image, depth))
+    Ok((median(&times), median(&edits), image, depth))
 }
 
 /// Run the sweep; `progress` hears one line per setting.

@@ -9,6 +9,7 @@
 //! references' time and weighted blended OIT's error against exact order, and the normals'
 //! estimation time.
 
+use crate::study::median;
 use std::time::Instant;
 
 use super::scene::{DrawChoice, SortChoice};
@@ -227,8 +228,8 @@ pub fn frames(
         }
         let row = FrameRow {
             sort: name,
-            ms: median(&mut times),
-            sort_ms: median(&mut order_times),
+            ms: median(&times),
+            sort_ms: median(&order_times),
         };
         progress(&format!(
             "{:<26} {:>9.1} ms/frame, of which order and upload {:>7.1} ms",
@@ -252,11 +253,6 @@ fn order_ms(status: Option<&str>) -> f64 {
         return 0.0;
     }
     after("last lists ").or_else(|| after("): ")).unwrap_or(0.0)
-}
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
 }
 
 /// Both sweeps as CSV text: sorts, then frames.
