@@ -226,86 +226,45 @@ pub struct ClipTextures {
     pub multires: Option<MultiRes>,
 }
 
-fn finite(what: &str, v: &[f64]) -> Result<(), ClipError> {
-    if v.iter().all(|x| x.is_finite()) {
-        Ok(())
-    } else {
-        Err(ClipError::Invalid(format!("{what} {v:?}: must be finite")))
-    }
-}
-
-fn positive(what: &str, v: &[f64]) -> Result<(), ClipError> {
-    if v.iter().all(|x| x.is_finite() && *x > 0.0) {
-        Ok(())
-    } else {
-        Err(ClipError::Invalid(format!(
-            "{what} {v:?}: must be positive"
-        )))
-    }
-}
-
 impl ShapeSpec {
     /// Build the shape: load files (relative to `base`), check parameters. `half` is the
     /// clipped volume's half-extent (masks span it).
     pub fn build(&self, base: &Path, half: [f64; 3]) -> Result<Shape, ClipError> {
-        self.build_at(base, half, 0)
+        // One set of checks: the scene's (every parameter, nesting depth, empty lists).
+        self.validate()
+            .map_err(|e| ClipError::Invalid(e.to_string()))?;
+        self.build_checked(base, half)
     }
 
-    fn build_at(&self, base: &Path, half: [f64; 3], depth: usize) -> Result<Shape, ClipError> {
-        if depth > MAX_DEPTH {
-            return Err(ClipError::Invalid(format!(
-                "clip shapes nested deeper than {MAX_DEPTH}"
-            )));
-        }
+    fn build_checked(&self, base: &Path, half: [f64; 3]) -> Result<Shape, ClipError> {
         let v = DVec3::from_array;
         Ok(match self {
-            ShapeSpec::Sphere { center, radius } => {
-                finite("sphere center", center)?;
-                positive("sphere radius", &[*radius])?;
-                Shape::Sphere {
-                    center: v(*center),
-                    radius: *radius,
-                }
-            }
+            ShapeSpec::Sphere { center, radius } => Shape::Sphere {
+                center: v(*center),
+                radius: *radius,
+            },
             ShapeSpec::Box {
                 center,
                 half_size,
                 rotation,
-            } => {
-                finite("box center", center)?;
-                finite("box rotation", rotation)?;
-                positive("box half_size", half_size)?;
-                Shape::Box {
-                    center: v(*center),
-                    half_size: v(*half_size),
-                    rotation: rotation_from_degrees(*rotation),
-                }
-            }
+            } => Shape::Box {
+                center: v(*center),
+                half_size: v(*half_size),
+                rotation: rotation_from_degrees(*rotation),
+            },
             ShapeSpec::Cylinder {
                 center,
                 radius,
                 half_height,
                 rotation,
-            } => {
-                finite("cylinder center", center)?;
-                finite("cylinder rotation", rotation)?;
-                positive("cylinder radius and half_height", &[*radius, *half_height])?;
-                Shape::Cylinder {
-                    center: v(*center),
-                    radius: *radius,
-                    half_height: *half_height,
-                    rotation: rotation_from_degrees(*rotation),
-                }
-            }
+            } => Shape::Cylinder {
+                center: v(*center),
+                radius: *radius,
+                half_height: *half_height,
+                rotation: rotation_from_degrees(*rotation),
+            },
             ShapeSpec::HalfSpace { point, normal } => {
-                finite("half-space point", point)?;
-                finite("half-space normal", normal)?;
                 let n = v(*normal);
-                if n.length() == 0.0 || !n.length().is_finite() {
-                    return Err(ClipError::Invalid(format!(
-                        "half-space normal {normal:?}: must not be zero"
-                    )));
-                }
                 Shape::HalfSpace {
                     point: v(*point),
                     normal: n / n.length(),
@@ -317,9 +276,6 @@ impl ShapeSpec {
                 scale,
                 rotation,
             } => {
-                finite("mesh position", position)?;
-                finite("mesh rotation", rotation)?;
-                positive("mesh scale", &[*scale])?;
                 let mesh = crate::surface::read(&base.join(path))?;
                 Shape::Mesh(Box::new(mesh_field::MeshShape::new(
                     &mesh,
@@ -335,9 +291,6 @@ impl ShapeSpec {
                 rotation,
                 segments,
             } => {
-                if let Err(e) = self.validate() {
-                    return Err(ClipError::Invalid(e.to_string()));
-                }
                 let mesh = scene::torus(*major_radius, *minor_radius, *segments)?;
                 Shape::Mesh(Box::new(mesh_field::MeshShape::new(
                     &mesh,
@@ -347,23 +300,15 @@ impl ShapeSpec {
                 )))
             }
             ShapeSpec::Mask { volume, threshold } => {
-                if threshold.is_nan() {
-                    return Err(ClipError::Invalid("mask threshold is NaN".into()));
-                }
                 let volume = volume.load(base, &crate::volume::Limits::default())?;
                 Shape::Mask(Box::new(mask_field::MaskShape::new(
                     &volume, *threshold, half,
                 )))
             }
             ShapeSpec::Union(list) | ShapeSpec::Intersection(list) => {
-                if list.is_empty() {
-                    return Err(ClipError::Invalid(
-                        "a union or intersection needs at least one shape".into(),
-                    ));
-                }
                 let shapes = list
                     .iter()
-                    .map(|s| s.build_at(base, half, depth + 1))
+                    .map(|s| s.build_checked(base, half))
                     .collect::<Result<Vec<_>, _>>()?;
                 if matches!(self, ShapeSpec::Union(_)) {
                     Shape::Union(shapes)
@@ -372,8 +317,8 @@ impl ShapeSpec {
                 }
             }
             ShapeSpec::Difference(pair) => Shape::Difference(
-                Box::new(pair[0].build_at(base, half, depth + 1)?),
-                Box::new(pair[1].build_at(base, half, depth + 1)?),
+                Box::new(pair[0].build_checked(base, half)?),
+                Box::new(pair[1].build_checked(base, half)?),
             ),
         })
     }

@@ -93,8 +93,12 @@ impl ShapeSpec {
             ShapeSpec::HalfSpace { point, normal } => {
                 finite(key("point"), point)?;
                 finite(key("normal"), normal)?;
-                if normal.iter().all(|c| *c == 0.0) {
-                    return Err(FieldError::new(key("normal"), "must not be zero"));
+                let length = normal.iter().map(|c| c * c).sum::<f64>().sqrt();
+                if !(length > 0.0 && length.is_finite()) {
+                    return Err(FieldError::new(
+                        key("normal"),
+                        "must not be zero (and its length must be finite)",
+                    ));
                 }
                 Ok(())
             }

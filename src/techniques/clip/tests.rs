@@ -648,6 +648,11 @@ fn scene_specs_parse_and_build() {
         build_err("shape = { half-space = { point = [0, 0, 0], normal = [0, 0, 0] } }")
             .contains("zero")
     );
+    // A normal whose length overflows cannot be normalized either.
+    assert!(build_err(
+        "shape = { half-space = { point = [0, 0, 0], normal = [1e308, 1e308, 0] } }"
+    )
+    .contains("finite"));
     assert!(build_err("shape = { union = [] }").contains("at least one"));
     assert!(
         build_err("shape = { sphere = { center = [0, 0, 0], radius = 1 } }\nblock = 0")
