@@ -65,50 +65,15 @@ enum Command {
     Bench {
         #[command(flatten)]
         scene: SceneArgs,
-        /// Timed frames per setting and round.
-        #[arg(long, default_value_t = 5)]
-        frames: usize,
-        /// Passes over all settings (interleaved).
-        #[arg(long, default_value_t = 1)]
-        rounds: usize,
+        #[command(flatten)]
+        options: arbvis::study::bench::BenchOptions,
         /// Print JSON instead of text.
         #[arg(long)]
         json: bool,
-        /// Score against the f64 reference (3D opacity; RMSE and largest error over RGB).
-        #[arg(long)]
-        score: bool,
-        /// Reference steps per voxel.
-        #[arg(long, default_value_t = 16.0)]
-        oversample: f64,
-        /// Faithful slicing at these slice counts, e.g. 128,256.
-        #[arg(long, value_delimiter = ',')]
-        faithful: Vec<usize>,
-        /// Precise slicing at these slice counts.
-        #[arg(long, value_delimiter = ',')]
-        precise: Vec<usize>,
-        /// The precise ray caster at these steps per voxel, e.g. 0.5,1,2 (the scene's
-        /// [technique.opacity3d.raycast] options, else the defaults).
-        #[arg(long, value_delimiter = ',')]
-        raycast: Vec<f64>,
-        /// The pre-integrated ray caster (one attribute) at these steps per voxel.
-        #[arg(long, value_delimiter = ',')]
-        raycast_preint: Vec<f64>,
         /// How to look at the scene: its own camera, or an axis-aligned, rotated or
         /// perspective view.
         #[arg(long, value_enum, default_value_t = arbvis::study::bench::View::File)]
         view: arbvis::study::bench::View,
-        /// Also time probe programs on the scene's slices: rasterization and blending, one
-        /// 2D fetch (fill rate), the 3D fetch, dependent table fetches, RGBA8 / RGBA32F.
-        #[arg(long)]
-        breakdown: bool,
-        /// Turn the camera this many degrees about the vertical axis before every frame,
-        /// so each frame pays for a moving view (the splats' sort and tile lists).
-        #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
-        turn: f64,
-        /// Write the levels, tables, camera (and with --score the reference) for a peer
-        /// into this folder; the reference is reused from it when the scene matches.
-        #[arg(long)]
-        export: Option<PathBuf>,
         /// Offscreen backend.
         #[arg(long, value_enum, default_value_t = Backend::Egl)]
         backend: Backend,
@@ -380,47 +345,16 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Bench {
             scene,
-            frames,
-            rounds,
+            options,
             json,
-            score,
-            oversample,
-            faithful,
-            precise,
-            raycast,
-            raycast_preint,
             view,
-            breakdown,
-            turn,
-            export,
             backend,
         } => {
-            if frames == 0 || rounds == 0 {
-                bail!("--frames and --rounds must be at least 1");
-            }
-            if !(turn.is_finite() && turn.abs() <= 360.0) {
-                bail!("--turn {turn}: degrees, at most 360 either way");
-            }
-            if !(oversample.is_finite() && oversample > 0.0 && oversample <= 1024.0) {
-                bail!("--oversample {oversample}: must be above 0 and at most 1024");
-            }
+            options.check()?;
             let (scene, origin) = scene.load()?;
             let scene = view.apply(&scene);
             let origin = format!("{origin} ({} view)", view.name());
             let headless = Headless::new(backend)?;
-            let options = arbvis::study::bench::BenchOptions {
-                frames,
-                rounds,
-                score,
-                oversample,
-                faithful,
-                precise,
-                raycast,
-                raycast_preint,
-                export,
-                breakdown,
-                turn,
-            };
             let report = arbvis::study::bench::run(&headless, &scene, &origin, &options, |line| {
                 eprintln!("{line}")
             })

@@ -29,32 +29,45 @@ use crate::techniques::opacity3d::renderer::{path, preintegrated, resolve_kind, 
 use crate::techniques::opacity3d::{Opacity3dRenderer, Raycast};
 use crate::techniques::{self, Frame, Renderer};
 
-/// What to measure.
-#[derive(Debug, Clone)]
+/// What to measure (also `arbvis bench`'s options: the doc lines are its help).
+#[derive(Debug, Clone, clap::Args)]
 pub struct BenchOptions {
     /// Timed frames per setting and round (after the first, timed apart).
+    #[arg(long, default_value_t = 5)]
     pub frames: usize,
-    /// Passes over all settings, interleaved.
+    /// Passes over all settings (interleaved).
+    #[arg(long, default_value_t = 1)]
     pub rounds: usize,
-    /// Score against the f64 reference (3D opacity).
+    /// Score against the f64 reference (3D opacity; RMSE and largest error over RGB).
+    #[arg(long)]
     pub score: bool,
     /// Reference steps per voxel.
+    #[arg(long, default_value_t = 16.0)]
     pub oversample: f64,
-    /// Faithful slicing at these slice counts.
+    /// Faithful slicing at these slice counts, e.g. 128,256.
+    #[arg(long, value_delimiter = ',')]
     pub faithful: Vec<usize>,
     /// Precise slicing at these slice counts.
+    #[arg(long, value_delimiter = ',')]
     pub precise: Vec<usize>,
-    /// The precise ray caster at these steps per voxel (the scene's ray-caster options,
-    /// else the defaults).
+    /// The precise ray caster at these steps per voxel, e.g. 0.5,1,2 (the scene's
+    /// [technique.opacity3d.raycast] options, else the defaults).
+    #[arg(long, value_delimiter = ',')]
     pub raycast: Vec<f64>,
-    /// The pre-integrated ray caster at these steps per voxel.
+    /// The pre-integrated ray caster (one attribute) at these steps per voxel.
+    #[arg(long, value_delimiter = ',')]
     pub raycast_preint: Vec<f64>,
-    /// Folder for the data a peer needs (levels, tables, camera, reference).
+    /// Write the levels, tables, camera (and with --score the reference) for a peer
+    /// into this folder; the reference is reused from it when the scene matches.
+    #[arg(long)]
     pub export: Option<PathBuf>,
-    /// Also time the probes of [`super::breakdown`] on the scene's slices.
+    /// Also time probe programs on the scene's slices: rasterization and blending, one
+    /// 2D fetch (fill rate), the 3D fetch, dependent table fetches, RGBA8 / RGBA32F.
+    #[arg(long)]
     pub breakdown: bool,
-    /// Degrees the camera turns about the vertical axis before every frame (0: still),
-    /// so that every frame pays for what a moving view costs (the splats' sort).
+    /// Turn the camera this many degrees about the vertical axis before every frame,
+    /// so each frame pays for a moving view (the splats' sort and tile lists).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub turn: f64,
 }
 
@@ -73,6 +86,23 @@ impl Default for BenchOptions {
             breakdown: false,
             turn: 0.0,
         }
+    }
+}
+
+impl BenchOptions {
+    /// Refuse values no run can use, naming the option.
+    pub fn check(&self) -> Result<()> {
+        if self.frames == 0 || self.rounds == 0 {
+            bail!("--frames and --rounds must be at least 1");
+        }
+        if !(self.turn.is_finite() && self.turn.abs() <= 360.0) {
+            bail!("--turn {}: degrees, at most 360 either way", self.turn);
+        }
+        let o = self.oversample;
+        if !(o.is_finite() && o > 0.0 && o <= 1024.0) {
+            bail!("--oversample {o}: must be above 0 and at most 1024");
+        }
+        Ok(())
     }
 }
 
