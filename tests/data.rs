@@ -270,12 +270,7 @@ fn inspect_prints_what_the_loader_sees() {
     let Some(path) = shared_data("seismic/f3.sgy") else {
         return;
     };
-    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args(["inspect", path.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{text}");
+    let text = inspect(&path);
     for expect in [
         "SEG-Y rev 1.0",
         "int16 (3)",
@@ -325,16 +320,7 @@ fn inspect_reads_meshes_point_clouds_and_surfaces() {
         let Some(path) = shared_data(file) else {
             return;
         };
-        let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-            .args(["inspect", path.to_str().unwrap()])
-            .output()
-            .unwrap();
-        let text = String::from_utf8_lossy(&out.stdout);
-        assert!(
-            out.status.success(),
-            "{file}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let text = inspect(&path);
         for e in expect {
             assert!(text.contains(e), "{file}: missing {e:?} in\n{text}");
         }
@@ -413,4 +399,19 @@ fn point_cloud_scenes_render() {
         // 16-bit fields once came out black).
         assert!(lit > 160 * 120 / 10, "{file}: {lit} pixels drawn");
     }
+}
+
+/// `arbvis inspect FILE`'s standard output, the command having succeeded.
+fn inspect(path: &std::path::Path) -> String {
+    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args(["inspect", path.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}: {}",
+        path.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
 }

@@ -508,17 +508,18 @@ pub fn run(
 }
 
 impl Measured {
-    /// A probe of [`super::breakdown`] (GLSL, on `slices` slices).
-    pub fn probe(name: String, target: TargetFormat, slices: usize, first: f64) -> Measured {
+    /// A setting named `name` whose first frame took `first` ms, nothing else known yet
+    /// (frames, medians and errors are filled in as they are measured).
+    fn untimed(name: String, first: f64) -> Measured {
         Measured {
             name,
-            technique: "opacity3d".into(),
+            technique: String::new(),
             fidelity: String::new(),
-            path: "probe".into(),
-            slices: Some(slices),
+            path: String::new(),
+            slices: None,
             steps_per_voxel: None,
-            programs: ProgramKind::Glsl.name().into(),
-            target: target.name().into(),
+            programs: String::new(),
+            target: String::new(),
             first_ms: first,
             frames_ms: Vec::new(),
             median_ms: f64::NAN,
@@ -526,6 +527,18 @@ impl Measured {
             max_ms: f64::NAN,
             rmse: None,
             max_abs: None,
+        }
+    }
+
+    /// A probe of [`super::breakdown`] (GLSL, on `slices` slices).
+    pub fn probe(name: String, target: TargetFormat, slices: usize, first: f64) -> Measured {
+        Measured {
+            technique: "opacity3d".into(),
+            path: "probe".into(),
+            slices: Some(slices),
+            programs: ProgramKind::Glsl.name().into(),
+            target: target.name().into(),
+            ..Measured::untimed(name, first)
         }
     }
 }
@@ -539,7 +552,6 @@ fn new_measured(setting: &Setting, s: &Scene, kind: ProgramKind, first: f64) -> 
         _ => ("", None, None),
     };
     Measured {
-        name: setting.name.clone(),
         technique: s.technique.name().to_string(),
         fidelity: s.fidelity.name().to_string(),
         path: path.to_string(),
@@ -547,13 +559,7 @@ fn new_measured(setting: &Setting, s: &Scene, kind: ProgramKind, first: f64) -> 
         steps_per_voxel: steps,
         programs: kind.name().to_string(),
         target: s.target_format().name().to_string(),
-        first_ms: first,
-        frames_ms: Vec::new(),
-        median_ms: f64::NAN,
-        min_ms: f64::NAN,
-        max_ms: f64::NAN,
-        rmse: None,
-        max_abs: None,
+        ..Measured::untimed(setting.name.clone(), first)
     }
 }
 

@@ -152,13 +152,7 @@ impl<'a> Reader<'a> {
             return self.c.ascii_f64(n, what);
         }
         let start = self.c.pos;
-        let len = n.checked_mul(t.size()).ok_or_else(|| {
-            self.c
-                .err_bin(start, format!("{what}: {n} values overflow"))
-        })?;
-        let data = self.c.take(len, what)?;
-        let mut out = vec_for(n, what).map_err(|m| self.c.err_bin(start, m))?;
-        t.decode_f64(data, true, &mut out);
+        let out = self.binary(n, t, what, |data, out| t.decode_f64(data, true, out))?;
         let bad = out
             .iter()
             .position(|v| !v.is_finite())
@@ -177,14 +171,28 @@ impl<'a> Reader<'a> {
         if !self.binary {
             return Ok((self.c.ascii_int(n, what)?, start));
         }
+        let out = self.binary(n, t, what, |data, out| t.decode_int(data, true, out))?;
+        Ok((out, start))
+    }
+
+    /// `n` big-endian binary values of type `t`, decoded by `decode` (the length checked
+    /// against the file before anything is allocated).
+    fn binary<T>(
+        &mut self,
+        n: usize,
+        t: Num,
+        what: &str,
+        decode: impl FnOnce(&[u8], &mut Vec<T>),
+    ) -> Result<Vec<T>, MeshError> {
+        let start = self.c.pos;
         let len = n.checked_mul(t.size()).ok_or_else(|| {
             self.c
                 .err_bin(start, format!("{what}: {n} values overflow"))
         })?;
         let data = self.c.take(len, what)?;
         let mut out = vec_for(n, what).map_err(|m| self.c.err_bin(start, m))?;
-        t.decode_int(data, true, &mut out);
-        Ok((out, start))
+        decode(data, &mut out);
+        Ok(out)
     }
 
     /// An error about integer `i` of an array read by [`Reader::ints`] from `start`.
