@@ -8,6 +8,7 @@
 
 #![deny(unsafe_code)]
 
+pub mod budget;
 pub mod camera;
 pub mod colortable;
 #[allow(unsafe_code)] // the one module allowed to call GL and the platform

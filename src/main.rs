@@ -19,6 +19,12 @@ use arbvis::scene::{parse_size, Fidelity, Scene};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// The memory budget: the most one file, scene or computation may make arbvis
+    /// allocate, checked before each large allocation (bytes with K/M/G/T, or a share of
+    /// physical memory such as 75%). Default: ARBVIS_MEMORY_BUDGET, else the scene's
+    /// memory_budget, else half of physical memory.
+    #[arg(long, global = true, value_name = "SIZE", value_parser = arbvis::budget::parse)]
+    memory_budget: Option<u64>,
 }
 
 #[derive(Subcommand)]
@@ -270,6 +276,12 @@ impl SceneArgs {
         if self.transparent {
             scene.transparent = true;
         }
+        if let Some(bytes) = scene
+            .memory_budget_bytes()
+            .map_err(|e| anyhow::anyhow!("{origin}: {e}"))?
+        {
+            arbvis::budget::set_from_scene(bytes);
+        }
         Ok((scene, origin))
     }
 }
@@ -300,6 +312,9 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> Result<()> {
+    if let Some(bytes) = cli.memory_budget {
+        arbvis::budget::set(bytes);
+    }
     match cli.command {
         Command::Info { backend, json } => {
             let headless = Headless::new(backend)?;

@@ -95,6 +95,10 @@ pub struct Scene {
     /// The camera.
     #[serde(default)]
     pub camera: Camera,
+    /// The memory budget this scene asks for (`"16G"`, `"75%"`): taken where neither
+    /// `--memory-budget` nor `ARBVIS_MEMORY_BUDGET` sets one ([`crate::budget`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory_budget: Option<String>,
     /// The technique and its parameters.
     pub technique: TechniqueScene,
     /// Folder that relative data paths are read from: the scene file's folder, or the
@@ -288,6 +292,15 @@ impl Scene {
         }
     }
 
+    /// The scene's `memory_budget` in bytes, if it names one.
+    pub fn memory_budget_bytes(&self) -> Result<Option<u64>, FieldError> {
+        self.memory_budget
+            .as_deref()
+            .map(crate::budget::parse)
+            .transpose()
+            .map_err(|m| FieldError::new("memory_budget", m))
+    }
+
     /// The target precision in effect.
     pub fn target_format(&self) -> TargetFormat {
         self.target.unwrap_or(self.fidelity.default_target())
@@ -305,6 +318,7 @@ impl Scene {
         if self.background.iter().any(|v| !v.is_finite()) {
             return Err(FieldError::new("background", "must be finite"));
         }
+        self.memory_budget_bytes()?;
         match &self.technique {
             TechniqueScene::Opacity3d(o) => {
                 o.validate().map_err(|e| e.within("technique.opacity3d"))

@@ -1,0 +1,342 @@
+//! The memory budget: how much memory one file, scene or computation may make arbvis
+//! allocate, checked *before* the allocation from what the input declares or implies.
+//!
+//! A small file can ask for a great deal (a compressed array that inflates a thousandfold,
+//! a point count that a LAZ file repeats cheaply, a grid size in a scene), so every large
+//! allocation is first estimated and compared with the budget; where no estimate is
+//! possible the allocation is fallible ([`vec_for`], `try_reserve`), so it ends in an error,
+//! never in an abort.
+//!
+//! How the budget is set, first match wins:
+//! 1. the command line's `--memory-budget SIZE` (or a library caller's [`set`]);
+//! 2. the environment variable `ARBVIS_MEMORY_BUDGET=SIZE`;
+//! 3. a scene's top-level `memory_budget = "SIZE"`;
+//! 4. the default: half of the machine's physical memory (the smaller of `MemTotal` in
+//!    `/proc/meminfo` and a cgroup limit), 4 GiB where neither can be read.
+//!
+//! SIZE is bytes with an optional unit (`512M`, `16G`, `1.5T`; K/M/G/T are powers of 1024,
+//! an optional `iB`/`B` is accepted) or a share of physical memory (`75%`).
+//!
+//! The check is per allocation (or per group of allocations made together), not a running
+//! total: it bounds what one input can make arbvis ask for.
+
+use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};
+use std::sync::OnceLock;
+
+/// Where the budget in force came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Source {
+    /// Half of physical memory.
+    Default,
+    /// `ARBVIS_MEMORY_BUDGET`.
+    Environment,
+    /// A scene's `memory_budget`.
+    Scene,
+    /// `--memory-budget` or [`set`].
+    Explicit,
+}
+
+impl Source {
+    fn describe(self) -> &'static str {
+        match self {
+            Source::Default => "the default, half of physical memory",
+            Source::Environment => "from ARBVIS_MEMORY_BUDGET",
+            Source::Scene => "from the scene's memory_budget",
+            Source::Explicit => "from --memory-budget",
+        }
+    }
+}
+
+/// The budget in force: bytes and where they came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Budget {
+    /// Largest allocation (or group of allocations) allowed, in bytes.
+    pub bytes: u64,
+    /// Where that number came from.
+    pub source: Source,
+}
+
+/// An allocation the budget refuses, or one the system could not make.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum OverBudget {
+    /// The estimate is over the budget.
+    #[error(
+        "{what} needs about {}, more than the memory budget of {} ({}); raise it with \
+         --memory-budget SIZE, ARBVIS_MEMORY_BUDGET=SIZE or memory_budget = \"SIZE\" in the \
+         scene (e.g. 16G or 75%)",
+        format_bytes(*.estimate), format_bytes(.budget.bytes), .budget.source.describe()
+    )]
+    Over {
+        /// What was to be allocated.
+        what: String,
+        /// Its estimated size in bytes.
+        estimate: u64,
+        /// The budget it was held to.
+        budget: Budget,
+    },
+    /// Within the budget, but the system refused the memory.
+    #[error("{what}: the system could not provide {} of memory", format_bytes(*.bytes))]
+    Refused {
+        /// What was to be allocated.
+        what: String,
+        /// How much.
+        bytes: u64,
+    },
+}
+
+const NOT_SET: u8 = 0;
+static CHOSEN_BYTES: AtomicU64 = AtomicU64::new(0);
+static CHOSEN_SOURCE: AtomicU8 = AtomicU8::new(NOT_SET);
+
+fn source_code(s: Source) -> u8 {
+    match s {
+        Source::Default => 1,
+        Source::Environment => 2,
+        Source::Scene => 3,
+        Source::Explicit => 4,
+    }
+}
+
+fn source_of(code: u8) -> Source {
+    match code {
+        2 => Source::Environment,
+        3 => Source::Scene,
+        4 => Source::Explicit,
+        _ => Source::Default,
+    }
+}
+
+/// The budget before anything was chosen: the environment's, else the default.
+fn initial() -> Budget {
+    static INITIAL: OnceLock<Budget> = OnceLock::new();
+    *INITIAL.get_or_init(|| {
+        if let Ok(text) = std::env::var("ARBVIS_MEMORY_BUDGET") {
+            if let Ok(bytes) = parse(&text) {
+                return Budget {
+                    bytes,
+                    source: Source::Environment,
+                };
+            }
+        }
+        Budget {
+            bytes: default_bytes(),
+            source: Source::Default,
+        }
+    })
+}
+
+/// Half of physical memory, 4 GiB where it cannot be read.
+pub fn default_bytes() -> u64 {
+    physical_memory().map_or(4 << 30, |m| m / 2)
+}
+
+/// The machine's memory as this process may use it: the smaller of `MemTotal` and the
+/// cgroup's `memory.max`, when either can be read.
+pub fn physical_memory() -> Option<u64> {
+    let total = std::fs::read_to_string("/proc/meminfo").ok().and_then(|t| {
+        let line = t.lines().find(|l| l.starts_with("MemTotal:"))?;
+        let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        kib.checked_mul(1024)
+    });
+    let cgroup = std::fs::read_to_string("/sys/fs/cgroup/memory.max")
+        .ok()
+        .and_then(|t| t.trim().parse::<u64>().ok());
+    match (total, cgroup) {
+        (Some(a), Some(b)) => Some(a.min(b)),
+        (a, b) => a.or(b),
+    }
+}
+
+/// The budget in force.
+pub fn current() -> Budget {
+    let code = CHOSEN_SOURCE.load(Ordering::Acquire);
+    if code == NOT_SET {
+        return initial();
+    }
+    Budget {
+        bytes: CHOSEN_BYTES.load(Ordering::Acquire),
+        source: source_of(code),
+    }
+}
+
+/// Choose the budget for the rest of the process (`--memory-budget`, a test's bound).
+pub fn set(bytes: u64) {
+    choose(bytes, Source::Explicit);
+}
+
+/// A scene's `memory_budget`: taken only where neither `--memory-budget` nor
+/// `ARBVIS_MEMORY_BUDGET` chose one.
+pub fn set_from_scene(bytes: u64) {
+    let now = current().source;
+    if matches!(now, Source::Default | Source::Scene) {
+        choose(bytes, Source::Scene);
+    }
+}
+
+fn choose(bytes: u64, source: Source) {
+    CHOSEN_BYTES.store(bytes, Ordering::Release);
+    CHOSEN_SOURCE.store(source_code(source), Ordering::Release);
+}
+
+/// Refuse `estimate` bytes for `what` if it is over the budget.
+pub fn check(what: impl Into<String>, estimate: u64) -> Result<(), OverBudget> {
+    let budget = current();
+    if estimate > budget.bytes {
+        return Err(OverBudget::Over {
+            what: what.into(),
+            estimate,
+            budget,
+        });
+    }
+    Ok(())
+}
+
+/// `count` items of `each` bytes, saturating (an estimate, never an overflow).
+pub fn times(count: u64, each: u64) -> u64 {
+    count.saturating_mul(each)
+}
+
+/// An empty vector with room for `n` items: checked against the budget, then reserved
+/// fallibly, so a refusal is an error value, never an abort.
+pub fn vec_for<T>(n: usize, what: &str) -> Result<Vec<T>, OverBudget> {
+    let bytes = times(n as u64, std::mem::size_of::<T>() as u64);
+    check(what, bytes)?;
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| OverBudget::Refused {
+        what: what.to_string(),
+        bytes,
+    })?;
+    Ok(v)
+}
+
+/// Reserve room for `more` items in `v`, checked against the budget (counting what `v`
+/// already holds) and fallible.
+pub fn reserve<T>(v: &mut Vec<T>, more: usize, what: &str) -> Result<(), OverBudget> {
+    let items = (v.len() as u64).saturating_add(more as u64);
+    let bytes = times(items, std::mem::size_of::<T>() as u64);
+    check(what, bytes)?;
+    v.try_reserve(more).map_err(|_| OverBudget::Refused {
+        what: what.to_string(),
+        bytes,
+    })
+}
+
+/// Parse a SIZE: bytes with an optional K/M/G/T unit (powers of 1024, `B`/`iB` optional),
+/// or a percentage of physical memory.
+pub fn parse(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let bad = || {
+        format!(
+            "{text:?} is not a memory size: write bytes with an optional unit (512M, 16G, 1.5T) \
+             or a share of physical memory (75%)"
+        )
+    };
+    if let Some(p) = t.strip_suffix('%') {
+        let share: f64 = p.trim().parse().map_err(|_| bad())?;
+        if !(share > 0.0 && share <= 100.0) {
+            return Err(format!("{text:?}: a share of memory must be in (0, 100] %"));
+        }
+        let mem = physical_memory().unwrap_or(8 << 30) as f64;
+        return Ok((mem * share / 100.0) as u64);
+    }
+    let upper = t.to_ascii_uppercase();
+    let body = upper
+        .strip_suffix("IB")
+        .or_else(|| upper.strip_suffix('B'))
+        .unwrap_or(&upper);
+    let (number, scale) = match body.chars().last() {
+        Some('K') => (&body[..body.len() - 1], 1u64 << 10),
+        Some('M') => (&body[..body.len() - 1], 1 << 20),
+        Some('G') => (&body[..body.len() - 1], 1 << 30),
+        Some('T') => (&body[..body.len() - 1], 1 << 40),
+        _ => (body, 1),
+    };
+    let value: f64 = number.trim().parse().map_err(|_| bad())?;
+    let bytes = value * scale as f64;
+    if !(bytes.is_finite() && bytes >= 1.0 && bytes < 2f64.powi(63)) {
+        return Err(format!(
+            "{text:?}: a memory budget must be at least 1 byte and below 8 EiB"
+        ));
+    }
+    Ok(bytes as u64)
+}
+
+/// Bytes for people: `512 B`, `3.5 MiB`, `2.00 GiB`.
+pub fn format_bytes(bytes: u64) -> String {
+    const UNITS: [&str; 6] = ["B", "KiB", "MiB", "GiB", "TiB", "PiB"];
+    let mut v = bytes as f64;
+    let mut u = 0;
+    while v >= 1024.0 && u + 1 < UNITS.len() {
+        v /= 1024.0;
+        u += 1;
+    }
+    if u == 0 {
+        format!("{bytes} B")
+    } else if v >= 100.0 {
+        format!("{v:.0} {}", UNITS[u])
+    } else {
+        format!("{v:.2} {}", UNITS[u])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_parse_with_units_and_shares() {
+        assert_eq!(parse("1024").unwrap(), 1024);
+        assert_eq!(parse("512M").unwrap(), 512 << 20);
+        assert_eq!(parse("16g").unwrap(), 16 << 30);
+        assert_eq!(parse("2GiB").unwrap(), 2 << 30);
+        assert_eq!(parse("1.5K").unwrap(), 1536);
+        assert_eq!(parse(" 3 TB ").unwrap(), 3 << 40);
+        let half = parse("50%").unwrap();
+        assert!(half > 0);
+        for bad in [
+            "", "G", "-1G", "0", "abc", "101%", "0%", "nan", "1e30T", "inf",
+        ] {
+            assert!(parse(bad).is_err(), "{bad:?} should be refused");
+        }
+    }
+
+    #[test]
+    fn bytes_format_for_people() {
+        assert_eq!(format_bytes(512), "512 B");
+        assert_eq!(format_bytes(1536), "1.50 KiB");
+        assert_eq!(format_bytes(4 << 30), "4.00 GiB");
+        assert_eq!(format_bytes(300 << 20), "300 MiB");
+    }
+
+    #[test]
+    fn the_default_is_half_of_memory() {
+        if let Some(m) = physical_memory() {
+            assert_eq!(default_bytes(), m / 2);
+        }
+    }
+
+    #[test]
+    fn over_budget_names_the_estimate_the_budget_and_the_way_out() {
+        let budget = Budget {
+            bytes: 1 << 30,
+            source: Source::Default,
+        };
+        let e = OverBudget::Over {
+            what: "the point cloud (5 points)".into(),
+            estimate: 3 << 30,
+            budget,
+        };
+        let m = e.to_string();
+        for part in [
+            "the point cloud",
+            "3.00 GiB",
+            "1.00 GiB",
+            "--memory-budget",
+            "ARBVIS_MEMORY_BUDGET",
+            "memory_budget",
+        ] {
+            assert!(m.contains(part), "{m}");
+        }
+        assert_eq!(times(u64::MAX, 2), u64::MAX);
+    }
+}
