@@ -48,8 +48,8 @@ impl TableSpec {
 
     /// Check what can be checked without reading files: the built-in name and the alpha
     /// curve. The error names the key (`builtin` or `alpha`).
-    pub fn validate(&self) -> Result<(), crate::scene::FieldError> {
-        use crate::scene::FieldError;
+    pub fn validate(&self) -> Result<(), crate::vocab::FieldError> {
+        use crate::vocab::FieldError;
         if self.file.is_none() && !BUILTINS.contains(&self.builtin.as_str()) {
             return Err(FieldError::new(
                 "builtin",

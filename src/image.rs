@@ -1,7 +1,7 @@
 //! Images read back from targets: RGBA f32, top row first, with the precision they came
 //! from; comparison metrics (max abs, RMSE, PSNR) and diff images for tests and studies.
 
-use crate::gl::TargetFormat;
+use crate::vocab::TargetFormat;
 
 /// An RGBA image, top row first, channels in 0..1 (float targets may exceed that).
 #[derive(Debug, Clone, PartialEq)]

@@ -3,13 +3,17 @@
 //! point-based geological sections — each in a faithful mode (the original programs,
 //! 8-bit targets) and a precise mode (corrected maths, float targets).
 //!
-//! Layers, top to bottom: [`scene`] → data → [`techniques`] (CPU preparation, GL
-//! renderer, CPU reference) → [`gl`] (the only `unsafe`) → [`image`] / [`png_io`].
+//! Layers, from the ground up (ARCHITECTURE.md; `tests/layers.rs` keeps them): the
+//! vocabulary ([`vocab`], [`budget`], [`input`], [`camera`], [`image`], [`png_io`],
+//! [`colortable`]) → data and GL ([`volume`], [`mesh`], [`points`], [`surface`], [`gl`],
+//! the only `unsafe`) → [`programs`] → [`techniques`] (CPU preparation, GL renderer, CPU
+//! reference) → [`catalog`] → [`scene`] / [`render`] → [`study`] → `viewer`.
 
 #![deny(unsafe_code)]
 
 pub mod budget;
 pub mod camera;
+pub mod catalog;
 pub mod colortable;
 #[allow(unsafe_code)] // the one module allowed to call GL and the platform
 pub mod gl;
@@ -28,4 +32,5 @@ pub mod surface;
 pub mod techniques;
 #[cfg(feature = "viewer")]
 pub mod viewer;
+pub mod vocab;
 pub mod volume;

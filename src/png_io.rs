@@ -6,8 +6,8 @@ use std::io::{BufReader, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use crate::gl::TargetFormat;
 use crate::image::Image;
+use crate::vocab::TargetFormat;
 
 /// Errors reading or writing PNG files; each names the file.
 #[derive(Debug, thiserror::Error)]

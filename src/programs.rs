@@ -108,6 +108,13 @@ pub fn with_transform(kind: ProgramKind, arb: &ProgramText, glsl: &ProgramText) 
     }
 }
 
+/// Both kinds of the pair that draws `arb` or its GLSL twin `glsl` (see [`with_transform`]).
+pub fn both_kinds(arb: &ProgramText, glsl: &ProgramText) -> Vec<ProgramPair> {
+    [ProgramKind::Arb, ProgramKind::Glsl]
+        .map(|kind| with_transform(kind, arb, glsl))
+        .into()
+}
+
 /// Clip prologue (seed 002), single resolution: inserted after a host's `!!ARBfp1.0`.
 pub const CLIP_SINGLE_ARBFP: ProgramText = program!("clip/single.arbfp");
 /// Clip prologue, INDEX-DATA with the seed's coordinate formula (faithful).
@@ -121,66 +128,6 @@ pub const CLIP_SINGLE_GLSL: ProgramText = program!("clip/single.glsl");
 pub const CLIP_MULTIRES_SLOT_CENTRE_GLSL: ProgramText = program!("clip/multires_slot_centre.glsl");
 /// GLSL twin of [`CLIP_MULTIRES_OFFSET_ARBFP`].
 pub const CLIP_MULTIRES_OFFSET_GLSL: ProgramText = program!("clip/multires_offset.glsl");
-
-/// Every pair the techniques can draw with, both kinds (the compile-everything test).
-pub fn all_pairs() -> Vec<ProgramPair> {
-    let fragments = [
-        (QUAD_ARBFP, QUAD_FRAG),
-        (OPACITY3D_SUM_ARBFP, OPACITY3D_SUM_FRAG),
-        (OPACITY3D_PRODUCT_ARBFP, OPACITY3D_PRODUCT_FRAG),
-        (SPLATS_OIT_COMPOSITE_ARBFP, SPLATS_OIT_COMPOSITE_FRAG),
-    ];
-    let mut pairs = Vec::new();
-    for (arb, glsl) in &fragments {
-        for kind in [ProgramKind::Arb, ProgramKind::Glsl] {
-            pairs.push(with_transform(kind, arb, glsl));
-        }
-    }
-    let own_vertex_stage = [
-        (
-            ProgramKind::Arb,
-            CELLPROJ_PERSPECTIVE_ARBVP,
-            CELLPROJ_PERSPECTIVE_ARBFP,
-        ),
-        (
-            ProgramKind::Glsl,
-            CELLPROJ_PERSPECTIVE_VERT,
-            CELLPROJ_PERSPECTIVE_FRAG,
-        ),
-        (
-            ProgramKind::Arb,
-            CELLPROJ_ORTHOGRAPHIC_ARBVP,
-            CELLPROJ_ORTHOGRAPHIC_ARBFP,
-        ),
-        (
-            ProgramKind::Glsl,
-            CELLPROJ_ORTHOGRAPHIC_VERT,
-            CELLPROJ_ORTHOGRAPHIC_FRAG,
-        ),
-        (
-            ProgramKind::Glsl,
-            CELLPROJ_PRECISE_VERT,
-            CELLPROJ_PRECISE_FRAG,
-        ),
-        (ProgramKind::Arb, SPLATS_ARBVP, SPLATS_SEED_ARBFP),
-        (ProgramKind::Arb, SPLATS_ARBVP, SPLATS_PRECISE_ARBFP),
-        (ProgramKind::Glsl, SPLATS_VERT, SPLATS_SEED_FRAG),
-        (ProgramKind::Glsl, SPLATS_VERT, SPLATS_PRECISE_FRAG),
-        (ProgramKind::Glsl, TRANSFORM_VERT, SPLATS_TILES_FRAG),
-    ];
-    for (kind, vertex, fragment) in own_vertex_stage {
-        pairs.push(ProgramPair {
-            kind,
-            vertex,
-            fragment,
-        });
-    }
-    // Templates compile only specialized: every specialization of opacity3d's.
-    pairs.extend(crate::techniques::opacity3d::programs::all_precise_pairs());
-    // The clip's prologues and functions, composed with the verbatim v3o2 programs.
-    pairs.extend(crate::techniques::opacity3d::clipping::all_clip_pairs());
-    pairs
-}
 
 /// Every embedded text, by name (to check that `programs/` holds nothing unembedded).
 pub fn all_texts() -> Vec<ProgramText> {

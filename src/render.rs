@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 use crate::gl::{Backend, Caps, GlResult, Headless, ProgramKind, Resource, Surface, Target};
 use crate::image::Image;
 use crate::scene::Scene;
-use crate::techniques::{self, Frame};
+use crate::techniques::{Frame, Renderer};
 
 /// One rendered scene and what made it.
 pub struct Rendered {
@@ -49,6 +49,15 @@ impl Rendered {
     }
 }
 
+/// Build the renderer `scene` names, with programs of `kind`; nothing else is created.
+pub fn build(
+    gpu: &crate::gl::Gpu,
+    scene: &Scene,
+    kind: ProgramKind,
+) -> GlResult<Box<dyn Renderer>> {
+    crate::catalog::build(gpu, &scene.technique, &scene.settings(), kind)
+}
+
 /// Render `scene` offscreen on `backend`.
 pub fn render(scene: &Scene, backend: Backend) -> GlResult<Rendered> {
     let headless = Headless::new(backend)?;
@@ -61,7 +70,7 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
     let kind = scene.programs.resolve(gpu);
     let [width, height] = scene.size;
     let t0 = Instant::now();
-    let mut renderer = techniques::build(gpu, scene, kind)?;
+    let mut renderer = build(gpu, scene, kind)?;
     let target = Target::create(
         gpu,
         width,

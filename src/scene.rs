@@ -7,67 +7,9 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::camera::Camera;
+pub use crate::catalog::TechniqueScene;
 use crate::gl::{ProgramChoice, TargetFormat};
-use crate::techniques::cellproj::CellprojScene;
-use crate::techniques::opacity3d::Opacity3dScene;
-use crate::techniques::quad::QuadScene;
-use crate::techniques::splats::SplatsScene;
-
-/// Faithful (the original programs, 8-bit targets, original formulas) or precise
-/// (corrected maths, float targets). DESIGN.md §3.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize, clap::ValueEnum)]
-#[serde(rename_all = "lowercase")]
-pub enum Fidelity {
-    /// As the original system did it.
-    #[default]
-    Faithful,
-    /// As it should be done.
-    Precise,
-}
-
-impl Fidelity {
-    /// The target precision this fidelity uses unless the scene names one.
-    pub fn default_target(self) -> TargetFormat {
-        match self {
-            Fidelity::Faithful => TargetFormat::Rgba8,
-            Fidelity::Precise => TargetFormat::Rgba32f,
-        }
-    }
-
-    /// Lower-case name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Fidelity::Faithful => "faithful",
-            Fidelity::Precise => "precise",
-        }
-    }
-}
-
-/// Which technique and its parameters; in TOML a `[technique.NAME]` table.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case", deny_unknown_fields)]
-pub enum TechniqueScene {
-    /// The full-screen quad demo.
-    Quad(QuadScene),
-    /// v3o2's 3D opacity (boxed: it is much larger than the other variants).
-    Opacity3d(Box<Opacity3dScene>),
-    /// Isosurfaces of tetrahedral meshes by cell projection.
-    Cellproj(Box<CellprojScene>),
-    /// Point-based rendering of geological sections as splats.
-    Splats(Box<SplatsScene>),
-}
-
-impl TechniqueScene {
-    /// Technique name as written in scenes.
-    pub fn name(&self) -> &'static str {
-        match self {
-            TechniqueScene::Quad(_) => "quad",
-            TechniqueScene::Opacity3d(_) => "opacity3d",
-            TechniqueScene::Cellproj(_) => "cellproj",
-            TechniqueScene::Splats(_) => "splats",
-        }
-    }
-}
+pub use crate::vocab::{Fidelity, FieldError};
 
 /// A whole scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -301,6 +243,16 @@ impl Scene {
             .map_err(|m| FieldError::new("memory_budget", m))
     }
 
+    /// What a renderer needs of the scene besides its technique's parameters.
+    pub fn settings(&self) -> crate::catalog::Settings<'_> {
+        crate::catalog::Settings {
+            fidelity: self.fidelity,
+            programs: self.programs,
+            base: &self.base,
+            projection: self.camera.projection,
+        }
+    }
+
     /// The target precision in effect.
     pub fn target_format(&self) -> TargetFormat {
         self.target.unwrap_or(self.fidelity.default_target())
@@ -336,43 +288,6 @@ impl Scene {
 
 /// Longest message quoted from a scene error (a 50 MB key must not reach the terminal).
 const MESSAGE_CHARS: usize = 300;
-
-/// A value that parses but cannot be used: the dotted key that holds it, and why.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FieldError {
-    /// Dotted key relative to where the check ran, e.g. `primary.table.builtin`.
-    pub key: String,
-    /// What is wrong.
-    pub message: String,
-}
-
-impl FieldError {
-    /// An error at `key`.
-    pub fn new(key: impl Into<String>, message: impl Into<String>) -> FieldError {
-        FieldError {
-            key: key.into(),
-            message: message.into(),
-        }
-    }
-
-    /// The same error seen from the enclosing table `prefix`.
-    pub fn within(self, prefix: &str) -> FieldError {
-        FieldError {
-            key: if self.key.is_empty() {
-                prefix.to_string()
-            } else {
-                format!("{prefix}.{}", self.key)
-            },
-            message: self.message,
-        }
-    }
-}
-
-impl std::fmt::Display for FieldError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}: {}", self.key, self.message)
-    }
-}
 
 /// Line and column of the dotted `key` in `text`, or of its longest prefix that the text
 /// spells out (a value left at its default has no position of its own).

@@ -447,7 +447,7 @@ fn the_scene_builds_only_what_it_draws_and_isovalue_edits_touch_only_the_table()
     let mut edited = (**c).clone();
     edited.isovalues[0].value = 0.35;
     edited.isovalues[1].color = [1.0, 1.0, 0.0, 1.0];
-    r.update(gpu, &TechniqueScene::Cellproj(Box::new(edited)))
+    r.update(gpu, arbvis::techniques::Params::of(&edited))
         .unwrap();
     let after: Vec<_> = gpu.resources()[before + built..].to_vec();
     assert_eq!(after.len(), 1, "{after:?}");

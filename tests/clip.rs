@@ -542,7 +542,7 @@ fn update_rebuilds_the_clip() {
             height,
         };
         for edited in [&second, &third, &first] {
-            renderer.update(gpu, &edited.technique).unwrap();
+            renderer.update(gpu, edited.technique.params()).unwrap();
             target.clear(gpu, edited.clear_colour()).unwrap();
             renderer
                 .draw(gpu, Surface::Target(&target), &frame)

@@ -15,7 +15,7 @@ fn every_program_compiles_on_this_driver() {
     let h = headless(Backend::Egl);
     let gpu = h.gpu();
     let mut failures = Vec::new();
-    let pairs = programs::all_pairs();
+    let pairs = arbvis::catalog::all_program_pairs();
     for pair in &pairs {
         if let Err(e) = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment) {
             failures.push(format!(

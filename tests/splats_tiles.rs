@@ -238,7 +238,7 @@ fn edits_reach_the_tiles() {
     let (mut r, target) = renderer(&h, &tiles(base));
     let before = frame(&mut r, &h, &target, cam);
     let new = arbvis::scene::TechniqueScene::Splats(Box::new(params(&tiles(edited))));
-    r.update(h.gpu(), &new).unwrap();
+    r.update(h.gpu(), new.params()).unwrap();
     let after = frame(&mut r, &h, &target, cam);
     let (mut fresh, fresh_target) = renderer(&h, &tiles(edited));
     let expected = frame(&mut fresh, &h, &fresh_target, cam);

@@ -769,7 +769,7 @@ fn drawing_in_parts_equals_one_draw() {
         arbvis::scene::Fidelity::Precise,
     ] {
         scene.fidelity = fidelity;
-        let mut renderer = arbvis::techniques::build(gpu, &scene, kind).unwrap();
+        let mut renderer = arbvis::render::build(gpu, &scene, kind).unwrap();
         let frame = arbvis::techniques::Frame {
             camera: scene.camera,
             width: 64,

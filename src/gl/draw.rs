@@ -8,7 +8,7 @@ use super::gpu::Gpu;
 use super::mesh::Mesh;
 use super::program::Program;
 use super::state::StateGuard;
-use super::target::Target;
+use super::target::Surface;
 use super::texture::Texture;
 
 /// How fragments combine with the target.
@@ -42,15 +42,6 @@ pub enum Primitive {
     /// the fragment gets its position in the sprite (`gl_PointCoord`, or
     /// `fragment.texcoord[0]` for ARB programs).
     Points,
-}
-
-/// Where a draw goes.
-#[derive(Clone, Copy)]
-pub enum Surface<'a> {
-    /// An offscreen target (its whole area).
-    Target(&'a Target),
-    /// The default framebuffer, in the viewport `[x, y, width, height]`.
-    Window([i32; 4]),
 }
 
 /// Everything one draw needs.
@@ -89,36 +80,6 @@ impl<'a> DrawCall<'a> {
             primitive: Primitive::Triangles,
         }
     }
-}
-
-/// Clear `surface` (only its viewport, for a window) to `rgba`.
-pub fn clear(gpu: &Gpu, surface: Surface<'_>, rgba: [f32; 4]) -> GlResult<()> {
-    let _guard = StateGuard::save(gpu);
-    let gl = gpu.glow();
-    // SAFETY: plain state calls.
-    unsafe {
-        match surface {
-            Surface::Target(t) => {
-                t.bind();
-                gl.disable(glow::SCISSOR_TEST);
-                if t.has_depth() {
-                    gl.depth_mask(true);
-                    gl.clear_depth_f64(1.0);
-                    gl.clear(glow::DEPTH_BUFFER_BIT);
-                }
-            }
-            Surface::Window([x, y, w, h]) => {
-                gl.bind_framebuffer(glow::FRAMEBUFFER, None);
-                gl.viewport(x, y, w, h);
-                gl.enable(glow::SCISSOR_TEST);
-                gl.scissor(x, y, w, h);
-            }
-        }
-        gl.color_mask(true, true, true, true);
-        gl.clear_color(rgba[0], rgba[1], rgba[2], rgba[3]);
-        gl.clear(glow::COLOR_BUFFER_BIT);
-    }
-    crate::gl_check!(gpu)
 }
 
 /// Execute `call` on `surface`; the state the draw set is restored afterwards.

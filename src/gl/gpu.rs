@@ -156,15 +156,6 @@ impl Gpu {
         &self.caps
     }
 
-    /// What a volume may hold on this GL: its 3D texture side limit, checked by loaders
-    /// before they read or generate samples.
-    pub fn volume_limits(&self) -> crate::volume::Limits {
-        crate::volume::Limits {
-            max_side: (self.caps.max_3d_texture_size.max(1)) as usize,
-            ..Default::default()
-        }
-    }
-
     /// Drain `glGetError`; the first error becomes `Err`, naming `file:line`.
     pub fn check_errors(&self, file: &'static str, line: u32) -> GlResult<()> {
         let mut first = None;

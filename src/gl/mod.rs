@@ -19,12 +19,12 @@ mod texture;
 #[cfg(feature = "viewer")]
 pub mod window;
 
-pub use draw::{clear, draw, Blend, DrawCall, Primitive, Surface};
+pub use draw::{draw, Blend, DrawCall, Primitive};
 pub use error::{error_name, CompileError, GlError, GlResult};
 pub use gpu::{renderer_is_software, ArbLimits, Caps, Gpu, Resource};
 pub use headless::{Backend, Headless, OSMESA_LIBRARIES};
 pub use mesh::Mesh;
 pub use program::{Program, ProgramChoice, ProgramKind, ProgramText, MAX_LOCALS, MAX_UNITS};
 pub use state::{SavedState, StateGuard};
-pub use target::{read_window, Target, TargetFormat};
+pub use target::{clear, read_window, Surface, Target, TargetFormat};
 pub use texture::{Extent, Filter, TexelData, TexelFormat, Texture};

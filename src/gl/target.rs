@@ -9,68 +9,57 @@ use glow::HasContext;
 
 use super::error::{GlError, GlResult};
 use super::gpu::Gpu;
+use super::state::StateGuard;
 use super::texture::{TexelFormat, Texture};
 use crate::image::Image;
+pub use crate::vocab::TargetFormat;
 
-/// Colour-target precision; faithful mode draws into RGBA8 as the original did.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    Default,
-    serde::Serialize,
-    serde::Deserialize,
-    clap::ValueEnum,
-)]
-#[serde(rename_all = "lowercase")]
-pub enum TargetFormat {
-    /// 8 bits per channel, normalized.
-    #[default]
-    Rgba8,
-    /// 16-bit float per channel.
-    Rgba16f,
-    /// 32-bit float per channel.
-    Rgba32f,
+/// The texel format of a target's colour texture.
+pub(crate) fn texel_format(format: TargetFormat) -> TexelFormat {
+    match format {
+        TargetFormat::Rgba8 => TexelFormat::Rgba8,
+        TargetFormat::Rgba16f => TexelFormat::Rgba16f,
+        TargetFormat::Rgba32f => TexelFormat::Rgba32f,
+    }
 }
 
-impl TargetFormat {
-    /// Bytes per pixel.
-    pub fn bytes_per_pixel(self) -> u64 {
-        match self {
-            TargetFormat::Rgba8 => 4,
-            TargetFormat::Rgba16f => 8,
-            TargetFormat::Rgba32f => 16,
-        }
-    }
+/// Where a draw goes.
+#[derive(Clone, Copy)]
+pub enum Surface<'a> {
+    /// An offscreen target (its whole area).
+    Target(&'a Target),
+    /// The default framebuffer, in the viewport `[x, y, width, height]`.
+    Window([i32; 4]),
+}
 
-    /// Smallest step between two stored values near 1.0, the quantum tolerances derive from.
-    pub fn quantum(self) -> f32 {
-        match self {
-            TargetFormat::Rgba8 => 1.0 / 255.0,
-            TargetFormat::Rgba16f => 1.0 / 1024.0, // 10-bit mantissa
-            TargetFormat::Rgba32f => f32::EPSILON,
+/// Clear `surface` (only its viewport, for a window) to `rgba`.
+pub fn clear(gpu: &Gpu, surface: Surface<'_>, rgba: [f32; 4]) -> GlResult<()> {
+    let _guard = StateGuard::save(gpu);
+    let gl = gpu.glow();
+    // SAFETY: plain state calls.
+    unsafe {
+        match surface {
+            Surface::Target(t) => {
+                t.bind();
+                gl.disable(glow::SCISSOR_TEST);
+                if t.has_depth() {
+                    gl.depth_mask(true);
+                    gl.clear_depth_f64(1.0);
+                    gl.clear(glow::DEPTH_BUFFER_BIT);
+                }
+            }
+            Surface::Window([x, y, w, h]) => {
+                gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+                gl.viewport(x, y, w, h);
+                gl.enable(glow::SCISSOR_TEST);
+                gl.scissor(x, y, w, h);
+            }
         }
+        gl.color_mask(true, true, true, true);
+        gl.clear_color(rgba[0], rgba[1], rgba[2], rgba[3]);
+        gl.clear(glow::COLOR_BUFFER_BIT);
     }
-
-    /// Name as written in scenes and on the command line.
-    pub fn name(self) -> &'static str {
-        match self {
-            TargetFormat::Rgba8 => "rgba8",
-            TargetFormat::Rgba16f => "rgba16f",
-            TargetFormat::Rgba32f => "rgba32f",
-        }
-    }
-
-    /// The texel format of a target's colour texture.
-    pub fn texel(self) -> TexelFormat {
-        match self {
-            TargetFormat::Rgba8 => TexelFormat::Rgba8,
-            TargetFormat::Rgba16f => TexelFormat::Rgba16f,
-            TargetFormat::Rgba32f => TexelFormat::Rgba32f,
-        }
-    }
+    crate::gl_check!(gpu)
 }
 
 /// An owned framebuffer with one colour texture and, when asked for, a 24-bit depth
@@ -115,7 +104,7 @@ impl Target {
             )));
         }
         let gl = gpu.glow().clone();
-        let color = Texture::render_target(gpu, width, height, format.texel())?;
+        let color = Texture::render_target(gpu, width, height, texel_format(format))?;
         // SAFETY: fresh objects; the previous framebuffer binding is restored.
         let (framebuffer, depth, status) = unsafe {
             let prev_fb = gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING);
@@ -262,7 +251,7 @@ impl Target {
 
     /// Clear to `rgba`.
     pub fn clear(&self, gpu: &Gpu, rgba: [f32; 4]) -> GlResult<()> {
-        super::draw::clear(gpu, super::draw::Surface::Target(self), rgba)
+        clear(gpu, Surface::Target(self), rgba)
     }
 
     /// Read the whole target, top row first. RGBA8 keeps its bytes exactly (as `k/255`).

@@ -13,6 +13,7 @@
 //! colour channels of every pixel. The reference (see `opacity3d::reference`) is cached
 //! in the export folder, keyed by the scene text, size and oversampling.
 
+pub use super::measured::Measured;
 use super::median;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -20,14 +21,16 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::gl::{Headless, ProgramKind, Surface, Target, TargetFormat};
+use crate::gl::{Headless, ProgramKind, Surface, Target};
 use crate::image::Image;
-use crate::scene::{Fidelity, Scene, TechniqueScene};
+use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::reference::reference_clipped;
 use crate::techniques::opacity3d::renderer::{path, preintegrated, resolve_kind, Path3d};
 use crate::techniques::opacity3d::{Opacity3dRenderer, Raycast};
-use crate::techniques::{self, Frame, Renderer};
+use crate::techniques::{Frame, Renderer};
+use crate::vocab::Fidelity;
+use crate::vocab::TargetFormat;
 
 /// What to measure (also `arbvis bench`'s options: the doc lines are its help).
 #[derive(Debug, Clone, clap::Args)]
@@ -264,41 +267,6 @@ fn raycast_name(r: &Raycast, scene: &Scene) -> String {
     )
 }
 
-/// One setting measured.
-#[derive(Debug, Clone, Serialize)]
-pub struct Measured {
-    /// The setting's name.
-    pub name: String,
-    /// Technique name.
-    pub technique: String,
-    /// `faithful` or `precise`.
-    pub fidelity: String,
-    /// `slicing` or `raycast` (3D opacity), else empty.
-    pub path: String,
-    /// Slice count (slicing).
-    pub slices: Option<usize>,
-    /// Steps per voxel (ray caster).
-    pub steps_per_voxel: Option<f64>,
-    /// `arb` or `glsl`.
-    pub programs: String,
-    /// Colour target.
-    pub target: String,
-    /// The first frame (program variants compiled, meshes built), ms.
-    pub first_ms: f64,
-    /// Every timed frame, ms, in the order taken.
-    pub frames_ms: Vec<f64>,
-    /// Median of `frames_ms`.
-    pub median_ms: f64,
-    /// Smallest of `frames_ms`.
-    pub min_ms: f64,
-    /// Largest of `frames_ms`.
-    pub max_ms: f64,
-    /// RMSE over RGB against the reference.
-    pub rmse: Option<f64>,
-    /// Largest RGB difference from the reference.
-    pub max_abs: Option<f64>,
-}
-
 /// A bench run.
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
@@ -363,8 +331,12 @@ pub fn run(
     let prepared = match &scene.technique {
         TechniqueScene::Opacity3d(p) => {
             let t0 = Instant::now();
-            let prepared =
-                prepare(p, &scene.base, &gpu.volume_limits()).map_err(anyhow::Error::msg)?;
+            let prepared = prepare(
+                p,
+                &scene.base,
+                &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
+            )
+            .map_err(anyhow::Error::msg)?;
             progress(&format!(
                 "prepared the data in {:.1} s",
                 t0.elapsed().as_secs_f64()
@@ -399,7 +371,7 @@ pub fn run(
             let key = slot_key(s, kind);
             let slot = match slots.iter().position(|x| x.key == key) {
                 Some(n) => {
-                    slots[n].renderer.update(gpu, &s.technique)?;
+                    slots[n].renderer.update(gpu, s.technique.params())?;
                     &mut slots[n]
                 }
                 None => {
@@ -407,7 +379,7 @@ pub fn run(
                         (TechniqueScene::Opacity3d(p), Some(prepared)) => {
                             Box::new(Opacity3dRenderer::from_prepared(
                                 gpu,
-                                resolve_kind(s, kind),
+                                resolve_kind(p, s.fidelity, s.programs, kind),
                                 s.fidelity,
                                 p,
                                 &s.base,
@@ -415,7 +387,7 @@ pub fn run(
                                 s.camera.projection,
                             )?)
                         }
-                        _ => techniques::build(gpu, s, kind)?,
+                        _ => crate::render::build(gpu, s, kind)?,
                     };
                     let target = if renderer.needs_depth() {
                         Target::with_depth(gpu, w, h, s.target_format())?
@@ -505,42 +477,6 @@ pub fn run(
         reference_s,
         settings,
     })
-}
-
-impl Measured {
-    /// A setting named `name` whose first frame took `first` ms, nothing else known yet
-    /// (frames, medians and errors are filled in as they are measured).
-    fn untimed(name: String, first: f64) -> Measured {
-        Measured {
-            name,
-            technique: String::new(),
-            fidelity: String::new(),
-            path: String::new(),
-            slices: None,
-            steps_per_voxel: None,
-            programs: String::new(),
-            target: String::new(),
-            first_ms: first,
-            frames_ms: Vec::new(),
-            median_ms: f64::NAN,
-            min_ms: f64::NAN,
-            max_ms: f64::NAN,
-            rmse: None,
-            max_abs: None,
-        }
-    }
-
-    /// A probe of [`super::breakdown`] (GLSL, on `slices` slices).
-    pub fn probe(name: String, target: TargetFormat, slices: usize, first: f64) -> Measured {
-        Measured {
-            technique: "opacity3d".into(),
-            path: "probe".into(),
-            slices: Some(slices),
-            programs: ProgramKind::Glsl.name().into(),
-            target: target.name().into(),
-            ..Measured::untimed(name, first)
-        }
-    }
 }
 
 fn new_measured(setting: &Setting, s: &Scene, kind: ProgramKind, first: f64) -> Measured {

@@ -11,10 +11,10 @@ use std::time::Instant;
 
 use anyhow::Result;
 
-use super::bench::Measured;
+use super::measured::Measured;
 use crate::gl::{
-    self, Blend, DrawCall, Extent, Headless, Mesh, Program, ProgramKind, Surface, TargetFormat,
-    TexelData, TexelFormat, Texture,
+    self, Blend, DrawCall, Extent, Headless, Mesh, Program, ProgramKind, Surface, TexelData,
+    TexelFormat, Texture,
 };
 use crate::programs::{self, with_transform};
 use crate::scene::{Scene, TechniqueScene};
@@ -23,6 +23,7 @@ use crate::techniques::opacity3d::programs::specialize;
 use crate::techniques::opacity3d::renderer::{model_view_projection, toward_viewer};
 use crate::techniques::opacity3d::slicing::slice_box;
 use crate::techniques::Frame;
+use crate::vocab::TargetFormat;
 
 /// One probe: a name, its tags, which volume it reads, its target and blend.
 struct Probe {

@@ -8,18 +8,21 @@
 pub mod bench;
 pub mod breakdown;
 pub mod export;
+pub mod measured;
 pub mod peers;
 
 use std::path::Path;
 use std::time::Instant;
 
-use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target, TargetFormat};
+use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target};
 use crate::image::Image;
-use crate::scene::{Fidelity, Scene, TechniqueScene};
+use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::reference::reference;
 use crate::techniques::opacity3d::{Opacity3dRenderer, Opacity3dScene};
 use crate::techniques::{Frame, Renderer};
+use crate::vocab::Fidelity;
+use crate::vocab::TargetFormat;
 use crate::volume::synthetic::SyntheticSpec;
 use crate::volume::VolumeSource;
 
@@ -177,7 +180,7 @@ pub fn run(
     let prepared = prepare(
         params(&base_scene),
         &base_scene.base,
-        &headless.gpu().volume_limits(),
+        &crate::volume::Limits::for_max_side(headless.gpu().caps().max_3d_texture_size),
     )
     .map_err(anyhow::Error::msg)?;
     progress(&format!(

@@ -10,9 +10,10 @@ pub mod quad;
 pub mod rays;
 pub mod splats;
 
+use std::any::Any;
+
 use crate::camera::Camera;
-use crate::gl::{GlResult, Gpu, ProgramKind, Surface};
-use crate::scene::{Scene, TechniqueScene};
+use crate::gl::{GlError, GlResult, Gpu, ProgramKind, Surface};
 
 /// What changes from frame to frame.
 #[derive(Debug, Clone, Copy)]
@@ -54,8 +55,9 @@ pub trait Renderer {
             Ok(())
         }
     }
-    /// Take changed parameters (the viewer's editors); resends what changed.
-    fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()>;
+    /// Take changed parameters (the viewer's editors); resends what changed. Parameters
+    /// of another technique are an error.
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()>;
     /// The program kind in use.
     fn program_kind(&self) -> ProgramKind;
     /// Whether its surface needs a depth buffer (opaque geometry with a depth test).
@@ -73,31 +75,34 @@ pub trait Renderer {
     }
 }
 
-/// Build the renderer a scene names, with programs of `kind`; nothing else is created.
-pub fn build(gpu: &Gpu, scene: &Scene, kind: ProgramKind) -> GlResult<Box<dyn Renderer>> {
-    Ok(match &scene.technique {
-        TechniqueScene::Quad(params) => Box::new(quad::QuadRenderer::new(gpu, kind, params)?),
-        TechniqueScene::Opacity3d(params) => Box::new(opacity3d::Opacity3dRenderer::new(
-            gpu,
-            opacity3d::renderer::resolve_kind(scene, kind),
-            scene.fidelity,
+/// A technique's scene parameters (`[technique.NAME]`), as [`Renderer::update`] takes
+/// them: each technique's scene type implements it, so the renderers need not know the
+/// list of techniques (that list, `crate::catalog::TechniqueScene`, sits above them).
+pub trait TechniqueParams: Any {
+    /// The technique's name as written in scenes.
+    const NAME: &'static str;
+}
+
+/// Some technique's parameters; a renderer takes its own with [`Params::get`].
+#[derive(Clone, Copy)]
+pub struct Params<'a> {
+    params: &'a dyn Any,
+    name: &'static str,
+}
+
+impl<'a> Params<'a> {
+    /// Wrap one technique's parameters.
+    pub fn of<T: TechniqueParams>(params: &'a T) -> Params<'a> {
+        Params {
             params,
-            &scene.base,
-            scene.camera.projection,
-        )?),
-        TechniqueScene::Splats(params) => Box::new(splats::SplatsRenderer::new(
-            gpu,
-            kind,
-            scene.fidelity,
-            params,
-            &scene.base,
-        )?),
-        TechniqueScene::Cellproj(params) => Box::new(cellproj::CellprojRenderer::new(
-            gpu,
-            kind,
-            scene.fidelity,
-            params,
-            &scene.base,
-        )?),
-    })
+            name: T::NAME,
+        }
+    }
+
+    /// The parameters as technique `T`'s, or an error naming both techniques.
+    pub fn get<T: TechniqueParams>(&self) -> GlResult<&'a T> {
+        self.params.downcast_ref::<T>().ok_or_else(|| {
+            GlError::Invalid(format!("{} renderer given a {} scene", T::NAME, self.name))
+        })
+    }
 }

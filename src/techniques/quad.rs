@@ -12,11 +12,10 @@
 use glam::{DMat4, DVec3};
 use serde::{Deserialize, Serialize};
 
-use super::{Frame, Renderer};
+use super::{Frame, Params, Renderer, TechniqueParams};
 use crate::gl::{self, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface};
 use crate::image::Image;
 use crate::programs;
-use crate::scene::TechniqueScene;
 
 /// Parameters of the quad demo.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -26,6 +25,10 @@ pub struct QuadScene {
     pub left: [f64; 4],
     /// Colour at the right edge (RGBA), `program.local[1]`.
     pub right: [f64; 4],
+}
+
+impl TechniqueParams for QuadScene {
+    const NAME: &'static str = "quad";
 }
 
 impl Default for QuadScene {
@@ -97,19 +100,18 @@ impl Renderer for QuadRenderer {
         gl::draw(gpu, surface, &DrawCall::new(&self.program, &self.mesh))
     }
 
-    fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()> {
-        match technique {
-            TechniqueScene::Quad(params) => self.set_colours(gpu, params),
-            other => Err(GlError::Invalid(format!(
-                "quad renderer given a {} scene",
-                other.name()
-            ))),
-        }
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
+        self.set_colours(gpu, params.get::<QuadScene>()?)
     }
 
     fn program_kind(&self) -> ProgramKind {
         self.program.kind()
     }
+}
+
+/// The program pairs the quad draws with, both kinds.
+pub fn program_pairs() -> Vec<programs::ProgramPair> {
+    programs::both_kinds(&programs::QUAD_ARBFP, &programs::QUAD_FRAG)
 }
 
 /// CPU reference (f64) of the default-camera image at pixel centres, top row first;

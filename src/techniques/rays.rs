@@ -6,8 +6,8 @@ use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 
 use crate::camera::Camera;
-use crate::gl::TargetFormat;
 use crate::image::Image;
+use crate::vocab::TargetFormat;
 
 /// A pixel's ray in object space: origin on the near plane, direction toward the far
 /// plane (not normalized: the parameter runs 0..1 from near to far).

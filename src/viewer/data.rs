@@ -17,7 +17,7 @@ use crate::gl::{GlError, Gpu, ProgramKind};
 use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::Opacity3dRenderer;
-use crate::techniques::{self, Renderer};
+use crate::techniques::Renderer;
 
 /// The two axes a section at fixed `axis` shows: (across, down).
 pub fn section_axes(axis: usize) -> (usize, usize) {
@@ -65,13 +65,18 @@ pub fn build(
 ) -> Result<Box<dyn Renderer>, GlError> {
     let TechniqueScene::Opacity3d(params) = &scene.technique else {
         data.volume = None;
-        return techniques::build(gpu, scene, kind);
+        return crate::render::build(gpu, scene, kind);
     };
     if data.volume.is_none() {
         params
             .validate()
             .map_err(|e| GlError::Data(e.to_string()))?;
-        let prepared = prepare(params, &scene.base, &gpu.volume_limits()).map_err(GlError::Data)?;
+        let prepared = prepare(
+            params,
+            &scene.base,
+            &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
+        )
+        .map_err(GlError::Data)?;
         let axes = axes::describe(&params.primary.volume, &scene.base, prepared.dims);
         let histograms = std::array::from_fn(|a| {
             prepared.tables[a].as_ref().map(|_| {

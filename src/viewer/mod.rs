@@ -24,6 +24,7 @@ pub mod curve;
 pub mod data;
 pub mod isovalues;
 pub mod lut3d;
+mod options;
 pub mod overlay;
 pub mod panel;
 pub mod runner;
@@ -33,7 +34,6 @@ pub mod splats;
 pub mod volume_view;
 pub mod widgets;
 
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::Context as _;
@@ -42,24 +42,11 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy};
 use winit::window::WindowId;
 
-use crate::scene::Scene;
 use runner::{ScriptRunner, ScriptStep};
-use script::Script;
 use session::Running;
 
+pub use options::ViewerOptions;
 pub use session::fit_zoom;
-
-/// What `arbvis view` was asked to show.
-pub struct ViewerOptions {
-    /// The scene.
-    pub scene: Scene,
-    /// Where it came from (recorded in screenshots).
-    pub origin: String,
-    /// Folder for screenshots and saved scenes.
-    pub screenshot_dir: PathBuf,
-    /// UI actions to run, then exit.
-    pub script: Option<Script>,
-}
 
 /// Wakes the event loop.
 #[derive(Debug, Clone, Copy)]

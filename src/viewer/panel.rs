@@ -15,7 +15,8 @@ use super::volume_view::InteractiveQuality;
 use super::widgets::Widgets;
 use crate::camera::Projection;
 use crate::gl::{Caps, ProgramKind};
-use crate::scene::{Fidelity, Scene, TechniqueScene};
+use crate::scene::{Scene, TechniqueScene};
+use crate::vocab::Fidelity;
 
 /// Width of the left panel in points.
 pub const PANEL_WIDTH: f32 = 250.0;

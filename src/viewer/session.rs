@@ -13,11 +13,11 @@ use winit::window::Window;
 
 use super::data::{self, ViewData};
 use super::lut3d;
+use super::options::ViewerOptions;
 use super::panel::{self, PanelState, UiAction, PANEL_WIDTH, SECTIONS_HEIGHT};
 use super::runner::Observed;
 use super::script::MeasureMode;
 use super::volume_view::{Key, Pending, VolumeView, SETTLE};
-use super::ViewerOptions;
 use crate::camera::{Arcball, Camera, Projection};
 use crate::gl::window::GlWindow;
 use crate::gl::{self, ProgramKind, Surface};
@@ -203,7 +203,7 @@ impl Running {
                 UiAction::ParamsChanged => {
                     match self
                         .renderer
-                        .update(self.window.gpu(), &self.scene.technique)
+                        .update(self.window.gpu(), self.scene.technique.params())
                     {
                         Ok(()) => self.generation += 1,
                         Err(e) => self.fail_action(format!("error: {e}")),

@@ -4,9 +4,9 @@
 //! function. The frame, sort and tile-list times show in the panel's status line.
 
 use super::widgets::Widgets;
-use crate::scene::Fidelity;
 use crate::techniques::splats::scene::{ColourMode, DrawChoice, Kernel, Mode, SortChoice};
 use crate::techniques::splats::SplatsScene;
+use crate::vocab::Fidelity;
 
 /// Layer ids with a toggle (the seed's sections have layers 0..7).
 pub const LAYERS: i32 = 8;

@@ -16,9 +16,10 @@
 use std::time::{Duration, Instant};
 
 use crate::camera::Camera;
-use crate::gl::{Gpu, Surface, Target, TargetFormat};
+use crate::gl::{Gpu, Surface, Target};
 use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::{Frame, Renderer};
+use crate::vocab::TargetFormat;
 
 /// How long after the last edit the view counts as still.
 pub const SETTLE: Duration = Duration::from_millis(250);
@@ -220,9 +221,9 @@ impl VolumeView {
             renderer.needs_depth(),
         )?;
         target.clear(gpu, key.background)?;
-        renderer.update(gpu, &reduced(technique, d))?;
+        renderer.update(gpu, reduced(technique, d).params())?;
         let drawn = renderer.draw(gpu, Surface::Target(&target), &frame);
-        renderer.update(gpu, technique)?;
+        renderer.update(gpu, technique.params())?;
         drawn?;
         gpu.finish();
         self.interactive_ms = t0.elapsed().as_secs_f64() * 1e3;

@@ -333,6 +333,14 @@ impl Default for Limits {
 }
 
 impl Limits {
+    /// The limits on a GL whose `GL_MAX_3D_TEXTURE_SIZE` is `max_3d_texture_size`.
+    pub fn for_max_side(max_3d_texture_size: i32) -> Limits {
+        Limits {
+            max_side: max_3d_texture_size.max(1) as usize,
+            ..Default::default()
+        }
+    }
+
     /// Check `dims` declared by `what` (a file or a scene value).
     pub fn check(&self, dims: [usize; 3], what: &str) -> Result<(), VolumeError> {
         let voxels = dims.iter().try_fold(1u64, |a, &d| a.checked_mul(d as u64));
@@ -377,8 +385,8 @@ impl VolumeSource {
     }
 
     /// Check the scene values that can be checked without reading files.
-    pub fn validate(&self) -> Result<(), crate::scene::FieldError> {
-        use crate::scene::FieldError;
+    pub fn validate(&self) -> Result<(), crate::vocab::FieldError> {
+        use crate::vocab::FieldError;
         match self {
             VolumeSource::Synthetic(spec) => {
                 spec.validate().map_err(|e| FieldError::new("synthetic", e))

@@ -73,7 +73,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::mesh::scalars::ScalarSpec;
 use crate::mesh::MeshSource;
-use crate::scene::FieldError;
+use crate::vocab::FieldError;
 
 pub use renderer::CellprojRenderer;
 
@@ -160,6 +160,10 @@ pub struct CellprojScene {
     /// Depth written by the precise programs.
     #[serde(default)]
     pub depth: Depth,
+}
+
+impl crate::techniques::TechniqueParams for CellprojScene {
+    const NAME: &'static str = "cellproj";
 }
 
 fn yes() -> bool {

@@ -15,8 +15,9 @@ use crate::gl::{
     ProgramText, Surface, TexelData, TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
-use crate::scene::{Fidelity, TechniqueScene};
-use crate::techniques::{Frame, Renderer};
+
+use crate::techniques::{Frame, Params, Renderer};
+use crate::vocab::Fidelity;
 
 /// Texture unit of the table (faithful) or isovalue list (precise).
 pub const TABLE_UNIT: u32 = 0;
@@ -340,13 +341,8 @@ impl Renderer for CellprojRenderer {
         )
     }
 
-    fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()> {
-        let TechniqueScene::Cellproj(new) = technique else {
-            return Err(GlError::Invalid(format!(
-                "cellproj renderer given a {} scene",
-                technique.name()
-            )));
-        };
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
+        let new = params.get::<CellprojScene>()?;
         new.validate().map_err(|e| GlError::Data(e.to_string()))?;
         if new.mesh != self.params.mesh || new.scalars != self.params.scalars {
             return Err(GlError::Invalid(
@@ -358,7 +354,7 @@ impl Renderer for CellprojRenderer {
         let active_changed =
             new.isovalues != self.params.isovalues || new.active_only != self.params.active_only;
         let order_changed = new.order != self.params.order;
-        self.params = (**new).clone();
+        self.params = new.clone();
         if order_changed {
             (self.mesh, self.faces) = face_mesh(gpu, &self.prepared, self.params.order)?;
         }
@@ -381,4 +377,43 @@ impl Renderer for CellprojRenderer {
     fn needs_depth(&self) -> bool {
         true
     }
+}
+
+/// Every pair cell projection draws with: the faithful ports (per-fragment and per-vertex
+/// exit) in ARB and GLSL, and the precise GLSL pair.
+pub fn program_pairs() -> Vec<ProgramPair> {
+    use programs::*;
+    [
+        (
+            ProgramKind::Arb,
+            CELLPROJ_PERSPECTIVE_ARBVP,
+            CELLPROJ_PERSPECTIVE_ARBFP,
+        ),
+        (
+            ProgramKind::Glsl,
+            CELLPROJ_PERSPECTIVE_VERT,
+            CELLPROJ_PERSPECTIVE_FRAG,
+        ),
+        (
+            ProgramKind::Arb,
+            CELLPROJ_ORTHOGRAPHIC_ARBVP,
+            CELLPROJ_ORTHOGRAPHIC_ARBFP,
+        ),
+        (
+            ProgramKind::Glsl,
+            CELLPROJ_ORTHOGRAPHIC_VERT,
+            CELLPROJ_ORTHOGRAPHIC_FRAG,
+        ),
+        (
+            ProgramKind::Glsl,
+            CELLPROJ_PRECISE_VERT,
+            CELLPROJ_PRECISE_FRAG,
+        ),
+    ]
+    .map(|(kind, vertex, fragment)| ProgramPair {
+        kind,
+        vertex,
+        fragment,
+    })
+    .into()
 }

@@ -5,14 +5,16 @@
 //! with the right isovalue colour).
 
 use crate::study::median;
+use crate::techniques::Params;
 use std::time::Instant;
 
 use crate::camera::{Camera, Projection};
-use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target, TargetFormat};
+use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target};
 use crate::mesh::grid::{generate, Field, GridSpec};
 use crate::mesh::scalars::ScalarSpec;
-use crate::scene::{Fidelity, TechniqueScene};
 use crate::techniques::{Frame, Renderer};
+use crate::vocab::Fidelity;
+use crate::vocab::TargetFormat;
 
 use super::prepare::{from_mesh, Prepared};
 use super::reference::{agreement, reference, silhouette_pixels};
@@ -133,11 +135,11 @@ fn measure(
         let mut edited = params.clone();
         edited.isovalues[0].value = 0.3 + 0.01 * (i % 5) as f64;
         let t0 = Instant::now();
-        r.update(gpu, &TechniqueScene::Cellproj(Box::new(edited)))?;
+        r.update(gpu, Params::of(&edited))?;
         draw(&mut r)?;
         edits.push(t0.elapsed().as_secs_f64() * 1e3);
     }
-    r.update(gpu, &TechniqueScene::Cellproj(Box::new(params.clone())))?;
+    r.update(gpu, Params::of(&params.clone()))?;
     draw(&mut r)?;
     let image = target.read(gpu)?;
     let depth = target.read_depth(gpu)?.unwrap_or_default();

@@ -23,7 +23,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::texture::ClipGrid;
+use super::grid::ClipGrid;
 use crate::volume::Volume;
 
 const NONE: u32 = u32::MAX;

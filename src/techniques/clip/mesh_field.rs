@@ -36,7 +36,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::texture::ClipGrid;
+use super::grid::ClipGrid;
 use crate::surface::TriangleMesh;
 
 /// Largest number of (triangle, slice) pairs binned before slices scan all triangles.

@@ -53,6 +53,8 @@
 //! reaches 0.16 at 256³ (best 0.171 with an RGBA8 INDEX, which cannot address the slots);
 //! the ratio falls as 1/N: 0.140 at 384³, 0.114 at 512³.
 
+mod error;
+pub mod grid;
 pub mod mask_field;
 pub mod mesh_field;
 pub mod multires;
@@ -71,23 +73,10 @@ use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 use crate::volume::VolumeSource;
+pub use error::ClipError;
 use multires::MultiRes;
 use shape::{rotation_from_degrees, Shape};
 use texture::{ClipGrid, ClipTexture};
-
-/// Errors preparing a clip: the shape's files, or parameters that cannot be built.
-#[derive(Debug, thiserror::Error)]
-pub enum ClipError {
-    /// A clip mesh could not be read.
-    #[error(transparent)]
-    Surface(#[from] crate::surface::SurfaceError),
-    /// A mask volume could not be read.
-    #[error(transparent)]
-    Volume(#[from] crate::volume::VolumeError),
-    /// Parameters out of range, or a texture that cannot be built.
-    #[error("{0}")]
-    Invalid(String),
-}
 
 /// A clip shape as written in a scene, e.g. `{ sphere = { center = [0, 0, 0], radius =
 /// 0.5 } }`. Coordinates are the volume's object space; rotations Euler degrees

@@ -52,8 +52,8 @@ use std::time::Instant;
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::error::ClipError;
 use super::texture::{trilinear, ClipTexture};
-use super::ClipError;
 
 /// Largest DATA texture built (texels; 2 GiB of f32).
 pub const MAX_DATA_TEXELS: usize = 1 << 29;

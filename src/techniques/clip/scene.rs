@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use super::texture::MAX_CLIP_VOXELS;
 use super::{ClipSpec, ShapeSpec, MAX_DEPTH};
-use crate::scene::FieldError;
 use crate::surface::{SurfaceError, TriangleMesh};
+use crate::vocab::FieldError;
 
 /// Largest block side accepted (one block of 512³ is already the largest clip grid).
 pub const MAX_BLOCK: usize = 512;

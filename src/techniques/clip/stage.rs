@@ -27,7 +27,7 @@ use super::texture::ClipTexture;
 use super::ClipTextures;
 use crate::gl::{Extent, Filter, GlResult, Gpu, Program, TexelData, TexelFormat, Texture};
 use crate::programs;
-use crate::scene::Fidelity;
+use crate::vocab::Fidelity;
 
 /// The ARB clip prologue of `lookup` (`programs/clip/*.arbfp`, units 7/8 and locals
 /// 10-13 written there), reading the host program's volume coordinate `coord`.

@@ -6,7 +6,7 @@
 
 use super::multires::TexelFormat;
 use super::ClipTextures;
-use crate::scene::Fidelity;
+use crate::vocab::Fidelity;
 
 /// A built clip's cost.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -19,7 +19,8 @@ use super::texture::ClipTexture;
 use super::{ClipSpec, ShapeSpec};
 use crate::gl::{Headless, Surface, Target};
 use crate::scene::{Scene, TechniqueScene};
-use crate::techniques::{self, Frame};
+use crate::techniques::Frame;
+use crate::techniques::Params;
 use crate::volume::VolumeSource;
 
 /// What to sweep.
@@ -239,7 +240,7 @@ pub fn frames(
     let gpu = headless.gpu();
     let scene = frame_scene(options)?;
     let kind = scene.programs.resolve(gpu);
-    let mut renderer = techniques::build(gpu, &scene, kind)?;
+    let mut renderer = crate::render::build(gpu, &scene, kind)?;
     let [w, h] = scene.size;
     let target = Target::create(gpu, w, h, scene.target_format(), renderer.needs_depth())?;
     let frame = Frame {
@@ -274,7 +275,7 @@ pub fn frames(
     for (name, clip) in settings {
         let mut p = base.clone();
         p.clip = clip;
-        renderer.update(gpu, &TechniqueScene::Opacity3d(p))?;
+        renderer.update(gpu, Params::of(&*p))?;
         let mut times = Vec::new();
         for i in 0..=options.frames.max(1) {
             let t0 = Instant::now();

@@ -11,8 +11,7 @@
 //! therefore leaves the result unchanged.
 
 use super::prepare::Prepared;
-use super::renderer::coefficients;
-use super::{Combine, Opacity3dScene};
+use super::{coefficients, Combine, Opacity3dScene};
 
 /// Level ranges per brick.
 #[derive(Debug, Clone, PartialEq)]

@@ -38,16 +38,16 @@ use std::path::Path;
 use std::time::Instant;
 
 use super::prepare::Prepared;
-use super::renderer::Path3d;
+use super::Path3d;
 use crate::gl::{GlError, GlResult, Gpu, ProgramKind, ProgramText};
 use crate::programs::ProgramPair;
-use crate::scene::Fidelity;
 use crate::techniques::clip::multires::IndexEncoding;
 use crate::techniques::clip::stage::{
     arb_prologue, compose_arb, compose_glsl, compose_glsl_at, glsl_function, ClipStage, Lookup,
 };
 use crate::techniques::clip::stats::ClipStats;
 use crate::techniques::clip::{ClipSpec, ClipTextures};
+use crate::vocab::Fidelity;
 
 /// Where 3D opacity's programs read the sample's volume coordinate.
 pub const ARB_COORD: &str = "fragment.texcoord[0]";
@@ -122,7 +122,7 @@ pub fn compose(pair: ProgramPair, stage: &ClipStage, path: Path3d) -> GlResult<P
 /// The verbatim v3o2 pairs (sum, product; ARB and GLSL) composed with every clip lookup,
 /// for the compile-everything test (`programs/clip/` holds fragments, not programs).
 pub fn all_clip_pairs() -> Vec<ProgramPair> {
-    use super::renderer::faithful_pair;
+    use super::programs::faithful_pair;
     use super::Combine;
     let lookups = [
         Lookup::Single,

@@ -62,8 +62,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::colortable::TableSpec;
 use crate::gl::Filter;
-use crate::scene::FieldError;
 use crate::techniques::clip::ClipSpec;
+use crate::vocab::{Fidelity, FieldError};
 use crate::volume::attributes::Attribute;
 use crate::volume::quantize::Quantization;
 use crate::volume::VolumeSource;
@@ -145,6 +145,10 @@ pub struct Opacity3dScene {
     /// (outside with `invert`) is drawn.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clip: Option<ClipSpec>,
+}
+
+impl crate::techniques::TechniqueParams for Opacity3dScene {
+    const NAME: &'static str = "opacity3d";
 }
 
 /// `[technique.opacity3d.raycast]`: how the precise ray caster samples.
@@ -290,6 +294,54 @@ impl Opacity3dScene {
 
 /// The attributes' names in scenes, in texture order.
 pub const ATTRIBUTE_NAMES: [&str; 3] = ["primary", "secondary", "tertiary"];
+
+/// How a scene is drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Path3d {
+    /// View-aligned slices (faithful, or precise without `raycast`).
+    Slicing,
+    /// Precise single-pass ray casting (GLSL).
+    Raycast,
+}
+
+/// The path `params` asks for at `fidelity`.
+pub fn path(params: &Opacity3dScene, fidelity: Fidelity) -> Path3d {
+    if fidelity == Fidelity::Precise && params.raycast.is_some() {
+        Path3d::Raycast
+    } else {
+        Path3d::Slicing
+    }
+}
+
+/// Whether the ray caster pre-integrates: one attribute, opacity correction on,
+/// `raycast.preintegrate`
+/// and no clip (whole steps would skip the per-sample clip test).
+pub fn preintegrated(params: &Opacity3dScene, fidelity: Fidelity, attributes: usize) -> bool {
+    path(params, fidelity) == Path3d::Raycast
+        && attributes == 1
+        && params.clip.is_none()
+        && corrected(params, fidelity)
+        && params.raycast.is_some_and(|r| r.preintegrate)
+}
+
+/// The coefficient vectors sent to `program.local[1..3]`: the scene's for present
+/// attributes; for absent ones 0 in a sum and 1 in a product (neutral either way).
+pub fn coefficients(params: &Opacity3dScene) -> [[f64; 4]; 3] {
+    let absent = match params.combine {
+        Combine::Sum => [0.0; 4],
+        Combine::Product => [1.0; 4],
+    };
+    params
+        .attributes()
+        .map(|a| a.map_or(absent, |a| a.coefficients))
+}
+
+/// Whether opacity correction is on (by default when precise).
+pub fn corrected(params: &Opacity3dScene, fidelity: Fidelity) -> bool {
+    params
+        .opacity_correction
+        .unwrap_or(fidelity == Fidelity::Precise)
+}
 
 #[cfg(test)]
 mod tests {

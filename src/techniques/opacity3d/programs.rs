@@ -212,6 +212,16 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
     pairs
 }
 
+/// The verbatim faithful pair (or its GLSL port) for a combination.
+pub fn faithful_pair(kind: ProgramKind, combine: Combine) -> programs::ProgramPair {
+    use programs::*;
+    let (arb, glsl) = match combine {
+        Combine::Sum => (OPACITY3D_SUM_ARBFP, OPACITY3D_SUM_FRAG),
+        Combine::Product => (OPACITY3D_PRODUCT_ARBFP, OPACITY3D_PRODUCT_FRAG),
+    };
+    with_transform(kind, &arb, &glsl)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

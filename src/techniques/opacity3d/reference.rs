@@ -29,13 +29,13 @@
 use glam::DVec3;
 
 use super::prepare::Prepared;
-use super::renderer::coefficients;
-use super::{Combine, Opacity3dScene};
+use super::{coefficients, Combine, Opacity3dScene};
 use crate::camera::Camera;
 use crate::colortable::ColorTable;
-use crate::gl::{Filter, TargetFormat};
+use crate::gl::Filter;
 use crate::image::Image;
 use crate::techniques::rays::{box_interval, trace_pixels};
+use crate::vocab::TargetFormat;
 
 /// How a table is addressed with a value `v` in [0, 1].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -18,8 +18,10 @@ use glam::{DMat4, DVec3};
 use super::bricks::Bricks;
 use super::clipping::{self, Clip};
 use super::prepare::{prepare, Prepared};
+pub use super::programs::faithful_pair;
 use super::programs::{raycast_pair, slicing_pair, Variant};
 use super::slicing::slice_box;
+pub use super::{coefficients, corrected, path, preintegrated, Path3d};
 use super::{Combine, Opacity3dScene};
 use crate::camera::Projection;
 use crate::colortable::ColorTable;
@@ -28,10 +30,11 @@ use crate::gl::{
     ProgramKind, Surface, TexelData, TexelFormat, Texture,
 };
 use crate::programs;
-use crate::scene::{Fidelity, Scene, TechniqueScene};
+
 use crate::techniques::clip::stage as clipping_stage;
 use crate::techniques::clip::stats::ClipStats;
-use crate::techniques::{Frame, Renderer};
+use crate::techniques::{Frame, Params, Renderer};
+use crate::vocab::Fidelity;
 
 /// Texture unit of the packed volume and of the three tables (unit 1 is v3o2's
 /// lighting, unused here).
@@ -42,35 +45,6 @@ pub const TABLE_UNITS: [u32; 3] = [2, 3, 4];
 pub const BRICK_UNIT: u32 = 5;
 /// Unit of the ray caster's pre-integration table.
 pub const PREINT_UNIT: u32 = 6;
-
-/// How a scene is drawn.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Path3d {
-    /// View-aligned slices (faithful, or precise without `raycast`).
-    Slicing,
-    /// Precise single-pass ray casting (GLSL).
-    Raycast,
-}
-
-/// The path `params` asks for at `fidelity`.
-pub fn path(params: &Opacity3dScene, fidelity: Fidelity) -> Path3d {
-    if fidelity == Fidelity::Precise && params.raycast.is_some() {
-        Path3d::Raycast
-    } else {
-        Path3d::Slicing
-    }
-}
-
-/// Whether the ray caster pre-integrates: one attribute, opacity correction on,
-/// `raycast.preintegrate`
-/// and no clip (whole steps would skip the per-sample clip test).
-pub fn preintegrated(params: &Opacity3dScene, fidelity: Fidelity, attributes: usize) -> bool {
-    path(params, fidelity) == Path3d::Raycast
-        && attributes == 1
-        && params.clip.is_none()
-        && corrected(params, fidelity)
-        && params.raycast.is_some_and(|r| r.preintegrate)
-}
 
 /// The ray caster's table on unit 6, if its scene uses one.
 pub enum StepTable {
@@ -115,45 +89,32 @@ pub fn step_table(params: &Opacity3dScene, fidelity: Fidelity, prepared: &Prepar
 
 /// The program kind a scene draws with: the ray caster is GLSL only, so `auto` gives GLSL
 /// there; an explicit `arb` stays (and the renderer says why it cannot).
-pub fn resolve_kind(scene: &Scene, kind: ProgramKind) -> ProgramKind {
-    match &scene.technique {
-        TechniqueScene::Opacity3d(p)
-            if path(p, scene.fidelity) == Path3d::Raycast
-                && scene.programs == ProgramChoice::Auto =>
-        {
-            ProgramKind::Glsl
-        }
-        _ => kind,
+pub fn resolve_kind(
+    params: &Opacity3dScene,
+    fidelity: Fidelity,
+    programs: ProgramChoice,
+    kind: ProgramKind,
+) -> ProgramKind {
+    if path(params, fidelity) == Path3d::Raycast && programs == ProgramChoice::Auto {
+        ProgramKind::Glsl
+    } else {
+        kind
     }
 }
 
-/// The verbatim faithful pair (or its GLSL port) for a combination.
-pub fn faithful_pair(kind: ProgramKind, combine: Combine) -> programs::ProgramPair {
-    use programs::*;
-    let (arb, glsl) = match combine {
-        Combine::Sum => (OPACITY3D_SUM_ARBFP, OPACITY3D_SUM_FRAG),
-        Combine::Product => (OPACITY3D_PRODUCT_ARBFP, OPACITY3D_PRODUCT_FRAG),
-    };
-    with_transform(kind, &arb, &glsl)
-}
-
-/// The coefficient vectors sent to `program.local[1..3]`: the scene's for present
-/// attributes; for absent ones 0 in a sum and 1 in a product (neutral either way).
-pub fn coefficients(params: &Opacity3dScene) -> [[f64; 4]; 3] {
-    let absent = match params.combine {
-        Combine::Sum => [0.0; 4],
-        Combine::Product => [1.0; 4],
-    };
-    params
-        .attributes()
-        .map(|a| a.map_or(absent, |a| a.coefficients))
-}
-
-/// Whether opacity correction is on (by default when precise).
-pub fn corrected(params: &Opacity3dScene, fidelity: Fidelity) -> bool {
-    params
-        .opacity_correction
-        .unwrap_or(fidelity == Fidelity::Precise)
+/// Every pair 3D opacity can draw with: the verbatim faithful programs and their GLSL
+/// ports, every specialization of the precise templates, and the clip's prologues composed
+/// with the verbatim programs.
+pub fn program_pairs() -> Vec<programs::ProgramPair> {
+    let mut pairs = Vec::new();
+    for combine in [Combine::Sum, Combine::Product] {
+        for kind in [ProgramKind::Arb, ProgramKind::Glsl] {
+            pairs.push(faithful_pair(kind, combine));
+        }
+    }
+    pairs.extend(super::programs::all_precise_pairs());
+    pairs.extend(clipping::all_clip_pairs());
+    pairs
 }
 
 /// Object space to clip space: the camera's view-projection (the box sits in [-1, 1]³).
@@ -284,7 +245,12 @@ impl Opacity3dRenderer {
         params
             .validate()
             .map_err(|e| GlError::Data(e.to_string()))?;
-        let prepared = prepare(params, base, &gpu.volume_limits()).map_err(GlError::Data)?;
+        let prepared = prepare(
+            params,
+            base,
+            &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
+        )
+        .map_err(GlError::Data)?;
         Opacity3dRenderer::from_prepared(gpu, kind, fidelity, params, base, prepared, projection)
     }
 
@@ -714,22 +680,21 @@ impl Renderer for Opacity3dRenderer {
         self.draw_slices(gpu, surface, frame, slices)
     }
 
-    fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()> {
-        let TechniqueScene::Opacity3d(new) = technique else {
-            return Err(GlError::Invalid(format!(
-                "opacity3d renderer given a {} scene",
-                technique.name()
-            )));
-        };
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
+        let new = params.get::<Opacity3dScene>()?;
         new.validate().map_err(|e| GlError::Data(e.to_string()))?;
-        let new: &Opacity3dScene = new;
         let old = std::mem::replace(&mut self.params, new.clone());
         let data = |p: &Opacity3dScene| {
             p.attributes()
                 .map(|a| a.map(|a| (a.volume.clone(), a.attribute, a.quantize)))
         };
         if data(&old) != data(new) || old.volume_filter != new.volume_filter {
-            let prepared = prepare(new, &self.base, &gpu.volume_limits()).map_err(GlError::Data)?;
+            let prepared = prepare(
+                new,
+                &self.base,
+                &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
+            )
+            .map_err(GlError::Data)?;
             *self = Opacity3dRenderer::from_prepared(
                 gpu,
                 self.kind,

@@ -31,10 +31,10 @@ use super::reference::OitWeight;
 use crate::camera::{Camera, Projection};
 use crate::gl::{
     self, Blend, DrawCall, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind, Surface, Target,
-    TargetFormat,
 };
 use crate::programs;
 use crate::techniques::quad::quad_vertices;
+use crate::vocab::TargetFormat;
 
 /// The weight the GPU programs compute (eq. 7), for comparisons with the reference.
 pub const OIT_WEIGHT: OitWeight = OitWeight::Eq7;

@@ -10,7 +10,7 @@ use super::normals::{estimate_cloud, DEFAULT_K};
 use super::scene::{ColourMode, Kernel, Mode, SplatsScene};
 use crate::points::section::{facies_colour, PALETTE};
 use crate::points::{PointCloud, FACIES, FAULT, LAYER, UNDEFINED_FACIES};
-use crate::scene::Fidelity;
+use crate::vocab::Fidelity;
 
 /// Floats per vertex: position 3, colour 3, property value 1, normal 3.
 pub const VERTEX_COMPONENTS: [usize; 4] = [3, 3, 1, 3];

@@ -63,8 +63,8 @@ use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 
 use crate::camera::{Camera, Projection};
-use crate::gl::TargetFormat;
 use crate::image::Image;
+use crate::vocab::TargetFormat;
 
 /// How a splat's alpha falls off with `n_dist` (0 at the centre, 1 on the rim).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -29,8 +29,9 @@ use crate::gl::{
 };
 use crate::points::PointCloud;
 use crate::programs::{self, ProgramPair};
-use crate::scene::{Fidelity, TechniqueScene};
-use crate::techniques::{Frame, Renderer};
+
+use crate::techniques::{Frame, Params, Renderer};
+use crate::vocab::Fidelity;
 
 /// The program pair of a fidelity and kind.
 pub fn program_pair(fidelity: Fidelity, kind: ProgramKind) -> ProgramPair {
@@ -392,13 +393,8 @@ impl Renderer for SplatsRenderer {
         )
     }
 
-    fn update(&mut self, gpu: &Gpu, technique: &TechniqueScene) -> GlResult<()> {
-        let TechniqueScene::Splats(new) = technique else {
-            return Err(GlError::Invalid(format!(
-                "splats renderer given a {} scene",
-                technique.name()
-            )));
-        };
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
+        let new = params.get::<SplatsScene>()?;
         new.validate().map_err(|e| GlError::Data(e.to_string()))?;
         new.draw_allowed(self.fidelity, crate::gl::ProgramChoice::Auto)
             .map_err(|e| GlError::Data(e.to_string()))?;
@@ -420,7 +416,7 @@ impl Renderer for SplatsRenderer {
             || new.sort != p.sort
             || new.draw != p.draw
             || new.tile != p.tile;
-        self.params = (**new).clone();
+        self.params = new.clone();
         if rebuild {
             self.prepared =
                 from_cloud(&self.cloud, new, self.normals.clone()).map_err(GlError::Data)?;
@@ -469,4 +465,28 @@ impl Renderer for SplatsRenderer {
             ),
         })
     }
+}
+
+/// Every pair the splats draw with: the seed's and the precise programs as points (ARB
+/// and GLSL), the OIT composite, and the tiles' gather.
+pub fn program_pairs() -> Vec<ProgramPair> {
+    use programs::*;
+    let mut pairs: Vec<ProgramPair> = [
+        (ProgramKind::Arb, SPLATS_ARBVP, SPLATS_SEED_ARBFP),
+        (ProgramKind::Arb, SPLATS_ARBVP, SPLATS_PRECISE_ARBFP),
+        (ProgramKind::Glsl, SPLATS_VERT, SPLATS_SEED_FRAG),
+        (ProgramKind::Glsl, SPLATS_VERT, SPLATS_PRECISE_FRAG),
+        (ProgramKind::Glsl, TRANSFORM_VERT, SPLATS_TILES_FRAG),
+    ]
+    .map(|(kind, vertex, fragment)| ProgramPair {
+        kind,
+        vertex,
+        fragment,
+    })
+    .into();
+    pairs.extend(both_kinds(
+        &SPLATS_OIT_COMPOSITE_ARBFP,
+        &SPLATS_OIT_COMPOSITE_FRAG,
+    ));
+    pairs
 }

@@ -10,6 +10,7 @@
 //! estimation time.
 
 use crate::study::median;
+use crate::techniques::Params;
 use std::time::Instant;
 
 use super::scene::{DrawChoice, SortChoice};
@@ -18,8 +19,9 @@ use crate::camera::{Camera, Projection};
 use crate::gl::{Headless, Surface, Target};
 use crate::points::section::{generate, SectionSpec};
 use crate::points::{PointCloud, PointSource};
-use crate::scene::{Fidelity, Scene, TechniqueScene};
+use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::{self, Frame};
+use crate::vocab::Fidelity;
 
 /// What to sweep.
 #[derive(Debug, Clone)]
@@ -192,7 +194,7 @@ pub fn frames(
     for (name, fidelity, p) in settings {
         let renderer = match &mut built {
             Some((f, r)) if *f == fidelity => {
-                r.update(gpu, &TechniqueScene::Splats(Box::new(p)))?;
+                r.update(gpu, Params::of(&p))?;
                 r
             }
             _ => {
@@ -201,7 +203,7 @@ pub fn frames(
                 s.technique = TechniqueScene::Splats(Box::new(p));
                 let kind = s.programs.resolve(gpu);
                 &mut built
-                    .insert((fidelity, techniques::build(gpu, &s, kind)?))
+                    .insert((fidelity, crate::render::build(gpu, &s, kind)?))
                     .1
             }
         };

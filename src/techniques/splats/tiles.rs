@@ -43,16 +43,13 @@ use super::reference::SplatParams;
 use super::scene::SplatsScene;
 use super::sort::View;
 use crate::camera::Camera;
-use crate::scene::Fidelity;
+use crate::vocab::Fidelity;
 
 /// Pixels a splat's listed square is widened by on each side (f32 rounding of window
 /// positions is far below it; the program's exact test decides).
 pub const MARGIN: f32 = 1.0 / 64.0;
 
-/// Default tile side in pixels: for 1.3-pixel splats at 1600x900 on llvmpipe, the camera
-/// turning, tiles of 1, 2, 3, 4 and 8 pixels took 75, 75, 95, 106 and over 137 ms per
-/// frame; 2 lists a quarter fewer entries than 1.
-pub const DEFAULT_TILE: u32 = 2;
+pub use super::scene::DEFAULT_TILE;
 
 /// Default bound on list entries (16 M entries, 256 MiB).
 pub const DEFAULT_MAX_ENTRIES: usize = 1 << 24;

@@ -1,10 +1,10 @@
 use super::*;
 use crate::camera::Projection;
-use crate::gl::TargetFormat;
 use crate::image::Image;
 use crate::points::section::SplitMix64;
 use crate::techniques::splats::reference::{composite, exact_order, Footprint, SplatScene};
 use crate::techniques::splats::sort::View;
+use crate::vocab::TargetFormat;
 
 /// Odd sizes: tiles do not divide them.
 const SIZE: [u32; 2] = [37, 23];

@@ -1,0 +1,113 @@
+//! Every technique in one list, where each registers what the layers above need: its
+//! scene parameters (a variant of [`TechniqueScene`], `[technique.NAME]` in TOML), how its
+//! renderer is built ([`build`]) and the program pairs it can draw with
+//! ([`all_program_pairs`], for the compile-everything test).
+//!
+//! The catalog sits above the techniques and below the scene: techniques never import it
+//! (their renderers take their own parameters through [`crate::techniques::Params`]), so
+//! adding a technique touches its own folder and this file.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::camera::Projection;
+use crate::gl::{GlResult, Gpu, ProgramChoice, ProgramKind};
+use crate::programs::ProgramPair;
+use crate::techniques::cellproj::{self, CellprojScene};
+use crate::techniques::opacity3d::{self, Opacity3dScene};
+use crate::techniques::quad::{self, QuadScene};
+use crate::techniques::splats::{self, SplatsScene};
+use crate::techniques::{Params, Renderer};
+use crate::vocab::Fidelity;
+
+/// Which technique and its parameters; in TOML a `[technique.NAME]` table.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", deny_unknown_fields)]
+pub enum TechniqueScene {
+    /// The full-screen quad demo.
+    Quad(QuadScene),
+    /// v3o2's 3D opacity (boxed: it is much larger than the other variants).
+    Opacity3d(Box<Opacity3dScene>),
+    /// Isosurfaces of tetrahedral meshes by cell projection.
+    Cellproj(Box<CellprojScene>),
+    /// Point-based rendering of geological sections as splats.
+    Splats(Box<SplatsScene>),
+}
+
+impl TechniqueScene {
+    /// Technique name as written in scenes.
+    pub fn name(&self) -> &'static str {
+        match self {
+            TechniqueScene::Quad(_) => "quad",
+            TechniqueScene::Opacity3d(_) => "opacity3d",
+            TechniqueScene::Cellproj(_) => "cellproj",
+            TechniqueScene::Splats(_) => "splats",
+        }
+    }
+
+    /// The parameters as a renderer's [`Renderer::update`] takes them.
+    pub fn params(&self) -> Params<'_> {
+        match self {
+            TechniqueScene::Quad(p) => Params::of(p),
+            TechniqueScene::Opacity3d(p) => Params::of(&**p),
+            TechniqueScene::Cellproj(p) => Params::of(&**p),
+            TechniqueScene::Splats(p) => Params::of(&**p),
+        }
+    }
+}
+
+/// What a renderer needs of the scene besides its own parameters.
+#[derive(Debug, Clone, Copy)]
+pub struct Settings<'a> {
+    /// Faithful or precise.
+    pub fidelity: Fidelity,
+    /// The program kind the scene asked for (`auto` resolved to `kind` by the caller).
+    pub programs: ProgramChoice,
+    /// The folder relative data paths are read from.
+    pub base: &'a Path,
+    /// The camera's projection when the renderer is built.
+    pub projection: Projection,
+}
+
+/// Build the renderer for `technique`, with programs of `kind`; nothing else is created.
+pub fn build(
+    gpu: &Gpu,
+    technique: &TechniqueScene,
+    settings: &Settings<'_>,
+    kind: ProgramKind,
+) -> GlResult<Box<dyn Renderer>> {
+    let Settings {
+        fidelity,
+        programs,
+        base,
+        projection,
+    } = *settings;
+    Ok(match technique {
+        TechniqueScene::Quad(params) => Box::new(quad::QuadRenderer::new(gpu, kind, params)?),
+        TechniqueScene::Opacity3d(params) => Box::new(opacity3d::Opacity3dRenderer::new(
+            gpu,
+            opacity3d::renderer::resolve_kind(params, fidelity, programs, kind),
+            fidelity,
+            params,
+            base,
+            projection,
+        )?),
+        TechniqueScene::Splats(params) => Box::new(splats::SplatsRenderer::new(
+            gpu, kind, fidelity, params, base,
+        )?),
+        TechniqueScene::Cellproj(params) => Box::new(cellproj::CellprojRenderer::new(
+            gpu, kind, fidelity, params, base,
+        )?),
+    })
+}
+
+/// Every program pair the techniques can draw with, both kinds (the compile-everything
+/// test): each technique lists its own.
+pub fn all_program_pairs() -> Vec<ProgramPair> {
+    let mut pairs = quad::program_pairs();
+    pairs.extend(opacity3d::renderer::program_pairs());
+    pairs.extend(cellproj::renderer::program_pairs());
+    pairs.extend(splats::renderer::program_pairs());
+    pairs
+}

@@ -1,0 +1,16 @@
+//! What can go wrong preparing a clip (its own file, so that every part of the clip
+//! can name it without importing the module that assembles them).
+
+/// Errors preparing a clip: the shape's files, or parameters that cannot be built.
+#[derive(Debug, thiserror::Error)]
+pub enum ClipError {
+    /// A clip mesh could not be read.
+    #[error(transparent)]
+    Surface(#[from] crate::surface::SurfaceError),
+    /// A mask volume could not be read.
+    #[error(transparent)]
+    Volume(#[from] crate::volume::VolumeError),
+    /// Parameters out of range, or a texture that cannot be built.
+    #[error("{0}")]
+    Invalid(String),
+}

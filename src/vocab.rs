@@ -1,0 +1,133 @@
+//! The shared vocabulary at the bottom of the house: words every layer uses and none
+//! owns. A scene value that cannot be used ([`FieldError`]), the two fidelity modes
+//! ([`Fidelity`]) and the precision of a colour target ([`TargetFormat`]). Nothing here
+//! imports anything of arbvis (ARCHITECTURE.md, "Layers").
+
+/// Colour-target precision; faithful mode draws into RGBA8 as the original did.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum TargetFormat {
+    /// 8 bits per channel, normalized.
+    #[default]
+    Rgba8,
+    /// 16-bit float per channel.
+    Rgba16f,
+    /// 32-bit float per channel.
+    Rgba32f,
+}
+
+impl TargetFormat {
+    /// Bytes per pixel.
+    pub fn bytes_per_pixel(self) -> u64 {
+        match self {
+            TargetFormat::Rgba8 => 4,
+            TargetFormat::Rgba16f => 8,
+            TargetFormat::Rgba32f => 16,
+        }
+    }
+
+    /// Smallest step between two stored values near 1.0, the quantum tolerances derive from.
+    pub fn quantum(self) -> f32 {
+        match self {
+            TargetFormat::Rgba8 => 1.0 / 255.0,
+            TargetFormat::Rgba16f => 1.0 / 1024.0, // 10-bit mantissa
+            TargetFormat::Rgba32f => f32::EPSILON,
+        }
+    }
+
+    /// Name as written in scenes and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            TargetFormat::Rgba8 => "rgba8",
+            TargetFormat::Rgba16f => "rgba16f",
+            TargetFormat::Rgba32f => "rgba32f",
+        }
+    }
+}
+
+/// Faithful (the original programs, 8-bit targets, original formulas) or precise
+/// (corrected maths, float targets). DESIGN.md §3.
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Default,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Fidelity {
+    /// As the original system did it.
+    #[default]
+    Faithful,
+    /// As it should be done.
+    Precise,
+}
+
+impl Fidelity {
+    /// The target precision this fidelity uses unless the scene names one.
+    pub fn default_target(self) -> TargetFormat {
+        match self {
+            Fidelity::Faithful => TargetFormat::Rgba8,
+            Fidelity::Precise => TargetFormat::Rgba32f,
+        }
+    }
+
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Fidelity::Faithful => "faithful",
+            Fidelity::Precise => "precise",
+        }
+    }
+}
+
+/// A value that parses but cannot be used: the dotted key that holds it, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FieldError {
+    /// Dotted key relative to where the check ran, e.g. `primary.table.builtin`.
+    pub key: String,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl FieldError {
+    /// An error at `key`.
+    pub fn new(key: impl Into<String>, message: impl Into<String>) -> FieldError {
+        FieldError {
+            key: key.into(),
+            message: message.into(),
+        }
+    }
+
+    /// The same error seen from the enclosing table `prefix`.
+    pub fn within(self, prefix: &str) -> FieldError {
+        FieldError {
+            key: if self.key.is_empty() {
+                prefix.to_string()
+            } else {
+                format!("{prefix}.{}", self.key)
+            },
+            message: self.message,
+        }
+    }
+}
+
+impl std::fmt::Display for FieldError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}: {}", self.key, self.message)
+    }
+}
