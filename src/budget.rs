@@ -191,6 +191,42 @@ pub fn check(what: impl Into<String>, estimate: u64) -> Result<(), OverBudget> {
     Ok(())
 }
 
+/// One large allocation something will make, estimated before any work.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Estimate {
+    /// What it is for, e.g. `the read-back of a 16384x16384 frame`.
+    pub what: String,
+    /// Its size in bytes.
+    pub bytes: u64,
+}
+
+impl Estimate {
+    /// `count` items of `each` bytes for `what`.
+    pub fn of(what: impl Into<String>, count: u64, each: u64) -> Estimate {
+        Estimate {
+            what: what.into(),
+            bytes: times(count, each),
+        }
+    }
+}
+
+/// Refuse `estimates`, made together for `of` (e.g. `rendering scene.toml`), when their
+/// sum is over the budget; the error lists each part.
+pub fn check_estimates(of: &str, estimates: &[Estimate]) -> Result<(), OverBudget> {
+    let total = estimates
+        .iter()
+        .fold(0u64, |a, e| a.saturating_add(e.bytes));
+    if total <= current().bytes {
+        return Ok(());
+    }
+    let parts: Vec<String> = estimates
+        .iter()
+        .filter(|e| e.bytes > 0)
+        .map(|e| format!("{}: {}", e.what, format_bytes(e.bytes)))
+        .collect();
+    check(format!("{of} ({})", parts.join("; ")), total)
+}
+
 /// `count` items of `each` bytes, saturating (an estimate, never an overflow).
 pub fn times(count: u64, each: u64) -> u64 {
     count.saturating_mul(each)
@@ -298,6 +334,25 @@ mod tests {
         ] {
             assert!(parse(bad).is_err(), "{bad:?} should be refused");
         }
+    }
+
+    #[test]
+    fn estimates_add_up_and_name_their_parts() {
+        let parts = [
+            Estimate::of("a read-back", 1 << 40, 16),
+            Estimate::of("nothing", 0, 16),
+            Estimate::of("a grid", 10, 8),
+        ];
+        let e = check_estimates("rendering x.toml", &parts)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("rendering x.toml (a read-back: 16.00 TiB; a grid: 80 B)"),
+            "{e}"
+        );
+        assert!(!e.contains("nothing"), "{e}");
+        assert!(check_estimates("small", &parts[1..]).is_ok());
+        assert_eq!(Estimate::of("x", u64::MAX, 3).bytes, u64::MAX);
     }
 
     #[test]

@@ -57,6 +57,19 @@ impl TechniqueScene {
     }
 }
 
+impl TechniqueScene {
+    /// The large allocations preparing and drawing it at `size` makes that the scene
+    /// alone determines (generated data, grids, lists); files are checked by their loaders.
+    pub fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
+        match self {
+            TechniqueScene::Quad(_) => Vec::new(),
+            TechniqueScene::Opacity3d(p) => p.memory_estimate(),
+            TechniqueScene::Cellproj(p) => p.memory_estimate(),
+            TechniqueScene::Splats(p) => p.memory_estimate(size),
+        }
+    }
+}
+
 /// What a renderer needs of the scene besides its own parameters.
 #[derive(Debug, Clone, Copy)]
 pub struct Settings<'a> {

@@ -69,6 +69,10 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
     let gpu = headless.gpu();
     let kind = scene.programs.resolve(gpu);
     let [width, height] = scene.size;
+    crate::budget::check_estimates(
+        &format!("this {} scene", scene.technique.name()),
+        &scene.memory_estimate(true),
+    )?;
     let t0 = Instant::now();
     let mut renderer = build(gpu, scene, kind)?;
     let target = Target::create(

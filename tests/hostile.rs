@@ -223,3 +223,116 @@ fn errors_point_at_the_place() {
         &["scene.toml:1:12", "\"faithful\""],
     );
 }
+
+// --- issue 17: what a scene makes arbvis allocate ---
+
+/// The parts of a refusal by the memory budget: the estimate, the budget, where it came
+/// from and how to raise it.
+const OVER_BUDGET: [&str; 3] = [
+    "more than the memory budget of",
+    "--memory-budget",
+    "ARBVIS_MEMORY_BUDGET",
+];
+
+fn over_budget(name: &str, scene_text: &str, parts: &[&str]) {
+    let mut expect: Vec<&str> = OVER_BUDGET.to_vec();
+    expect.extend_from_slice(parts);
+    refused(name, scene_text, &expect);
+}
+
+#[test]
+fn scene_values_the_machine_cannot_hold_are_refused_before_any_work() {
+    // Each of these once allocated gigabytes (or tried to) before failing; each is
+    // estimated from the scene alone and refused in milliseconds under a 1 GiB budget.
+    let budget = "memory_budget = \"1G\"\n";
+    over_budget(
+        "readback",
+        &format!("{budget}size = [16384, 16384]\n[technique.quad]\n"),
+        &[
+            "the 16384x16384 rgba8 target",
+            "reading back and writing the 16384x16384 frame",
+            "1.00 GiB (from the scene's memory_budget)",
+        ],
+    );
+    over_budget(
+        "grid64",
+        &format!(
+            "{budget}[technique.cellproj]\nmesh = {{ grid = {{ points = [64, 64, 64] }} }}\nisovalues = []\n"
+        ),
+        &["the generated grid's 1500282 tetrahedra"],
+    );
+    over_budget(
+        "clip512-block1",
+        &format!(
+            "{budget}[technique.opacity3d]\nslices = 8\n[technique.opacity3d.primary]\n\
+             volume = {{ synthetic = {{ size = [16, 16, 16] }} }}\n\
+             [technique.opacity3d.clip]\nshape = {{ sphere = {{ center = [0.0, 0.0, 0.0], radius = 0.5 }} }}\n\
+             block = 1\nresolution = [512, 512, 512]\n"
+        ),
+        &["the clip's [512, 512, 512] grid", "the INDEX texture of 134217728 blocks of 1³"],
+    );
+    over_budget(
+        "tiles-16384",
+        &format!(
+            "{budget}size = [16384, 16384]\nfidelity = \"precise\"\nprograms = \"glsl\"\n\
+             [technique.splats]\ncloud = {{ section = {{ points = 1000, seed = 1 }} }}\n\
+             draw = \"tiles\"\ntile = 1\n"
+        ),
+        &["the lists of 268435456 tiles of 1 pixels"],
+    );
+    over_budget(
+        "section-20m",
+        &format!(
+            "{budget}[technique.splats]\ncloud = {{ section = {{ points = 20000000, seed = 1 }} }}\n"
+        ),
+        &["the generated section's 20000000 points"],
+    );
+}
+
+#[test]
+fn the_budget_comes_from_the_flag_then_the_environment_then_the_scene() {
+    let dir = temp_dir("budget-order");
+    let scene = dir.join("scene.toml");
+    // A 64x64 quad needs about 0.25 MiB (target and read-back): over 100K, under 1G.
+    std::fs::write(
+        &scene,
+        "memory_budget = \"1G\"\nsize = [64, 64]\n[technique.quad]\n",
+    )
+    .unwrap();
+    let png = dir.join("out.png");
+    let run = |flag: Option<&str>, env: Option<&str>| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_arbvis"));
+        c.env_remove("ARBVIS_MEMORY_BUDGET");
+        if let Some(e) = env {
+            c.env("ARBVIS_MEMORY_BUDGET", e);
+        }
+        if let Some(f) = flag {
+            c.args(["--memory-budget", f]);
+        }
+        let out = c
+            .args([
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                png.to_str().unwrap(),
+            ])
+            .output()
+            .unwrap();
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    assert!(run(None, None).0, "the scene's 1G holds a 64x64 quad");
+    let (ok, e) = run(Some("100K"), None);
+    assert!(!ok && e.contains("100 KiB (from --memory-budget)"), "{e}");
+    let (ok, e) = run(None, Some("100K"));
+    assert!(!ok && e.contains("(from ARBVIS_MEMORY_BUDGET)"), "{e}");
+    // The flag wins over the environment, the environment over the scene.
+    assert!(run(Some("1G"), Some("100K")).0);
+    let (ok, e) = run(None, Some("nonsense"));
+    assert!(!ok && e.contains("ARBVIS_MEMORY_BUDGET=nonsense"), "{e}");
+    let (ok, e) = run(Some("12 parsecs"), None);
+    assert!(!ok && e.contains("is not a memory size"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -356,6 +356,15 @@ impl Limits {
                 self.max_side
             )));
         }
+        if let Some(n) = voxels {
+            // The samples as f32 (the loaders' output); derived attributes and textures are
+            // estimated by the technique that makes them.
+            crate::budget::check(
+                format!("{what}: {n} samples of {dims:?} as f32"),
+                crate::budget::times(n, 4),
+            )
+            .map_err(|e| VolumeError::Invalid(e.to_string()))?;
+        }
         match voxels {
             Some(n) if n <= self.max_voxels => Ok(()),
             _ => Err(VolumeError::Invalid(format!(
@@ -367,6 +376,27 @@ impl Limits {
 }
 
 impl VolumeSource {
+    /// The voxel count the source declares without reading anything (a generated
+    /// volume's size); `None` for files, whose loaders check their headers.
+    pub fn declared_voxels(&self) -> Option<u64> {
+        match self {
+            VolumeSource::Synthetic(spec) => Some(
+                spec.size
+                    .iter()
+                    .fold(1u64, |a, &d| a.saturating_mul(d as u64)),
+            ),
+            _ => None,
+        }
+    }
+
+    /// The dimensions a generated volume will have (`None` for files).
+    pub fn declared_dims(&self) -> Option<[usize; 3]> {
+        match self {
+            VolumeSource::Synthetic(spec) => Some(spec.size),
+            _ => None,
+        }
+    }
+
     /// Read the volume; relative paths are taken from `base` (the scene's folder). The
     /// dimensions are checked against `limits` before any sample is read.
     pub fn load(&self, base: &Path, limits: &Limits) -> Result<Volume, VolumeError> {
