@@ -44,7 +44,7 @@ enum Command {
         scene: SceneArgs,
         /// Output PNG (written atomically; the name must end in .png).
         #[arg(short, long, value_parser = png_path)]
-        output: PathBuf,
+        output: Option<PathBuf>,
         /// Offscreen backend.
         #[arg(long, value_enum, default_value_t = Backend::Egl)]
         backend: Backend,
@@ -155,7 +155,32 @@ enum Command {
         #[arg(long, verbatim_doc_comment)]
         script: Option<PathBuf>,
     },
+    /// The desktop viewer is not in this build (headless, --no-default-features).
+    #[cfg(not(feature = "viewer"))]
+    View {
+        /// Whatever was asked of the viewer.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        rest: Vec<String>,
+    },
 }
+
+impl Command {
+    /// The scene arguments of the commands that take a scene.
+    fn scene_args(&self) -> Option<&SceneArgs> {
+        match self {
+            Command::Render { scene, .. } | Command::Bench { scene, .. } => Some(scene),
+            #[cfg(feature = "viewer")]
+            Command::View { scene, .. } => Some(scene),
+            _ => None,
+        }
+    }
+}
+
+/// What a build without the viewer answers to `arbvis view`.
+#[cfg(not(feature = "viewer"))]
+const NO_VIEWER: &str = "this arbvis was built without the viewer (cargo's --no-default-features, \
+the headless build); build the whole program with `cargo install --path .` (or run \
+`cargo run --release -- view ...`)";
 
 /// Write a study's files into `out` (created if missing), atomically, saying so.
 fn write_study<const N: usize>(out: &Path, files: [(&str, String); N]) -> Result<()> {
@@ -231,9 +256,11 @@ const VTK_MS: f64 = 1260.0;
 struct SceneArgs {
     /// Scene file (TOML).
     scene: Option<PathBuf>,
-    /// A built-in demo instead of a file.
-    #[arg(long, conflicts_with = "scene",
-          value_parser = clap::builder::PossibleValuesParser::new(arbvis::scene::DEMOS.iter().map(|d| d.0)))]
+    /// A built-in demo instead of a file; `--demo` alone lists them. Demos: quad,
+    /// v3o2-sum, v3o2-product, cellproj-planar, cellproj-spherical, splats-section,
+    /// clip-sphere, clip-mesh.
+    #[arg(long, conflicts_with = "scene", num_args = 0..=1, default_missing_value = "",
+          value_name = "NAME", value_parser = demo_name)]
     demo: Option<String>,
     /// Image size, e.g. 512x512.
     #[arg(long, value_parser = parse_size)]
@@ -286,6 +313,24 @@ impl SceneArgs {
     }
 }
 
+/// A demo's name, or "" (`--demo` alone: list them).
+fn demo_name(s: &str) -> Result<String, String> {
+    if s.is_empty() || arbvis::scene::DEMOS.iter().any(|d| d.0 == s) {
+        Ok(s.to_string())
+    } else {
+        Err(format!("no demo named {s:?}; demos: {}", demo_list(", ")))
+    }
+}
+
+/// The demos' names joined by `separator`.
+fn demo_list(separator: &str) -> String {
+    arbvis::scene::DEMOS
+        .iter()
+        .map(|d| d.0)
+        .collect::<Vec<_>>()
+        .join(separator)
+}
+
 /// An output path ending in `.png` (arbvis writes PNG only: a `.jpg` name would hold a
 /// PNG and mislead every program that trusts the extension).
 fn png_path(s: &str) -> Result<PathBuf, String> {
@@ -314,6 +359,19 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<()> {
     if let Some(bytes) = cli.memory_budget {
         arbvis::budget::set(bytes);
+    } else if let Ok(text) = std::env::var("ARBVIS_MEMORY_BUDGET") {
+        // The library ignores a value it cannot read; the command line says so.
+        arbvis::budget::parse(&text)
+            .map_err(|e| anyhow::anyhow!("ARBVIS_MEMORY_BUDGET={text}: {e}"))?;
+    }
+    if cli
+        .command
+        .scene_args()
+        .is_some_and(|a| a.demo.as_deref() == Some(""))
+    {
+        // `--demo` without a name: the list is the answer.
+        println!("{}", demo_list("\n"));
+        return Ok(());
     }
     match cli.command {
         Command::Info { backend, json } => {
@@ -331,6 +389,9 @@ fn run(cli: Cli) -> Result<()> {
             backend,
             stats,
         } => {
+            let Some(output) = output else {
+                bail!("render needs an output file: -o OUT.png");
+            };
             let (scene, origin) = scene.load()?;
             let rendered = arbvis::render::render(&scene, backend)
                 .with_context(|| format!("rendering {origin}"))?;
@@ -519,6 +580,8 @@ fn run(cli: Cli) -> Result<()> {
                 );
             }
         }
+        #[cfg(not(feature = "viewer"))]
+        Command::View { .. } => bail!("{NO_VIEWER}"),
         #[cfg(feature = "viewer")]
         Command::View {
             scene,
