@@ -257,8 +257,9 @@ struct SceneArgs {
     /// Scene file (TOML).
     scene: Option<PathBuf>,
     /// A built-in demo instead of a file; `--demo` alone lists them. Demos: quad,
-    /// v3o2-sum, v3o2-product, cellproj-planar, cellproj-spherical, splats-section,
-    /// clip-sphere, clip-mesh.
+    /// v3o2-sum, v3o2-product, cellproj-planar, cellproj-spherical,
+    /// cellproj-spherical-precise, splats-section, splats-section-precise, clip-sphere,
+    /// clip-mesh.
     #[arg(long, conflicts_with = "scene", num_args = 0..=1, default_missing_value = "",
           value_name = "NAME", value_parser = demo_name)]
     demo: Option<String>,

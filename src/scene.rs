@@ -113,8 +113,16 @@ pub const DEMOS: &[(&str, &str)] = &[
         include_str!("../scenes/demo/cellproj-spherical.toml"),
     ),
     (
+        "cellproj-spherical-precise",
+        include_str!("../scenes/demo/cellproj-spherical-precise.toml"),
+    ),
+    (
         "splats-section",
         include_str!("../scenes/demo/splats-section.toml"),
+    ),
+    (
+        "splats-section-precise",
+        include_str!("../scenes/demo/splats-section-precise.toml"),
     ),
     (
         "clip-sphere",

@@ -516,7 +516,7 @@ fn clip_stats_lines(stdout: &str) -> Vec<&str> {
 
 #[test]
 fn the_clip_editor_reaches_the_saved_scene() {
-    // The demo: an inverted sphere at [-1, 1, 1], radius 1.45, B = 8, INDEX-DATA. The
+    // The demo: an inverted sphere at [-1, -1, 1], radius 1.3, B = 8, INDEX-DATA. The
     // clip is switched off and on again (restored), made a torus, moved, resized and
     // turned, no longer inverted, B = 16, then the single texture.
     let script = "\
@@ -616,7 +616,7 @@ fn a_clip_the_editor_cannot_edit_is_kept() {
     let demo = include_str!("../scenes/demo/clip-sphere.toml");
     let csg = "shape = { difference = [{ sphere = { center = [0.0, 0.0, 0.0], radius = 0.9 } }, { box = { center = [0.5, 0.5, 0.5], half_size = [0.5, 0.5, 0.5] } }] }";
     let text = demo.replace(
-        "shape = { sphere = { center = [-1.0, 1.0, 1.0], radius = 1.45 } }",
+        "shape = { sphere = { center = [-1.0, -1.0, 1.0], radius = 1.3 } }",
         csg,
     );
     assert_ne!(text, demo);
