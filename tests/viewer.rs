@@ -709,8 +709,9 @@ fn script_steps_that_do_nothing_fail_with_their_line() {
             "wait 1\n\nset primary Cr 7\n",
             "wait 1\nset primary table rainbow\n",
             "wait 1\nset Lock primary maybe\n",
-            // A click on an existing curve point neither adds nor removes one.
-            "wait 1\nclick-at tertiary alpha 1 0.9\n",
+            // A click on an existing curve point ((1, 0.3): 0.7 from the top) neither adds nor
+            // removes one.
+            "wait 1\nclick-at tertiary alpha 1 0.7\n",
             "wait 1\nwait 1\nkey F5\n",
             "wait 1\nset slices 2.5\n",
             // No clip in this demo: the section opens, the clip is added, B is disabled
@@ -733,7 +734,7 @@ fn script_steps_that_do_nothing_fail_with_their_line() {
             "no option \"rainbow\"",
         ),
         ("line 2 (set Lock primary maybe)", "takes true or false"),
-        ("line 2 (click-at tertiary alpha 1 0.9)", "did nothing"),
+        ("line 2 (click-at tertiary alpha 1 0.7)", "did nothing"),
         ("line 3 (key F5)", "did nothing"),
         ("line 2 (set slices 2.5)", "not a whole number"),
         ("line 5 (set Clip block 16)", "Clip block is disabled"),
