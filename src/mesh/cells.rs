@@ -438,7 +438,10 @@ impl RawCells {
             }
         };
         let most = self.most_tets();
-        let what = format!("the tetrahedra of {} cells (at most {most})", self.len());
+        let what = format!(
+            "making the tetrahedra of {} cells (at most {most})",
+            self.len()
+        );
         let budget_err = |e: crate::budget::OverBudget| err(0, e.to_string());
         let mut out = Converted {
             tets: crate::budget::vec_for(most, &what).map_err(budget_err)?,

@@ -17,6 +17,19 @@
 //!   legacy file, `<VTKFile` (after an optional XML declaration) an XML file, and
 //!   `$MeshFormat` a gmsh file.
 //! - Files are read whole through [`crate::input`], at most [`MAX_MESH_BYTES`].
+//! - Sections may come in any order the format allows (gmsh data before `$Nodes`, VTK
+//!   `POINT_DATA` before `POINTS`); what refers to another section is checked against it
+//!   once both are read, with the file and the position of the one that disagrees, and
+//!   [`Mesh::assemble`] refuses any array whose tuple count is not the point or cell
+//!   count (it never indexes past one). A section a file may hold once (`POINTS`) is
+//!   refused the second time.
+//! - Memory: every allocation whose size comes from the file is checked against the
+//!   memory budget ([`crate::budget`]) before it is made, and made fallibly; compressed
+//!   `.vtu` arrays are checked against what the piece declares, and the total against
+//!   the budget, before anything is inflated. A refusal names the file, the place that
+//!   declared the size, the estimate, the budget and how to raise it.
+//! - Geometry is computed on coordinates scaled by an exact power of two
+//!   ([`cells::unit_scale`]), so coordinates near ±1.7e308 orient, measure and draw.
 
 pub mod cells;
 pub mod gmsh;
@@ -105,7 +118,7 @@ pub struct MeshInfo {
     pub reduced_to_corners: usize,
     /// File tetrahedra whose vertex order was reversed to make their volume positive.
     pub flipped: usize,
-    /// Tetrahedra of split cells dropped because the cell repeated a vertex.
+    /// Tetrahedra dropped because their cell repeated a point (a collapsed cell).
     pub degenerate_dropped: usize,
 }
 
@@ -219,8 +232,14 @@ pub fn read(path: &Path) -> Result<Mesh, MeshError> {
     parse(path, &bytes)
 }
 
-/// Parse a mesh file held in memory; `name` is used in errors.
+/// Parse a mesh file held in memory; `name` is used in errors. What it may make is
+/// bounded by the memory budget, and by default also by the file's size
+/// ([`budget::for_input`]).
 pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    budget::for_input(bytes.len() as u64, || parse_format(name, bytes))
+}
+
+fn parse_format(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     let head = &bytes[..bytes.len().min(4096)];
     let trimmed = head.trim_ascii_start();
     if trimmed.len() >= 14 && trimmed[..14].eq_ignore_ascii_case(b"# vtk DataFile") {
@@ -294,7 +313,7 @@ impl Mesh {
             let bytes_needed = budget::times(budget::times(n as u64, per_tet as u64), 8);
             budget::check(
                 format!(
-                    "{} cell array{} copied to each of {n} tetrahedra",
+                    "copying {} cell array{} to each of {n} tetrahedra",
                     cell_arrays.len(),
                     if cell_arrays.len() == 1 { "" } else { "s" }
                 ),
@@ -404,7 +423,7 @@ pub fn describe(mesh: &Mesh) -> String {
     if i.degenerate_dropped > 0 {
         let _ = writeln!(
             s,
-            "dropped (collapsed split tetrahedra): {}",
+            "dropped (tetrahedra with a repeated point, of collapsed cells): {}",
             i.degenerate_dropped
         );
     }

@@ -94,6 +94,65 @@ fn longest_edge_scaled(points: &[[f64; 3]], t: [u32; 4], scale: f64) -> f64 {
     l.sqrt()
 }
 
+/// What one pass over a tetrahedron measures (coordinates times a scale).
+#[derive(Debug, Clone, Copy)]
+pub struct Measure {
+    /// Signed volume.
+    pub volume: f64,
+    /// Flat (see the module doc).
+    pub flat: bool,
+    /// Surface area.
+    pub area: f64,
+    /// Radius ratio (0 when the volume is 0).
+    pub rho: f64,
+}
+
+/// Volume, flatness, surface area and radius ratio of `t`, from its corners times
+/// `scale` (a power of two: see [`mesh_scale`]), in one pass.
+pub fn measure(points: &[[f64; 3]], t: [u32; 4], scale: f64) -> Measure {
+    let p = corners(points, t, scale);
+    let (a, b, c) = (sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0]));
+    let (ab, bc, ca) = (cross(a, b), cross(b, c), cross(c, a));
+    let v6 = a[0] * bc[0] + a[1] * bc[1] + a[2] * bc[2];
+    let longest2 = [a, b, c, sub(p[2], p[1]), sub(p[3], p[1]), sub(p[3], p[2])]
+        .iter()
+        .map(|e| norm2(*e))
+        .fold(0.0, f64::max);
+    let l = longest2.sqrt();
+    // NaN (an overflow the scale did not prevent) counts as flat.
+    let flat = (v6 / 6.0)
+        .abs()
+        .partial_cmp(&(FLAT_RELATIVE_VOLUME * l * l * l))
+        != Some(std::cmp::Ordering::Greater);
+    // Twice the face areas: three around p0, and the one opposite it.
+    let twice = [
+        norm2(ab).sqrt(),
+        norm2(bc).sqrt(),
+        norm2(ca).sqrt(),
+        norm2(cross(sub(b, a), sub(c, a))).sqrt(),
+    ];
+    let faces: f64 = twice.iter().sum();
+    let rho = if v6 == 0.0 || !v6.is_finite() {
+        0.0
+    } else {
+        let r = v6.abs() / faces; // 3V / (sum of areas) = (6V) / (2 * sum of areas)
+        let num: [f64; 3] =
+            std::array::from_fn(|k| norm2(a) * bc[k] + norm2(b) * ca[k] + norm2(c) * ab[k]);
+        let big_r = norm2(num).sqrt() / (2.0 * v6.abs()); // |...| / (12 V)
+        if big_r > 0.0 && big_r.is_finite() {
+            (3.0 * r / big_r).clamp(0.0, 1.0)
+        } else {
+            0.0
+        }
+    };
+    Measure {
+        volume: v6 / 6.0,
+        flat,
+        area: faces / 2.0,
+        rho,
+    }
+}
+
 /// True when `t` is flat (see the module doc).
 pub fn is_flat(points: &[[f64; 3]], t: [u32; 4]) -> bool {
     is_flat_scaled(points, t, unit_scale(largest_of(points, t)))
@@ -108,47 +167,17 @@ fn largest_of(points: &[[f64; 3]], t: [u32; 4]) -> f64 {
 /// [`is_flat`] on coordinates times `scale` (flatness does not depend on the scale, but
 /// overflow does).
 pub fn is_flat_scaled(points: &[[f64; 3]], t: [u32; 4], scale: f64) -> bool {
-    let l = longest_edge_scaled(points, t, scale);
-    let v = signed_volume_scaled(points, t, scale);
-    // NaN (an overflow the scale did not prevent) counts as flat.
-    v.abs().partial_cmp(&(FLAT_RELATIVE_VOLUME * l * l * l)) != Some(std::cmp::Ordering::Greater)
+    measure(points, t, scale).flat
 }
 
-/// Radius ratio `3 r / R` of `t` (1 for the regular tetrahedron, 0 when flat).
+/// Radius ratio `3 r / R` of `t` (1 for the regular tetrahedron, 0 when its volume is 0).
 pub fn radius_ratio(points: &[[f64; 3]], t: [u32; 4]) -> f64 {
-    radius_ratio_scaled(points, t, unit_scale(largest_of(points, t)))
-}
-
-fn radius_ratio_scaled(points: &[[f64; 3]], t: [u32; 4], scale: f64) -> f64 {
-    let p = corners(points, t, scale);
-    let (a, b, c) = (sub(p[1], p[0]), sub(p[2], p[0]), sub(p[3], p[0]));
-    let v6 = det_scaled(points, t, scale).abs();
-    if v6 == 0.0 || !v6.is_finite() {
-        return 0.0;
-    }
-    let area2 = |x: [f64; 3], y: [f64; 3]| norm2(cross(x, y)).sqrt(); // twice a face area
-    let faces = area2(a, b) + area2(b, c) + area2(c, a) + area2(sub(b, a), sub(c, a));
-    let r = v6 / faces; // 3V / (sum of areas) = (6V) / (2 * sum of areas)
-    let (ab, bc, ca) = (cross(a, b), cross(b, c), cross(c, a));
-    let num: [f64; 3] =
-        std::array::from_fn(|k| norm2(a) * bc[k] + norm2(b) * ca[k] + norm2(c) * ab[k]);
-    let big_r = norm2(num).sqrt() / (2.0 * v6); // |...| / (12 V)
-    if big_r > 0.0 && big_r.is_finite() {
-        (3.0 * r / big_r).clamp(0.0, 1.0)
-    } else {
-        0.0
-    }
+    measure(points, t, unit_scale(largest_of(points, t))).rho
 }
 
 /// Surface area of `t` with the coordinates times `scale`.
 pub fn surface_area_scaled(points: &[[f64; 3]], t: [u32; 4], scale: f64) -> f64 {
-    let p = corners(points, t, scale);
-    let area = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| norm2(cross(sub(b, a), sub(c, a))).sqrt();
-    (area(p[0], p[1], p[2])
-        + area(p[0], p[1], p[3])
-        + area(p[0], p[2], p[3])
-        + area(p[1], p[2], p[3]))
-        / 2.0
+    measure(points, t, scale).area
 }
 
 /// Surface area of the bounding box of `points` times `scale`.
@@ -268,6 +297,11 @@ pub struct Quality {
 impl Quality {
     /// Measure every tetrahedron of `mesh`.
     pub fn of(mesh: &Mesh) -> Quality {
+        Quality::classify(mesh).0
+    }
+
+    /// [`Quality::of`], and which tetrahedra are flat.
+    pub fn classify(mesh: &Mesh) -> (Quality, Vec<bool>) {
         let scale = mesh_scale(&mesh.points);
         let points = &mesh.points;
         let mut q = Quality {
@@ -284,12 +318,14 @@ impl Quality {
             min_radius_ratio: 1.0,
         };
         let again = repeats(mesh.tets.len(), |t| place_key(points, mesh.tets[t]));
+        let mut flat = Vec::with_capacity(mesh.tets.len());
         let mut area = 0.0;
         for (i, &t) in mesh.tets.iter().enumerate() {
-            let v = signed_volume_scaled(points, t, scale);
-            q.scaled_volumes.0 += v;
-            q.scaled_volumes.1 = q.scaled_volumes.1.min(v);
-            if is_flat_scaled(points, t, scale) {
+            let m = measure(points, t, scale);
+            flat.push(m.flat);
+            q.scaled_volumes.0 += m.volume;
+            q.scaled_volumes.1 = q.scaled_volumes.1.min(m.volume);
+            if m.flat {
                 q.flat += 1;
                 q.first_flat.get_or_insert(i);
                 continue;
@@ -298,11 +334,10 @@ impl Quality {
                 q.repeated += 1;
                 q.first_repeat.get_or_insert((i, earlier as usize));
             } else {
-                area += surface_area_scaled(points, t, scale);
+                area += m.area;
             }
-            let rho = radius_ratio_scaled(points, t, scale);
-            q.min_radius_ratio = q.min_radius_ratio.min(rho);
-            if rho < SLIVER_RADIUS_RATIO {
+            q.min_radius_ratio = q.min_radius_ratio.min(m.rho);
+            if m.rho < SLIVER_RADIUS_RATIO {
                 q.slivers += 1;
             }
         }
@@ -310,7 +345,7 @@ impl Quality {
         q.depth = if box_area > 0.0 { area / box_area } else { 0.0 };
         q.total_volume = times_pow2(q.scaled_volumes.0, q.volume_log2);
         q.min_volume = times_pow2(q.scaled_volumes.1, q.volume_log2);
-        q
+        (q, flat)
     }
 }
 

@@ -118,7 +118,7 @@ pub(super) fn resolve(
     if let Some(first) = pending.first() {
         budget::check(
             format!(
-                "the {} $NodeData/$ElementData sections (one value per node or element and component each)",
+                "making the {} $NodeData/$ElementData sections into arrays (a value per node or element and component)",
                 pending.len()
             ),
             total,

@@ -76,34 +76,13 @@ pub(super) fn build(
         )?;
     }
 
-    // What the declared counts make: every array decoded (the stored bytes and the f64
-    // or i64 they become), the points as [f64; 3], a cell's kind and offsets, and up to
-    // 6 tetrahedra per cell; all before anything is inflated.
-    let per_point: u64 = 3 * decoded_bytes(pts)
-        + 24
-        + arrays
-            .iter()
-            .filter(|d| d.section == Section::PointData)
-            .map(|d| d.comps as u64 * decoded_bytes(d))
-            .sum::<u64>();
-    let per_cell: u64 = decoded_bytes(off_d)
-        + decoded_bytes(types_d)
-        + 64
-        + 6 * 20
-        + arrays
-            .iter()
-            .filter(|d| d.section == Section::CellData)
-            .map(|d| d.comps as u64 * (decoded_bytes(d) + 6 * 8))
-            .sum::<u64>();
-    let estimate = budget::times(np, per_point).saturating_add(budget::times(nc, per_cell));
-    budget::check(
-        format!("the piece's {np} points and {nc} cells, decoded"),
-        estimate,
-    )
-    .map_err(|e| terr(piece_at, e.to_string()))?;
-
     // The cells' own small arrays first: offsets and types say whether there is any
     // volume to read before the connectivity and the points are inflated.
+    budget::check(
+        format!("decoding the offsets and types of {nc} cells"),
+        budget::times(nc, decoded_bytes(off_d) + decoded_bytes(types_d) + 64),
+    )
+    .map_err(|e| terr(piece_at, e.to_string()))?;
     let offsets = f.ints(off_d, Some(nc_usize), &cells_need)?;
     let mut prev = 0;
     for (i, &o) in offsets.iter().enumerate() {
@@ -126,6 +105,32 @@ pub(super) fn build(
             ),
         ));
     }
+    // What the declared counts make: every array decoded (the stored bytes and the f64
+    // or i64 they become), the points as [f64; 3], a cell's kind and offsets, and up to
+    // 6 tetrahedra per cell; before the connectivity, points and data are inflated.
+    let per_point: u64 = 3 * decoded_bytes(pts)
+        + 24
+        + arrays
+            .iter()
+            .filter(|d| d.section == Section::PointData)
+            .map(|d| d.comps as u64 * decoded_bytes(d))
+            .sum::<u64>();
+    let per_cell: u64 = decoded_bytes(off_d)
+        + decoded_bytes(types_d)
+        + 64
+        + 6 * 20
+        + arrays
+            .iter()
+            .filter(|d| d.section == Section::CellData)
+            .map(|d| d.comps as u64 * (decoded_bytes(d) + 6 * 8))
+            .sum::<u64>();
+    let estimate = budget::times(np, per_point).saturating_add(budget::times(nc, per_cell));
+    budget::check(
+        format!("decoding the piece's {np} points and {nc} cells"),
+        estimate,
+    )
+    .map_err(|e| terr(piece_at, e.to_string()))?;
+
     let conn_len = offsets.last().copied().unwrap_or(0);
     let conn_n = usize::try_from(conn_len)
         .map_err(|_| terr(off_d.at, format!("the last offset {conn_len} is too large")))?;

@@ -132,14 +132,9 @@ pub fn from_mesh(
         .map(|p| (DVec3::from_array(*p) - centre) * scale)
         .collect();
     let half = (half_extent * scale).max(DVec3::splat(1e-9));
-    let quality = Quality::of(mesh);
+    let (quality, flat) = Quality::classify(mesh);
     let finite = |t: &[u32; 4]| t.iter().all(|&v| scalars[v as usize].is_finite());
     let unit = quality::mesh_scale(&mesh.points);
-    let flat: Vec<bool> = mesh
-        .tets
-        .iter()
-        .map(|&t| quality::is_flat_scaled(&mesh.points, t, unit))
-        .collect();
     let again = quality::repeats(mesh.tets.len(), |i| {
         let t = mesh.tets[i];
         let mut k = t.map(|v| {
