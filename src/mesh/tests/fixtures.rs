@@ -775,9 +775,10 @@ pub fn sections(b: &[u8]) -> Vec<(usize, usize)> {
             let name_end = (s..b.len())
                 .find(|&i| b[i].is_ascii_whitespace())
                 .unwrap_or(b.len());
-            let end_tag = [b"\n$End".as_slice(), &b[s + 1..name_end]].concat();
+            // Binary data may run right up to the end line (no line end before it).
+            let end_tag = [b"$End".as_slice(), &b[s + 1..name_end]].concat();
             if let Some(e) = find(name_end, &end_tag) {
-                out.push((s, line_end(e + 1)));
+                out.push((s, line_end(e)));
             }
         }
     } else if b.starts_with(b"# vtk") {
