@@ -365,3 +365,68 @@ fn pieces_without_volume_are_refused_before_their_points_are_inflated() {
         assert!(t.elapsed().as_millis() < 300, "{:?}", t.elapsed());
     }
 }
+
+/// `bytes` with `block` cut out and put back at `to` (an offset into the original,
+/// before the block), followed by a line end.
+fn moved(bytes: &[u8], block: (usize, usize), to: usize) -> Vec<u8> {
+    let (a, b) = block;
+    assert!(to <= a, "moves go toward the start");
+    let mut piece = bytes[a..b].to_vec();
+    if piece.last() != Some(&b'\n') {
+        piece.push(b'\n');
+    }
+    [&bytes[..to], &piece, &bytes[to..a], &bytes[b..]].concat()
+}
+
+#[test]
+fn every_format_reads_the_same_mesh_with_its_data_before_its_mesh() {
+    use super::formats::check_fixture;
+    let find = |b: &[u8], what: &[u8]| b.windows(what.len()).position(|w| w == what).unwrap();
+    for (name, bytes) in fixtures::all_fixtures() {
+        // Float32 coordinates in some fixtures: within 1e-7 of the f64 ones (up to 1.7).
+        let tol = 1e-6;
+        let out = if name.ends_with(".msh") {
+            // gmsh 2.2 and 4.1, ASCII and binary: every data section right after
+            // $EndMeshFormat, before $Nodes and $Elements.
+            let blocks: Vec<(usize, usize)> = fixtures::sections(&bytes)
+                .into_iter()
+                .filter(|&(a, _)| {
+                    bytes[a..].starts_with(b"$NodeData") || bytes[a..].starts_with(b"$ElementData")
+                })
+                .collect();
+            assert_eq!(blocks.len(), 3, "{name}");
+            let to = find(&bytes, b"$EndMeshFormat\n") + 15;
+            let mut out = bytes[..to].to_vec();
+            for &(a, b) in &blocks {
+                out.extend(&bytes[a..b]);
+            }
+            let mut at = to;
+            for &(a, b) in &blocks {
+                out.extend(&bytes[at..a]);
+                at = b;
+            }
+            out.extend(&bytes[at..]);
+            out
+        } else if name.ends_with(".vtk") {
+            // VTK legacy: POINT_DATA and CELL_DATA (to the end of the file) before POINTS.
+            let data = ["\nCELL_DATA", "\nPOINT_DATA"]
+                .iter()
+                .map(|k| find(&bytes, k.as_bytes()) + 1)
+                .min()
+                .unwrap();
+            moved(&bytes, (data, bytes.len()), find(&bytes, b"\nPOINTS ") + 1)
+        } else {
+            // .vtu: the order of XML elements is free; CellData first of all.
+            let s = fixtures::sections(&bytes);
+            let cell_data = s
+                .iter()
+                .find(|&&(a, _)| bytes[a..].starts_with(b"<CellData"))
+                .copied()
+                .unwrap();
+            moved(&bytes, cell_data, find(&bytes, b"<PointData"))
+        };
+        assert_ne!(out, bytes, "{name}");
+        let m = parse(Path::new(&name), &out).unwrap_or_else(|e| panic!("{name}: {e}"));
+        check_fixture(&m, tol, &format!("{name}, data first"));
+    }
+}
