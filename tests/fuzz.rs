@@ -13,19 +13,26 @@
 //! `ARBVIS_FUZZ_VERBOSE=1` prints each case before running it (to find the one that
 //! aborts), and `ARBVIS_FUZZ_CASE=TARGET:SEED:INDEX` replays one case.
 //!
+//! `ARBVIS_FUZZ_TARGETS=mesh,scene` runs only the named targets (a name also selects the
+//! targets it prefixes: `mesh` is `mesh-legacy`, `mesh-vtu` and `mesh-gmsh`).
+//!
 //! Allocation: a counting global allocator refuses any single allocation above
-//! [`ALLOCATION_CAP`] while a case runs, so a loader that sizes memory from a header
-//! without checking it against the input fails here (a `try_reserve` sees an error; an
-//! infallible allocation aborts the test with "memory allocation of N bytes failed").
+//! [`ALLOCATION_CAP`], and any allocation that would make the bytes a case holds at once
+//! exceed [`LIVE_CAP`], while a case runs, so a loader that sizes memory from a header
+//! without checking it against the input, or that amplifies a small input by many
+//! medium allocations, fails here (a `try_reserve` sees an error; an infallible
+//! allocation aborts the test with "memory allocation of N bytes failed"). The memory
+//! budget (`arbvis::budget`) is set to [`FUZZ_BUDGET`] so that loaders refuse first.
 
 mod common;
 #[path = "../src/mesh/tests/fixtures.rs"]
 mod mesh_fixtures;
+#[path = "../src/mesh/tests/hostile_files.rs"]
+mod mesh_hostile;
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 use std::path::Path;
-use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use arbvis::colortable::ColorTable;
@@ -36,6 +43,15 @@ use arbvis::volume::{nifti_file, segy, Limits, Volume};
 /// volume: at most the corpus's f32 copy of its largest file (ICBM152, 35 MB).
 const ALLOCATION_CAP: usize = 256 << 20;
 
+/// Most bytes a case may hold at once (allocated and not yet freed, on its thread): four
+/// allocations at [`ALLOCATION_CAP`].
+const LIVE_CAP: usize = 1 << 30;
+
+/// The memory budget loaders are held to while fuzzing: each of their checked
+/// allocations (or groups) must fit [`ALLOCATION_CAP`], so a refusal comes from the
+/// loader, with its message, before the allocator refuses.
+const FUZZ_BUDGET: u64 = 256 << 20;
+
 /// Slowest case allowed (the debug-profile build; real inputs parse in milliseconds).
 const CASE_TIME: Duration = Duration::from_secs(5);
 
@@ -44,33 +60,52 @@ const DEFAULT_CASES: usize = 300;
 
 struct Capped;
 
-static PEAK_REQUEST: AtomicUsize = AtomicUsize::new(0);
-
 thread_local! {
     static CAPPING: Cell<bool> = const { Cell::new(false) };
+    /// Largest single request of the running case.
+    static PEAK_REQUEST: Cell<usize> = const { Cell::new(0) };
+    /// Bytes the running case holds (what it allocated minus what it freed).
+    static LIVE: Cell<isize> = const { Cell::new(0) };
+    /// The most it held at once.
+    static PEAK_LIVE: Cell<isize> = const { Cell::new(0) };
 }
 
-// SAFETY: forwards to the system allocator; only refuses (returns null) large requests
-// while the current thread runs a fuzz case.
+fn capping() -> bool {
+    CAPPING.try_with(Cell::get).unwrap_or(false)
+}
+
+/// Account for `grow` more bytes (negative: freed) in a request of `size`; false when
+/// the request must be refused (and then nothing is counted).
+fn admit(size: usize, grow: isize) -> bool {
+    let _ = PEAK_REQUEST.try_with(|p| p.set(p.get().max(size)));
+    let live = LIVE.try_with(Cell::get).unwrap_or(0) + grow;
+    if size > ALLOCATION_CAP || (grow > 0 && live > LIVE_CAP as isize) {
+        return false;
+    }
+    let _ = LIVE.try_with(|l| l.set(live));
+    let _ = PEAK_LIVE.try_with(|p| p.set(p.get().max(live)));
+    true
+}
+
+// SAFETY: forwards to the system allocator; only refuses (returns null) requests over
+// the caps while the current thread runs a fuzz case.
 unsafe impl GlobalAlloc for Capped {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if CAPPING.try_with(Cell::get).unwrap_or(false) {
-            PEAK_REQUEST.fetch_max(layout.size(), Ordering::Relaxed);
-            if layout.size() > ALLOCATION_CAP {
-                return std::ptr::null_mut();
-            }
+        if capping() && !admit(layout.size(), layout.size() as isize) {
+            return std::ptr::null_mut();
         }
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        if capping() {
+            let _ = LIVE.try_with(|l| l.set(l.get() - layout.size() as isize));
+        }
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if CAPPING.try_with(Cell::get).unwrap_or(false) {
-            PEAK_REQUEST.fetch_max(new_size, Ordering::Relaxed);
-            if new_size > ALLOCATION_CAP {
-                return std::ptr::null_mut();
-            }
+        let grow = new_size as isize - layout.size() as isize;
+        if capping() && !admit(new_size, grow) {
+            return std::ptr::null_mut();
         }
         unsafe { System.realloc(ptr, layout, new_size) }
     }
@@ -204,10 +239,12 @@ fn mutate(input: &[u8], rng: &mut Rng, text: bool) -> Vec<u8> {
     out
 }
 
-/// A fuzz target: a name, whether its inputs are text, its corpus and the call.
+/// A fuzz target: a name, whether its inputs are text, whether cases also move whole
+/// sections (mesh formats), its corpus and the call.
 struct Target {
     name: &'static str,
     text: bool,
+    sections: bool,
     corpus: Vec<Vec<u8>>,
     run: fn(&[u8]),
 }
@@ -275,17 +312,72 @@ fn scene_corpus() -> Vec<Vec<u8>> {
     corpus
 }
 
-fn mesh_corpus() -> Vec<Vec<u8>> {
+/// The mesh fixtures and real files whose name ends in `.{ext}`.
+fn mesh_corpus(ext: &str) -> Vec<Vec<u8>> {
+    let suffix = format!(".{ext}");
     let mut corpus: Vec<Vec<u8>> = mesh_fixtures::all_fixtures()
         .into_iter()
+        .filter(|(name, _)| name.ends_with(&suffix))
         .map(|(_, b)| b)
         .collect();
-    for name in ["tetraMesh.vtk", "Tetrahedron.vtu"] {
+    for name in [
+        "tetraMesh.vtk",
+        "Tetrahedron.vtu",
+        "bracket-2.2.msh",
+        "bracket-4.1-binary.msh",
+    ] {
+        if !name.ends_with(&suffix) {
+            continue;
+        }
         if let Some(p) = common::shared_data(&format!("tets/{name}")) {
             corpus.push(std::fs::read(p).unwrap());
         }
     }
     corpus
+}
+
+/// `input` with one of its sections (see `mesh_fixtures::sections`: gmsh `$Name` blocks,
+/// XML elements, legacy keyword sections) moved before another, repeated there, or
+/// swapped with it.
+fn reorder(input: &[u8], rng: &mut Rng) -> Vec<u8> {
+    let blocks = mesh_fixtures::sections(input);
+    if blocks.len() < 2 {
+        return input.to_vec();
+    }
+    let (a0, a1) = blocks[rng.below(blocks.len())];
+    let (b0, b1) = blocks[rng.below(blocks.len())];
+    let block = &input[a0..a1];
+    match rng.below(3) {
+        // Move block a to where block b starts.
+        0 if b0 <= a0 || b0 >= a1 => {
+            let mut out: Vec<u8> = [&input[..a0], &input[a1..]].concat();
+            let to = if b0 >= a1 { b0 - (a1 - a0) } else { b0 };
+            out.splice(to..to, block.iter().copied());
+            out
+        }
+        // Swap two blocks that do not overlap.
+        1 if a1 <= b0 || b1 <= a0 => {
+            let ((x0, x1), (y0, y1)) = if a1 <= b0 {
+                ((a0, a1), (b0, b1))
+            } else {
+                ((b0, b1), (a0, a1))
+            };
+            [
+                &input[..x0],
+                &input[y0..y1],
+                &input[x1..y0],
+                &input[x0..x1],
+                &input[y1..],
+            ]
+            .concat()
+        }
+        // Repeat block a where block b starts.
+        _ => {
+            let mut out = input.to_vec();
+            out.splice(b0..b0, block.iter().copied());
+            out
+        }
+    }
 }
 
 fn dat_corpus() -> Vec<Vec<u8>> {
@@ -404,6 +496,7 @@ fn targets() -> Vec<Target> {
         Target {
             name: "segy",
             text: false,
+            sections: false,
             corpus: segy_corpus(),
             run: |b| {
                 let options = segy::ReadOptions {
@@ -416,6 +509,7 @@ fn targets() -> Vec<Target> {
         Target {
             name: "nifti",
             text: false,
+            sections: false,
             corpus: nifti_corpus(),
             run: |b| {
                 let _ = nifti_file::parse(Path::new("fuzz.nii"), b, &fuzz_limits());
@@ -424,6 +518,7 @@ fn targets() -> Vec<Target> {
         Target {
             name: "scene",
             text: true,
+            sections: false,
             corpus: scene_corpus(),
             run: |b| {
                 let text = String::from_utf8_lossy(b);
@@ -441,16 +536,36 @@ fn targets() -> Vec<Target> {
             },
         },
         Target {
-            name: "mesh",
+            name: "mesh-legacy",
             text: false,
-            corpus: mesh_corpus(),
+            sections: true,
+            corpus: mesh_corpus("vtk"),
             run: |b| {
-                let _ = arbvis::mesh::parse(Path::new("fuzz.mesh"), b);
+                let _ = arbvis::mesh::parse(Path::new("fuzz.vtk"), b);
+            },
+        },
+        Target {
+            name: "mesh-vtu",
+            text: false,
+            sections: true,
+            corpus: mesh_corpus("vtu"),
+            run: |b| {
+                let _ = arbvis::mesh::parse(Path::new("fuzz.vtu"), b);
+            },
+        },
+        Target {
+            name: "mesh-gmsh",
+            text: false,
+            sections: true,
+            corpus: mesh_corpus("msh"),
+            run: |b| {
+                let _ = arbvis::mesh::parse(Path::new("fuzz.msh"), b);
             },
         },
         Target {
             name: "points-dat",
             text: true,
+            sections: false,
             corpus: dat_corpus(),
             run: |b| {
                 let columns = arbvis::points::dat::DatColumns::default();
@@ -460,6 +575,7 @@ fn targets() -> Vec<Target> {
         Target {
             name: "points-las",
             text: false,
+            sections: false,
             corpus: las_corpus(),
             run: |b| {
                 let _ = arbvis::points::lasfile::parse(Path::new("fuzz.laz"), b);
@@ -468,6 +584,7 @@ fn targets() -> Vec<Target> {
         Target {
             name: "points-ply",
             text: false,
+            sections: false,
             corpus: ply_corpus(),
             run: |b| {
                 let _ = arbvis::points::plycloud::parse(Path::new("fuzz.ply"), b);
@@ -476,6 +593,7 @@ fn targets() -> Vec<Target> {
         Target {
             name: "surface-obj",
             text: true,
+            sections: false,
             corpus: obj_corpus(),
             run: |b| {
                 let _ = arbvis::surface::parse(Path::new("fuzz.obj"), b);
@@ -484,6 +602,7 @@ fn targets() -> Vec<Target> {
         Target {
             name: "surface-stl",
             text: false,
+            sections: false,
             corpus: stl_corpus(),
             run: |b| {
                 let _ = arbvis::surface::parse(Path::new("fuzz.stl"), b);
@@ -492,6 +611,7 @@ fn targets() -> Vec<Target> {
         Target {
             name: "table",
             text: true,
+            sections: false,
             corpus: vec![ColorTable::builtin("viridis")
                 .unwrap()
                 .to_text()
@@ -503,38 +623,87 @@ fn targets() -> Vec<Target> {
     ]
 }
 
+/// What one capped run of an input did.
+struct CaseRun {
+    /// The panic's message, if it panicked.
+    panic: Option<String>,
+    elapsed: Duration,
+    /// Largest single request.
+    peak_request: usize,
+    /// Most bytes held at once.
+    peak_live: isize,
+}
+
+/// Run `f` under the caps (and the fuzz budget), catching a panic.
+fn capped(f: impl FnOnce()) -> CaseRun {
+    arbvis::budget::set(FUZZ_BUDGET);
+    PEAK_REQUEST.with(|p| p.set(0));
+    LIVE.with(|l| l.set(0));
+    PEAK_LIVE.with(|p| p.set(0));
+    let t0 = Instant::now();
+    CAPPING.with(|c| c.set(true));
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
+    CAPPING.with(|c| c.set(false));
+    let elapsed = t0.elapsed();
+    CaseRun {
+        panic: outcome.err().map(|panic| {
+            panic
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default()
+        }),
+        elapsed,
+        peak_request: PEAK_REQUEST.with(Cell::get),
+        peak_live: PEAK_LIVE.with(Cell::get),
+    }
+}
+
 /// Run case `index` of `target` with `seed`; panics with the case's name on failure.
 fn run_case(target: &Target, seed: u64, index: usize) {
     let mut rng = Rng(seed ^ (index as u64).wrapping_mul(0x2545_F491_4F6C_DD1D));
     let base = &target.corpus[rng.below(target.corpus.len())];
-    let input = mutate(base, &mut rng, target.text);
+    let mut input = base.clone();
+    // Mesh targets: a third of the cases first move, repeat or swap whole sections.
+    if target.sections && rng.below(3) == 0 {
+        input = reorder(&input, &mut rng);
+    }
+    let input = mutate(&input, &mut rng, target.text);
     let case = format!("{}:{seed}:{index}", target.name);
     if std::env::var_os("ARBVIS_FUZZ_VERBOSE").is_some() {
         eprintln!("case {case} ({} bytes)", input.len());
     }
-    PEAK_REQUEST.store(0, Ordering::Relaxed);
-    let t0 = Instant::now();
-    CAPPING.with(|c| c.set(true));
-    let outcome = std::panic::catch_unwind(|| (target.run)(&input));
-    CAPPING.with(|c| c.set(false));
-    let elapsed = t0.elapsed();
-    if let Err(panic) = outcome {
-        let what = panic
-            .downcast_ref::<String>()
-            .cloned()
-            .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-            .unwrap_or_default();
+    let run = target.run;
+    let r = capped(|| run(&input));
+    if let Some(what) = r.panic {
         panic!("case {case} panicked: {what}; replay with ARBVIS_FUZZ_CASE={case}");
     }
     assert!(
-        elapsed < CASE_TIME,
-        "case {case} took {elapsed:?} (bound {CASE_TIME:?}); replay with ARBVIS_FUZZ_CASE={case}"
+        r.elapsed < CASE_TIME,
+        "case {case} took {:?} (bound {CASE_TIME:?}); replay with ARBVIS_FUZZ_CASE={case}",
+        r.elapsed
     );
-    let peak = PEAK_REQUEST.load(Ordering::Relaxed);
     assert!(
-        peak <= ALLOCATION_CAP,
-        "case {case} asked for {peak} bytes at once; replay with ARBVIS_FUZZ_CASE={case}"
+        r.peak_request <= ALLOCATION_CAP,
+        "case {case} asked for {} bytes at once; replay with ARBVIS_FUZZ_CASE={case}",
+        r.peak_request
     );
+    assert!(
+        r.peak_live <= LIVE_CAP as isize,
+        "case {case} held {} bytes at once; replay with ARBVIS_FUZZ_CASE={case}",
+        r.peak_live
+    );
+}
+
+/// The targets `ARBVIS_FUZZ_TARGETS` selects (all when it is not set): a listed name,
+/// or a prefix of names up to a `-`.
+fn selected(name: &str) -> bool {
+    match std::env::var("ARBVIS_FUZZ_TARGETS") {
+        Err(_) => true,
+        Ok(list) => list.split(',').map(str::trim).any(|want| {
+            !want.is_empty() && (name == want || name.starts_with(&format!("{want}-")))
+        }),
+    }
 }
 
 #[test]
@@ -544,7 +713,8 @@ fn loaders_and_scenes_survive_mutated_inputs() {
     if std::env::var_os("ARBVIS_FUZZ_CASE").is_none() {
         std::panic::set_hook(Box::new(|_| {}));
     }
-    let targets = targets();
+    let targets: Vec<Target> = targets().into_iter().filter(|t| selected(t.name)).collect();
+    assert!(!targets.is_empty(), "ARBVIS_FUZZ_TARGETS selects no target");
     let result = std::panic::catch_unwind(|| {
         if let Ok(case) = std::env::var("ARBVIS_FUZZ_CASE") {
             let mut parts = case.split(':');
@@ -606,4 +776,130 @@ fn the_mutator_changes_inputs_and_is_deterministic() {
     let b: Vec<Vec<u8>> = (0..50).map(|i| mutate(&base, &mut Rng(i), true)).collect();
     assert_eq!(a, b);
     assert!(a.iter().filter(|m| **m != base).count() > 40);
+}
+
+// --- issue 17: meshes ---
+
+/// One fixed mesh case: a name (its extension picks nothing: the content does), the
+/// file, and `Ok(tetrahedra)` or a part of the error expected.
+type MeshCase = (&'static str, Vec<u8>, Result<usize, &'static str>);
+
+/// Issue 17's mesh reproducers, one or more per class, each read under the allocation
+/// caps and the fuzz budget: the result and message they must give, no panic, and what
+/// they may hold at once (a refusal must come before the big allocation, not from the
+/// allocator).
+fn issue17_mesh_cases() -> Vec<MeshCase> {
+    use mesh_hostile::*;
+    vec![
+        // 1. Section order: data before what it names is read as if it came last.
+        ("data-first.msh", gmsh_data_first(), Ok(2)),
+        // 2. Amplification. 2,000 empty $NodeData sections of 9 components over 20,000
+        // nodes: 2.9 GB of NaN from 0.4 MB, refused by the budget before any is made.
+        (
+            "empty-data.msh",
+            empty_node_data(20_000, 2_000),
+            Err("making the 2000 $NodeData/$ElementData sections into arrays"),
+        ),
+        // 10 million zero points (240 MB inflated): refused before inflating.
+        (
+            "no-cells.vtu",
+            inflating_points_without_volume(10_000_000, 0),
+            Err("the piece has no cells"),
+        ),
+        (
+            "faces.vtu",
+            inflating_points_without_volume(10_000_000, 3),
+            Err("no volume cells"),
+        ),
+        // With a tetrahedron, the 10 million points are legal but need 720 MB decoded:
+        // over the 256 MiB fuzz budget, refused before inflating.
+        (
+            "points.vtu",
+            inflating_points(10_000_000, 1, 10),
+            Err("decoding the piece's 10000000 points and 1 cells needs about"),
+        ),
+        // A 9-component cell array over 400,000 hexahedra: 2.4 million tetrahedra x 72
+        // bytes once copied, refused by the budget from the piece's counts.
+        (
+            "cell-data.vtu",
+            stacked_hexahedra_with(400_000, CUBE, 9),
+            Err("decoding the piece's 8 points and 400000 cells needs about"),
+        ),
+        // 3. Complexity: stacked and collapsed hexahedra read in bounded time.
+        (
+            "stacked.vtu",
+            stacked_hexahedra(200_000, CUBE),
+            Ok(1_200_000),
+        ),
+        (
+            "four.vtu",
+            stacked_hexahedra(200_000, FOUR_PLACES),
+            Ok(1_200_000),
+        ),
+        ("plates.vtk", stacked_plates(1_400, 1e-4), Ok(8_400)),
+        // 5. Messages.
+        (
+            "collapsed.vtk",
+            collapsed_hexahedron(),
+            Err("all 1 volume cells are collapsed (degenerate)"),
+        ),
+        // 6. Extreme numbers.
+        ("huge.vtk", huge_coordinates(), Ok(2)),
+    ]
+}
+
+#[test]
+fn issue17_mesh_reproducers_hold_under_the_caps() {
+    for (name, bytes, want) in issue17_mesh_cases() {
+        let mut got: Option<Result<usize, String>> = None;
+        let r = capped(|| {
+            got = Some(
+                arbvis::mesh::parse(Path::new(name), &bytes)
+                    .map(|m| m.tets.len())
+                    .map_err(|e| e.to_string()),
+            );
+        });
+        assert!(r.panic.is_none(), "{name} panicked: {:?}", r.panic);
+        // Milliseconds in a release build; the debug build on two busy cores gets the
+        // harness's per-case bound.
+        assert!(r.elapsed < CASE_TIME, "{name} took {:?}", r.elapsed);
+        let got = got.unwrap();
+        match (&got, want) {
+            (Ok(n), Ok(w)) => assert_eq!(*n, w, "{name}"),
+            (Err(e), Err(w)) => {
+                assert!(e.contains(w), "{name}: expected {w:?} in {e}");
+                assert!(e.starts_with(&format!("{name}: ")), "{e}");
+                // A refusal comes from the reader before the memory is taken: what the
+                // case held stays near the size of its input (the largest here is the
+                // 2.4 MB of inflated cell types and offsets of cell-data.vtu).
+                assert!(r.peak_live < 64 << 20, "{name} held {} bytes", r.peak_live);
+            }
+            _ => panic!("{name}: expected {want:?}, got {got:?}"),
+        }
+        assert!(r.peak_request <= ALLOCATION_CAP && r.peak_live <= LIVE_CAP as isize);
+    }
+}
+
+#[test]
+fn issue17_reordering_moves_whole_sections() {
+    // Every mesh fixture has sections to move, and moving them changes the file
+    // without changing its length (a move or a swap) or adds a whole one (a repeat).
+    for (name, bytes) in mesh_fixtures::all_fixtures() {
+        let blocks = mesh_fixtures::sections(&bytes);
+        assert!(blocks.len() >= 3, "{name}: {blocks:?}");
+        for &(a, b) in &blocks {
+            assert!(a < b && b <= bytes.len(), "{name}: {a}..{b}");
+        }
+        let mut changed = 0;
+        for seed in 0..40 {
+            let out = reorder(&bytes, &mut Rng(seed));
+            changed += usize::from(out != bytes);
+            let longer = out.len() - bytes.len();
+            assert!(
+                longer == 0 || blocks.iter().any(|&(a, b)| b - a == longer),
+                "{name}: grew by {longer}"
+            );
+        }
+        assert!(changed > 20, "{name}: {changed} of 40 reorders changed it");
+    }
 }

@@ -336,3 +336,348 @@ fn the_budget_comes_from_the_flag_then_the_environment_then_the_scene() {
     assert!(!ok && e.contains("is not a memory size"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+// --- issue 17: meshes ---
+
+#[path = "../src/mesh/tests/hostile_files.rs"]
+mod mesh_hostile;
+
+/// Run `arbvis ARGS` with `env`, killing it (and failing) if it runs past twice
+/// [`REFUSAL_TIME`]; its output and how long it took.
+fn arbvis(args: &[&str], env: &[(&str, &str)]) -> (Output, Duration) {
+    let t0 = Instant::now();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args(args)
+        .envs(env.iter().copied())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed() > REFUSAL_TIME * 2 {
+            let _ = child.kill();
+            panic!("arbvis {args:?} hung");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    (child.wait_with_output().unwrap(), t0.elapsed())
+}
+
+/// Write `bytes` to DIR/name and run `arbvis inspect` on it.
+fn inspect_file(dir: &Path, name: &str, bytes: &[u8], env: &[(&str, &str)]) -> (Output, Duration) {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    arbvis(&["inspect", path.to_str().unwrap()], env)
+}
+
+/// `arbvis inspect` must refuse, within the bound, naming the file and containing every
+/// `expect` string.
+fn inspect_refused(dir: &Path, name: &str, bytes: &[u8], env: &[(&str, &str)], expect: &[&str]) {
+    let (out, took) = inspect_file(dir, name, bytes, env);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{name} was read");
+    assert!(stderr.contains(&format!("{name}: ")), "{stderr}");
+    for e in expect {
+        assert!(stderr.contains(e), "expected {e:?} in: {stderr}");
+    }
+    assert!(took < REFUSAL_TIME, "{name} took {took:?}");
+}
+
+/// A cell-projection scene on the mesh file `mesh` (in the scene's folder).
+fn mesh_scene(mesh: &str) -> String {
+    format!("size = [160, 120]\nfidelity = \"precise\"\n[technique.cellproj]\nmesh = {{ file = \"{mesh}\" }}\nisovalues = [ {{ value = 0.5, color = [0.2, 0.9, 0.3, 1.0] }} ]\n")
+}
+
+#[test]
+fn issue17_mesh_sections_in_any_order_are_checked_against_each_other() {
+    let dir = temp_dir("i17-order");
+    let (out, _) = inspect_file(&dir, "first.msh", &mesh_hostile::gmsh_data_first(), &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for want in [
+        "tetrahedra: 2\n",
+        "point array \"t\": 1 component, range [-1.5, 7]",
+        "cell array \"m\": 1 component, range [40, 41]",
+    ] {
+        assert!(stdout.contains(want), "missing {want:?} in {stdout}");
+    }
+    // A $NodeData entry for a node no $Nodes section has, before the nodes.
+    let bad = String::from_utf8(mesh_hostile::gmsh_data_first())
+        .unwrap()
+        .replacen("5 3\n$EndNodeData", "6 3\n$EndNodeData", 1);
+    inspect_refused(
+        &dir,
+        "bad.msh",
+        bad.as_bytes(),
+        &[],
+        &[
+            "line 17, column 1",
+            "data entry for node 6, which is in no $Nodes section",
+        ],
+    );
+}
+
+#[test]
+fn issue17_mesh_amplification_is_refused_within_the_budget() {
+    let dir = temp_dir("i17-amplification");
+    let budget = [("ARBVIS_MEMORY_BUDGET", "64M")];
+    // 200 empty 9-component $NodeData sections over 20,000 nodes: 288 MB from 0.3 MB.
+    inspect_refused(
+        &dir,
+        "empty-data.msh",
+        &mesh_hostile::empty_node_data(20_000, 200),
+        &budget,
+        &[
+            "line 20011, column 1",
+            "making the 200 $NodeData/$ElementData sections into arrays",
+            "needs about 275 MiB, more than the memory budget of 64.00 MiB (from ARBVIS_MEMORY_BUDGET)",
+        ],
+    );
+    // 5 million zero points around one tetrahedron: 360 MB decoded from 0.2 MB,
+    // refused from the piece's counts before anything is inflated.
+    inspect_refused(
+        &dir,
+        "points.vtu",
+        &mesh_hostile::inflating_points(5_000_000, 1, 10),
+        &budget,
+        &[
+            "line 4, column 1",
+            "decoding the piece's 5000000 points and 1 cells needs about",
+        ],
+    );
+    // A 9-component cell array over 100,000 hexahedra, copied to 600,000 tetrahedra.
+    inspect_refused(
+        &dir,
+        "cell-data.vtu",
+        &mesh_hostile::stacked_hexahedra_with(100_000, mesh_hostile::CUBE, 9),
+        &budget,
+        &["decoding the piece's 8 points and 100000 cells needs about"],
+    );
+    // No cells at all, whatever the budget: refused before the 1.4 GB of points.
+    inspect_refused(
+        &dir,
+        "no-cells.vtu",
+        &mesh_hostile::inflating_points_without_volume(60_000_000, 0),
+        &[],
+        &["line 4, column 1", "the piece has no cells"],
+    );
+}
+
+#[test]
+fn issue17_degenerate_and_stacked_cells_are_reported_and_drawn_in_bounded_time_or_refused() {
+    let dir = temp_dir("i17-degenerate");
+    let files = [
+        (
+            "stacked.vtu",
+            mesh_hostile::stacked_hexahedra(200_000, mesh_hostile::CUBE),
+        ),
+        (
+            "four.vtu",
+            mesh_hostile::stacked_hexahedra(200_000, mesh_hostile::FOUR_PLACES),
+        ),
+        ("plates.vtk", mesh_hostile::stacked_plates(1_400, 1e-4)),
+    ];
+    for (name, bytes) in &files {
+        std::fs::write(dir.join(name), bytes).unwrap();
+    }
+    let inspect = |name: &str, want: &str| {
+        let (out, took) = arbvis(&["inspect", dir.join(name).to_str().unwrap()], &[]);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            stdout.contains(want),
+            "{name}: missing {want:?} in {stdout}"
+        );
+        assert!(took < REFUSAL_TIME, "{name}: inspect took {took:?}");
+    };
+    inspect(
+        "stacked.vtu",
+        "repeated tetrahedra (at the place of an earlier one): 1199994, the first is tetrahedron 6 from file cell 1 repeating 0 from file cell 0",
+    );
+    inspect(
+        "four.vtu",
+        "flat (degenerate) tetrahedra (|volume| <= 1e-12 x longest edge^3, not drawn): 1200000, the first is tetrahedron 0 from file cell 0",
+    );
+    inspect(
+        "plates.vtk",
+        "depth: a line through the bounding box crosses 3281.6 tetrahedra on average",
+    );
+    // Drawn once: 6 of 1.2 million tetrahedra, said on stderr (it once rasterized all of
+    // them, for minutes).
+    let scene = dir.join("stacked.toml");
+    std::fs::write(&scene, mesh_scene("stacked.vtu")).unwrap();
+    let (out, took) = render(&scene, &dir.join("stacked.png"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("stacked.vtu: 1199994 of 1200000 tetrahedra are not drawn: 1199994 repeating an earlier one's corners and scalars"),
+        "{stderr}"
+    );
+    assert!(took < REFUSAL_TIME, "{took:?}");
+    // All flat: nothing can be drawn, said so.
+    std::fs::write(dir.join("four.toml"), mesh_scene("four.vtu")).unwrap();
+    refused_at(
+        &dir,
+        &dir.join("four.toml"),
+        &["four.vtu: no tetrahedron to draw: of 1200000, 1200000 are flat (degenerate: zero volume, the first is tetrahedron 0 of file cell 0)"],
+    );
+    // Legal but 3,282 layers deep: refused rather than rasterized for half a minute.
+    std::fs::write(dir.join("plates.toml"), mesh_scene("plates.vtk")).unwrap();
+    refused_at(
+        &dir,
+        &dir.join("plates.toml"),
+        &["plates.vtk: a line through the mesh crosses 3282 of its 8400 drawn tetrahedra on average", "more than the 1024 layers"],
+    );
+}
+
+#[test]
+fn issue17_mesh_messages_name_the_file_the_position_and_the_cause() {
+    let dir = temp_dir("i17-messages");
+    inspect_refused(
+        &dir,
+        "collapsed.vtk",
+        &mesh_hostile::collapsed_hexahedron(),
+        &[],
+        &[
+            "line 9, column 1 (byte 127)",
+            "no tetrahedra: all 1 volume cells are collapsed (degenerate)",
+            "cell 1 (VTK_HEXAHEDRON) with points [3, 3, 3, 3, 3, 3, 3, 3]",
+        ],
+    );
+    let lie = String::from_utf8(mesh_hostile::stacked_hexahedra(3, mesh_hostile::CUBE))
+        .unwrap()
+        .replace("NumberOfCells=\"3\"", "NumberOfCells=\"4\"");
+    inspect_refused(
+        &dir,
+        "lie.vtu",
+        lie.as_bytes(),
+        &[],
+        &["DataArray \"offsets\": the compression header declares 1 blocks of 65536 bytes (last 12): 12 bytes, but 16 are needed (NumberOfCells=\"4\" (line 4) x 4 bytes)"],
+    );
+    // Truncated after its data, before </AppendedData></VTKFile>.
+    let vtu = b"<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt32\">\n<UnstructuredGrid><Piece NumberOfPoints=\"4\" NumberOfCells=\"1\">\n<Points><DataArray type=\"Float32\" NumberOfComponents=\"3\" format=\"appended\" offset=\"0\"/></Points>\n<Cells><DataArray type=\"Int32\" Name=\"connectivity\" format=\"ascii\">0 1 2 3</DataArray><DataArray type=\"Int32\" Name=\"offsets\" format=\"ascii\">4</DataArray><DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">10</DataArray></Cells>\n</Piece></UnstructuredGrid>\n<AppendedData encoding=\"raw\">_";
+    let mut file = vtu.to_vec();
+    file.extend(48u32.to_le_bytes());
+    for v in [0f32, 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1.] {
+        file.extend(v.to_le_bytes());
+    }
+    inspect_refused(
+        &dir,
+        "cut.vtu",
+        &file,
+        &[],
+        &[&format!(
+            "the file ends at byte {} without </AppendedData> and </VTKFile>",
+            file.len()
+        )],
+    );
+    file.extend(b"\n</AppendedData>\n</VTKFile>\n");
+    let (out, _) = inspect_file(&dir, "whole.vtu", &file, &[]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn issue17_coordinates_near_the_largest_f64_are_inspected_and_drawn() {
+    let dir = temp_dir("i17-huge");
+    let (out, _) = inspect_file(&dir, "huge.vtk", &mesh_hostile::huge_coordinates(), &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for want in [
+        "bounds: x [-1.7e308, 1.7e308] y [-1.7e308, 1.7e308] z [-1.7e308, 1.7e308]",
+        // (3.4e308)^3 x (1/6 + 1/3): beyond the f64 range, written from its scaled form.
+        "volume: total 1.965200e925, smallest tetrahedron 6.550667e924",
+    ] {
+        assert!(stdout.contains(want), "missing {want:?} in {stdout}");
+    }
+    assert!(
+        !stdout.contains("NaN") && !stdout.contains("inf"),
+        "{stdout}"
+    );
+    let scene = dir.join("huge.toml");
+    std::fs::write(&scene, mesh_scene("huge.vtk")).unwrap();
+    let png = dir.join("huge.png");
+    let (out, _) = render(&scene, &png);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The isosurface s = 0.5 crosses both tetrahedra: its green covers a good part of
+    // the picture (it once came out empty, every position NaN).
+    let (image, _) = arbvis::png_io::read_png(&png).unwrap();
+    let green = image
+        .data
+        .chunks_exact(4)
+        .filter(|p| p[1] > 0.5 && p[0] < 0.5)
+        .count();
+    let total = (image.width * image.height) as usize;
+    assert!(green > total / 20, "{green} of {total} pixels green");
+}
+
+#[test]
+fn issue17_every_mesh_file_under_2_mb_is_read_or_refused_fast() {
+    // The promise is 5 s in a release build on this machine (2 cores; measured by hand,
+    // see the README); a debug build is a few times slower on these paths and the cores
+    // are shared, so REFUSAL_TIME (20 s) bounds it here. Each file is the worst of its
+    // kind that fits in 2 MB: what it makes is bounded by the default budget's 32 bytes
+    // per byte of file (at least 64 MiB).
+    let dir = temp_dir("i17-time");
+    let files: Vec<(&str, Vec<u8>, Result<&str, &str>)> = vec![
+        // 300,000 stacked cubes (1.8 million tetrahedra): within the bound, read.
+        (
+            "stacked.vtu",
+            mesh_hostile::stacked_hexahedra(300_000, mesh_hostile::CUBE),
+            Ok("tetrahedra: 1800000\n"),
+        ),
+        // 600,000: over it, refused from the piece's counts.
+        (
+            "stacked-more.vtu",
+            mesh_hostile::stacked_hexahedra(600_000, mesh_hostile::CUBE),
+            Err("decoding the piece's 8 points and 600000 cells needs about"),
+        ),
+        (
+            "plates.vtk",
+            mesh_hostile::stacked_plates(15_000, 1e-6),
+            Ok("tetrahedra: 90000\n"),
+        ),
+        (
+            "empty-data.msh",
+            mesh_hostile::empty_node_data(20_000, 20_000),
+            Err("making the 20000 $NodeData/$ElementData sections into arrays"),
+        ),
+        (
+            "no-cells.vtu",
+            mesh_hostile::inflating_points_without_volume(60_000_000, 0),
+            Err("the piece has no cells"),
+        ),
+        (
+            "points.vtu",
+            mesh_hostile::inflating_points(60_000_000, 1, 10),
+            Err("32 bytes per byte of the file"),
+        ),
+    ];
+    for (name, bytes, want) in &files {
+        assert!(bytes.len() < 2 << 20, "{name}: {} bytes", bytes.len());
+        let (out, took) = inspect_file(&dir, name, bytes, &[]);
+        let (stdout, stderr) = (
+            String::from_utf8_lossy(&out.stdout),
+            String::from_utf8_lossy(&out.stderr),
+        );
+        match want {
+            Ok(w) => assert!(stdout.contains(w), "{name}: {w:?} not in {stdout}{stderr}"),
+            Err(w) => assert!(stderr.contains(w), "{name}: {w:?} not in {stderr}"),
+        }
+        assert!(took < REFUSAL_TIME, "{name} took {took:?}");
+    }
+}

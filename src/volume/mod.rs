@@ -458,13 +458,21 @@ pub fn inspect(path: &Path) -> Result<String, VolumeError> {
             nifti_file::inspect(path)?
         ));
     }
-    let s = segy::read(path, &segy::ReadOptions::default())?;
-    Ok(format!(
-        "{}\n{}{}",
-        path.display(),
-        s.describe(),
-        describe(&s.volume)
-    ))
+    let bytes = read_file(path, u64::MAX)?;
+    match segy::parse(path, &bytes, &segy::ReadOptions::default()) {
+        Ok(s) => Ok(format!(
+            "{}\n{}{}",
+            path.display(),
+            s.describe(),
+            describe(&s.volume)
+        )),
+        // A pre-stack file cannot be gridded as one cube without a choice: describe its
+        // gathers and say how a scene makes that choice.
+        Err(e) => match segy::gathers(path, &bytes) {
+            Ok(g) if g.is_prestack() => Ok(format!("{}\n{}", path.display(), g.describe(path))),
+            _ => Err(e),
+        },
+    }
 }
 
 /// Dimensions and value statistics, one item per line.

@@ -9,15 +9,17 @@
 //! on a full rectangular grid, in any order, or the file is refused as pre-stack or
 //! irregular. The volume's axes are sample (i), crossline (j), inline (k).
 
+mod gathers;
 mod grid;
 mod source;
 mod write;
 
 use std::path::Path;
 
+pub use gathers::{gathers, Gathers};
 pub use grid::{Prestack, ReadOptions};
 pub use source::SegySource;
-pub use write::{write, WriteOptions};
+pub use write::{write, write_prestack, WriteOptions};
 
 use super::{read_file, Volume, VolumeError};
 
@@ -306,8 +308,15 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<SegyCube, VolumeError>
     parse(path, &bytes, options)
 }
 
-/// Parse SEG-Y bytes; `path` names the file in errors.
-pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCube, VolumeError> {
+/// What the textual and binary headers say, and where the traces are.
+struct Headers {
+    layout: grid::Layout,
+    revision: (u8, u8),
+    interval_us: u32,
+}
+
+/// Read the headers of SEG-Y bytes and find the traces (`path` names the file in errors).
+fn headers(path: &Path, bytes: &[u8]) -> Result<Headers, VolumeError> {
     let bin = TEXT_HEADER;
     if bytes.len() < TEXT_HEADER + BINARY_HEADER {
         return Err(VolumeError::format(
@@ -411,6 +420,20 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
         big,
         header_samples: declared_samples,
     };
+    Ok(Headers {
+        layout,
+        revision,
+        interval_us,
+    })
+}
+
+/// Parse SEG-Y bytes; `path` names the file in errors.
+pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCube, VolumeError> {
+    let Headers {
+        layout,
+        revision,
+        interval_us,
+    } = headers(path, bytes)?;
     let grid::Gridded {
         dims,
         values,
@@ -424,13 +447,13 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
     Ok(SegyCube {
         volume,
         revision,
-        format,
-        big_endian: big,
+        format: layout.format,
+        big_endian: layout.big,
         ebcdic: bytes[0] == 0xC3 || bytes[0] == 0x40,
         interval_us,
         inlines,
         crosslines,
-        traces,
+        traces: layout.traces,
         offsets,
     })
 }
@@ -575,18 +598,44 @@ mod tests {
     /// Two cubes as one pre-stack file: every cell holds a trace of offset 100 (from
     /// `a`) and one of offset 300 (from `b`), interleaved.
     fn prestack_file(a: &Volume, b: &Volume) -> Vec<u8> {
-        let o = options(SampleFormat::IeeeFloat);
-        let (fa, fb) = (write(a, &o), write(b, &o));
-        let trace = TRACE_HEADER + a.dims[0] * 4;
-        let mut out = fa[..3600].to_vec();
-        for t in 0..(fa.len() - 3600) / trace {
-            for (f, offset) in [(&fa, 100i32), (&fb, 300)] {
-                let mut tr = f[3600 + t * trace..][..trace].to_vec();
-                tr[36..40].copy_from_slice(&offset.to_be_bytes());
-                out.extend(tr);
-            }
+        write_prestack(&[(100, a), (300, b)], &options(SampleFormat::IeeeFloat))
+    }
+
+    #[test]
+    fn inspect_describes_a_prestack_file_and_how_a_scene_reads_it() {
+        let a = cube();
+        let mut b = cube();
+        b.values.iter_mut().for_each(|v| *v = *v * 3.0 + 1.0);
+        let dir = std::env::temp_dir().join(format!("arbvis-prestack-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("gathers.sgy");
+        std::fs::write(&path, prestack_file(&a, &b)).unwrap();
+        let g = gathers(&path, &std::fs::read(&path).unwrap()).unwrap();
+        assert!(g.is_prestack());
+        // The cube is 5 samples x 3 crosslines x 4 inlines: 12 gathers of 2 traces;
+        // values -20..=39 (a) and -59..=118 (b = 3a + 1).
+        assert_eq!((g.traces, g.gathers, g.per_gather), (24, 12, (2, 2)));
+        assert_eq!(g.offsets, [(100, 12), (300, 12)]);
+        assert_eq!((g.inlines, g.crosslines), ((1, 4), (1, 3)));
+        assert_eq!(g.range, Some((-59.0, 118.0)));
+        let s = crate::volume::inspect(&path).unwrap();
+        for want in [
+            "format: SEG-Y rev 1.0, pre-stack",
+            "traces: 24\n",
+            "gathers: 12 (inline/crossline positions, trace bytes 189-196), 2 traces each",
+            "offsets (trace bytes 37-40): 2 values: 100 (12 traces), 300 (12 traces)",
+            "samples: 5 per trace, interval 4000 us, 0..=16 ms",
+            "values: [-59, 118] over all traces",
+            "prestack = { offset = 100 }",
+            "prestack = \"stack\"",
+        ] {
+            assert!(s.contains(want), "missing {want:?} in\n{s}");
         }
-        out
+        // A post-stack file is still described as a cube.
+        std::fs::write(&path, write(&a, &options(SampleFormat::IeeeFloat))).unwrap();
+        let s = crate::volume::inspect(&path).unwrap();
+        assert!(s.contains("dimensions (i, j, k): 5 x 3 x 4"), "{s}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

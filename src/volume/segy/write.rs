@@ -69,3 +69,29 @@ pub fn write(volume: &Volume, o: &WriteOptions) -> Vec<u8> {
     }
     out
 }
+
+/// A pre-stack file: the volumes of `gathers` (each with its offset, all of one size)
+/// interleaved, so that every inline/crossline position holds one trace per offset, in
+/// the order given, with the offset in trace bytes 37-40 (nothing for no volume).
+pub fn write_prestack(gathers: &[(i32, &Volume)], o: &WriteOptions) -> Vec<u8> {
+    let Some((_, first)) = gathers.first() else {
+        return Vec::new();
+    };
+    let files: Vec<Vec<u8>> = gathers.iter().map(|(_, v)| write(v, o)).collect();
+    let head = TEXT_HEADER + BINARY_HEADER;
+    let trace = TRACE_HEADER + first.dims[0] * o.format.bytes();
+    let mut out = files[0][..head].to_vec();
+    for t in 0..(files[0].len() - head) / trace {
+        for (f, (offset, _)) in files.iter().zip(gathers) {
+            let mut tr = f[head + t * trace..][..trace].to_vec();
+            let b = if o.big_endian {
+                offset.to_be_bytes()
+            } else {
+                offset.to_le_bytes()
+            };
+            tr[36..40].copy_from_slice(&b);
+            out.extend(tr);
+        }
+    }
+    out
+}
