@@ -9,6 +9,14 @@ use std::path::Path;
 use super::header::{f64_at, text_at, u16_at, u32_at, u64_at, LasInfo, RawVlr, RECORD_LENGTH};
 use crate::points::{PointsError, MAX_POINTS};
 
+/// Points a LAZ file may declare whatever its size (about half a second to decode).
+pub(super) const LAZ_FREE_POINTS: u64 = 1_000_000;
+
+/// Further points a LAZ file may declare per byte of compressed data (with
+/// [`LAZ_FREE_POINTS`]: a file under 2 MB holds at most 5.2 million, decoded in about two
+/// seconds).
+pub(super) const LAZ_POINTS_PER_BYTE: u64 = 2;
+
 /// What the checks found in the header.
 pub(super) struct Checked {
     pub(super) info: LasInfo,
@@ -178,6 +186,24 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
     };
     if compressed {
         check_laz(name, b, &info, offset_to_points, &vlrs)?;
+        // Time: LAZ decodes about 2.5 million points a second here, and a stream of equal
+        // points packs 85 into a byte, so a 2 MB file could take a minute. Real lidar
+        // compresses to under one point per byte.
+        let data = (len - offset_to_points) as u64;
+        let most = LAZ_FREE_POINTS.saturating_add(LAZ_POINTS_PER_BYTE.saturating_mul(data));
+        if points > most {
+            return Err(fail(
+                count_at,
+                format!(
+                    "the header declares {points} points in {data} bytes of LAZ data ({:.0} a byte): \
+                     this reader decodes at most {LAZ_FREE_POINTS} points plus \
+                     {LAZ_POINTS_PER_BYTE} a byte ({most} here), so that a file is read or refused \
+                     in seconds (decoding takes about 0.4 µs a point; real lidar compresses to less \
+                     than one point a byte)",
+                    points as f64 / data.max(1) as f64
+                ),
+            ));
+        }
     } else {
         let need = points.checked_mul(record_length as u64);
         let have = (len - offset_to_points) as u64;

@@ -651,3 +651,47 @@ fn extreme_scales_and_offsets() {
         .describe()
         .contains("positions stored as f32 in [-1, 1]^3"));
 }
+
+/// A LAZ file of `n` equal points (format 3): about 85 points a compressed byte.
+pub(crate) fn equal_points(n: usize) -> Vec<u8> {
+    let mut b = Builder::from((1, 2));
+    b.point_format = Format::new(3).unwrap();
+    b.point_format.is_compressed = true;
+    let mut w = Writer::new(Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
+    let p = Point {
+        x: 1.0,
+        y: 2.0,
+        z: 3.0,
+        color: Some(Color::new(1, 2, 3)),
+        gps_time: Some(0.0),
+        ..Default::default()
+    };
+    for _ in 0..n {
+        w.write_point(p.clone()).unwrap();
+    }
+    w.close().unwrap();
+    w.into_inner().unwrap().into_inner()
+}
+
+#[test]
+fn laz_denser_than_two_points_a_byte_past_a_million_is_refused() {
+    // 1.1 million equal points in about 13 KB: past 1,000,000 + 2 a byte.
+    let dense = equal_points(1_100_000);
+    let data = dense.len() - u32_at(&dense, 96) as usize;
+    assert!(data < 20_000, "{data} bytes");
+    let e = error(&dense);
+    assert!(
+        e.starts_with(&format!(
+            "t.las: at byte 107: the header declares 1100000 points in {data} bytes of LAZ data"
+        )),
+        "{e}"
+    );
+    assert!(
+        e.contains(&format!("({} here)", 1_000_000 + 2 * data)),
+        "{e}"
+    );
+    // Within the bound the same stream is read.
+    let c = parse(name(), &equal_points(50_000)).unwrap();
+    assert_eq!(c.cloud.len(), 50_000);
+    assert_eq!(c.cloud.bounds, [[1.0, 2.0, 3.0], [1.0, 2.0, 3.0]]);
+}
