@@ -10,13 +10,17 @@
 //! ```
 //!
 //! spreads the time over the targets with fresh seeds and prints the cases per target.
+//! `ARBVIS_FUZZ_TARGETS=points-las,surface-stl` runs only the targets named (a comma list
+//! of names or prefixes: `points` runs every cloud target), in a plain run too.
 //! `ARBVIS_FUZZ_VERBOSE=1` prints each case before running it (to find the one that
 //! aborts), and `ARBVIS_FUZZ_CASE=TARGET:SEED:INDEX` replays one case.
 //!
 //! Allocation: a counting global allocator refuses any single allocation above
 //! [`ALLOCATION_CAP`] while a case runs, so a loader that sizes memory from a header
 //! without checking it against the input fails here (a `try_reserve` sees an error; an
-//! infallible allocation aborts the test with "memory allocation of N bytes failed").
+//! infallible allocation aborts the test with "memory allocation of N bytes failed"). The
+//! memory budget (`arbvis::budget`) is set to the same cap, so a loader that checks its
+//! estimate refuses before it asks.
 
 mod common;
 #[path = "../src/mesh/tests/fixtures.rs"]
@@ -544,7 +548,8 @@ fn loaders_and_scenes_survive_mutated_inputs() {
     if std::env::var_os("ARBVIS_FUZZ_CASE").is_none() {
         std::panic::set_hook(Box::new(|_| {}));
     }
-    let targets = targets();
+    arbvis::budget::set(ALLOCATION_CAP as u64);
+    let targets = selected(targets());
     let result = std::panic::catch_unwind(|| {
         if let Ok(case) = std::env::var("ARBVIS_FUZZ_CASE") {
             let mut parts = case.split(':');
@@ -597,6 +602,27 @@ fn loaders_and_scenes_survive_mutated_inputs() {
             .unwrap_or_default();
         panic!("{message}");
     }
+}
+
+/// The targets `ARBVIS_FUZZ_TARGETS` names (all when it is not set).
+fn selected(targets: Vec<Target>) -> Vec<Target> {
+    let Ok(list) = std::env::var("ARBVIS_FUZZ_TARGETS") else {
+        return targets;
+    };
+    let wanted: Vec<&str> = list
+        .split(',')
+        .map(str::trim)
+        .filter(|w| !w.is_empty())
+        .collect();
+    let chosen: Vec<Target> = targets
+        .into_iter()
+        .filter(|t| wanted.iter().any(|w| t.name.starts_with(w)))
+        .collect();
+    assert!(
+        !chosen.is_empty(),
+        "ARBVIS_FUZZ_TARGETS={list:?} names no target"
+    );
+    chosen
 }
 
 #[test]
