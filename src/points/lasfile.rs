@@ -23,10 +23,11 @@
 //! Memory and time: the header's count, times what each point costs once loaded
 //! ([`super::footprint`] and an f64 per extra-bytes value), plus the file and one batch of
 //! records, is checked against [`crate::budget`] before anything is decoded; the columns
-//! are then reserved once. A LAZ file may declare at most 1,000,000 points plus 2 per byte
-//! of compressed data: LAZ decodes about 2.5 million points a second here and a stream of
-//! equal points (legal) packs 85 into a byte, so without that a 2 MB file could take a
-//! minute; real lidar compresses to less than a point a byte. Points are decoded in
+//! are then reserved once. A LAZ file may declare at most 1,000,000 points plus 1 per byte
+//! of compressed data, each extra-bytes attribute counting a third of a point (see
+//! `check::laz_bound`): LAZ decodes about 2.5 million points a second here and a stream
+//! of equal points (legal) packs 85 into a byte, so without it a 2 MB file could take
+//! minutes; real lidar compresses to less than a point a byte. Points are decoded in
 //! batches of at most 65,536 points and 16 MiB of records, and a decoder error names the
 //! batch.
 //! `laz` panics on some corrupt compressed streams; those calls run under
@@ -41,7 +42,7 @@ mod check;
 mod extra;
 mod header;
 
-use check::check;
+use check::{check, laz_bound};
 use extra::{decode_extra, extra_bytes, extra_type_size, Extra};
 pub use header::LasInfo;
 use header::RECORD_LENGTH;
@@ -88,6 +89,7 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
     let record = info.record_length as usize;
     let extras = extra_bytes(name, &bytes, &checked.vlrs, base, record)?;
     info.extra_bytes = extras.iter().map(|e| e.name.clone()).collect();
+    laz_bound(name, &bytes, &info, checked.count_at, extras.len())?;
     let count = info.points;
     let decode_error = |what: String| PointsError::Decode {
         path: name.to_path_buf(),

@@ -673,9 +673,40 @@ pub(crate) fn equal_points(n: usize) -> Vec<u8> {
     w.into_inner().unwrap().into_inner()
 }
 
+/// A LAZ 1.4 file (format 6) of `n` equal points with `extras` one-byte attributes.
+fn equal_points_with_extras(n: usize, extras: usize) -> Vec<u8> {
+    let mut b = Builder::default();
+    b.version = (1, 4).into();
+    b.point_format = Format::new(6).unwrap();
+    b.point_format.is_compressed = true;
+    b.point_format.extra_bytes = extras as u16;
+    b.vlrs.push(Vlr {
+        user_id: "LASF_Spec".into(),
+        record_id: 4,
+        description: "extra bytes".into(),
+        data: (0..extras)
+            .flat_map(|k| descriptor(1, 0, &format!("e{k}"), [0; 8], 0.0, 0.0))
+            .collect(),
+    });
+    let mut w = Writer::new(Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
+    for _ in 0..n {
+        w.write_point(Point {
+            x: 1.0,
+            y: 2.0,
+            z: 3.0,
+            gps_time: Some(0.0),
+            extra_bytes: vec![9; extras],
+            ..Default::default()
+        })
+        .unwrap();
+    }
+    w.close().unwrap();
+    w.into_inner().unwrap().into_inner()
+}
+
 #[test]
-fn laz_denser_than_two_points_a_byte_past_a_million_is_refused() {
-    // 1.1 million equal points in about 13 KB: past 1,000,000 + 2 a byte.
+fn laz_denser_than_a_point_a_byte_past_a_million_is_refused() {
+    // 1.1 million equal points in about 13 KB: past 1,000,000 + 1 a byte.
     let dense = equal_points(1_100_000);
     let data = dense.len() - u32_at(&dense, 96) as usize;
     assert!(data < 20_000, "{data} bytes");
@@ -686,8 +717,24 @@ fn laz_denser_than_two_points_a_byte_past_a_million_is_refused() {
         )),
         "{e}"
     );
+    assert!(e.contains(&format!("({} here)", 1_000_000 + data)), "{e}");
+    // Extra-bytes attributes count a third of a point each: with 6 of them, 700,000 points
+    // cost as much as 2.1 million plain ones.
+    let b = equal_points_with_extras(700_000, 6);
+    let data = b.len() - u32_at(&b, 96) as usize;
+    let allowed = 1_000_000 + data;
     assert!(
-        e.contains(&format!("({} here)", 1_000_000 + 2 * data)),
+        700_000 <= allowed && 700_000 * 9 > 3 * allowed,
+        "{data} bytes"
+    );
+    let e = error(&b);
+    assert!(
+        e.contains(&format!(
+            "700000 points with 6 extra-bytes attributes in {data} bytes of LAZ data"
+        )) && e.contains(&format!(
+            "({allowed} here, {} with 6 attributes",
+            allowed * 3 / 9
+        )),
         "{e}"
     );
     // Within the bound the same stream is read.
