@@ -10,6 +10,8 @@
 //! ```
 //!
 //! spreads the time over the targets with fresh seeds and prints the cases per target.
+//! `ARBVIS_FUZZ_TARGETS=points-las,surface-stl` runs only the targets named (a comma list
+//! of names or prefixes: `points` runs every cloud target), in a plain run too.
 //! `ARBVIS_FUZZ_VERBOSE=1` prints each case before running it (to find the one that
 //! aborts), and `ARBVIS_FUZZ_CASE=TARGET:SEED:INDEX` replays one case.
 //!
@@ -595,17 +597,29 @@ fn targets() -> Vec<Target> {
             text: true,
             sections: false,
             corpus: obj_corpus(),
-            run: |b| {
-                let _ = arbvis::surface::parse(Path::new("fuzz.obj"), b);
-            },
+            run: |b| surface(b, "fuzz.obj"),
         },
         Target {
             name: "surface-stl",
             text: false,
             sections: false,
             corpus: stl_corpus(),
+            run: |b| surface(b, "fuzz.stl"),
+        },
+        Target {
+            name: "surface-ply",
+            text: false,
+            sections: false,
+            corpus: ply_corpus(),
+            run: |b| surface(b, "fuzz.ply"),
+        },
+        Target {
+            name: "points-laz",
+            text: false,
+            sections: false,
+            corpus: laz_corpus(),
             run: |b| {
-                let _ = arbvis::surface::parse(Path::new("fuzz.stl"), b);
+                let _ = arbvis::points::lasfile::parse(Path::new("fuzz.laz"), b);
             },
         },
         Target {
@@ -902,4 +916,170 @@ fn issue17_reordering_moves_whole_sections() {
         }
         assert!(changed > 20, "{name}: {changed} of 40 reorders changed it");
     }
+}
+
+// --- issue 17: clouds and surfaces ---
+
+/// A surface target: parse, then inspect what parsed (edges, volume, the bounded
+/// self-intersection search), as `arbvis inspect` does.
+fn surface(bytes: &[u8], name: &str) {
+    if let Ok(mesh) = arbvis::surface::parse(Path::new(name), bytes) {
+        let _ = arbvis::surface::inspect(&mesh);
+    }
+}
+
+/// LAZ and LAS 1.4 files for `points-laz`: compressed 1.2 and 1.4, with and without
+/// extra bytes, and a stream of equal points (85 a compressed byte).
+fn laz_corpus() -> Vec<Vec<u8>> {
+    vec![
+        common::hostile_files::las14(30, 3, true),
+        common::hostile_files::las14(12, 0, true),
+        common::hostile_files::las14(9, 2, false),
+        common::hostile_files::equal_points_laz(2_000),
+    ]
+}
+
+/// Run `f` as a fuzz case runs (allocation and live caps, time bound), naming `what` on
+/// failure.
+fn reproduce<T>(what: &str, f: impl FnOnce() -> T) -> Result<T, String> {
+    let mut value = None;
+    let run = capped(|| value = Some(f()));
+    if let Some(panic) = run.panic {
+        return Err(format!("{what}: panicked: {panic}"));
+    }
+    if run.elapsed >= CASE_TIME {
+        return Err(format!("{what}: took {:?} (bound {CASE_TIME:?})", run.elapsed));
+    }
+    if run.peak_request > ALLOCATION_CAP || run.peak_live > LIVE_CAP as isize {
+        return Err(format!(
+            "{what}: asked for {} bytes at once, held {}",
+            run.peak_request, run.peak_live
+        ));
+    }
+    value.ok_or_else(|| format!("{what}: no value"))
+}
+
+/// `result` must be an error whose message contains every one of `parts`.
+fn refused<T, E: std::fmt::Display>(
+    what: &str,
+    result: Result<T, E>,
+    parts: &[&str],
+) -> Result<(), String> {
+    let message = match result {
+        Ok(_) => return Err(format!("{what}: accepted")),
+        Err(e) => e.to_string(),
+    };
+    match parts.iter().find(|p| !message.contains(*p)) {
+        Some(p) => Err(format!("{what}: expected {p:?} in: {message}")),
+        None => Ok(()),
+    }
+}
+
+/// Each class of issue 17 that clouds and surfaces had, as a fixed case under the fuzz
+/// harness's bounds. (A `Result`, not panics: the fuzz test silences the panic hook.)
+#[test]
+fn issue_17_cloud_and_surface_reproducers() -> Result<(), String> {
+    use arbvis::points::{lasfile, plycloud};
+    use arbvis::surface;
+    use common::hostile_files::*;
+    arbvis::budget::set(ALLOCATION_CAP as u64);
+    // Amplification: an OBJ face of 1.6 million corners (3.2 MB of text) is estimated at
+    // about 330 MB while read: over the 256 MiB budget, refused at the face's line.
+    let fan = format!(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf {}\n",
+        "1 2 3 ".repeat(540_000)
+    );
+    let r = reproduce("big face", || {
+        surface::parse(Path::new("f.obj"), fan.as_bytes())
+    })?;
+    refused(
+        "big face",
+        r,
+        &[
+            "f.obj: line 4, column 1: reading 3 vertices and 1 faces of 1620000 corners",
+            "memory budget",
+        ],
+    )?;
+    // Time: a small LAZ whose 250,000 points carry 120 extra bytes (a third of a point
+    // each): past the LAZ bound.
+    let extras = las14(250_000, 120, true);
+    if extras.len() > 1 << 20 {
+        return Err(format!("the extra-bytes LAZ is {} bytes", extras.len()));
+    }
+    let r = reproduce("extra bytes LAZ", || {
+        lasfile::parse(Path::new("x.laz"), &extras)
+    })?;
+    refused(
+        "extra bytes LAZ",
+        r,
+        &["x.laz: at byte 107: the header declares 250000 points with 120 extra-bytes attributes"],
+    )?;
+    // Time: equal points past 1,000,000 + 1 a compressed byte.
+    let dense = equal_points_laz(1_200_000);
+    let r = reproduce("dense LAZ", || lasfile::parse(Path::new("d.laz"), &dense))?;
+    refused(
+        "dense LAZ",
+        r,
+        &["d.laz: at byte 107: the header declares 1200000 points"],
+    )?;
+    // Time: 2,400 copies of one face (2.9 million pairs, each tested): the search stops.
+    let copies = binary_stl(&face_copies(2_400));
+    let report = reproduce("face copies", || {
+        surface::parse(Path::new("c.stl"), &copies).map(|m| surface::inspect(&m))
+    })?
+    .map_err(|e| e.to_string())?;
+    if report.self_intersection_search_complete
+        || report.self_intersection_work > surface::topology::MAX_WORK + 64
+    {
+        return Err(format!("face copies: {report}"));
+    }
+    // Time: one ASCII STL line of 12,000 facets (1 MB), linear.
+    let line = one_line_ascii_stl(12_000);
+    let mesh = reproduce("one long line", || {
+        surface::parse(Path::new("l.stl"), line.as_bytes())
+    })?
+    .map_err(|e| e.to_string())?;
+    if mesh.triangles.len() != 12_000 {
+        return Err(format!("one long line: {} triangles", mesh.triangles.len()));
+    }
+    // Messages: a two-corner OBJ face among good ones; a LAS version; a 2^63 count; a
+    // PLY coordinate declared as a list.
+    let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2\n";
+    let r = reproduce("two corners", || surface::parse(Path::new("t.obj"), obj))?;
+    refused(
+        "two corners",
+        r,
+        &["t.obj: line 5, column 1: a face with 2 corners"],
+    )?;
+    let mut las = las14(4, 0, false);
+    las[25] = 7;
+    let r = reproduce("LAS version", || lasfile::parse(Path::new("v.las"), &las))?;
+    refused("LAS version", r, &["v.las: at byte 24: LAS version 1.7"])?;
+    let mut las = las14(4, 0, false);
+    set(&mut las, 107, &0u32.to_le_bytes());
+    set(&mut las, 247, &(1u64 << 63).to_le_bytes());
+    let r = reproduce("2^63 points", || lasfile::parse(Path::new("n.las"), &las))?;
+    refused(
+        "2^63 points",
+        r,
+        &["n.las: at byte 247: the header declares 9223372036854775808"],
+    )?;
+    let ply = b"ply\nformat ascii 1.0\nelement vertex 1\nproperty list uchar float x\nproperty float y\nproperty float z\nend_header\n1 0 0 0\n";
+    let r = reproduce("list coordinate", || {
+        plycloud::parse(Path::new("l.ply"), ply)
+    })?;
+    refused(
+        "list coordinate",
+        r,
+        &["l.ply: line 4, column 27: vertex property \"x\""],
+    )?;
+    // Extreme numbers: a cloud at ±1.7e308 is stored in [-1, 1]³, finite.
+    let ply = b"ply\nformat ascii 1.0\nelement vertex 2\nproperty double x\nproperty double y\nproperty double z\nend_header\n1.7e308 -1.7e308 0\n-1.7e308 1.7e308 1\n";
+    let cloud = reproduce("huge cloud", || plycloud::parse(Path::new("h.ply"), ply))?
+        .map_err(|e| e.to_string())?
+        .cloud;
+    if !cloud.positions.iter().flatten().all(|v| v.abs() <= 1.0) {
+        return Err(format!("huge cloud: {:?}", cloud.positions));
+    }
+    Ok(())
 }

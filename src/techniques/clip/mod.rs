@@ -54,6 +54,7 @@
 //! the ratio falls as 1/N: 0.140 at 384³, 0.114 at 512³.
 
 mod error;
+pub mod fast_winding;
 pub mod grid;
 pub mod mask_field;
 pub mod mesh_field;
@@ -306,13 +307,15 @@ impl ShapeSpec {
                 scale,
                 rotation,
             } => {
-                let mesh = crate::surface::read(&base.join(path))?;
-                Shape::Mesh(Box::new(mesh_field::MeshShape::new(
+                let file = base.join(path);
+                let mesh = crate::surface::read(&file)?;
+                Shape::Mesh(Box::new(mesh_field::MeshShape::placed(
+                    &file,
                     &mesh,
                     v(*position),
                     DVec3::splat(*scale),
                     rotation_from_degrees(*rotation),
-                )))
+                )?))
             }
             ShapeSpec::TorusMesh {
                 center,
