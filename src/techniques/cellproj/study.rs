@@ -78,6 +78,8 @@ fn scene_for(points: usize, exit: Exit, active_only: bool) -> CellprojScene {
             field: Field::Spherical,
         }),
         scalars: ScalarSpec::default(),
+        mode: Default::default(),
+        volume: None,
         isovalues: seed_isovalues(),
         exit,
         table_size: 256,
