@@ -16,20 +16,9 @@
 //!   O(points crossed) per texel.
 
 use rayon::prelude::*;
-use serde::{Deserialize, Serialize};
 
+pub use super::transfer::Build;
 use super::transfer::Transfer;
-
-/// How the table is built.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Build {
-    /// Integral functions (Engel et al. 2001).
-    #[default]
-    Engel,
-    /// The exact segment integral at every texel.
-    Exact,
-}
 
 /// `∫0^s tau` and `∫0^s c tau` of a piecewise-linear transfer function, exact.
 struct Integrals<'a> {

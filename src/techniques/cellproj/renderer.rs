@@ -5,8 +5,6 @@
 
 use std::path::Path;
 
-use glam::DVec3;
-
 use super::prepare::{iso_list, iso_table, prepare, Prepared, Viewer, VERTEX_COMPONENTS};
 use super::{CellprojScene, Depth, Exit, Order};
 use crate::camera::Projection;
@@ -98,22 +96,7 @@ pub fn program_pair(variant: Variant, kind: ProgramKind) -> GlResult<ProgramPair
     })
 }
 
-/// The eye in object space (perspective) and the unit view direction (both cameras).
-pub fn eye_and_direction(frame: &Frame) -> (DVec3, DVec3) {
-    let inverse = frame.camera.view().inverse();
-    let eye = inverse.transform_point3(DVec3::ZERO);
-    let dir = inverse.transform_vector3(DVec3::NEG_Z).normalize();
-    (eye, dir)
-}
-
-/// The viewer of a frame, in object space (what [`Order::View`] sorts and culls for).
-pub fn viewer(frame: &Frame) -> Viewer {
-    let (eye, dir) = eye_and_direction(frame);
-    match frame.camera.projection {
-        Projection::Orthographic => Viewer::Parallel(dir),
-        Projection::Perspective => Viewer::Eye(eye),
-    }
-}
+pub use super::volume::{eye_and_direction, viewer};
 
 /// The cell-projection renderer.
 pub struct CellprojRenderer {

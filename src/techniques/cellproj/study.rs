@@ -4,6 +4,8 @@
 //! precise; each setting scored against the f64 reference (fraction of interior pixels
 //! with the right isovalue colour).
 
+pub mod volume;
+
 use crate::study::median;
 use crate::techniques::Params;
 use std::time::Instant;

@@ -58,11 +58,22 @@ pub struct VolumeSpec {
     pub table_size: [u32; 2],
     /// How that table is built.
     #[serde(default)]
-    pub build: super::preint::Build,
+    pub build: Build,
     /// Precise mode: entries into the mesh followed along a ray (0: 1 for a convex
     /// boundary, 4 otherwise).
     #[serde(default)]
     pub entries: u32,
+}
+
+/// How the table is built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Build {
+    /// Integral functions (Engel et al. 2001).
+    #[default]
+    Engel,
+    /// The exact segment integral at every texel.
+    Exact,
 }
 
 /// Faithful mode's visibility order.

@@ -22,7 +22,6 @@ use rayon::prelude::*;
 use super::order::{boundary_is_convex, centroid_order, mpvonc_order, neighbours, BOUNDARY};
 use super::preint;
 use super::prepare::{gradient, normal, Prepared, Viewer, FACES, VERTEX_COMPONENTS};
-use super::renderer::{eye_and_direction, viewer};
 use super::transfer::{Sort, Transfer, VolumeSpec};
 use crate::camera::Projection;
 use crate::gl::ProgramText;
@@ -527,6 +526,23 @@ impl VolumeRenderer {
                 ..DrawCall::new(&p.walk, &p.quad)
             },
         )
+    }
+}
+
+/// The eye in object space (perspective) and the unit view direction (both cameras).
+pub fn eye_and_direction(frame: &Frame) -> (DVec3, DVec3) {
+    let inverse = frame.camera.view().inverse();
+    let eye = inverse.transform_point3(DVec3::ZERO);
+    let dir = inverse.transform_vector3(DVec3::NEG_Z).normalize();
+    (eye, dir)
+}
+
+/// The viewer of a frame, in object space (what [`Order::View`] sorts and culls for).
+pub fn viewer(frame: &Frame) -> Viewer {
+    let (eye, dir) = eye_and_direction(frame);
+    match frame.camera.projection {
+        Projection::Orthographic => Viewer::Parallel(dir),
+        Projection::Perspective => Viewer::Eye(eye),
     }
 }
 
