@@ -21,7 +21,6 @@
 // eye tetrahedron or -1); [6]: (entry layers, 1 / unit distance, most steps, 0).
 uniform sampler2D texture0;
 uniform usampler2D texture1;
-uniform sampler2D texture2;
 uniform sampler2D texture3;
 uniform sampler2D texture4;
 uniform sampler2D texture5;
@@ -41,75 +40,9 @@ ivec2 at(int k) {
     return ivec2(k % ROW, k / ROW);
 }
 
-vec4 acc = vec4(0.0);
-bool done = false;
 vec3 ray_o;
 vec3 ray_d;
 float ray_end;
-int points;
-float inv_unit;
-
-float tf_s(int k) {
-    return texelFetch(texture2, ivec2(k, 1), 0).r;
-}
-
-vec4 tf_c(int k) {
-    return texelFetch(texture2, ivec2(k, 0), 0);
-}
-
-// Number of control points at or below s (<= when `inclusive`, else < s).
-int count_below(float s, bool inclusive) {
-    int lo = 0;
-    int hi = points;
-    while (lo < hi) {
-        int mid = (lo + hi) / 2;
-        float x = tf_s(mid);
-        if (inclusive ? x <= s : x < s) lo = mid + 1; else hi = mid;
-    }
-    return lo;
-}
-
-vec4 tf_at(float s) {
-    int k = count_below(s, true);
-    if (k == 0) return tf_c(0);
-    if (k >= points) return tf_c(points - 1);
-    float x0 = tf_s(k - 1);
-    float x1 = tf_s(k);
-    float w = x1 > x0 ? (s - x0) / (x1 - x0) : 1.0;
-    return mix(tf_c(k - 1), tf_c(k), w);
-}
-
-void composite(vec4 c) {
-    acc += (1.0 - acc.a) * c;
-}
-
-// The segment from scalar sf to sb over `len` object units, cut at control points.
-void integrate(float sf, float sb, float len) {
-    vec4 front = tf_at(sf);
-    float u = 0.0;
-    if (sb > sf) {
-        for (int k = count_below(sf, true); k < points && !done; k++) {
-            float x = tf_s(k);
-            if (x >= sb) break;
-            float v = (x - sf) / (sb - sf);
-            vec4 back = tf_c(k);
-            composite(piece(front, back, (v - u) * len, inv_unit));
-            front = back;
-            u = v;
-        }
-    } else if (sb < sf) {
-        for (int k = count_below(sf, false) - 1; k >= 0 && !done; k--) {
-            float x = tf_s(k);
-            if (x <= sb) break;
-            float v = (x - sf) / (sb - sf);
-            vec4 back = tf_c(k);
-            composite(piece(front, back, (v - u) * len, inv_unit));
-            front = back;
-            u = v;
-        }
-    }
-    composite(piece(front, tf_at(sb), (1.0 - u) * len, inv_unit));
-}
 
 // The segment [a, b] of the ray in a tetrahedron whose scalar is G.p + s0.
 void segment(vec4 scalar, float a, float b) {

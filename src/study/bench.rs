@@ -68,8 +68,9 @@ pub struct BenchOptions {
     /// 2D fetch (fill rate), the 3D fetch, dependent table fetches, RGBA8 / RGBA32F.
     #[arg(long)]
     pub breakdown: bool,
-    /// Cell-projection volume settings, e.g. centroid:64,mpvonc:128,precise (faithful
-    /// with a table of N x N x N/2 texels, or the precise walk).
+    /// Cell-projection volume settings, e.g. centroid:64,mpvonc:128,precise,projected
+    /// (faithful with a table of N x N x N/2 texels, the precise walk, or precise as a
+    /// projection in MPVONC order with the exact integral per fragment).
     #[arg(long, value_delimiter = ',')]
     pub cellproj: Vec<String>,
     /// Turn the camera this many degrees about the vertical axis before every frame,
@@ -275,7 +276,11 @@ fn cellproj_settings(
         let mut volume = c.volume_spec();
         let (kind, size) = name.split_once(':').unwrap_or((name.as_str(), ""));
         match kind {
-            "precise" => s.fidelity = Fidelity::Precise,
+            "precise" | "walk" => s.fidelity = Fidelity::Precise,
+            "projected" => {
+                s.fidelity = Fidelity::Precise;
+                volume.precise = crate::techniques::cellproj::transfer::Precise::Projected;
+            }
             "centroid" | "mpvonc" => {
                 s.fidelity = Fidelity::Faithful;
                 volume.sort = if kind == "centroid" {
@@ -288,7 +293,7 @@ fn cellproj_settings(
                     .with_context(|| format!("--cellproj {name}: the table size after ':'"))?;
                 volume.table_size = [n, (n / 2).max(2)];
             }
-            _ => bail!("--cellproj {name}: centroid:N, mpvonc:N or precise"),
+            _ => bail!("--cellproj {name}: centroid:N, mpvonc:N, precise (the walk) or projected"),
         }
         c.volume = Some(volume);
         c.validate()

@@ -336,8 +336,9 @@ impl CellprojRenderer {
 impl Renderer for CellprojRenderer {
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
         // Precise scenes drawing both find the isosurfaces in the volume's walk.
-        let both_in_walk =
-            self.fidelity == Fidelity::Precise && self.params.mode == super::Mode::Both;
+        let both_in_walk = self.fidelity == Fidelity::Precise
+            && self.params.mode == super::Mode::Both
+            && self.params.volume_spec().precise == super::transfer::Precise::Walk;
         if !self.params.mode.isosurfaces() || both_in_walk {
             return self.draw_volume(gpu, surface, frame);
         }

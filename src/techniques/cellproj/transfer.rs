@@ -63,6 +63,21 @@ pub struct VolumeSpec {
     /// boundary, 4 otherwise).
     #[serde(default)]
     pub entries: u32,
+    /// Precise mode's method.
+    #[serde(default)]
+    pub precise: Precise,
+}
+
+/// How precise mode draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Precise {
+    /// The neighbour walk: exact order for any mesh and view, camera inside included.
+    #[default]
+    Walk,
+    /// The faithful projection (MPVONC order) with the exact integral per fragment into a
+    /// float target: exact where the order is.
+    Projected,
 }
 
 /// How the table is built.
@@ -117,6 +132,7 @@ impl Default for VolumeSpec {
             table_size: default_table(),
             build: Default::default(),
             entries: 0,
+            precise: Precise::Walk,
         }
     }
 }

@@ -78,8 +78,9 @@ pub fn with_integral(fragment: &ProgramText) -> ProgramText {
     }
 }
 
-/// The precise pairs: entry layers, and the walk (with the integral joined).
-pub fn precise_pairs() -> [ProgramPair; 2] {
+/// The precise pairs: entry layers, the walk, and the projected variant (the integral
+/// joined to the last two).
+pub fn precise_pairs() -> [ProgramPair; 3] {
     use programs::*;
     [
         ProgramPair {
@@ -92,13 +93,22 @@ pub fn precise_pairs() -> [ProgramPair; 2] {
             vertex: TRANSFORM_VERT,
             fragment: with_integral(&CELLPROJ_VOLUME_WALK_FRAG),
         },
+        ProgramPair {
+            kind: ProgramKind::Glsl,
+            vertex: CELLPROJ_PRECISE_VERT,
+            fragment: with_integral(&CELLPROJ_VOLUME_PROJECTED_FRAG),
+        },
     ]
 }
 
 struct Faithful {
     program: Program,
     faces: Mesh,
+    /// The pre-integrated table (unit 0), or for the projected precise variant the
+    /// transfer function (unit 2).
     table: Texture,
+    /// Precise projected: exact integral per fragment.
+    exact: bool,
     /// `(sf, sb, length)` to texture coordinates: scale and offset.
     map: [[f64; 4]; 2],
     built_for: Option<Viewer>,
@@ -194,6 +204,9 @@ impl VolumeRenderer {
         };
         match fidelity {
             Fidelity::Faithful => r.faithful = Some(r.build_faithful(gpu, kind, prepared)?),
+            Fidelity::Precise if spec.precise == super::transfer::Precise::Projected => {
+                r.faithful = Some(r.build_projected(gpu, prepared)?)
+            }
             Fidelity::Precise => r.precise = Some(r.build_precise(gpu, prepared, isovalues)?),
         }
         Ok(r)
@@ -224,7 +237,36 @@ impl VolumeRenderer {
             program,
             faces,
             table,
+            exact: false,
             map,
+            built_for: None,
+        })
+    }
+
+    fn build_projected(&self, gpu: &Gpu, prepared: &Prepared) -> GlResult<Faithful> {
+        let pair = &precise_pairs()[2];
+        let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
+        let faces = Mesh::new(
+            gpu,
+            "cellproj volume faces (4 per tetrahedron)",
+            &VERTEX_COMPONENTS,
+            &prepared.face_vertices(),
+        )?;
+        let tf_data = tf_texels(&self.transfer);
+        let table = Texture::new(
+            gpu,
+            "cellproj volume transfer function",
+            Extent::D2(self.transfer.s.len() as u32, 2),
+            TexelFormat::Rgba32f,
+            Filter::Nearest,
+            TexelData::F32(&tf_data),
+        )?;
+        Ok(Faithful {
+            program,
+            faces,
+            table,
+            exact: true,
+            map: [[0.0; 4]; 2],
             built_for: None,
         })
     }
@@ -235,7 +277,7 @@ impl VolumeRenderer {
         prepared: &Prepared,
         isovalues: &[super::Isovalue],
     ) -> GlResult<Precise> {
-        let [peel, walk] = precise_pairs();
+        let [peel, walk, _] = precise_pairs();
         let peel = Program::new(gpu, peel.kind, &peel.vertex, &peel.fragment)?;
         let walk = Program::new(gpu, walk.kind, &walk.vertex, &walk.fragment)?;
         walk.set_transform(gpu, glam::DMat4::IDENTITY)?;
@@ -410,21 +452,28 @@ impl VolumeRenderer {
         let f = self.faithful.as_ref().expect("faithful");
         let mvp = frame.camera.view_projection(frame.aspect());
         let (eye, dir) = eye_and_direction(frame);
-        let eye = if frame.camera.projection == Projection::Perspective {
-            eye
-        } else {
-            -dir * 1.0e6
-        };
+        let perspective = frame.camera.projection == Projection::Perspective;
         f.program.set_transform(gpu, mvp)?;
-        f.program
-            .set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, 1.0])?;
-        f.program.set_local(gpu, 0, f.map[0])?;
-        f.program.set_local(gpu, 1, f.map[1])?;
+        if f.exact {
+            let w = if perspective { 1.0 } else { 0.0 };
+            f.program.set_local(gpu, 4, [eye.x, eye.y, eye.z, w])?;
+            f.program.set_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
+            let points = self.transfer.s.len() as f64;
+            f.program
+                .set_local(gpu, 6, [points, 1.0 / self.transfer.unit, 0.0, 0.0])?;
+        } else {
+            let eye = if perspective { eye } else { -dir * 1.0e6 };
+            f.program
+                .set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, 1.0])?;
+            f.program.set_local(gpu, 0, f.map[0])?;
+            f.program.set_local(gpu, 1, f.map[1])?;
+        }
+        let unit = if f.exact { 2 } else { 0 };
         gl::draw(
             gpu,
             surface,
             &DrawCall {
-                textures: &[(0, &f.table)],
+                textures: &[(unit, &f.table)],
                 blend: Blend::PremultipliedOver,
                 depth_test,
                 cull_back: true,

@@ -140,6 +140,13 @@ pub fn run(
                 }
             }
             settings.push(("precise walk".into(), Fidelity::Precise, base.clone()));
+            let mut projected = base.clone();
+            projected.precise = super::super::transfer::Precise::Projected;
+            settings.push((
+                "precise projected (mpvonc)".into(),
+                Fidelity::Precise,
+                projected,
+            ));
             for (name, fidelity, volume) in settings {
                 let mut scene = case.scene.clone();
                 scene.mode = super::super::Mode::Volume;
