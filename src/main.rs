@@ -102,6 +102,10 @@ enum Command {
         /// 24,576 tetrahedra; 56: about a million).
         #[arg(long, value_delimiter = ',', default_values_t = [17, 25, 33, 45, 56])]
         grids: Vec<usize>,
+        /// Cell projection's volume: cell-projection scenes whose meshes and transfer
+        /// functions to add to the grids.
+        #[arg(long, value_delimiter = ',')]
+        scenes: Vec<PathBuf>,
         /// Clipping: clip grid sides of the texture sweep.
         #[arg(long, value_delimiter = ',', default_values_t = [256, 512])]
         clip_sizes: Vec<usize>,
@@ -194,6 +198,30 @@ fn write_study<const N: usize>(out: &Path, files: [(&str, String); N]) -> Result
     Ok(())
 }
 
+/// A volume study case from a cell-projection scene (its camera, mesh and transfer
+/// function).
+fn volume_case(
+    name: &str,
+    scene: &Scene,
+) -> Result<arbvis::techniques::cellproj::study::volume::Case> {
+    let arbvis::scene::TechniqueScene::Cellproj(c) = &scene.technique else {
+        bail!("{name}: not a cell-projection scene");
+    };
+    let prepared = arbvis::techniques::cellproj::prepare::prepare(c, &scene.base)
+        .map_err(anyhow::Error::msg)?;
+    let camera = if scene.camera == arbvis::camera::Camera::default() {
+        arbvis::techniques::cellproj::study::study_camera(arbvis::camera::Projection::Orthographic)
+    } else {
+        scene.camera
+    };
+    Ok(arbvis::techniques::cellproj::study::volume::Case {
+        name: name.to_string(),
+        scene: (**c).clone(),
+        prepared,
+        camera,
+    })
+}
+
 /// Techniques with a trade study.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum StudyTechnique {
@@ -202,6 +230,10 @@ enum StudyTechnique {
     /// Cell projection: mesh sizes, exit per vertex / per fragment, faithful / precise,
     /// mesh / view order, isovalue-edit latency.
     Cellproj,
+    /// Cell projection's volume: faithful (both sorts, table sizes) and precise, still
+    /// and turning, ortho and perspective, against the f64 reference, on the `--grids`
+    /// meshes and any `--scenes` (e.g. scenes/data/bracket-volume.toml).
+    CellprojVolume,
     /// Volume clipping: clip grid sizes, shapes and block sizes (bytes, ratio, build
     /// time), and frame times with no clip, the single texture and INDEX-DATA.
     Clip,
@@ -517,6 +549,43 @@ fn run(cli: Cli) -> Result<()> {
                 &out,
                 [("clip-textures.csv", textures), ("clip-frames.csv", times)],
             )?;
+        }
+        Command::Study {
+            sweep,
+            technique: StudyTechnique::CellprojVolume,
+            grids,
+            scenes,
+            out,
+            ..
+        } => {
+            use arbvis::techniques::cellproj::study::volume;
+            let headless = Headless::new(sweep.backend)?;
+            let mut cases = Vec::new();
+            for &n in &grids {
+                if !(2..=128).contains(&n) {
+                    bail!("--grids: each must be 2..=128 points per side");
+                }
+                let scene = Scene::parse(
+                    &format!(
+                        "[technique.cellproj]\nmesh = {{ grid = {{ points = [{n}, {n}, {n}], field = \"spherical\" }} }}\nmode = \"volume\"\n[technique.cellproj.volume]\npoints = [[0.0, 0.1, 0.2, 0.9, 0.0], [0.45, 0.2, 0.6, 0.8, 0.3], [0.5, 1.0, 0.9, 0.2, 1.0], [0.55, 0.9, 0.3, 0.1, 0.3], [1.0, 0.8, 0.1, 0.1, 0.6]]\nunit_distance = 0.25\n"
+                    ),
+                    "grid",
+                )?;
+                cases.push(volume_case(&format!("grid{n}"), &scene)?);
+            }
+            for path in &scenes {
+                let scene = Scene::load(path)?;
+                let name = path
+                    .file_stem()
+                    .map_or("scene".into(), |s| s.to_string_lossy().to_string());
+                cases.push(volume_case(&name, &scene)?);
+            }
+            let options = volume::Options {
+                frames: sweep.frames.max(1),
+                ..Default::default()
+            };
+            let rows = volume::run(&headless, &cases, &options, |line| eprintln!("{line}"))?;
+            write_study(&out, [("cellproj-volume.csv", volume::to_csv(&rows))])?;
         }
         Command::Study {
             sweep,

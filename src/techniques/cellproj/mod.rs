@@ -64,10 +64,15 @@
 //! from the origin (re-centred in f64); a one-tetrahedron mesh; isovalues outside the
 //! data range (nothing drawn).
 
+pub mod order;
+pub mod preint;
 pub mod prepare;
 pub mod reference;
 pub mod renderer;
 pub mod study;
+pub mod transfer;
+pub mod volume;
+pub mod volume_reference;
 
 use serde::{Deserialize, Serialize};
 
@@ -130,6 +135,31 @@ pub enum Depth {
     Entry,
 }
 
+/// What a cell-projection scene draws.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    /// The isosurfaces (the seed's picture).
+    #[default]
+    Isosurfaces,
+    /// Volume rendering with `[technique.cellproj.volume]`'s transfer function.
+    Volume,
+    /// Opaque isosurfaces inside the translucent volume.
+    Both,
+}
+
+impl Mode {
+    /// Whether isosurfaces are drawn.
+    pub fn isosurfaces(self) -> bool {
+        self != Mode::Volume
+    }
+
+    /// Whether the volume is drawn.
+    pub fn volume(self) -> bool {
+        self != Mode::Isosurfaces
+    }
+}
+
 /// `[technique.cellproj]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -139,8 +169,16 @@ pub struct CellprojScene {
     /// Which point scalar (default: the first point array).
     #[serde(default)]
     pub scalars: ScalarSpec,
+    /// Isosurfaces, volume or both.
+    #[serde(default)]
+    pub mode: Mode,
     /// The isosurfaces, any order.
+    #[serde(default)]
     pub isovalues: Vec<Isovalue>,
+    /// The volume's transfer function and settings (`mode = "volume"` or `"both"`;
+    /// defaults when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub volume: Option<transfer::VolumeSpec>,
     /// Where the exit point is computed.
     #[serde(default)]
     pub exit: Exit,
@@ -232,6 +270,9 @@ impl CellprojScene {
                 ));
             }
         }
+        if let Some(v) = &self.volume {
+            v.validate().map_err(|e| e.within("volume"))?;
+        }
         if !(2..=4096).contains(&self.table_size) {
             return Err(FieldError::new(
                 "table_size",
@@ -239,6 +280,11 @@ impl CellprojScene {
             ));
         }
         Ok(())
+    }
+
+    /// The volume settings (the defaults when the scene gives none).
+    pub fn volume_spec(&self) -> transfer::VolumeSpec {
+        self.volume.clone().unwrap_or_default()
     }
 
     /// The isovalues sorted by value (ties keep their order).

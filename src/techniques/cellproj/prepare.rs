@@ -68,6 +68,8 @@ pub struct Prepared {
     pub scalar_name: String,
     /// Range mapped to [0, 1].
     pub scalar_range: [f64; 2],
+    /// Object units per mesh-file unit (the box's scale: lengths in the file times this).
+    pub scale: f64,
 }
 
 /// Most layers cell projection draws: the mean number of tetrahedra a line through the
@@ -207,6 +209,7 @@ pub fn from_mesh(
         quality,
         scalar_name,
         scalar_range,
+        scale,
     })
 }
 
@@ -404,6 +407,23 @@ impl Prepared {
             }
         }
         out
+    }
+
+    /// The longest edge of any tetrahedron (object units).
+    pub fn longest_edge(&self) -> f64 {
+        (0..self.tets.len())
+            .into_par_iter()
+            .map(|t| {
+                let (p, _) = self.tet(t);
+                let mut m = 0f64;
+                for i in 0..4 {
+                    for j in i + 1..4 {
+                        m = m.max((p[i] - p[j]).length());
+                    }
+                }
+                m
+            })
+            .reduce(|| 0.0, f64::max)
     }
 
     /// Number of face vertices [`Prepared::face_vertices`] yields.
