@@ -11,13 +11,15 @@
 
 mod grid;
 mod source;
+mod stream;
 mod write;
 
 use std::path::Path;
 
 pub use grid::{Prestack, ReadOptions};
 pub use source::SegySource;
-pub use write::{write, WriteOptions};
+pub use stream::SegyStream;
+pub use write::{write, TraceWriter, WriteOptions};
 
 use super::{read_file, Volume, VolumeError};
 
@@ -306,8 +308,47 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<SegyCube, VolumeError>
     parse(path, &bytes, options)
 }
 
+/// What the binary header and the file's length say, before any trace is gridded.
+#[derive(Debug, Clone)]
+pub(crate) struct Headers {
+    pub layout: grid::Layout,
+    pub revision: (u8, u8),
+    pub ebcdic: bool,
+    pub interval_us: u32,
+}
+
 /// Parse SEG-Y bytes; `path` names the file in errors.
 pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCube, VolumeError> {
+    let h = headers(path, bytes, bytes.len() as u64)?;
+    let layout = h.layout;
+    let grid::Gridded {
+        dims,
+        values,
+        inlines,
+        crosslines,
+        offsets,
+    } = grid::grid(path, bytes, &layout, options)?;
+    // Spacing: one sample, one crossline step and one inline step each count as one unit;
+    // SEG-Y has no common unit for time and distance.
+    let volume = Volume::new(dims, [1.0, 1.0, 1.0], values).map_err(VolumeError::Invalid)?;
+    Ok(SegyCube {
+        volume,
+        revision: h.revision,
+        format: layout.format,
+        big_endian: layout.big,
+        ebcdic: h.ebcdic,
+        interval_us: h.interval_us,
+        inlines,
+        crosslines,
+        traces: layout.traces,
+        offsets,
+    })
+}
+
+/// Read the textual, binary and extended headers from `bytes` (the start of a file of
+/// `len` bytes, holding at least the first trace's header when the file has one) and
+/// check the trace layout against `len`.
+pub(crate) fn headers(path: &Path, bytes: &[u8], len: u64) -> Result<Headers, VolumeError> {
     let bin = TEXT_HEADER;
     if bytes.len() < TEXT_HEADER + BINARY_HEADER {
         return Err(VolumeError::format(
@@ -373,28 +414,29 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
         interval_us = r.u16(first_trace + 116) as u32;
     }
     let trace_len = TRACE_HEADER + samples * format.bytes();
-    let data = bytes.len().checked_sub(first_trace).ok_or_else(|| {
+    let data = len.checked_sub(first_trace as u64).ok_or_else(|| {
         VolumeError::format(
             path,
-            bytes.len() as u64,
+            len,
             format!("file ends before the first trace, which the headers place at byte {first_trace} ({extended} extended textual headers)"),
         )
     })?;
-    if data % trace_len != 0 {
-        let whole = data / trace_len;
-        let start = first_trace + whole * trace_len;
+    let tl = trace_len as u64;
+    if data % tl != 0 {
+        let whole = data / tl;
+        let start = first_trace as u64 + whole * tl;
         return Err(VolumeError::format(
             path,
-            bytes.len() as u64,
+            len,
             format!(
                 "file ends inside trace {} (which starts at byte {start}): each trace is {trace_len} bytes (240-byte header + {samples} samples of {}), {} bytes are missing; the file is truncated or its headers are wrong",
                 whole + 1,
                 format.name(),
-                trace_len - (data - whole * trace_len)
+                tl - (data - whole * tl)
             ),
         ));
     }
-    let traces = data / trace_len;
+    let traces = usize::try_from(data / tl).unwrap_or(usize::MAX);
     if traces == 0 {
         return Err(VolumeError::format(
             path,
@@ -402,36 +444,19 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
             "no traces after the headers",
         ));
     }
-    let layout = grid::Layout {
-        first_trace,
-        trace_len,
-        traces,
-        samples,
-        format,
-        big,
-        header_samples: declared_samples,
-    };
-    let grid::Gridded {
-        dims,
-        values,
-        inlines,
-        crosslines,
-        offsets,
-    } = grid::grid(path, bytes, &layout, options)?;
-    // Spacing: one sample, one crossline step and one inline step each count as one unit;
-    // SEG-Y has no common unit for time and distance.
-    let volume = Volume::new(dims, [1.0, 1.0, 1.0], values).map_err(VolumeError::Invalid)?;
-    Ok(SegyCube {
-        volume,
+    Ok(Headers {
+        layout: grid::Layout {
+            first_trace,
+            trace_len,
+            traces,
+            samples,
+            format,
+            big,
+            header_samples: declared_samples,
+        },
         revision,
-        format,
-        big_endian: big,
         ebcdic: bytes[0] == 0xC3 || bytes[0] == 0x40,
         interval_us,
-        inlines,
-        crosslines,
-        traces,
-        offsets,
     })
 }
 
