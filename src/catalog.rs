@@ -98,6 +98,15 @@ pub fn build(
     } = *settings;
     Ok(match technique {
         TechniqueScene::Quad(params) => Box::new(quad::QuadRenderer::new(gpu, kind, params)?),
+        TechniqueScene::Opacity3d(params)
+            if opacity3d::bricked::store_of(params)
+                .map_err(crate::gl::GlError::Data)?
+                .is_some() =>
+        {
+            Box::new(opacity3d::bricked::BrickedRenderer::new(
+                gpu, kind, fidelity, params, base, None,
+            )?)
+        }
         TechniqueScene::Opacity3d(params) => Box::new(opacity3d::Opacity3dRenderer::new(
             gpu,
             opacity3d::renderer::resolve_kind(params, fidelity, programs, kind),

@@ -125,6 +125,37 @@ enum Command {
         #[arg(long, default_value = "study")]
         out: PathBuf,
     },
+    /// Convert a survey (SEG-Y, NIfTI-1, raw) into a bricked multi-resolution zarr v3
+    /// store that `{ store = "STORE" }` scenes stream (src/store/). Streams the input
+    /// (one column of traces per worker), computes the derived attributes, builds the
+    /// levels; run it again after an interruption to resume.
+    Convert {
+        /// The survey: SEG-Y, NIfTI-1 (.nii, .nii.gz), or raw with --raw-dims.
+        input: PathBuf,
+        /// The store's folder (created; an interrupted conversion there is resumed).
+        store: PathBuf,
+        /// Brick (chunk) side in voxels.
+        #[arg(long, default_value_t = 64)]
+        brick: usize,
+        /// Derived attributes (per-trace Hilbert transform), comma-separated, or "none".
+        #[arg(long, value_delimiter = ',', default_values_t = ["envelope".to_string(), "phase".to_string(), "frequency".to_string()])]
+        attributes: Vec<String>,
+        /// zstd level of the chunks (0: uncompressed).
+        #[arg(long, default_value_t = 1)]
+        zstd: i32,
+        /// A raw input's dimensions I,J,K (i fastest).
+        #[arg(long, value_delimiter = ',', num_args = 3)]
+        raw_dims: Option<Vec<usize>>,
+        /// A raw input's sample type (u8, i8, u16, i16, u32, i32, f32, f64).
+        #[arg(long, default_value = "f32")]
+        raw_type: String,
+        /// A raw input's byte order.
+        #[arg(long, default_value = "little")]
+        raw_endian: String,
+        /// Bytes to skip at the start of a raw input.
+        #[arg(long, default_value_t = 0)]
+        raw_offset: u64,
+    },
     /// Open the desktop viewer (winit + glutin + egui).
     #[cfg(feature = "viewer")]
     View {
@@ -311,6 +342,14 @@ struct SceneArgs {
     /// what the screen shows).
     #[arg(long)]
     transparent: bool,
+    /// Texture memory for a survey store's bricks (e.g. 256M, 2G): the GPU brick cache's
+    /// budget (a scene's `[technique.opacity3d.store] gpu_memory`).
+    #[arg(long, value_name = "SIZE", value_parser = gpu_memory)]
+    gpu_memory: Option<String>,
+}
+
+fn gpu_memory(s: &str) -> Result<String, String> {
+    arbvis::budget::parse(s).map(|_| s.to_string())
 }
 
 impl SceneArgs {
@@ -335,6 +374,11 @@ impl SceneArgs {
         }
         if self.transparent {
             scene.transparent = true;
+        }
+        if let Some(g) = &self.gpu_memory {
+            if let arbvis::scene::TechniqueScene::Opacity3d(p) = &mut scene.technique {
+                p.store.get_or_insert_with(Default::default).gpu_memory = g.clone();
+            }
         }
         if let Some(bytes) = scene
             .memory_budget_bytes()
@@ -445,12 +489,62 @@ fn run(cli: Cli) -> Result<()> {
             );
             if stats {
                 print!("{}", arbvis::render::format_stats(&rendered.resources));
+                if let Some(status) = &rendered.status {
+                    println!("{status}");
+                }
                 println!(
                     "build {:.3} ms, draw {:.3} ms",
                     rendered.build_time.as_secs_f64() * 1e3,
                     rendered.draw_time.as_secs_f64() * 1e3
                 );
             }
+        }
+        Command::Convert {
+            input,
+            store,
+            brick,
+            attributes,
+            zstd,
+            raw_dims,
+            raw_type,
+            raw_endian,
+            raw_offset,
+        } => {
+            let mut derived = Vec::new();
+            for name in attributes.iter().filter(|a| a.as_str() != "none") {
+                match arbvis::volume::attributes::by_name(name) {
+                    Some(arbvis::volume::attributes::Attribute::Amplitude) | None => bail!(
+                        "--attributes {name}: derived attributes are envelope, phase, cosine-phase, frequency (or none)"
+                    ),
+                    Some(a) => derived.push(a),
+                }
+            }
+            let raw = match raw_dims {
+                Some(d) => Some(arbvis::volume::raw::RawSpec {
+                    path: input.clone(),
+                    dims: [d[0], d[1], d[2]],
+                    sample: serde_json::from_value(serde_json::json!(raw_type)).map_err(|_| {
+                        anyhow::anyhow!(
+                            "--raw-type {raw_type}: one of u8, i8, u16, i16, u32, i32, f32, f64"
+                        )
+                    })?,
+                    endian: serde_json::from_value(serde_json::json!(raw_endian))
+                        .map_err(|_| anyhow::anyhow!("--raw-endian {raw_endian}: little or big"))?,
+                    offset: raw_offset,
+                    spacing: [1.0; 3],
+                }),
+                None => None,
+            };
+            let options = arbvis::store::convert::ConvertOptions {
+                brick,
+                derived,
+                zstd,
+                raw,
+                ..Default::default()
+            };
+            let report = arbvis::store::convert::convert(&input, &store, &options)
+                .with_context(|| format!("converting {}", input.display()))?;
+            print!("{}", arbvis::store::convert::describe(&report, &store));
         }
         Command::Bench {
             scene,

@@ -24,6 +24,8 @@ pub struct Rendered {
     pub build_time: Duration,
     /// Time to draw and finish the frame.
     pub draw_time: Duration,
+    /// The renderer's own line about the frame (a store's resident bricks, levels, bytes).
+    pub status: Option<String>,
 }
 
 impl Rendered {
@@ -104,6 +106,7 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
         resources: gpu.resources(),
         build_time,
         draw_time,
+        status: renderer.status(),
     })
 }
 

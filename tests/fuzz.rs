@@ -948,7 +948,10 @@ fn reproduce<T>(what: &str, f: impl FnOnce() -> T) -> Result<T, String> {
         return Err(format!("{what}: panicked: {panic}"));
     }
     if run.elapsed >= CASE_TIME {
-        return Err(format!("{what}: took {:?} (bound {CASE_TIME:?})", run.elapsed));
+        return Err(format!(
+            "{what}: took {:?} (bound {CASE_TIME:?})",
+            run.elapsed
+        ));
     }
     if run.peak_request > ALLOCATION_CAP || run.peak_live > LIVE_CAP as isize {
         return Err(format!(

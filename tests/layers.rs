@@ -27,7 +27,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ),
     (
         "data and GL",
-        &["volume", "mesh", "points", "surface", "gl"],
+        &["volume", "store", "mesh", "points", "surface", "gl"],
     ),
     ("program texts", &["programs"]),
     ("techniques", &["techniques"]),

@@ -308,6 +308,9 @@ pub enum VolumeSource {
     Raw(raw::RawSpec),
     /// The built-in seismic-like cube.
     Synthetic(synthetic::SyntheticSpec),
+    /// A bricked multi-resolution store made by `arbvis convert` (3D opacity streams it
+    /// brick by brick; it is never loaded whole).
+    Store(PathBuf),
 }
 
 /// What a volume may hold, checked against the dimensions a file or scene declares
@@ -411,6 +414,10 @@ impl VolumeSource {
             VolumeSource::Nifti(p) => nifti_file::read(&base.join(p), limits),
             VolumeSource::Raw(spec) => raw::read(base, spec, limits),
             VolumeSource::Synthetic(spec) => synthetic::amplitude(spec, limits),
+            VolumeSource::Store(p) => Err(VolumeError::Unsupported {
+                path: base.join(p),
+                message: "a store is streamed brick by brick by 3D opacity, never loaded whole (use it as every attribute's volume of an opacity3d scene)".into(),
+            }),
         }
     }
 
@@ -422,7 +429,7 @@ impl VolumeSource {
                 spec.validate().map_err(|e| FieldError::new("synthetic", e))
             }
             VolumeSource::Raw(spec) => spec.validate().map_err(|e| FieldError::new("raw", e)),
-            VolumeSource::Segy(_) | VolumeSource::Nifti(_) => Ok(()),
+            VolumeSource::Segy(_) | VolumeSource::Nifti(_) | VolumeSource::Store(_) => Ok(()),
         }
     }
 
@@ -432,6 +439,7 @@ impl VolumeSource {
             VolumeSource::Segy(s) => Some(&mut s.path),
             VolumeSource::Nifti(p) => Some(p),
             VolumeSource::Raw(spec) => Some(&mut spec.path),
+            VolumeSource::Store(p) => Some(p),
             VolumeSource::Synthetic(_) => None,
         }
     }
@@ -442,6 +450,7 @@ impl VolumeSource {
             VolumeSource::Segy(s) => Some(&s.path),
             VolumeSource::Nifti(p) => Some(p),
             VolumeSource::Raw(spec) => Some(&spec.path),
+            VolumeSource::Store(p) => Some(p),
             VolumeSource::Synthetic(_) => None,
         }
     }

@@ -48,6 +48,7 @@
 //! 1 x N volume; constant attributes (all quantize to 0); NaN samples (quantize to 0);
 //! volumes of different grids (an error naming both).
 
+pub mod bricked;
 pub mod bricks;
 pub mod clipping;
 pub mod mirror;
@@ -145,6 +146,10 @@ pub struct Opacity3dScene {
     /// (outside with `invert`) is drawn.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub clip: Option<ClipSpec>,
+    /// How a survey store is streamed (`[technique.opacity3d.store]`; for attributes whose
+    /// volume is `{ store = "..." }`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub store: Option<bricked::StoreView>,
 }
 
 impl crate::techniques::TechniqueParams for Opacity3dScene {
@@ -306,6 +311,9 @@ impl Opacity3dScene {
         }
         if let Some(clip) = &self.clip {
             clip.validate().map_err(|e| e.within("clip"))?;
+        }
+        if let Some(store) = &self.store {
+            store.validate().map_err(|e| e.within("store"))?;
         }
         for (name, a) in ATTRIBUTE_NAMES.iter().zip(self.attributes()) {
             if let Some(a) = a {

@@ -55,7 +55,8 @@ pub fn gathers(path: &Path, bytes: &[u8]) -> Result<Gathers, VolumeError> {
         layout: l,
         revision,
         interval_us,
-    } = headers(path, bytes)?;
+        ..
+    } = headers(path, bytes, bytes.len() as u64)?;
     let mut cells: HashMap<(i32, i32), usize> = HashMap::new();
     let mut offsets: BTreeMap<i32, usize> = BTreeMap::new();
     let (mut il, mut xl) = ((i32::MAX, i32::MIN), (i32::MAX, i32::MIN));

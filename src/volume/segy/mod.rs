@@ -12,6 +12,7 @@
 mod gathers;
 mod grid;
 mod source;
+mod stream;
 mod write;
 
 use std::path::Path;
@@ -19,7 +20,8 @@ use std::path::Path;
 pub use gathers::{gathers, Gathers};
 pub use grid::{Prestack, ReadOptions};
 pub use source::SegySource;
-pub use write::{write, write_prestack, WriteOptions};
+pub use stream::SegyStream;
+pub use write::{write, write_prestack, TraceWriter, WriteOptions};
 
 use super::{read_file, Volume, VolumeError};
 
@@ -308,15 +310,47 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<SegyCube, VolumeError>
     parse(path, &bytes, options)
 }
 
-/// What the textual and binary headers say, and where the traces are.
-struct Headers {
-    layout: grid::Layout,
-    revision: (u8, u8),
-    interval_us: u32,
+/// What the binary header and the file's length say, before any trace is gridded.
+#[derive(Debug, Clone)]
+pub(crate) struct Headers {
+    pub layout: grid::Layout,
+    pub revision: (u8, u8),
+    pub ebcdic: bool,
+    pub interval_us: u32,
 }
 
-/// Read the headers of SEG-Y bytes and find the traces (`path` names the file in errors).
-fn headers(path: &Path, bytes: &[u8]) -> Result<Headers, VolumeError> {
+/// Parse SEG-Y bytes; `path` names the file in errors.
+pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCube, VolumeError> {
+    let h = headers(path, bytes, bytes.len() as u64)?;
+    let layout = h.layout;
+    let grid::Gridded {
+        dims,
+        values,
+        inlines,
+        crosslines,
+        offsets,
+    } = grid::grid(path, bytes, &layout, options)?;
+    // Spacing: one sample, one crossline step and one inline step each count as one unit;
+    // SEG-Y has no common unit for time and distance.
+    let volume = Volume::new(dims, [1.0, 1.0, 1.0], values).map_err(VolumeError::Invalid)?;
+    Ok(SegyCube {
+        volume,
+        revision: h.revision,
+        format: layout.format,
+        big_endian: layout.big,
+        ebcdic: h.ebcdic,
+        interval_us: h.interval_us,
+        inlines,
+        crosslines,
+        traces: layout.traces,
+        offsets,
+    })
+}
+
+/// Read the textual, binary and extended headers from `bytes` (the start of a file of
+/// `len` bytes, holding at least the first trace's header when the file has one) and
+/// check the trace layout against `len`.
+pub(crate) fn headers(path: &Path, bytes: &[u8], len: u64) -> Result<Headers, VolumeError> {
     let bin = TEXT_HEADER;
     if bytes.len() < TEXT_HEADER + BINARY_HEADER {
         return Err(VolumeError::format(
@@ -382,28 +416,29 @@ fn headers(path: &Path, bytes: &[u8]) -> Result<Headers, VolumeError> {
         interval_us = r.u16(first_trace + 116) as u32;
     }
     let trace_len = TRACE_HEADER + samples * format.bytes();
-    let data = bytes.len().checked_sub(first_trace).ok_or_else(|| {
+    let data = len.checked_sub(first_trace as u64).ok_or_else(|| {
         VolumeError::format(
             path,
-            bytes.len() as u64,
+            len,
             format!("file ends before the first trace, which the headers place at byte {first_trace} ({extended} extended textual headers)"),
         )
     })?;
-    if data % trace_len != 0 {
-        let whole = data / trace_len;
-        let start = first_trace + whole * trace_len;
+    let tl = trace_len as u64;
+    if data % tl != 0 {
+        let whole = data / tl;
+        let start = first_trace as u64 + whole * tl;
         return Err(VolumeError::format(
             path,
-            bytes.len() as u64,
+            len,
             format!(
                 "file ends inside trace {} (which starts at byte {start}): each trace is {trace_len} bytes (240-byte header + {samples} samples of {}), {} bytes are missing; the file is truncated or its headers are wrong",
                 whole + 1,
                 format.name(),
-                trace_len - (data - whole * trace_len)
+                tl - (data - whole * tl)
             ),
         ));
     }
-    let traces = data / trace_len;
+    let traces = usize::try_from(data / tl).unwrap_or(usize::MAX);
     if traces == 0 {
         return Err(VolumeError::format(
             path,
@@ -411,50 +446,19 @@ fn headers(path: &Path, bytes: &[u8]) -> Result<Headers, VolumeError> {
             "no traces after the headers",
         ));
     }
-    let layout = grid::Layout {
-        first_trace,
-        trace_len,
-        traces,
-        samples,
-        format,
-        big,
-        header_samples: declared_samples,
-    };
     Ok(Headers {
-        layout,
+        layout: grid::Layout {
+            first_trace,
+            trace_len,
+            traces,
+            samples,
+            format,
+            big,
+            header_samples: declared_samples,
+        },
         revision,
-        interval_us,
-    })
-}
-
-/// Parse SEG-Y bytes; `path` names the file in errors.
-pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCube, VolumeError> {
-    let Headers {
-        layout,
-        revision,
-        interval_us,
-    } = headers(path, bytes)?;
-    let grid::Gridded {
-        dims,
-        values,
-        inlines,
-        crosslines,
-        offsets,
-    } = grid::grid(path, bytes, &layout, options)?;
-    // Spacing: one sample, one crossline step and one inline step each count as one unit;
-    // SEG-Y has no common unit for time and distance.
-    let volume = Volume::new(dims, [1.0, 1.0, 1.0], values).map_err(VolumeError::Invalid)?;
-    Ok(SegyCube {
-        volume,
-        revision,
-        format: layout.format,
-        big_endian: layout.big,
         ebcdic: bytes[0] == 0xC3 || bytes[0] == 0x40,
         interval_us,
-        inlines,
-        crosslines,
-        traces: layout.traces,
-        offsets,
     })
 }
 
