@@ -21,10 +21,9 @@ if [ -d ../shared/data ]; then
 fi
 # Issue 16: volume rendering of the real tetrahedral meshes (cell projection's volume mode).
 if [ -d ../shared/data ]; then
-  for s in bracket-volume post-volume can-volume tetrahedron-volume; do
+  for s in bracket-volume post-volume; do
     "$arbvis" render "scenes/data/$s.toml" -o "$out/data-$s.png"
   done
   "$arbvis" render scenes/data/bracket-volume.toml --fidelity faithful -o "$out/data-bracket-volume-faithful.png"
 fi
 "$arbvis" render scenes/bench/cellproj-seed-volume.toml -o "$out/cellproj-seed-volume.png"
-"$arbvis" render scenes/bench/cellproj-seed-volume.toml --fidelity precise -o "$out/cellproj-seed-volume-precise.png"
