@@ -1018,6 +1018,29 @@ fn issue_17_cloud_and_surface_reproducers() -> Result<(), String> {
         &["x.laz: at byte 107: the header declares 250000 points with 120 extra-bytes attributes"],
     )?;
     // Time: equal points past 1,000,000 + 1 a compressed byte.
+    // Amplification: point-14 items (layered chunks) under a VLR whose compressor field
+    // says 2 (point-wise chunks), with a first layer of 600 MB declared in a small file:
+    // laz decodes by the items, so the layer sizes are checked by them too (found by a
+    // 600 s fuzz run: laz aborted allocating 603,979,776 bytes).
+    let mut layered = las14(30, 0, true);
+    let tag = layered
+        .windows(14)
+        .position(|w| w == b"laszip encoded")
+        .ok_or("no laszip VLR")?;
+    let vlr_data = tag - 2 + 54;
+    layered[vlr_data..vlr_data + 2].copy_from_slice(&2u16.to_le_bytes());
+    let data_start = u32::from_le_bytes(layered[96..100].try_into().unwrap()) as usize;
+    let record = u16::from_le_bytes(layered[105..107].try_into().unwrap()) as usize;
+    let first_layer = data_start + 8 + record + 4;
+    layered[first_layer..first_layer + 4].copy_from_slice(&0x2400_0000u32.to_le_bytes());
+    let r = reproduce("layered LAZ under compressor 2", || {
+        lasfile::parse(Path::new("l.laz"), &layered)
+    })?;
+    refused(
+        "layered LAZ under compressor 2",
+        r,
+        &["l.laz: at byte", "LAZ chunk 0 declares layers of"],
+    )?;
     let dense = equal_points_laz(1_200_000);
     let r = reproduce("dense LAZ", || lasfile::parse(Path::new("d.laz"), &dense))?;
     refused(

@@ -422,7 +422,7 @@ fn check_laz(
         table = u64_at(b, b.len() - 8) as i64;
     }
     if table <= data_start as i64 {
-        if compressor == 3 {
+        if compressor == 3 || layers > 0 {
             return Err(fail(
                 data_start,
                 "a LAZ 1.4 (layered) file without a chunk table: neither the offset here nor \
@@ -472,7 +472,10 @@ fn check_laz(
             ),
         ));
     }
-    if compressor == 3 {
+    // Layered chunks are decoded by the items' types (10 to 14), whatever the VLR's
+    // compressor field says, so their layer sizes are checked by the types too (a file
+    // that said compressor 2 over point-14 items once made laz allocate 600 MB).
+    if compressor == 3 || layers > 0 {
         // Each chunk: first point raw, a u32 count, the layer sizes, the layers.
         let mut start = data_start as u64 + 8;
         // Only the chunks the declared points reach are decoded.
