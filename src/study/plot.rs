@@ -194,7 +194,8 @@ mod tests {
         // The first series is drawn in the palette's first colour: its line (three
         // segments, each tens of pixels long) and the legend's sample, well over 100
         // pixels; "b" has no point to draw.
-        let c = plotters::style::Palette99::pick(0).to_rgba();
+        use plotters::style::{Color, Palette, Palette99};
+        let c = Palette99::pick(0).to_rgba();
         let colour = [c.0, c.1, c.2].map(|v| v as f32 / 255.0);
         let drawn = image
             .data
