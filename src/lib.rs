@@ -5,7 +5,7 @@
 //!
 //! Layers, from the ground up (ARCHITECTURE.md; `tests/layers.rs` keeps them): the
 //! vocabulary ([`vocab`], [`budget`], [`input`], [`camera`], [`image`], [`png_io`],
-//! [`colortable`]) → data and GL ([`volume`], [`mesh`], [`points`], [`surface`], [`gl`],
+//! [`colortable`], [`progress`]) → data and GL ([`volume`], [`mesh`], [`points`], [`surface`], [`gl`],
 //! the only `unsafe`) → [`programs`] → [`techniques`] (CPU preparation, GL renderer, CPU
 //! reference) → [`catalog`] → [`scene`] / [`render`] → [`study`] → `viewer`.
 
@@ -25,6 +25,7 @@ pub mod mesh;
 pub mod png_io;
 pub mod points;
 pub mod programs;
+pub mod progress;
 pub mod render;
 pub mod scene;
 pub mod store;

@@ -84,15 +84,65 @@ enum Command {
         #[arg(long, value_enum, default_value_t = Backend::Egl)]
         backend: Backend,
     },
-    /// The speed-for-accuracy study of 3D opacity: every slice count, target precision,
-    /// opacity correction on/off and program kind, timed and scored against the f64
-    /// reference; writes OUT/opacity3d.csv and OUT/opacity3d.png. With --from, the trade
-    /// against VTK instead, from runs of benches/peers/vtk_volume.py --json: a plot per
-    /// run, OUT/study.csv and the README-ready OUT/study.md.
+    /// Measure what a technique trades between speed and accuracy, and plot it.
+    ///
+    /// Each study prints a line per setting on stderr, with a progress bar and the time
+    /// left while stderr is a terminal (never in pipes, or when CI is set), and writes CSV
+    /// and plots of error against time (log-log, one line per series) into --out. Times
+    /// are for the default sizes, release build, llvmpipe on 2 cores: the opacity3d one
+    /// measured, the others estimated from the README's per-frame figures; the bar gives
+    /// this machine's estimate as the study runs. Use small sizes for a quick look (e.g.
+    /// --volume 32 --size 64 --slices 16,64 --frames 1).
+    ///
+    /// --technique opacity3d (the default): v3o2's 3D opacity on a synthetic --volume³
+    /// cube of 3 attributes at --size²: each --slices count x ARB / GLSL x faithful and
+    /// precise (RGBA8 / RGBA16F / RGBA32F targets, opacity correction on and off), the
+    /// median of --frames frames, scored as RGB RMSE against the f64 reference
+    /// (--oversample steps per voxel). Writes opacity3d.csv and opacity3d.png (RMSE
+    /// against ms). About 9 minutes.
+    ///
+    /// --technique cellproj: isosurfaces by cell projection on generated spherical-field
+    /// grids (--grids points per side: 17 is the seed's 24,576 tetrahedra, 56 about a
+    /// million) at 320x240: the seed's settings, per-vertex / per-fragment exit, active
+    /// tetrahedra only, faithful / precise, mesh / view order; frame time, isovalue-edit
+    /// latency, and the fraction of interior pixels with the reference's colour (meshes up
+    /// to --score-up-to points per side; larger ones print "unscored"). Writes cellproj.csv
+    /// and cellproj.png (wrong-colour fraction against ms). About 3 minutes.
+    ///
+    /// --technique cellproj-volume: cell projection's volume rendering on the --grids
+    /// meshes and any --scenes, orthographic and perspective: faithful (MPVONC at table
+    /// sizes 32-256, centroid order at 128) and precise (the walk, projected); frame time
+    /// with the camera still and turning, the sort's and upload's share, RGB RMSE against
+    /// the f64 reference (meshes up to 250,000 tetrahedra; larger ones print "unscored").
+    /// Writes cellproj-volume.csv and cellproj-volume-MESH.png per scored mesh (RMSE
+    /// against ms). About 10 minutes.
+    ///
+    /// --technique clip: volume clipping. Textures: each --clip-sizes grid x shape
+    /// (sphere, torus mesh, open half-torus, cow.obj where ../shared has it) x --blocks B:
+    /// bytes of INDEX-DATA against the single texture and build time (clip-textures.csv).
+    /// Frames: the clipped --volume³ cube at --size², no clip / single texture /
+    /// INDEX-DATA at each B, with RMSE against the clipped f64 reference and the largest
+    /// difference from the single texture (clip-frames.csv, clip.png: RMSE against ms,
+    /// the unclipped frame's time as a vertical line). About 3 minutes.
+    ///
+    /// --technique splats: the generated geological section. Sorts: every back-to-front
+    /// method at each --points size, the f64 references' and normals' times up to 2 M
+    /// points (splats-sorts.csv). Frames: --frame-points points at 1600x900, the camera
+    /// turning 1° a frame, each sort choice, OIT, precise points and tiles of 1-4 px, with
+    /// RMSE against the f64 reference in exact order (splats-frames.csv, splats.png: RMSE
+    /// against ms). About 2 minutes.
+    ///
+    /// --from RUN.json...: instead of sweeping, the trade against VTK from runs of the
+    /// peer script made on this machine (pip install vtk numpy; cargo build --release
+    /// --no-default-features; then e.g. `python3 benches/peers/vtk_volume.py
+    /// scenes/bench/cube256-amplitude.toml --precise 128,256,512 --raycast 0.5,1,2
+    /// --faithful 128,256 --json run.json`): a plot per run (RUN.png), study.csv and the
+    /// README-ready study.md. Peer figures are printed only from such runs.
     Study {
         #[command(flatten)]
         sweep: SweepArgs,
-        /// Peer-script runs (JSON) to plot and tabulate instead of sweeping.
+        /// Peer-script runs (JSON, from `benches/peers/vtk_volume.py ... --json RUN.json`)
+        /// to plot and tabulate instead of sweeping.
         #[arg(long, num_args = 1..)]
         from: Vec<PathBuf>,
         /// The technique whose trade to sweep.
@@ -102,6 +152,10 @@ enum Command {
         /// 24,576 tetrahedra; 56: about a million).
         #[arg(long, value_delimiter = ',', default_values_t = [17, 25, 33, 45, 56])]
         grids: Vec<usize>,
+        /// Cell projection: score meshes up to this many grid points per side against the
+        /// f64 reference (larger meshes are timed only and print "unscored").
+        #[arg(long, value_name = "POINTS", default_value_t = arbvis::techniques::cellproj::study::Options::default().score_up_to)]
+        score_up_to: usize,
         /// Cell projection's volume: cell-projection scenes whose meshes and transfer
         /// functions to add to the grids.
         #[arg(long, value_delimiter = ',')]
@@ -118,7 +172,7 @@ enum Command {
         /// Splats: cloud size and image of the frame times.
         #[arg(long, default_value_t = 570_000)]
         frame_points: usize,
-        /// Reference steps per voxel.
+        /// Steps per voxel of the f64 references (opacity3d and clip).
         #[arg(long, default_value_t = 4.0)]
         oversample: f64,
         /// Output folder.
@@ -310,9 +364,14 @@ impl SweepArgs {
     }
 }
 
-/// VTK 9.7's GPU ray caster on a 3-component 256³ volume at 512², llvmpipe, 2 cores
-/// (DESIGN.md §8, measured on an idle machine of this kind): the study's yardstick.
-const VTK_MS: f64 = 1260.0;
+/// `--oversample`, refused where no reference can use it.
+fn checked_oversample(o: f64) -> Result<f64> {
+    if o.is_finite() && o > 0.0 && o <= 1024.0 {
+        Ok(o)
+    } else {
+        bail!("--oversample {o}: must be above 0 and at most 1024")
+    }
+}
 
 /// Where the scene comes from and what overrides it.
 #[derive(Args)]
@@ -558,9 +617,13 @@ fn run(cli: Cli) -> Result<()> {
             let scene = view.apply(&scene);
             let origin = format!("{origin} ({} view)", view.name());
             let headless = Headless::new(backend)?;
-            let report = arbvis::study::bench::run(&headless, &scene, &origin, &options, |line| {
-                eprintln!("{line}")
-            })
+            let report = arbvis::study::bench::run(
+                &headless,
+                &scene,
+                &origin,
+                &options,
+                arbvis::progress::line,
+            )
             .with_context(|| format!("benchmarking {origin}"))?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
@@ -594,19 +657,29 @@ fn run(cli: Cli) -> Result<()> {
                 runs: sweep.frames.max(1),
                 ..Default::default()
             };
-            let sorts = arbvis::techniques::splats::study::sorts(&options, |l| eprintln!("{l}"))?;
+            let sorts = arbvis::techniques::splats::study::sorts(&options, arbvis::progress::line)?;
             let headless = Headless::new(sweep.backend)?;
-            let frames = arbvis::techniques::splats::study::frames(&headless, &options, |l| {
-                eprintln!("{l}")
-            })?;
+            let frames = arbvis::techniques::splats::study::frames(
+                &headless,
+                &options,
+                arbvis::progress::line,
+            )?;
             let (s, f) = arbvis::techniques::splats::study::to_csv(&sorts, &frames);
             write_study(&out, [("splats-sorts.csv", s), ("splats-frames.csv", f)])?;
+            let png = out.join("splats.png");
+            let title = format!(
+                "splats: {} points at 1600x900, camera turning",
+                options.frame_points
+            );
+            arbvis::techniques::splats::study::plot(&frames, &png, &title)?;
+            println!("wrote {}", png.display());
         }
         Command::Study {
             sweep,
             technique: StudyTechnique::Clip,
             clip_sizes,
             blocks,
+            oversample,
             out,
             ..
         } => {
@@ -631,18 +704,29 @@ fn run(cli: Cli) -> Result<()> {
                 frame_volume: sweep.volume,
                 image: sweep.size,
                 frames: sweep.frames.max(1),
+                oversample: checked_oversample(oversample)?,
             };
             let headless = Headless::new(sweep.backend)?;
             let max = headless.gpu().caps().max_3d_texture_size.max(1) as usize;
             let study =
-                arbvis::techniques::clip::study::textures(&options, max, |l| eprintln!("{l}"))?;
-            let frames =
-                arbvis::techniques::clip::study::frames(&headless, &options, |l| eprintln!("{l}"))?;
+                arbvis::techniques::clip::study::textures(&options, max, arbvis::progress::line)?;
+            let frames = arbvis::techniques::clip::study::frames(
+                &headless,
+                &options,
+                arbvis::progress::line,
+            )?;
             let (textures, times) = arbvis::techniques::clip::study::to_csv(&study, &frames);
             write_study(
                 &out,
                 [("clip-textures.csv", textures), ("clip-frames.csv", times)],
             )?;
+            let png = out.join("clip.png");
+            let title = format!(
+                "clipping: {0}³ x 3 attributes at {1}x{1}, sphere r = 0.35 N",
+                options.frame_volume, options.image
+            );
+            arbvis::techniques::clip::study::plot(&frames, &png, &title)?;
+            println!("wrote {}", png.display());
         }
         Command::Study {
             sweep,
@@ -678,13 +762,24 @@ fn run(cli: Cli) -> Result<()> {
                 frames: sweep.frames.max(1),
                 ..Default::default()
             };
-            let rows = volume::run(&headless, &cases, &options, |line| eprintln!("{line}"))?;
+            let rows = volume::run(&headless, &cases, &options, arbvis::progress::line)?;
             write_study(&out, [("cellproj-volume.csv", volume::to_csv(&rows))])?;
+            let plots = volume::plot(&rows, &out)?;
+            for png in &plots {
+                println!("wrote {}", png.display());
+            }
+            if plots.is_empty() {
+                println!(
+                    "no plot: no mesh was scored (each has more than {} tetrahedra)",
+                    options.score_up_to
+                );
+            }
         }
         Command::Study {
             sweep,
             technique: StudyTechnique::Cellproj,
             grids,
+            score_up_to,
             out,
             ..
         } => {
@@ -692,16 +787,33 @@ fn run(cli: Cli) -> Result<()> {
             let options = arbvis::techniques::cellproj::study::Options {
                 grids,
                 frames: sweep.frames.max(1),
+                score_up_to,
                 ..Default::default()
             };
             if options.grids.iter().any(|&g| !(2..=128).contains(&g)) {
                 bail!("--grids: each must be 2..=128 points per side");
             }
-            let rows = arbvis::techniques::cellproj::study::run(&headless, &options, |line| {
-                eprintln!("{line}")
-            })?;
+            let rows = arbvis::techniques::cellproj::study::run(
+                &headless,
+                &options,
+                arbvis::progress::line,
+            )?;
             let text = arbvis::techniques::cellproj::study::to_csv(&rows);
             write_study(&out, [("cellproj.csv", text)])?;
+            if rows.iter().any(|r| r.agreement.is_some()) {
+                let png = out.join("cellproj.png");
+                let title = format!(
+                    "cell projection: the seed's isosurfaces at {}x{}",
+                    options.size[0], options.size[1]
+                );
+                arbvis::techniques::cellproj::study::plot(&rows, &png, &title)?;
+                println!("wrote {}", png.display());
+            } else {
+                println!(
+                    "no plot: no mesh was scored (each has more than {} points per side)",
+                    options.score_up_to
+                );
+            }
         }
         Command::Study {
             sweep,
@@ -712,8 +824,8 @@ fn run(cli: Cli) -> Result<()> {
             let headless = Headless::new(sweep.backend)?;
             let caps = headless.gpu().caps().clone();
             let mut options = sweep.options(true, true)?;
-            options.oversample = oversample;
-            let rows = arbvis::study::run(&headless, &options, |line| eprintln!("{line}"))?;
+            options.oversample = checked_oversample(oversample)?;
+            let rows = arbvis::study::run(&headless, &options, arbvis::progress::line)?;
             std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
             let csv = out.join("opacity3d.csv");
             arbvis::png_io::write_atomic(&csv, arbvis::study::to_csv(&rows).as_bytes())
@@ -723,8 +835,8 @@ fn run(cli: Cli) -> Result<()> {
                 "v3o2 3D opacity, {0}^3 x 3 attributes at {1}x{1}: {2}",
                 options.volume, options.size, caps.renderer
             );
-            arbvis::study::plot(&rows, &png, &title, VTK_MS)?;
-            print!("{}", arbvis::study::summary(&rows, VTK_MS));
+            arbvis::study::plot(&rows, &png, &title)?;
+            print!("{}", arbvis::study::summary(&rows));
             println!("wrote {} and {}", csv.display(), png.display());
         }
         Command::Inspect { file, time } => {

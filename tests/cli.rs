@@ -250,6 +250,20 @@ fn study_writes_csv_and_plot_and_bench_times() {
     let (plot, _) = read_png(&dir.join("opacity3d.png")).unwrap();
     assert_eq!((plot.width, plot.height), (1100, 700));
     assert!(stdout.contains("wrote"), "{stdout}");
+    // No peer figure written in the code: the summary names no VTK time (it once printed
+    // "(1.2x VTK's 1260 ms)" from a constant) and says how to measure one here instead.
+    let peer_times: Vec<&str> = stdout
+        .lines()
+        .filter(|l| l.contains("VTK") && (l.contains(" ms") || l.contains("1260")))
+        .collect();
+    assert!(peer_times.is_empty(), "{peer_times:?}");
+    assert!(
+        stdout.contains("benches/peers/vtk_volume.py") && stdout.contains("--from run.json"),
+        "{stdout}"
+    );
+    // stderr is a pipe here: lines, never a bar (no carriage returns, no escapes).
+    assert_no_bar(&stderr);
+    assert!(stderr.contains("slices"), "{stderr}");
     // bench times any scene; for 3D opacity it sweeps, scores and exports for a peer.
     let export = dir.join("peer");
     let bench = arbvis(&[
@@ -376,10 +390,11 @@ fn study_of_cell_projection_writes_its_sweep() {
     // Two tiny grids (48 and 384 tetrahedra): the full sweep (up to a million) is a
     // benchmark. Every setting is timed, the edit latency measured and, for meshes this
     // small, scored against the f64 reference.
-    let dir = study(
+    let (dir, _) = study(
         "study-cellproj",
         &["--technique", "cellproj", "--grids", "3,5", "--frames", "1"],
     );
+    assert_plot(&dir.join("cellproj.png"));
     let csv = std::fs::read_to_string(dir.join("cellproj.csv")).unwrap();
     // 9 settings per grid (the seed's two, three faithful, two precise, two view-ordered).
     assert_eq!(csv.lines().count(), 1 + 2 * 9, "{csv}");
@@ -398,6 +413,38 @@ fn study_of_cell_projection_writes_its_sweep() {
         // the column is a real score, not a placeholder.
         assert!(agree > 0.9 && agree <= 1.0, "{line}");
     }
+    // A mesh above the scoring limit (here 4 points per side) is timed but not scored:
+    // the line says "unscored", the CSV leaves the field empty, no "NaN" anywhere.
+    let big = temp_dir("study-cellproj-unscored");
+    let out = arbvis(&[
+        "study",
+        "--technique",
+        "cellproj",
+        "--grids",
+        "5",
+        "--score-up-to",
+        "4",
+        "--frames",
+        "1",
+        "--out",
+        big.to_str().unwrap(),
+    ]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("unscored") && !stderr.contains("NaN"),
+        "{stderr}"
+    );
+    assert!(stdout.contains("no plot"), "{stdout}");
+    let csv = std::fs::read_to_string(big.join("cellproj.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 9, "{csv}");
+    // 5 points per side: 4³ cubes of 6 tetrahedra.
+    assert!(
+        csv.lines()
+            .skip(1)
+            .all(|l| l.starts_with("384,") && l.ends_with(',')),
+        "{csv}"
+    );
     let bad = arbvis(&["study", "--technique", "cellproj", "--grids", "1"]);
     assert!(!bad.status.success());
     assert!(text(&bad).1.contains("--grids"), "{}", text(&bad).1);
@@ -407,7 +454,7 @@ fn study_of_cell_projection_writes_its_sweep() {
 fn study_of_clipping_writes_its_sweeps() {
     // A 24³ clip grid, B = 4 and 8, frames of a 16³ volume at 32²: the 256³ and
     // 512³ are a benchmark.
-    let dir = study(
+    let (dir, _) = study(
         "study-clip",
         &[
             "--technique",
@@ -436,19 +483,37 @@ fn study_of_clipping_writes_its_sweeps() {
     let frames = std::fs::read_to_string(dir.join("clip-frames.csv")).unwrap();
     let rows: Vec<&str> = frames.lines().skip(1).collect();
     assert_eq!(rows.len(), 4, "{frames}");
+    // No clip draws another picture (nothing to score, nothing to compare); the single
+    // texture is the comparison's baseline: empty fields, not NaN.
+    assert!(
+        rows[0].starts_with("\"no clip\",") && rows[0].ends_with(",,"),
+        "{frames}"
+    );
+    assert!(
+        rows[1].starts_with("\"single\",") && rows[1].ends_with(','),
+        "{frames}"
+    );
+    let rmse = |row: &str| -> f64 { row.rsplit(',').nth(1).unwrap().parse().unwrap() };
     for row in &rows[2..] {
         // INDEX-DATA keeps what the single texture keeps (the keep/discard decision is
         // the same at every point, clip/mod.rs): the bound is 1/255 (measured 0 here,
         // 1 level at 512², where the 8-bit target rounds a blend the other way).
         let levels: f64 = row.rsplit(',').next().unwrap().parse().unwrap();
         assert!(levels <= 1.0, "{row}");
+        // So its error against the clipped f64 reference is the single texture's, within
+        // what one level (1/255) at every pixel could change.
+        assert!((rmse(row) - rmse(rows[1])).abs() <= 1.0 / 255.0, "{frames}");
     }
+    // A real score: faithful 8-bit slicing of 16³ at 32² is neither exact nor far off
+    // (measured about 0.01; 1e-4 and 0.2 bound it by 50x and 20x).
+    assert!(rmse(rows[1]) > 1e-4 && rmse(rows[1]) < 0.2, "{frames}");
+    assert_plot(&dir.join("clip.png"));
 }
 
 #[test]
 fn study_of_splats_writes_its_sweeps() {
     // 3,000 points (at the demo's 1600x900): the seed's 570k and 10 M are a benchmark.
-    let dir = study(
+    let (dir, _) = study(
         "study-splats",
         &[
             "--technique",
@@ -488,13 +553,22 @@ fn study_of_splats_writes_its_sweeps() {
         ],
         "{frames}"
     );
+    let mut rmse = std::collections::BTreeMap::new();
     for line in frames.lines().skip(1) {
         let ms: f64 = line.split(',').nth(1).unwrap().parse().unwrap();
         assert!(ms > 0.0 && ms.is_finite(), "{line}");
         // Tiles report their lists' time as the order's.
         let order: f64 = line.split(',').nth(2).unwrap().parse().unwrap();
         assert!(!line.starts_with("tiles") || order > 0.0, "{line}");
+        let e: f64 = line.split(',').nth(3).unwrap().parse().unwrap();
+        rmse.insert(line.split(',').next().unwrap().to_string(), e);
     }
+    // Against the f64 reference in exact order: precise tiles are exact to float
+    // rounding (the README's 3e-5 per pixel; 1e-3 RMSE leaves room for llvmpipe), and
+    // the file order ("none") is further off than the sorted faithful draw.
+    assert!(rmse["tiles 2px (precise)"] < 1e-3, "{rmse:?}");
+    assert!(rmse["none"] > rmse["radix"], "{rmse:?}");
+    assert_plot(&dir.join("splats.png"));
     let bad = arbvis(&["study", "--technique", "splats", "--points", "0"]);
     assert!(!bad.status.success() && text(&bad).1.contains("--points"));
 }
@@ -515,14 +589,143 @@ fn inspect_times_loading_when_asked() {
     assert!(stdout.contains("ms (median of 3)"), "{stdout}");
 }
 
+#[test]
+fn study_of_the_cell_projection_volume_writes_csv_and_a_plot_per_scored_mesh() {
+    // The 3-point grid (48 tetrahedra): 7 settings x 2 projections, scored.
+    let (dir, _) = study(
+        "study-cellproj-volume",
+        &[
+            "--technique",
+            "cellproj-volume",
+            "--grids",
+            "3",
+            "--frames",
+            "1",
+        ],
+    );
+    let csv = std::fs::read_to_string(dir.join("cellproj-volume.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + 14, "{csv}");
+    for line in csv.lines().skip(1) {
+        let rmse: f64 = line.rsplit(',').nth(3).unwrap().parse().unwrap();
+        // A real score (not a placeholder): below 0.2 of full scale.
+        assert!((0.0..0.2).contains(&rmse), "{line}");
+    }
+    assert_plot(&dir.join("cellproj-volume-grid3.png"));
+}
+
+#[test]
+fn study_help_describes_every_technique_and_how_to_make_run_json() {
+    let help = arbvis(&["study", "--help"]);
+    let (stdout, _) = text(&help);
+    assert!(help.status.success());
+    // The techniques as clap lists them ("- NAME: ..." under --technique's values):
+    // each has its own paragraph, with what it writes.
+    let values = stdout
+        .split_once("--technique <TECHNIQUE>")
+        .map(|(_, rest)| rest)
+        .unwrap_or_default();
+    let names: Vec<&str> = values
+        .lines()
+        .skip(1)
+        .take_while(|l| !l.trim_start().starts_with("--"))
+        .filter_map(|l| l.trim().strip_prefix("- "))
+        .filter_map(|l| l.split(':').next())
+        .collect();
+    assert!(
+        names.len() >= 5 && names.contains(&"cellproj-volume"),
+        "{names:?}\n{stdout}"
+    );
+    for name in names {
+        assert!(
+            stdout.contains(&format!("--technique {name}")),
+            "{name}: {stdout}"
+        );
+    }
+    for file in [
+        "opacity3d.png",
+        "cellproj.png",
+        "cellproj-volume-MESH.png",
+        "clip.png",
+        "splats.png",
+        "vtk_volume.py",
+        "--json run.json",
+        "minutes",
+    ] {
+        assert!(stdout.contains(file), "{file}: {stdout}");
+    }
+}
+
+#[test]
+fn progress_bars_only_on_a_terminal_outside_ci() {
+    // The smallest 3D-opacity study (8³, 16², 4 slices): well under a second of work.
+    let dir = temp_dir("study-bars");
+    let args = format!(
+        "{} study --volume 8 --size 16 --slices 4 --frames 1 --out {}",
+        env!("CARGO_BIN_EXE_arbvis"),
+        dir.display()
+    );
+    // A pipe (as in every test): no bar whatever CI says.
+    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args(args.split(' ').skip(1))
+        .env_remove("CI")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", text(&out).1);
+    assert_no_bar(&text(&out).1);
+    // A terminal: `script` gives the command one (stdout and stderr both go to it).
+    let tty = |ci: Option<&str>| -> Option<String> {
+        let mut c = Command::new("script");
+        c.args(["-qec", &args, "/dev/null"]);
+        match ci {
+            Some(v) => c.env("CI", v),
+            None => c.env_remove("CI"),
+        };
+        let out = c.output().ok()?;
+        out.status.success().then(|| text(&out).0)
+    };
+    let Some(with_ci) = tty(Some("true")) else {
+        eprintln!("SKIPPED: no `script` (util-linux) to run the study on a terminal");
+        return;
+    };
+    assert!(with_ci.contains("wrote"), "{with_ci}");
+    assert_no_bar(&with_ci);
+    // Outside CI the same terminal shows the bar (so the check above can fail).
+    let without = tty(None).unwrap();
+    assert!(
+        without.contains("3D-opacity study") && without.contains("left"),
+        "{without}"
+    );
+}
+
+/// Stderr holds lines only: no bar drawn (indicatif redraws with carriage returns and
+/// escape sequences, and its template says how long is "left").
+fn assert_no_bar(stderr: &str) {
+    assert!(
+        !stderr.contains('\u{1b}') && !stderr.contains("left") && !stderr.contains("[="),
+        "{stderr:?}"
+    );
+    // `script` turns each newline into CR LF; any other carriage return is a redraw.
+    assert!(!stderr.replace("\r\n", "\n").contains('\r'), "{stderr:?}");
+}
+
+/// A study's plot: a 1100x700 PNG.
+fn assert_plot(path: &std::path::Path) {
+    let (plot, _) = read_png(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert_eq!((plot.width, plot.height), (1100, 700), "{}", path.display());
+}
+
 /// Run `arbvis study ARGS --out DIR` in a fresh folder named `name`; fails the test if
-/// the study fails; returns the folder.
-fn study(name: &str, args: &[&str]) -> std::path::PathBuf {
+/// the study fails or prints NaN or a bar; returns the folder and the study's lines.
+fn study(name: &str, args: &[&str]) -> (std::path::PathBuf, String) {
     let dir = temp_dir(name);
     let mut all = vec!["study"];
     all.extend_from_slice(args);
     all.extend(["--out", dir.to_str().unwrap()]);
     let out = arbvis(&all);
-    assert!(out.status.success(), "{}", text(&out).1);
-    dir
+    let (_, stderr) = text(&out);
+    assert!(out.status.success(), "{stderr}");
+    // Every unmeasured value is said in words: no "NaN" in the lines.
+    assert!(!stderr.contains("NaN"), "{stderr}");
+    assert_no_bar(&stderr);
+    (dir, stderr)
 }

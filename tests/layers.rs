@@ -23,6 +23,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "image",
             "png_io",
             "colortable",
+            "progress",
         ],
     ),
     (

@@ -23,6 +23,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::gl::{Headless, ProgramKind, Surface, Target};
 use crate::image::Image;
+use crate::progress::{Bar, Unit};
 use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::reference::reference_clipped;
@@ -427,8 +428,15 @@ pub fn run(
     };
     let mut slots: Vec<Slot> = Vec::new();
     let mut results: Vec<Option<Measured>> = vec![None; settings.len()];
-    for round in 0..options.rounds.max(1) {
+    let rounds = options.rounds.max(1);
+    let bar = Bar::new((settings.len() * rounds) as u64, "bench", Unit::Work);
+    for round in 0..rounds {
         for (i, setting) in settings.iter().enumerate() {
+            bar.set_message(&format!(
+                "bench round {} of {rounds}: {}",
+                round + 1,
+                setting.name
+            ));
             let s = &setting.scene;
             let kind = s.programs.resolve(gpu);
             let key = slot_key(s, kind);
@@ -506,8 +514,10 @@ pub fn run(
                     .map(|r| format!(", RMSE {r:.5}"))
                     .unwrap_or_default()
             ));
+            bar.inc(1);
         }
     }
+    drop(bar);
     let mut results: Vec<Measured> = results.into_iter().flatten().collect();
     if let (true, Some(prepared)) = (options.breakdown, &prepared) {
         results.extend(super::breakdown::run(

@@ -3,19 +3,25 @@
 //! attributes of `volume³`) is drawn at `size²` for each setting that trades speed for
 //! accuracy — slice count, target precision, opacity correction, ARB vs GLSL, faithful vs
 //! precise — timed over several frames (median), and scored against the f64 reference
-//! integral (RGB: max abs, RMSE, PSNR). `study` writes CSV and a plot (error against time).
+//! integral (RGB: max abs, RMSE, PSNR). `study` writes CSV and a plot (error against time,
+//! [`plot::plot_lines`], which every technique's study draws with). Peer figures come only
+//! from peer runs made on this machine ([`peers`], `study --from`).
 
 pub mod bench;
 pub mod breakdown;
 pub mod export;
 pub mod measured;
 pub mod peers;
+pub mod plot;
+
+pub use plot::{plot_lines, Chart};
 
 use std::path::Path;
 use std::time::Instant;
 
 use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target};
 use crate::image::Image;
+use crate::progress::{Bar, Unit};
 use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::reference::reference;
@@ -239,6 +245,13 @@ pub fn run(
             }
         }
     }
+    // Work per setting: slices times frames drawn (a frame's time grows with its slices).
+    let work = |slices: usize| (slices * (options.frames.max(1) + 1)) as u64;
+    let bar = Bar::new(
+        settings.iter().map(|s| work(s.4)).sum(),
+        "3D-opacity study",
+        Unit::Work,
+    );
     let mut rows = Vec::new();
     for (fidelity, kind, target, correction, slices) in settings {
         let mut scene = base_scene.clone();
@@ -248,6 +261,12 @@ pub fn run(
             o.slices = slices;
             o.opacity_correction = Some(correction);
         }
+        bar.set_message(&format!(
+            "3D-opacity study: {} {} {} at {slices} slices",
+            fidelity.name(),
+            kind.name(),
+            target.name()
+        ));
         let (ms, image) = measure(headless, &scene, &prepared, kind, options.frames)?;
         let (max_abs, rmse, psnr) = match &reference_image {
             Some(r) => {
@@ -281,6 +300,7 @@ pub fn run(
             ms
         ));
         rows.push(row);
+        bar.inc(work(slices));
     }
     Ok(rows)
 }
@@ -307,9 +327,8 @@ pub fn to_csv(rows: &[Row]) -> String {
     s
 }
 
-/// Plot RMSE against time per frame, one line per setting through its slice counts,
-/// with the VTK GPU ray caster's time on this machine kind as a vertical line.
-pub fn plot(rows: &[Row], path: &Path, title: &str, vtk_ms: f64) -> anyhow::Result<()> {
+/// Plot RMSE against time per frame, one line per setting through its slice counts.
+pub fn plot(rows: &[Row], path: &Path, title: &str) -> anyhow::Result<()> {
     let mut series: Vec<String> = rows.iter().map(Row::series).collect();
     series.sort();
     series.dedup();
@@ -324,92 +343,12 @@ pub fn plot(rows: &[Row], path: &Path, title: &str, vtk_ms: f64) -> anyhow::Resu
             (name, points)
         })
         .collect();
-    let vtk = format!("VTK 9.7 GPU ray caster, 3 components ({vtk_ms:.0} ms)");
-    plot_lines(&lines, path, title, Some((vtk_ms, vtk.as_str())))
-}
-
-/// Plot named lines of (ms, RMSE) points on log axes (a line and dots per series), and
-/// where given a vertical line at a time with its label.
-pub fn plot_lines(
-    lines: &[(String, Vec<(f64, f64)>)],
-    path: &Path,
-    title: &str,
-    vertical: Option<(f64, &str)>,
-) -> anyhow::Result<()> {
-    use plotters::prelude::*;
-    register_plot_font()?;
-    let (w, h) = (1100u32, 700u32);
-    let mut buffer = vec![0u8; (w * h * 3) as usize];
-    {
-        let root = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
-        root.fill(&WHITE)?;
-        let finite = |v: f64| v.is_finite() && v > 0.0;
-        let points: Vec<(f64, f64)> = lines
-            .iter()
-            .flat_map(|(_, p)| p.iter().copied())
-            .filter(|&(x, y)| finite(x) && finite(y))
-            .collect();
-        if points.is_empty() {
-            anyhow::bail!("nothing to plot");
-        }
-        let xs = points
-            .iter()
-            .map(|p| p.0)
-            .chain(vertical.map(|v| v.0).filter(|&x| finite(x)));
-        let (x0, x1) = xs.fold((f64::INFINITY, 0.0f64), |(lo, hi), x| {
-            (lo.min(x), hi.max(x))
-        });
-        let (y0, y1) = points.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), p| {
-            (lo.min(p.1), hi.max(p.1))
-        });
-        let (x0, x1, y0, y1) = (x0 * 0.8, x1 * 1.25, y0 * 0.8, y1 * 1.25);
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())?;
-        chart
-            .configure_mesh()
-            .x_desc("time per frame (ms, log)")
-            .y_desc("RMSE of RGB against the f64 reference (log)")
-            .label_style(("sans-serif", 14))
-            .draw()?;
-        for (n, (name, pts)) in lines.iter().enumerate() {
-            let colour = Palette99::pick(n).to_rgba();
-            let mut pts: Vec<(f64, f64)> = pts
-                .iter()
-                .copied()
-                .filter(|&(x, y)| finite(x) && finite(y))
-                .collect();
-            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            chart
-                .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))?
-                .label(name.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
-                });
-            chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))?;
-        }
-        if let Some((x, label)) = vertical.filter(|v| finite(v.0)) {
-            chart
-                .draw_series(LineSeries::new(
-                    vec![(x, y0), (x, y1)],
-                    BLACK.stroke_width(1),
-                ))?
-                .label(label)
-                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK));
-        }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 13))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()?;
-        root.present()?;
-    }
-    save_plot(&buffer, w, h, path)
+    let chart = Chart {
+        title,
+        x: "time per frame (ms)",
+        y: "RMSE of RGB against the f64 reference",
+    };
+    plot_lines(&lines, path, &chart, &[])
 }
 
 /// The median of `v` (the mean of the middle two for an even count; NaN when empty).
@@ -423,34 +362,10 @@ pub fn median(v: &[f64]) -> f64 {
     }
 }
 
-/// The plots' font (egui's, already a dependency), registered with plotters.
-fn register_plot_font() -> anyhow::Result<()> {
-    plotters::style::register_font(
-        "sans-serif",
-        plotters::style::FontStyle::Normal,
-        epaint_default_fonts::UBUNTU_LIGHT,
-    )
-    .map_err(|_| anyhow::anyhow!("the plot font did not load"))
-}
-
-/// Write a plotters RGB buffer as an opaque PNG.
-fn save_plot(buffer: &[u8], w: u32, h: u32, path: &Path) -> anyhow::Result<()> {
-    let data: Vec<f32> = buffer
-        .chunks_exact(3)
-        .flat_map(|p| [p[0], p[1], p[2], 255].map(|v| v as f32 / 255.0))
-        .collect();
-    let image = Image {
-        width: w,
-        height: h,
-        format: TargetFormat::Rgba8,
-        data,
-    };
-    crate::png_io::write_png(path, &image, &[("Software", "arbvis study".into())])?;
-    Ok(())
-}
-
-/// The README's one-paragraph summary: the fastest setting within a given error.
-pub fn summary(rows: &[Row], vtk_ms: f64) -> String {
+/// The README's one-paragraph summary: the fastest setting within a given error. Peer
+/// figures are not guessed here: `arbvis study --from RUN.json` compares with a peer run
+/// made on this machine.
+pub fn summary(rows: &[Row]) -> String {
     let mut s = String::new();
     let best = |pred: &dyn Fn(&Row) -> bool| {
         rows.iter()
@@ -462,20 +377,31 @@ pub fn summary(rows: &[Row], vtk_ms: f64) -> String {
         ("RMSE < 1/255", 1.0 / 255.0),
         ("RMSE < 0.5/255", 0.5 / 255.0),
     ] {
-        if let Some(r) = best(&|r: &Row| r.rmse < bound) {
-            s += &format!(
-                "fastest with {label}: {} at {} slices, {:.1} ms/frame ({:.1}x VTK's {:.0} ms), RMSE {:.5}\n",
-                r.series(),
-                r.slices,
-                r.ms,
-                vtk_ms / r.ms,
-                vtk_ms,
-                r.rmse
-            );
+        match best(&|r: &Row| r.rmse < bound) {
+            Some(r) => {
+                s += &format!(
+                    "fastest with {label}: {} at {} slices, {:.1} ms/frame, RMSE {:.5}\n",
+                    r.series(),
+                    r.slices,
+                    r.ms,
+                    r.rmse
+                )
+            }
+            None => s += &format!("no setting reached {label}\n"),
         }
     }
-    s
+    s + PEER_HINT
 }
+
+/// Where peer figures come from (printed after the summary): a run of the VTK peer made
+/// on this machine, never a number written in the code.
+pub const PEER_HINT: &str = "\
+to compare with VTK's GPU ray caster on this machine (pip install vtk numpy; \
+cargo build --release --no-default-features):
+  python3 benches/peers/vtk_volume.py scenes/bench/cube256-amplitude.toml \\
+      --precise 128,256,512 --raycast 0.5,1,2 --faithful 128,256 --json run.json
+  arbvis study --from run.json --out study
+";
 
 #[cfg(test)]
 mod tests {

@@ -122,6 +122,16 @@ fn work_for(points: &[Point], bound: f64) -> Option<f64> {
     })
 }
 
+/// Work as a reader counts it: whole slices for slicing (rounded up: the least count
+/// that reaches the bound), else steps per voxel.
+fn work_words(series: &str, work: f64) -> String {
+    if series.contains("slicing") {
+        format!("{} slices", work.ceil() as u64)
+    } else {
+        format!("{} step/voxel", (work * 100.0).round() / 100.0)
+    }
+}
+
 /// The Markdown for one run.
 fn markdown(name: &str, run: &Run, series: &BTreeMap<String, Vec<Point>>) -> String {
     let mut s = format!(
@@ -171,7 +181,7 @@ fn markdown(name: &str, run: &Run, series: &BTreeMap<String, Vec<Point>>) -> Str
     for (label, points) in series.iter().filter(|(k, _)| k.starts_with("arbvis")) {
         let settings: Vec<String> = points
             .iter()
-            .map(|p| format!("{}: {:.0} / {:.4}", p.work, p.ms, p.rmse))
+            .map(|p| format!("{}: {:.0} / {:.4}", work_words(label, p.work), p.ms, p.rmse))
             .collect();
         let falls = points.windows(2).all(|w| w[1].rmse <= w[0].rmse);
         let orders: Vec<String> = points
@@ -181,7 +191,8 @@ fn markdown(name: &str, run: &Run, series: &BTreeMap<String, Vec<Point>>) -> Str
                 format!("{p:.1}")
             })
             .collect();
-        let need = |b: f64| work_for(points, b).map_or("beyond".to_string(), |w| format!("{w:.3}"));
+        let need =
+            |b: f64| work_for(points, b).map_or("beyond".to_string(), |w| work_words(label, w));
         s += &format!(
             "| {label} | {} | {} | {} | {} | {} |\n",
             settings.join(", "),
@@ -223,7 +234,12 @@ pub fn study(runs: &[PathBuf], out: &Path) -> Result<String> {
             "{name}: {} at {}x{}, {}",
             run.arbvis.scene, run.arbvis.size[0], run.arbvis.size[1], run.arbvis.renderer
         );
-        super::plot_lines(&lines, &out.join(format!("{name}.png")), &title, None)?;
+        let chart = super::Chart {
+            title: &title,
+            x: "time per frame, median (ms)",
+            y: "RMSE of RGB against the f64 reference",
+        };
+        super::plot_lines(&lines, &out.join(format!("{name}.png")), &chart, &[])?;
     }
     crate::png_io::write_atomic(&out.join("study.csv"), csv.as_bytes())?;
     crate::png_io::write_atomic(&out.join("study.md"), md.as_bytes())?;
@@ -266,6 +282,21 @@ mod tests {
             "{md}"
         );
         // 128 -> 256 slices: error / 4 for work x 2: order 2; 1e-3 needs 256.
-        assert!(md.contains("| yes | 2.0 | 128.000 | 256.000 |"), "{md}");
+        // Slice counts are whole numbers.
+        assert!(
+            md.contains("| yes | 2.0 | 128 slices | 256 slices |"),
+            "{md}"
+        );
+        assert!(
+            md.contains("| 128 slices: 11 / 0.0039, 256 slices: 21 / 0.0010 |"),
+            "{md}"
+        );
+        // Between bracketing settings the count is interpolated (log-log) and rounded up:
+        // 0.002 lies t = ln(0.002/0.0039) / ln(0.001/0.0039) = 0.4907 of the way from 128
+        // to 256 slices, at 128 x 2^0.4907 = 179.8: 180 slices.
+        let w = work_for(&s["arbvis precise slicing"], 0.002).unwrap();
+        assert!((w - 179.8).abs() < 0.1, "{w}");
+        assert_eq!(work_words("arbvis precise slicing", w), "180 slices");
+        assert_eq!(work_words("arbvis raycast", 0.755), "0.76 step/voxel");
     }
 }

@@ -1,12 +1,14 @@
 //! Pixel rays for the CPU references: one ray per pixel centre, in object space, from
 //! the near plane to the far plane of the camera's projection (so orthographic and
-//! perspective views are handled alike), traced in parallel rows.
+//! perspective views are handled alike), traced in parallel rows, with a progress bar
+//! ([`crate::progress`]) when a reference runs longer than a couple of seconds.
 
 use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::image::Image;
+use crate::progress::{Bar, Unit};
 use crate::vocab::TargetFormat;
 
 /// A pixel's ray in object space: origin on the near plane, direction toward the far
@@ -40,6 +42,9 @@ pub fn box_interval(origin: DVec3, dir: DVec3, half: DVec3) -> Option<(f64, f64)
     (hi > lo).then_some((lo, hi))
 }
 
+/// How long a reference runs before its bar appears.
+const BAR_AFTER: std::time::Duration = std::time::Duration::from_secs(2);
+
 /// Trace one ray per pixel centre (object space, near to far) in parallel rows and
 /// collect `shade(origin, dir)` as an image of `format`, top row first.
 pub fn trace_pixels(
@@ -62,14 +67,19 @@ pub fn trace_rays<T: Send>(
     let [width, height] = size;
     let aspect = width as f64 / height.max(1) as f64;
     let inverse = camera.view_projection(aspect).inverse();
+    // A bar (rows done, time left) for references that run past a couple of seconds.
+    let bar = Bar::delayed(height as u64, "f64 reference", Unit::Rows, BAR_AFTER);
     (0..height)
         .into_par_iter()
         .flat_map_iter(|y| {
-            let shade = &shade;
-            (0..width).map(move |x| {
-                let (origin, dir) = pixel_ray(&inverse, x, y, width, height);
-                shade(origin, dir)
-            })
+            let row: Vec<T> = (0..width)
+                .map(|x| {
+                    let (origin, dir) = pixel_ray(&inverse, x, y, width, height);
+                    shade(origin, dir)
+                })
+                .collect();
+            bar.inc(1);
+            row
         })
         .collect()
 }

@@ -2,7 +2,10 @@
 //! size (24,576 tetrahedra, 320x240) and up to about a million tetrahedra; the latency
 //! from an isovalue change to the new frame; per-vertex vs per-fragment exit; faithful vs
 //! precise; each setting scored against the f64 reference (fraction of interior pixels
-//! with the right isovalue colour).
+//! with the right isovalue colour; one reference per mesh and projection), on meshes up to
+//! [`Options::score_up_to`] points per side; larger meshes are timed only and say
+//! "unscored" (they once printed "agree NaN"). [`plot`] draws the wrong-colour fraction
+//! against time.
 
 pub mod volume;
 
@@ -19,8 +22,9 @@ use crate::vocab::Fidelity;
 use crate::vocab::TargetFormat;
 
 use super::prepare::{from_mesh, Prepared};
-use super::reference::{agreement, reference, silhouette_pixels};
+use super::reference::{agreement, reference, silhouette_pixels, Hit};
 use super::{CellprojRenderer, CellprojScene, Exit, Isovalue};
+use crate::progress::{Bar, Unit};
 
 /// What to sweep.
 #[derive(Debug, Clone)]
@@ -31,8 +35,8 @@ pub struct Options {
     pub size: [u32; 2],
     /// Timed frames per setting (median), after one warm-up frame.
     pub frames: usize,
-    /// Score against the reference (slow for big meshes: only up to `score_up_to` points
-    /// per side).
+    /// Score against the reference on meshes up to this many points per side (one
+    /// reference per mesh and projection: about 10 s each at a million tetrahedra).
     pub score_up_to: usize,
 }
 
@@ -42,7 +46,7 @@ impl Default for Options {
             grids: vec![17, 25, 33, 45, 56],
             size: [320, 240],
             frames: 5,
-            score_up_to: 33,
+            score_up_to: 64,
         }
     }
 }
@@ -58,8 +62,9 @@ pub struct Row {
     pub ms: f64,
     /// Milliseconds from an isovalue edit to the finished new frame (median).
     pub edit_ms: f64,
-    /// Fraction of interior pixels agreeing with the reference (NaN when not scored).
-    pub agreement: f64,
+    /// Fraction of interior pixels agreeing with the reference (None: the mesh is larger
+    /// than [`Options::score_up_to`], not scored).
+    pub agreement: Option<f64>,
 }
 
 /// The seed's isovalues.
@@ -158,7 +163,17 @@ pub fn run(
 ) -> anyhow::Result<Vec<Row>> {
     let mut rows = Vec::new();
     let has_arb = headless.gpu().caps().has_arb();
+    // Work per setting: its tetrahedra (frames and the reference grow with them).
+    let tets_of = |points: usize| 6 * points.saturating_sub(1).pow(3) as u64;
+    let bar = Bar::new(
+        options.grids.iter().map(|&g| SETTINGS * tets_of(g)).sum(),
+        "cell-projection study",
+        Unit::Work,
+    );
     for &points in &options.grids {
+        // The reference of each projection, computed once per mesh (every setting of a
+        // projection draws the same isosurfaces from the same camera).
+        let mut references: Vec<(Projection, Vec<Option<Hit>>, Vec<bool>)> = Vec::new();
         let mesh = generate(&GridSpec {
             points: [points; 3],
             field: Field::Spherical,
@@ -259,6 +274,7 @@ pub fn run(
             ),
         ];
         for (name, fidelity, kind, exit, projection, active_only, view_order) in settings {
+            bar.set_message(&format!("cell projection, {tets} tets: {name}"));
             let mut params = scene_for(points, exit, active_only);
             if view_order {
                 params.order = super::Order::View;
@@ -269,20 +285,29 @@ pub fn run(
                 headless, &params, &prepared, fidelity, kind, camera, options,
             )?;
             let agreement_fraction = if points <= options.score_up_to {
-                let hits = reference(&prepared, &params.isovalues, &camera, options.size);
-                let silhouette = silhouette_pixels(&prepared, &camera, options.size, 1.5);
+                if !references.iter().any(|r| r.0 == projection) {
+                    let hits = reference(&prepared, &params.isovalues, &camera, options.size);
+                    let silhouette = silhouette_pixels(&prepared, &camera, options.size, 1.5);
+                    references.push((projection, hits, silhouette));
+                }
+                let (_, hits, silhouette) = references
+                    .iter()
+                    .find(|r| r.0 == projection)
+                    .expect("computed above");
                 let sorted = params.sorted_isovalues();
-                agreement(
-                    &image,
-                    Some(&depth),
-                    &hits,
-                    &sorted,
-                    [0.0, 0.0, 0.0, 1.0],
-                    &silhouette,
+                Some(
+                    agreement(
+                        &image,
+                        Some(&depth),
+                        hits,
+                        &sorted,
+                        [0.0, 0.0, 0.0, 1.0],
+                        silhouette,
+                    )
+                    .interior_fraction(),
                 )
-                .interior_fraction()
             } else {
-                f64::NAN
+                None
             };
             let row = Row {
                 tets,
@@ -292,22 +317,61 @@ pub fn run(
                 agreement: agreement_fraction,
             };
             progress(&format!(
-                "{:>9} tets  {:<36} {:>8.2} ms ({:>6.1} fps, {:>8.0} tets/s)  edit->frame {:>7.2} ms  agree {:.4}",
+                "{:>9} tets  {:<36} {:>8.2} ms ({:>6.1} fps, {:>8.0} tets/s)  edit->frame {:>7.2} ms  {}",
                 row.tets,
                 row.setting,
                 row.ms,
                 1e3 / row.ms,
                 row.tets as f64 / row.ms * 1e3,
                 row.edit_ms,
-                row.agreement
+                agreement_words(row.agreement, options.score_up_to)
             ));
             rows.push(row);
+            bar.inc(tets_of(points));
         }
     }
     Ok(rows)
 }
 
-/// The rows as CSV (the setting quoted: names hold commas).
+/// Settings per mesh.
+const SETTINGS: u64 = 9;
+
+/// The agreement as the progress line says it: a fraction, or why there is none.
+pub fn agreement_words(agreement: Option<f64>, score_up_to: usize) -> String {
+    match agreement {
+        Some(a) => format!("agree {a:.4}"),
+        None => format!("unscored (above --score-up-to {score_up_to} points per side)"),
+    }
+}
+
+/// Plot each setting's disagreement with the reference (1 - interior agreement) against
+/// its frame time, through the mesh sizes (unscored meshes are left out).
+pub fn plot(rows: &[Row], path: &std::path::Path, title: &str) -> anyhow::Result<()> {
+    let mut names: Vec<&str> = rows.iter().map(|r| r.setting.as_str()).collect();
+    names.dedup();
+    names.sort();
+    names.dedup();
+    let lines: Vec<(String, Vec<(f64, f64)>)> = names
+        .into_iter()
+        .map(|name| {
+            let points = rows
+                .iter()
+                .filter(|r| r.setting == name)
+                .filter_map(|r| Some((r.ms, 1.0 - r.agreement?)))
+                .collect();
+            (name.to_string(), points)
+        })
+        .collect();
+    let chart = crate::study::Chart {
+        title,
+        x: "time per frame (ms)",
+        y: "interior pixels with the wrong isovalue colour (fraction)",
+    };
+    crate::study::plot_lines(&lines, path, &chart, &[])
+}
+
+/// The rows as CSV (the setting quoted: names hold commas; an unscored agreement is an
+/// empty field).
 pub fn to_csv(rows: &[Row]) -> String {
     let mut s = String::from("tets,setting,ms_per_frame,fps,edit_to_frame_ms,interior_agreement\n");
     for r in rows {
@@ -318,7 +382,7 @@ pub fn to_csv(rows: &[Row]) -> String {
             r.ms,
             1e3 / r.ms,
             r.edit_ms,
-            r.agreement
+            r.agreement.map_or(String::new(), |a| format!("{a:.5}"))
         );
     }
     s

@@ -2,8 +2,12 @@
 //! volume size, shape and block size B, what the INDEX-DATA texture costs in bytes against
 //! the single-resolution texture (the seed's compression ratio), how long each takes to
 //! build, and, on the GPU, the frame time of the clipped 3D-opacity scene with no clip, the
-//! single texture and INDEX-DATA at each B, with the largest difference between the
-//! INDEX-DATA and the single-texture images.
+//! single texture and INDEX-DATA at each B, each clipped frame's RMSE against the f64
+//! reference clipped by the analytic shape, and the largest difference between the
+//! INDEX-DATA and the single-texture images. [`plot`] draws RMSE against time. The
+//! unclipped frame has no error (it draws another picture) and the single texture no
+//! difference from itself: those fields are empty in the CSV and said in words in the
+//! lines (they once printed as NaN).
 //!
 //! Shapes: the sphere of radius 0.35 N at the volume's centre; a torus generated as
 //! a closed triangle mesh (1,152 triangles, tilted, so its surface cuts blocks at every
@@ -25,9 +29,13 @@ use super::shape::Shape;
 use super::texture::{ClipGrid, ClipTexture};
 use super::{ClipError, ClipSpec, ShapeSpec};
 use crate::gl::{Headless, Surface, Target};
+use crate::progress::{Bar, Unit};
 use crate::scene::{Scene, TechniqueScene};
+use crate::techniques::opacity3d::prepare::prepare;
+use crate::techniques::opacity3d::reference::reference_clipped;
 use crate::techniques::Frame;
 use crate::techniques::Params;
+use crate::volume::Limits;
 use crate::volume::VolumeSource;
 
 /// What to sweep.
@@ -43,6 +51,8 @@ pub struct Options {
     pub image: u32,
     /// Timed frames per setting (median), after one warm-up frame.
     pub frames: usize,
+    /// Steps per voxel of the f64 reference the frames are scored against.
+    pub oversample: f64,
 }
 
 impl Default for Options {
@@ -53,6 +63,7 @@ impl Default for Options {
             frame_volume: 256,
             image: 512,
             frames: 3,
+            oversample: 4.0,
         }
     }
 }
@@ -88,9 +99,29 @@ pub struct FrameRow {
     pub setting: String,
     /// Median milliseconds per frame (clear + draw + finish).
     pub ms: f64,
+    /// RMSE of RGB against the f64 reference of the clipped volume (None for `no clip`,
+    /// which draws another picture: the whole volume).
+    pub rmse: Option<f64>,
     /// Largest channel difference against the single-texture image, in 1/255 levels
-    /// (NaN for the rows without a clip or the single texture itself).
-    pub levels_from_single: f64,
+    /// (None for `no clip` and for the single texture itself, the comparison's baseline).
+    pub levels_from_single: Option<f64>,
+}
+
+impl FrameRow {
+    /// The row's errors as the progress line says them: numbers, or why there are none.
+    pub fn words(&self) -> String {
+        let rmse = self
+            .rmse
+            .map_or("no RMSE (unclipped: another picture)".into(), |r| {
+                format!("RMSE {r:.5}")
+            });
+        let levels = match (self.levels_from_single, self.setting.as_str()) {
+            (Some(l), _) => format!("{l:.1} levels from the single texture"),
+            (None, "single") => "(the single texture: the baseline of INDEX-DATA)".into(),
+            (None, _) => "(not compared with the single texture)".into(),
+        };
+        format!("{rmse}  {levels}")
+    }
 }
 
 /// The shapes of the sweep; `base` resolves `cow.obj`.
@@ -160,7 +191,20 @@ pub fn textures(
     mut progress: impl FnMut(&str),
 ) -> anyhow::Result<Vec<TextureRow>> {
     let mut rows = Vec::new();
+    // Work: texels of each shape's grid, once for the single texture and once per B.
+    let shapes_count = shapes().len() as u64 + 1;
+    let per_size = shapes_count * (1 + options.blocks.len() as u64);
+    let bar = Bar::new(
+        options
+            .sizes
+            .iter()
+            .map(|&n| per_size * (n as u64).pow(3))
+            .sum(),
+        "clip study, textures (1 of 2)",
+        Unit::Work,
+    );
     for &n in &options.sizes {
+        bar.set_message(&format!("clip study, textures at {n}³ (1 of 2)"));
         let mut built = Vec::new();
         for (name, shape, base) in shapes() {
             let spec = ClipSpec {
@@ -191,6 +235,7 @@ pub fn textures(
                     row.build_seconds
                 ));
                 rows.push(row);
+                bar.inc((n as u64).pow(3));
             };
             push(TextureRow {
                 n,
@@ -304,9 +349,17 @@ pub fn frames(
             }),
         ));
     }
+    let reference = reference_rgb(headless, &scene, options.oversample, &mut progress)?;
+    let bar = Bar::new(
+        settings.len() as u64,
+        "clip study, frames (2 of 2)",
+        Unit::Work,
+    );
     let mut rows = Vec::new();
     let mut single_image = None;
     for (name, clip) in settings {
+        bar.set_message(&format!("clip study, frames (2 of 2): {name}"));
+        let clipped = clip.is_some();
         let mut p = base.clone();
         p.clip = clip;
         renderer.update(gpu, Params::of(&*p))?;
@@ -323,26 +376,99 @@ pub fn frames(
         times.sort_by(f64::total_cmp);
         let image = target.read(gpu)?;
         let levels = match (&single_image, name.starts_with("INDEX")) {
-            (Some(single), true) => image
-                .compare(single, 0.0)
-                .map_or(f64::INFINITY, |d| d.max_abs * 255.0),
-            _ => f64::NAN,
+            (Some(single), true) => Some(
+                image
+                    .compare(single, 0.0)
+                    .map_or(f64::INFINITY, |d| d.max_abs * 255.0),
+            ),
+            _ => None,
         };
+        let rmse = clipped.then(|| crate::study::bench::rgb_error(&image, &reference).1);
         if name == "single" {
             single_image = Some(image);
         }
         let row = FrameRow {
             setting: name,
             ms: times[times.len() / 2],
+            rmse,
             levels_from_single: levels,
         };
         progress(&format!(
-            "{:<18} {:>9.1} ms/frame  {:>5.1} levels from the single texture",
-            row.setting, row.ms, row.levels_from_single
+            "{:<18} {:>9.1} ms/frame  {}",
+            row.setting,
+            row.ms,
+            row.words()
         ));
         rows.push(row);
+        bar.inc(1);
     }
     Ok(rows)
+}
+
+/// The f64 reference of the frame scene, clipped by the analytic shape (RGB, 3 floats a
+/// pixel, top row first).
+fn reference_rgb(
+    headless: &Headless,
+    scene: &Scene,
+    oversample: f64,
+    progress: &mut impl FnMut(&str),
+) -> anyhow::Result<Vec<f32>> {
+    let TechniqueScene::Opacity3d(params) = &scene.technique else {
+        anyhow::bail!("the clip study scene is not a 3D-opacity scene");
+    };
+    let t0 = Instant::now();
+    let limits = Limits::for_max_side(headless.gpu().caps().max_3d_texture_size);
+    let prepared = prepare(params, &scene.base, &limits).map_err(anyhow::Error::msg)?;
+    let spec = params.clip.as_ref().expect("frame_scene sets a clip");
+    let shape = spec.shape(&scene.base, prepared.half.to_array())?;
+    let image = reference_clipped(
+        &prepared,
+        params,
+        &scene.camera,
+        scene.size,
+        scene.background.map(f64::from),
+        oversample,
+        |x| shape.inside(x),
+    );
+    progress(&format!(
+        "clipped f64 reference ({oversample} steps per voxel) in {:.1} s",
+        t0.elapsed().as_secs_f64()
+    ));
+    Ok(image
+        .data
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect())
+}
+
+/// Plot the frames' RMSE against their time: the single texture and INDEX-DATA through
+/// its block sides, with the unclipped frame's time as a vertical line.
+pub fn plot(frames: &[FrameRow], path: &Path, title: &str) -> anyhow::Result<()> {
+    let of = |pick: &dyn Fn(&FrameRow) -> bool| -> Vec<(f64, f64)> {
+        frames
+            .iter()
+            .filter(|r| pick(r))
+            .filter_map(|r| Some((r.ms, r.rmse?)))
+            .collect()
+    };
+    let lines = vec![
+        ("single texture".to_string(), of(&|r| r.setting == "single")),
+        (
+            "INDEX-DATA, block sides B".to_string(),
+            of(&|r| r.setting.starts_with("INDEX")),
+        ),
+    ];
+    let verticals: Vec<(f64, String)> = frames
+        .iter()
+        .filter(|r| r.rmse.is_none())
+        .map(|r| (r.ms, format!("{} ({:.1} ms)", r.setting, r.ms)))
+        .collect();
+    let chart = crate::study::Chart {
+        title,
+        x: "time per frame (ms)",
+        y: "RMSE of RGB against the clipped f64 reference",
+    };
+    crate::study::plot_lines(&lines, path, &chart, &verticals)
 }
 
 /// Both sweeps as CSV text: textures, then frames.
@@ -364,11 +490,16 @@ pub fn to_csv(textures: &[TextureRow], frames: &[FrameRow]) -> (String, String) 
             r.build_seconds
         );
     }
-    let mut f = String::from("setting,ms_per_frame,levels_from_single\n");
+    // Unmeasured errors are empty fields (see [`FrameRow`] for why).
+    let cell = |v: Option<f64>, digits: usize| v.map_or(String::new(), |v| format!("{v:.digits$}"));
+    let mut f = String::from("setting,ms_per_frame,rmse,levels_from_single\n");
     for r in frames {
         f += &format!(
-            "\"{}\",{:.3},{:.2}\n",
-            r.setting, r.ms, r.levels_from_single
+            "\"{}\",{:.3},{},{}\n",
+            r.setting,
+            r.ms,
+            cell(r.rmse, 6),
+            cell(r.levels_from_single, 2)
         );
     }
     (t, f)

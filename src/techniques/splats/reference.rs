@@ -307,6 +307,13 @@ fn rasterize<T: Send>(
 ) {
     let [width, height] = size;
     let band = 16usize;
+    // A bar (bands of rows done, time left) when a reference runs past a couple of seconds.
+    let bar = crate::progress::Bar::delayed(
+        height.div_ceil(band as u32) as u64,
+        "f64 splat reference (bands of 16 rows)",
+        crate::progress::Unit::Rows,
+        std::time::Duration::from_secs(2),
+    );
     pixels
         .par_chunks_mut(width.max(1) as usize * band)
         .enumerate()
@@ -335,6 +342,7 @@ fn rasterize<T: Send>(
                     }
                 }
             }
+            bar.inc(1);
         });
 }
 

@@ -5,20 +5,23 @@
 //! each sort method while the camera turns 1° per frame (so every frame sorts and uploads,
 //! as a user's drag does), with the sort's share of it; then the same demo in precise
 //! mode drawn as points and as tiles (`draw = "tiles"`, each tile size), where the
-//! order's share is the tile lists' time. For clouds up to 2 M points also the f64
-//! references' time and weighted blended OIT's error against exact order, and the normals'
-//! estimation time.
+//! order's share is the tile lists' time, and each drawing's RMSE against the f64
+//! reference of the same splats in exact order ([`plot`]: RMSE against time). For clouds
+//! up to 2 M points also the f64 references' time and weighted blended OIT's error against
+//! exact order, and the normals' estimation time.
 
 use crate::study::median;
 use crate::techniques::Params;
 use std::time::Instant;
 
+use super::prepare::prepare;
 use super::scene::{DrawChoice, SortChoice};
 use super::sort::time_methods;
 use crate::camera::{Camera, Projection};
 use crate::gl::{Headless, Surface, Target};
 use crate::points::section::{generate, SectionSpec};
 use crate::points::{PointCloud, PointSource};
+use crate::progress::{Bar, Unit};
 use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::{self, Frame};
 use crate::vocab::Fidelity;
@@ -68,6 +71,9 @@ pub struct FrameRow {
     /// Median milliseconds of the order (the sort, or the tile lists) and upload within
     /// it.
     pub sort_ms: f64,
+    /// RMSE of RGB of the last frame against the f64 reference of the same splats in
+    /// exact back-to-front order (with the fidelity's footprint and colours).
+    pub rmse: f64,
 }
 
 /// The sort timings (CPU); `progress` hears one line per row.
@@ -78,7 +84,14 @@ pub fn sorts(options: &Options, mut progress: impl FnMut(&str)) -> anyhow::Resul
         ..Camera::default()
     };
     let mut rows = Vec::new();
+    // Work: points sorted (the references, below 2 M points, grow with them too).
+    let bar = Bar::new(
+        options.points.iter().map(|&n| n as u64).sum(),
+        "splats study, sorts (1 of 2)",
+        Unit::Work,
+    );
     for &points in &options.points {
+        bar.set_message(&format!("splats study, sorts of {points} points (1 of 2)"));
         let cloud = generate(&SectionSpec { points, seed: 1 })?;
         let mut push = |method: String, ms: f64| {
             progress(&format!("{points:>9} points  {ms:>9.2} ms  {method}"));
@@ -92,6 +105,7 @@ pub fn sorts(options: &Options, mut progress: impl FnMut(&str)) -> anyhow::Resul
                 push(method, ms);
             }
         }
+        bar.inc(points as u64);
     }
     Ok(rows)
 }
@@ -195,7 +209,16 @@ pub fn frames(
     let [w, h] = scene.size;
     let mut rows = Vec::new();
     let mut built: Option<(Fidelity, Box<dyn techniques::Renderer>)> = None;
+    // The references of the last frame's view, one per fidelity, made when first needed.
+    let (_, prepared) = prepare(&base, &scene.base).map_err(anyhow::Error::msg)?;
+    let mut references = Vec::new();
+    let bar = Bar::new(
+        settings.len() as u64,
+        "splats study, frames (2 of 2)",
+        Unit::Work,
+    );
     for (name, fidelity, p) in settings {
+        bar.set_message(&format!("splats study, frames (2 of 2): {name}"));
         let renderer = match &mut built {
             Some((f, r)) if *f == fidelity => {
                 r.update(gpu, Params::of(&p))?;
@@ -204,7 +227,7 @@ pub fn frames(
             _ => {
                 let mut s = scene.clone();
                 s.fidelity = fidelity;
-                s.technique = TechniqueScene::Splats(Box::new(p));
+                s.technique = TechniqueScene::Splats(Box::new(p.clone()));
                 let kind = s.programs.resolve(gpu);
                 &mut built
                     .insert((fidelity, crate::render::build(gpu, &s, kind)?))
@@ -232,18 +255,92 @@ pub fn frames(
                 order_times.push(order_ms(renderer.status().as_deref()));
             }
         }
+        if !references.iter().any(|(f, _)| *f == fidelity) {
+            let t0 = Instant::now();
+            let background = scene.clear_colour().map(f64::from);
+            let image = reference_of(&prepared, &p, fidelity, &camera, scene.size, background);
+            progress(&format!(
+                "f64 reference ({}, exact order) in {:.1} s",
+                fidelity.name(),
+                t0.elapsed().as_secs_f64()
+            ));
+            references.push((fidelity, image));
+        }
+        let reference = &references
+            .iter()
+            .find(|(f, _)| *f == fidelity)
+            .expect("made above")
+            .1;
+        let rmse = super::reference::rmse_rgb(&target.read(gpu)?, reference).unwrap_or(f64::NAN);
         let row = FrameRow {
             sort: name,
             ms: median(&times),
             sort_ms: median(&order_times),
+            rmse,
         };
         progress(&format!(
-            "{:<26} {:>9.1} ms/frame, of which order and upload {:>7.1} ms",
-            row.sort, row.ms, row.sort_ms
+            "{:<26} {:>9.1} ms/frame, of which order and upload {:>7.1} ms, RMSE {:.5}",
+            row.sort, row.ms, row.sort_ms, row.rmse
         ));
         rows.push(row);
+        bar.inc(1);
     }
     Ok(rows)
+}
+
+/// The f64 reference of `prepared` drawn with `params` at `fidelity` from `camera`, in
+/// exact back-to-front order, over the scene's clear colour.
+fn reference_of(
+    prepared: &super::prepare::Prepared,
+    params: &super::SplatsScene,
+    fidelity: Fidelity,
+    camera: &Camera,
+    size: [u32; 2],
+    background: [f64; 4],
+) -> crate::image::Image {
+    use super::reference::{composite, eye_position, view_direction, SplatParams, SplatScene};
+    let rgba = super::prepare::point_rgba(
+        prepared,
+        params,
+        fidelity,
+        eye_position(camera),
+        view_direction(camera),
+    );
+    let splats = SplatScene {
+        positions: &prepared.positions,
+        rgba: &rgba,
+        params: SplatParams {
+            point_size: params.point_size,
+            factor: params.factor,
+            footprint: super::prepare::footprint(params, fidelity),
+            size_range: [1.0, 255.0],
+        },
+        background,
+    };
+    composite(&splats, camera, size)
+}
+
+/// Plot each drawing's RMSE against its frame time: the faithful sorts and OIT, precise
+/// points, and precise tiles through their tile sides.
+pub fn plot(frames: &[FrameRow], path: &std::path::Path, title: &str) -> anyhow::Result<()> {
+    let mut lines: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for r in frames {
+        let series = if r.sort.starts_with("tiles") {
+            "tiles (precise), 1 to 4 px".to_string()
+        } else {
+            r.sort.clone()
+        };
+        match lines.iter_mut().find(|(n, _)| *n == series) {
+            Some((_, points)) => points.push((r.ms, r.rmse)),
+            None => lines.push((series, vec![(r.ms, r.rmse)])),
+        }
+    }
+    let chart = crate::study::Chart {
+        title,
+        x: "time per frame, camera turning 1° a frame (ms)",
+        y: "RMSE of RGB against the f64 reference in exact order",
+    };
+    crate::study::plot_lines(&lines, path, &chart, &[])
 }
 
 /// The order's time in the renderer's status line: `last lists 21.3 ms` (tiles), else
@@ -267,9 +364,9 @@ pub fn to_csv(sorts: &[SortRow], frames: &[FrameRow]) -> (String, String) {
     for r in sorts {
         s += &format!("{},\"{}\",{:.3}\n", r.points, r.method, r.ms);
     }
-    let mut f = String::from("drawn,ms_per_frame,order_and_upload_ms\n");
+    let mut f = String::from("drawn,ms_per_frame,order_and_upload_ms,rmse\n");
     for r in frames {
-        f += &format!("{},{:.3},{:.3}\n", r.sort, r.ms, r.sort_ms);
+        f += &format!("{},{:.3},{:.3},{:.6}\n", r.sort, r.ms, r.sort_ms, r.rmse);
     }
     (s, f)
 }

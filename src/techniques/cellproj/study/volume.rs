@@ -10,6 +10,7 @@ use std::time::Instant;
 
 use crate::camera::{Camera, Projection};
 use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target};
+use crate::progress::{Bar, Unit};
 use crate::study::median;
 use crate::techniques::{Frame, Renderer};
 use crate::vocab::{Fidelity, TargetFormat};
@@ -75,7 +76,15 @@ pub struct Row {
     pub sort_ms: f64,
     /// Of the moving frame: building and uploading the index buffer (median).
     pub upload_ms: f64,
-    /// RMSE and largest error over the image (NaN unscored).
+    /// Errors against the f64 reference (None: more tetrahedra than
+    /// [`Options::score_up_to`], not scored).
+    pub score: Option<Score>,
+}
+
+/// A setting's errors against the f64 reference.
+#[derive(Debug, Clone, Copy)]
+pub struct Score {
+    /// RMSE over the image.
     pub rmse: f64,
     /// Largest error over the image.
     pub max: f64,
@@ -83,6 +92,33 @@ pub struct Row {
     pub rmse_interior: f64,
     /// Largest error over the interior pixels.
     pub max_interior: f64,
+}
+
+/// The settings of one mesh and projection: faithful MPVONC at each table size, centroid
+/// at 128, the precise walk and precise projected.
+fn settings(base: &VolumeSpec, options: &Options) -> Vec<(String, Fidelity, VolumeSpec)> {
+    let mut settings: Vec<(String, Fidelity, VolumeSpec)> = Vec::new();
+    for &n in &options.tables {
+        for sort in [Sort::Mpvonc, Sort::Centroid] {
+            if sort == Sort::Centroid && n != 128 {
+                continue;
+            }
+            let mut v = base.clone();
+            v.sort = sort;
+            v.table_size = [n, (n / 2).max(2)];
+            let name = format!("faithful {sort:?} table {n}x{n}x{}", (n / 2).max(2));
+            settings.push((name.to_lowercase(), Fidelity::Faithful, v));
+        }
+    }
+    settings.push(("precise walk".into(), Fidelity::Precise, base.clone()));
+    let mut projected = base.clone();
+    projected.precise = super::super::transfer::Precise::Projected;
+    settings.push((
+        "precise projected (mpvonc)".into(),
+        Fidelity::Precise,
+        projected,
+    ));
+    settings
 }
 
 /// Run the sweep; `progress` hears one line per setting.
@@ -100,6 +136,18 @@ pub fn run(
     };
     let [w, h] = options.size;
     let mut rows = Vec::new();
+    // Work per setting: its tetrahedra (sorting and drawing grow with them).
+    let per_case = cases.first().map_or(0, |c| {
+        2 * settings(&c.scene.volume_spec(), options).len() as u64
+    });
+    let bar = Bar::new(
+        cases
+            .iter()
+            .map(|c| per_case * c.prepared.tets.len() as u64)
+            .sum(),
+        "cell-projection volume study",
+        Unit::Work,
+    );
     for case in cases {
         let base = case.scene.volume_spec();
         for projection in [Projection::Orthographic, Projection::Perspective] {
@@ -126,28 +174,8 @@ pub fn run(
             } else {
                 (None, Vec::new())
             };
-            let mut settings: Vec<(String, Fidelity, VolumeSpec)> = Vec::new();
-            for &n in &options.tables {
-                for sort in [Sort::Mpvonc, Sort::Centroid] {
-                    if sort == Sort::Centroid && n != 128 {
-                        continue;
-                    }
-                    let mut v = base.clone();
-                    v.sort = sort;
-                    v.table_size = [n, (n / 2).max(2)];
-                    let name = format!("faithful {sort:?} table {n}x{n}x{}", (n / 2).max(2));
-                    settings.push((name.to_lowercase(), Fidelity::Faithful, v));
-                }
-            }
-            settings.push(("precise walk".into(), Fidelity::Precise, base.clone()));
-            let mut projected = base.clone();
-            projected.precise = super::super::transfer::Precise::Projected;
-            settings.push((
-                "precise projected (mpvonc)".into(),
-                Fidelity::Precise,
-                projected,
-            ));
-            for (name, fidelity, volume) in settings {
+            for (name, fidelity, volume) in settings(&base, options) {
+                bar.set_message(&format!("cell-projection volume, {}: {name}", case.name));
                 let mut scene = case.scene.clone();
                 scene.mode = super::super::Mode::Volume;
                 scene.volume = Some(volume);
@@ -189,10 +217,15 @@ pub fn run(
                     sort.push(t.sort_ms);
                     upload.push(t.upload_ms);
                 }
-                let ((rmse, max), (rmse_interior, max_interior)) = match &want {
-                    Some(want) => score(&image, want, &mask),
-                    None => ((f64::NAN, f64::NAN), (f64::NAN, f64::NAN)),
-                };
+                let score = want.as_ref().map(|want| {
+                    let ((rmse, max), (rmse_interior, max_interior)) = score(&image, want, &mask);
+                    Score {
+                        rmse,
+                        max,
+                        rmse_interior,
+                        max_interior,
+                    }
+                });
                 let row = Row {
                     mesh: case.name.clone(),
                     tets: case.prepared.tets.len(),
@@ -205,31 +238,91 @@ pub fn run(
                     moving_ms: median(&moving),
                     sort_ms: median(&sort),
                     upload_ms: median(&upload),
-                    rmse,
-                    max,
-                    rmse_interior,
-                    max_interior,
+                    score,
+                };
+                let scored = match row.score {
+                    Some(s) => format!(
+                        "RMSE {:.5} (interior {:.5}) max {:.4}",
+                        s.rmse, s.rmse_interior, s.max
+                    ),
+                    None => format!(
+                        "unscored (more than {} tetrahedra: no reference)",
+                        options.score_up_to
+                    ),
                 };
                 progress(&format!(
-                    "{:<10} {:>8} {} {:<36} still {:>8.1} ms  moving {:>8.1} ms (sort {:>6.1}, indices {:>5.1})  RMSE {:.5} (interior {:.5}) max {:.4}",
+                    "{:<10} {:>8} {} {:<36} still {:>8.1} ms  moving {:>8.1} ms (sort {:>6.1}, indices {:>5.1})  {scored}",
                     row.mesh, row.tets, row.projection, row.setting, row.still_ms, row.moving_ms,
-                    row.sort_ms, row.upload_ms, row.rmse, row.rmse_interior, row.max
+                    row.sort_ms, row.upload_ms
                 ));
                 rows.push(row);
+                bar.inc(case.prepared.tets.len() as u64);
             }
         }
     }
     Ok(rows)
 }
 
-/// The rows as CSV.
+/// The series of a setting name: faithful MPVONC through its table sizes is one line.
+fn family(setting: &str) -> &str {
+    match setting.find(" table ") {
+        Some(i) if setting.starts_with("faithful mpvonc") => &setting[..i],
+        _ => setting,
+    }
+}
+
+/// Plot RMSE over the image against the still frame's time, one plot per scored mesh
+/// (`OUT/cellproj-volume-MESH.png`): a line per setting family and projection, faithful
+/// MPVONC through its table sizes. Returns the files written.
+pub fn plot(rows: &[Row], out: &std::path::Path) -> anyhow::Result<Vec<std::path::PathBuf>> {
+    let mut meshes: Vec<&str> = rows
+        .iter()
+        .filter(|r| r.score.is_some())
+        .map(|r| r.mesh.as_str())
+        .collect();
+    meshes.dedup();
+    let mut written = Vec::new();
+    for mesh in meshes {
+        let of_mesh: Vec<&Row> = rows.iter().filter(|r| r.mesh == mesh).collect();
+        let mut names: Vec<String> = of_mesh
+            .iter()
+            .map(|r| format!("{} ({})", family(&r.setting), r.projection))
+            .collect();
+        names.sort();
+        names.dedup();
+        let lines: Vec<(String, Vec<(f64, f64)>)> = names
+            .into_iter()
+            .map(|name| {
+                let points = of_mesh
+                    .iter()
+                    .filter(|r| format!("{} ({})", family(&r.setting), r.projection) == name)
+                    .filter_map(|r| Some((r.still_ms, r.score?.rmse)))
+                    .collect();
+                (name, points)
+            })
+            .collect();
+        let tets = of_mesh.first().map_or(0, |r| r.tets);
+        let title = format!("cell-projection volume: {mesh} ({tets} tetrahedra)");
+        let chart = crate::study::Chart {
+            title: &title,
+            x: "time per frame, camera still (ms)",
+            y: "RMSE of RGB against the f64 reference",
+        };
+        let path = out.join(format!("cellproj-volume-{mesh}.png"));
+        crate::study::plot_lines(&lines, &path, &chart, &[])?;
+        written.push(path);
+    }
+    Ok(written)
+}
+
+/// The rows as CSV (an unscored setting's errors are empty fields).
 pub fn to_csv(rows: &[Row]) -> String {
     let mut s = String::from(
         "mesh,tets,projection,setting,still_ms,moving_ms,sort_ms,upload_ms,rmse,max,rmse_interior,max_interior\n",
     );
     for r in rows {
         s += &format!(
-            "{},{},{},\"{}\",{:.3},{:.3},{:.3},{:.3},{:.6},{:.6},{:.6},{:.6}\n",
+            "{},{},{},\"{}\",{:.3},{:.3},{:.3},{:.3},{}\n",
             r.mesh,
             r.tets,
             r.projection,
@@ -238,10 +331,10 @@ pub fn to_csv(rows: &[Row]) -> String {
             r.moving_ms,
             r.sort_ms,
             r.upload_ms,
-            r.rmse,
-            r.max,
-            r.rmse_interior,
-            r.max_interior
+            r.score.map_or(",,,".to_string(), |s| format!(
+                "{:.6},{:.6},{:.6},{:.6}",
+                s.rmse, s.max, s.rmse_interior, s.max_interior
+            ))
         );
     }
     s
