@@ -2,6 +2,8 @@
 #![allow(dead_code)]
 
 pub mod splats;
+#[cfg(feature = "viewer")]
+pub mod viewer;
 
 use std::path::{Path, PathBuf};
 
