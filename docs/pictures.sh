@@ -6,14 +6,25 @@ cargo build --release --quiet
 arbvis=target/release/arbvis
 out=docs/pictures
 mkdir -p "$out"
-for demo in v3o2-sum v3o2-product cellproj-planar cellproj-spherical clip-sphere clip-mesh; do
+for demo in v3o2-sum v3o2-product cellproj-planar cellproj-spherical cellproj-spherical-precise \
+            clip-sphere clip-mesh; do
   "$arbvis" render --demo "$demo" -o "$out/$demo.png"
 done
-"$arbvis" render --demo cellproj-spherical --fidelity precise -o "$out/cellproj-spherical-precise.png"
-"$arbvis" render --demo splats-section --size 1200x675 -o "$out/splats-section.png"
+for demo in splats-section splats-section-precise; do
+  "$arbvis" render --demo "$demo" --size 1200x675 -o "$out/$demo.png"
+done
 # Real data (from ../shared/data, which a user's clone may not have).
 if [ -d ../shared/data ]; then
   for s in f3 icbm152 post autzen bunny; do
     "$arbvis" render "scenes/data/$s.toml" -o "$out/data-$s.png"
   done
 fi
+# Issue 16: volume rendering of the real tetrahedral meshes (cell projection's volume mode).
+if [ -d ../shared/data ]; then
+  for s in bracket-volume post-volume can-volume tetrahedron-volume; do
+    "$arbvis" render "scenes/data/$s.toml" -o "$out/data-$s.png"
+  done
+  "$arbvis" render scenes/data/bracket-volume.toml --fidelity faithful -o "$out/data-bracket-volume-faithful.png"
+fi
+"$arbvis" render scenes/bench/cellproj-seed-volume.toml -o "$out/cellproj-seed-volume.png"
+"$arbvis" render scenes/bench/cellproj-seed-volume.toml --fidelity precise -o "$out/cellproj-seed-volume-precise.png"

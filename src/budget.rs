@@ -17,9 +17,18 @@
 //! SIZE is bytes with an optional unit (`512M`, `16G`, `1.5T`; K/M/G/T are powers of 1024,
 //! an optional `iB`/`B` is accepted) or a share of physical memory (`75%`).
 //!
+//! While a reader runs inside [`for_input`] and the budget is the default, it is also
+//! bounded by the size of the file being read: [`INPUT_RATIO`] bytes per byte of the
+//! file, at least [`INPUT_FLOOR`]. A legal file that makes far more than it holds (a
+//! zlib array that inflates a thousandfold, gmsh data sections that each make a dense
+//! array) is then refused in milliseconds instead of being made for tens of seconds;
+//! choosing a budget (1 to 3 above) lifts the ratio, so a user who wants such a file read
+//! says so with a size.
+//!
 //! The check is per allocation (or per group of allocations made together), not a running
 //! total: it bounds what one input can make arbvis ask for.
 
+use std::cell::Cell;
 use std::sync::atomic::{AtomicU64, AtomicU8, Ordering};
 use std::sync::OnceLock;
 
@@ -34,17 +43,49 @@ pub enum Source {
     Scene,
     /// `--memory-budget` or [`set`].
     Explicit,
+    /// The default bounded by the size (bytes) of the file being read ([`for_input`]).
+    Input(u64),
 }
 
 impl Source {
-    fn describe(self) -> &'static str {
+    fn describe(self) -> String {
         match self {
-            Source::Default => "the default, half of physical memory",
-            Source::Environment => "from ARBVIS_MEMORY_BUDGET",
-            Source::Scene => "from the scene's memory_budget",
-            Source::Explicit => "from --memory-budget",
+            Source::Default => "the default, half of physical memory".into(),
+            Source::Environment => "from ARBVIS_MEMORY_BUDGET".into(),
+            Source::Scene => "from the scene's memory_budget".into(),
+            Source::Explicit => "from --memory-budget".into(),
+            Source::Input(len) => format!(
+                "the default for a file of {}: {INPUT_RATIO} bytes per byte of the file, at least {}",
+                format_bytes(len),
+                format_bytes(INPUT_FLOOR)
+            ),
         }
     }
+}
+
+/// Bytes a reader may make per byte of its file while the budget is the default.
+pub const INPUT_RATIO: u64 = 32;
+
+/// What a reader may make whatever the size of its file, while the budget is the default.
+pub const INPUT_FLOOR: u64 = 64 << 20;
+
+thread_local! {
+    /// The size of the file the reader running on this thread reads ([`for_input`]).
+    static INPUT: Cell<Option<u64>> = const { Cell::new(None) };
+}
+
+/// Run `read`, a reader of a file of `len` bytes, with the default budget also bounded by
+/// that size (see the module doc); on this thread only, and restored afterwards (also
+/// when `read` panics).
+pub fn for_input<R>(len: u64, read: impl FnOnce() -> R) -> R {
+    struct Restore(Option<u64>);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            INPUT.set(self.0);
+        }
+    }
+    let _restore = Restore(INPUT.replace(Some(len)));
+    read()
 }
 
 /// The budget in force: bytes and where they came from.
@@ -94,6 +135,7 @@ fn source_code(s: Source) -> u8 {
         Source::Environment => 2,
         Source::Scene => 3,
         Source::Explicit => 4,
+        Source::Input(_) => 1,
     }
 }
 
@@ -147,8 +189,8 @@ pub fn physical_memory() -> Option<u64> {
     }
 }
 
-/// The budget in force.
-pub fn current() -> Budget {
+/// The budget chosen for the process (not bounded by an input).
+fn chosen() -> Budget {
     let code = CHOSEN_SOURCE.load(Ordering::Acquire);
     if code == NOT_SET {
         return initial();
@@ -156,6 +198,24 @@ pub fn current() -> Budget {
     Budget {
         bytes: CHOSEN_BYTES.load(Ordering::Acquire),
         source: source_of(code),
+    }
+}
+
+/// The budget in force (on this thread: see [`for_input`]).
+pub fn current() -> Budget {
+    let chosen = chosen();
+    match (chosen.source, INPUT.get()) {
+        (Source::Default, Some(len)) => {
+            let bound = len.saturating_mul(INPUT_RATIO).max(INPUT_FLOOR);
+            if bound < chosen.bytes {
+                return Budget {
+                    bytes: bound,
+                    source: Source::Input(len),
+                };
+            }
+            chosen
+        }
+        _ => chosen,
     }
 }
 
@@ -167,7 +227,7 @@ pub fn set(bytes: u64) {
 /// A scene's `memory_budget`: taken only where neither `--memory-budget` nor
 /// `ARBVIS_MEMORY_BUDGET` chose one.
 pub fn set_from_scene(bytes: u64) {
-    let now = current().source;
+    let now = chosen().source;
     if matches!(now, Source::Default | Source::Scene) {
         choose(bytes, Source::Scene);
     }
@@ -189,6 +249,42 @@ pub fn check(what: impl Into<String>, estimate: u64) -> Result<(), OverBudget> {
         });
     }
     Ok(())
+}
+
+/// One large allocation something will make, estimated before any work.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Estimate {
+    /// What it is for, e.g. `the read-back of a 16384x16384 frame`.
+    pub what: String,
+    /// Its size in bytes.
+    pub bytes: u64,
+}
+
+impl Estimate {
+    /// `count` items of `each` bytes for `what`.
+    pub fn of(what: impl Into<String>, count: u64, each: u64) -> Estimate {
+        Estimate {
+            what: what.into(),
+            bytes: times(count, each),
+        }
+    }
+}
+
+/// Refuse `estimates`, made together for `of` (e.g. `rendering scene.toml`), when their
+/// sum is over the budget; the error lists each part.
+pub fn check_estimates(of: &str, estimates: &[Estimate]) -> Result<(), OverBudget> {
+    let total = estimates
+        .iter()
+        .fold(0u64, |a, e| a.saturating_add(e.bytes));
+    if total <= current().bytes {
+        return Ok(());
+    }
+    let parts: Vec<String> = estimates
+        .iter()
+        .filter(|e| e.bytes > 0)
+        .map(|e| format!("{}: {}", e.what, format_bytes(e.bytes)))
+        .collect();
+    check(format!("{of} ({})", parts.join("; ")), total)
 }
 
 /// `count` items of `each` bytes, saturating (an estimate, never an overflow).
@@ -301,6 +397,25 @@ mod tests {
     }
 
     #[test]
+    fn estimates_add_up_and_name_their_parts() {
+        let parts = [
+            Estimate::of("a read-back", 1 << 40, 16),
+            Estimate::of("nothing", 0, 16),
+            Estimate::of("a grid", 10, 8),
+        ];
+        let e = check_estimates("rendering x.toml", &parts)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("rendering x.toml (a read-back: 16.00 TiB; a grid: 80 B)"),
+            "{e}"
+        );
+        assert!(!e.contains("nothing"), "{e}");
+        assert!(check_estimates("small", &parts[1..]).is_ok());
+        assert_eq!(Estimate::of("x", u64::MAX, 3).bytes, u64::MAX);
+    }
+
+    #[test]
     fn bytes_format_for_people() {
         assert_eq!(format_bytes(512), "512 B");
         assert_eq!(format_bytes(1536), "1.50 KiB");
@@ -313,6 +428,36 @@ mod tests {
         if let Some(m) = physical_memory() {
             assert_eq!(default_bytes(), m / 2);
         }
+    }
+
+    #[test]
+    fn a_reader_is_bounded_by_its_file_while_the_budget_is_the_default() {
+        // Run where nothing else sets the budget: on a thread of its own, with the
+        // source read back (another test may have chosen one for the process).
+        std::thread::spawn(|| {
+            let outside = current();
+            let inside = for_input(1 << 20, current);
+            if outside.source == Source::Default && outside.bytes > 320 << 20 {
+                // 1 MiB of file: max(32 MiB, 64 MiB) = 64 MiB.
+                assert_eq!(inside.bytes, INPUT_FLOOR);
+                assert_eq!(inside.source, Source::Input(1 << 20));
+                let big = for_input(10 << 20, current);
+                assert_eq!(big.bytes, 320 << 20);
+                let e = for_input(10 << 20, || check("x", 1 << 30)).unwrap_err();
+                assert!(
+                    e.to_string().contains(
+                        "more than the memory budget of 320 MiB (the default for a file of 10.00 MiB: 32 bytes per byte of the file, at least 64.00 MiB)"
+                    ),
+                    "{e}"
+                );
+            } else {
+                // A chosen budget is not bounded by the file.
+                assert_eq!(inside, outside);
+            }
+            assert_eq!(current(), outside, "restored after the reader");
+        })
+        .join()
+        .unwrap();
     }
 
     #[test]

@@ -57,6 +57,19 @@ impl TechniqueScene {
     }
 }
 
+impl TechniqueScene {
+    /// The large allocations preparing and drawing it at `size` makes that the scene
+    /// alone determines (generated data, grids, lists); files are checked by their loaders.
+    pub fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
+        match self {
+            TechniqueScene::Quad(_) => Vec::new(),
+            TechniqueScene::Opacity3d(p) => p.memory_estimate(),
+            TechniqueScene::Cellproj(p) => p.memory_estimate(),
+            TechniqueScene::Splats(p) => p.memory_estimate(size),
+        }
+    }
+}
+
 /// What a renderer needs of the scene besides its own parameters.
 #[derive(Debug, Clone, Copy)]
 pub struct Settings<'a> {
@@ -85,6 +98,15 @@ pub fn build(
     } = *settings;
     Ok(match technique {
         TechniqueScene::Quad(params) => Box::new(quad::QuadRenderer::new(gpu, kind, params)?),
+        TechniqueScene::Opacity3d(params)
+            if opacity3d::bricked::store_of(params)
+                .map_err(crate::gl::GlError::Data)?
+                .is_some() =>
+        {
+            Box::new(opacity3d::bricked::BrickedRenderer::new(
+                gpu, kind, fidelity, params, base, None,
+            )?)
+        }
         TechniqueScene::Opacity3d(params) => Box::new(opacity3d::Opacity3dRenderer::new(
             gpu,
             opacity3d::renderer::resolve_kind(params, fidelity, programs, kind),

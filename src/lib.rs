@@ -27,6 +27,7 @@ pub mod points;
 pub mod programs;
 pub mod render;
 pub mod scene;
+pub mod store;
 pub mod study;
 pub mod surface;
 pub mod techniques;

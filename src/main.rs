@@ -44,7 +44,7 @@ enum Command {
         scene: SceneArgs,
         /// Output PNG (written atomically; the name must end in .png).
         #[arg(short, long, value_parser = png_path)]
-        output: PathBuf,
+        output: Option<PathBuf>,
         /// Offscreen backend.
         #[arg(long, value_enum, default_value_t = Backend::Egl)]
         backend: Backend,
@@ -102,6 +102,10 @@ enum Command {
         /// 24,576 tetrahedra; 56: about a million).
         #[arg(long, value_delimiter = ',', default_values_t = [17, 25, 33, 45, 56])]
         grids: Vec<usize>,
+        /// Cell projection's volume: cell-projection scenes whose meshes and transfer
+        /// functions to add to the grids.
+        #[arg(long, value_delimiter = ',')]
+        scenes: Vec<PathBuf>,
         /// Clipping: clip grid sides of the texture sweep.
         #[arg(long, value_delimiter = ',', default_values_t = [256, 512])]
         clip_sizes: Vec<usize>,
@@ -120,6 +124,37 @@ enum Command {
         /// Output folder.
         #[arg(long, default_value = "study")]
         out: PathBuf,
+    },
+    /// Convert a survey (SEG-Y, NIfTI-1, raw) into a bricked multi-resolution zarr v3
+    /// store that `{ store = "STORE" }` scenes stream (src/store/). Streams the input
+    /// (one column of traces per worker), computes the derived attributes, builds the
+    /// levels; run it again after an interruption to resume.
+    Convert {
+        /// The survey: SEG-Y, NIfTI-1 (.nii, .nii.gz), or raw with --raw-dims.
+        input: PathBuf,
+        /// The store's folder (created; an interrupted conversion there is resumed).
+        store: PathBuf,
+        /// Brick (chunk) side in voxels.
+        #[arg(long, default_value_t = 64)]
+        brick: usize,
+        /// Derived attributes (per-trace Hilbert transform), comma-separated, or "none".
+        #[arg(long, value_delimiter = ',', default_values_t = ["envelope".to_string(), "phase".to_string(), "frequency".to_string()])]
+        attributes: Vec<String>,
+        /// zstd level of the chunks (0: uncompressed).
+        #[arg(long, default_value_t = 1)]
+        zstd: i32,
+        /// A raw input's dimensions I,J,K (i fastest).
+        #[arg(long, value_delimiter = ',', num_args = 3)]
+        raw_dims: Option<Vec<usize>>,
+        /// A raw input's sample type (u8, i8, u16, i16, u32, i32, f32, f64).
+        #[arg(long, default_value = "f32")]
+        raw_type: String,
+        /// A raw input's byte order.
+        #[arg(long, default_value = "little")]
+        raw_endian: String,
+        /// Bytes to skip at the start of a raw input.
+        #[arg(long, default_value_t = 0)]
+        raw_offset: u64,
     },
     /// Open the desktop viewer (winit + glutin + egui).
     #[cfg(feature = "viewer")]
@@ -155,7 +190,32 @@ enum Command {
         #[arg(long, verbatim_doc_comment)]
         script: Option<PathBuf>,
     },
+    /// The desktop viewer is not in this build (headless, --no-default-features).
+    #[cfg(not(feature = "viewer"))]
+    View {
+        /// Whatever was asked of the viewer.
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        rest: Vec<String>,
+    },
 }
+
+impl Command {
+    /// The scene arguments of the commands that take a scene.
+    fn scene_args(&self) -> Option<&SceneArgs> {
+        match self {
+            Command::Render { scene, .. } | Command::Bench { scene, .. } => Some(scene),
+            #[cfg(feature = "viewer")]
+            Command::View { scene, .. } => Some(scene),
+            _ => None,
+        }
+    }
+}
+
+/// What a build without the viewer answers to `arbvis view`.
+#[cfg(not(feature = "viewer"))]
+const NO_VIEWER: &str = "this arbvis was built without the viewer (cargo's --no-default-features, \
+the headless build); build the whole program with `cargo install --path .` (or run \
+`cargo run --release -- view ...`)";
 
 /// Write a study's files into `out` (created if missing), atomically, saying so.
 fn write_study<const N: usize>(out: &Path, files: [(&str, String); N]) -> Result<()> {
@@ -169,6 +229,30 @@ fn write_study<const N: usize>(out: &Path, files: [(&str, String); N]) -> Result
     Ok(())
 }
 
+/// A volume study case from a cell-projection scene (its camera, mesh and transfer
+/// function).
+fn volume_case(
+    name: &str,
+    scene: &Scene,
+) -> Result<arbvis::techniques::cellproj::study::volume::Case> {
+    let arbvis::scene::TechniqueScene::Cellproj(c) = &scene.technique else {
+        bail!("{name}: not a cell-projection scene");
+    };
+    let prepared = arbvis::techniques::cellproj::prepare::prepare(c, &scene.base)
+        .map_err(anyhow::Error::msg)?;
+    let camera = if scene.camera == arbvis::camera::Camera::default() {
+        arbvis::techniques::cellproj::study::study_camera(arbvis::camera::Projection::Orthographic)
+    } else {
+        scene.camera
+    };
+    Ok(arbvis::techniques::cellproj::study::volume::Case {
+        name: name.to_string(),
+        scene: (**c).clone(),
+        prepared,
+        camera,
+    })
+}
+
 /// Techniques with a trade study.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum StudyTechnique {
@@ -177,6 +261,10 @@ enum StudyTechnique {
     /// Cell projection: mesh sizes, exit per vertex / per fragment, faithful / precise,
     /// mesh / view order, isovalue-edit latency.
     Cellproj,
+    /// Cell projection's volume: faithful (both sorts, table sizes) and precise, still
+    /// and turning, ortho and perspective, against the f64 reference, on the `--grids`
+    /// meshes and any `--scenes` (e.g. scenes/data/bracket-volume.toml).
+    CellprojVolume,
     /// Volume clipping: clip grid sizes, shapes and block sizes (bytes, ratio, build
     /// time), and frame times with no clip, the single texture and INDEX-DATA.
     Clip,
@@ -231,9 +319,12 @@ const VTK_MS: f64 = 1260.0;
 struct SceneArgs {
     /// Scene file (TOML).
     scene: Option<PathBuf>,
-    /// A built-in demo instead of a file.
-    #[arg(long, conflicts_with = "scene",
-          value_parser = clap::builder::PossibleValuesParser::new(arbvis::scene::DEMOS.iter().map(|d| d.0)))]
+    /// A built-in demo instead of a file; `--demo` alone lists them. Demos: quad,
+    /// v3o2-sum, v3o2-product, cellproj-planar, cellproj-spherical,
+    /// cellproj-spherical-precise, splats-section, splats-section-precise, clip-sphere,
+    /// clip-mesh.
+    #[arg(long, conflicts_with = "scene", num_args = 0..=1, default_missing_value = "",
+          value_name = "NAME", value_parser = demo_name)]
     demo: Option<String>,
     /// Image size, e.g. 512x512.
     #[arg(long, value_parser = parse_size)]
@@ -251,6 +342,14 @@ struct SceneArgs {
     /// what the screen shows).
     #[arg(long)]
     transparent: bool,
+    /// Texture memory for a survey store's bricks (e.g. 256M, 2G): the GPU brick cache's
+    /// budget (a scene's `[technique.opacity3d.store] gpu_memory`).
+    #[arg(long, value_name = "SIZE", value_parser = gpu_memory)]
+    gpu_memory: Option<String>,
+}
+
+fn gpu_memory(s: &str) -> Result<String, String> {
+    arbvis::budget::parse(s).map(|_| s.to_string())
 }
 
 impl SceneArgs {
@@ -276,6 +375,11 @@ impl SceneArgs {
         if self.transparent {
             scene.transparent = true;
         }
+        if let Some(g) = &self.gpu_memory {
+            if let arbvis::scene::TechniqueScene::Opacity3d(p) = &mut scene.technique {
+                p.store.get_or_insert_with(Default::default).gpu_memory = g.clone();
+            }
+        }
         if let Some(bytes) = scene
             .memory_budget_bytes()
             .map_err(|e| anyhow::anyhow!("{origin}: {e}"))?
@@ -284,6 +388,24 @@ impl SceneArgs {
         }
         Ok((scene, origin))
     }
+}
+
+/// A demo's name, or "" (`--demo` alone: list them).
+fn demo_name(s: &str) -> Result<String, String> {
+    if s.is_empty() || arbvis::scene::DEMOS.iter().any(|d| d.0 == s) {
+        Ok(s.to_string())
+    } else {
+        Err(format!("no demo named {s:?}; demos: {}", demo_list(", ")))
+    }
+}
+
+/// The demos' names joined by `separator`.
+fn demo_list(separator: &str) -> String {
+    arbvis::scene::DEMOS
+        .iter()
+        .map(|d| d.0)
+        .collect::<Vec<_>>()
+        .join(separator)
 }
 
 /// An output path ending in `.png` (arbvis writes PNG only: a `.jpg` name would hold a
@@ -314,6 +436,19 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<()> {
     if let Some(bytes) = cli.memory_budget {
         arbvis::budget::set(bytes);
+    } else if let Ok(text) = std::env::var("ARBVIS_MEMORY_BUDGET") {
+        // The library ignores a value it cannot read; the command line says so.
+        arbvis::budget::parse(&text)
+            .map_err(|e| anyhow::anyhow!("ARBVIS_MEMORY_BUDGET={text}: {e}"))?;
+    }
+    if cli
+        .command
+        .scene_args()
+        .is_some_and(|a| a.demo.as_deref() == Some(""))
+    {
+        // `--demo` without a name: the list is the answer.
+        println!("{}", demo_list("\n"));
+        return Ok(());
     }
     match cli.command {
         Command::Info { backend, json } => {
@@ -331,6 +466,9 @@ fn run(cli: Cli) -> Result<()> {
             backend,
             stats,
         } => {
+            let Some(output) = output else {
+                bail!("render needs an output file: -o OUT.png");
+            };
             let (scene, origin) = scene.load()?;
             let rendered = arbvis::render::render(&scene, backend)
                 .with_context(|| format!("rendering {origin}"))?;
@@ -351,12 +489,62 @@ fn run(cli: Cli) -> Result<()> {
             );
             if stats {
                 print!("{}", arbvis::render::format_stats(&rendered.resources));
+                if let Some(status) = &rendered.status {
+                    println!("{status}");
+                }
                 println!(
                     "build {:.3} ms, draw {:.3} ms",
                     rendered.build_time.as_secs_f64() * 1e3,
                     rendered.draw_time.as_secs_f64() * 1e3
                 );
             }
+        }
+        Command::Convert {
+            input,
+            store,
+            brick,
+            attributes,
+            zstd,
+            raw_dims,
+            raw_type,
+            raw_endian,
+            raw_offset,
+        } => {
+            let mut derived = Vec::new();
+            for name in attributes.iter().filter(|a| a.as_str() != "none") {
+                match arbvis::volume::attributes::by_name(name) {
+                    Some(arbvis::volume::attributes::Attribute::Amplitude) | None => bail!(
+                        "--attributes {name}: derived attributes are envelope, phase, cosine-phase, frequency (or none)"
+                    ),
+                    Some(a) => derived.push(a),
+                }
+            }
+            let raw = match raw_dims {
+                Some(d) => Some(arbvis::volume::raw::RawSpec {
+                    path: input.clone(),
+                    dims: [d[0], d[1], d[2]],
+                    sample: serde_json::from_value(serde_json::json!(raw_type)).map_err(|_| {
+                        anyhow::anyhow!(
+                            "--raw-type {raw_type}: one of u8, i8, u16, i16, u32, i32, f32, f64"
+                        )
+                    })?,
+                    endian: serde_json::from_value(serde_json::json!(raw_endian))
+                        .map_err(|_| anyhow::anyhow!("--raw-endian {raw_endian}: little or big"))?,
+                    offset: raw_offset,
+                    spacing: [1.0; 3],
+                }),
+                None => None,
+            };
+            let options = arbvis::store::convert::ConvertOptions {
+                brick,
+                derived,
+                zstd,
+                raw,
+                ..Default::default()
+            };
+            let report = arbvis::store::convert::convert(&input, &store, &options)
+                .with_context(|| format!("converting {}", input.display()))?;
+            print!("{}", arbvis::store::convert::describe(&report, &store));
         }
         Command::Bench {
             scene,
@@ -458,6 +646,43 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Study {
             sweep,
+            technique: StudyTechnique::CellprojVolume,
+            grids,
+            scenes,
+            out,
+            ..
+        } => {
+            use arbvis::techniques::cellproj::study::volume;
+            let headless = Headless::new(sweep.backend)?;
+            let mut cases = Vec::new();
+            for &n in &grids {
+                if !(2..=128).contains(&n) {
+                    bail!("--grids: each must be 2..=128 points per side");
+                }
+                let scene = Scene::parse(
+                    &format!(
+                        "[technique.cellproj]\nmesh = {{ grid = {{ points = [{n}, {n}, {n}], field = \"spherical\" }} }}\nmode = \"volume\"\n[technique.cellproj.volume]\npoints = [[0.0, 0.1, 0.2, 0.9, 0.0], [0.45, 0.2, 0.6, 0.8, 0.3], [0.5, 1.0, 0.9, 0.2, 1.0], [0.55, 0.9, 0.3, 0.1, 0.3], [1.0, 0.8, 0.1, 0.1, 0.6]]\nunit_distance = 0.25\n"
+                    ),
+                    "grid",
+                )?;
+                cases.push(volume_case(&format!("grid{n}"), &scene)?);
+            }
+            for path in &scenes {
+                let scene = Scene::load(path)?;
+                let name = path
+                    .file_stem()
+                    .map_or("scene".into(), |s| s.to_string_lossy().to_string());
+                cases.push(volume_case(&name, &scene)?);
+            }
+            let options = volume::Options {
+                frames: sweep.frames.max(1),
+                ..Default::default()
+            };
+            let rows = volume::run(&headless, &cases, &options, |line| eprintln!("{line}"))?;
+            write_study(&out, [("cellproj-volume.csv", volume::to_csv(&rows))])?;
+        }
+        Command::Study {
+            sweep,
             technique: StudyTechnique::Cellproj,
             grids,
             out,
@@ -519,6 +744,8 @@ fn run(cli: Cli) -> Result<()> {
                 );
             }
         }
+        #[cfg(not(feature = "viewer"))]
+        Command::View { .. } => bail!("{NO_VIEWER}"),
         #[cfg(feature = "viewer")]
         Command::View {
             scene,

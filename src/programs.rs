@@ -59,6 +59,20 @@ pub const CELLPROJ_ORTHOGRAPHIC_FRAG: ProgramText = program!("cellproj/orthograp
 pub const CELLPROJ_PRECISE_VERT: ProgramText = program!("cellproj/precise.vert");
 /// Precise cell projection: fragment stage (exact crossing, guarded exit, depth, shading).
 pub const CELLPROJ_PRECISE_FRAG: ProgramText = program!("cellproj/precise.frag");
+/// Volume, faithful: the seed's exit computation and the pre-integrated 3D table.
+pub const CELLPROJ_VOLUME_ARBFP: ProgramText = program!("cellproj/volume.arbfp");
+/// GLSL twin of [`CELLPROJ_VOLUME_ARBFP`].
+pub const CELLPROJ_VOLUME_FRAG: ProgramText = program!("cellproj/volume.frag");
+/// Volume, precise: the boundary faces for the entry layers (vertex stage).
+pub const CELLPROJ_VOLUME_PEEL_VERT: ProgramText = program!("cellproj/volume_peel.vert");
+/// Volume, precise: one entry layer (depth peeling of the boundary).
+pub const CELLPROJ_VOLUME_PEEL_FRAG: ProgramText = program!("cellproj/volume_peel.frag");
+/// Volume, precise: the neighbour walk (joined with [`CELLPROJ_VOLUME_INTEGRAL_GLSL`]).
+pub const CELLPROJ_VOLUME_WALK_FRAG: ProgramText = program!("cellproj/volume_walk.frag");
+/// Volume, precise as a projection: exact integral per fragment, CPU order.
+pub const CELLPROJ_VOLUME_PROJECTED_FRAG: ProgramText = program!("cellproj/volume_projected.frag");
+/// Volume, precise: the exact segment integral, a GLSL part joined before a main.
+pub const CELLPROJ_VOLUME_INTEGRAL_GLSL: ProgramText = program!("cellproj/volume_integral.glsl");
 
 /// Splats: the vertex stage (the seed's size rule, per-point Phong).
 pub const SPLATS_VERT: ProgramText = program!("splats/splat.vert");
@@ -156,6 +170,13 @@ pub fn all_texts() -> Vec<ProgramText> {
         CELLPROJ_ORTHOGRAPHIC_FRAG,
         CELLPROJ_PRECISE_VERT,
         CELLPROJ_PRECISE_FRAG,
+        CELLPROJ_VOLUME_ARBFP,
+        CELLPROJ_VOLUME_FRAG,
+        CELLPROJ_VOLUME_PEEL_VERT,
+        CELLPROJ_VOLUME_PEEL_FRAG,
+        CELLPROJ_VOLUME_WALK_FRAG,
+        CELLPROJ_VOLUME_PROJECTED_FRAG,
+        CELLPROJ_VOLUME_INTEGRAL_GLSL,
         SPLATS_VERT,
         SPLATS_SEED_FRAG,
         SPLATS_PRECISE_FRAG,

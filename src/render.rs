@@ -24,6 +24,8 @@ pub struct Rendered {
     pub build_time: Duration,
     /// Time to draw and finish the frame.
     pub draw_time: Duration,
+    /// The renderer's own line about the frame (a store's resident bricks, levels, bytes).
+    pub status: Option<String>,
 }
 
 impl Rendered {
@@ -69,6 +71,10 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
     let gpu = headless.gpu();
     let kind = scene.programs.resolve(gpu);
     let [width, height] = scene.size;
+    crate::budget::check_estimates(
+        &format!("this {} scene", scene.technique.name()),
+        &scene.memory_estimate(true),
+    )?;
     let t0 = Instant::now();
     let mut renderer = build(gpu, scene, kind)?;
     let target = Target::create(
@@ -100,6 +106,7 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
         resources: gpu.resources(),
         build_time,
         draw_time,
+        status: renderer.status(),
     })
 }
 

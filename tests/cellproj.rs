@@ -37,6 +37,8 @@ fn params(field: Field, isovalues: Vec<Isovalue>) -> CellprojScene {
             field,
         }),
         scalars: ScalarSpec::default(),
+        mode: Default::default(),
+        volume: None,
         isovalues,
         exit: Default::default(),
         table_size: 256,

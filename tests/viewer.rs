@@ -354,7 +354,7 @@ fn clip_stats_lines(stdout: &str) -> Vec<&str> {
 
 #[test]
 fn the_clip_editor_reaches_the_saved_scene() {
-    // The demo: an inverted sphere at [-1, 1, 1], radius 1.45, B = 8, INDEX-DATA. The
+    // The demo: an inverted sphere at [-1, -1, 1], radius 1.3, B = 8, INDEX-DATA. The
     // clip is switched off and on again (restored), made a torus, moved, resized and
     // turned, no longer inverted, B = 16, then the single texture.
     let script = "\
@@ -455,7 +455,7 @@ fn a_clip_the_editor_cannot_edit_is_kept() {
     let demo = include_str!("../scenes/demo/clip-sphere.toml");
     let csg = "shape = { difference = [{ sphere = { center = [0.0, 0.0, 0.0], radius = 0.9 } }, { box = { center = [0.5, 0.5, 0.5], half_size = [0.5, 0.5, 0.5] } }] }";
     let text = demo.replace(
-        "shape = { sphere = { center = [-1.0, 1.0, 1.0], radius = 1.45 } }",
+        "shape = { sphere = { center = [-1.0, -1.0, 1.0], radius = 1.3 } }",
         csg,
     );
     assert_ne!(text, demo);
@@ -548,8 +548,9 @@ fn script_steps_that_do_nothing_fail_with_their_line() {
             "wait 1\n\nset primary Cr 7\n",
             "wait 1\nset primary table rainbow\n",
             "wait 1\nset Lock primary maybe\n",
-            // A click on an existing curve point neither adds nor removes one.
-            "wait 1\nclick-at tertiary alpha 1 0.9\n",
+            // A click on an existing curve point ((1, 0.3): 0.7 from the top) neither adds nor
+            // removes one.
+            "wait 1\nclick-at tertiary alpha 1 0.7\n",
             "wait 1\nwait 1\nkey F5\n",
             "wait 1\nset slices 2.5\n",
             // No clip in this demo: the section opens, the clip is added, B is disabled
@@ -572,7 +573,7 @@ fn script_steps_that_do_nothing_fail_with_their_line() {
             "no option \"rainbow\"",
         ),
         ("line 2 (set Lock primary maybe)", "takes true or false"),
-        ("line 2 (click-at tertiary alpha 1 0.9)", "did nothing"),
+        ("line 2 (click-at tertiary alpha 1 0.7)", "did nothing"),
         ("line 3 (key F5)", "did nothing"),
         ("line 2 (set slices 2.5)", "not a whole number"),
         ("line 5 (set Clip block 16)", "Clip block is disabled"),

@@ -42,6 +42,18 @@ pub enum GlError {
         /// Rust source line of the check.
         line: u32,
     },
+    /// The GL could not allocate memory for an object (`GL_OUT_OF_MEMORY`).
+    #[error("the GL ran out of memory (GL_OUT_OF_MEMORY) creating {what}, {}; try a smaller \
+             size, fewer slices or points, or a coarser grid", crate::budget::format_bytes(*.bytes))]
+    OutOfMemory {
+        /// What was being created.
+        what: String,
+        /// Its size in bytes.
+        bytes: u64,
+    },
+    /// What was asked for is over the memory budget ([`crate::budget`]).
+    #[error(transparent)]
+    Budget(#[from] crate::budget::OverBudget),
     /// A program failed to compile or link.
     #[error(transparent)]
     Compile(#[from] CompileError),

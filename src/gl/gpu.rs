@@ -20,6 +20,15 @@ macro_rules! gl_check {
     };
 }
 
+/// [`gl_check!`] after creating `what` of `bytes` bytes: `GL_OUT_OF_MEMORY` becomes
+/// [`GlError::OutOfMemory`] naming them.
+#[macro_export]
+macro_rules! gl_check_alloc {
+    ($gpu:expr, $what:expr, $bytes:expr) => {
+        $gpu.check_allocation(file!(), line!(), $what, $bytes)
+    };
+}
+
 /// Like [`gl_check!`] in debug builds; nothing in release builds (for per-draw paths).
 #[macro_export]
 macro_rules! gl_debug_check {
@@ -175,6 +184,27 @@ impl Gpu {
                 file,
                 line,
             }),
+        }
+    }
+
+    /// [`Gpu::check_errors`] after an allocation: `GL_OUT_OF_MEMORY` names what was being
+    /// created and its size.
+    pub fn check_allocation(
+        &self,
+        file: &'static str,
+        line: u32,
+        what: impl FnOnce() -> String,
+        bytes: u64,
+    ) -> GlResult<()> {
+        match self.check_errors(file, line) {
+            Err(GlError::Gl {
+                code: glow::OUT_OF_MEMORY,
+                ..
+            }) => Err(GlError::OutOfMemory {
+                what: what(),
+                bytes,
+            }),
+            other => other,
         }
     }
 

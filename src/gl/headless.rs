@@ -57,6 +57,11 @@ enum HeadlessContext {
     },
 }
 
+/// What to install when no EGL context can be made.
+const EGL_HINT: &str = "arbvis renders offscreen through EGL: install Mesa's EGL and software \
+renderer (Debian/Ubuntu: apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri, or run \
+scripts/install-deps.sh) or a GPU driver, or try --backend osmesa";
+
 impl Headless {
     /// Create a context on `backend` and make it current on this thread.
     pub fn new(backend: Backend) -> GlResult<Headless> {
@@ -79,7 +84,7 @@ impl Headless {
     fn egl() -> GlResult<Headless> {
         let err = |reason: String| GlError::Context {
             backend: "egl",
-            reason,
+            reason: format!("{reason}; {EGL_HINT}"),
         };
         let mut devices: Vec<Device> = Device::query_devices()
             .map_err(|e| err(format!("no EGL devices: {e}")))?

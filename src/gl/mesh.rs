@@ -69,7 +69,11 @@ impl Mesh {
             label: label.to_string(),
         };
         mesh.upload(vertices)?;
-        crate::gl_check!(gpu)?;
+        crate::gl_check_alloc!(
+            gpu,
+            || format!("the vertex buffer of {label}"),
+            std::mem::size_of_val(vertices) as u64
+        )?;
         gpu.record(
             "buffer",
             format!("vertices {label}"),

@@ -308,11 +308,12 @@ impl Texture {
             extent,
             format,
         };
-        crate::gl_check!(gpu)?;
+        let bytes = (extent.texels() * format.bytes()) as u64;
+        crate::gl_check_alloc!(gpu, || format!("texture {label} {extent:?}"), bytes)?;
         gpu.record(
             "texture",
             format!("{label} {extent:?} {}", format.name()),
-            (extent.texels() * format.bytes()) as u64,
+            bytes,
         );
         Ok(texture)
     }
@@ -373,7 +374,11 @@ impl Texture {
             extent: Extent::D2(width, height),
             format,
         };
-        crate::gl_check!(gpu)?;
+        crate::gl_check_alloc!(
+            gpu,
+            || format!("a {width}x{height} {} texture", format.name()),
+            width as u64 * height as u64 * format.bytes() as u64
+        )?;
         Ok(texture)
     }
 

@@ -274,9 +274,18 @@ pub struct Converted {
     pub degenerate_dropped: usize,
 }
 
-/// Six times the signed volume of tetrahedron `t`.
+/// Six times the signed volume of tetrahedron `t` (in the file's units; infinite or NaN
+/// when that overflows: [`det_scaled`] does not).
 pub fn det(points: &[[f64; 3]], t: [u32; 4]) -> f64 {
-    let p = t.map(|i| points[i as usize]);
+    det_scaled(points, t, 1.0)
+}
+
+/// Six times the signed volume of tetrahedron `t` with every coordinate multiplied by
+/// `scale` first. With a power of two (see [`unit_scale`]) the products are exact, so
+/// this is the file's determinant times `scale³`, without overflow when the scaled
+/// coordinates are at most 1 in magnitude.
+pub fn det_scaled(points: &[[f64; 3]], t: [u32; 4], scale: f64) -> f64 {
+    let p = t.map(|i| points[i as usize].map(|c| c * scale));
     let a = sub(p[1], p[0]);
     let b = sub(p[2], p[0]);
     let c = sub(p[3], p[0]);
@@ -284,13 +293,44 @@ pub fn det(points: &[[f64; 3]], t: [u32; 4]) -> f64 {
         + a[2] * (b[0] * c[1] - b[1] * c[0])
 }
 
+/// The power of two `2^-e` that brings `largest` (a largest coordinate magnitude) into
+/// `[0.5, 1)`; 1 for 0 and for values that are not finite. Multiplying by it is exact
+/// (for normal numbers), so volumes, extents and orientations can be computed on scaled
+/// coordinates without overflow near 1.7e308 or underflow near 1e-308.
+pub fn unit_scale(largest: f64) -> f64 {
+    if !(largest.is_finite() && largest > 0.0) {
+        return 1.0;
+    }
+    // largest = m 2^e with m in [0.5, 1): e - 1 is the biased exponent field minus 1022.
+    let field = ((largest.to_bits() >> 52) & 0x7ff) as i32;
+    let e = if field == 0 {
+        // Subnormal: the scale 2^1022 brings it to at least 2^-52, far from underflow.
+        -1021
+    } else {
+        field - 1022
+    };
+    let exp = (-e).clamp(-1022, 1023);
+    f64::from_bits(((exp + 1023) as u64) << 52)
+}
+
+/// The base-2 logarithm of a [`unit_scale`] (an exact integer).
+pub fn scale_log2(scale: f64) -> i32 {
+    ((scale.to_bits() >> 52) & 0x7ff) as i32 - 1023
+}
+
 fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
 /// `t` with a positive volume (last two vertices swapped when negative); true if swapped.
+/// The sign comes from coordinates scaled by the tetrahedron's own [`unit_scale`], so it
+/// is right for coordinates near ±1.7e308 too.
 pub fn orient(points: &[[f64; 3]], t: [u32; 4]) -> ([u32; 4], bool) {
-    if det(points, t) < 0.0 {
+    let largest = t
+        .iter()
+        .flat_map(|&i| points[i as usize])
+        .fold(0.0f64, |m, c| m.max(c.abs()));
+    if det_scaled(points, t, unit_scale(largest)) < 0.0 {
         ([t[0], t[1], t[3], t[2]], true)
     } else {
         (t, false)
@@ -362,7 +402,24 @@ impl RawCells {
         self.kinds.is_empty()
     }
 
-    /// Convert to tetrahedra over `points`, checking node counts and indices.
+    /// The most tetrahedra the cells can become (hexahedra and voxels 6, wedges 3,
+    /// pyramids 2, tetrahedra 1), to check the memory before converting.
+    pub fn most_tets(&self) -> usize {
+        self.kinds
+            .iter()
+            .map(|k| match k.shape {
+                Shape::Tet => 1,
+                Shape::Hex | Shape::Voxel => 6,
+                Shape::Wedge => 3,
+                Shape::Pyramid => 2,
+                Shape::Skip => 0,
+            })
+            .sum()
+    }
+
+    /// Convert to tetrahedra over `points`, checking node counts and indices. A file with
+    /// no tetrahedra left (no volume cells, or only collapsed ones) is an error that names
+    /// the first collapsed cell.
     pub fn convert(
         &self,
         name: &std::path::Path,
@@ -380,9 +437,21 @@ impl RawCells {
                 super::read::binary_error(name, at, m)
             }
         };
-        let mut out = Converted::default();
+        let most = self.most_tets();
+        let what = format!(
+            "making the tetrahedra of {} cells (at most {most})",
+            self.len()
+        );
+        let budget_err = |e: crate::budget::OverBudget| err(0, e.to_string());
+        let mut out = Converted {
+            tets: crate::budget::vec_for(most, &what).map_err(budget_err)?,
+            source_cell: crate::budget::vec_for(most, &what).map_err(budget_err)?,
+            ..Converted::default()
+        };
         let mut names: Vec<(&'static str, usize)> = Vec::new();
         let mut scratch = Vec::with_capacity(6);
+        let mut volume_cells = 0usize;
+        let mut first_collapsed = None;
         for (i, k) in self.kinds.iter().enumerate() {
             let (s, e) = (self.offsets[i], self.offsets[i + 1]);
             let nodes = &self.nodes[s..e];
@@ -417,35 +486,41 @@ impl RawCells {
                 out.reduced += 1;
             }
             let cell = i as u32;
-            match k.shape {
-                Shape::Skip => out.skipped += 1,
+            scratch.clear();
+            let corners: Vec<u32> = match k.shape {
+                Shape::Skip => {
+                    out.skipped += 1;
+                    continue;
+                }
                 Shape::Tet => {
-                    let (t, flipped) = orient(points, [nodes[0], nodes[1], nodes[2], nodes[3]]);
+                    scratch.push([nodes[0], nodes[1], nodes[2], nodes[3]]);
+                    nodes[..4].to_vec()
+                }
+                Shape::Voxel => [0, 1, 3, 2, 4, 5, 7, 6].iter().map(|&j| nodes[j]).collect(),
+                Shape::Hex => nodes[..8].to_vec(),
+                Shape::Wedge => nodes[..6].to_vec(),
+                Shape::Pyramid => nodes[..5].to_vec(),
+            };
+            volume_cells += 1;
+            if k.shape != Shape::Tet {
+                out.split += 1;
+                split(&corners, faces(k.shape).unwrap_or(&[]), &mut scratch);
+            }
+            let before = out.tets.len();
+            for &t in &scratch {
+                if (0..4).any(|a| (a + 1..4).any(|b| t[a] == t[b])) {
+                    out.degenerate_dropped += 1;
+                    continue;
+                }
+                let (t, flipped) = orient(points, t);
+                if k.shape == Shape::Tet {
                     out.flipped += usize::from(flipped);
-                    out.tets.push(t);
-                    out.source_cell.push(cell);
                 }
-                shape => {
-                    out.split += 1;
-                    let corners: Vec<u32> = match shape {
-                        Shape::Voxel => {
-                            [0, 1, 3, 2, 4, 5, 7, 6].iter().map(|&j| nodes[j]).collect()
-                        }
-                        Shape::Hex => nodes[..8].to_vec(),
-                        Shape::Wedge => nodes[..6].to_vec(),
-                        _ => nodes[..5].to_vec(),
-                    };
-                    scratch.clear();
-                    split(&corners, faces(shape).unwrap_or(&[]), &mut scratch);
-                    for &t in &scratch {
-                        if (0..4).any(|a| (a + 1..4).any(|b| t[a] == t[b])) {
-                            out.degenerate_dropped += 1;
-                            continue;
-                        }
-                        out.tets.push(orient(points, t).0);
-                        out.source_cell.push(cell);
-                    }
-                }
+                out.tets.push(t);
+                out.source_cell.push(cell);
+            }
+            if out.tets.len() == before && first_collapsed.is_none() {
+                first_collapsed = Some((i, corners));
             }
         }
         out.cells = names
@@ -455,6 +530,33 @@ impl RawCells {
                 count,
             })
             .collect();
+        if out.tets.is_empty() {
+            let held: Vec<String> = out
+                .cells
+                .iter()
+                .map(|k| format!("{}: {}", k.name, k.count))
+                .collect();
+            return Err(match first_collapsed {
+                Some((i, corners)) => err(
+                    i,
+                    format!(
+                        "no tetrahedra: all {volume_cells} volume cells are collapsed (degenerate): each repeats points so that every tetrahedron it splits into has a repeated corner; the first is cell {i} ({}) with points {corners:?}",
+                        self.kinds[i].name
+                    ),
+                ),
+                None => err(
+                    0,
+                    format!(
+                        "no volume cells (tetrahedra, hexahedra, voxels, wedges, pyramids): the file holds {}",
+                        if held.is_empty() {
+                            "no cells".to_string()
+                        } else {
+                            held.join(", ")
+                        }
+                    ),
+                ),
+            });
+        }
         Ok(out)
     }
 }

@@ -17,6 +17,19 @@
 //!   legacy file, `<VTKFile` (after an optional XML declaration) an XML file, and
 //!   `$MeshFormat` a gmsh file.
 //! - Files are read whole through [`crate::input`], at most [`MAX_MESH_BYTES`].
+//! - Sections may come in any order the format allows (gmsh data before `$Nodes`, VTK
+//!   `POINT_DATA` before `POINTS`); what refers to another section is checked against it
+//!   once both are read, with the file and the position of the one that disagrees, and
+//!   [`Mesh::assemble`] refuses any array whose tuple count is not the point or cell
+//!   count (it never indexes past one). A section a file may hold once (`POINTS`) is
+//!   refused the second time.
+//! - Memory: every allocation whose size comes from the file is checked against the
+//!   memory budget ([`crate::budget`]) before it is made, and made fallibly; compressed
+//!   `.vtu` arrays are checked against what the piece declares, and the total against
+//!   the budget, before anything is inflated. A refusal names the file, the place that
+//!   declared the size, the estimate, the budget and how to raise it.
+//! - Geometry is computed on coordinates scaled by an exact power of two
+//!   ([`cells::unit_scale`]), so coordinates near ±1.7e308 orient, measure and draw.
 
 pub mod cells;
 pub mod gmsh;
@@ -34,6 +47,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
+
+use crate::budget;
 
 /// Largest mesh file read (1 GiB).
 pub const MAX_MESH_BYTES: u64 = 1 << 30;
@@ -103,7 +118,7 @@ pub struct MeshInfo {
     pub reduced_to_corners: usize,
     /// File tetrahedra whose vertex order was reversed to make their volume positive.
     pub flipped: usize,
-    /// Tetrahedra of split cells dropped because the cell repeated a vertex.
+    /// Tetrahedra dropped because their cell repeated a point (a collapsed cell).
     pub degenerate_dropped: usize,
 }
 
@@ -217,8 +232,14 @@ pub fn read(path: &Path) -> Result<Mesh, MeshError> {
     parse(path, &bytes)
 }
 
-/// Parse a mesh file held in memory; `name` is used in errors.
+/// Parse a mesh file held in memory; `name` is used in errors. What it may make is
+/// bounded by the memory budget, and by default also by the file's size
+/// ([`budget::for_input`]).
 pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
+    budget::for_input(bytes.len() as u64, || parse_format(name, bytes))
+}
+
+fn parse_format(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     let head = &bytes[..bytes.len().min(4096)];
     let trimmed = head.trim_ascii_start();
     if trimmed.len() >= 14 && trimmed[..14].eq_ignore_ascii_case(b"# vtk DataFile") {
@@ -238,48 +259,80 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
     }
 }
 
+/// A data array as a loader read it, with the byte where its declaration starts (a
+/// section keyword or a tag: always text, in every format), for errors.
+#[derive(Debug)]
+pub(crate) struct ReadArray {
+    /// The array, one tuple per point or per file cell.
+    pub array: DataArray,
+    /// Where it was declared.
+    pub at: usize,
+}
+
 impl Mesh {
-    /// Assemble a mesh from loader output: converts the cells and expands cell arrays to
-    /// one tuple per tetrahedron. `cell_arrays` hold one tuple per file cell.
+    /// Assemble a mesh from loader output: checks that every array holds one tuple per
+    /// point (per file cell), converts the cells and expands cell arrays to one tuple per
+    /// tetrahedron within the memory budget.
     pub(crate) fn assemble(
         name: &Path,
         bytes: &[u8],
         points: Vec<[f64; 3]>,
         raw: &cells::RawCells,
-        point_arrays: Vec<DataArray>,
-        cell_arrays: Vec<DataArray>,
+        point_arrays: Vec<ReadArray>,
+        cell_arrays: Vec<ReadArray>,
         mut info: MeshInfo,
     ) -> Result<Mesh, MeshError> {
         if points.len() > u32::MAX as usize {
             return Err(MeshError::whole_file(name, "more than 2^32 - 1 points"));
         }
-        let c = raw.convert(name, bytes, &points)?;
-        if c.tets.is_empty() {
-            let held: Vec<String> = c
-                .cells
-                .iter()
-                .map(|k| format!("{}: {}", k.name, k.count))
-                .collect();
-            return Err(MeshError::whole_file(
-                name,
-                format!(
-                    "no volume cells (tetrahedra, hexahedra, voxels, wedges, pyramids): the file holds {}",
-                    if held.is_empty() { "no cells".to_string() } else { held.join(", ") }
-                ),
-            ));
-        }
-        let cell_arrays = cell_arrays
-            .into_iter()
-            .map(|a| {
-                let k = a.components;
-                let mut values = Vec::with_capacity(c.source_cell.len() * k);
-                for &s in &c.source_cell {
-                    let s = s as usize * k;
-                    values.extend_from_slice(&a.values[s..s + k]);
+        for (list, want, what) in [
+            (&point_arrays, points.len(), "point"),
+            (&cell_arrays, raw.len(), "cell"),
+        ] {
+            for a in list {
+                let k = a.array.components;
+                if k == 0 || Some(a.array.values.len()) != want.checked_mul(k) {
+                    return Err(read::text_error(
+                        name,
+                        bytes,
+                        a.at,
+                        format!(
+                            "{what} array \"{}\" holds {} values ({} components each), but the mesh has {want} {what}s: one tuple per {what} is needed",
+                            a.array.name,
+                            a.array.values.len(),
+                            k
+                        ),
+                    ));
                 }
-                DataArray { values, ..a }
-            })
-            .collect();
+            }
+        }
+        let c = raw.convert(name, bytes, &points)?;
+        let per_tet: usize = cell_arrays.iter().map(|a| a.array.components).sum();
+        if let Some(first) = cell_arrays.first() {
+            let n = c.tets.len();
+            let bytes_needed = budget::times(budget::times(n as u64, per_tet as u64), 8);
+            budget::check(
+                format!(
+                    "copying {} cell array{} to each of {n} tetrahedra",
+                    cell_arrays.len(),
+                    if cell_arrays.len() == 1 { "" } else { "s" }
+                ),
+                bytes_needed,
+            )
+            .map_err(|e| read::text_error(name, bytes, first.at, e.to_string()))?;
+        }
+        let mut expanded = Vec::with_capacity(cell_arrays.len());
+        for a in cell_arrays {
+            let k = a.array.components;
+            let n = c.source_cell.len().saturating_mul(k);
+            let mut values = budget::vec_for(n, &format!("cell array \"{}\"", a.array.name))
+                .map_err(|e| read::text_error(name, bytes, a.at, e.to_string()))?;
+            for &s in &c.source_cell {
+                let s = s as usize * k;
+                values.extend_from_slice(&a.array.values[s..s + k]);
+            }
+            expanded.push(DataArray { values, ..a.array });
+        }
         info.source = name.display().to_string();
         info.cells = c.cells;
         info.split_cells = c.split;
@@ -291,8 +344,8 @@ impl Mesh {
             points,
             tets: c.tets,
             source_cell: c.source_cell,
-            point_arrays,
-            cell_arrays,
+            point_arrays: point_arrays.into_iter().map(|a| a.array).collect(),
+            cell_arrays: expanded,
             info,
         })
     }
@@ -324,6 +377,17 @@ impl Mesh {
 pub fn inspect(path: &Path) -> Result<String, MeshError> {
     let mesh = read(path)?;
     Ok(describe(&mesh))
+}
+
+/// A number as Rust writes it (shortest round trip), in exponent form beyond 1e16 or
+/// below 1e-5, where the plain form runs to hundreds of digits.
+fn num(v: f64) -> String {
+    let a = v.abs();
+    if a != 0.0 && a.is_finite() && !(1e-5..1e16).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
 }
 
 /// The report [`inspect`] prints, one item per line.
@@ -359,7 +423,7 @@ pub fn describe(mesh: &Mesh) -> String {
     if i.degenerate_dropped > 0 {
         let _ = writeln!(
             s,
-            "dropped (collapsed split tetrahedra): {}",
+            "dropped (tetrahedra with a repeated point, of collapsed cells): {}",
             i.degenerate_dropped
         );
     }
@@ -368,14 +432,19 @@ pub fn describe(mesh: &Mesh) -> String {
         let _ = writeln!(
             s,
             "bounds: x [{}, {}] y [{}, {}] z [{}, {}]",
-            lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
+            num(lo[0]),
+            num(hi[0]),
+            num(lo[1]),
+            num(hi[1]),
+            num(lo[2]),
+            num(hi[2])
         );
     }
     for (kind, arrays) in [("point", &mesh.point_arrays), ("cell", &mesh.cell_arrays)] {
         for a in arrays {
             let r = scalars::finite_range(&a.values);
             let range = match r {
-                Some((lo, hi)) => format!("range [{lo}, {hi}]"),
+                Some((lo, hi)) => format!("range [{}, {}]", num(lo), num(hi)),
                 None => "no finite values".to_string(),
             };
             let bad = a.values.iter().filter(|v| !v.is_finite()).count();
@@ -395,10 +464,29 @@ pub fn describe(mesh: &Mesh) -> String {
     }
     let q = quality::Quality::of(mesh);
     let _ = writeln!(s, "flipped to positive orientation: {}", i.flipped);
+    let cell_of = |t: usize| {
+        mesh.source_cell
+            .get(t)
+            .map_or(String::new(), |c| format!(" from file cell {c}"))
+    };
     let _ = writeln!(
         s,
-        "flat tetrahedra (|volume| <= 1e-12 x longest edge^3): {}",
-        q.flat
+        "flat (degenerate) tetrahedra (|volume| <= 1e-12 x longest edge^3, not drawn): {}{}",
+        q.flat,
+        q.first_flat.map_or(String::new(), |t| format!(
+            ", the first is tetrahedron {t}{}",
+            cell_of(t)
+        ))
+    );
+    let _ = writeln!(
+        s,
+        "repeated tetrahedra (at the place of an earlier one): {}{}",
+        q.repeated,
+        q.first_repeat.map_or(String::new(), |(t, e)| format!(
+            ", the first is tetrahedron {t}{} repeating {e}{}",
+            cell_of(t),
+            cell_of(e)
+        ))
     );
     let _ = writeln!(
         s,
@@ -408,8 +496,19 @@ pub fn describe(mesh: &Mesh) -> String {
     );
     let _ = writeln!(
         s,
-        "volume: total {:.6e}, smallest tetrahedron {:.6e}, radius ratio min {:.4}",
-        q.total_volume, q.min_volume, q.min_radius_ratio
+        "depth: a line through the bounding box crosses {:.1} tetrahedra on average",
+        q.depth
+    );
+    let _ = writeln!(
+        s,
+        "volume: total {}, smallest tetrahedron {}, radius ratio min {:.4}",
+        quality::format_pow2(q.scaled_volumes.0, q.volume_log2),
+        if mesh.tets.is_empty() {
+            "-".to_string()
+        } else {
+            quality::format_pow2(q.scaled_volumes.1, q.volume_log2)
+        },
+        q.min_radius_ratio
     );
     s
 }

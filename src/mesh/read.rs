@@ -199,13 +199,11 @@ pub fn quote(token: &[u8]) -> String {
     )
 }
 
-/// An empty vector with room for `n` items, or an error (never an abort) when the
-/// memory cannot be had.
+/// An empty vector with room for `n` items, checked against the memory budget and
+/// reserved fallibly: the error (the estimate, the budget and how to raise it, or the
+/// system's refusal) is a message the caller places at a position, never an abort.
 pub fn vec_for<T>(n: usize, what: &str) -> Result<Vec<T>, String> {
-    let mut v = Vec::new();
-    v.try_reserve_exact(n)
-        .map_err(|_| format!("cannot allocate memory for {n} {what}"))?;
-    Ok(v)
+    crate::budget::vec_for(n, &format!("{n} {what}")).map_err(|e| e.to_string())
 }
 
 /// A cursor over a file's bytes.

@@ -21,7 +21,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::quality::signed_volume;
+use super::quality::{mesh_scale, signed_volume_scaled};
 use super::{DataArray, Mesh, MeshError};
 
 /// How a cell array becomes a point array.
@@ -110,10 +110,7 @@ fn pick(
         None if k == 1 => Ok((a.name.clone(), a.values.clone())),
         None => Ok((
             format!("|{}|", a.name),
-            a.values
-                .chunks_exact(k)
-                .map(|t| t.iter().map(|x| x * x).sum::<f64>().sqrt())
-                .collect(),
+            a.values.chunks_exact(k).map(magnitude).collect(),
         )),
     }
 }
@@ -171,7 +168,8 @@ impl ScalarSpec {
             }
             None => finite_range(&values).map_or([0.0, 0.0], |(lo, hi)| [lo, hi]),
         };
-        let span = range[1] - range[0];
+        // Halves first: a range near ±1.7e308 has a span beyond the largest f64.
+        let half_span = range[1] / 2.0 - range[0] / 2.0;
         let mut non_finite = 0;
         let values = values
             .into_iter()
@@ -179,8 +177,8 @@ impl ScalarSpec {
                 if !v.is_finite() {
                     non_finite += 1;
                     v
-                } else if span > 0.0 {
-                    (v - range[0]) / span
+                } else if half_span > 0.0 {
+                    (v / 2.0 - range[0] / 2.0) / half_span
                 } else {
                     0.0
                 }
@@ -195,9 +193,21 @@ impl ScalarSpec {
     }
 }
 
+/// The length of a vector of any size, without overflow or underflow: the components are
+/// scaled by a power of two first (NaN when one is NaN, infinite when one is).
+fn magnitude(v: &[f64]) -> f64 {
+    let largest = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if !largest.is_finite() || v.iter().any(|x| x.is_nan()) {
+        return v.iter().map(|x| x.abs()).sum();
+    }
+    let s = super::cells::unit_scale(largest);
+    v.iter().map(|x| (x * s) * (x * s)).sum::<f64>().sqrt() / s
+}
+
 /// Volume-weighted average of per-tetrahedron values at each point (see the module doc).
 pub fn average_to_points(mesh: &Mesh, per_tet: &[f64]) -> Vec<f64> {
     let n = mesh.points.len();
+    let scale = mesh_scale(&mesh.points);
     let mut sum = vec![0.0; n];
     let mut weight = vec![0.0; n];
     let mut plain = vec![0.0; n];
@@ -206,7 +216,8 @@ pub fn average_to_points(mesh: &Mesh, per_tet: &[f64]) -> Vec<f64> {
         if !s.is_finite() {
             continue;
         }
-        let w = signed_volume(&mesh.points, *t).abs();
+        // Relative weights: volumes on scaled coordinates cannot overflow.
+        let w = signed_volume_scaled(&mesh.points, *t, scale).abs();
         for &p in t {
             let p = p as usize;
             sum[p] += w * s;

@@ -189,19 +189,11 @@ impl PointCloud {
             ));
         }
         let bounds = bounds(&parts.positions);
-        let origin: [f64; 3] = std::array::from_fn(|a| 0.5 * (bounds[0][a] + bounds[1][a]));
-        let extent = (0..3)
-            .map(|a| bounds[1][a] - bounds[0][a])
-            .fold(0.0, f64::max);
-        let scale = if extent > 0.0 && extent.is_finite() {
-            0.5 * extent
-        } else {
-            1.0
-        };
+        let (origin, scale) = origin_and_scale(&bounds);
         let positions = parts
             .positions
             .par_iter()
-            .map(|p| std::array::from_fn(|a| ((p[a] - origin[a]) / scale) as f32))
+            .map(|p| std::array::from_fn(|a| local(p[a], origin[a], scale)))
             .collect();
         let attributes = parts
             .attributes
@@ -321,6 +313,47 @@ impl PointCloud {
         }
         s
     }
+}
+
+/// The centre of `bounds` and half of its largest extent (1 when that is 0), computed
+/// from halves so that finite coordinates anywhere in f64's range (±1.7e308) give a
+/// finite origin and scale: `0.5 * (lo + hi)` and `hi - lo` would overflow there.
+fn origin_and_scale(bounds: &[[f64; 3]; 2]) -> ([f64; 3], f64) {
+    let [lo, hi] = bounds;
+    let origin = std::array::from_fn(|a| 0.5 * lo[a] + 0.5 * hi[a]);
+    let half = (0..3)
+        .map(|a| 0.5 * hi[a] - 0.5 * lo[a])
+        .fold(0.0, f64::max);
+    let scale = if half > 0.0 && half.is_finite() {
+        half
+    } else {
+        1.0
+    };
+    (origin, scale)
+}
+
+/// `(v - origin) / scale` as f32, in halves where `v - origin` overflows (coordinates
+/// near ±f64::MAX on both sides of the origin; the scale is then large, so halving it
+/// loses nothing).
+fn local(v: f64, origin: f64, scale: f64) -> f32 {
+    let d = v - origin;
+    if d.is_finite() {
+        (d / scale) as f32
+    } else {
+        ((0.5 * v - 0.5 * origin) / (0.5 * scale)) as f32
+    }
+}
+
+/// Bytes that [`PointCloud::from_parts`] holds at its peak for a cloud of `points`
+/// points with `attributes` attributes: the parts (f64 positions, one i32 or f32 per
+/// attribute, u16 colours, f32 normals), the f32 positions made from them, and the copy
+/// of each attribute that its median is selected in (all made in parallel). Loaders add
+/// what they hold besides (their input, decoding buffers) and check the sum against
+/// [`crate::budget`] before reading the points.
+pub fn footprint(points: u64, attributes: usize, rgb: bool, normals: bool) -> u64 {
+    let per_point =
+        24 + 12 + 8 * attributes as u64 + if rgb { 6 } else { 0 } + if normals { 12 } else { 0 };
+    crate::budget::times(points, per_point)
 }
 
 /// Decimals that show a step of `step` (0 to 12).

@@ -179,10 +179,29 @@ pub fn parse(name: &Path, bytes: &[u8], columns: &DatColumns) -> Result<PointClo
         .layout()
         .map_err(|m| PointsError::Invalid(format!("{}: {m}", name.display())))?;
     let chunks = split_lines(bytes, chunk_size(bytes.len()));
-    // Lines are only counted for a bar that will be drawn (a point line has 16+ bytes).
+    let lines: usize = chunks.par_iter().map(|c| count_lines(c)).sum();
+    // Every line may be a point: the chunks' columns and the joined ones are held
+    // together, then the cloud is made from the joined ones.
+    let attributes = layout.names.len() as u64;
+    let estimate = crate::budget::times(lines as u64, 2 * (24 + 4 * attributes))
+        .max(super::footprint(
+            lines as u64,
+            layout.names.len(),
+            false,
+            false,
+        ))
+        .saturating_add(bytes.len() as u64);
+    crate::budget::check(format!("the points of {lines} lines"), estimate).map_err(|e| {
+        PointsError::text(
+            name,
+            1,
+            1,
+            format!("the file's {lines} lines may each hold a point: {e}"),
+        )
+    })?;
+    // A bar only where it will be drawn (a point line has 16+ bytes).
     let progress =
         if bytes.len() as u64 >= super::progress::MIN_POINTS * 16 && super::progress::enabled() {
-            let lines: usize = chunks.par_iter().map(|c| count_lines(c)).sum();
             Progress::new(lines as u64, &format!("reading {}", name.display()))
         } else {
             Progress::hidden()

@@ -18,10 +18,18 @@
 //! offset for LAS, at most [`MAX_POINTS`](super::MAX_POINTS) points; for LAZ the laszip
 //! VLR's items must match the record length, the chunk table must be smaller than the
 //! compressed data and hold at least the declared points, and every LAZ 1.4 chunk's
-//! layer sizes must fit in the file. Points are then decoded in batches of 65,536, so
-//! memory grows only with points actually decoded, and a decoder error names the batch.
-//! (No ratio of points to compressed bytes bounds LAZ safely: a flat grid with constant
-//! attributes, written by `las` itself, packs 72 points into a byte.)
+//! layer sizes must fit in the file.
+//!
+//! Memory and time: the header's count, times what each point costs once loaded
+//! ([`super::footprint`] and an f64 per extra-bytes value), plus the file and one batch of
+//! records, is checked against [`crate::budget`] before anything is decoded; the columns
+//! are then reserved once. A LAZ file may declare at most 1,000,000 points plus 1 per byte
+//! of compressed data, each extra-bytes attribute counting a third of a point (see
+//! `check::laz_bound`): LAZ decodes about 2.5 million points a second here and a stream
+//! of equal points (legal) packs 85 into a byte, so without it a 2 MB file could take
+//! minutes; real lidar compresses to less than a point a byte. Points are decoded in
+//! batches of at most 65,536 points and 16 MiB of records, and a decoder error names the
+//! batch.
 //! `laz` panics on some corrupt compressed streams; those calls run under
 //! `catch_unwind` and the panic becomes an error (see `guarded`).
 
@@ -32,74 +40,27 @@ use las::{PointData, PointDataBuilder, Reader};
 
 mod check;
 mod extra;
+mod header;
 
-use check::{check, RECORD_LENGTH};
+use check::{check, laz_bound};
 use extra::{decode_extra, extra_bytes, extra_type_size, Extra};
+pub use header::LasInfo;
+use header::RECORD_LENGTH;
 
 use super::progress::Progress;
-use super::{decimals_for, fixed, read_file, CloudParts, PointCloud, PointsError, Values};
+use super::{read_file, CloudParts, PointCloud, PointsError, Values};
+use crate::budget::{vec_for, OverBudget};
 
-/// Header facts of a LAS/LAZ file.
-#[derive(Debug, Clone, PartialEq)]
-pub struct LasInfo {
-    /// Version, major and minor.
-    pub version: (u8, u8),
-    /// Point data record format (0-10), without the compression bit.
-    pub point_format: u8,
-    /// True for LAZ.
-    pub compressed: bool,
-    /// Bytes per point record (uncompressed).
-    pub record_length: u16,
-    /// Points declared by the header.
-    pub points: u64,
-    /// Scale factors of x, y, z.
-    pub scale: [f64; 3],
-    /// Offsets of x, y, z.
-    pub offset: [f64; 3],
-    /// Bounds written in the header (min, max).
-    pub header_bounds: [[f64; 3]; 2],
-    /// Names of the extra-bytes attributes read.
-    pub extra_bytes: Vec<String>,
-}
-
-impl LasInfo {
-    /// The format lines of `arbvis inspect`.
-    pub fn describe(&self) -> String {
-        let [lo, hi] = self.header_bounds;
-        // Bounds with the decimals of the header's scale factors (0.01 → 2).
-        let d: [usize; 3] = std::array::from_fn(|a| decimals_for(self.scale[a]));
-        let b = |v: f64, a: usize| fixed(v, d[a]);
-        format!(
-            "format: LAS {}.{}, point format {}, {}, {}-byte records\nheader: {} points, scale {} {} {}, offset {} {} {}, bounds x {} .. {}, y {} .. {}, z {} .. {}\nextra bytes: {}\n",
-            self.version.0,
-            self.version.1,
-            self.point_format,
-            if self.compressed { "compressed (LAZ)" } else { "uncompressed" },
-            self.record_length,
-            self.points,
-            self.scale[0],
-            self.scale[1],
-            self.scale[2],
-            self.offset[0],
-            self.offset[1],
-            self.offset[2],
-            b(lo[0], 0),
-            b(hi[0], 0),
-            b(lo[1], 1),
-            b(hi[1], 1),
-            b(lo[2], 2),
-            b(hi[2], 2),
-            if self.extra_bytes.is_empty() {
-                "none".to_string()
-            } else {
-                self.extra_bytes.join(", ")
-            }
-        )
-    }
-}
-
-/// Points decoded per batch.
+/// Points decoded per batch, at most.
 const BATCH: u64 = 65_536;
+
+/// Bytes of records decoded per batch, at most (a record may be 64 KiB long).
+const BATCH_BYTES: u64 = 16 << 20;
+
+/// Points per batch for records of `record` bytes.
+fn batch_points(record: usize) -> u64 {
+    (BATCH_BYTES / record.max(1) as u64).clamp(1, BATCH)
+}
 
 /// A LAS/LAZ file's cloud and header facts.
 #[derive(Debug, Clone)]
@@ -128,20 +89,41 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
     let record = info.record_length as usize;
     let extras = extra_bytes(name, &bytes, &checked.vlrs, base, record)?;
     info.extra_bytes = extras.iter().map(|e| e.name.clone()).collect();
+    laz_bound(name, &bytes, &info, checked.count_at, extras.len())?;
     let count = info.points;
     let decode_error = |what: String| PointsError::Decode {
         path: name.to_path_buf(),
         message: what,
     };
+    let has_rgb = matches!(info.point_format, 2 | 3 | 5 | 7 | 8 | 10);
+    // Memory before reading: what the points become, what decoding holds besides (an f64
+    // per extra-bytes value, one batch of records) and the file itself.
+    let batch = batch_points(record);
+    let extra_values = crate::budget::times(count, 8 * extras.len() as u64);
+    let estimate = super::footprint(count, 4 + extras.len(), has_rgb, false)
+        .saturating_add(extra_values)
+        .saturating_add(bytes.len() as u64)
+        .saturating_add(batch * record as u64);
+    let over = |e: crate::budget::OverBudget| {
+        PointsError::format(
+            name,
+            checked.count_at as u64,
+            format!("the header declares {count} points: {e}"),
+        )
+    };
+    crate::budget::check(
+        format!("reading {count} points of {record} bytes"),
+        estimate,
+    )
+    .map_err(over)?;
+    let mut cols = Columns::new(count, extras.len(), has_rgb).map_err(over)?;
     let mut reader = guarded(|| Reader::new(Cursor::new(bytes)))
         .map_err(|e| decode_error(format!("the header: {e}")))?;
-    let has_rgb = reader.header().point_format().has_color;
     let mut pd: PointData = PointDataBuilder::new().for_header(reader.header()).build();
-    let mut cols = Columns::new(extras.len(), has_rgb);
     let progress = Progress::new(count, &format!("reading {}", name.display()));
     let mut done = 0u64;
     while done < count {
-        let want = BATCH.min(count - done);
+        let want = batch.min(count - done);
         let n = guarded(|| reader.fill_points(want, &mut pd)).map_err(|e| {
             decode_error(format!(
                 "decoding points {done}..{} of {count}: {e}",
@@ -153,8 +135,12 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
                 "the point data ends after {done} of the {count} points the header declares"
             )));
         }
-        cols.append(&pd, &extras, record)
-            .map_err(|_| decode_error(format!("cannot allocate memory for {count} points")))?;
+        cols.append(&pd, &extras, record).map_err(|_| {
+            decode_error(format!(
+                "points {done}..{}: more points than the {count} the header declares",
+                done + n
+            ))
+        })?;
         done += n;
         progress.inc(n);
     }
@@ -230,34 +216,31 @@ struct Columns {
 }
 
 impl Columns {
-    fn new(extras: usize, has_rgb: bool) -> Columns {
-        Columns {
-            positions: Vec::new(),
-            intensity: Vec::new(),
-            classification: Vec::new(),
-            return_number: Vec::new(),
-            number_of_returns: Vec::new(),
-            rgb: Vec::new(),
+    /// Columns with room for `count` points, reserved at once (the caller checked the
+    /// estimate against the budget), so that appending never grows them.
+    fn new(count: u64, extras: usize, has_rgb: bool) -> Result<Columns, OverBudget> {
+        let n = usize::try_from(count).unwrap_or(usize::MAX);
+        let ints = || vec_for::<i32>(n, "the integer attributes");
+        Ok(Columns {
+            positions: vec_for(n, "the positions")?,
+            intensity: ints()?,
+            classification: ints()?,
+            return_number: ints()?,
+            number_of_returns: ints()?,
+            rgb: vec_for(if has_rgb { n } else { 0 }, "the colours")?,
             has_rgb,
-            extras: vec![Vec::new(); extras],
-        }
+            extras: (0..extras)
+                .map(|_| vec_for(n, "the extra-bytes attributes"))
+                .collect::<Result<_, _>>()?,
+        })
     }
 
-    fn append(
-        &mut self,
-        pd: &PointData,
-        extras: &[Extra],
-        record: usize,
-    ) -> Result<(), std::collections::TryReserveError> {
+    /// Append a batch; fails (without allocating) when the points would pass the
+    /// reserved count.
+    fn append(&mut self, pd: &PointData, extras: &[Extra], record: usize) -> Result<(), ()> {
         let n = pd.len();
-        self.positions.try_reserve(n)?;
-        for v in [
-            &mut self.intensity,
-            &mut self.classification,
-            &mut self.return_number,
-            &mut self.number_of_returns,
-        ] {
-            v.try_reserve(n)?;
+        if self.positions.len() + n > self.positions.capacity() {
+            return Err(());
         }
         self.positions
             .extend(pd.x().zip(pd.y()).zip(pd.z()).map(|((x, y), z)| [x, y, z]));
@@ -268,13 +251,11 @@ impl Columns {
         self.number_of_returns
             .extend(pd.number_of_returns().map(i32::from));
         if self.has_rgb {
-            self.rgb.try_reserve(n)?;
             if let Some(rgb) = pd.rgb() {
                 self.rgb.extend(rgb.map(|(r, g, b)| [r, g, b]));
             }
         }
         for (e, column) in extras.iter().zip(&mut self.extras) {
-            column.try_reserve(n)?;
             let size = extra_type_size(e.ty);
             column.extend(pd.raw_bytes().chunks_exact(record).map(|r| {
                 let v = decode_extra(e.ty, &r[e.at..e.at + size]);

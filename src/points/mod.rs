@@ -48,6 +48,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+pub use cloud::footprint;
 pub(crate) use cloud::{decimals_for, fixed};
 pub use cloud::{Attribute, CloudParts, PointCloud, Stats, Values};
 
@@ -77,13 +78,14 @@ pub const UNDEFINED_FACIES: i32 = -999;
 /// in text, byte offset in binary) with what was expected and what was found.
 #[derive(Debug, thiserror::Error)]
 pub enum PointsError {
-    /// The file could not be opened or read.
-    #[error("{path}: {source}")]
+    /// The file could not be opened or read. (The field is not called `source`: the
+    /// message already holds it, and a chain printed with `{:#}` would repeat it.)
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// What failed.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// Binary content that is not what the format requires.
     #[error("{path}: at byte {offset}: {message}")]
@@ -149,10 +151,10 @@ impl PointsError {
             message: message.into(),
         }
     }
-    pub(crate) fn io(path: &Path, source: std::io::Error) -> PointsError {
+    pub(crate) fn io(path: &Path, error: std::io::Error) -> PointsError {
         PointsError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         }
     }
     pub(crate) fn unsupported(path: &Path, message: impl Into<String>) -> PointsError {
@@ -163,8 +165,15 @@ impl PointsError {
     }
 }
 
-/// Read a whole point file (at most [`MAX_FILE_BYTES`]), naming it in the error.
+/// Read a whole point file (at most [`MAX_FILE_BYTES`], and within the memory budget),
+/// naming it in the error.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, PointsError> {
+    if let Ok(meta) = std::fs::metadata(path) {
+        if meta.is_file() {
+            crate::budget::check("reading the file", meta.len())
+                .map_err(|e| PointsError::unsupported(path, e.to_string()))?;
+        }
+    }
     crate::input::read_regular(path, MAX_FILE_BYTES).map_err(|e| PointsError::io(path, e))
 }
 

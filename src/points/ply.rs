@@ -253,6 +253,8 @@ pub struct Property {
     pub data: PropertyData,
     /// Row and position of the first NaN or infinite value, if any.
     pub first_non_finite: Option<(usize, Position)>,
+    /// Where the header declares it (the line and column of its name).
+    pub declared: Position,
 }
 
 /// One element (`vertex`, `face`, ...) with its rows.
@@ -266,6 +268,8 @@ pub struct Element {
     pub properties: Vec<Property>,
     /// Where its data starts.
     pub start: Position,
+    /// Where the header declares it (the line and column of its row count).
+    pub declared: Position,
 }
 
 impl Element {

@@ -87,17 +87,26 @@ pub fn cloud(name: &Path, ply: &Ply) -> Result<PointCloud, PointsError> {
         .element("vertex")
         .ok_or_else(|| unsupported("no \"vertex\" element: not a point cloud".into()))?;
     let n = vertex.count;
+    let at = |p: Position, message: String| match p {
+        Position::Byte(b) => PointsError::format(name, b, message),
+        Position::Line { line, column } => PointsError::text(name, line, column, message),
+    };
     let mut xyz = Vec::with_capacity(3);
     for axis in ["x", "y", "z"] {
         let property = vertex.property(axis).ok_or_else(|| {
-            unsupported(format!(
-                "the vertex element has no scalar property \"{axis}\""
-            ))
+            at(
+                vertex.declared,
+                format!("the vertex element has no scalar property \"{axis}\""),
+            )
         })?;
         let PropertyData::Scalar { values, .. } = &property.data else {
-            return Err(unsupported(format!(
-                "vertex property \"{axis}\" is a list, not a coordinate"
-            )));
+            return Err(at(
+                property.declared,
+                format!(
+                    "vertex property \"{axis}\" is declared as a list (property list ...), \
+                     a coordinate must be a scalar (property float {axis})"
+                ),
+            ));
         };
         if let Some((row, at)) = property.first_non_finite {
             let message = format!(
@@ -111,6 +120,22 @@ pub fn cloud(name: &Path, ply: &Ply) -> Result<PointCloud, PointsError> {
         }
         xyz.push(values);
     }
+    // The cloud is built while the PLY's f64 columns are held: both count. (Every other
+    // scalar property becomes an attribute; colours and normals take no more than that.)
+    let held: u64 = ply.elements.iter().fold(0, |sum, e| {
+        sum.saturating_add(crate::budget::times(
+            e.count as u64,
+            8 * e.properties.len() as u64,
+        ))
+    });
+    let estimate =
+        super::footprint(n as u64, vertex.properties.len(), false, false).saturating_add(held);
+    crate::budget::check(format!("the cloud of {n} vertices"), estimate).map_err(|e| {
+        at(
+            vertex.declared,
+            format!("the vertex element declares {n} rows: {e}"),
+        )
+    })?;
     let positions = (0..n).map(|i| [xyz[0][i], xyz[1][i], xyz[2][i]]).collect();
     let all_three = |names: [&str; 3]| -> Result<Option<[Channel; 3]>, PointsError> {
         let found: Vec<_> = names
@@ -123,10 +148,13 @@ pub fn cloud(name: &Path, ply: &Ply) -> Result<PointCloud, PointsError> {
         match found.len() {
             0 => Ok(None),
             3 => Ok(Some([found[0], found[1], found[2]])),
-            k => Err(unsupported(format!(
-                "the vertex element has {k} of the 3 scalar properties {}",
-                names.join(", ")
-            ))),
+            k => Err(at(
+                vertex.declared,
+                format!(
+                    "the vertex element has {k} of the 3 scalar properties {}",
+                    names.join(", ")
+                ),
+            )),
         }
     };
     let mut used: Vec<&str> = vec!["x", "y", "z"];

@@ -68,6 +68,11 @@ pub struct BenchOptions {
     /// 2D fetch (fill rate), the 3D fetch, dependent table fetches, RGBA8 / RGBA32F.
     #[arg(long)]
     pub breakdown: bool,
+    /// Cell-projection volume settings, e.g. centroid:64,mpvonc:128,precise,projected
+    /// (faithful with a table of N x N x N/2 texels, the precise walk, or precise as a
+    /// projection in MPVONC order with the exact integral per fragment).
+    #[arg(long, value_delimiter = ',')]
+    pub cellproj: Vec<String>,
     /// Turn the camera this many degrees about the vertical axis before every frame,
     /// so each frame pays for a moving view (the splats' sort and tile lists).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -87,6 +92,7 @@ impl Default for BenchOptions {
             raycast_preint: Vec::new(),
             export: None,
             breakdown: false,
+            cellproj: Vec::new(),
             turn: 0.0,
         }
     }
@@ -179,6 +185,11 @@ pub fn settings(scene: &Scene, options: &BenchOptions) -> Result<Vec<Setting>> {
         && options.precise.is_empty()
         && options.raycast.is_empty()
         && options.raycast_preint.is_empty());
+    if let TechniqueScene::Cellproj(c) = &scene.technique {
+        if !options.cellproj.is_empty() {
+            return cellproj_settings(scene, c, &options.cellproj);
+        }
+    }
     let TechniqueScene::Opacity3d(base) = &scene.technique else {
         if sweeping {
             bail!("--faithful, --precise and --raycast[-preint] sweep 3D-opacity scenes only");
@@ -246,6 +257,52 @@ pub fn settings(scene: &Scene, options: &BenchOptions) -> Result<Vec<Setting>> {
                 p.raycast = Some(r);
             })?;
         }
+    }
+    Ok(out)
+}
+
+/// One setting per `--cellproj` name (see [`BenchOptions::cellproj`]).
+fn cellproj_settings(
+    scene: &Scene,
+    base: &crate::techniques::cellproj::CellprojScene,
+    names: &[String],
+) -> Result<Vec<Setting>> {
+    use crate::techniques::cellproj::transfer::Sort;
+    let mut out = Vec::new();
+    for name in names {
+        let mut s = scene.clone();
+        s.target = None;
+        let mut c = base.clone();
+        let mut volume = c.volume_spec();
+        let (kind, size) = name.split_once(':').unwrap_or((name.as_str(), ""));
+        match kind {
+            "precise" | "walk" => s.fidelity = Fidelity::Precise,
+            "projected" => {
+                s.fidelity = Fidelity::Precise;
+                volume.precise = crate::techniques::cellproj::transfer::Precise::Projected;
+            }
+            "centroid" | "mpvonc" => {
+                s.fidelity = Fidelity::Faithful;
+                volume.sort = if kind == "centroid" {
+                    Sort::Centroid
+                } else {
+                    Sort::Mpvonc
+                };
+                let n: u32 = size
+                    .parse()
+                    .with_context(|| format!("--cellproj {name}: the table size after ':'"))?;
+                volume.table_size = [n, (n / 2).max(2)];
+            }
+            _ => bail!("--cellproj {name}: centroid:N, mpvonc:N, precise (the walk) or projected"),
+        }
+        c.volume = Some(volume);
+        c.validate()
+            .map_err(|e| anyhow::anyhow!("--cellproj {name}: {}: {}", e.key, e.message))?;
+        s.technique = TechniqueScene::Cellproj(Box::new(c));
+        out.push(Setting {
+            name: name.clone(),
+            scene: s,
+        });
     }
     Ok(out)
 }
@@ -345,12 +402,18 @@ pub fn run(
         }
         _ => None,
     };
-    let (reference_rgb, reference_s) = match (&prepared, options.score) {
-        (Some(prepared), true) => {
+    let volume = cellproj_volume(scene, options, &mut progress)?;
+    let (reference_rgb, reference_s) = match (&prepared, &volume, options.score) {
+        (Some(prepared), _, true) => {
             let (rgb, seconds) = reference_rgb(scene, prepared, options, &mut progress)?;
             (Some(rgb), Some(seconds))
         }
-        (None, true) => bail!("--score needs a 3D-opacity scene (its f64 reference)"),
+        (None, Some((_, rgb, seconds)), true) => (Some(rgb.clone()), Some(*seconds)),
+        (None, None, true) => {
+            bail!(
+                "--score needs a 3D-opacity or cell-projection volume scene (their f64 references)"
+            )
+        }
         _ => (None, None),
     };
     if let (Some(dir), Some(prepared)) = (&options.export, &prepared) {
@@ -497,6 +560,58 @@ fn new_measured(setting: &Setting, s: &Scene, kind: ProgramKind, first: f64) -> 
         target: s.target_format().name().to_string(),
         ..Measured::untimed(setting.name.clone(), first)
     }
+}
+
+/// For a cell-projection volume scene scored or exported: the prepared mesh, the
+/// reference's RGB and the seconds it took (the export written when asked).
+fn cellproj_volume(
+    scene: &Scene,
+    options: &BenchOptions,
+    progress: &mut impl FnMut(&str),
+) -> Result<
+    Option<(
+        crate::techniques::cellproj::prepare::Prepared,
+        Vec<f32>,
+        f64,
+    )>,
+> {
+    let TechniqueScene::Cellproj(c) = &scene.technique else {
+        return Ok(None);
+    };
+    if !c.mode.volume() || !(options.score || options.export.is_some()) {
+        return Ok(None);
+    }
+    let prepared = crate::techniques::cellproj::prepare::prepare(c, &scene.base)
+        .map_err(anyhow::Error::msg)?;
+    let spec = c.volume_spec();
+    let tf = spec
+        .build(&scene.base, prepared.scale)
+        .map_err(anyhow::Error::msg)?;
+    let isos = if c.mode == crate::techniques::cellproj::Mode::Both {
+        c.isovalues.clone()
+    } else {
+        Vec::new()
+    };
+    let t0 = Instant::now();
+    let image = crate::techniques::cellproj::volume_reference::reference(
+        &prepared,
+        &tf,
+        &isos,
+        &scene.camera,
+        scene.size,
+        scene.background.map(|v| v as f64),
+    );
+    let seconds = t0.elapsed().as_secs_f64();
+    progress(&format!("volume reference in {seconds:.1} s"));
+    let rgb: Vec<f32> = image
+        .data
+        .chunks_exact(4)
+        .flat_map(|p| [p[0], p[1], p[2]])
+        .collect();
+    if let Some(dir) = &options.export {
+        super::export::write_cellproj(dir, scene, &prepared, &tf, &rgb)?;
+    }
+    Ok(Some((prepared, rgb, seconds)))
 }
 
 /// What identifies a cached reference.

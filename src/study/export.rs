@@ -89,7 +89,7 @@ fn camera_json(scene: &Scene) -> CameraJson {
 /// Write the peer's files into `dir` (created if needed).
 pub fn write(dir: &Path, scene: &Scene, prepared: &Prepared, oversample: f64) -> Result<()> {
     let TechniqueScene::Opacity3d(params) = &scene.technique else {
-        anyhow::bail!("--export needs a 3D-opacity scene");
+        anyhow::bail!("--export needs a 3D-opacity or cell-projection volume scene");
     };
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let voxels = prepared.dims.iter().product::<usize>();
@@ -124,6 +124,80 @@ pub fn write(dir: &Path, scene: &Scene, prepared: &Prepared, oversample: f64) ->
         camera: camera_json(scene),
         reference: "reference.f32",
         oversample,
+    };
+    let text = serde_json::to_string_pretty(&json)?;
+    crate::png_io::write_atomic(&dir.join("scene.json"), text.as_bytes())?;
+    Ok(())
+}
+
+#[derive(Serialize)]
+struct MeshJson {
+    points: usize,
+    tets: usize,
+    /// Object-space points (f64 xyz), tetrahedra (u32 x 4), normalized point scalars (f64).
+    points_file: &'static str,
+    tets_file: &'static str,
+    scalars_file: &'static str,
+    /// Transfer function control points `[s, r, g, b, a]` over the normalized scalar.
+    transfer: Vec<[f64; 5]>,
+    /// VTK's scalar opacity unit distance, in the exported (object) units.
+    unit_distance: f64,
+    size: [u32; 2],
+    background: [f32; 4],
+    camera: CameraJson,
+    reference: &'static str,
+}
+
+/// Write a cell-projection volume scene for a peer (`benches/peers/vtk_unstructured.py`):
+/// the prepared mesh in object units, its scalars, the transfer function, the camera
+/// and the reference's RGB.
+pub fn write_cellproj(
+    dir: &Path,
+    scene: &Scene,
+    prepared: &crate::techniques::cellproj::prepare::Prepared,
+    tf: &crate::techniques::cellproj::transfer::Transfer,
+    reference_rgb: &[f32],
+) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let points: Vec<u8> = prepared
+        .points
+        .iter()
+        .flat_map(|p| p.to_array())
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let tets: Vec<u8> = prepared
+        .tets
+        .iter()
+        .flatten()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let scalars: Vec<u8> = prepared
+        .scalars
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    let rgb: Vec<u8> = reference_rgb.iter().flat_map(|v| v.to_le_bytes()).collect();
+    crate::png_io::write_atomic(&dir.join("points.f64"), &points)?;
+    crate::png_io::write_atomic(&dir.join("tets.u32"), &tets)?;
+    crate::png_io::write_atomic(&dir.join("scalars.f64"), &scalars)?;
+    crate::png_io::write_atomic(&dir.join("reference.f32"), &rgb)?;
+    let json = MeshJson {
+        points: prepared.points.len(),
+        tets: prepared.tets.len(),
+        points_file: "points.f64",
+        tets_file: "tets.u32",
+        scalars_file: "scalars.f64",
+        transfer: tf
+            .s
+            .iter()
+            .zip(&tf.rgba)
+            .map(|(s, c)| [*s, c[0], c[1], c[2], c[3]])
+            .collect(),
+        unit_distance: tf.unit,
+        size: scene.size,
+        background: scene.background,
+        camera: camera_json(scene),
+        reference: "reference.f32",
     };
     let text = serde_json::to_string_pretty(&json)?;
     crate::png_io::write_atomic(&dir.join("scene.json"), text.as_bytes())?;

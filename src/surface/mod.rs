@@ -72,13 +72,14 @@ impl std::fmt::Display for Position {
 /// and the position of the problem.
 #[derive(Debug, thiserror::Error)]
 pub enum SurfaceError {
-    /// The file could not be opened or read.
-    #[error("{path}: {source}")]
+    /// The file could not be opened or read. (The field is not called `source`: the
+    /// message already holds it, and a chain printed with `{:#}` would repeat it.)
+    #[error("{path}: {error}")]
     Io {
         /// The file.
         path: PathBuf,
         /// What failed.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The content is not what the format requires, or the mesh is unusable.
     #[error("{path}: {position}: {message}")]
@@ -237,17 +238,43 @@ fn parse_ply(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
     let vertex = ply
         .element("vertex")
         .ok_or_else(|| missing("a vertex element"))?;
-    let axis = |a: &str| {
-        vertex
-            .scalar(a)
-            .ok_or_else(|| missing(&format!("vertex property {a}")))
+    let declared = |p: crate::points::ply::Position| match p {
+        crate::points::ply::Position::Line { line, column } => Position::Line { line, column },
+        crate::points::ply::Position::Byte(b) => Position::Byte(b),
+    };
+    let axis = |a: &str| match vertex.property(a) {
+        None => Err(SurfaceError::format(
+            name,
+            declared(vertex.declared),
+            format!("the vertex element has no property {a}: a PLY surface needs x, y and z"),
+        )),
+        Some(p) => vertex.scalar(a).ok_or_else(|| {
+            SurfaceError::format(
+                name,
+                declared(p.declared),
+                format!("vertex property {a} is declared as a list: a coordinate must be a scalar"),
+            )
+        }),
     };
     let (x, y, z) = (axis("x")?, axis("y")?, axis("z")?);
-    let vertices: Vec<[f64; 3]> = (0..x.len()).map(|i| [x[i], y[i], z[i]]).collect();
     let faces = ply
         .element("face")
         .and_then(|f| f.face_indices())
         .ok_or_else(|| missing("a face element with a vertex_indices list"))?;
+    // The vertices and the fans' triangles, made while the PLY's columns are held (those
+    // were checked as they were read).
+    let corners = faces.values().len() as u64;
+    let estimate =
+        crate::budget::times(x.len() as u64, 24).saturating_add(crate::budget::times(corners, 12));
+    crate::budget::check(
+        format!("the surface of {} vertices and {corners} corners", x.len()),
+        estimate,
+    )
+    .map_err(|e| {
+        let face = ply.element("face").map_or(vertex.declared, |f| f.declared);
+        SurfaceError::format(name, declared(face), e.to_string())
+    })?;
+    let vertices: Vec<[f64; 3]> = (0..x.len()).map(|i| [x[i], y[i], z[i]]).collect();
     // Indices arrive as f64 (the PLY reader's one numeric type): non-integers and
     // negatives become u32::MAX, which from_indexed reports as out of range.
     let polygons = faces.iter().map(|f| {
@@ -267,11 +294,32 @@ fn parse_ply(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
 /// Read a surface file (regular files of at most [`MAX_SURFACE_BYTES`]).
 pub fn read(path: &Path) -> Result<TriangleMesh, SurfaceError> {
     let bytes =
-        crate::input::read_regular(path, MAX_SURFACE_BYTES).map_err(|source| SurfaceError::Io {
+        crate::input::read_regular(path, MAX_SURFACE_BYTES).map_err(|error| SurfaceError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         })?;
     parse(path, &bytes)
+}
+
+/// `bytes` as UTF-8 text, or an error naming the line, column and byte of the first byte
+/// that is not (OBJ and ASCII STL are text).
+pub(crate) fn utf8<'a>(name: &Path, bytes: &'a [u8]) -> Result<&'a str, SurfaceError> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let at = e.valid_up_to();
+        let valid = &bytes[..at];
+        let line = valid.iter().filter(|&&b| b == b'\n').count() + 1;
+        let start = valid.iter().rposition(|&b| b == b'\n').map_or(0, |p| p + 1);
+        // The valid prefix is UTF-8: count its characters.
+        let column = std::str::from_utf8(&valid[start..]).map_or(1, |s| s.chars().count() + 1);
+        SurfaceError::format(
+            name,
+            Position::Line { line, column },
+            format!(
+                "byte {at} (0x{:02x}) is not UTF-8: the file must be text",
+                bytes[at]
+            ),
+        )
+    })
 }
 
 /// `arbvis inspect` text for a surface: counts, bounds and the defects of

@@ -20,16 +20,31 @@ use super::{Position, SurfaceError, TriangleMesh};
 
 /// Parse OBJ text (`name` names it in errors).
 pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
-    let text = crate::input::utf8(bytes.to_vec()).map_err(|source| SurfaceError::Io {
-        path: name.to_path_buf(),
-        source,
-    })?;
+    let text = super::utf8(name, bytes)?;
     // Checked before tobj sees the text: tobj 4.0.5 multiplies indices unchecked
     // (`vn * 3 + 2`), which overflows on a hostile index.
-    if let Some((position, message)) = locate(&text) {
+    let mut counts = Counts::default();
+    if let Some((position, message)) = locate(text, &mut counts) {
         return Err(SurfaceError::format(name, position, message));
     }
-    let text = geometry_only(&text);
+    crate::budget::check(
+        format!(
+            "reading {} vertices and {} faces of {} corners",
+            counts.vertices, counts.faces, counts.corners
+        ),
+        counts.bytes(text.len()),
+    )
+    .map_err(|e| {
+        SurfaceError::format(
+            name,
+            Position::Line {
+                line: counts.last_face_line.max(1),
+                column: 1,
+            },
+            e.to_string(),
+        )
+    })?;
+    let text = geometry_only(text);
     let options = tobj::LoadOptions {
         single_index: false,
         triangulate: false,
@@ -43,7 +58,7 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
     let models = match loaded {
         Ok((models, _materials)) => models,
         Err(e) => {
-            if let Some((position, message)) = locate(&text) {
+            if let Some((position, message)) = locate(&text, &mut Counts::default()) {
                 return Err(SurfaceError::format(name, position, message));
             }
             let at = (cursor.position() as usize).min(text.len());
@@ -86,7 +101,7 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
         }
     }
     if vertices.iter().flatten().any(|c| !c.is_finite()) {
-        if let Some((position, message)) = locate(&text) {
+        if let Some((position, message)) = locate(&text, &mut Counts::default()) {
             return Err(SurfaceError::format(name, position, message));
         }
     }
@@ -126,8 +141,43 @@ pub(crate) fn weld(vertices: Vec<[f64; 3]>) -> (Vec<[f64; 3]>, Vec<u32>) {
     (out, remap)
 }
 
-/// The first non-finite vertex or out-of-range face index in OBJ text, with its line and
-/// column (`None` when this scan finds nothing wrong).
+/// What an OBJ file holds, counted before `tobj` reads it.
+#[derive(Debug, Default)]
+struct Counts {
+    vertices: u64,
+    faces: u64,
+    corners: u64,
+    last_face_line: usize,
+}
+
+impl Counts {
+    fn add(&mut self, keyword: &str, words: &std::str::SplitWhitespace, line: usize) {
+        match keyword {
+            "v" => self.vertices += 1,
+            "f" => {
+                self.faces += 1;
+                self.corners += words.clone().count() as u64;
+                self.last_face_line = line;
+            }
+            _ => {}
+        }
+    }
+
+    /// Bytes held at the peak of reading `len` bytes of text with these counts: the
+    /// geometry-only copy of the text; `tobj`'s positions (24 bytes a vertex), its faces
+    /// (about 100 bytes each, 24 a corner) and per-group copies (24 + 4 bytes a corner);
+    /// our polygons (40 bytes each, 4 a corner) and corner positions (24 a corner); the
+    /// welding (about 110 bytes a corner) and the triangles (12 each, fewer than the
+    /// corners).
+    fn bytes(&self, len: usize) -> u64 {
+        let times = crate::budget::times;
+        (2 * len as u64)
+            .saturating_add(times(self.vertices, 24))
+            .saturating_add(times(self.faces, 140))
+            .saturating_add(times(self.corners, 24 + 28 + 4 + 24 + 110 + 12))
+    }
+}
+
 /// The text with what this reader ignores blanked (line numbers kept): texture and
 /// normal lines, and the texture/normal parts of face corners (`f 1/2/3` becomes `f 1`).
 fn geometry_only(text: &str) -> String {
@@ -150,13 +200,16 @@ fn geometry_only(text: &str) -> String {
     out
 }
 
-fn locate(text: &str) -> Option<(Position, String)> {
+/// The first non-finite vertex, face of fewer than 3 corners or out-of-range face index
+/// in OBJ text, with its line and column (`None` when this scan finds nothing wrong).
+fn locate(text: &str, counts: &mut Counts) -> Option<(Position, String)> {
     let mut vertex_count: i64 = 0;
     for (l, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
         let Some(keyword) = words.next() else {
             continue;
         };
+        counts.add(keyword, &words, l + 1);
         let column_of = |word: &str| {
             let offset = word.as_ptr() as usize - line.as_ptr() as usize;
             line[..offset].chars().count() + 1
@@ -180,6 +233,19 @@ fn locate(text: &str) -> Option<(Position, String)> {
                 }
             }
             "f" => {
+                let corners = words.clone().count();
+                if corners < 3 {
+                    return Some((
+                        Position::Line {
+                            line: l + 1,
+                            column: column_of(keyword),
+                        },
+                        format!(
+                            "a face with {corners} corner{}: a face needs 3 or more (2 corners are a line, written `l`)",
+                            if corners == 1 { "" } else { "s" }
+                        ),
+                    ));
+                }
                 for word in words {
                     let first = word.split('/').next().unwrap_or("");
                     let Ok(i) = first.parse::<i64>() else {
@@ -277,6 +343,69 @@ mod tests {
         assert!(e.contains("no faces"), "{e}");
         let e = parse(name(), b"v 0 0 0\n\xff\n").unwrap_err().to_string();
         assert!(e.contains("line 2, column 1"), "{e}");
+    }
+
+    // --- issue 17: clouds and surfaces ---
+
+    #[test]
+    fn faces_of_fewer_than_three_corners_are_errors_at_their_line() {
+        let e = parse(name(), b"v 0 0 0\nv 1 0 0\n  f 1 2\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("t.obj: line 3, column 3: a face with 2 corners: a face needs 3"),
+            "{e}"
+        );
+        // Among good faces: not dropped silently.
+        let mixed = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 3 1\nf 1 3 2\n";
+        let e = parse(name(), mixed.as_bytes()).unwrap_err().to_string();
+        assert!(
+            e.starts_with("t.obj: line 5, column 1: a face with 2 corners"),
+            "{e}"
+        );
+        let e = parse(name(), b"v 0 0 0\nf 1\n").unwrap_err().to_string();
+        assert!(e.contains("line 2, column 1: a face with 1 corner:"), "{e}");
+        let e = parse(name(), b"v 0 0 0\nf\n").unwrap_err().to_string();
+        assert!(e.contains("line 2, column 1: a face with 0 corners"), "{e}");
+    }
+
+    #[test]
+    fn text_that_is_not_utf8_is_named_once() {
+        let e = parse(name(), b"v 0 0 0\n# caf\xe9\nf 1 1 1\n").unwrap_err();
+        let chain = format!("{:#}", anyhow::Error::from(e));
+        assert_eq!(
+            chain,
+            "t.obj: line 2, column 6: byte 13 (0xe9) is not UTF-8: the file must be text"
+        );
+    }
+
+    #[test]
+    fn coordinates_near_the_f64_limit() {
+        // A closed tetrahedron spanning ±1.6e308: its volume is beyond f64, said so.
+        let text = "v -1.6e308 -1.6e308 -1.6e308\nv 1.6e308 -1.6e308 -1.6e308\nv -1.6e308 1.6e308 -1.6e308\nv -1.6e308 -1.6e308 1.6e308\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+        let m = parse(name(), text.as_bytes()).unwrap();
+        let r = inspect(&m);
+        assert!(r.is_closed(), "{r}");
+        // (3.2e308)^3 / 6 = 5.46e924.
+        assert!(r.signed_volume == f64::INFINITY, "{r}");
+        assert!((r.volume_log10 - ((3.2f64.log10() + 308.0) * 3.0 - 6f64.log10())).abs() < 1e-9);
+        assert!(
+            r.to_string()
+                .contains("signed volume: 5.461333e924 (beyond f64's range)"),
+            "{r}"
+        );
+        assert_eq!((r.degenerate_triangles, r.self_intersections), (0, 0));
+        // Tiny coordinates keep their volume too (no underflow in the products).
+        let tiny = text.replace("1.6e308", "1e-200");
+        let r = inspect(&parse(name(), tiny.as_bytes()).unwrap());
+        // (2e-200)^3 / 6 = 1.33e-600 underflows f64: 0, with its power of ten said.
+        assert_eq!(r.signed_volume, 0.0);
+        assert!(
+            (r.volume_log10 - (8f64 / 6.0).log10() + 600.0).abs() < 1e-9,
+            "{r}"
+        );
+        assert!(r.to_string().contains("signed volume: 1.33333"), "{r}");
+        assert!(r.to_string().contains("e-600 (beyond f64's range)"), "{r}");
     }
 
     #[test]

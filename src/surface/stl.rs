@@ -74,6 +74,11 @@ fn binary(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
         ));
     }
     let count = count as usize; // at most len / 50
+    crate::budget::check(
+        format!("reading {count} triangles"),
+        crate::budget::times(3 * count as u64, CORNER_BYTES),
+    )
+    .map_err(|e| SurfaceError::format(name, Position::Byte(80), e.to_string()))?;
     let mut corners: Vec<[f64; 3]> = Vec::new();
     corners
         .try_reserve_exact(3 * count)
@@ -98,31 +103,40 @@ fn binary(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
             corners.push(p);
         }
     }
-    indexed(name, corners.chunks_exact(3).map(|c| c.to_vec()).collect())
+    let (vertices, remap) = weld(corners);
+    TriangleMesh::from_indexed(name, vertices, remap.chunks_exact(3))
 }
 
-/// Weld corners (one polygon per entry) into an indexed mesh.
-fn indexed(name: &Path, polygons: Vec<Vec<[f64; 3]>>) -> Result<TriangleMesh, SurfaceError> {
-    let flat: Vec<[f64; 3]> = polygons.iter().flatten().copied().collect();
-    let (vertices, remap) = weld(flat);
+/// Bytes a corner costs while it is read and welded: its position (24), the welding's
+/// hash map (up to about 80 with the map's spare room), the welded position (24) and
+/// index (4), and its share of the triangles (4).
+const CORNER_BYTES: u64 = 24 + 80 + 24 + 4 + 4;
+
+/// Weld the corners of polygons of `sizes` corners each, in order, into an indexed mesh.
+fn indexed(
+    name: &Path,
+    corners: Vec<[f64; 3]>,
+    sizes: &[u32],
+) -> Result<TriangleMesh, SurfaceError> {
+    let (vertices, remap) = weld(corners);
     let mut next = 0usize;
-    let faces: Vec<Vec<u32>> = polygons
-        .iter()
-        .map(|p| {
-            let f = remap[next..next + p.len()].to_vec();
-            next += p.len();
-            f
-        })
-        .collect();
+    let faces = sizes.iter().map(|&n| {
+        let f = &remap[next..next + n as usize];
+        next += n as usize;
+        f
+    });
     TriangleMesh::from_indexed(name, vertices, faces)
 }
 
-/// Whitespace-separated words with their 1-based line and column.
+/// Whitespace-separated words with their 1-based line and column. Columns are counted
+/// on from the last word's, so a long line costs its length once, not once per word.
 struct Words<'a> {
     text: &'a str,
     at: usize,
     line: usize,
     line_start: usize,
+    /// A byte offset on the current line and its 0-based character column.
+    counted: (usize, usize),
 }
 
 struct Word<'a> {
@@ -151,8 +165,20 @@ impl<'a> Words<'a> {
         Some(Word {
             text: &self.text[start..self.at],
             line: self.line,
-            column: self.text[self.line_start..start].chars().count() + 1,
+            column: self.column(start),
         })
+    }
+
+    /// The 1-based character column of byte `at` on the current line (`at` never moves
+    /// back within a line).
+    fn column(&mut self, at: usize) -> usize {
+        if self.counted.0 < self.line_start {
+            self.counted = (self.line_start, 0);
+        }
+        let (from, chars) = self.counted;
+        let chars = chars + self.text[from..at].chars().count();
+        self.counted = (at, chars);
+        chars + 1
     }
 
     /// Skip the rest of the current line (a solid's name).
@@ -163,27 +189,22 @@ impl<'a> Words<'a> {
         }
     }
 
-    fn position(&self) -> Position {
+    fn position(&mut self) -> Position {
         Position::Line {
             line: self.line,
-            column: self.text[self.line_start..self.at].chars().count() + 1,
+            column: self.column(self.at),
         }
     }
 }
 
 fn ascii(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
-    let text = std::str::from_utf8(bytes).map_err(|_| {
-        let e = crate::input::utf8(bytes.to_vec()).err();
-        SurfaceError::Io {
-            path: name.to_path_buf(),
-            source: e.unwrap_or_else(|| crate::input::invalid("not UTF-8")),
-        }
-    })?;
+    let text = super::utf8(name, bytes)?;
     let mut words = Words {
         text,
         at: 0,
         line: 1,
         line_start: 0,
+        counted: (0, 0),
     };
     let err = |w: &Word, message: String| {
         SurfaceError::format(
@@ -195,7 +216,17 @@ fn ascii(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
             message,
         )
     };
-    let mut polygons: Vec<Vec<[f64; 3]>> = Vec::new();
+    // Each corner takes at least `vertex 0 0 0` (14 bytes): the budget holds for the
+    // corners the text can hold.
+    crate::budget::check(
+        "reading the ASCII STL's vertices",
+        crate::budget::times(text.len() as u64 / 14 + 1, CORNER_BYTES + 4),
+    )
+    .map_err(|e| {
+        SurfaceError::format(name, Position::Line { line: 1, column: 1 }, e.to_string())
+    })?;
+    let mut corners: Vec<[f64; 3]> = Vec::new();
+    let mut sizes: Vec<u32> = Vec::new();
     // Expect one keyword; at the end of the text, name the end.
     macro_rules! expect {
         ($kw:expr) => {{
@@ -285,7 +316,7 @@ fn ascii(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
             }
             expect!("outer");
             let loop_word = expect!("loop");
-            let mut corners = Vec::new();
+            let first = corners.len();
             loop {
                 let Some(w) = words.next() else {
                     return Err(SurfaceError::format(
@@ -312,24 +343,25 @@ fn ascii(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
                 }
                 corners.push(p);
             }
-            if corners.len() < 3 {
+            let size = corners.len() - first;
+            if size < 3 {
                 return Err(err(
                     &loop_word,
-                    format!("a loop needs 3 or more vertices, found {}", corners.len()),
+                    format!("a loop needs 3 or more vertices, found {size}"),
                 ));
             }
             expect!("endfacet");
-            polygons.push(corners);
+            sizes.push(size as u32);
         }
     }
-    if polygons.is_empty() {
+    if sizes.is_empty() {
         return Err(SurfaceError::format(
             name,
             words.position(),
             "no facets in the ASCII STL",
         ));
     }
-    indexed(name, polygons)
+    indexed(name, corners, &sizes)
 }
 
 /// Binary STL bytes for `triangles` (tests and fixtures).
@@ -476,6 +508,44 @@ mod tests {
         for cut in 0..text.len() {
             let _ = parse(name(), &text.as_bytes()[..cut]);
         }
+    }
+
+    // --- issue 17: clouds and surfaces ---
+
+    #[test]
+    fn one_long_line_is_read_in_linear_time() {
+        // 20,000 facets on one 1.7 MB line; the last keyword misspelt after a two-byte
+        // character, so its column counts characters, not bytes.
+        let facet = "facet normal 0 0 1 outer loop vertex 0 0 0 vertex 1 0 0 vertex 0 1 0 endloop endfacet ";
+        let body = facet.repeat(20_000);
+        let text = format!("solid x\n{body}é endsolid x\n");
+        let t = std::time::Instant::now();
+        let e = parse(name(), text.as_bytes()).unwrap_err().to_string();
+        let took = t.elapsed();
+        let column = body.chars().count() + 1;
+        assert!(
+            e.contains(&format!(
+                "line 2, column {column}: expected `facet` or `endsolid`, found \"é\""
+            )),
+            "{e}"
+        );
+        // Linear: milliseconds in release. Counting each word's column from the line start
+        // (380,000 words, 0.85 MB each on average) took minutes.
+        assert!(took.as_secs_f64() < 10.0, "{took:?}");
+        let good = format!("solid x\n{body}endsolid x\n");
+        let m = parse(name(), good.as_bytes()).unwrap();
+        assert_eq!((m.vertices.len(), m.triangles.len()), (3, 20_000));
+    }
+
+    #[test]
+    fn coordinates_near_the_f32_limit_in_binary() {
+        // f32::MAX corners: finite, welded, inspected without overflow.
+        let big = f32::MAX;
+        let t = [[[-big, -big, -big], [big, -big, -big], [-big, big, -big]]];
+        let m = parse(name(), &to_binary(&header("big"), &t)).unwrap();
+        let r = inspect(&m);
+        assert_eq!((r.degenerate_triangles, r.open_edges), (0, 3), "{r}");
+        assert_eq!(r.min, [-(big as f64), -(big as f64), -(big as f64)]);
     }
 
     #[test]

@@ -64,6 +64,16 @@ pub trait Renderer {
     fn needs_depth(&self) -> bool {
         false
     }
+    /// Streaming (the viewer): draw what is at hand and refine over later frames, instead
+    /// of waiting for all the data a full-quality frame needs (offscreen renders). Only
+    /// renderers that stream data (a survey store) care.
+    fn set_streaming(&mut self, streaming: bool) {
+        let _ = streaming;
+    }
+    /// Whether a streaming renderer still has data on its way (the viewer keeps drawing).
+    fn pending(&self) -> bool {
+        false
+    }
     /// A line for the viewer about the last frame's CPU work (e.g. the sort time).
     fn status(&self) -> Option<String> {
         None

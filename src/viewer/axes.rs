@@ -234,7 +234,7 @@ pub fn describe(source: &VolumeSource, base: &Path, dims: [usize; 3]) -> [Axis; 
                 indices(["i", "j", "k"][a], dims[a])
             }
         }),
-        VolumeSource::Synthetic(_) => [
+        VolumeSource::Synthetic(_) | VolumeSource::Store(_) => [
             indices("sample", dims[0]),
             indices("crossline", dims[1]),
             indices("inline", dims[2]),

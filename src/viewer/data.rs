@@ -130,6 +130,17 @@ pub fn build(
             return crate::render::build(gpu, scene, kind);
         }
     };
+    // A survey store is streamed: frames draw what is resident and refine.
+    if crate::techniques::opacity3d::bricked::store_of(params)
+        .ok()
+        .flatten()
+        .is_some()
+    {
+        data.volume = None;
+        let mut r = crate::render::build(gpu, scene, kind)?;
+        r.set_streaming(true);
+        return Ok(r);
+    }
     if data.volume.is_none() {
         params
             .validate()

@@ -296,6 +296,11 @@ impl Running {
             !screenshot && (self.dragging || settling || measure == Some(MeasureMode::Interactive));
         let key = Key::of(&self.scene, self.scene.size, self.generation);
         let gpu = self.window.gpu();
+        // A store's bricks keep arriving: draw the full picture again until none is due.
+        let streaming = self.renderer.pending();
+        if streaming && !interacting {
+            self.volume.refine();
+        }
         let pending = self.volume.update(
             gpu,
             self.renderer.as_mut(),
@@ -337,6 +342,7 @@ impl Running {
         }
         self.window.swap_buffers()?;
         Ok(match pending {
+            Pending::Done if streaming => Some(Instant::now()),
             Pending::Done => None,
             Pending::Building => Some(Instant::now()),
             Pending::Refine => Some(self.last_edit.unwrap_or(now) + SETTLE),

@@ -168,6 +168,13 @@ pub fn reduced(technique: &TechniqueScene, divisor: u32) -> TechniqueScene {
 }
 
 impl VolumeView {
+    /// Draw the full-quality picture again (a streaming renderer has more data for it).
+    pub fn refine(&mut self) {
+        if let Some(p) = &mut self.shown {
+            p.full = false;
+        }
+    }
+
     /// Bring the picture up to date with `key`: at `quality` while `interacting`, else
     /// in full-quality parts within the frame budget (`sync` draws them all now).
     #[allow(clippy::too_many_arguments)]

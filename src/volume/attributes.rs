@@ -90,12 +90,26 @@ pub fn derive(amplitude: &Volume, attribute: Attribute) -> Volume {
         .chunks_exact(ns)
         .zip(out.values.chunks_exact_mut(ns))
     {
-        let trace: Vec<f64> = src
-            .iter()
-            .map(|&v| if v.is_finite() { v as f64 } else { 0.0 })
-            .collect();
-        let a = analytic(&trace, &mut planner);
-        let phase: Vec<f64> = a.iter().map(|c| c.im.atan2(c.re)).collect();
+        derive_trace(src, &mut planner, &mut [(attribute, dst)]);
+    }
+    out
+}
+
+/// Derive several attributes of one trace from one analytic signal: each `(attribute,
+/// out)` gets `src.len()` values (the same as [`derive`] gives for a volume).
+pub fn derive_trace(
+    src: &[f32],
+    planner: &mut FftPlanner<f64>,
+    outputs: &mut [(Attribute, &mut [f32])],
+) {
+    let ns = src.len();
+    let trace: Vec<f64> = src
+        .iter()
+        .map(|&v| if v.is_finite() { v as f64 } else { 0.0 })
+        .collect();
+    let a = analytic(&trace, planner);
+    let phase: Vec<f64> = a.iter().map(|c| c.im.atan2(c.re)).collect();
+    for (attribute, dst) in outputs.iter_mut() {
         for (i, d) in dst.iter_mut().enumerate() {
             let v = match attribute {
                 Attribute::Amplitude => trace[i],
@@ -121,7 +135,11 @@ pub fn derive(amplitude: &Volume, attribute: Attribute) -> Volume {
             };
         }
     }
-    out
+}
+
+/// The attribute named `name` (as in scenes).
+pub fn by_name(name: &str) -> Option<Attribute> {
+    Attribute::ALL.into_iter().find(|a| a.name() == name)
 }
 
 #[cfg(test)]

@@ -308,6 +308,9 @@ pub enum VolumeSource {
     Raw(raw::RawSpec),
     /// The built-in seismic-like cube.
     Synthetic(synthetic::SyntheticSpec),
+    /// A bricked multi-resolution store made by `arbvis convert` (3D opacity streams it
+    /// brick by brick; it is never loaded whole).
+    Store(PathBuf),
 }
 
 /// What a volume may hold, checked against the dimensions a file or scene declares
@@ -356,6 +359,15 @@ impl Limits {
                 self.max_side
             )));
         }
+        if let Some(n) = voxels {
+            // The samples as f32 (the loaders' output); derived attributes and textures are
+            // estimated by the technique that makes them.
+            crate::budget::check(
+                format!("{what}: {n} samples of {dims:?} as f32"),
+                crate::budget::times(n, 4),
+            )
+            .map_err(|e| VolumeError::Invalid(e.to_string()))?;
+        }
         match voxels {
             Some(n) if n <= self.max_voxels => Ok(()),
             _ => Err(VolumeError::Invalid(format!(
@@ -367,6 +379,27 @@ impl Limits {
 }
 
 impl VolumeSource {
+    /// The voxel count the source declares without reading anything (a generated
+    /// volume's size); `None` for files, whose loaders check their headers.
+    pub fn declared_voxels(&self) -> Option<u64> {
+        match self {
+            VolumeSource::Synthetic(spec) => Some(
+                spec.size
+                    .iter()
+                    .fold(1u64, |a, &d| a.saturating_mul(d as u64)),
+            ),
+            _ => None,
+        }
+    }
+
+    /// The dimensions a generated volume will have (`None` for files).
+    pub fn declared_dims(&self) -> Option<[usize; 3]> {
+        match self {
+            VolumeSource::Synthetic(spec) => Some(spec.size),
+            _ => None,
+        }
+    }
+
     /// Read the volume; relative paths are taken from `base` (the scene's folder). The
     /// dimensions are checked against `limits` before any sample is read.
     pub fn load(&self, base: &Path, limits: &Limits) -> Result<Volume, VolumeError> {
@@ -381,6 +414,10 @@ impl VolumeSource {
             VolumeSource::Nifti(p) => nifti_file::read(&base.join(p), limits),
             VolumeSource::Raw(spec) => raw::read(base, spec, limits),
             VolumeSource::Synthetic(spec) => synthetic::amplitude(spec, limits),
+            VolumeSource::Store(p) => Err(VolumeError::Unsupported {
+                path: base.join(p),
+                message: "a store is streamed brick by brick by 3D opacity, never loaded whole (use it as every attribute's volume of an opacity3d scene)".into(),
+            }),
         }
     }
 
@@ -392,7 +429,7 @@ impl VolumeSource {
                 spec.validate().map_err(|e| FieldError::new("synthetic", e))
             }
             VolumeSource::Raw(spec) => spec.validate().map_err(|e| FieldError::new("raw", e)),
-            VolumeSource::Segy(_) | VolumeSource::Nifti(_) => Ok(()),
+            VolumeSource::Segy(_) | VolumeSource::Nifti(_) | VolumeSource::Store(_) => Ok(()),
         }
     }
 
@@ -402,6 +439,7 @@ impl VolumeSource {
             VolumeSource::Segy(s) => Some(&mut s.path),
             VolumeSource::Nifti(p) => Some(p),
             VolumeSource::Raw(spec) => Some(&mut spec.path),
+            VolumeSource::Store(p) => Some(p),
             VolumeSource::Synthetic(_) => None,
         }
     }
@@ -412,6 +450,7 @@ impl VolumeSource {
             VolumeSource::Segy(s) => Some(&s.path),
             VolumeSource::Nifti(p) => Some(p),
             VolumeSource::Raw(spec) => Some(&spec.path),
+            VolumeSource::Store(p) => Some(p),
             VolumeSource::Synthetic(_) => None,
         }
     }
@@ -428,13 +467,21 @@ pub fn inspect(path: &Path) -> Result<String, VolumeError> {
             nifti_file::inspect(path)?
         ));
     }
-    let s = segy::read(path, &segy::ReadOptions::default())?;
-    Ok(format!(
-        "{}\n{}{}",
-        path.display(),
-        s.describe(),
-        describe(&s.volume)
-    ))
+    let bytes = read_file(path, u64::MAX)?;
+    match segy::parse(path, &bytes, &segy::ReadOptions::default()) {
+        Ok(s) => Ok(format!(
+            "{}\n{}{}",
+            path.display(),
+            s.describe(),
+            describe(&s.volume)
+        )),
+        // A pre-stack file cannot be gridded as one cube without a choice: describe its
+        // gathers and say how a scene makes that choice.
+        Err(e) => match segy::gathers(path, &bytes) {
+            Ok(g) if g.is_prestack() => Ok(format!("{}\n{}", path.display(), g.describe(path))),
+            _ => Err(e),
+        },
+    }
 }
 
 /// Dimensions and value statistics, one item per line.

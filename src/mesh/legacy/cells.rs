@@ -1,9 +1,10 @@
 //! The two cell layouts of legacy files: the classic `CELLS n size` list (a count before
 //! each cell's point indices) and VTK 9's `OFFSETS` / `CONNECTIVITY` arrays.
 
-use super::{MeshError, Reader};
+use super::reader::Reader;
 use crate::mesh::cells::RawCells;
 use crate::mesh::read::{vec_for, Num};
+use crate::mesh::MeshError;
 
 /// `CELLS n size` then `size` integers: for each cell a count and its point indices.
 pub(super) fn classic_cells(r: &mut Reader, n: u64, size: u64) -> Result<RawCells, MeshError> {

@@ -21,29 +21,13 @@
 use std::path::Path;
 
 mod cells;
+mod reader;
 
 use self::cells::{classic_cells, modern_cells};
+use self::reader::Reader;
 use super::cells::{vtk_kind, RawCells};
-use super::read::{nth_token, quote, vec_for, Cursor, Floats, Num};
-use super::{DataArray, Mesh, MeshError, MeshInfo};
-
-/// The numeric type of a legacy type name (`None` for `bit`, strings and unknown names).
-fn num_type(t: &[u8]) -> Option<Num> {
-    let t = String::from_utf8_lossy(t).to_ascii_lowercase();
-    Some(match t.as_str() {
-        "unsigned_char" | "vtktypeuint8" => Num::U8,
-        "char" | "signed_char" | "vtktypeint8" => Num::I8,
-        "unsigned_short" | "vtktypeuint16" => Num::U16,
-        "short" | "vtktypeint16" => Num::I16,
-        "unsigned_int" | "vtktypeuint32" => Num::U32,
-        "int" | "vtkidtype" | "vtktypeint32" => Num::I32,
-        "unsigned_long" | "vtktypeuint64" | "unsigned_long_long" | "unsigned___int64" => Num::U64,
-        "long" | "vtktypeint64" | "long_long" | "__int64" => Num::I64,
-        "float" | "vtktypefloat32" => Num::F32,
-        "double" | "vtktypefloat64" => Num::F64,
-        _ => return None,
-    })
-}
+use super::read::{quote, vec_for, Cursor, Num};
+use super::{DataArray, Mesh, MeshError, MeshInfo, ReadArray};
 
 /// Which attribute section arrays go to.
 #[derive(Clone, Copy, PartialEq)]
@@ -51,158 +35,6 @@ enum Target {
     None,
     Points(usize),
     Cells(usize),
-}
-
-struct Reader<'a> {
-    c: Cursor<'a>,
-    binary: bool,
-}
-
-impl<'a> Reader<'a> {
-    /// The remaining tokens of the current line.
-    fn args(&mut self) -> Vec<(usize, &'a [u8])> {
-        let (at, line) = self.c.line();
-        let mut out = Vec::new();
-        let mut i = 0;
-        while i < line.len() {
-            while i < line.len() && line[i].is_ascii_whitespace() {
-                i += 1;
-            }
-            let s = i;
-            while i < line.len() && !line[i].is_ascii_whitespace() {
-                i += 1;
-            }
-            if i > s {
-                out.push((at + s, &line[s..i]));
-            }
-        }
-        out
-    }
-
-    /// Argument `i` of a header line, parsed.
-    fn arg<T: std::str::FromStr>(
-        &self,
-        args: &[(usize, &[u8])],
-        i: usize,
-        kw_at: usize,
-        what: &str,
-    ) -> Result<T, MeshError> {
-        let (at, t) = args.get(i).copied().ok_or_else(|| {
-            self.c.err(
-                kw_at,
-                format!("expected {what} on this line, found the line end"),
-            )
-        })?;
-        std::str::from_utf8(t)
-            .ok()
-            .and_then(|s| s.parse().ok())
-            .ok_or_else(|| {
-                self.c
-                    .err(at, format!("expected {what}, found {}", quote(t)))
-            })
-    }
-
-    /// A type-name argument.
-    fn type_arg(&self, args: &[(usize, &[u8])], i: usize, kw_at: usize) -> Result<Num, MeshError> {
-        let (at, t) = args.get(i).copied().ok_or_else(|| {
-            self.c.err(
-                kw_at,
-                "expected a data type on this line, found the line end",
-            )
-        })?;
-        num_type(t).ok_or_else(|| {
-            self.c.err(
-                at,
-                format!(
-                    "data type {} is not supported (expected unsigned_char, char, short, int, long, float, double, vtktypeint32, vtktypeint64, ...)",
-                    quote(t)
-                ),
-            )
-        })
-    }
-
-    /// A count argument that must fit in the rest of the file.
-    fn count_arg(
-        &self,
-        args: &[(usize, &[u8])],
-        i: usize,
-        kw_at: usize,
-        what: &str,
-        min_bytes: usize,
-    ) -> Result<usize, MeshError> {
-        let n: i64 = self.arg(args, i, kw_at, what)?;
-        let at = args[i].0;
-        if n < 0 {
-            return Err(self.c.err(at, format!("{what} is negative: {n}")));
-        }
-        self.c.check_fits(at, what, n as u64, min_bytes)
-    }
-
-    fn min_bytes(&self, t: Num) -> usize {
-        if self.binary {
-            t.size()
-        } else {
-            2
-        }
-    }
-
-    /// `n` values of type `t` as f64, with the index and offset of the first non-finite.
-    fn values(&mut self, n: usize, t: Num, what: &str) -> Result<Floats, MeshError> {
-        if !self.binary {
-            return self.c.ascii_f64(n, what);
-        }
-        let start = self.c.pos;
-        let out = self.binary(n, t, what, |data, out| t.decode_f64(data, true, out))?;
-        let bad = out
-            .iter()
-            .position(|v| !v.is_finite())
-            .map(|i| (i, start + i * t.size()));
-        Ok((out, bad))
-    }
-
-    /// `n` integers of type `t`, with the offset of each value given by `at(i)` later.
-    fn ints(&mut self, n: usize, t: Num, what: &str) -> Result<(Vec<i64>, usize), MeshError> {
-        let start = self.c.pos;
-        if t.is_float() {
-            return Err(self
-                .c
-                .err(start, format!("{what} must be integers, not floats")));
-        }
-        if !self.binary {
-            return Ok((self.c.ascii_int(n, what)?, start));
-        }
-        let out = self.binary(n, t, what, |data, out| t.decode_int(data, true, out))?;
-        Ok((out, start))
-    }
-
-    /// `n` big-endian binary values of type `t`, decoded by `decode` (the length checked
-    /// against the file before anything is allocated).
-    fn binary<T>(
-        &mut self,
-        n: usize,
-        t: Num,
-        what: &str,
-        decode: impl FnOnce(&[u8], &mut Vec<T>),
-    ) -> Result<Vec<T>, MeshError> {
-        let start = self.c.pos;
-        let len = n.checked_mul(t.size()).ok_or_else(|| {
-            self.c
-                .err_bin(start, format!("{what}: {n} values overflow"))
-        })?;
-        let data = self.c.take(len, what)?;
-        let mut out = vec_for(n, what).map_err(|m| self.c.err_bin(start, m))?;
-        decode(data, &mut out);
-        Ok(out)
-    }
-
-    /// An error about integer `i` of an array read by [`Reader::ints`] from `start`.
-    fn int_err(&self, start: usize, i: usize, t: Num, m: String) -> MeshError {
-        if self.binary {
-            self.c.err_bin(start + i * t.size(), m)
-        } else {
-            self.c.err(nth_token(self.c.bytes, start, i), m)
-        }
-    }
 }
 
 /// Decode `%XX` escapes in array names, as VTK writes spaces and other bytes.
@@ -299,8 +131,26 @@ struct State {
     cells: Option<(usize, RawCells)>,
     types: Option<(usize, Vec<super::cells::Kind>)>,
     target: Option<(usize, Target)>,
-    point_arrays: Vec<DataArray>,
-    cell_arrays: Vec<DataArray>,
+    /// Every POINT_DATA and CELL_DATA line, checked against POINTS and CELLS at the end
+    /// (they may come in any order).
+    data_sections: Vec<(usize, Target)>,
+    point_arrays: Vec<ReadArray>,
+    cell_arrays: Vec<ReadArray>,
+}
+
+/// Refuse a second `kw` section (a second POINTS would silently replace the first, and
+/// the arrays checked against it).
+fn once<T>(r: &Reader, slot: &Option<(usize, T)>, kw: &str, at: usize) -> Result<(), MeshError> {
+    match slot {
+        Some((first, _)) => Err(r.c.err(
+            at,
+            format!(
+                "a second {kw} section: the file already has one at line {}",
+                super::read::line_column(r.c.bytes, *first).0
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 fn section(
@@ -313,6 +163,7 @@ fn section(
     let target = st.target.map_or(Target::None, |t| t.1);
     match kw {
         b"POINTS" => {
+            once(r, &st.points, "POINTS", kw_at)?;
             let t = r.type_arg(args, 1, kw_at)?;
             let n = r.count_arg(args, 0, kw_at, "the point count", 3 * r.min_bytes(t))?;
             let (v, bad) = r.values(3 * n, t, "the point coordinates")?;
@@ -324,6 +175,7 @@ fn section(
             st.points = Some((kw_at, pts));
         }
         b"CELLS" => {
+            once(r, &st.cells, "CELLS", kw_at)?;
             let a: i64 = r.arg(args, 0, kw_at, "the cell count")?;
             let b: i64 = r.arg(args, 1, kw_at, "the cell list size")?;
             if a < 0 || b < 0 {
@@ -337,6 +189,7 @@ fn section(
             st.cells = Some((kw_at, cells));
         }
         b"CELL_TYPES" => {
+            once(r, &st.types, "CELL_TYPES", kw_at)?;
             let t = if r.binary { Num::I32 } else { Num::I64 };
             let n = r.count_arg(args, 0, kw_at, "the cell type count", r.min_bytes(t))?;
             let (v, start) = r.ints(n, t, "the cell types")?;
@@ -350,10 +203,9 @@ fn section(
             let n: i64 = r.arg(args, 0, kw_at, "the tuple count")?;
             let n = usize::try_from(n)
                 .map_err(|_| r.c.err(args[0].0, format!("negative tuple count {n}")))?;
-            st.target = Some((
-                kw_at,
-                if kw == b"POINT_DATA" { Target::Points(n) } else { Target::Cells(n) },
-            ));
+            let target = if kw == b"POINT_DATA" { Target::Points(n) } else { Target::Cells(n) };
+            st.target = Some((kw_at, target));
+            st.data_sections.push((kw_at, target));
         }
         b"METADATA" => {
             // Skip lines up to the first blank one.
@@ -450,7 +302,7 @@ fn store(
             ),
         ));
     }
-    list.push(array);
+    list.push(ReadArray { array, at });
     Ok(())
 }
 
@@ -572,7 +424,7 @@ fn attribute(
 
 fn finish(r: Reader, st: State, version: String) -> Result<Mesh, MeshError> {
     let end = r.c.bytes.len();
-    let (_, points) = st
+    let (points_at, points) = st
         .points
         .ok_or_else(|| r.c.err(end, "the file has no POINTS section"))?;
     let (cells_at, mut cells) = st
@@ -593,17 +445,24 @@ fn finish(r: Reader, st: State, version: String) -> Result<Mesh, MeshError> {
         ));
     }
     cells.kinds = kinds;
-    for (list, want, what) in [
-        (&st.point_arrays, points.len(), "points"),
-        (&st.cell_arrays, cells.len(), "cells"),
-    ] {
-        if let Some(a) = list.iter().find(|a| a.tuples() != want) {
+    let line = |at: usize| super::read::line_column(r.c.bytes, at).0;
+    for &(at, target) in &st.data_sections {
+        let (n, have, what, kw, kw_at) = match target {
+            Target::Points(n) => (n, points.len(), "points", "POINTS", points_at),
+            Target::Cells(n) => (n, cells.len(), "cells", "CELLS", cells_at),
+            Target::None => continue,
+        };
+        if n != have {
             return Err(r.c.err(
-                st.target.map_or(0, |t| t.0),
+                at,
                 format!(
-                    "array \"{}\" has {} tuples but the mesh has {want} {what}",
-                    a.name,
-                    a.tuples()
+                    "{} {n} does not match the {have} {what} of {kw} (line {})",
+                    if what == "points" {
+                        "POINT_DATA"
+                    } else {
+                        "CELL_DATA"
+                    },
+                    line(kw_at)
                 ),
             ));
         }

@@ -744,3 +744,95 @@ pub fn mutate(bytes: &[u8], rng: &mut Rng) -> Vec<u8> {
     }
     b
 }
+
+/// The sections of a mesh file as byte ranges, for mutations that move, repeat or swap
+/// whole sections: gmsh `$Name ... $EndName` blocks (to the end of the end line), XML
+/// elements (`Piece`, `Points`, `Cells`, `PointData`, `CellData`, `DataArray`, from `<` to
+/// the end of the closing tag; they nest), and legacy sections (a keyword at a line
+/// start up to the next keyword line).
+pub fn sections(b: &[u8]) -> Vec<(usize, usize)> {
+    let find = |from: usize, what: &[u8]| {
+        b.get(from..)
+            .and_then(|r| r.windows(what.len()).position(|w| w == what))
+            .map(|p| from + p)
+    };
+    let line_end = |at: usize| find(at, b"\n").map_or(b.len(), |p| p + 1);
+    let starts: Vec<usize> = std::iter::once(0)
+        .chain(
+            b.iter()
+                .enumerate()
+                .filter(|(_, &c)| c == b'\n')
+                .map(|(i, _)| i + 1),
+        )
+        .filter(|&i| i < b.len())
+        .collect();
+    let mut out = Vec::new();
+    if b.starts_with(b"$MeshFormat") {
+        for &s in &starts {
+            if b[s] != b'$' || b[s..].starts_with(b"$End") {
+                continue;
+            }
+            let name_end = (s..b.len())
+                .find(|&i| b[i].is_ascii_whitespace())
+                .unwrap_or(b.len());
+            // Binary data may run right up to the end line (no line end before it).
+            let end_tag = [b"$End".as_slice(), &b[s + 1..name_end]].concat();
+            if let Some(e) = find(name_end, &end_tag) {
+                out.push((s, line_end(e)));
+            }
+        }
+    } else if b.starts_with(b"# vtk") {
+        const KEYWORDS: [&[u8]; 12] = [
+            b"POINTS",
+            b"CELLS",
+            b"CELL_TYPES",
+            b"POINT_DATA",
+            b"CELL_DATA",
+            b"SCALARS",
+            b"VECTORS",
+            b"FIELD",
+            b"METADATA",
+            b"OFFSETS",
+            b"CONNECTIVITY",
+            b"LOOKUP_TABLE",
+        ];
+        let keyed: Vec<usize> = starts
+            .iter()
+            .copied()
+            .filter(|&s| KEYWORDS.iter().any(|k| b[s..].starts_with(k)))
+            .collect();
+        for (i, &s) in keyed.iter().enumerate() {
+            out.push((s, keyed.get(i + 1).copied().unwrap_or(b.len())));
+        }
+    } else {
+        for tag in [
+            "Piece",
+            "Points",
+            "Cells",
+            "PointData",
+            "CellData",
+            "DataArray",
+        ] {
+            let open = format!("<{tag}");
+            let close = format!("</{tag}>");
+            let mut from = 0;
+            while let Some(s) = find(from, open.as_bytes()) {
+                from = s + 1;
+                let after = b.get(s + open.len()).copied().unwrap_or(b' ');
+                if !(after.is_ascii_whitespace() || after == b'>' || after == b'/') {
+                    continue;
+                }
+                let Some(gt) = find(s, b">") else { break };
+                let end = if b[gt - 1] == b'/' {
+                    Some(gt + 1)
+                } else {
+                    find(gt, close.as_bytes()).map(|e| e + close.len())
+                };
+                if let Some(e) = end {
+                    out.push((s, e));
+                }
+            }
+        }
+    }
+    out
+}

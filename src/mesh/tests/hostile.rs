@@ -167,7 +167,7 @@ fn counts_larger_than_the_file() {
             "NumberOfPoints=\"6\"",
             "NumberOfPoints=\"1000000000000\"",
         ),
-        "but the",
+        "DataArray \"Points\": holds 18 values, but 3 x NumberOfPoints=\"1000000000000\" (line 5) needs 3000000000000",
     );
     let g = fixtures::msh22(false);
     fails(
@@ -365,7 +365,7 @@ fn bad_indices_types_and_structure() {
             "$NodeData\n1\n\"temp\"\n1\n0.0\n3\n0\n1\n6\n5 7.5",
             "$NodeData\n1\n\"temp\"\n1\n0.0\n3\n0\n1\n6\n66 7.5",
         ),
-        "data entry for node 66, which does not exist",
+        "data entry for node 66, which is in no $Nodes section",
     );
     let m = fixtures::legacy_51(false, false);
     fails(
@@ -469,8 +469,16 @@ fn zlib_blocks_that_inflate_beyond_the_header_and_bombs() {
         &vtu_points_appended(&junk, false),
         "zlib block 0 does not inflate",
     );
-    // A table whose block count runs past the file.
+    // A table whose block count disagrees with the points (found before the table,
+    // which would run past the file, is read).
     let long = [table(1_000_000_000, 96, 0, &[]), vec![0; 8]].concat();
+    fails(
+        "table.vtu",
+        &vtu_points_appended(&long, false),
+        "the compression header declares 1000000000 blocks of 96 bytes (last 96): 96000000000 bytes, but 96 are needed",
+    );
+    // One that agrees with them but runs past the file.
+    let long = [table(96, 1, 0, &[]), vec![0; 8]].concat();
     fails(
         "table.vtu",
         &vtu_points_appended(&long, false),

@@ -247,8 +247,10 @@ fn inspect_reports_what_was_read() {
         "point array \"DISPL\": 3 components, range [",
         "cell array \"EQPS\": 1 component, range [",
         "flipped to positive orientation: 0",
-        "flat tetrahedra (|volume| <= 1e-12 x longest edge^3): 0",
+        "flat (degenerate) tetrahedra (|volume| <= 1e-12 x longest edge^3, not drawn): 0\n",
+        "repeated tetrahedra (at the place of an earlier one): 0\n",
         "sliver tetrahedra (radius ratio < 0.1): ",
+        "depth: a line through the bounding box crosses ",
     ] {
         assert!(s.contains(want), "missing {want:?} in\n{s}");
     }

@@ -24,71 +24,19 @@
 //! or compressed data cannot be mapped back to the file: such errors give the position
 //! of the `DataArray` tag and the index of the value.
 
+mod assemble;
 mod data;
+mod desc;
 
 use std::borrow::Cow;
+use std::cell::Cell;
 use std::path::Path;
 
 use quick_xml::events::{BytesStart, Event};
 
-use super::cells::{vtk_kind, RawCells};
-use super::read::{quote, text_error, vec_for, Num};
-use super::{DataArray, Mesh, MeshError, MeshInfo};
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Section {
-    Points,
-    Cells,
-    PointData,
-    CellData,
-    Other,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Format {
-    Ascii,
-    Binary,
-    Appended,
-}
-
-#[derive(Debug)]
-struct ArrayDesc<'a> {
-    section: Section,
-    name: String,
-    ty: Option<Num>,
-    type_name: String,
-    comps: usize,
-    format: Format,
-    offset: Option<u64>,
-    at: usize,
-    text: Vec<(usize, &'a [u8])>,
-}
-
-struct File<'a> {
-    name: &'a Path,
-    bytes: &'a [u8],
-    big: bool,
-    header: Num,
-    zlib: bool,
-    /// Start of the appended data (after `_`) and whether it is base64.
-    appended: Option<(usize, bool)>,
-}
-
-fn num_type(t: &[u8]) -> Option<Num> {
-    Some(match t {
-        b"Int8" | b"Char" => Num::I8,
-        b"UInt8" | b"UChar" => Num::U8,
-        b"Int16" | b"Short" => Num::I16,
-        b"UInt16" | b"UShort" => Num::U16,
-        b"Int32" | b"Int" => Num::I32,
-        b"UInt32" | b"UInt" => Num::U32,
-        b"Int64" | b"Long" | b"IdType" => Num::I64,
-        b"UInt64" | b"ULong" => Num::U64,
-        b"Float32" | b"Float" => Num::F32,
-        b"Float64" | b"Double" => Num::F64,
-        _ => return None,
-    })
-}
+use self::desc::{num_type, ArrayDesc, File, Format, Section};
+use super::read::{quote, text_error, Num};
+use super::{Mesh, MeshError};
 
 /// Attribute `key` of `e`, raw.
 fn attr(e: &BytesStart, key: &[u8]) -> Option<Vec<u8>> {
@@ -113,9 +61,11 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
         header: Num::U32,
         zlib: false,
         appended: None,
+        appended_end: Cell::new(0),
     };
     let mut version = String::new();
-    let mut stack: Vec<Vec<u8>> = Vec::new();
+    // Open elements and where each starts.
+    let mut stack: Vec<(Vec<u8>, usize)> = Vec::new();
     let mut arrays: Vec<ArrayDesc> = Vec::new();
     let mut current: Option<ArrayDesc> = None;
     let mut piece: Option<(usize, u64, u64)> = None;
@@ -242,7 +192,7 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
                         break;
                     }
                     b"DataArray" => {
-                        let section = match stack.last().map(|s| s.as_slice()) {
+                        let section = match stack.last().map(|s| s.0.as_slice()) {
                             Some(b"Points") => Section::Points,
                             Some(b"Cells") => Section::Cells,
                             Some(b"PointData") => Section::PointData,
@@ -309,12 +259,12 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
                     _ => {}
                 }
                 if !empty {
-                    stack.push(local);
+                    stack.push((local, before));
                 }
             }
             Event::Text(_) => {
                 if let Some(d) = current.as_mut() {
-                    if stack.last().is_some_and(|s| s == b"DataArray") {
+                    if stack.last().is_some_and(|s| s.0 == b"DataArray") {
                         let end = reader.buffer_position() as usize;
                         d.text.push((before, &bytes[before..end]));
                     }
@@ -328,7 +278,19 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
                     }
                 }
             }
-            Event::Eof => break,
+            Event::Eof => {
+                if let Some((open, at)) = stack.last() {
+                    return Err(terr(
+                        bytes.len(),
+                        format!(
+                            "the file ends inside <{}> (opened at line {}): it is truncated, or an element is never closed",
+                            String::from_utf8_lossy(open),
+                            super::read::line_column(bytes, *at).0
+                        ),
+                    ));
+                }
+                break;
+            }
             _ => {}
         }
     }
@@ -336,150 +298,5 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
         return Err(terr(0, "no <VTKFile> element".into()));
     }
     let (piece_at, np, nc) = piece.ok_or_else(|| terr(bytes.len(), "no <Piece> element".into()))?;
-    build(&f, &arrays, piece_at, np, nc, version)
-}
-
-fn build(
-    f: &File,
-    arrays: &[ArrayDesc],
-    piece_at: usize,
-    np: u64,
-    nc: u64,
-    version: String,
-) -> Result<Mesh, MeshError> {
-    let terr = |at: usize, m: String| text_error(f.name, f.bytes, at, m);
-    let find = |section: Section, name: Option<&str>, what: &str| {
-        arrays
-            .iter()
-            .find(|d| d.section == section && name.is_none_or(|n| d.name == n))
-            .ok_or_else(|| terr(piece_at, format!("the piece has no {what} DataArray")))
-    };
-    let pts = find(Section::Points, None, "Points")?;
-    if pts.comps != 3 {
-        return Err(terr(
-            pts.at,
-            format!("Points have {} components, expected 3", pts.comps),
-        ));
-    }
-    let np_usize = usize::try_from(np)
-        .map_err(|_| terr(piece_at, format!("NumberOfPoints={np} is too large")))?;
-    let nc_usize = usize::try_from(nc)
-        .map_err(|_| terr(piece_at, format!("NumberOfCells={nc} is too large")))?;
-    let coords = f.floats(pts, np_usize.checked_mul(3))?;
-    if let Some(i) = coords.iter().position(|v| !v.is_finite()) {
-        return Err(terr(
-            pts.at,
-            format!(
-                "point {} has a coordinate that is not finite ({})",
-                i / 3,
-                coords[i]
-            ),
-        ));
-    }
-    let points: Vec<[f64; 3]> = coords.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
-
-    let off_d = find(Section::Cells, Some("offsets"), "Cells offsets")?;
-    let offsets = f.ints(off_d, Some(nc_usize))?;
-    let conn_len = offsets.last().copied().unwrap_or(0);
-    let mut prev = 0;
-    for (i, &o) in offsets.iter().enumerate() {
-        if o < prev {
-            return Err(terr(off_d.at, format!("offset {i} is {o}, less than the one before ({prev}): offsets must not decrease")));
-        }
-        prev = o;
-    }
-    let conn_d = find(Section::Cells, Some("connectivity"), "Cells connectivity")?;
-    let conn_n = usize::try_from(conn_len)
-        .map_err(|_| terr(off_d.at, format!("the last offset {conn_len} is too large")))?;
-    let conn = f.ints(conn_d, Some(conn_n))?;
-    let types_d = find(Section::Cells, Some("types"), "Cells types")?;
-    let types = f.ints(types_d, Some(nc_usize))?;
-
-    let mut cells = RawCells {
-        text: true,
-        token_base: (conn_d.format == Format::Ascii)
-            .then(|| conn_d.text.first().map_or(conn_d.at, |t| t.0)),
-        ..RawCells::default()
-    };
-    let mk = |m: String| terr(piece_at, m);
-    cells.kinds = vec_for(nc_usize, "cell types").map_err(mk)?;
-    cells.offsets = vec_for(nc_usize + 1, "cell offsets").map_err(mk)?;
-    cells.at = vec_for(nc_usize, "cell positions").map_err(mk)?;
-    cells.nodes = vec_for(conn.len(), "cell nodes").map_err(mk)?;
-    cells.offsets.push(0);
-    for (i, (&t, &o)) in types.iter().zip(&offsets).enumerate() {
-        cells
-            .kinds
-            .push(vtk_kind(t).map_err(|m| terr(types_d.at, format!("cell {i}: {m}")))?);
-        let start = *cells.offsets.last().unwrap_or(&0);
-        cells.at.push(if cells.token_base.is_some() {
-            start
-        } else {
-            conn_d.at
-        });
-        cells.offsets.push(o as usize);
-    }
-    for (j, &p) in conn.iter().enumerate() {
-        let p = u32::try_from(p)
-            .ok()
-            .filter(|&p| p < u32::MAX)
-            .ok_or_else(|| {
-                terr(
-                    conn_d.at,
-                    format!("connectivity value {j} is {p}, not a point index (0 to 2^32 - 2)"),
-                )
-            })?;
-        cells.nodes.push(p);
-    }
-    let mut point_arrays = Vec::new();
-    let mut cell_arrays = Vec::new();
-    for d in arrays {
-        let (list, n) = match d.section {
-            Section::PointData => (&mut point_arrays, np_usize),
-            Section::CellData => (&mut cell_arrays, nc_usize),
-            _ => continue,
-        };
-        let values = f.floats(d, n.checked_mul(d.comps))?;
-        list.push(DataArray {
-            name: d.name.clone(),
-            components: d.comps,
-            values,
-        });
-    }
-    let encodings: Vec<&str> = arrays
-        .iter()
-        .filter(|d| d.section != Section::Other)
-        .map(|d| match (d.format, f.appended) {
-            (Format::Ascii, _) => "ascii",
-            (Format::Binary, _) => "binary (base64)",
-            (Format::Appended, Some((_, true))) => "appended base64",
-            _ => "appended raw",
-        })
-        .fold(Vec::new(), |mut v, e| {
-            if !v.contains(&e) {
-                v.push(e);
-            }
-            v
-        });
-    let info = MeshInfo {
-        format: "VTK XML UnstructuredGrid".into(),
-        version,
-        encoding: format!(
-            "{}{}, {} headers, {}",
-            encodings.join(" + "),
-            if f.zlib { ", zlib" } else { "" },
-            f.header.xml_name(),
-            if f.big { "big-endian" } else { "little-endian" }
-        ),
-        ..MeshInfo::default()
-    };
-    Mesh::assemble(
-        f.name,
-        f.bytes,
-        points,
-        &cells,
-        point_arrays,
-        cell_arrays,
-        info,
-    )
+    assemble::build(&f, &arrays, piece_at, np, nc, version)
 }

@@ -6,46 +6,77 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use super::LasInfo;
+use super::header::{f64_at, text_at, u16_at, u32_at, u64_at, LasInfo, RawVlr, RECORD_LENGTH};
 use crate::points::{PointsError, MAX_POINTS};
 
-/// Bytes of a point record of each format, without extra bytes.
-pub(super) const RECORD_LENGTH: [u16; 11] = [20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67];
+/// Points a LAZ file may declare whatever its size (about half a second to decode).
+pub(super) const LAZ_FREE_POINTS: u64 = 1_000_000;
 
-/// A variable length record: where its data is in the file.
-pub(super) struct RawVlr {
-    pub(super) user_id: String,
-    pub(super) record_id: u16,
-    /// Byte offset of the record's header.
-    pub(super) at: usize,
-    /// Its data.
-    pub(super) data: std::ops::Range<usize>,
+/// Further points a LAZ file may declare per byte of compressed data (with
+/// [`LAZ_FREE_POINTS`]: a file under 2 MB holds at most 3.1 million, read in about 1.5 s
+/// of one core).
+pub(super) const LAZ_POINTS_PER_BYTE: u64 = 1;
+
+/// What reading a point costs against the LAZ bound, in thirds of a plain point: the
+/// point itself, and one more third for each extra-bytes attribute (each is decoded,
+/// kept as f64, converted and summarised: about a third of a point's time).
+fn laz_cost(extras: usize) -> u64 {
+    3 + extras as u64
+}
+
+/// The LAZ time bound: at most [`LAZ_FREE_POINTS`] plus [`LAZ_POINTS_PER_BYTE`] per byte
+/// of compressed data, each extra-bytes attribute counting a third of a point. LAZ
+/// decodes about 2.5 million points a second here and a stream of equal points (legal)
+/// packs 85 into a byte, so without it a 2 MB file could take minutes; real lidar
+/// compresses to less than a point a byte.
+pub(super) fn laz_bound(
+    name: &Path,
+    b: &[u8],
+    info: &LasInfo,
+    count_at: usize,
+    extras: usize,
+) -> Result<(), PointsError> {
+    if !info.compressed {
+        return Ok(());
+    }
+    let data = b.len().saturating_sub(u32_at(b, 96) as usize) as u64;
+    let allowed = LAZ_FREE_POINTS.saturating_add(LAZ_POINTS_PER_BYTE.saturating_mul(data));
+    let cost = laz_cost(extras);
+    if info.points.saturating_mul(cost) <= allowed.saturating_mul(3) {
+        return Ok(());
+    }
+    Err(PointsError::format(
+        name,
+        count_at as u64,
+        format!(
+            "the header declares {} points{} in {data} bytes of LAZ data: this reader decodes \
+             at most {LAZ_FREE_POINTS} points plus {LAZ_POINTS_PER_BYTE} a compressed byte \
+             ({allowed} here{}), so that a file is read or refused in seconds (real lidar \
+             compresses to less than a point a byte)",
+            info.points,
+            if extras > 0 {
+                format!(" with {extras} extra-bytes attributes")
+            } else {
+                String::new()
+            },
+            if extras > 0 {
+                format!(
+                    ", {} with {extras} attributes, each a third of a point",
+                    allowed.saturating_mul(3) / cost
+                )
+            } else {
+                String::new()
+            }
+        ),
+    ))
 }
 
 /// What the checks found in the header.
 pub(super) struct Checked {
     pub(super) info: LasInfo,
     pub(super) vlrs: Vec<RawVlr>,
-}
-
-pub(super) fn u16_at(b: &[u8], at: usize) -> u16 {
-    u16::from_le_bytes([b[at], b[at + 1]])
-}
-pub(super) fn u32_at(b: &[u8], at: usize) -> u32 {
-    u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
-}
-pub(super) fn u64_at(b: &[u8], at: usize) -> u64 {
-    let mut a = [0u8; 8];
-    a.copy_from_slice(&b[at..at + 8]);
-    u64::from_le_bytes(a)
-}
-pub(super) fn f64_at(b: &[u8], at: usize) -> f64 {
-    f64::from_bits(u64_at(b, at))
-}
-pub(super) fn text_at(b: &[u8], range: std::ops::Range<usize>) -> String {
-    let s = &b[range];
-    let end = s.iter().position(|&c| c == 0).unwrap_or(s.len());
-    String::from_utf8_lossy(&s[..end]).trim().to_string()
+    /// Byte offset of the point count in force (107, or 247 for LAS 1.4's 64-bit one).
+    pub(super) count_at: usize,
 }
 
 /// Check the header, VLRs and sizes before the `las` crate reads anything.
@@ -69,8 +100,8 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
     }
     let version = (b[24], b[25]);
     if version.0 != 1 || version.1 > 4 {
-        return Err(PointsError::unsupported(
-            name,
+        return Err(fail(
+            24,
             format!(
                 "LAS version {}.{}: 1.0 to 1.4 are read",
                 version.0, version.1
@@ -104,10 +135,14 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
     let format_byte = b[104];
     let compressed = format_byte & 0x80 != 0;
     let point_format = format_byte & 0x3f;
-    if point_format > 10 {
-        return Err(PointsError::unsupported(
-            name,
-            format!("point data format {format_byte}: formats 0 to 10 are read"),
+    if point_format > 10 || (!compressed && format_byte > 10) {
+        return Err(fail(
+            104,
+            format!(
+                "point data format {format_byte} ({point_format}{}): formats 0 to 10 are read, \
+                 +128 when compressed",
+                if compressed { ", compressed" } else { "" }
+            ),
         ));
     }
     let record_length = u16_at(b, 105);
@@ -121,10 +156,10 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
         ));
     }
     let legacy_count = u32_at(b, 107) as u64;
-    let points = if legacy_count == 0 && version.1 >= 4 {
-        u64_at(b, 247)
+    let (points, count_at) = if legacy_count == 0 && version.1 >= 4 {
+        (u64_at(b, 247), 247)
     } else {
-        legacy_count
+        (legacy_count, 107)
     };
     let read3 = |at: usize| -> [f64; 3] { std::array::from_fn(|a| f64_at(b, at + 8 * a)) };
     let scale = read3(131);
@@ -139,9 +174,25 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
             format!("scale {scale:?} and offset {offset:?} must be finite"),
         ));
     }
+    // A stored coordinate is an i32 times the scale plus the offset: every one must be a
+    // finite f64, or positions would become infinite.
+    if let Some(a) =
+        (0..3).find(|&a| !(scale[a].abs() * 2f64.powi(31) + offset[a].abs()).is_finite())
+    {
+        return Err(fail(
+            131 + 8 * a,
+            format!(
+                "{} scale {:e} and offset {:e}: an i32 coordinate times the scale plus the \
+                 offset overflows f64 (|scale| * 2^31 + |offset| must be below 1.8e308)",
+                ["x", "y", "z"][a],
+                scale[a],
+                offset[a]
+            ),
+        ));
+    }
     if points > MAX_POINTS {
-        return Err(PointsError::unsupported(
-            name,
+        return Err(fail(
+            count_at,
             format!(
                 "the header declares {points} points, more than the {MAX_POINTS} this reader loads"
             ),
@@ -175,35 +226,7 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
         });
         at = data.end;
     }
-    // The first EVLR (LAS 1.4), the only one `las` reads.
-    if version.1 >= 4 && u32_at(b, 243) > 0 && u64_at(b, 235) > 0 {
-        let start = u64_at(b, 235);
-        let fits = usize::try_from(start)
-            .ok()
-            .filter(|&s| s >= offset_to_points && s.checked_add(60).is_some_and(|e| e <= len));
-        let Some(start) = fits else {
-            return Err(fail(
-                235,
-                format!("the first EVLR at byte {start} lies outside the data ({offset_to_points}..{len})"),
-            ));
-        };
-        let size = u64_at(b, start + 20);
-        if size > (len - start - 60) as u64 {
-            return Err(fail(
-                start,
-                format!(
-                    "the EVLR declares {size} bytes, but {} remain",
-                    len - start - 60
-                ),
-            ));
-        }
-        vlrs.push(RawVlr {
-            user_id: text_at(b, start + 2..start + 18),
-            record_id: u16_at(b, start + 18),
-            at: start,
-            data: start + 60..start + 60 + size as usize,
-        });
-    }
+    evlrs(name, b, version, offset_to_points, &mut vlrs)?;
     let info = LasInfo {
         version,
         point_format,
@@ -230,7 +253,72 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
             ));
         }
     }
-    Ok(Checked { info, vlrs })
+    Ok(Checked {
+        info,
+        vlrs,
+        count_at,
+    })
+}
+
+/// Every EVLR (LAS 1.4): each inside the file, one after another from the header's
+/// start offset. `las` reads only the first; the Extra Bytes descriptors may be in any.
+fn evlrs(
+    name: &Path,
+    b: &[u8],
+    version: (u8, u8),
+    offset_to_points: usize,
+    vlrs: &mut Vec<RawVlr>,
+) -> Result<(), PointsError> {
+    if version.1 < 4 {
+        return Ok(());
+    }
+    let count = u32_at(b, 243);
+    if count == 0 || u64_at(b, 235) == 0 {
+        return Ok(());
+    }
+    let len = b.len();
+    let fail = |at: usize, m: String| PointsError::format(name, at as u64, m);
+    let start = u64_at(b, 235);
+    let mut at = usize::try_from(start)
+        .ok()
+        .filter(|&s| s >= offset_to_points && s <= len)
+        .ok_or_else(|| {
+            fail(
+                235,
+                format!("the first EVLR at byte {start} lies outside the data ({offset_to_points}..{len})"),
+            )
+        })?;
+    for i in 0..count {
+        // Each EVLR takes at least its 60-byte header, so this loop ends within the file.
+        if len - at < 60 {
+            return Err(fail(
+                at,
+                format!(
+                    "EVLR {i} (of {count}) would start here, but {} bytes remain and its header takes 60",
+                    len - at
+                ),
+            ));
+        }
+        let size = u64_at(b, at + 20);
+        if size > (len - at - 60) as u64 {
+            return Err(fail(
+                at,
+                format!(
+                    "EVLR {i} (of {count}) declares {size} bytes, but {} remain",
+                    len - at - 60
+                ),
+            ));
+        }
+        let data = at + 60..at + 60 + size as usize;
+        vlrs.push(RawVlr {
+            user_id: text_at(b, at + 2..at + 18),
+            record_id: u16_at(b, at + 18),
+            at,
+            data: data.clone(),
+        });
+        at = data.end;
+    }
+    Ok(())
 }
 
 /// LAZ: laszip VLR items against the record, chunk table against the data, and LAZ 1.4
@@ -292,9 +380,9 @@ fn check_laz(
             13 => (29, 1),
             14 => (size, size as u64),
             _ => {
-                return Err(PointsError::unsupported(
-                    name,
-                    format!("LAZ item type {ty}: not a laszip item"),
+                return Err(fail(
+                    vlr.data.start + 34 + 6 * k,
+                    format!("LAZ item {k}: type {ty} is not a laszip item (0, 6 to 14)"),
                 ))
             }
         };
@@ -335,9 +423,11 @@ fn check_laz(
     }
     if table <= data_start as i64 {
         if compressor == 3 {
-            return Err(PointsError::unsupported(
-                name,
-                "a LAZ 1.4 (layered) file without a chunk table",
+            return Err(fail(
+                data_start,
+                "a LAZ 1.4 (layered) file without a chunk table: neither the offset here nor \
+                 the one in the file's last 8 bytes points after the point data"
+                    .into(),
             ));
         }
         return Ok(());

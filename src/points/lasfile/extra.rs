@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::check::{text_at, RawVlr};
+use super::header::{text_at, RawVlr};
 use crate::points::PointsError;
 
 /// One extra-bytes attribute: where it is in the record and how to decode it.
@@ -45,7 +45,9 @@ pub(super) fn decode_extra(ty: u8, b: &[u8]) -> f64 {
     }
 }
 
-/// The extra-bytes descriptors of the Extra Bytes VLR, laid out after `base` bytes.
+/// The extra-bytes descriptors of every Extra Bytes record (`LASF_Spec` record 4, VLRs
+/// then EVLRs, in file order), laid out one after another after `base` bytes. (A file may
+/// split its descriptors over several such records; laspy reads them all.)
 pub(super) fn extra_bytes(
     name: &Path,
     b: &[u8],
@@ -53,97 +55,113 @@ pub(super) fn extra_bytes(
     base: usize,
     record: usize,
 ) -> Result<Vec<Extra>, PointsError> {
-    let Some(vlr) = vlrs
-        .iter()
-        .find(|v| v.user_id == "LASF_Spec" && v.record_id == 4)
-    else {
-        return Ok(Vec::new());
-    };
-    let data = &b[vlr.data.clone()];
-    if !data.len().is_multiple_of(192) {
-        return Err(PointsError::format(
-            name,
-            vlr.at as u64,
-            format!(
-                "the Extra Bytes VLR holds {} bytes, not a multiple of its 192-byte descriptors",
-                data.len()
-            ),
-        ));
-    }
     let mut extras = Vec::new();
     let mut at = base;
-    for (k, d) in data.chunks_exact(192).enumerate() {
-        let (ty, options) = (d[2], d[3]);
-        let label = text_at(d, 4..36);
-        let label = if label.is_empty() {
-            format!("extra{k}")
-        } else {
-            label
-        };
-        let (scalar, parts) = match ty {
-            0 => {
-                at += options as usize; // undocumented bytes: skipped
-                continue;
-            }
-            1..=10 => (ty, 1),
-            11..=20 => (ty - 10, 2),
-            21..=30 => (ty - 20, 3),
-            _ => {
+    let mut k = 0;
+    for vlr in vlrs
+        .iter()
+        .filter(|v| v.user_id == "LASF_Spec" && v.record_id == 4)
+    {
+        let data = &b[vlr.data.clone()];
+        if !data.len().is_multiple_of(192) {
+            return Err(PointsError::format(
+                name,
+                vlr.at as u64,
+                format!(
+                    "the Extra Bytes record holds {} bytes, not a multiple of its 192-byte descriptors",
+                    data.len()
+                ),
+            ));
+        }
+        for (j, d) in data.chunks_exact(192).enumerate() {
+            let at_type = vlr.data.start + 192 * j + 2;
+            describe(name, d, k, at_type, &mut at, &mut extras)?;
+            k += 1;
+            if at > record {
                 return Err(PointsError::format(
                     name,
-                    (vlr.data.start + 192 * k + 2) as u64,
-                    format!("extra bytes \"{label}\": data type {ty} is not 0..30"),
-                ))
+                    at_type as u64,
+                    format!(
+                        "extra bytes descriptor {k} ends at byte {} of the record, but the records have {} extra bytes",
+                        at - base,
+                        record - base
+                    ),
+                ));
             }
-        };
-        for p in 0..parts {
-            let size = extra_type_size(scalar);
-            let field = |base: usize| &d[base + 8 * p..base + 8 * p + 8];
-            let value = |base: usize| {
-                if scalar >= 9 {
-                    f64::from_le_bytes(field(base).try_into().unwrap_or([0; 8]))
-                } else if matches!(scalar, 2 | 4 | 6 | 8) {
-                    i64::from_le_bytes(field(base).try_into().unwrap_or([0; 8])) as f64
-                } else {
-                    u64::from_le_bytes(field(base).try_into().unwrap_or([0; 8])) as f64
-                }
-            };
-            let no_data = if options & 1 != 0 {
-                Some(if scalar == 9 {
-                    // a float's no-data is stored as a double
-                    value(40) as f32 as f64
-                } else {
-                    value(40)
-                })
-            } else {
-                None
-            };
-            let f = |base: usize| f64::from_le_bytes(field(base).try_into().unwrap_or([0; 8]));
-            extras.push(Extra {
-                name: if parts == 1 {
-                    label.clone()
-                } else {
-                    format!("{label}[{p}]")
-                },
-                at,
-                ty: scalar,
-                no_data,
-                scale: if options & 8 != 0 { f(112) } else { 1.0 },
-                offset: if options & 16 != 0 { f(136) } else { 0.0 },
-            });
-            at += size;
         }
     }
-    if at > record {
-        return Err(PointsError::format(
-            name,
-            vlr.at as u64,
-            format!(
-                "the Extra Bytes VLR describes {} bytes, but the records have {} extra bytes",
-                at - base,
-                record - base
-            ),
-        ));
-    }
     Ok(extras)
+}
+
+/// Add the attributes of descriptor `d` (the `k`-th, its data type at byte `at_type` of the
+/// file) that start at byte `at` of the record; `at` moves past them.
+fn describe(
+    name: &Path,
+    d: &[u8],
+    k: usize,
+    at_type: usize,
+    at: &mut usize,
+    extras: &mut Vec<Extra>,
+) -> Result<(), PointsError> {
+    let (ty, options) = (d[2], d[3]);
+    let label = text_at(d, 4..36);
+    let label = if label.is_empty() {
+        format!("extra{k}")
+    } else {
+        label
+    };
+    let (scalar, parts) = match ty {
+        0 => {
+            *at += options as usize; // undocumented bytes: skipped
+            return Ok(());
+        }
+        1..=10 => (ty, 1),
+        11..=20 => (ty - 10, 2),
+        21..=30 => (ty - 20, 3),
+        _ => {
+            return Err(PointsError::format(
+                name,
+                at_type as u64,
+                format!("extra bytes \"{label}\": data type {ty} is not 0..30"),
+            ))
+        }
+    };
+    for p in 0..parts {
+        let size = extra_type_size(scalar);
+        let field = |base: usize| &d[base + 8 * p..base + 8 * p + 8];
+        let value = |base: usize| {
+            if scalar >= 9 {
+                f64::from_le_bytes(field(base).try_into().unwrap_or([0; 8]))
+            } else if matches!(scalar, 2 | 4 | 6 | 8) {
+                i64::from_le_bytes(field(base).try_into().unwrap_or([0; 8])) as f64
+            } else {
+                u64::from_le_bytes(field(base).try_into().unwrap_or([0; 8])) as f64
+            }
+        };
+        let no_data = if options & 1 != 0 {
+            Some(if scalar == 9 {
+                // a float's no-data is stored as a double
+                value(40) as f32 as f64
+            } else {
+                value(40)
+            })
+        } else {
+            None
+        };
+        let f = |base: usize| f64::from_le_bytes(field(base).try_into().unwrap_or([0; 8]));
+        extras.push(Extra {
+            name: if parts == 1 {
+                label.clone()
+            } else {
+                format!("{label}[{p}]")
+            },
+            at: *at,
+            ty: scalar,
+            no_data,
+            scale: if options & 8 != 0 { f(112) } else { 1.0 },
+            offset: if options & 16 != 0 { f(136) } else { 0.0 },
+        });
+        *at += size;
+    }
+    Ok(())
 }

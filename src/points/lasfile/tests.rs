@@ -1,4 +1,4 @@
-use super::check::{u32_at, u64_at};
+use super::header::{u32_at, u64_at};
 use super::*;
 use las::point::{Classification, Format};
 use las::{Builder, Color, Point, Transform, Vector, Vlr, Writer};
@@ -284,7 +284,7 @@ fn hostile_headers_are_refused_before_reading() {
     set(&mut b, 235, &(evlr as u64).to_le_bytes());
     set(&mut b, 243, &1u32.to_le_bytes());
     assert!(error(&b).contains(&format!(
-        "at byte {evlr}: the EVLR declares 1152921504606846976 bytes"
+        "at byte {evlr}: EVLR 0 (of 1) declares 1152921504606846976 bytes"
     )));
     set(&mut b, 235, &u64::MAX.to_le_bytes());
     assert!(error(&b).contains("at byte 235: the first EVLR"));
@@ -322,7 +322,10 @@ fn bad_extra_bytes_descriptors() {
     let mut b = good.clone();
     b[data + 192 * 2 + 3] = 200; // the undocumented block grows past the record
     assert!(
-        error(&b).contains("at byte 375: the Extra Bytes VLR describes"),
+        error(&b).contains(&format!(
+            "at byte {}: extra bytes descriptor 3 ends at byte 203 of the record, but the records have 29",
+            data + 192 * 2 + 2
+        )),
         "{}",
         error(&b)
     );
@@ -480,4 +483,262 @@ fn empty_files_give_empty_clouds() {
         assert!(c.cloud.is_empty(), "format {format}");
         assert_eq!(c.info.points, 0);
     }
+}
+
+// --- issue 17: clouds and surfaces ---
+
+/// The 1.4 fixture with its four extra-bytes descriptors split over two records: the
+/// first two in one VLR, the other two in a second VLR (`in_evlr` false) or an EVLR.
+fn split_extra_bytes_fixture(n: usize, in_evlr: bool) -> Vec<u8> {
+    let whole = extra_vlr();
+    let (first, second) = whole.data.split_at(2 * 192);
+    let record = |data: &[u8]| Vlr {
+        user_id: "LASF_Spec".into(),
+        record_id: 4,
+        description: "extra bytes".into(),
+        data: data.to_vec(),
+    };
+    let mut b = Builder::default();
+    b.version = (1, 4).into();
+    b.point_format = Format::new(6).unwrap();
+    b.point_format.extra_bytes = EXTRA as u16;
+    b.transforms = Vector {
+        x: Transform {
+            scale: 0.001,
+            offset: 500_000.0,
+        },
+        y: Transform {
+            scale: 0.001,
+            offset: 7_400_000.0,
+        },
+        z: Transform {
+            scale: 0.001,
+            offset: 0.0,
+        },
+    };
+    b.vlrs.push(record(first));
+    if in_evlr {
+        b.evlrs.push(record(second));
+    } else {
+        b.vlrs.push(record(second));
+    }
+    let mut w = Writer::new(Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
+    for i in 0..n {
+        let [x, y, z] = fixture_point(i);
+        w.write_point(Point {
+            x,
+            y,
+            z,
+            gps_time: Some(i as f64),
+            extra_bytes: extra_bytes_of(i),
+            ..Default::default()
+        })
+        .unwrap();
+    }
+    w.close().unwrap();
+    w.into_inner().unwrap().into_inner()
+}
+
+#[test]
+fn every_extra_bytes_record_is_read() {
+    let one = parse(name(), &fixture(6, 4, false)).unwrap();
+    for in_evlr in [false, true] {
+        let bytes = split_extra_bytes_fixture(4, in_evlr);
+        // The layout is what the test means: two records of LASF_Spec 4, one in an EVLR.
+        let evlrs = u32_at(&bytes, 243);
+        assert_eq!(evlrs, u32::from(in_evlr), "EVLRs in the fixture");
+        let c = parse(name(), &bytes).unwrap();
+        assert_eq!(
+            c.info.extra_bytes, one.info.extra_bytes,
+            "in_evlr {in_evlr}"
+        );
+        assert_eq!(c.info.extra_bytes.len(), 5);
+        for e in ["temperature", "flags", "velocity[0]", "velocity[2]"] {
+            let (a, b) = (
+                c.cloud.attribute(e).unwrap(),
+                one.cloud.attribute(e).unwrap(),
+            );
+            assert_eq!(a.values.kind(), b.values.kind(), "{e}");
+            for i in 0..4 {
+                let (x, y) = (a.values.get(i).unwrap(), b.values.get(i).unwrap());
+                assert!(x == y || (x.is_nan() && y.is_nan()), "{e}[{i}]: {x} vs {y}");
+            }
+        }
+        // Values the second record describes, as written.
+        assert_eq!(c.cloud.floats("velocity[1]").unwrap()[3], 31.25);
+    }
+    // The second record's descriptors run past the record: named at its data type byte.
+    let mut bytes = split_extra_bytes_fixture(2, false);
+    let second = 375 + 54 + 2 * 192 + 54; // the second VLR's data
+    bytes[second + 3] = 100; // the undocumented block grows
+    let e = error(&bytes);
+    assert!(
+        e.contains(&format!(
+            "at byte {}: extra bytes descriptor 3 ends",
+            second + 2
+        )),
+        "{e}"
+    );
+}
+
+#[test]
+fn header_errors_name_their_byte() {
+    let good = fixture(6, 4, false);
+    let mut b = good.clone();
+    b[25] = 9;
+    assert!(
+        error(&b).contains("t.las: at byte 24: LAS version 1.9"),
+        "{}",
+        error(&b)
+    );
+    let mut b = good.clone();
+    b[104] = 12;
+    assert!(
+        error(&b).contains("t.las: at byte 104: point data format 12"),
+        "{}",
+        error(&b)
+    );
+    // 2^63 points in the 64-bit count (the legacy one at 0).
+    let mut b = good.clone();
+    set(&mut b, 107, &0u32.to_le_bytes());
+    set(&mut b, 247, &(1u64 << 63).to_le_bytes());
+    assert!(
+        error(&b).contains("t.las: at byte 247: the header declares 9223372036854775808 points"),
+        "{}",
+        error(&b)
+    );
+    // A legacy count past the limit is named at its own field.
+    let mut b = fixture(1, 3, false);
+    set(&mut b, 107, &u32::MAX.to_le_bytes());
+    assert!(error(&b).contains("t.las: at byte 107: the header declares 4294967295 points"));
+    // A LAZ item of no laszip type: at the item's type.
+    let mut b = fixture(3, 20, true);
+    let item = 227 + 54 + 34;
+    set(&mut b, item, &99u16.to_le_bytes());
+    assert!(
+        error(&b).contains(&format!("at byte {item}: LAZ item 0: type 99")),
+        "{}",
+        error(&b)
+    );
+}
+
+#[test]
+fn extreme_scales_and_offsets() {
+    // A scale that makes i32 coordinates overflow f64 is refused at its field.
+    let good = fixture(1, 3, false);
+    let mut b = good.clone();
+    set(&mut b, 139, &1e300f64.to_le_bytes()); // y scale
+    let e = error(&b);
+    assert!(e.contains("t.las: at byte 139: y scale 1e300"), "{e}");
+    // An offset near f64::MAX with a small scale is legal: positions stay finite and in
+    // [-1, 1]^3, and the originals keep f64's precision of the offset.
+    let mut b = good;
+    let huge = 1.7e308f64;
+    set(&mut b, 155, &huge.to_le_bytes()); // x offset
+    set(&mut b, 163, &(-huge).to_le_bytes()); // y offset
+    let c = parse(name(), &b).unwrap();
+    assert!(c
+        .cloud
+        .positions
+        .iter()
+        .flatten()
+        .all(|v| v.is_finite() && v.abs() <= 1.0));
+    let p = c.cloud.original(0).unwrap();
+    // x and y coincide with the offsets to f64 precision (the i32 parts vanish in them).
+    assert_eq!((p[0], p[1]), (huge, -huge));
+    assert!(c
+        .cloud
+        .describe()
+        .contains("positions stored as f32 in [-1, 1]^3"));
+}
+
+/// A LAZ file of `n` equal points (format 3): about 85 points a compressed byte.
+pub(crate) fn equal_points(n: usize) -> Vec<u8> {
+    let mut b = Builder::from((1, 2));
+    b.point_format = Format::new(3).unwrap();
+    b.point_format.is_compressed = true;
+    let mut w = Writer::new(Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
+    let p = Point {
+        x: 1.0,
+        y: 2.0,
+        z: 3.0,
+        color: Some(Color::new(1, 2, 3)),
+        gps_time: Some(0.0),
+        ..Default::default()
+    };
+    for _ in 0..n {
+        w.write_point(p.clone()).unwrap();
+    }
+    w.close().unwrap();
+    w.into_inner().unwrap().into_inner()
+}
+
+/// A LAZ 1.4 file (format 6) of `n` equal points with `extras` one-byte attributes.
+fn equal_points_with_extras(n: usize, extras: usize) -> Vec<u8> {
+    let mut b = Builder::default();
+    b.version = (1, 4).into();
+    b.point_format = Format::new(6).unwrap();
+    b.point_format.is_compressed = true;
+    b.point_format.extra_bytes = extras as u16;
+    b.vlrs.push(Vlr {
+        user_id: "LASF_Spec".into(),
+        record_id: 4,
+        description: "extra bytes".into(),
+        data: (0..extras)
+            .flat_map(|k| descriptor(1, 0, &format!("e{k}"), [0; 8], 0.0, 0.0))
+            .collect(),
+    });
+    let mut w = Writer::new(Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
+    for _ in 0..n {
+        w.write_point(Point {
+            x: 1.0,
+            y: 2.0,
+            z: 3.0,
+            gps_time: Some(0.0),
+            extra_bytes: vec![9; extras],
+            ..Default::default()
+        })
+        .unwrap();
+    }
+    w.close().unwrap();
+    w.into_inner().unwrap().into_inner()
+}
+
+#[test]
+fn laz_denser_than_a_point_a_byte_past_a_million_is_refused() {
+    // 1.1 million equal points in about 13 KB: past 1,000,000 + 1 a byte.
+    let dense = equal_points(1_100_000);
+    let data = dense.len() - u32_at(&dense, 96) as usize;
+    assert!(data < 20_000, "{data} bytes");
+    let e = error(&dense);
+    assert!(
+        e.starts_with(&format!(
+            "t.las: at byte 107: the header declares 1100000 points in {data} bytes of LAZ data"
+        )),
+        "{e}"
+    );
+    assert!(e.contains(&format!("({} here)", 1_000_000 + data)), "{e}");
+    // Extra-bytes attributes count a third of a point each: with 6 of them, 700,000 points
+    // cost as much as 2.1 million plain ones.
+    let b = equal_points_with_extras(700_000, 6);
+    let data = b.len() - u32_at(&b, 96) as usize;
+    let allowed = 1_000_000 + data;
+    assert!(
+        700_000 <= allowed && 700_000 * 9 > 3 * allowed,
+        "{data} bytes"
+    );
+    let e = error(&b);
+    assert!(
+        e.contains(&format!(
+            "700000 points with 6 extra-bytes attributes in {data} bytes of LAZ data"
+        )) && e.contains(&format!(
+            "({allowed} here, {} with 6 attributes",
+            allowed * 3 / 9
+        )),
+        "{e}"
+    );
+    // Within the bound the same stream is read.
+    let c = parse(name(), &equal_points(50_000)).unwrap();
+    assert_eq!(c.cloud.len(), 50_000);
+    assert_eq!(c.cloud.bounds, [[1.0, 2.0, 3.0], [1.0, 2.0, 3.0]]);
 }

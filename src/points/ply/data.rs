@@ -62,28 +62,30 @@ pub(super) fn read_binary(
     Ok(elements)
 }
 
-/// Empty columns for `e`, reserved for its rows (the caller checked the count).
+/// Empty columns for `e`, reserved for its rows (the caller checked the count against
+/// the bytes left, the estimate against the budget).
 fn columns(name: &Path, e: &DeclaredElement) -> Result<Vec<Property>, PointsError> {
-    let fail = |_| {
-        PointsError::Invalid(format!(
-            "{}: cannot allocate memory for {} rows of element {}",
-            name.display(),
-            e.count,
-            e.name
-        ))
+    let (line, column) = e.at;
+    let fail = |error: crate::budget::OverBudget| {
+        PointsError::text(
+            name,
+            line,
+            column,
+            format!("element {} declares {} rows: {error}", e.name, e.count),
+        )
     };
+    let what = format!("the columns of element {}", e.name);
     e.properties
         .iter()
         .map(|d| {
             let data = match d.count {
-                None => {
-                    let mut values = Vec::new();
-                    values.try_reserve_exact(e.count).map_err(fail)?;
-                    PropertyData::Scalar { ty: d.ty, values }
-                }
+                None => PropertyData::Scalar {
+                    ty: d.ty,
+                    values: crate::budget::vec_for(e.count, &what).map_err(fail)?,
+                },
                 Some(count) => {
-                    let mut offsets = Vec::new();
-                    offsets.try_reserve_exact(e.count + 1).map_err(fail)?;
+                    let mut offsets =
+                        crate::budget::vec_for(e.count.saturating_add(1), &what).map_err(fail)?;
                     offsets.push(0);
                     PropertyData::List {
                         count,
@@ -99,6 +101,10 @@ fn columns(name: &Path, e: &DeclaredElement) -> Result<Vec<Property>, PointsErro
                 name: d.name.clone(),
                 data,
                 first_non_finite: None,
+                declared: Position::Line {
+                    line: d.at.0,
+                    column: d.at.1,
+                },
             })
         })
         .collect()
@@ -181,6 +187,7 @@ fn binary_element(
                             ),
                         ));
                     }
+                    reserve_items(name, Position::Byte(at as u64), &mut lists.values, n, e)?;
                     for _ in 0..n as usize {
                         let v = value(*item, *pos)?;
                         *pos += item.size();
@@ -196,7 +203,35 @@ fn binary_element(
         count: e.count,
         properties,
         start: Position::Byte(start as u64),
+        declared: declared(e),
     })
+}
+
+/// Room for `n` more list items (checked against the budget, fallible): the items of all
+/// rows together may outgrow it even though each list fits the file.
+fn reserve_items(
+    name: &Path,
+    at: Position,
+    values: &mut Vec<f64>,
+    n: f64,
+    e: &DeclaredElement,
+) -> Result<(), PointsError> {
+    let what = format!("the list items of element {}", e.name);
+    crate::budget::reserve(values, n as usize, &what).map_err(|error| {
+        let message = format!("element {}: {error}", e.name);
+        match at {
+            Position::Byte(b) => PointsError::format(name, b, message),
+            Position::Line { line, column } => PointsError::text(name, line, column, message),
+        }
+    })
+}
+
+/// Where the header declares `e`.
+fn declared(e: &DeclaredElement) -> Position {
+    Position::Line {
+        line: e.at.0,
+        column: e.at.1,
+    }
 }
 
 /// Whitespace-separated tokens with their line and column.
@@ -291,7 +326,8 @@ fn ascii_element(
                 PropertyData::List { count, item, lists } => {
                     let (n, line, column) = at.next(tokens, *count, "a list length")?;
                     let left = tokens.bytes.len() - tokens.pos;
-                    if n < 0.0 || n > left as f64 {
+                    // Each item takes a character and a separator.
+                    if n < 0.0 || 2.0 * n > left as f64 + 1.0 {
                         return Err(PointsError::text(
                             name,
                             line,
@@ -302,6 +338,13 @@ fn ascii_element(
                             ),
                         ));
                     }
+                    reserve_items(
+                        name,
+                        Position::Line { line, column },
+                        &mut lists.values,
+                        n,
+                        e,
+                    )?;
                     for _ in 0..n as usize {
                         lists.values.push(at.next(tokens, *item, "a list item")?.0);
                     }
@@ -315,6 +358,7 @@ fn ascii_element(
         count: e.count,
         properties,
         start: Position::Line { line, column },
+        declared: declared(e),
     })
 }
 

@@ -12,12 +12,16 @@ pub(super) struct Declared {
     /// `Some(count type)` for lists.
     pub(super) count: Option<ScalarType>,
     pub(super) ty: ScalarType,
+    /// Line and column of the `property` line's name.
+    pub(super) at: (usize, usize),
 }
 
 pub(super) struct DeclaredElement {
     pub(super) name: String,
     pub(super) count: usize,
     pub(super) properties: Vec<Declared>,
+    /// Line and column of the `element` line's count.
+    pub(super) at: (usize, usize),
 }
 
 pub(super) struct Header {
@@ -132,6 +136,7 @@ pub(super) fn parse(name: &Path, bytes: &[u8]) -> Result<Header, PointsError> {
                     name: word(1).to_string(),
                     count,
                     properties: Vec::new(),
+                    at: (number, col(2)),
                 });
             }
             "property" => {
@@ -162,6 +167,7 @@ pub(super) fn parse(name: &Path, bytes: &[u8]) -> Result<Header, PointsError> {
                             name: word(4).to_string(),
                             count: Some(count),
                             ty: ty(3)?,
+                            at: (number, col(4)),
                         },
                         5,
                     )
@@ -171,6 +177,7 @@ pub(super) fn parse(name: &Path, bytes: &[u8]) -> Result<Header, PointsError> {
                             name: word(2).to_string(),
                             count: None,
                             ty: ty(1)?,
+                            at: (number, col(2)),
                         },
                         3,
                     )

@@ -111,7 +111,7 @@ impl Bvh {
 
     /// Call `visit(tet)` for every tetrahedron whose box the ray `o + t d`, `t` in
     /// `[0, t_max]`, meets.
-    fn visit(&self, o: DVec3, d: DVec3, t_max: f64, mut visit: impl FnMut(usize)) {
+    pub fn visit(&self, o: DVec3, d: DVec3, t_max: f64, mut visit: impl FnMut(usize)) {
         let inv = d.recip();
         let mut stack = vec![0usize];
         while let Some(i) = stack.pop() {

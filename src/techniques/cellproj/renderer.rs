@@ -5,8 +5,6 @@
 
 use std::path::Path;
 
-use glam::DVec3;
-
 use super::prepare::{iso_list, iso_table, prepare, Prepared, Viewer, VERTEX_COMPONENTS};
 use super::{CellprojScene, Depth, Exit, Order};
 use crate::camera::Projection;
@@ -98,22 +96,7 @@ pub fn program_pair(variant: Variant, kind: ProgramKind) -> GlResult<ProgramPair
     })
 }
 
-/// The eye in object space (perspective) and the unit view direction (both cameras).
-pub fn eye_and_direction(frame: &Frame) -> (DVec3, DVec3) {
-    let inverse = frame.camera.view().inverse();
-    let eye = inverse.transform_point3(DVec3::ZERO);
-    let dir = inverse.transform_vector3(DVec3::NEG_Z).normalize();
-    (eye, dir)
-}
-
-/// The viewer of a frame, in object space (what [`Order::View`] sorts and culls for).
-pub fn viewer(frame: &Frame) -> Viewer {
-    let (eye, dir) = eye_and_direction(frame);
-    match frame.camera.projection {
-        Projection::Orthographic => Viewer::Parallel(dir),
-        Projection::Perspective => Viewer::Eye(eye),
-    }
-}
+pub use super::volume::{eye_and_direction, viewer};
 
 /// The cell-projection renderer.
 pub struct CellprojRenderer {
@@ -133,6 +116,10 @@ pub struct CellprojRenderer {
     ranges: Vec<[f64; 2]>,
     table: Texture,
     program: Option<(Variant, Depth, Program)>,
+    /// The volume (`mode = "volume"` or `"both"`).
+    volume: Option<super::volume::VolumeRenderer>,
+    /// Where the scene's files are read from (colour tables).
+    base: std::path::PathBuf,
 }
 
 /// Slack of the active test: the precise programs' crossing slack (2^-16) and a margin
@@ -195,7 +182,7 @@ impl CellprojRenderer {
             .validate()
             .map_err(|e| GlError::Data(e.to_string()))?;
         let prepared = prepare(params, base).map_err(GlError::Data)?;
-        CellprojRenderer::from_prepared(gpu, kind, fidelity, params, prepared)
+        CellprojRenderer::build(gpu, kind, fidelity, params, prepared, base)
     }
 
     /// Upload a mesh prepared elsewhere (tests craft meshes in memory).
@@ -206,7 +193,23 @@ impl CellprojRenderer {
         params: &CellprojScene,
         prepared: Prepared,
     ) -> GlResult<CellprojRenderer> {
-        let (mesh, faces) = face_mesh(gpu, &prepared, params.order)?;
+        CellprojRenderer::build(gpu, kind, fidelity, params, prepared, Path::new("."))
+    }
+
+    fn build(
+        gpu: &Gpu,
+        kind: ProgramKind,
+        fidelity: Fidelity,
+        params: &CellprojScene,
+        prepared: Prepared,
+        base: &Path,
+    ) -> GlResult<CellprojRenderer> {
+        let (mesh, faces) = if params.mode.isosurfaces() {
+            face_mesh(gpu, &prepared, params.order)?
+        } else {
+            let label = "cellproj faces (none: volume only)";
+            (Mesh::new(gpu, label, &VERTEX_COMPONENTS, &[])?, None)
+        };
         let table = table_texture(gpu, params, fidelity)?;
         let mut renderer = CellprojRenderer {
             kind,
@@ -220,15 +223,52 @@ impl CellprojRenderer {
             built_for: None,
             table,
             program: None,
+            volume: None,
+            base: base.to_path_buf(),
         };
         renderer.select_active(gpu)?;
+        renderer.build_volume(gpu)?;
         Ok(renderer)
+    }
+
+    /// (Re)build the volume when the scene draws one.
+    fn build_volume(&mut self, gpu: &Gpu) -> GlResult<()> {
+        self.volume = None;
+        if !self.params.mode.volume() {
+            return Ok(());
+        }
+        let spec = self.params.volume_spec();
+        let transfer = spec
+            .build(&self.base, self.prepared.scale)
+            .map_err(GlError::Data)?;
+        let isos = if self.params.mode == super::Mode::Both {
+            self.params.isovalues.clone()
+        } else {
+            Vec::new()
+        };
+        self.volume = Some(super::volume::VolumeRenderer::new(
+            gpu,
+            self.kind,
+            self.fidelity,
+            &spec,
+            transfer,
+            &self.prepared,
+            &isos,
+        )?);
+        Ok(())
+    }
+
+    /// The volume's renderer, when the scene draws one.
+    pub fn volume(&self) -> Option<&super::volume::VolumeRenderer> {
+        self.volume.as_ref()
     }
 
     /// Choose the tetrahedra to draw (the active ones, or all): an index list for
     /// [`Order::Mesh`]; for [`Order::View`] the next draw rebuilds its buffer.
     fn select_active(&mut self, gpu: &Gpu) -> GlResult<()> {
-        self.drawn = if self.params.active_only {
+        self.drawn = if !self.params.mode.isosurfaces() {
+            Vec::new()
+        } else if self.params.active_only {
             Prepared::active_tets(&self.ranges, &self.params.isovalues, ACTIVE_SLACK)
         } else {
             (0..self.prepared.tets.len() as u32).collect()
@@ -295,6 +335,13 @@ impl CellprojRenderer {
 
 impl Renderer for CellprojRenderer {
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+        // Precise scenes drawing both find the isosurfaces in the volume's walk.
+        let both_in_walk = self.fidelity == Fidelity::Precise
+            && self.params.mode == super::Mode::Both
+            && self.params.volume_spec().precise == super::transfer::Precise::Walk;
+        if !self.params.mode.isosurfaces() || both_in_walk {
+            return self.draw_volume(gpu, surface, frame);
+        }
         let variant = variant(&self.params, self.fidelity, frame.camera.projection)?;
         let mvp = frame.camera.view_projection(frame.aspect());
         let (eye, dir) = eye_and_direction(frame);
@@ -324,7 +371,7 @@ impl Renderer for CellprojRenderer {
             }
         }
         if self.params.isovalues.is_empty() {
-            return Ok(());
+            return self.draw_volume(gpu, surface, frame);
         }
         self.build_view(gpu, frame)?;
         let program = &self.program.as_ref().expect("compiled above").2;
@@ -338,7 +385,8 @@ impl Renderer for CellprojRenderer {
                 primitive: Default::default(),
                 ..DrawCall::new(program, &self.mesh)
             },
-        )
+        )?;
+        self.draw_volume(gpu, surface, frame)
     }
 
     fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
@@ -354,7 +402,18 @@ impl Renderer for CellprojRenderer {
         let active_changed =
             new.isovalues != self.params.isovalues || new.active_only != self.params.active_only;
         let order_changed = new.order != self.params.order;
+        let volume_changed = new.mode != self.params.mode
+            || new.volume != self.params.volume
+            || (new.mode == super::Mode::Both && new.isovalues != self.params.isovalues);
+        let iso_mesh_changed = new.mode.isosurfaces() != self.params.mode.isosurfaces();
         self.params = new.clone();
+        if iso_mesh_changed && !order_changed {
+            (self.mesh, self.faces) = face_mesh(gpu, &self.prepared, self.params.order)?;
+            self.select_active(gpu)?;
+        }
+        if volume_changed {
+            self.build_volume(gpu)?;
+        }
         if order_changed {
             (self.mesh, self.faces) = face_mesh(gpu, &self.prepared, self.params.order)?;
         }
@@ -376,6 +435,25 @@ impl Renderer for CellprojRenderer {
 
     fn needs_depth(&self) -> bool {
         true
+    }
+
+    fn status(&self) -> Option<String> {
+        let v = self.volume.as_ref()?;
+        let t = v.times();
+        Some(format!(
+            "volume: sort {:.1} ms, indices {:.1} ms, {} cycles broken",
+            t.sort_ms, t.upload_ms, t.cycles
+        ))
+    }
+}
+
+impl CellprojRenderer {
+    fn draw_volume(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+        let depth = self.params.mode == super::Mode::Both;
+        match &mut self.volume {
+            Some(v) => v.draw(gpu, surface, frame, &self.prepared, depth),
+            None => Ok(()),
+        }
     }
 }
 
@@ -415,5 +493,11 @@ pub fn program_pairs() -> Vec<ProgramPair> {
         vertex,
         fragment,
     })
-    .into()
+    .into_iter()
+    .chain([
+        super::volume::faithful_pair(ProgramKind::Arb),
+        super::volume::faithful_pair(ProgramKind::Glsl),
+    ])
+    .chain(super::volume::precise_pairs())
+    .collect()
 }

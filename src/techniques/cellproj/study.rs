@@ -4,6 +4,8 @@
 //! precise; each setting scored against the f64 reference (fraction of interior pixels
 //! with the right isovalue colour).
 
+pub mod volume;
+
 use crate::study::median;
 use crate::techniques::Params;
 use std::time::Instant;
@@ -78,6 +80,8 @@ fn scene_for(points: usize, exit: Exit, active_only: bool) -> CellprojScene {
             field: Field::Spherical,
         }),
         scalars: ScalarSpec::default(),
+        mode: Default::default(),
+        volume: None,
         isovalues: seed_isovalues(),
         exit,
         table_size: 256,

@@ -9,7 +9,15 @@
 //! cracks or a few flipped triangles it degrades smoothly and only near the defect, which
 //! is why it was chosen over ray parity (one ray through a hole flips a whole streak).
 //! Its cost is one `atan2` per triangle per point: fine for the reference, far too slow
-//! for every voxel of a 256³ grid (16.7 M points x 11,036 triangles).
+//! for every voxel of a 256³ grid (16.7 M points x 11,036 triangles). The grid's rows
+//! that need it use the fast winding number instead ([`super::fast_winding`]: a tree of
+//! Taylor expansions, within [`super::fast_winding::ERROR_BOUND`] of the exact sum).
+//!
+//! # Placement
+//! [`MeshShape::placed`] refuses a mesh whose placed vertices are not finite or lie
+//! beyond [`MAX_PLACED`] of the grid's centre (scale is applied first, so a file's
+//! coordinates near ±1.7e308 with a small scale are fine): every length, cross product
+//! and expansion term the field forms then stays finite.
 //!
 //! # The grid
 //! The texture clamps at one voxel diagonal, so exact distances are needed only within
@@ -36,17 +44,38 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use glam::DVec3;
 use rayon::prelude::*;
 
+use super::error::ClipError;
+use super::fast_winding::{solid_angle, WindingTree};
 use super::grid::ClipGrid;
-use crate::surface::TriangleMesh;
+use crate::surface::{Position, SurfaceError, TriangleMesh};
+
+/// Largest coordinate of a placed clip mesh (the grid spans at most [-1, 1]³: 1e15 is
+/// as far as infinity for it, and keeps every product the field forms, up to seventh
+/// powers of distances in the expansions, far from overflow).
+pub const MAX_PLACED: f64 = 1e15;
+
+/// Bytes a triangle costs once placed: its corners (72), the tree's copy (72) and its
+/// share of the tree's nodes (about 40), its box while the field is made (48).
+const TRIANGLE_BYTES: u64 = 72 + 72 + 40 + 48;
 
 /// Largest number of (triangle, slice) pairs binned before slices scan all triangles.
-const MAX_BIN_ENTRIES: usize = 1 << 26;
+pub const MAX_BIN_ENTRIES: usize = 1 << 26;
+
+/// How [`MeshShape::field_with`] evaluates winding numbers.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Winding {
+    /// The tree of expansions ([`super::fast_winding`]).
+    Fast,
+    /// Every triangle (the reference; slow on large grids).
+    Exact,
+}
 
 /// A mesh placed in object space, ready to evaluate.
 #[derive(Debug)]
 pub struct MeshShape {
     /// Triangles' corners in object space.
     pub triangles: Vec<[DVec3; 3]>,
+    tree: WindingTree,
     repaired: AtomicUsize,
 }
 
@@ -54,6 +83,7 @@ impl Clone for MeshShape {
     fn clone(&self) -> Self {
         MeshShape {
             triangles: self.triangles.clone(),
+            tree: self.tree.clone(),
             repaired: AtomicUsize::new(self.repaired_rows()),
         }
     }
@@ -68,12 +98,48 @@ impl MeshShape {
         rotation: glam::DQuat,
     ) -> MeshShape {
         let place = |p: [f64; 3]| position + rotation * (scale * DVec3::from_array(p));
+        let triangles: Vec<[DVec3; 3]> = (0..mesh.triangles.len())
+            .map(|t| mesh.corners(t).map(place))
+            .collect();
         MeshShape {
-            triangles: (0..mesh.triangles.len())
-                .map(|t| mesh.corners(t).map(place))
-                .collect(),
+            tree: WindingTree::new(&triangles),
+            triangles,
             repaired: AtomicUsize::new(0),
         }
+    }
+
+    /// [`MeshShape::new`] for a mesh read from `name`, refused (naming the vertex) when a
+    /// placed vertex is not finite or lies beyond [`MAX_PLACED`], or when the placed
+    /// triangles and their tree would pass the memory budget.
+    pub fn placed(
+        name: &std::path::Path,
+        mesh: &TriangleMesh,
+        position: DVec3,
+        scale: DVec3,
+        rotation: glam::DQuat,
+    ) -> Result<MeshShape, ClipError> {
+        let fail = |position: Position, message: String| {
+            ClipError::Surface(SurfaceError::format(name, position, message))
+        };
+        let triangles = mesh.triangles.len() as u64;
+        crate::budget::check(
+            format!("placing a clip mesh of {triangles} triangles"),
+            crate::budget::times(triangles, TRIANGLE_BYTES),
+        )
+        .map_err(|e| fail(Position::Item("triangle", 0), e.to_string()))?;
+        for (i, p) in mesh.vertices.iter().enumerate() {
+            let q = position + rotation * (scale * DVec3::from_array(*p));
+            if !q.is_finite() || q.abs().max_element() > MAX_PLACED {
+                return Err(fail(
+                    Position::Item("vertex", i),
+                    format!(
+                        "[{:.3e}, {:.3e}, {:.3e}] placed with scale {} at [{:.3e}, {:.3e}, {:.3e}]: a clip mesh must lie within ±{MAX_PLACED:e} of the volume's centre (the volume spans at most ±1); scale it down or move it",
+                        p[0], p[1], p[2], scale.x, q.x, q.y, q.z
+                    ),
+                ));
+            }
+        }
+        Ok(MeshShape::new(mesh, position, scale, rotation))
     }
 
     /// Rows of the last [`MeshShape::field`] whose crossings did not sum to zero (holes,
@@ -82,17 +148,17 @@ impl MeshShape {
         self.repaired.load(Ordering::Relaxed)
     }
 
-    /// Generalized winding number at `p` (van Oosterom-Strackee solid angles).
+    /// Generalized winding number at `p` (van Oosterom-Strackee solid angles, every
+    /// triangle: the exact sum).
     pub fn winding_number(&self, p: DVec3) -> f64 {
-        let mut sum = 0.0;
-        for t in &self.triangles {
-            let [a, b, c] = t.map(|v| v - p);
-            let (la, lb, lc) = (a.length(), b.length(), c.length());
-            let det = a.dot(b.cross(c));
-            let den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-            sum += 2.0 * det.atan2(den);
-        }
+        let sum: f64 = self.triangles.iter().map(|t| solid_angle(t, p)).sum();
         sum / (4.0 * std::f64::consts::PI)
+    }
+
+    /// The fast winding number at `p` (within [`super::fast_winding::ERROR_BOUND`] of
+    /// [`MeshShape::winding_number`]).
+    pub fn fast_winding_number(&self, p: DVec3) -> f64 {
+        self.tree.winding_number(p)
     }
 
     /// The f64 reference: inside when `|winding number| >= 0.5`.
@@ -115,6 +181,17 @@ impl MeshShape {
 
     /// [`MeshShape::field`] binning at most `max_bin_entries` (triangle, slice) pairs.
     pub(crate) fn field_binned(&self, grid: &ClipGrid, max_bin_entries: usize) -> Vec<f32> {
+        self.field_with(grid, max_bin_entries, Winding::Fast)
+    }
+
+    /// [`MeshShape::field_binned`] deciding damaged rows with `winding` (the exact sum is
+    /// for comparisons: tests, and the study's timing of what the fast one replaced).
+    pub fn field_with(
+        &self,
+        grid: &ClipGrid,
+        max_bin_entries: usize,
+        winding: Winding,
+    ) -> Vec<f32> {
         let [ni, nj, nk] = grid.dims;
         let h = grid.voxel();
         let diag = grid.diagonal();
@@ -210,7 +287,7 @@ impl MeshShape {
                 for (j, row) in rows.iter_mut().enumerate() {
                     row.sort_by(|a, b| a.0.total_cmp(&b.0));
                     let y = lo.y + (j as f64 + 0.5) * h.y;
-                    let inside = self.row_inside(row, ni, lo.x, h.x, y, z);
+                    let inside = self.row_inside(row, ni, lo.x, h.x, [y, z], winding);
                     for (i, inside) in inside.into_iter().enumerate() {
                         let d = distance[i + ni * j].min(2.0 * diag);
                         slice[i + ni * j] = (if inside { d } else { -d }) as f32;
@@ -227,8 +304,8 @@ impl MeshShape {
         ni: usize,
         x0: f64,
         hx: f64,
-        y: f64,
-        z: f64,
+        [y, z]: [f64; 2],
+        winding: Winding,
     ) -> Vec<bool> {
         let x_of = |i: usize| x0 + (i as f64 + 0.5) * hx;
         let total: i32 = row.iter().map(|c| c.1).sum();
@@ -259,7 +336,15 @@ impl MeshShape {
             while end + 1 < ni && !(next < row.len() && row[next].0 < x_of(end + 1)) {
                 end += 1;
             }
-            let at = |i: usize| self.inside(DVec3::new(x_of(i), y, z));
+            let at = |i: usize| {
+                let p = DVec3::new(x_of(i), y, z);
+                match winding {
+                    Winding::Fast => self.fast_winding_number(p),
+                    Winding::Exact => self.winding_number(p),
+                }
+                .abs()
+                    >= 0.5
+            };
             let (a, b) = (at(start), at(end));
             self.bisect(&mut out, start, end, a, b, &at);
             start = end + 1;

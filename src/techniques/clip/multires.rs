@@ -226,9 +226,15 @@ impl MultiRes {
                 "a DATA texture of {data_dims:?} texels is more than the {MAX_DATA_TEXELS} texels built here"
             ))
         })?;
-        let mut data = Vec::new();
-        data.try_reserve_exact(texels)
-            .map_err(|_| ClipError::Invalid(format!("cannot allocate {texels} DATA texels")))?;
+        // DATA as f32 here, and its 8-bit or float texture: checked once the boundary
+        // blocks are counted (the scene's estimate could not know how many there are).
+        let mut data: Vec<f32> = crate::budget::vec_for(
+            texels,
+            &format!(
+                "the DATA texture of {slots} boundary blocks of {side}³ ({data_dims:?} texels)"
+            ),
+        )
+        .map_err(|e| ClipError::Invalid(e.to_string()))?;
         data.resize(texels, 0f32);
         // Which block each slot holds.
         let mut slot_block = vec![0usize; slots as usize];

@@ -7,16 +7,23 @@
 //!
 //! Shapes: the sphere of radius 0.35 N at the volume's centre; a torus generated as
 //! a closed triangle mesh (1,152 triangles, tilted, so its surface cuts blocks at every
-//! angle); and `cow.obj` (5,804 triangles) when `../shared/data/surfaces/` is present.
+//! angle); and `cow.obj` (5,804 triangles) when `../shared/data/surfaces/` is present. The
+//! texture sweep adds an *open* mesh, the upper half of a finer torus's tube (4,608
+//! triangles, open along the whole ring), whose unbalanced rows the fast winding number
+//! decides: its "built in" time is the open-mesh clip's cost at each grid size.
 //! Bytes: single-resolution and DATA one byte per texel (R8, the era's LUMINANCE8), INDEX
 //! 16 (RGBA32F: the slot coordinates need more than 8 bits, see [`super::multires`]).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use glam::DVec3;
+
+use super::mesh_field::MeshShape;
 use super::multires::{MultiRes, TexelFormat};
-use super::texture::ClipTexture;
-use super::{ClipSpec, ShapeSpec};
+use super::shape::Shape;
+use super::texture::{ClipGrid, ClipTexture};
+use super::{ClipError, ClipSpec, ShapeSpec};
 use crate::gl::{Headless, Surface, Target};
 use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::Frame;
@@ -127,6 +134,25 @@ pub fn shapes() -> Vec<(String, ShapeSpec, PathBuf)> {
     out
 }
 
+/// The open mesh of the texture sweep: the triangles of a tilted torus's tube above its
+/// plane (4,608 of 9,216), open along the whole ring.
+pub fn open_half_torus() -> Result<Shape, ClipError> {
+    let torus = super::scene::torus(0.55, 0.22, [96, 48])?;
+    let mut half = torus.clone();
+    half.triangles.retain(|t| {
+        t.iter()
+            .map(|&i| torus.vertices[i as usize][2])
+            .sum::<f64>()
+            > 0.0
+    });
+    Ok(Shape::Mesh(Box::new(MeshShape::new(
+        &half,
+        DVec3::new(0.05, -0.03, 0.02),
+        DVec3::ONE,
+        glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.6, 0.35, 0.0),
+    ))))
+}
+
 /// The texture sweep (CPU only); `progress` hears one line per row.
 pub fn textures(
     options: &Options,
@@ -135,6 +161,7 @@ pub fn textures(
 ) -> anyhow::Result<Vec<TextureRow>> {
     let mut rows = Vec::new();
     for &n in &options.sizes {
+        let mut built = Vec::new();
         for (name, shape, base) in shapes() {
             let spec = ClipSpec {
                 shape,
@@ -143,8 +170,11 @@ pub fn textures(
                 multires: false,
                 resolution: None,
             };
-            let grid = spec.grid([n; 3], [1.0; 3])?;
-            let built = spec.shape(&base, [1.0; 3])?;
+            built.push((name, spec.shape(&base, [1.0; 3])?));
+        }
+        built.push(("open half-torus mesh".to_string(), open_half_torus()?));
+        for (name, built) in built {
+            let grid = ClipGrid::new([n; 3], [1.0; 3])?;
             let single = ClipTexture::build(&built, &grid);
             let texels = n * n * n;
             let mut push = |row: TextureRow| {
@@ -199,14 +229,18 @@ pub fn textures(
     Ok(rows)
 }
 
-/// The scene the frame times draw: the `clip-sphere` demo's three attributes on a
-/// synthetic cube of `options.frame_volume`³, `options.image`² pixels, clipped (keeping the
-/// inside) by the sphere.
+/// The scene the frame times draw: the three attributes of `scenes/bench/clip-sphere-study.toml`
+/// (the `clip-sphere` demo as the README's numbers were measured) on a synthetic cube of
+/// `options.frame_volume`³, `options.image`² pixels, clipped (keeping the inside) by the
+/// issue's sphere.
 pub fn frame_scene(options: &Options) -> anyhow::Result<Scene> {
-    let mut scene = Scene::demo("clip-sphere")?;
+    let mut scene = Scene::parse(
+        include_str!("../../../scenes/bench/clip-sphere-study.toml"),
+        "scenes/bench/clip-sphere-study.toml",
+    )?;
     scene.size = [options.image; 2];
     let TechniqueScene::Opacity3d(p) = &mut scene.technique else {
-        anyhow::bail!("the clip-sphere demo is not a 3D-opacity scene");
+        anyhow::bail!("the clip study scene is not a 3D-opacity scene");
     };
     let n = options.frame_volume;
     for a in [

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::mesh_field::MeshShape;
+use super::mesh_field::{MeshShape, Winding};
 use super::multires::{BlockClass, IndexEncoding, MultiRes, TexelFormat};
 use super::shape::{rotation_from_degrees, Shape};
 use super::texture::{ClipGrid, ClipTexture};
@@ -699,4 +699,90 @@ fn bad_clip_meshes_give_clear_errors() {
     assert!(e("empty.obj").contains("no faces"));
     assert!(e("empty.stl").contains("too short"), "{}", e("empty.stl"));
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+// --- issue 17: clouds and surfaces ---
+
+#[test]
+fn placement_scales_first_and_refuses_what_overflows() {
+    let m = box_mesh([-0.4, -0.3, -0.2], [0.5, 0.35, 0.25]);
+    let huge = m.map_vertices(|p| p.map(|c| c * 1e308));
+    let name = Path::new("huge.obj");
+    let id = glam::DQuat::IDENTITY;
+    // At scale 1 the vertices lie 4e307 from the grid: refused, naming file and vertex.
+    let e = MeshShape::placed(name, &huge, DVec3::ZERO, DVec3::ONE, id)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with(
+            "huge.obj: vertex 0: [-4.000e307, -3.000e307, -2.000e307] placed with scale 1 at [-4.000e307"
+        ),
+        "{e}"
+    );
+    assert!(e.contains("within ±1e15"), "{e}");
+    // Scale 5 overflows f64 itself (-2e308; the rotation turns infinity into NaN).
+    let e = MeshShape::placed(name, &huge, DVec3::ZERO, DVec3::splat(5.0), id)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("placed with scale 5 at [NaN, NaN, NaN]"), "{e}");
+    // Scaled first, the same file fits: the field equals the plain box's to f32 rounding.
+    let small = MeshShape::placed(name, &huge, DVec3::ZERO, DVec3::splat(1e-308), id).unwrap();
+    let plain = MeshShape::new(&m, DVec3::ZERO, DVec3::ONE, id);
+    let dims = [13, 11, 9];
+    let grid = ClipGrid::new(dims, half(dims)).unwrap();
+    let (a, b) = (small.field(&grid), plain.field(&grid));
+    // 1e308 * 1e-308 is 1 within an ulp or two: distances agree to f32 precision.
+    let worst = a
+        .iter()
+        .zip(&b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0f32, f32::max);
+    assert!(worst < 1e-6, "{worst}");
+    assert!(a.iter().zip(&b).all(|(x, y)| x.signum() == y.signum()));
+}
+
+#[test]
+fn an_open_mesh_field_agrees_with_the_exact_winding_number() {
+    // Half of a tilted torus's tube (the triangles above its plane): open along the whole
+    // ring, so many rows through it are decided by the winding number.
+    let torus = super::scene::torus(0.55, 0.22, [48, 24]).unwrap();
+    let mut half_tube = torus.clone();
+    half_tube.triangles.retain(|t| {
+        t.iter()
+            .map(|&i| torus.vertices[i as usize][2])
+            .sum::<f64>()
+            > 0.0
+    });
+    let mesh = MeshShape::new(
+        &half_tube,
+        DVec3::new(0.04, -0.03, 0.05),
+        DVec3::ONE,
+        glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.6, 0.35, 0.0),
+    );
+    let dims = [36, 30, 26];
+    let grid = ClipGrid::new(dims, half(dims)).unwrap();
+    let fast = mesh.field(&grid);
+    assert!(mesh.repaired_rows() > 100, "{}", mesh.repaired_rows());
+    let exact = mesh.field_with(&grid, super::mesh_field::MAX_BIN_ENTRIES, Winding::Exact);
+    // The fields differ only in rows holding a voxel whose exact winding number is within
+    // the fast one's error bound of 0.5 (where the two may take different sides).
+    let bound = super::fast_winding::ERROR_BOUND;
+    let (mut rows, mut differing) = (0, 0);
+    for k in 0..dims[2] {
+        for j in 0..dims[1] {
+            let row = |f: &[f32]| -> Vec<bool> {
+                (0..dims[0]).map(|i| f[grid.index(i, j, k)] > 0.0).collect()
+            };
+            rows += 1;
+            if row(&fast) == row(&exact) {
+                continue;
+            }
+            differing += 1;
+            let near = (0..dims[0])
+                .any(|i| (mesh.winding_number(grid.centre(i, j, k)).abs() - 0.5).abs() <= bound);
+            assert!(near, "row ({j}, {k}) differs away from the 0.5 level");
+        }
+    }
+    assert!(differing * 100 <= rows, "{differing} of {rows} rows differ");
+    assert!(fast.iter().filter(|&&f| f > 0.0).count() > 500);
 }

@@ -36,7 +36,8 @@ pub struct ReadOptions {
 }
 
 /// Where the traces sit in the file.
-pub(super) struct Layout {
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Layout {
     pub first_trace: usize,
     pub trace_len: usize,
     pub traces: usize,

@@ -9,15 +9,19 @@
 //! on a full rectangular grid, in any order, or the file is refused as pre-stack or
 //! irregular. The volume's axes are sample (i), crossline (j), inline (k).
 
+mod gathers;
 mod grid;
 mod source;
+mod stream;
 mod write;
 
 use std::path::Path;
 
+pub use gathers::{gathers, Gathers};
 pub use grid::{Prestack, ReadOptions};
 pub use source::SegySource;
-pub use write::{write, WriteOptions};
+pub use stream::SegyStream;
+pub use write::{write, write_prestack, TraceWriter, WriteOptions};
 
 use super::{read_file, Volume, VolumeError};
 
@@ -306,8 +310,47 @@ pub fn read(path: &Path, options: &ReadOptions) -> Result<SegyCube, VolumeError>
     parse(path, &bytes, options)
 }
 
+/// What the binary header and the file's length say, before any trace is gridded.
+#[derive(Debug, Clone)]
+pub(crate) struct Headers {
+    pub layout: grid::Layout,
+    pub revision: (u8, u8),
+    pub ebcdic: bool,
+    pub interval_us: u32,
+}
+
 /// Parse SEG-Y bytes; `path` names the file in errors.
 pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCube, VolumeError> {
+    let h = headers(path, bytes, bytes.len() as u64)?;
+    let layout = h.layout;
+    let grid::Gridded {
+        dims,
+        values,
+        inlines,
+        crosslines,
+        offsets,
+    } = grid::grid(path, bytes, &layout, options)?;
+    // Spacing: one sample, one crossline step and one inline step each count as one unit;
+    // SEG-Y has no common unit for time and distance.
+    let volume = Volume::new(dims, [1.0, 1.0, 1.0], values).map_err(VolumeError::Invalid)?;
+    Ok(SegyCube {
+        volume,
+        revision: h.revision,
+        format: layout.format,
+        big_endian: layout.big,
+        ebcdic: h.ebcdic,
+        interval_us: h.interval_us,
+        inlines,
+        crosslines,
+        traces: layout.traces,
+        offsets,
+    })
+}
+
+/// Read the textual, binary and extended headers from `bytes` (the start of a file of
+/// `len` bytes, holding at least the first trace's header when the file has one) and
+/// check the trace layout against `len`.
+pub(crate) fn headers(path: &Path, bytes: &[u8], len: u64) -> Result<Headers, VolumeError> {
     let bin = TEXT_HEADER;
     if bytes.len() < TEXT_HEADER + BINARY_HEADER {
         return Err(VolumeError::format(
@@ -373,28 +416,29 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
         interval_us = r.u16(first_trace + 116) as u32;
     }
     let trace_len = TRACE_HEADER + samples * format.bytes();
-    let data = bytes.len().checked_sub(first_trace).ok_or_else(|| {
+    let data = len.checked_sub(first_trace as u64).ok_or_else(|| {
         VolumeError::format(
             path,
-            bytes.len() as u64,
+            len,
             format!("file ends before the first trace, which the headers place at byte {first_trace} ({extended} extended textual headers)"),
         )
     })?;
-    if data % trace_len != 0 {
-        let whole = data / trace_len;
-        let start = first_trace + whole * trace_len;
+    let tl = trace_len as u64;
+    if data % tl != 0 {
+        let whole = data / tl;
+        let start = first_trace as u64 + whole * tl;
         return Err(VolumeError::format(
             path,
-            bytes.len() as u64,
+            len,
             format!(
                 "file ends inside trace {} (which starts at byte {start}): each trace is {trace_len} bytes (240-byte header + {samples} samples of {}), {} bytes are missing; the file is truncated or its headers are wrong",
                 whole + 1,
                 format.name(),
-                trace_len - (data - whole * trace_len)
+                tl - (data - whole * tl)
             ),
         ));
     }
-    let traces = data / trace_len;
+    let traces = usize::try_from(data / tl).unwrap_or(usize::MAX);
     if traces == 0 {
         return Err(VolumeError::format(
             path,
@@ -402,36 +446,19 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
             "no traces after the headers",
         ));
     }
-    let layout = grid::Layout {
-        first_trace,
-        trace_len,
-        traces,
-        samples,
-        format,
-        big,
-        header_samples: declared_samples,
-    };
-    let grid::Gridded {
-        dims,
-        values,
-        inlines,
-        crosslines,
-        offsets,
-    } = grid::grid(path, bytes, &layout, options)?;
-    // Spacing: one sample, one crossline step and one inline step each count as one unit;
-    // SEG-Y has no common unit for time and distance.
-    let volume = Volume::new(dims, [1.0, 1.0, 1.0], values).map_err(VolumeError::Invalid)?;
-    Ok(SegyCube {
-        volume,
+    Ok(Headers {
+        layout: grid::Layout {
+            first_trace,
+            trace_len,
+            traces,
+            samples,
+            format,
+            big,
+            header_samples: declared_samples,
+        },
         revision,
-        format,
-        big_endian: big,
         ebcdic: bytes[0] == 0xC3 || bytes[0] == 0x40,
         interval_us,
-        inlines,
-        crosslines,
-        traces,
-        offsets,
     })
 }
 
@@ -575,18 +602,44 @@ mod tests {
     /// Two cubes as one pre-stack file: every cell holds a trace of offset 100 (from
     /// `a`) and one of offset 300 (from `b`), interleaved.
     fn prestack_file(a: &Volume, b: &Volume) -> Vec<u8> {
-        let o = options(SampleFormat::IeeeFloat);
-        let (fa, fb) = (write(a, &o), write(b, &o));
-        let trace = TRACE_HEADER + a.dims[0] * 4;
-        let mut out = fa[..3600].to_vec();
-        for t in 0..(fa.len() - 3600) / trace {
-            for (f, offset) in [(&fa, 100i32), (&fb, 300)] {
-                let mut tr = f[3600 + t * trace..][..trace].to_vec();
-                tr[36..40].copy_from_slice(&offset.to_be_bytes());
-                out.extend(tr);
-            }
+        write_prestack(&[(100, a), (300, b)], &options(SampleFormat::IeeeFloat))
+    }
+
+    #[test]
+    fn inspect_describes_a_prestack_file_and_how_a_scene_reads_it() {
+        let a = cube();
+        let mut b = cube();
+        b.values.iter_mut().for_each(|v| *v = *v * 3.0 + 1.0);
+        let dir = std::env::temp_dir().join(format!("arbvis-prestack-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("gathers.sgy");
+        std::fs::write(&path, prestack_file(&a, &b)).unwrap();
+        let g = gathers(&path, &std::fs::read(&path).unwrap()).unwrap();
+        assert!(g.is_prestack());
+        // The cube is 5 samples x 3 crosslines x 4 inlines: 12 gathers of 2 traces;
+        // values -20..=39 (a) and -59..=118 (b = 3a + 1).
+        assert_eq!((g.traces, g.gathers, g.per_gather), (24, 12, (2, 2)));
+        assert_eq!(g.offsets, [(100, 12), (300, 12)]);
+        assert_eq!((g.inlines, g.crosslines), ((1, 4), (1, 3)));
+        assert_eq!(g.range, Some((-59.0, 118.0)));
+        let s = crate::volume::inspect(&path).unwrap();
+        for want in [
+            "format: SEG-Y rev 1.0, pre-stack",
+            "traces: 24\n",
+            "gathers: 12 (inline/crossline positions, trace bytes 189-196), 2 traces each",
+            "offsets (trace bytes 37-40): 2 values: 100 (12 traces), 300 (12 traces)",
+            "samples: 5 per trace, interval 4000 us, 0..=16 ms",
+            "values: [-59, 118] over all traces",
+            "prestack = { offset = 100 }",
+            "prestack = \"stack\"",
+        ] {
+            assert!(s.contains(want), "missing {want:?} in\n{s}");
         }
-        out
+        // A post-stack file is still described as a cube.
+        std::fs::write(&path, write(&a, &options(SampleFormat::IeeeFloat))).unwrap();
+        let s = crate::volume::inspect(&path).unwrap();
+        assert!(s.contains("dimensions (i, j, k): 5 x 3 x 4"), "{s}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

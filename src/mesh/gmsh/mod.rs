@@ -21,159 +21,17 @@
 //!   Data sections store their tags as 4-byte integers in both versions.
 //! - Format 4.0, 3.0 and MSH1 are refused by name (gmsh can re-save them as 4.1).
 
-use std::collections::HashMap;
+mod data;
+mod reader;
+
 use std::path::Path;
 
+use self::data::PendingData;
+use self::reader::{Reader, TagMap};
 use super::cells::{gmsh_kind, RawCells};
 use super::read::{quote, vec_for, Cursor};
-use super::{DataArray, Mesh, MeshError, MeshInfo};
-
-struct Reader<'a> {
-    c: Cursor<'a>,
-    binary: bool,
-    big: bool,
-    size_t: usize,
-}
-
-impl Reader<'_> {
-    fn err(&self, at: usize, m: impl Into<String>) -> MeshError {
-        if self.binary {
-            self.c.err_bin(at, m)
-        } else {
-            self.c.err(at, m)
-        }
-    }
-
-    /// An integer: ASCII token, or binary of `width` bytes (signed when `width == 4`).
-    fn int(&mut self, width: usize, what: &str) -> Result<(usize, i64), MeshError> {
-        if !self.binary {
-            return self.c.parse_with::<i64>(|| what.to_string());
-        }
-        let at = self.c.pos;
-        let b = self.c.take(width, what)?;
-        let v = if width == 4 {
-            let a = [b[0], b[1], b[2], b[3]];
-            i64::from(if self.big {
-                i32::from_be_bytes(a)
-            } else {
-                i32::from_le_bytes(a)
-            })
-        } else {
-            let mut a = [0u8; 8];
-            a.copy_from_slice(b);
-            let u = if self.big {
-                u64::from_be_bytes(a)
-            } else {
-                u64::from_le_bytes(a)
-            };
-            i64::try_from(u).unwrap_or(i64::MAX)
-        };
-        Ok((at, v))
-    }
-
-    /// A non-negative count whose items need at least `min` bytes each (ASCII: `min_text`).
-    fn count(
-        &mut self,
-        width: usize,
-        what: &str,
-        min: usize,
-        min_text: usize,
-    ) -> Result<usize, MeshError> {
-        let (at, n) = self.int(width, what)?;
-        if n < 0 {
-            return Err(self.err(at, format!("{what} is negative: {n}")));
-        }
-        self.c
-            .check_fits(at, what, n as u64, if self.binary { min } else { min_text })
-    }
-
-    fn f64(&mut self, what: &str) -> Result<(usize, f64), MeshError> {
-        if !self.binary {
-            return self.c.parse_with::<f64>(|| what.to_string());
-        }
-        let at = self.c.pos;
-        let b = self.c.take(8, what)?;
-        let mut a = [0u8; 8];
-        a.copy_from_slice(b);
-        Ok((
-            at,
-            if self.big {
-                f64::from_be_bytes(a)
-            } else {
-                f64::from_le_bytes(a)
-            },
-        ))
-    }
-
-    /// The section's end line `$End<name>`.
-    fn end(&mut self, name: &str) -> Result<(), MeshError> {
-        let want = format!("$End{name}");
-        let (at, t) = self.c.need(&want)?;
-        if t != want.as_bytes() {
-            return Err(self
-                .c
-                .err(at, format!("expected {want}, found {}", quote(t))));
-        }
-        Ok(())
-    }
-}
-
-/// Tag to index: a table indexed by tag while the tags stay compact (gmsh writes 1..n),
-/// a hash map once one does not (sparse tags stay correct, only slower).
-enum TagMap {
-    Dense(Vec<u32>),
-    Sparse(HashMap<i64, u32>),
-}
-
-const NO_INDEX: u32 = u32::MAX;
-
-impl Default for TagMap {
-    fn default() -> Self {
-        TagMap::Dense(Vec::new())
-    }
-}
-
-impl TagMap {
-    /// Map `tag` to `index`; false if the tag is already there. Tags below `room` (a
-    /// bound from counts already checked against the file) may use the table.
-    fn insert(&mut self, tag: i64, index: u32, room: usize) -> bool {
-        if let TagMap::Dense(v) = self {
-            if tag >= 0 && (tag as u64) < room.max(v.len()) as u64 {
-                let t = tag as usize;
-                if t >= v.len() {
-                    v.resize(t + 1, NO_INDEX);
-                }
-                let fresh = v[t] == NO_INDEX;
-                if fresh {
-                    v[t] = index;
-                }
-                return fresh;
-            }
-            let map = v
-                .iter()
-                .enumerate()
-                .filter(|(_, &i)| i != NO_INDEX)
-                .map(|(t, &i)| (t as i64, i))
-                .collect();
-            *self = TagMap::Sparse(map);
-        }
-        match self {
-            TagMap::Sparse(m) => m.insert(tag, index).is_none(),
-            TagMap::Dense(_) => false,
-        }
-    }
-
-    fn get(&self, tag: i64) -> Option<u32> {
-        match self {
-            TagMap::Dense(v) => usize::try_from(tag)
-                .ok()
-                .and_then(|t| v.get(t))
-                .copied()
-                .filter(|&i| i != NO_INDEX),
-            TagMap::Sparse(m) => m.get(&tag).copied(),
-        }
-    }
-}
+use super::{Mesh, MeshError, MeshInfo};
+use crate::budget;
 
 #[derive(Default)]
 struct State {
@@ -183,8 +41,7 @@ struct State {
     cells: RawCells,
     cell_index: TagMap,
     cell_room: usize,
-    point_arrays: Vec<DataArray>,
-    cell_arrays: Vec<DataArray>,
+    data: Vec<PendingData>,
     have_nodes: bool,
     have_elements: bool,
 }
@@ -276,7 +133,7 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
             }
             b"$NodeData" | b"$ElementData" => {
                 let nodes = t == b"$NodeData";
-                data(&mut r, &mut st, nodes, at)?;
+                st.data.push(data::read(&mut r, nodes, at)?);
                 r.end(if nodes { "NodeData" } else { "ElementData" })?;
             }
             _ if t.first() == Some(&b'$') && !t.starts_with(b"$End") => {
@@ -321,13 +178,19 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<Mesh, MeshError> {
         ..MeshInfo::default()
     };
     st.cells.text = !binary;
+    let (point_arrays, cell_arrays) = data::resolve(
+        &r,
+        &st.data,
+        (st.points.len(), &st.node_index),
+        (st.cells.kinds.len(), &st.cell_index),
+    )?;
     Mesh::assemble(
         name,
         r.c.bytes,
         st.points,
         &st.cells,
-        st.point_arrays,
-        st.cell_arrays,
+        point_arrays,
+        cell_arrays,
         info,
     )
 }
@@ -349,9 +212,7 @@ fn add_node(r: &Reader, st: &mut State, at: usize, tag: i64, p: [f64; 3]) -> Res
 
 fn reserve_nodes(r: &Reader, st: &mut State, n: usize, at: usize) -> Result<(), MeshError> {
     st.node_room = st.node_room.saturating_add(2 * n + 1024);
-    st.points
-        .try_reserve_exact(n)
-        .map_err(|_| r.err(at, format!("cannot allocate {n} nodes")))
+    budget::reserve(&mut st.points, n, "the nodes").map_err(|e| r.err(at, e.to_string()))
 }
 
 fn nodes_v2(r: &mut Reader, st: &mut State) -> Result<(), MeshError> {
@@ -461,10 +322,10 @@ fn element(
 }
 
 fn reserve_cells(r: &Reader, st: &mut State, n: usize, at: usize) -> Result<(), MeshError> {
-    let e = |_| r.err(at, format!("cannot allocate {n} elements"));
-    st.cells.kinds.try_reserve_exact(n).map_err(e)?;
-    st.cells.at.try_reserve_exact(n).map_err(e)?;
-    st.cells.offsets.try_reserve_exact(n + 1).map_err(e)?;
+    let e = |e: budget::OverBudget| r.err(at, e.to_string());
+    budget::reserve(&mut st.cells.kinds, n, "the elements").map_err(e)?;
+    budget::reserve(&mut st.cells.at, n, "the elements' positions").map_err(e)?;
+    budget::reserve(&mut st.cells.offsets, n + 1, "the elements' offsets").map_err(e)?;
     st.cell_room = st.cell_room.saturating_add(2 * n + 1024);
     if st.cells.offsets.is_empty() {
         st.cells.offsets.push(0);
@@ -547,116 +408,5 @@ fn elements_v4(r: &mut Reader, st: &mut State) -> Result<(), MeshError> {
             format!("the element blocks hold {total} elements, but {n} were announced"),
         ));
     }
-    Ok(())
-}
-
-/// `$NodeData` / `$ElementData`: string, real and integer tags, then `tag value...` rows.
-fn data(r: &mut Reader, st: &mut State, nodes: bool, at: usize) -> Result<(), MeshError> {
-    let (sat, ns) = r.c.parse::<i64>("the number of string tags")?;
-    if !(0..=1024).contains(&ns) {
-        return Err(r.c.err(sat, format!("{ns} string tags")));
-    }
-    r.c.end_line()?;
-    let mut name = None;
-    for _ in 0..ns {
-        let (_, l) = r.c.line();
-        let s = String::from_utf8_lossy(l.trim_ascii())
-            .trim_matches('"')
-            .to_string();
-        name.get_or_insert(s);
-    }
-    let (rat, nr) = r.c.parse::<i64>("the number of real tags")?;
-    if !(0..=1024).contains(&nr) {
-        return Err(r.c.err(rat, format!("{nr} real tags")));
-    }
-    for _ in 0..nr {
-        r.c.parse::<f64>("a real tag")?;
-    }
-    let (iat, ni) = r.c.parse::<i64>("the number of integer tags")?;
-    if !(3..=1024).contains(&ni) {
-        return Err(r.c.err(
-            iat,
-            format!(
-                "expected at least 3 integer tags (time step, components, entries), found {ni}"
-            ),
-        ));
-    }
-    let mut ints = Vec::new();
-    for _ in 0..ni {
-        ints.push(r.c.parse::<i64>("an integer tag")?);
-    }
-    let (kat, k) = ints[1];
-    let (eat, entries) = ints[2];
-    if !(1..=9).contains(&k) {
-        return Err(r
-            .c
-            .err(kat, format!("{k} components per entry (expected 1 to 9)")));
-    }
-    let count = if nodes {
-        st.points.len()
-    } else {
-        st.cells.kinds.len()
-    };
-    if entries < 0 || entries as usize > count {
-        return Err(r.c.err(
-            eat,
-            format!(
-                "{entries} entries for {count} {}",
-                if nodes { "nodes" } else { "elements" }
-            ),
-        ));
-    }
-    let k = k as usize;
-    let per = if r.binary { 4 + 8 * k } else { 2 * (k + 1) };
-    let entries =
-        r.c.check_fits(eat, "the data entries", entries as u64, per)?;
-    if r.binary {
-        r.c.end_line()?;
-    }
-    let mut values = vec_for(count * k, "data values").map_err(|m| r.c.err(at, m))?;
-    values.resize(count * k, f64::NAN);
-    for _ in 0..entries {
-        let (tat, tag) = r.int(4, "an entry's tag")?;
-        let map = if nodes {
-            &st.node_index
-        } else {
-            &st.cell_index
-        };
-        let i = map.get(tag).ok_or_else(|| {
-            r.err(
-                tat,
-                format!(
-                    "data entry for {} {tag}, which does not exist",
-                    if nodes { "node" } else { "element" }
-                ),
-            )
-        })? as usize;
-        for j in 0..k {
-            values[i * k + j] = r.f64("a data value")?.1;
-        }
-    }
-    let list = if nodes {
-        &mut st.point_arrays
-    } else {
-        &mut st.cell_arrays
-    };
-    let base = name.unwrap_or_else(|| {
-        if nodes {
-            "NodeData".into()
-        } else {
-            "ElementData".into()
-        }
-    });
-    let mut unique = base.clone();
-    let mut n = 1;
-    while list.iter().any(|a| a.name == unique) {
-        n += 1;
-        unique = format!("{base} #{n}");
-    }
-    list.push(DataArray {
-        name: unique,
-        components: k,
-        values,
-    });
     Ok(())
 }

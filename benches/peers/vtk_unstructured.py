@@ -1,0 +1,234 @@
+#!/usr/bin/env python3
+"""VTK's unstructured-grid volume mappers as peers of arbvis's cell-projection volume.
+
+    pip install vtk numpy
+    cargo build --release --no-default-features
+    python3 benches/peers/vtk_unstructured.py scenes/bench/cellproj-seed-volume.toml \\
+        --cellproj centroid:64,mpvonc:64,mpvonc:128,precise --rounds 3
+
+1. `arbvis bench SCENE --cellproj ... --score --export DIR` prepares the mesh, computes the
+   f64 reference and writes what VTK needs (src/study/export.rs, write_cellproj): the
+   mesh's points in arbvis's object box (f64), its tetrahedra, the normalized point
+   scalars, the transfer function's control points, the unit distance in those units, the
+   camera (position, focal point, view up, parallel scale or view angle), size and
+   background, and the reference's RGB.
+2. VTK gets the same vtkUnstructuredGrid (VTK_TETRA cells, the scalars as point data), a
+   vtkColorTransferFunction and vtkPiecewiseFunction with one point per control point
+   (the same piecewise-linear function), SetScalarOpacityUnitDistance(unit) (VTK's
+   unstructured mappers read the opacity value as attenuation per unit distance, as arbvis
+   does), no shading, the same camera, size and background, and renders with
+   vtkProjectedTetrahedraMapper (ParaView's default for unstructured volumes),
+   vtkUnstructuredGridVolumeRayCastMapper and vtkUnstructuredGridVolumeZSweepMapper.
+3. Every system is scored as RGB against the one reference (RMSE and the largest channel
+   difference over every pixel) and timed per frame (VTK: Render then WaitForCompletion;
+   arbvis: clear + draw + glFinish), first frame apart, arbvis and VTK alternating round
+   by round. VTK's pictures are saved as PNG beside the export (ppm when no PIL).
+4. It prints, for each VTK mapper, the fastest arbvis setting with equal or lower RMSE and
+   the ratio of their median frame times.
+
+Offscreen through EGL (VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow, the same Mesa path as
+arbvis).
+"""
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+
+import numpy as np  # noqa: E402
+import vtk  # noqa: E402
+from vtk.util import numpy_support  # noqa: E402
+
+MAPPERS = {
+    "projected-tetrahedra": "vtkProjectedTetrahedraMapper",
+    "ray-cast": "vtkUnstructuredGridVolumeRayCastMapper",
+    "zsweep": "vtkUnstructuredGridVolumeZSweepMapper",
+}
+
+
+def arbvis_bench(args, score):
+    cmd = [args.arbvis, "bench", args.scene, "--json", "--frames", str(args.frames),
+           "--cellproj", args.cellproj, "--export", args.export]
+    if args.size:
+        cmd += ["--size", args.size]
+    if score:
+        cmd.append("--score")
+    out = subprocess.run(cmd, check=True, capture_output=True, text=True)
+    return json.loads(out.stdout)
+
+
+def load_export(folder):
+    with open(os.path.join(folder, "scene.json")) as f:
+        scene = json.load(f)
+    w, h = scene["size"]
+    ref = np.fromfile(os.path.join(folder, scene["reference"]), dtype="<f4")
+    if ref.size != w * h * 3:
+        sys.exit(f"{folder}: reference holds {ref.size} floats, expected {w * h * 3}")
+    return scene, ref.reshape(h, w, 3)
+
+
+def unstructured_grid(scene, folder):
+    pts = np.fromfile(os.path.join(folder, scene["points_file"]), dtype="<f8").reshape(-1, 3)
+    tets = np.fromfile(os.path.join(folder, scene["tets_file"]), dtype="<u4").reshape(-1, 4)
+    s = np.fromfile(os.path.join(folder, scene["scalars_file"]), dtype="<f8")
+    ug = vtk.vtkUnstructuredGrid()
+    p = vtk.vtkPoints()
+    p.SetData(numpy_support.numpy_to_vtk(pts, deep=True))
+    ug.SetPoints(p)
+    offsets = np.arange(0, 4 * len(tets) + 1, 4, dtype=np.int64)
+    ca = vtk.vtkCellArray()
+    ca.SetData(numpy_support.numpy_to_vtkIdTypeArray(offsets, deep=True),
+               numpy_support.numpy_to_vtkIdTypeArray(tets.astype(np.int64).ravel(), deep=True))
+    ug.SetCells(vtk.VTK_TETRA, ca)
+    arr = numpy_support.numpy_to_vtk(s.astype(np.float32), deep=True)
+    arr.SetName("scalars")
+    ug.GetPointData().SetScalars(arr)
+    return ug
+
+
+class VtkPeer:
+    def __init__(self, scene, folder, mapper_name):
+        self.scene = scene
+        ug = unstructured_grid(scene, folder)
+        colour = vtk.vtkColorTransferFunction()
+        opacity = vtk.vtkPiecewiseFunction()
+        for s, r, g, b, a in scene["transfer"]:
+            colour.AddRGBPoint(s, r, g, b)
+            opacity.AddPoint(s, a)
+        prop = vtk.vtkVolumeProperty()
+        prop.SetColor(colour)
+        prop.SetScalarOpacity(opacity)
+        prop.SetScalarOpacityUnitDistance(scene["unit_distance"])
+        prop.ShadeOff()
+        prop.SetInterpolationTypeToLinear()
+        self.mapper = getattr(vtk, MAPPERS[mapper_name])()
+        self.mapper.SetInputData(ug)
+        volume = vtk.vtkVolume()
+        volume.SetMapper(self.mapper)
+        volume.SetProperty(prop)
+        renderer = vtk.vtkRenderer()
+        renderer.AddVolume(volume)
+        renderer.SetBackground(*scene["background"][:3])
+        cam = renderer.GetActiveCamera()
+        c = scene["camera"]
+        cam.SetFocalPoint(*c["focal_point"])
+        cam.SetPosition(*c["position"])
+        cam.SetViewUp(*c["view_up"])
+        distance = float(np.linalg.norm(c["position"]))
+        if c["projection"] == "orthographic":
+            cam.ParallelProjectionOn()
+            cam.SetParallelScale(c["parallel_scale"])
+        else:
+            cam.ParallelProjectionOff()
+            cam.SetViewAngle(c["view_angle"])
+        cam.SetClippingRange(max(distance - 2.0, 1e-3), distance + 2.0)
+        window = vtk.vtkRenderWindow()
+        window.SetOffScreenRendering(1)
+        window.SetSize(*scene["size"])
+        window.AddRenderer(renderer)
+        self.window = window
+
+    def frame(self):
+        t0 = time.perf_counter()
+        self.window.Render()
+        self.window.WaitForCompletion()
+        return (time.perf_counter() - t0) * 1e3
+
+    def rgb(self):
+        grab = vtk.vtkWindowToImageFilter()
+        grab.SetInput(self.window)
+        grab.SetInputBufferTypeToRGB()
+        grab.ReadFrontBufferOff()
+        grab.Update()
+        out = grab.GetOutput()
+        w, h, _ = out.GetDimensions()
+        pixels = numpy_support.vtk_to_numpy(out.GetPointData().GetScalars())
+        return pixels.reshape(h, w, 3)[::-1].astype(np.float64) / 255.0
+
+
+def rgb_error(image, reference):
+    d = image - reference
+    return float(np.abs(d).max()), float(np.sqrt(np.mean(d * d)))
+
+
+def save_ppm(path, rgb):
+    h, w, _ = rgb.shape
+    with open(path, "wb") as f:
+        f.write(f"P6 {w} {h} 255\n".encode())
+        f.write((np.clip(rgb, 0, 1) * 255 + 0.5).astype(np.uint8).tobytes())
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    root = os.path.abspath(os.path.join(here, "..", ".."))
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("scene")
+    p.add_argument("--arbvis", default=os.path.join(root, "target", "release", "arbvis"))
+    p.add_argument("--export", default=None)
+    p.add_argument("--cellproj", default="centroid:64,mpvonc:64,mpvonc:128,precise")
+    p.add_argument("--mappers", default="projected-tetrahedra,ray-cast,zsweep")
+    p.add_argument("--frames", type=int, default=3)
+    p.add_argument("--rounds", type=int, default=3)
+    p.add_argument("--size", default=None)
+    p.add_argument("--json", default=None)
+    args = p.parse_args()
+    name = os.path.splitext(os.path.basename(args.scene))[0]
+    args.export = args.export or os.path.join(root, "target", f"peer-{name}")
+    scored = arbvis_bench(args, score=True)
+    scene, reference = load_export(args.export)
+    print(f"arbvis: {scored['renderer']}, {scene['size']}, {scene['tets']} tetrahedra; "
+          f"VTK {vtk.vtkVersion.GetVTKVersion()}", flush=True)
+    arb = {m["name"]: {"rmse": m["rmse"], "max_abs": m["max_abs"], "frames_ms": []}
+           for m in scored["settings"]}
+    peers = {}
+    for m in [x for x in args.mappers.split(",") if x]:
+        peer = VtkPeer(scene, args.export, m)
+        first = peer.frame()
+        image = peer.rgb()
+        err = rgb_error(image, reference)
+        save_ppm(os.path.join(args.export, f"vtk-{m}.ppm"), image)
+        peers[m] = {"peer": peer, "first_ms": first, "max_abs": err[0], "rmse": err[1],
+                    "frames_ms": []}
+        print(f"VTK {m}: first {first:.0f} ms, RMSE {err[1]:.5f}, max {err[0]:.3f}", flush=True)
+    for r in range(args.rounds):
+        report = arbvis_bench(args, score=False)
+        for m in report["settings"]:
+            arb[m["name"]]["frames_ms"] += m["frames_ms"]
+        for m, v in peers.items():
+            v["frames_ms"] += [v["peer"].frame() for _ in range(args.frames)]
+        print(f"round {r + 1} of {args.rounds} done", flush=True)
+    print("\n| system, setting | ms/frame (median) | RMSE | max |\n|---|---|---|---|")
+    for n, v in arb.items():
+        print(f"| arbvis {n} | {statistics.median(v['frames_ms']):.1f} | {v['rmse']:.5f} "
+              f"| {v['max_abs']:.3f} |")
+    for m, v in peers.items():
+        print(f"| VTK {MAPPERS[m]} | {statistics.median(v['frames_ms']):.1f} | {v['rmse']:.5f} "
+              f"| {v['max_abs']:.3f} |")
+    print("\n| VTK mapper | VTK ms | RMSE | fastest arbvis at equal or lower RMSE | ms | RMSE "
+          "| speed-up |\n|---|---|---|---|---|---|---|")
+    for m, v in peers.items():
+        vt = statistics.median(v["frames_ms"])
+        fit = [(statistics.median(a["frames_ms"]), n, a["rmse"]) for n, a in arb.items()
+               if a["rmse"] is not None and a["rmse"] <= v["rmse"]]
+        if fit:
+            at, an, ae = min(fit)
+            print(f"| {MAPPERS[m]} | {vt:.1f} | {v['rmse']:.5f} | {an} | {at:.1f} | {ae:.5f} "
+                  f"| {vt / at:.2f}x |")
+        else:
+            print(f"| {MAPPERS[m]} | {vt:.1f} | {v['rmse']:.5f} | none | - | - | - |")
+    if args.json:
+        out = {"arbvis": scored, "arbvis_frames": arb,
+               "vtk": [{"mapper": m, "first_ms": v["first_ms"], "frames_ms": v["frames_ms"],
+                        "rmse": v["rmse"], "max_abs": v["max_abs"]} for m, v in peers.items()],
+               "vtk_version": vtk.vtkVersion.GetVTKVersion()}
+        with open(args.json, "w") as f:
+            json.dump(out, f, indent=1)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,809 @@
+//! `arbvis convert SURVEY STORE`: a survey (SEG-Y, NIfTI-1, raw) to a store.
+//!
+//! # How it works
+//! 1. Level 0 in columns: the survey is cut into columns of `B x B` traces (every sample
+//!    of `B` crosslines and `B` inlines); each column is read ([`super::input`]), its
+//!    derived attributes computed trace by trace (one analytic signal per trace gives
+//!    envelope, phase and frequency, [`crate::volume::attributes::derive_trace`]), cut
+//!    into its `ceil(samples / B)` bricks, and each brick written as a zarr chunk of
+//!    every attribute. Columns run in parallel (rayon, one per core).
+//! 2. Levels 1, 2, ...: each brick of level `L` is filtered from the (up to) eight bricks
+//!    of level `L - 1` below it, read back from the store; again in columns, in parallel.
+//! 3. The per-brick ranges and each attribute's statistics are written, and the group's
+//!    `complete` flag set.
+//!
+//! # Resuming
+//! Every finished column appends one line to `STORE/arbvis-progress.log` (after its
+//! chunks are written and synced) with its bricks' ranges and its statistics; the first
+//! line describes the job (the input's path, length and modification time, and the
+//! options). Running the same command again skips the columns the log lists and redoes
+//! any other (a chunk half-written when the process died is written again); another
+//! input or other options are refused. The log is removed when the store is complete.
+//!
+//! # Memory
+//! Each worker holds one column: `samples x B² x (1 + derived attributes)` f32 plus the
+//! transform's f64 buffers (`samples x 48` bytes) and one brick per attribute while
+//! encoding; a level brick reads eight chunks. With `W` workers the conversion holds about
+//! `W x samples x B² x 4 x (attributes + 1)` bytes, whatever the number of traces
+//! ([`memory_bound`]); the reader's chunk cache adds 64 chunks. The bound is checked
+//! against the memory budget before anything is written.
+
+use std::collections::{BTreeMap, HashMap};
+use std::fs::{File, OpenOptions};
+use std::io::{BufRead, BufReader, Write};
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+use rayon::prelude::*;
+use rustfft::FftPlanner;
+use serde::{Deserialize, Serialize};
+use zarrs::array::codec::ZstdCodec;
+use zarrs::array::{data_type, Array, ArrayBuilder, CodecOptions};
+use zarrs::filesystem::FilesystemStore;
+use zarrs::group::GroupBuilder;
+
+use super::input::Input;
+use super::meta::{AttributeMeta, StoreMeta, FORMAT, VERSION};
+use super::reader::Store;
+use super::StoreError;
+use crate::volume::attributes::{derive_trace, Attribute};
+use crate::volume::raw::RawSpec;
+
+/// The progress log's name inside the store.
+pub const PROGRESS_LOG: &str = "arbvis-progress.log";
+
+/// How to convert.
+#[derive(Debug, Clone)]
+pub struct ConvertOptions {
+    /// Brick side in voxels (the chunk shape).
+    pub brick: usize,
+    /// Derived attributes to compute (amplitude is always stored).
+    pub derived: Vec<Attribute>,
+    /// zstd level (0: no compression).
+    pub zstd: i32,
+    /// A raw input's description.
+    pub raw: Option<RawSpec>,
+    /// Draw a progress bar (when stderr is a terminal).
+    pub progress: bool,
+    /// For tests: stop with [`StoreError::Interrupted`] once this many columns are done
+    /// in this run, as a killed process would.
+    pub stop_after: Option<usize>,
+}
+
+impl Default for ConvertOptions {
+    fn default() -> Self {
+        ConvertOptions {
+            brick: 64,
+            derived: vec![Attribute::Envelope, Attribute::Phase, Attribute::Frequency],
+            zstd: 1,
+            raw: None,
+            progress: true,
+            stop_after: None,
+        }
+    }
+}
+
+/// What a conversion did.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ConvertReport {
+    /// Columns written in this run (all levels).
+    pub written: usize,
+    /// Columns found done by an earlier run.
+    pub resumed: usize,
+    /// Bytes of the input read.
+    pub bytes_read: u64,
+    /// Seconds.
+    pub seconds: f64,
+    /// The store's description.
+    pub meta: StoreMeta,
+}
+
+/// Bytes the conversion holds at once with `workers` workers (see the module doc).
+pub fn memory_bound(samples: usize, brick: usize, attributes: usize, workers: usize) -> u64 {
+    let column = samples as u64 * (brick * brick) as u64 * 4 * (attributes as u64 + 1);
+    let fft = samples as u64 * 48;
+    let cache = super::reader::CHUNK_CACHE as u64 * (brick as u64).pow(3) * 4;
+    workers as u64 * (column + fft + 9 * (brick as u64).pow(3) * 4) + cache
+}
+
+/// The zarr data type name of an attribute: float32 for amplitude and envelope (any
+/// range), float16 for the bounded ones (phase within ±180, frequency within ±0.5,
+/// cosine within ±1).
+pub fn dtype(a: Attribute) -> &'static str {
+    match a {
+        Attribute::Amplitude | Attribute::Envelope => "float32",
+        _ => "float16",
+    }
+}
+
+/// The job, as the progress log's first line (a resumed run must match it).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct Job {
+    input: String,
+    bytes: u64,
+    modified: u64,
+    brick: usize,
+    attributes: Vec<String>,
+    zstd: i32,
+    raw: Option<String>,
+}
+
+/// One finished column: `u` = `[level, j brick, k brick]`; per attribute, the ranges of
+/// its bricks along i and `[sum, finite count, non-finite count]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Unit {
+    u: [usize; 3],
+    ranges: Vec<Vec<[f32; 2]>>,
+    sums: Vec<[f64; 3]>,
+}
+
+struct Log {
+    file: Mutex<File>,
+}
+
+fn job_of(input: &Path, o: &ConvertOptions, attributes: &[Attribute]) -> Result<Job, StoreError> {
+    let m = std::fs::metadata(input).map_err(|e| StoreError::io(input, e))?;
+    let modified = m
+        .modified()
+        .ok()
+        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+        .map_or(0, |d| d.as_secs());
+    let input = std::fs::canonicalize(input).unwrap_or_else(|_| input.to_path_buf());
+    Ok(Job {
+        input: input.display().to_string(),
+        bytes: m.len(),
+        modified,
+        brick: o.brick,
+        attributes: attributes.iter().map(|a| a.name().to_string()).collect(),
+        zstd: o.zstd,
+        raw: o.raw.as_ref().map(|r| format!("{r:?}")),
+    })
+}
+
+/// Convert `input` into a new store at `store`, or resume an interrupted conversion there.
+pub fn convert(
+    input: &Path,
+    store: &Path,
+    o: &ConvertOptions,
+) -> Result<ConvertReport, StoreError> {
+    let start = Instant::now();
+    if !(2..=512).contains(&o.brick) {
+        return Err(StoreError::invalid(
+            store,
+            format!("brick {}: must be 2..=512 voxels", o.brick),
+        ));
+    }
+    let mut attributes = vec![Attribute::Amplitude];
+    for &a in &o.derived {
+        if !attributes.contains(&a) {
+            attributes.push(a);
+        }
+    }
+    let src = Input::open(input, o.raw.as_ref())?;
+    let dims = src.dims();
+    let b = o.brick;
+    let levels = super::level_count(dims, b);
+    let job = job_of(input, o, &attributes)?;
+    let workers = rayon::current_num_threads().max(1);
+    let bound = memory_bound(dims[0], b, attributes.len(), workers);
+    crate::budget::check(
+        format!(
+            "converting {} ({} samples per trace, {b}³ bricks, {} attributes, {workers} workers)",
+            input.display(),
+            dims[0],
+            attributes.len()
+        ),
+        bound,
+    )
+    .map_err(|e| StoreError::Budget(e.to_string()))?;
+    let log_path = store.join(PROGRESS_LOG);
+    let mut done: HashMap<[usize; 3], Unit> = HashMap::new();
+    let meta = StoreMeta {
+        format: FORMAT.into(),
+        version: VERSION,
+        dims,
+        spacing: src.spacing(),
+        brick: b,
+        levels,
+        filter: "box: the mean of each 2x2x2 cell (of the voxels present at a far face of odd size); phase: the cell's first voxel".into(),
+        attributes: attributes
+            .iter()
+            .map(|&a| AttributeMeta {
+                name: a.name().into(),
+                dtype: dtype(a).into(),
+                min: None,
+                max: None,
+                mean: None,
+                non_finite: 0,
+            })
+            .collect(),
+        source: src.source_meta(),
+        compression: if o.zstd > 0 {
+            format!("zstd level {}", o.zstd)
+        } else {
+            "none".into()
+        },
+        complete: false,
+    };
+    let storage = if log_path.is_file() {
+        done = read_log(&log_path, &job)?;
+        Arc::new(FilesystemStore::new(store).map_err(|e| StoreError::io(store, e))?)
+    } else {
+        if store.exists() {
+            let empty = std::fs::read_dir(store)
+                .map(|mut d| d.next().is_none())
+                .unwrap_or(false);
+            if !empty {
+                return Err(StoreError::invalid(
+                    store,
+                    "already exists and holds no interrupted conversion: name a new store (arbvis never overwrites one)",
+                ));
+            }
+        }
+        std::fs::create_dir_all(store).map_err(|e| StoreError::io(store, e))?;
+        let storage = Arc::new(FilesystemStore::new(store).map_err(|e| StoreError::io(store, e))?);
+        create_arrays(&storage, store, &meta, o)?;
+        let mut f = File::create(&log_path).map_err(|e| StoreError::io(&log_path, e))?;
+        let line = serde_json::to_string(&job).map_err(|e| StoreError::io(&log_path, e))?;
+        writeln!(f, "{line}")
+            .and_then(|_| f.sync_all())
+            .map_err(|e| StoreError::io(&log_path, e))?;
+        storage
+    };
+    let log = Log {
+        file: Mutex::new(
+            OpenOptions::new()
+                .append(true)
+                .open(&log_path)
+                .map_err(|e| StoreError::io(&log_path, e))?,
+        ),
+    };
+    let resumed = done.len();
+    let arrays = open_arrays(&storage, store, &meta)?;
+    let ctx = Ctx {
+        store,
+        meta: &meta,
+        arrays: &arrays,
+        attributes: &attributes,
+        log: &log,
+        log_path: &log_path,
+        written: AtomicUsize::new(0),
+        stop_after: o.stop_after,
+        bytes: AtomicU64::new(0),
+    };
+    // Level 0 from the input.
+    let counts = meta.brick_counts(0);
+    let units: Vec<[usize; 3]> = (0..counts[2])
+        .flat_map(|k| (0..counts[1]).map(move |j| [0, j, k]))
+        .filter(|u| !done.contains_key(u))
+        .collect();
+    let bar = progress_bar(
+        o.progress,
+        (units.len() * b * b) as u64 * src.bytes_per_trace(),
+        &format!("converting {} (level 0)", input.display()),
+    );
+    let new: Vec<Unit> = units
+        .par_iter()
+        .map(|&u| {
+            let unit = ctx.level0(&src, u)?;
+            if let Some(bar) = &bar {
+                bar.inc((b * b) as u64 * src.bytes_per_trace());
+            }
+            ctx.finish(unit)
+        })
+        .collect::<Result<_, _>>()?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    done.extend(new.into_iter().map(|u| (u.u, u)));
+    // Levels above, each from the one below (read back through a reader).
+    let reader = Store::open_incomplete(store, meta.clone())?;
+    for level in 1..levels {
+        let counts = meta.brick_counts(level);
+        let units: Vec<[usize; 3]> = (0..counts[2])
+            .flat_map(|k| (0..counts[1]).map(move |j| [level, j, k]))
+            .filter(|u| !done.contains_key(u))
+            .collect();
+        let new: Vec<Unit> = units
+            .par_iter()
+            .map(|&u| {
+                let unit = ctx.upper(&reader, u)?;
+                ctx.finish(unit)
+            })
+            .collect::<Result<_, _>>()?;
+        done.extend(new.into_iter().map(|u| (u.u, u)));
+    }
+    let meta = finish_store(&storage, store, meta.clone(), &done)?;
+    std::fs::remove_file(&log_path).map_err(|e| StoreError::io(&log_path, e))?;
+    Ok(ConvertReport {
+        written: ctx.written.load(Ordering::Relaxed),
+        resumed,
+        bytes_read: ctx.bytes.load(Ordering::Relaxed),
+        seconds: start.elapsed().as_secs_f64(),
+        meta,
+    })
+}
+
+fn read_log(path: &Path, job: &Job) -> Result<HashMap<[usize; 3], Unit>, StoreError> {
+    let f = File::open(path).map_err(|e| StoreError::io(path, e))?;
+    let mut lines = BufReader::new(f).lines();
+    let first = lines
+        .next()
+        .transpose()
+        .map_err(|e| StoreError::io(path, e))?
+        .unwrap_or_default();
+    let was: Job = serde_json::from_str(&first).map_err(|e| {
+        StoreError::invalid(path, format!("line 1 is not the job's description: {e}"))
+    })?;
+    if &was != job {
+        return Err(StoreError::invalid(
+            path,
+            format!(
+                "the interrupted conversion here was of {} ({} bytes, brick {}, attributes {}, zstd {}); this one is of {} ({} bytes, brick {}, attributes {}, zstd {}): run the same command to resume, or name a new store",
+                was.input, was.bytes, was.brick, was.attributes.join(","), was.zstd,
+                job.input, job.bytes, job.brick, job.attributes.join(","), job.zstd
+            ),
+        ));
+    }
+    let mut done = HashMap::new();
+    let all: Vec<String> = lines
+        .collect::<Result<_, _>>()
+        .map_err(|e| StoreError::io(path, e))?;
+    for (n, line) in all.iter().enumerate() {
+        match serde_json::from_str::<Unit>(line) {
+            Ok(u) => {
+                done.insert(u.u, u);
+            }
+            // A line torn by the interruption: its column is done again.
+            Err(_) if n + 1 == all.len() => {}
+            Err(e) => return Err(StoreError::invalid(path, format!("line {}: {e}", n + 2))),
+        }
+    }
+    Ok(done)
+}
+
+fn create_arrays(
+    storage: &Arc<FilesystemStore>,
+    store: &Path,
+    meta: &StoreMeta,
+    o: &ConvertOptions,
+) -> Result<(), StoreError> {
+    let mut group = GroupBuilder::new()
+        .build(storage.clone(), "/")
+        .map_err(|e| StoreError::io(store, e))?;
+    group.attributes_mut().insert(
+        "arbvis".into(),
+        serde_json::to_value(meta).map_err(|e| StoreError::io(store, e))?,
+    );
+    group
+        .store_metadata()
+        .map_err(|e| StoreError::io(store, e))?;
+    let b = meta.brick as u64;
+    for (a, am) in meta.attributes.iter().enumerate() {
+        let g = GroupBuilder::new()
+            .build(storage.clone(), &format!("/{}", am.name))
+            .map_err(|e| StoreError::io(store, e))?;
+        g.store_metadata().map_err(|e| StoreError::io(store, e))?;
+        let g = GroupBuilder::new()
+            .build(storage.clone(), &format!("/{}/range", am.name))
+            .map_err(|e| StoreError::io(store, e))?;
+        g.store_metadata().map_err(|e| StoreError::io(store, e))?;
+        for level in 0..meta.levels {
+            let d = meta.level_dims(level);
+            let shape = vec![d[2] as u64, d[1] as u64, d[0] as u64];
+            let mut builder = if am.dtype == "float16" {
+                ArrayBuilder::new(shape, vec![b; 3], data_type::float16(), half::f16::ZERO)
+            } else {
+                ArrayBuilder::new(shape, vec![b; 3], data_type::float32(), 0.0f32)
+            };
+            if o.zstd > 0 {
+                builder.bytes_to_bytes_codecs(vec![Arc::new(ZstdCodec::new(o.zstd, false))]);
+            }
+            builder.dimension_names(Some(["inline", "crossline", "sample"]));
+            let p = Store::array_path(meta, a, level);
+            let array = builder
+                .build(storage.clone(), &p)
+                .map_err(|e| StoreError::io(store, e))?;
+            array
+                .store_metadata()
+                .map_err(|e| StoreError::io(store, e))?;
+            let c = meta.brick_counts(level);
+            let rshape = vec![c[2] as u64, c[1] as u64, c[0] as u64, 2];
+            let mut rb = ArrayBuilder::new(rshape.clone(), rshape, data_type::float32(), f32::NAN);
+            rb.dimension_names(Some([
+                "inline_brick",
+                "crossline_brick",
+                "sample_brick",
+                "min_max",
+            ]));
+            let r = rb
+                .build(storage.clone(), &Store::range_path(meta, a, level))
+                .map_err(|e| StoreError::io(store, e))?;
+            r.store_metadata().map_err(|e| StoreError::io(store, e))?;
+        }
+    }
+    Ok(())
+}
+
+type Arrays = Vec<Vec<Array<FilesystemStore>>>;
+
+fn open_arrays(
+    storage: &Arc<FilesystemStore>,
+    store: &Path,
+    meta: &StoreMeta,
+) -> Result<Arrays, StoreError> {
+    (0..meta.attributes.len())
+        .map(|a| {
+            (0..meta.levels)
+                .map(|l| {
+                    let p = Store::array_path(meta, a, l);
+                    Array::open(storage.clone(), &p).map_err(|e| {
+                        StoreError::invalid(&store.join(&p[1..]), format!("cannot open: {e}"))
+                    })
+                })
+                .collect()
+        })
+        .collect()
+}
+
+struct Ctx<'a> {
+    store: &'a Path,
+    meta: &'a StoreMeta,
+    arrays: &'a Arrays,
+    attributes: &'a [Attribute],
+    log: &'a Log,
+    log_path: &'a Path,
+    written: AtomicUsize,
+    stop_after: Option<usize>,
+    bytes: AtomicU64,
+}
+
+/// Range and sums of a brick's finite values.
+fn brick_stats(values: impl Iterator<Item = f32>) -> ([f32; 2], [f64; 3]) {
+    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
+    let (mut sum, mut n, mut bad) = (0.0f64, 0.0f64, 0.0f64);
+    for v in values {
+        if v.is_finite() {
+            lo = lo.min(v);
+            hi = hi.max(v);
+            sum += v as f64;
+            n += 1.0;
+        } else {
+            bad += 1.0;
+        }
+    }
+    if lo > hi {
+        (lo, hi) = (f32::NAN, f32::NAN);
+    }
+    ([lo, hi], [sum, n, bad])
+}
+
+impl Ctx<'_> {
+    fn store_chunk(
+        &self,
+        attr: usize,
+        level: usize,
+        c: [usize; 3],
+        values: &[f32],
+    ) -> Result<(), StoreError> {
+        let array = &self.arrays[attr][level];
+        let index = [c[2] as u64, c[1] as u64, c[0] as u64];
+        let options = CodecOptions::default().with_store_empty_chunks(true);
+        let result = if self.meta.attributes[attr].dtype == "float16" {
+            let h: Vec<half::f16> = values.iter().map(|&v| half::f16::from_f32(v)).collect();
+            array.store_chunk_opt(&index, h.as_slice(), &options)
+        } else {
+            array.store_chunk_opt(&index, values, &options)
+        };
+        result.map_err(|e| StoreError::Chunk {
+            path: self.store.join(format!(
+                "{}/c/{}/{}/{}",
+                &Store::array_path(self.meta, attr, level)[1..],
+                c[2],
+                c[1],
+                c[0]
+            )),
+            array: Store::array_path(self.meta, attr, level)[1..].to_string(),
+            chunk: index,
+            message: format!("cannot be written: {e}"),
+        })
+    }
+
+    /// Values as the store will hold them (float16 attributes rounded), so that ranges
+    /// and statistics are the stored values'.
+    fn round_to_stored(&self, attr: usize, values: &mut [f32]) {
+        if self.meta.attributes[attr].dtype == "float16" {
+            values
+                .iter_mut()
+                .for_each(|v| *v = half::f16::from_f32(*v).to_f32());
+        }
+    }
+
+    /// Log a finished column, or stop as the tests' interruption asks (decided under the
+    /// log's lock, so exactly `stop_after` columns are logged).
+    fn finish(&self, unit: Unit) -> Result<Unit, StoreError> {
+        let line = serde_json::to_string(&unit).map_err(|e| StoreError::io(self.log_path, e))?;
+        let mut f = self.log.file.lock().expect("progress log");
+        if let Some(limit) = self.stop_after {
+            if self.written.load(Ordering::SeqCst) >= limit {
+                return Err(StoreError::Interrupted(format!(
+                    "{}: conversion stopped after {limit} columns (run it again to resume)",
+                    self.store.display()
+                )));
+            }
+        }
+        f.write_all(line.as_bytes())
+            .and_then(|_| f.write_all(b"\n"))
+            .and_then(|_| f.sync_data())
+            .map_err(|e| StoreError::io(self.log_path, e))?;
+        self.written.fetch_add(1, Ordering::SeqCst);
+        Ok(unit)
+    }
+
+    /// One level-0 column: read, derive, cut, write.
+    fn level0(&self, src: &Input, u: [usize; 3]) -> Result<Unit, StoreError> {
+        let b = self.meta.brick;
+        let [ni, nj, nk] = self.meta.dims;
+        let (j0, k0) = (u[1] * b, u[2] * b);
+        let (j1, k1) = ((j0 + b).min(nj), (k0 + b).min(nk));
+        let traces = (j1 - j0) * (k1 - k0);
+        let mut column = vec![0f32; ni * traces];
+        src.read_column(j0..j1, k0..k1, &mut column)?;
+        self.bytes
+            .fetch_add(traces as u64 * src.bytes_per_trace(), Ordering::Relaxed);
+        let mut planes: Vec<Vec<f32>> = vec![column];
+        let derived: Vec<Attribute> = self.attributes[1..].to_vec();
+        if !derived.is_empty() {
+            let mut outs: Vec<Vec<f32>> = derived.iter().map(|_| vec![0f32; ni * traces]).collect();
+            let mut planner = FftPlanner::new();
+            for t in 0..traces {
+                let src = &planes[0][t * ni..(t + 1) * ni];
+                let mut slices: Vec<(Attribute, &mut [f32])> = derived
+                    .iter()
+                    .zip(outs.iter_mut())
+                    .map(|(&a, o)| (a, &mut o[t * ni..(t + 1) * ni]))
+                    .collect();
+                derive_trace(src, &mut planner, &mut slices);
+            }
+            planes.extend(outs);
+        }
+        for (a, plane) in planes.iter_mut().enumerate() {
+            self.round_to_stored(a, plane);
+        }
+        let bricks_i = ni.div_ceil(b);
+        let mut ranges = vec![Vec::with_capacity(bricks_i); planes.len()];
+        let mut sums = vec![[0.0f64; 3]; planes.len()];
+        let mut chunk = vec![0f32; b * b * b];
+        let (nj_c, nk_c) = (j1 - j0, k1 - k0);
+        for (a, plane) in planes.iter().enumerate() {
+            for bi in 0..bricks_i {
+                let (i0, i1) = (bi * b, ((bi + 1) * b).min(ni));
+                chunk.iter_mut().for_each(|v| *v = 0.0);
+                for z in 0..nk_c {
+                    for y in 0..nj_c {
+                        let src = &plane[(z * nj_c + y) * ni..][i0..i1];
+                        chunk[b * (y + b * z)..][..i1 - i0].copy_from_slice(src);
+                    }
+                }
+                let inside = (0..nk_c).flat_map(|z| {
+                    let chunk = &chunk;
+                    (0..nj_c).flat_map(move |y| chunk[b * (y + b * z)..][..i1 - i0].iter().copied())
+                });
+                let (range, s) = brick_stats(inside);
+                ranges[a].push(range);
+                for q in 0..3 {
+                    sums[a][q] += s[q];
+                }
+                self.store_chunk(a, 0, [bi, u[1], u[2]], &chunk)?;
+            }
+        }
+        Ok(Unit { u, ranges, sums })
+    }
+
+    /// One column of level `u[0]`, filtered from the level below.
+    fn upper(&self, below: &Store, u: [usize; 3]) -> Result<Unit, StoreError> {
+        let level = u[0];
+        let b = self.meta.brick;
+        let n = self.meta.level_dims(level);
+        let m = self.meta.level_dims(level - 1);
+        let bricks_i = n[0].div_ceil(b);
+        let mut ranges = vec![Vec::with_capacity(bricks_i); self.attributes.len()];
+        let mut sums = vec![[0.0f64; 3]; self.attributes.len()];
+        let mut chunk = vec![0f32; b * b * b];
+        for (a, &attribute) in self.attributes.iter().enumerate() {
+            for bi in 0..bricks_i {
+                let c = [bi, u[1], u[2]];
+                let lo = c.map(|x| x * b);
+                let hi: [usize; 3] = std::array::from_fn(|q| ((c[q] + 1) * b).min(n[q]));
+                // The voxels below: 2 lo .. 2 hi, clamped to the level below.
+                let size: [usize; 3] = std::array::from_fn(|q| 2 * (hi[q] - lo[q]));
+                let below_vals = below.region(a, level - 1, lo.map(|x| 2 * x as i64), size)?;
+                chunk.iter_mut().for_each(|v| *v = 0.0);
+                let mut inside =
+                    Vec::with_capacity((hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]));
+                for z in 0..hi[2] - lo[2] {
+                    for y in 0..hi[1] - lo[1] {
+                        for x in 0..hi[0] - lo[0] {
+                            let v = filter(attribute, |dx, dy, dz| {
+                                let g = [
+                                    2 * (lo[0] + x) + dx,
+                                    2 * (lo[1] + y) + dy,
+                                    2 * (lo[2] + z) + dz,
+                                ];
+                                if g[0] >= m[0] || g[1] >= m[1] || g[2] >= m[2] {
+                                    return None;
+                                }
+                                let (px, py, pz) = (2 * x + dx, 2 * y + dy, 2 * z + dz);
+                                Some(below_vals[px + size[0] * (py + size[1] * pz)])
+                            });
+                            chunk[x + b * (y + b * z)] = v;
+                            inside.push(v);
+                        }
+                    }
+                }
+                self.round_to_stored(a, &mut chunk);
+                self.round_to_stored(a, &mut inside);
+                let (range, s) = brick_stats(inside.into_iter());
+                ranges[a].push(range);
+                for q in 0..3 {
+                    sums[a][q] += s[q];
+                }
+                self.store_chunk(a, level, c, &chunk)?;
+            }
+        }
+        Ok(Unit { u, ranges, sums })
+    }
+}
+
+/// The level filter over one 2x2x2 cell (`get(dx, dy, dz)`: None beyond the level below):
+/// the mean of the finite voxels present (NaN when none is), or for phase the first voxel.
+pub fn filter(attribute: Attribute, get: impl Fn(usize, usize, usize) -> Option<f32>) -> f32 {
+    if attribute == Attribute::Phase {
+        return get(0, 0, 0).unwrap_or(f32::NAN);
+    }
+    let (mut sum, mut n) = (0.0f64, 0u32);
+    for dz in 0..2 {
+        for dy in 0..2 {
+            for dx in 0..2 {
+                if let Some(v) = get(dx, dy, dz) {
+                    if v.is_finite() {
+                        sum += v as f64;
+                        n += 1;
+                    }
+                }
+            }
+        }
+    }
+    if n == 0 {
+        f32::NAN
+    } else {
+        (sum / n as f64) as f32
+    }
+}
+
+/// Write the ranges and statistics from every column's record, and mark the store complete.
+fn finish_store(
+    storage: &Arc<FilesystemStore>,
+    store: &Path,
+    mut meta: StoreMeta,
+    done: &HashMap<[usize; 3], Unit>,
+) -> Result<StoreMeta, StoreError> {
+    let mut totals: BTreeMap<usize, [f64; 3]> = BTreeMap::new();
+    let mut extremes: BTreeMap<usize, [f64; 2]> = BTreeMap::new();
+    for a in 0..meta.attributes.len() {
+        for level in 0..meta.levels {
+            let c = meta.brick_counts(level);
+            let mut values = vec![f32::NAN; c[0] * c[1] * c[2] * 2];
+            for k in 0..c[2] {
+                for j in 0..c[1] {
+                    let unit = done.get(&[level, j, k]).ok_or_else(|| {
+                        StoreError::invalid(
+                            store,
+                            format!("column {j}, {k} of level {level} was never written"),
+                        )
+                    })?;
+                    for (i, r) in unit.ranges[a].iter().enumerate() {
+                        let at = 2 * (i + c[0] * (j + c[1] * k));
+                        values[at] = r[0];
+                        values[at + 1] = r[1];
+                        if level == 0 && r[0] <= r[1] {
+                            let e = extremes
+                                .entry(a)
+                                .or_insert([f64::INFINITY, f64::NEG_INFINITY]);
+                            e[0] = e[0].min(r[0] as f64);
+                            e[1] = e[1].max(r[1] as f64);
+                        }
+                    }
+                    if level == 0 {
+                        let t = totals.entry(a).or_insert([0.0; 3]);
+                        for (total, sum) in t.iter_mut().zip(unit.sums[a]) {
+                            *total += sum;
+                        }
+                    }
+                }
+            }
+            let p = Store::range_path(&meta, a, level);
+            let array = Array::open(storage.clone(), &p)
+                .map_err(|e| StoreError::io(&store.join(&p[1..]), e))?;
+            array
+                .store_chunk_opt(
+                    &[0, 0, 0, 0],
+                    values.as_slice(),
+                    &CodecOptions::default().with_store_empty_chunks(true),
+                )
+                .map_err(|e| StoreError::io(&store.join(&p[1..]), e))?;
+        }
+        let t = totals.get(&a).copied().unwrap_or([0.0; 3]);
+        let e = extremes.get(&a).copied();
+        let am = &mut meta.attributes[a];
+        am.min = e.map(|e| e[0]);
+        am.max = e.map(|e| e[1]);
+        am.mean = (t[1] > 0.0).then(|| t[0] / t[1]);
+        am.non_finite = t[2] as u64;
+    }
+    meta.complete = true;
+    let mut group =
+        zarrs::group::Group::open(storage.clone(), "/").map_err(|e| StoreError::io(store, e))?;
+    group.attributes_mut().insert(
+        "arbvis".into(),
+        serde_json::to_value(&meta).map_err(|e| StoreError::io(store, e))?,
+    );
+    group
+        .store_metadata()
+        .map_err(|e| StoreError::io(store, e))?;
+    Ok(meta)
+}
+
+/// A bar of `total` bytes on stderr, when asked for and stderr is a terminal.
+fn progress_bar(shown: bool, total: u64, what: &str) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if !shown || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(total),
+        indicatif::ProgressDrawTarget::stderr(),
+    );
+    if let Ok(style) = indicatif::ProgressStyle::with_template(
+        "{msg} [{bar:40}] {binary_bytes}/{binary_total_bytes} {binary_bytes_per_sec} {eta}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar.set_message(what.to_string());
+    Some(bar)
+}
+
+/// A summary of a conversion, for the command line.
+pub fn describe(report: &ConvertReport, store: &Path) -> String {
+    let m = &report.meta;
+    let mut s = format!(
+        "{}: {} x {} x {} (sample, crossline, inline), {} levels of {}³ bricks, attributes {}\n",
+        store.display(),
+        m.dims[0],
+        m.dims[1],
+        m.dims[2],
+        m.levels,
+        m.brick,
+        m.attributes
+            .iter()
+            .map(|a| a.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    s += &format!(
+        "{} columns written, {} resumed from an earlier run; {:.1} MB read in {:.1} s ({:.1} MB/s)\n",
+        report.written,
+        report.resumed,
+        report.bytes_read as f64 / 1e6,
+        report.seconds,
+        report.bytes_read as f64 / 1e6 / report.seconds.max(1e-9)
+    );
+    s
+}
+
+/// Where a store's progress log would be.
+pub fn progress_log(store: &Path) -> PathBuf {
+    store.join(PROGRESS_LOG)
+}

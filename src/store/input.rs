@@ -1,0 +1,246 @@
+//! The sources `arbvis convert` reads, a column at a time (every sample of a rectangle of
+//! crosslines and inlines), so that no more than one column per worker is ever held:
+//! SEG-Y through [`SegyStream`], uncompressed NIfTI-1 and raw files by offset. A
+//! gzip-compressed NIfTI file cannot be read out of order, so it is read whole (held to
+//! the memory budget; decompress a large one first).
+
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::ops::Range;
+use std::os::unix::fs::FileExt;
+use std::path::{Path, PathBuf};
+
+use super::meta::SourceMeta;
+use super::StoreError;
+use crate::volume::raw::RawSpec;
+use crate::volume::segy::SegyStream;
+use crate::volume::{nifti_file, Endian, SampleType, Volume, VolumeError};
+
+/// A survey read in columns.
+#[derive(Debug)]
+pub enum Input {
+    /// SEG-Y, trace by trace.
+    Segy(SegyStream, SourceMeta),
+    /// Samples at fixed offsets of a file (raw, uncompressed NIfTI).
+    Flat(Flat),
+    /// A volume held whole (gzip NIfTI).
+    Memory(Volume, SourceMeta),
+}
+
+/// A file of samples in i, j, k order from a byte offset.
+#[derive(Debug)]
+pub struct Flat {
+    path: PathBuf,
+    file: File,
+    offset: u64,
+    sample: SampleType,
+    big: bool,
+    dims: [usize; 3],
+    spacing: [f64; 3],
+    scaling: Option<(f32, f32)>,
+    meta: SourceMeta,
+}
+
+fn meta(path: &Path, kind: &str, bytes: u64, facts: Vec<(String, String)>) -> SourceMeta {
+    SourceMeta {
+        path: path.display().to_string(),
+        kind: kind.into(),
+        bytes,
+        facts: facts.into_iter().collect::<BTreeMap<_, _>>(),
+        inlines: None,
+        crosslines: None,
+        interval_us: None,
+    }
+}
+
+impl Input {
+    /// Open `path`: raw when `raw` describes it, NIfTI by extension (`.nii`, `.nii.gz`),
+    /// else SEG-Y.
+    pub fn open(path: &Path, raw: Option<&RawSpec>) -> Result<Input, StoreError> {
+        let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+        if let Some(spec) = raw {
+            spec.validate()
+                .map_err(|e| VolumeError::Invalid(format!("{}: {e}", path.display())))?;
+            let (file, flen) =
+                crate::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
+            let need = spec.dims.iter().map(|&d| d as u64).product::<u64>()
+                * spec.sample.bytes() as u64
+                + spec.offset;
+            if flen != need {
+                return Err(VolumeError::format(
+                    path,
+                    flen.min(need),
+                    format!("the file has {flen} bytes but the raw description needs {need}"),
+                )
+                .into());
+            }
+            let facts = vec![
+                ("sample type".to_string(), spec.sample.name().to_string()),
+                ("offset".to_string(), spec.offset.to_string()),
+            ];
+            return Ok(Input::Flat(Flat {
+                path: path.into(),
+                file,
+                offset: spec.offset,
+                sample: spec.sample,
+                big: spec.endian == Endian::Big,
+                dims: spec.dims,
+                spacing: spec.spacing,
+                scaling: None,
+                meta: meta(path, "raw", flen, facts),
+            }));
+        }
+        let name = path.to_string_lossy().to_lowercase();
+        if name.ends_with(".nii") || name.ends_with(".nii.gz") {
+            let header = nifti_file::read_header(path)?;
+            let facts: Vec<(String, String)> = header
+                .describe()
+                .lines()
+                .filter_map(|l| l.split_once(": "))
+                .map(|(a, b)| (a.to_string(), b.to_string()))
+                .collect();
+            let (file, flen) =
+                crate::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
+            let mut magic = [0u8; 2];
+            let gzip = file.read_exact_at(&mut magic, 0).is_ok() && magic == [0x1f, 0x8b];
+            if gzip {
+                let bytes = header.count().saturating_mul(4);
+                crate::budget::check(
+                    format!(
+                        "{} (gzip NIfTI is read whole; decompress it to convert in columns)",
+                        path.display()
+                    ),
+                    bytes,
+                )
+                .map_err(|e| StoreError::Budget(e.to_string()))?;
+                let limits = crate::volume::Limits {
+                    max_side: usize::MAX,
+                    max_voxels: u64::MAX,
+                };
+                let v = nifti_file::read(path, &limits)?;
+                return Ok(Input::Memory(v, meta(path, "NIfTI-1 (gzip)", flen, facts)));
+            }
+            if flen < header.vox_offset + header.data_bytes() {
+                return Err(VolumeError::format(
+                    path,
+                    flen,
+                    format!(
+                        "the file ends before the {} bytes of voxel data that dim and datatype declare from byte {}: it is truncated",
+                        header.data_bytes(),
+                        header.vox_offset
+                    ),
+                )
+                .into());
+            }
+            return Ok(Input::Flat(Flat {
+                path: path.into(),
+                file,
+                offset: header.vox_offset,
+                sample: header.sample,
+                big: header.big_endian,
+                dims: header.dims,
+                spacing: header.spacing,
+                scaling: header.scaling,
+                meta: meta(path, "NIfTI-1", flen, facts),
+            }));
+        }
+        let s = SegyStream::open(path)?;
+        let mut m = meta(path, "SEG-Y", len, s.describe());
+        let step = |v: &[i32]| [v[0] as i64, v.get(1).map_or(1, |&b| b as i64 - v[0] as i64)];
+        m.inlines = Some(step(&s.inlines));
+        m.crosslines = Some(step(&s.crosslines));
+        m.interval_us = Some(s.interval_us);
+        Ok(Input::Segy(s, m))
+    }
+
+    /// Voxels along i, j, k.
+    pub fn dims(&self) -> [usize; 3] {
+        match self {
+            Input::Segy(s, _) => s.dims(),
+            Input::Flat(f) => f.dims,
+            Input::Memory(v, _) => v.dims,
+        }
+    }
+
+    /// Voxel size (SEG-Y: one unit per sample, crossline and inline).
+    pub fn spacing(&self) -> [f64; 3] {
+        match self {
+            Input::Segy(..) => [1.0; 3],
+            Input::Flat(f) => f.spacing,
+            Input::Memory(v, _) => v.spacing,
+        }
+    }
+
+    /// The source's description for the store.
+    pub fn source_meta(&self) -> SourceMeta {
+        match self {
+            Input::Segy(_, m) => m.clone(),
+            Input::Flat(f) => f.meta.clone(),
+            Input::Memory(_, m) => m.clone(),
+        }
+    }
+
+    /// Bytes of input a column of `traces` traces stands for (progress).
+    pub fn bytes_per_trace(&self) -> u64 {
+        match self {
+            Input::Segy(s, _) => s.trace_bytes() as u64,
+            Input::Flat(f) => (f.dims[0] * f.sample.bytes()) as u64,
+            Input::Memory(v, _) => (v.dims[0] * 4) as u64,
+        }
+    }
+
+    /// Every sample of crosslines `j` and inlines `k`, sample fastest, into `out`.
+    pub fn read_column(
+        &self,
+        j: Range<usize>,
+        k: Range<usize>,
+        out: &mut [f32],
+    ) -> Result<(), StoreError> {
+        match self {
+            Input::Segy(s, _) => Ok(s.read_column(j, k, out)?),
+            Input::Flat(f) => f.read_column(j, k, out),
+            Input::Memory(v, _) => {
+                let ni = v.dims[0];
+                let mut at = 0;
+                for kk in k {
+                    let start = v.index(0, j.start, kk);
+                    let n = ni * j.len();
+                    out[at..at + n].copy_from_slice(&v.values[start..start + n]);
+                    at += n;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
+impl Flat {
+    fn read_column(
+        &self,
+        j: Range<usize>,
+        k: Range<usize>,
+        out: &mut [f32],
+    ) -> Result<(), StoreError> {
+        let [ni, nj, _] = self.dims;
+        let width = self.sample.bytes();
+        let n = ni * j.len();
+        let mut buf = vec![0u8; n * width];
+        let mut at = 0;
+        for kk in k {
+            let first = (kk * nj + j.start) * ni;
+            let byte = self.offset + (first * width) as u64;
+            self.file
+                .read_exact_at(&mut buf, byte)
+                .map_err(|e| StoreError::from(VolumeError::io(&self.path, e)))?;
+            for (d, b) in out[at..at + n].iter_mut().zip(buf.chunks_exact(width)) {
+                let v = self.sample.decode(b, self.big);
+                *d = match self.scaling {
+                    Some((s, i)) => v * s + i,
+                    None => v,
+                };
+            }
+            at += n;
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,377 @@
+//! Reading a store back: its description, chunks (f32 whatever the stored type), bricks
+//! grown by one voxel on every side (clamped at the survey's faces, as CLAMP_TO_EDGE), the
+//! per-brick ranges, and level-0 windows as a [`Volume`] (sections, references).
+//!
+//! Every error names the store and, for a chunk, its file and indices: a missing chunk
+//! file is corruption (the conversion writes every chunk, empty ones included).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+use zarrs::array::Array;
+use zarrs::filesystem::FilesystemStore;
+use zarrs::group::Group;
+
+use super::meta::{StoreMeta, FORMAT, VERSION};
+use super::StoreError;
+use crate::volume::Volume;
+
+/// The opened arrays, by (attribute, level).
+type OpenArrays = HashMap<(usize, usize), Arc<Array<FilesystemStore>>>;
+
+/// A decoded chunk, by (attribute, level, chunk index), with its last use.
+type CachedChunks = HashMap<(usize, usize, [usize; 3]), (Arc<Vec<f32>>, u64)>;
+
+/// An open store.
+pub struct Store {
+    /// The store's folder.
+    pub path: PathBuf,
+    /// Its description.
+    pub meta: StoreMeta,
+    storage: Arc<FilesystemStore>,
+    arrays: Mutex<OpenArrays>,
+    cache: Mutex<ChunkCache>,
+}
+
+/// Decoded chunks kept for neighbouring bricks' borders, least recently used first out.
+struct ChunkCache {
+    chunks: CachedChunks,
+    tick: u64,
+    capacity: usize,
+}
+
+impl ChunkCache {
+    fn get(&mut self, key: &(usize, usize, [usize; 3])) -> Option<Arc<Vec<f32>>> {
+        self.tick += 1;
+        let tick = self.tick;
+        self.chunks.get_mut(key).map(|(c, t)| {
+            *t = tick;
+            c.clone()
+        })
+    }
+    fn put(&mut self, key: (usize, usize, [usize; 3]), chunk: Arc<Vec<f32>>) {
+        while self.chunks.len() >= self.capacity.max(1) {
+            let oldest = self
+                .chunks
+                .iter()
+                .min_by_key(|(_, (_, t))| *t)
+                .map(|(k, _)| *k);
+            match oldest {
+                Some(k) => self.chunks.remove(&k),
+                None => break,
+            };
+        }
+        self.tick += 1;
+        self.chunks.insert(key, (chunk, self.tick));
+    }
+}
+
+/// Decoded chunks kept by default (64 MiB of 64³ f32 chunks).
+pub const CHUNK_CACHE: usize = 64;
+
+impl Store {
+    /// Open the store at `path` and check its description.
+    pub fn open(path: &Path) -> Result<Store, StoreError> {
+        if !path.join("zarr.json").is_file() {
+            return Err(StoreError::invalid(
+                path,
+                "no zarr.json: not a zarr v3 store (make one with `arbvis convert SURVEY STORE`)",
+            ));
+        }
+        let storage = Arc::new(FilesystemStore::new(path).map_err(|e| StoreError::io(path, e))?);
+        let group = Group::open(storage.clone(), "/").map_err(|e| {
+            StoreError::invalid(&path.join("zarr.json"), format!("not a zarr group: {e}"))
+        })?;
+        let meta = Store::meta_of(path, group.attributes())?;
+        if !meta.complete {
+            return Err(StoreError::invalid(
+                path,
+                "the conversion has not finished (run the same `arbvis convert` again to resume it)",
+            ));
+        }
+        Ok(Store::with_meta(path, meta, storage))
+    }
+
+    /// A store being written (the conversion reads the level below back).
+    pub(crate) fn open_incomplete(path: &Path, meta: StoreMeta) -> Result<Store, StoreError> {
+        let storage = Arc::new(FilesystemStore::new(path).map_err(|e| StoreError::io(path, e))?);
+        Ok(Store::with_meta(path, meta, storage))
+    }
+
+    fn with_meta(path: &Path, meta: StoreMeta, storage: Arc<FilesystemStore>) -> Store {
+        Store {
+            path: path.to_path_buf(),
+            meta,
+            storage,
+            arrays: Mutex::new(HashMap::new()),
+            cache: Mutex::new(ChunkCache {
+                chunks: HashMap::new(),
+                tick: 0,
+                capacity: CHUNK_CACHE,
+            }),
+        }
+    }
+
+    /// The `arbvis` attribute of a group's attributes.
+    pub fn meta_of(
+        path: &Path,
+        attributes: &serde_json::Map<String, serde_json::Value>,
+    ) -> Result<StoreMeta, StoreError> {
+        let value = attributes.get("arbvis").ok_or_else(|| {
+            StoreError::invalid(
+                &path.join("zarr.json"),
+                "no `arbvis` attribute: a zarr group that arbvis did not write",
+            )
+        })?;
+        let meta: StoreMeta = serde_json::from_value(value.clone()).map_err(|e| {
+            StoreError::invalid(&path.join("zarr.json"), format!("attribute `arbvis`: {e}"))
+        })?;
+        if meta.format != FORMAT || meta.version != VERSION {
+            return Err(StoreError::invalid(
+                &path.join("zarr.json"),
+                format!(
+                    "format {:?} version {}: arbvis reads {FORMAT:?} version {VERSION}",
+                    meta.format, meta.version
+                ),
+            ));
+        }
+        let bad = meta.brick == 0
+            || meta.dims.contains(&0)
+            || meta.levels == 0
+            || meta.levels > 40
+            || meta.attributes.is_empty()
+            || meta.dims.iter().any(|&d| d > 1 << 30);
+        if bad {
+            return Err(StoreError::invalid(
+                &path.join("zarr.json"),
+                format!(
+                    "dims {:?}, brick {}, {} levels, {} attributes: not a survey",
+                    meta.dims,
+                    meta.brick,
+                    meta.levels,
+                    meta.attributes.len()
+                ),
+            ));
+        }
+        Ok(meta)
+    }
+
+    /// The zarr path of attribute `attr`'s level `level` (`/amplitude/0`).
+    pub fn array_path(meta: &StoreMeta, attr: usize, level: usize) -> String {
+        format!("/{}/{level}", meta.attributes[attr].name)
+    }
+
+    /// The zarr path of the per-brick ranges of `attr` at `level`.
+    pub fn range_path(meta: &StoreMeta, attr: usize, level: usize) -> String {
+        format!("/{}/range/{level}", meta.attributes[attr].name)
+    }
+
+    fn array(&self, attr: usize, level: usize) -> Result<Arc<Array<FilesystemStore>>, StoreError> {
+        let mut arrays = self.arrays.lock().expect("array table");
+        if let Some(a) = arrays.get(&(attr, level)) {
+            return Ok(a.clone());
+        }
+        let p = Store::array_path(&self.meta, attr, level);
+        let a = Array::open(self.storage.clone(), &p).map_err(|e| {
+            StoreError::invalid(&self.path.join(&p[1..]).join("zarr.json"), e.to_string())
+        })?;
+        let a = Arc::new(a);
+        arrays.insert((attr, level), a.clone());
+        Ok(a)
+    }
+
+    /// The file of chunk `c` (`[i, j, k]` brick indices) of `attr` at `level`.
+    pub fn chunk_file(&self, attr: usize, level: usize, c: [usize; 3]) -> PathBuf {
+        let p = Store::array_path(&self.meta, attr, level);
+        self.path
+            .join(&p[1..])
+            .join(format!("c/{}/{}/{}", c[2], c[1], c[0]))
+    }
+
+    /// Chunk `c` (`[i, j, k]` brick indices) of `attr` at `level`: `B³` values, i fastest
+    /// (edge chunks padded with 0 beyond the level's voxels).
+    pub fn chunk(
+        &self,
+        attr: usize,
+        level: usize,
+        c: [usize; 3],
+    ) -> Result<Arc<Vec<f32>>, StoreError> {
+        let key = (attr, level, c);
+        if let Some(hit) = self.cache.lock().expect("chunk cache").get(&key) {
+            return Ok(hit);
+        }
+        let array = self.array(attr, level)?;
+        let index = [c[2] as u64, c[1] as u64, c[0] as u64];
+        let fail = |message: String| StoreError::Chunk {
+            path: self.chunk_file(attr, level, c),
+            array: Store::array_path(&self.meta, attr, level)[1..].to_string(),
+            chunk: index,
+            message,
+        };
+        let values: Option<Vec<f32>> = if self.meta.attributes[attr].dtype == "float16" {
+            array
+                .retrieve_chunk_if_exists::<Vec<half::f16>>(&index)
+                .map_err(|e| fail(format!("cannot be decoded: {e}")))?
+                .map(|v| v.into_iter().map(f32::from).collect())
+        } else {
+            array
+                .retrieve_chunk_if_exists::<Vec<f32>>(&index)
+                .map_err(|e| fail(format!("cannot be decoded: {e}")))?
+        };
+        let values = values.ok_or_else(|| {
+            fail("missing: the conversion writes every chunk, so the store is damaged (convert again into a new store)".into())
+        })?;
+        let b = self.meta.brick;
+        if values.len() != b * b * b {
+            return Err(fail(format!(
+                "holds {} values, not {}",
+                values.len(),
+                b * b * b
+            )));
+        }
+        let values = Arc::new(values);
+        self.cache
+            .lock()
+            .expect("chunk cache")
+            .put(key, values.clone());
+        Ok(values)
+    }
+
+    /// Per-brick `[min, max]` of `attr` at `level`, i fastest.
+    pub fn ranges(&self, attr: usize, level: usize) -> Result<Vec<[f32; 2]>, StoreError> {
+        let p = Store::range_path(&self.meta, attr, level);
+        let file = self.path.join(&p[1..]);
+        let array = Array::open(self.storage.clone(), &p)
+            .map_err(|e| StoreError::invalid(&file.join("zarr.json"), e.to_string()))?;
+        let counts = self.meta.brick_counts(level);
+        let n = counts.iter().product::<usize>();
+        let values: Vec<f32> = array
+            .retrieve_chunk_if_exists::<Vec<f32>>(&[0, 0, 0, 0])
+            .map_err(|e| StoreError::invalid(&file, e.to_string()))?
+            .ok_or_else(|| StoreError::invalid(&file, "the brick ranges are missing"))?;
+        if values.len() != 2 * n {
+            return Err(StoreError::invalid(
+                &file,
+                format!("{} values for {n} bricks", values.len()),
+            ));
+        }
+        Ok(values.chunks_exact(2).map(|p| [p[0], p[1]]).collect())
+    }
+
+    /// The values of `attr` at `level` over the box `lo .. lo + size` (voxel indices, i
+    /// fastest), positions outside the level clamped to its faces.
+    pub fn region(
+        &self,
+        attr: usize,
+        level: usize,
+        lo: [i64; 3],
+        size: [usize; 3],
+    ) -> Result<Vec<f32>, StoreError> {
+        let n = self.meta.level_dims(level);
+        let b = self.meta.brick;
+        let count = size.iter().product::<usize>();
+        let mut out = crate::budget::vec_for::<f32>(count, "a region of a store")
+            .map_err(|e| StoreError::Budget(e.to_string()))?;
+        out.resize(count, 0.0);
+        let clamp = |v: i64, a: usize| v.clamp(0, n[a] as i64 - 1) as usize;
+        // Source voxel per output index, per axis.
+        let src: [Vec<usize>; 3] =
+            std::array::from_fn(|a| (0..size[a]).map(|t| clamp(lo[a] + t as i64, a)).collect());
+        let mut current: Option<([usize; 3], Arc<Vec<f32>>)> = None;
+        for (z, &k) in src[2].iter().enumerate() {
+            for (y, &j) in src[1].iter().enumerate() {
+                let row = size[0] * (y + size[1] * z);
+                for (x, &i) in src[0].iter().enumerate() {
+                    let c = [i / b, j / b, k / b];
+                    let chunk = match &current {
+                        Some((key, chunk)) if *key == c => chunk.clone(),
+                        _ => {
+                            let chunk = self.chunk(attr, level, c)?;
+                            current = Some((c, chunk.clone()));
+                            chunk
+                        }
+                    };
+                    out[row + x] = chunk[(i % b) + b * ((j % b) + b * (k % b))];
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Brick `c` of `attr` at `level` grown by one voxel on each side: `(B+2)³` values, i
+    /// fastest, the voxels `c B - 1 ..= (c + 1) B` clamped to the level. Only the brick's
+    /// own chunk must be readable: where a neighbour's chunk is missing or corrupt, the
+    /// border repeats the brick's own edge (as at the survey's faces), so one bad chunk
+    /// costs one brick.
+    pub fn brick(&self, attr: usize, level: usize, c: [usize; 3]) -> Result<Vec<f32>, StoreError> {
+        let b = self.meta.brick;
+        let n = self.meta.level_dims(level);
+        let own = self.chunk(attr, level, c)?;
+        let side = b + 2;
+        let mut out = vec![0f32; side * side * side];
+        // Own voxels present: c B .. min((c + 1) B, n) - 1 per axis.
+        let own_hi: [usize; 3] = std::array::from_fn(|a| ((c[a] + 1) * b).min(n[a]) - 1);
+        let mut neighbours: std::collections::HashMap<[usize; 3], Option<Arc<Vec<f32>>>> =
+            std::collections::HashMap::new();
+        for z in 0..side {
+            for y in 0..side {
+                for x in 0..side {
+                    let t = [x, y, z];
+                    let g: [usize; 3] = std::array::from_fn(|a| {
+                        ((c[a] * b + t[a]) as i64 - 1).clamp(0, n[a] as i64 - 1) as usize
+                    });
+                    let cc = g.map(|v| v / b);
+                    let value = if cc == c {
+                        own[(g[0] % b) + b * ((g[1] % b) + b * (g[2] % b))]
+                    } else {
+                        let chunk = neighbours
+                            .entry(cc)
+                            .or_insert_with(|| self.chunk(attr, level, cc).ok())
+                            .clone();
+                        match chunk {
+                            Some(ch) => ch[(g[0] % b) + b * ((g[1] % b) + b * (g[2] % b))],
+                            None => {
+                                let q: [usize; 3] =
+                                    std::array::from_fn(|a| g[a].clamp(c[a] * b, own_hi[a]) % b);
+                                own[q[0] + b * (q[1] + b * q[2])]
+                            }
+                        }
+                    };
+                    out[x + side * (y + side * z)] = value;
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// Level 0 of `attr` over voxels `lo .. hi` as a volume (held to the memory budget).
+    pub fn window(
+        &self,
+        attr: usize,
+        lo: [usize; 3],
+        hi: [usize; 3],
+    ) -> Result<Volume, StoreError> {
+        let size: [usize; 3] = std::array::from_fn(|a| hi[a].saturating_sub(lo[a]).max(1));
+        let values = self.region(attr, 0, lo.map(|v| v as i64), size)?;
+        Volume::new(size, self.meta.spacing, values).map_err(|e| StoreError::invalid(&self.path, e))
+    }
+
+    /// Index of attribute `name`, or an error listing the stored ones.
+    pub fn attribute_index(&self, name: &str) -> Result<usize, StoreError> {
+        self.meta.attribute(name).map(|(i, _)| i).ok_or_else(|| {
+            StoreError::invalid(
+                &self.path,
+                format!(
+                    "no attribute {name:?}; the store holds {}",
+                    self.meta
+                        .attributes
+                        .iter()
+                        .map(|a| a.name.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )
+        })
+    }
+}

@@ -1,0 +1,637 @@
+//! The GL side of the volume (issue 16): faithful cell projection with a pre-integrated
+//! table, and the precise neighbour walk.
+//!
+//! **Faithful** (ARB or GLSL, RGBA8): every face vertex uploaded once (the isosurfaces'
+//! layout); per view change the tetrahedra are ordered back to front on the CPU
+//! ([`Sort`]: MPVONC or centroid) and an index buffer lists, in that order, the faces of
+//! each that face the viewer. `volume.arbfp` computes `sf`, `sb` and the length with the
+//! seed's exit computation and reads the segment from the 3D table ([`super::preint`]),
+//! blended `ONE, ONE_MINUS_SRC_ALPHA`. No depth test (volume alone) or the isosurfaces'
+//! depth (`mode = "both"`, drawn after them).
+//!
+//! **Precise** (GLSL, float target): the mesh in textures (face planes, scalar, face
+//! neighbours); `entries` passes peel the boundary faces through which rays enter the
+//! mesh (`volume_peel.frag`, one RGBA32F target each); one full-screen pass walks every
+//! pixel's ray through the tetrahedra (`volume_walk.frag`) and integrates it exactly.
+
+use std::time::Instant;
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::order::{boundary_is_convex, centroid_order, mpvonc_order, neighbours, BOUNDARY};
+use super::preint;
+use super::prepare::{gradient, normal, Prepared, Viewer, FACES, VERTEX_COMPONENTS};
+use super::transfer::{Sort, Transfer, VolumeSpec};
+use crate::camera::Projection;
+use crate::gl::ProgramText;
+use crate::gl::{
+    self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
+    Surface, Target, TargetFormat, TexelData, TexelFormat, Texture,
+};
+use crate::programs::{self, ProgramPair};
+use crate::techniques::Frame;
+use crate::vocab::Fidelity;
+
+/// Texels per row of the precise mode's mesh textures (`ROW` in `volume_walk.frag`).
+pub const ROW: usize = 4096;
+
+/// Where the time of the last frame went (milliseconds; CPU clocks, the GL's part
+/// measured with `glFinish`).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct VolumeTimes {
+    /// Ordering the tetrahedra (faithful; 0 when the view did not change).
+    pub sort_ms: f64,
+    /// Building and uploading the index buffer (faithful).
+    pub upload_ms: f64,
+    /// Cycles MPVONC broke.
+    pub cycles: usize,
+}
+
+/// The faithful program pair: the seed's vertex program and `volume.arbfp` (or GLSL twins).
+pub fn faithful_pair(kind: ProgramKind) -> ProgramPair {
+    use programs::*;
+    let (vertex, fragment) = match kind {
+        ProgramKind::Arb => (CELLPROJ_PERSPECTIVE_ARBVP, CELLPROJ_VOLUME_ARBFP),
+        ProgramKind::Glsl => (CELLPROJ_PERSPECTIVE_VERT, CELLPROJ_VOLUME_FRAG),
+    };
+    ProgramPair {
+        kind,
+        vertex,
+        fragment,
+    }
+}
+
+/// `volume_integral.glsl` joined before the main of `fragment` (after its `#version`).
+pub fn with_integral(fragment: &ProgramText) -> ProgramText {
+    let text = &fragment.text;
+    let cut = text.find('\n').map_or(0, |i| i + 1);
+    ProgramText {
+        name: fragment.name.clone(),
+        text: format!(
+            "{}{}\n{}",
+            &text[..cut],
+            programs::CELLPROJ_VOLUME_INTEGRAL_GLSL.text,
+            &text[cut..]
+        )
+        .into(),
+    }
+}
+
+/// The precise pairs: entry layers, the walk, and the projected variant (the integral
+/// joined to the last two).
+pub fn precise_pairs() -> [ProgramPair; 3] {
+    use programs::*;
+    [
+        ProgramPair {
+            kind: ProgramKind::Glsl,
+            vertex: CELLPROJ_VOLUME_PEEL_VERT,
+            fragment: CELLPROJ_VOLUME_PEEL_FRAG,
+        },
+        ProgramPair {
+            kind: ProgramKind::Glsl,
+            vertex: TRANSFORM_VERT,
+            fragment: with_integral(&CELLPROJ_VOLUME_WALK_FRAG),
+        },
+        ProgramPair {
+            kind: ProgramKind::Glsl,
+            vertex: CELLPROJ_PRECISE_VERT,
+            fragment: with_integral(&CELLPROJ_VOLUME_PROJECTED_FRAG),
+        },
+    ]
+}
+
+struct Faithful {
+    program: Program,
+    faces: Mesh,
+    /// The pre-integrated table (unit 0), or for the projected precise variant the
+    /// transfer function (unit 2).
+    table: Texture,
+    /// Precise projected: exact integral per fragment.
+    exact: bool,
+    /// `(sf, sb, length)` to texture coordinates: scale and offset.
+    map: [[f64; 4]; 2],
+    built_for: Option<Viewer>,
+}
+
+struct Precise {
+    peel: Program,
+    walk: Program,
+    boundary: Mesh,
+    quad: Mesh,
+    tets: Texture,
+    neighbours: Texture,
+    tf: Texture,
+    isos: Texture,
+    iso_count: usize,
+    layers: Vec<Target>,
+    entries: usize,
+}
+
+/// The volume of a cell-projection scene.
+pub struct VolumeRenderer {
+    spec: VolumeSpec,
+    transfer: Transfer,
+    neighbours: Vec<[u32; 4]>,
+    convex: bool,
+    faithful: Option<Faithful>,
+    precise: Option<Precise>,
+    times: VolumeTimes,
+    tets: usize,
+}
+
+fn table_texture(gpu: &Gpu, tf: &Transfer, spec: &VolumeSpec, longest: f64) -> GlResult<Texture> {
+    let [n, m] = spec.table_size;
+    let data = preint::table(tf, n as usize, m as usize, longest, spec.build);
+    Texture::new(
+        gpu,
+        "cellproj volume pre-integrated table (sf, sb, length)",
+        Extent::D3(n, n, m),
+        TexelFormat::Rgba8,
+        Filter::Linear,
+        TexelData::U8(&data),
+    )
+}
+
+/// The transfer function as `count x 2` RGBA32F texels (row 0 colour and opacity value,
+/// row 1 positions).
+fn tf_texels(tf: &Transfer) -> Vec<f32> {
+    let mut v: Vec<f32> = tf.rgba.iter().flat_map(|c| c.map(|x| x as f32)).collect();
+    v.extend(tf.s.iter().flat_map(|&s| [s as f32, 0.0, 0.0, 0.0]));
+    v
+}
+
+fn rows_texture(
+    gpu: &Gpu,
+    label: &str,
+    format: TexelFormat,
+    data: TexelData<'_>,
+    texels: usize,
+) -> GlResult<Texture> {
+    let rows = texels.div_ceil(ROW).max(1);
+    if rows > gpu.caps().max_texture_size.max(1) as usize {
+        return Err(GlError::Data(format!(
+            "{label}: {texels} texels need {rows} rows of {ROW}, more than GL_MAX_TEXTURE_SIZE"
+        )));
+    }
+    let texture = Texture::empty_2d(gpu, label, ROW as u32, rows as u32, format)?;
+    texture.update_texels(gpu, data)?;
+    Ok(texture)
+}
+
+impl VolumeRenderer {
+    /// Build what `fidelity` draws with.
+    pub fn new(
+        gpu: &Gpu,
+        kind: ProgramKind,
+        fidelity: Fidelity,
+        spec: &VolumeSpec,
+        transfer: Transfer,
+        prepared: &Prepared,
+        isovalues: &[super::Isovalue],
+    ) -> GlResult<VolumeRenderer> {
+        let neighbours = neighbours(&prepared.tets);
+        let convex = boundary_is_convex(prepared, &neighbours);
+        let mut r = VolumeRenderer {
+            spec: spec.clone(),
+            transfer,
+            neighbours,
+            convex,
+            faithful: None,
+            precise: None,
+            times: VolumeTimes::default(),
+            tets: prepared.tets.len(),
+        };
+        match fidelity {
+            Fidelity::Faithful => r.faithful = Some(r.build_faithful(gpu, kind, prepared)?),
+            Fidelity::Precise if spec.precise == super::transfer::Precise::Projected => {
+                r.faithful = Some(r.build_projected(gpu, prepared)?)
+            }
+            Fidelity::Precise => r.precise = Some(r.build_precise(gpu, prepared, isovalues)?),
+        }
+        Ok(r)
+    }
+
+    fn build_faithful(
+        &self,
+        gpu: &Gpu,
+        kind: ProgramKind,
+        prepared: &Prepared,
+    ) -> GlResult<Faithful> {
+        let pair = faithful_pair(kind);
+        let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
+        let faces = Mesh::new(
+            gpu,
+            "cellproj volume faces (4 per tetrahedron)",
+            &VERTEX_COMPONENTS,
+            &prepared.face_vertices(),
+        )?;
+        let longest = prepared.longest_edge().max(1e-12);
+        let table = table_texture(gpu, &self.transfer, &self.spec, longest)?;
+        let [n, m] = self.spec.table_size.map(|v| v as f64);
+        let map = [
+            [(n - 1.0) / n, (n - 1.0) / n, (m - 1.0) / m / longest, 0.0],
+            [0.5 / n, 0.5 / n, 0.5 / m, 0.0],
+        ];
+        Ok(Faithful {
+            program,
+            faces,
+            table,
+            exact: false,
+            map,
+            built_for: None,
+        })
+    }
+
+    fn build_projected(&self, gpu: &Gpu, prepared: &Prepared) -> GlResult<Faithful> {
+        let pair = &precise_pairs()[2];
+        let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
+        let faces = Mesh::new(
+            gpu,
+            "cellproj volume faces (4 per tetrahedron)",
+            &VERTEX_COMPONENTS,
+            &prepared.face_vertices(),
+        )?;
+        let tf_data = tf_texels(&self.transfer);
+        let table = Texture::new(
+            gpu,
+            "cellproj volume transfer function",
+            Extent::D2(self.transfer.s.len() as u32, 2),
+            TexelFormat::Rgba32f,
+            Filter::Nearest,
+            TexelData::F32(&tf_data),
+        )?;
+        Ok(Faithful {
+            program,
+            faces,
+            table,
+            exact: true,
+            map: [[0.0; 4]; 2],
+            built_for: None,
+        })
+    }
+
+    fn build_precise(
+        &self,
+        gpu: &Gpu,
+        prepared: &Prepared,
+        isovalues: &[super::Isovalue],
+    ) -> GlResult<Precise> {
+        let [peel, walk, _] = precise_pairs();
+        let peel = Program::new(gpu, peel.kind, &peel.vertex, &peel.fragment)?;
+        let walk = Program::new(gpu, walk.kind, &walk.vertex, &walk.fragment)?;
+        walk.set_transform(gpu, glam::DMat4::IDENTITY)?;
+        let n = prepared.tets.len();
+        let data: Vec<f32> = (0..n)
+            .into_par_iter()
+            .flat_map_iter(|t| {
+                let (p, s) = prepared.tet(t);
+                let mut v = Vec::with_capacity(20);
+                for (f, _) in FACES {
+                    let nrm = normal(p[f[0]], p[f[1]], p[f[2]]);
+                    v.extend([nrm.x, nrm.y, nrm.z, nrm.dot(p[f[0]])]);
+                }
+                let g = gradient(p, s);
+                v.extend([g.x, g.y, g.z, s[0] - g.dot(p[0])]);
+                v.into_iter().map(|x| x as f32)
+            })
+            .collect();
+        let tets = rows_texture(
+            gpu,
+            "cellproj volume tetrahedra (4 planes, scalar)",
+            TexelFormat::Rgba32f,
+            TexelData::F32(&data),
+            n * 5,
+        )?;
+        let nb: Vec<u32> = self.neighbours.iter().flatten().copied().collect();
+        let neighbours = rows_texture(
+            gpu,
+            "cellproj volume neighbours",
+            TexelFormat::Rgba32ui,
+            TexelData::U32(&nb),
+            n,
+        )?;
+        let tf_data = tf_texels(&self.transfer);
+        let tf = Texture::new(
+            gpu,
+            "cellproj volume transfer function",
+            Extent::D2(self.transfer.s.len() as u32, 2),
+            TexelFormat::Rgba32f,
+            Filter::Nearest,
+            TexelData::F32(&tf_data),
+        )?;
+        let iso_count = isovalues.len();
+        let mut list = super::prepare::iso_list(isovalues);
+        list.resize(iso_count.max(1) * 8, 0.0);
+        let isos = Texture::new(
+            gpu,
+            "cellproj volume isovalues",
+            Extent::D2(iso_count.max(1) as u32, 2),
+            TexelFormat::Rgba32f,
+            Filter::Nearest,
+            TexelData::F32(&list),
+        )?;
+        let mut boundary = Vec::new();
+        for (t, row) in self.neighbours.iter().enumerate() {
+            let (p, _) = prepared.tet(t);
+            for (k, &m) in row.iter().enumerate() {
+                if m == BOUNDARY {
+                    for &c in &FACES[k].0 {
+                        boundary.extend([p[c].x as f32, p[c].y as f32, p[c].z as f32, t as f32]);
+                    }
+                }
+            }
+        }
+        let boundary = Mesh::new(gpu, "cellproj volume boundary faces", &[3, 1], &boundary)?;
+        let quad: Vec<f32> = [
+            (-1.0, -1.0),
+            (1.0, -1.0),
+            (1.0, 1.0),
+            (-1.0, -1.0),
+            (1.0, 1.0),
+            (-1.0, 1.0),
+        ]
+        .iter()
+        .flat_map(|&(x, y)| [x, y, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])
+        .collect();
+        let quad = Mesh::new(gpu, "cellproj volume full-screen quad", &[4, 4], &quad)?;
+        let entries = match self.spec.entries {
+            0 if self.convex => 1,
+            0 => 4,
+            e => e as usize,
+        };
+        Ok(Precise {
+            peel,
+            walk,
+            boundary,
+            quad,
+            tets,
+            neighbours,
+            tf,
+            isos,
+            iso_count,
+            layers: Vec::new(),
+            entries,
+        })
+    }
+
+    /// Whether the mesh's boundary is convex (one entry per ray).
+    pub fn convex(&self) -> bool {
+        self.convex
+    }
+
+    /// The last frame's CPU times.
+    pub fn times(&self) -> VolumeTimes {
+        self.times
+    }
+
+    /// The face neighbours (for orders and tests).
+    pub fn neighbours(&self) -> &[[u32; 4]] {
+        &self.neighbours
+    }
+
+    /// Entry layers the precise walk follows.
+    pub fn entries(&self) -> usize {
+        self.precise.as_ref().map_or(0, |p| p.entries)
+    }
+
+    /// Draw onto `surface` (the isosurfaces' depth already there in `mode = "both"`).
+    pub fn draw(
+        &mut self,
+        gpu: &Gpu,
+        surface: Surface<'_>,
+        frame: &Frame,
+        prepared: &Prepared,
+        depth_test: bool,
+    ) -> GlResult<()> {
+        if self.faithful.is_some() {
+            self.draw_faithful(gpu, surface, frame, prepared, depth_test)
+        } else {
+            self.draw_precise(gpu, surface, frame, prepared)
+        }
+    }
+
+    /// The back-to-front order of the scene's sort for `viewer`.
+    pub fn order(&mut self, prepared: &Prepared, viewer: Viewer) -> Vec<u32> {
+        match self.spec.sort {
+            Sort::Centroid => {
+                let all: Vec<u32> = (0..prepared.tets.len() as u32).collect();
+                centroid_order(prepared, &all, viewer)
+            }
+            Sort::Mpvonc => {
+                let (order, stats) = mpvonc_order(prepared, &self.neighbours, viewer);
+                self.times.cycles = stats.cycles_broken;
+                order
+            }
+        }
+    }
+
+    fn draw_faithful(
+        &mut self,
+        gpu: &Gpu,
+        surface: Surface<'_>,
+        frame: &Frame,
+        prepared: &Prepared,
+        depth_test: bool,
+    ) -> GlResult<()> {
+        let v = viewer(frame);
+        if self.faithful.as_ref().expect("faithful").built_for != Some(v) {
+            let t0 = Instant::now();
+            let order = self.order(prepared, v);
+            let t1 = Instant::now();
+            let indices = front_face_indices(prepared, &order, v);
+            let f = self.faithful.as_mut().expect("faithful");
+            f.faces.set_indices(gpu, &indices)?;
+            f.built_for = Some(v);
+            self.times.sort_ms = (t1 - t0).as_secs_f64() * 1e3;
+            self.times.upload_ms = t1.elapsed().as_secs_f64() * 1e3;
+        } else {
+            self.times.sort_ms = 0.0;
+            self.times.upload_ms = 0.0;
+        }
+        let f = self.faithful.as_ref().expect("faithful");
+        let mvp = frame.camera.view_projection(frame.aspect());
+        let (eye, dir) = eye_and_direction(frame);
+        let perspective = frame.camera.projection == Projection::Perspective;
+        f.program.set_transform(gpu, mvp)?;
+        if f.exact {
+            let w = if perspective { 1.0 } else { 0.0 };
+            f.program.set_local(gpu, 4, [eye.x, eye.y, eye.z, w])?;
+            f.program.set_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
+            let points = self.transfer.s.len() as f64;
+            f.program
+                .set_local(gpu, 6, [points, 1.0 / self.transfer.unit, 0.0, 0.0])?;
+        } else {
+            let eye = if perspective { eye } else { -dir * 1.0e6 };
+            f.program
+                .set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, 1.0])?;
+            f.program.set_local(gpu, 0, f.map[0])?;
+            f.program.set_local(gpu, 1, f.map[1])?;
+        }
+        let unit = if f.exact { 2 } else { 0 };
+        gl::draw(
+            gpu,
+            surface,
+            &DrawCall {
+                textures: &[(unit, &f.table)],
+                blend: Blend::PremultipliedOver,
+                depth_test,
+                cull_back: true,
+                ..DrawCall::new(&f.program, &f.faces)
+            },
+        )
+    }
+
+    fn draw_precise(
+        &mut self,
+        gpu: &Gpu,
+        surface: Surface<'_>,
+        frame: &Frame,
+        prepared: &Prepared,
+    ) -> GlResult<()> {
+        let (w, h) = (frame.width, frame.height);
+        let p = self.precise.as_mut().expect("precise");
+        if p.layers
+            .first()
+            .is_none_or(|l| l.width() != w || l.height() != h)
+        {
+            p.layers.clear();
+            for _ in 0..p.entries {
+                p.layers
+                    .push(Target::with_depth(gpu, w, h, TargetFormat::Rgba32f)?);
+            }
+        }
+        let mvp = frame.camera.view_projection(frame.aspect());
+        let inv = mvp.inverse().transpose();
+        let rows = [inv.x_axis, inv.y_axis, inv.z_axis, inv.w_axis].map(|r| r.to_array());
+        p.peel.set_transform(gpu, mvp)?;
+        for (i, row) in rows.iter().enumerate() {
+            p.peel.set_local(gpu, i, *row)?;
+            p.walk.set_local(gpu, i, *row)?;
+        }
+        p.peel.set_local(gpu, 4, [w as f64, h as f64, 0.0, 0.0])?;
+        for k in 0..p.layers.len() {
+            p.layers[k].clear(gpu, [-1.0, -1.0, 0.0, 0.0])?;
+            p.peel
+                .set_local(gpu, 5, [(k > 0) as u8 as f64, 0.0, 0.0, 0.0])?;
+            let (before, rest) = p.layers.split_at(k);
+            let textures: Vec<(u32, &Texture)> =
+                before.last().map(|l| (3, l.color())).into_iter().collect();
+            gl::draw(
+                gpu,
+                Surface::Target(&rest[0]),
+                &DrawCall {
+                    textures: &textures,
+                    depth_test: true,
+                    cull_back: true,
+                    ..DrawCall::new(&p.peel, &p.boundary)
+                },
+            )?;
+        }
+        let corner = match surface {
+            Surface::Target(_) => [0.0, 0.0],
+            Surface::Window([x, y, _, _]) => [x as f64, y as f64],
+        };
+        let eye_tet = match frame.camera.projection {
+            Projection::Perspective => {
+                locate(prepared, eye_and_direction(frame).0).map_or(-1.0, |t| t as f64)
+            }
+            Projection::Orthographic => -1.0,
+        };
+        let s = &self.spec;
+        p.walk
+            .set_local(gpu, 4, [w as f64, h as f64, corner[0], corner[1]])?;
+        p.walk.set_local(
+            gpu,
+            5,
+            [
+                self.transfer.s.len() as f64,
+                p.iso_count as f64,
+                s.termination,
+                eye_tet,
+            ],
+        )?;
+        p.walk.set_local(
+            gpu,
+            6,
+            [
+                p.layers.len() as f64,
+                1.0 / self.transfer.unit,
+                self.tets as f64 + 16.0,
+                0.0,
+            ],
+        )?;
+        let mut textures: Vec<(u32, &Texture)> =
+            vec![(0, &p.tets), (1, &p.neighbours), (2, &p.tf), (3, &p.isos)];
+        for (k, l) in p.layers.iter().enumerate() {
+            textures.push((4 + k as u32, l.color()));
+        }
+        gl::draw(
+            gpu,
+            surface,
+            &DrawCall {
+                textures: &textures,
+                blend: Blend::PremultipliedOver,
+                ..DrawCall::new(&p.walk, &p.quad)
+            },
+        )
+    }
+}
+
+/// The eye in object space (perspective) and the unit view direction (both cameras).
+pub fn eye_and_direction(frame: &Frame) -> (DVec3, DVec3) {
+    let inverse = frame.camera.view().inverse();
+    let eye = inverse.transform_point3(DVec3::ZERO);
+    let dir = inverse.transform_vector3(DVec3::NEG_Z).normalize();
+    (eye, dir)
+}
+
+/// The viewer of a frame, in object space (what [`Order::View`] sorts and culls for).
+pub fn viewer(frame: &Frame) -> Viewer {
+    let (eye, dir) = eye_and_direction(frame);
+    match frame.camera.projection {
+        Projection::Orthographic => Viewer::Parallel(dir),
+        Projection::Perspective => Viewer::Eye(eye),
+    }
+}
+
+/// Indices into the face vertices (12 per tetrahedron) of the faces of `order`'s
+/// tetrahedra that may face `viewer`, in that order.
+pub fn front_face_indices(prepared: &Prepared, order: &[u32], viewer: Viewer) -> Vec<u32> {
+    order
+        .par_chunks(4096)
+        .flat_map_iter(|chunk| {
+            let mut out = Vec::with_capacity(chunk.len() * 6);
+            for &t in chunk {
+                let (p, _) = prepared.tet(t as usize);
+                for (k, (f, _)) in FACES.iter().enumerate() {
+                    let n = (p[f[1]] - p[f[0]]).cross(p[f[2]] - p[f[0]]);
+                    let toward = match viewer {
+                        Viewer::Parallel(d) => d,
+                        Viewer::Eye(e) => (p[f[0]] - e).normalize_or_zero(),
+                    };
+                    if n.dot(toward) < super::prepare::FACING_MARGIN * n.length() {
+                        let base = t * 12 + k as u32 * 3;
+                        out.extend([base, base + 1, base + 2]);
+                    }
+                }
+            }
+            out
+        })
+        .collect()
+}
+
+/// The tetrahedron holding `point` (barycentric test with a 1e-12 tolerance), if any.
+pub fn locate(prepared: &Prepared, point: DVec3) -> Option<usize> {
+    let (lo, hi) = (-prepared.half - 1e-9, prepared.half + 1e-9);
+    if point.cmplt(lo).any() || point.cmpgt(hi).any() {
+        return None;
+    }
+    (0..prepared.tets.len()).into_par_iter().find_first(|&t| {
+        let (p, _) = prepared.tet(t);
+        FACES.iter().all(|(f, _)| {
+            let n = normal(p[f[0]], p[f[1]], p[f[2]]);
+            n != DVec3::ZERO && n.dot(point - p[f[0]]) <= 1e-12
+        })
+    })
+}
