@@ -17,11 +17,14 @@ use std::path::Path;
 use common::viewer::{failing_scripts, run_script};
 use common::{opacity3d, temp_dir};
 
+use arbvis::colortable::ColorTable;
 use arbvis::gl::{Backend, Surface, Target, TargetFormat};
 use arbvis::image::Image;
 use arbvis::png_io::read_png;
 use arbvis::render::render;
 use arbvis::scene::{Scene, TechniqueScene};
+use arbvis::techniques::cellproj::transfer::{Precise, Sort};
+use arbvis::techniques::cellproj::Mode;
 use arbvis::techniques::clip::stats::ClipStats;
 use arbvis::techniques::clip::{ClipSpec, ShapeSpec};
 use arbvis::techniques::opacity3d::Combine;
@@ -288,6 +291,69 @@ click Save scene
     assert!((values[2] - 0.6).abs() < 1e-12, "{values:?}");
     assert!(c.shading);
     assert_eq!(saved.fidelity, arbvis::scene::Fidelity::Precise);
+    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_transfer_function_editor_reaches_the_saved_scene() {
+    // The spherical demo draws isosurfaces; switch to both, add a control point on the
+    // opacity curve (the table's alpha becomes points first), and set the unit distance,
+    // the faithful order and the table's length.
+    let script = "\
+resize 900 700
+wait 2
+click Mode both
+click-at TF opacity 0.5 0.25
+set Unit distance 0.25
+click Order centroid
+click Precise projected
+set Volume table length 32
+check layout
+set Box and labels false
+click Screenshot
+click Save scene
+";
+    let Some((dir, stdout)) = run_script("transfer", "cellproj-spherical", "160x120", script)
+    else {
+        return;
+    };
+    // The legends show the volume's colours and the isovalues, as both are drawn.
+    for want in ["overlay \"legend volume: ", "overlay \"legend isovalues"] {
+        assert!(stdout.contains(want), "{want} not in {stdout}");
+    }
+    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let TechniqueScene::Cellproj(c) = &saved.technique else {
+        panic!("saved scene is not cellproj");
+    };
+    assert_eq!(c.mode, Mode::Both);
+    let v = c.volume.as_ref().expect("the volume's settings are saved");
+    assert_eq!(v.unit_distance, 0.25);
+    assert_eq!(v.sort, Sort::Centroid);
+    assert_eq!(v.precise, Precise::Projected);
+    assert_eq!(v.table_size, [128, 32]);
+    // viridis' alpha ramps 0..1: the table became the points (0, 0) and (1, 1), and the
+    // click at x 0.5, y 0.25 (from the top) added (0.5, 0.75) between them.
+    let sa: Vec<[f64; 2]> = v.points.iter().map(|p| [p[0], p[4]]).collect();
+    assert_eq!(
+        sa,
+        vec![[0.0, 0.0], [0.5, 0.75], [1.0, 1.0]],
+        "{:?}",
+        v.points
+    );
+    // Each point has viridis' colour where it lies: s = 0.5 is halfway between entries
+    // 127 and 128; within 1e-3, the rounding of the written colours.
+    let viridis = ColorTable::builtin("viridis").unwrap().entries;
+    for (p, want) in v.points.iter().zip([
+        viridis[0].map(|e| e as f64 / 255.0),
+        std::array::from_fn(|c| (viridis[127][c] as f64 + viridis[128][c] as f64) / 510.0),
+        viridis[255].map(|e| e as f64 / 255.0),
+    ]) {
+        for c in 0..3 {
+            assert!((p[c + 1] - want[c]).abs() <= 1e-3, "{p:?} vs {want:?}");
+        }
+    }
     let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
     assert_screenshot_is_the_scene(&shot, &saved);
     let _ = std::fs::remove_dir_all(&dir);

@@ -107,7 +107,8 @@ fn every_control_fits_screens_of_three_sizes() {
         ("v3o2-sum", "", 40),
         ("clip-sphere", "", 50),
         ("splats-section", "", 40),
-        ("cellproj-spherical", "", 28),
+        // The volume editor shown too.
+        ("cellproj-spherical", "click Mode both\n", 36),
     ];
     for (screen, [sw, sh]) in SCREENS {
         for (demo, before, least) in scenes {

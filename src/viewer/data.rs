@@ -115,6 +115,7 @@ pub fn build(
                     data_box: data_box(lo, hi, scale, &Default::default()),
                     scalar: prepared.scalar_name.clone(),
                     range: prepared.scalar_range,
+                    histogram: super::transfer::histogram(&scalars.values, prepared.scalar_range),
                 });
             }
             return Ok(Box::new(CellprojRenderer::from_prepared(

@@ -1,6 +1,7 @@
 //! The legends, in a margin of their own at the 3D view's right (so that no box edge,
 //! tick or label of the data ever runs through them): a colour bar per 3D-opacity table
-//! with its attribute's range, the isovalues of cell projection with their colours and
+//! with its attribute's range, the transfer function of a cell-projection volume as a
+//! colour bar over its scalar's range, the isovalues of cell projection with their colours and
 //! values, and the key of a cloud's colours (facies, layers or classes by name, or the
 //! property's gradient with its range).
 //!
@@ -413,7 +414,12 @@ pub fn class_name(code: i32) -> String {
 }
 
 /// The legends of what `scene` shows (`ctx` makes the colour-bar textures).
-pub fn legends(ctx: &egui::Context, scene: &Scene, data: &mut ViewData) -> Vec<Legend> {
+pub fn legends(
+    ctx: &egui::Context,
+    scene: &Scene,
+    data: &mut ViewData,
+    transfer: Option<TextureId>,
+) -> Vec<Legend> {
     let mut out = Vec::new();
     match &scene.technique {
         TechniqueScene::Opacity3d(o) => {
@@ -454,10 +460,20 @@ pub fn legends(ctx: &egui::Context, scene: &Scene, data: &mut ViewData) -> Vec<L
                     (unit([i.color[0], i.color[1], i.color[2]]), label)
                 })
                 .collect();
-            out.push(Legend::Key {
-                title: format!("isovalues\nof {name}"),
-                entries,
-            });
+            if let (true, Some(texture)) = (c.mode.volume(), transfer) {
+                out.push(Legend::Bar {
+                    title: format!("volume: {name}"),
+                    texture,
+                    lo: lut3d::short(lo),
+                    hi: lut3d::short(hi),
+                });
+            }
+            if c.mode.isosurfaces() {
+                out.push(Legend::Key {
+                    title: format!("isovalues\nof {name}"),
+                    entries,
+                });
+            }
         }
         TechniqueScene::Splats(sp) => {
             let Some(s) = &data.cloud else { return out };

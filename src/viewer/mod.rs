@@ -37,6 +37,7 @@ pub mod script;
 mod session;
 pub mod splats;
 pub mod summary;
+pub mod transfer;
 pub mod units;
 pub mod volume_view;
 pub mod widgets;

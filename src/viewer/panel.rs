@@ -93,6 +93,8 @@ pub struct PanelState {
     pub overlay_items: Vec<(String, Rect)>,
     /// The clip editor's state (3D opacity).
     pub clip: super::clip::ClipEditor,
+    /// The transfer-function editor's textures (cell-projection volumes).
+    pub transfer: super::transfer::TransferState,
 }
 
 impl Default for PanelState {
@@ -114,6 +116,7 @@ impl Default for PanelState {
             overlay: true,
             overlay_items: Vec::new(),
             clip: super::clip::ClipEditor::default(),
+            transfer: Default::default(),
         }
     }
 }
@@ -152,7 +155,7 @@ pub fn show(
         .resizable(false)
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
-                controls(ui, scene, state, caps, &mut actions);
+                controls(ui, scene, data, state, caps, &mut actions);
             });
         });
 
@@ -238,6 +241,7 @@ pub fn show(
 fn controls(
     ui: &mut egui::Ui,
     scene: &mut Scene,
+    data: &ViewData,
     state: &mut PanelState,
     caps: &Caps,
     actions: &mut Vec<UiAction>,
@@ -298,6 +302,11 @@ fn controls(
         }
     }
     if let TechniqueScene::Cellproj(c) = &mut scene.technique {
+        ui.separator();
+        let counts = data.mesh.as_ref().map(|m| m.histogram.as_slice());
+        if super::transfer::editor(ui, c, &scene.base, counts, &mut state.transfer, w) {
+            actions.push(UiAction::ParamsChanged);
+        }
         ui.separator();
         if super::isovalues::editor(ui, c, w) {
             actions.push(UiAction::ParamsChanged);
@@ -450,7 +459,7 @@ fn draw_overlay(
             .size()
     };
     let ink = Ink::on(scene.background);
-    let legends = legend::legends(&ctx, scene, data);
+    let legends = legend::legends(&ctx, scene, data, state.transfer.colours());
     let placed = legend::layout(rect, &legends, ink, &measure);
     let view = placed.picture(rect);
     legend::paint(&painter, &placed);

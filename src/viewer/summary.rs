@@ -128,6 +128,8 @@ pub struct MeshSummary {
     pub scalar: String,
     /// The scalar values mapped to 0 and 1.
     pub range: [f64; 2],
+    /// The normalized scalar's histogram, 256 bins (the transfer-function editor's).
+    pub histogram: Vec<u32>,
 }
 
 #[cfg(test)]
