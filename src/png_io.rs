@@ -34,8 +34,15 @@ pub enum PngError {
 /// written as 8-bit PNG, float images as 16-bit PNG (values clamped to 0..1).
 pub fn write_png(path: &Path, image: &Image, text: &[(&str, String)]) -> Result<(), PngError> {
     let name = path.display().to_string();
+    let bytes = encode_png(&name, image, text)?;
+    write_atomic(path, &bytes).map_err(|error| PngError::Io { path: name, error })
+}
+
+/// `image` as PNG bytes with `text` chunks, as [`write_png`] writes them (`name` is the
+/// file named in errors).
+pub fn encode_png(name: &str, image: &Image, text: &[(&str, String)]) -> Result<Vec<u8>, PngError> {
     let fmt = |e: png::EncodingError| PngError::Format {
-        path: name.clone(),
+        path: name.to_string(),
         message: e.to_string(),
     };
     let mut bytes = Vec::new();
@@ -64,7 +71,7 @@ pub fn write_png(path: &Path, image: &Image, text: &[(&str, String)]) -> Result<
         }
         writer.finish().map_err(fmt)?;
     }
-    write_atomic(path, &bytes).map_err(|error| PngError::Io { path: name, error })
+    Ok(bytes)
 }
 
 /// Largest text embedded in one chunk; longer texts (a scene with a huge inline table)
@@ -208,6 +215,47 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// Write `bytes` to `path` only if no file has that name: it appears whole (a temporary,
+/// synced, then hard-linked to the name, which fails if the name is taken) or not at all,
+/// and two writers, in one process or two, never both take a name. An error of kind
+/// [`std::io::ErrorKind::AlreadyExists`] says the name was taken. On file systems
+/// without hard links the name is claimed by creating it empty (create-new) and the
+/// temporary renamed over it.
+pub fn write_new(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| crate::input::invalid("not a file path"))?
+        .to_string_lossy()
+        .to_string();
+    remove_stale(&dir, &file_name);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let tmp = dir.join(format!(".{file_name}{TMP_MARK}{}.{n}", std::process::id()));
+    lock_temporaries().push(tmp.clone());
+    let result = (|| {
+        let mut f = File::create_new(&tmp)?;
+        f.write_all(bytes)?;
+        f.sync_all()?;
+        match std::fs::hard_link(&tmp, path) {
+            Err(e) if e.kind() != std::io::ErrorKind::AlreadyExists => {
+                std::fs::OpenOptions::new()
+                    .write(true)
+                    .create_new(true)
+                    .open(path)?;
+                std::fs::rename(&tmp, path)
+            }
+            other => other,
+        }
+    })();
+    let _ = std::fs::remove_file(&tmp);
+    lock_temporaries().retain(|t| t != &tmp);
+    result
+}
+
 fn lock_temporaries() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
     TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
 }
@@ -227,7 +275,8 @@ pub fn remove_temporaries_on_signals() {
     });
 }
 
-/// Remove `.NAME.arbvis-tmp.PID` files in `dir` whose process no longer runs.
+/// Remove `.NAME.arbvis-tmp.PID` (and `.PID.N`, [`write_new`]'s) files in `dir` whose
+/// process no longer runs.
 fn remove_stale(dir: &Path, file_name: &str) {
     let prefix = format!(".{file_name}{TMP_MARK}");
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -237,6 +286,7 @@ fn remove_stale(dir: &Path, file_name: &str) {
         let name = entry.file_name().to_string_lossy().to_string();
         let Some(pid) = name
             .strip_prefix(&prefix)
+            .and_then(|p| p.split('.').next())
             .and_then(|p| p.parse::<u32>().ok())
         else {
             continue;
@@ -260,6 +310,43 @@ fn process_alive(pid: u32) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn write_new_never_overwrites_and_one_racer_wins() {
+        let dir = std::env::temp_dir().join(format!("arbvis-png-new-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let taken = dir.join("a.png");
+        std::fs::write(&taken, b"first").unwrap();
+        let e = write_new(&taken, b"second").unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::AlreadyExists);
+        assert_eq!(std::fs::read(&taken).unwrap(), b"first");
+        // Eight threads race for each of 20 names: each name goes to exactly one of
+        // them, whole.
+        for round in 0..20 {
+            let path = dir.join(format!("race-{round}.png"));
+            let wins: usize = std::thread::scope(|s| {
+                let handles: Vec<_> = (0..8u8)
+                    .map(|t| {
+                        let path = path.clone();
+                        s.spawn(move || write_new(&path, &[t; 4096]).is_ok() as usize)
+                    })
+                    .collect();
+                handles.into_iter().map(|h| h.join().unwrap()).sum()
+            });
+            assert_eq!(wins, 1, "round {round}");
+            let bytes = std::fs::read(&path).unwrap();
+            assert_eq!(bytes.len(), 4096);
+            assert!(bytes.iter().all(|&b| b == bytes[0]), "one writer's bytes");
+        }
+        let names: Vec<String> = std::fs::read_dir(&dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names.len(), 21, "no temporaries left: {names:?}");
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn stale_temporaries_of_dead_processes_are_removed() {

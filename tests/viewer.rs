@@ -3,7 +3,8 @@
 //! of the lut 3D editor reached by `--script` (clicks, drags and values injected through
 //! egui's input path), the isovalue, splat and clip editors reaching the saved scene (the
 //! clip's cost line read with `print`), and script steps that do nothing failing with
-//! their line.
+//! their line. (The screen sizes, screenshots' names and overlays, and legends are
+//! in `viewer_screen.rs`; the harness that runs the viewer is `common/viewer.rs`.)
 //!
 //! Needs an X server: `DISPLAY`, or `Xvfb` on PATH (started here). Without either the
 //! tests say so and pass, unless `ARBVIS_NO_SKIP=1` (set by `.ci/run`) makes that a failure.
@@ -11,187 +12,23 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
+use common::viewer::{failing_scripts, run_script};
 use common::{opacity3d, temp_dir};
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
 
+use arbvis::colortable::ColorTable;
 use arbvis::gl::{Backend, Surface, Target, TargetFormat};
 use arbvis::image::Image;
 use arbvis::png_io::read_png;
 use arbvis::render::render;
 use arbvis::scene::{Scene, TechniqueScene};
+use arbvis::techniques::cellproj::transfer::{Precise, Sort};
+use arbvis::techniques::cellproj::Mode;
 use arbvis::techniques::clip::stats::ClipStats;
 use arbvis::techniques::clip::{ClipSpec, ShapeSpec};
 use arbvis::techniques::opacity3d::Combine;
 use arbvis::techniques::quad::{reference_image, QuadScene};
-
-struct Display {
-    name: String,
-    _server: Option<KillOnDrop>,
-}
-
-/// An Xvfb on display `.1`, killed when dropped. SIGKILL leaves its lock file and
-/// socket behind, which would make the display look taken to the next test: remove them.
-struct KillOnDrop(Child, u32);
-impl Drop for KillOnDrop {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-        let _ = std::fs::remove_file(format!("/tmp/.X{}-lock", self.1));
-        let _ = std::fs::remove_file(format!("/tmp/.X11-unix/X{}", self.1));
-    }
-}
-
-fn skip(reason: &str) -> Option<Display> {
-    if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
-        panic!("ARBVIS_NO_SKIP=1 but {reason}");
-    }
-    eprintln!("SKIPPED: {reason}");
-    None
-}
-
-/// Viewer tests run one at a time: each may own an Xvfb, and none may outlive its test.
-static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
-static NEXT_DISPLAY: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-
-/// An X display: the caller's, or a fresh Xvfb on a free number.
-fn display() -> Option<Display> {
-    if let Some(d) = std::env::var_os("DISPLAY").filter(|d| !d.is_empty()) {
-        return Some(Display {
-            name: d.to_string_lossy().into_owned(),
-            _server: None,
-        });
-    }
-    // Display numbers per test process and per test, so nothing collides.
-    let base = 100 + (std::process::id() % 200) * 8;
-    for _ in 0..16 {
-        let n = base + NEXT_DISPLAY.fetch_add(1, std::sync::atomic::Ordering::SeqCst) % 8;
-        if display_taken(n) {
-            continue;
-        }
-        // A socket left by a dead server would pass the readiness check below at once.
-        let _ = std::fs::remove_file(format!("/tmp/.X11-unix/X{n}"));
-        let child = match Command::new("Xvfb")
-            .args([
-                format!(":{n}"),
-                "-screen".into(),
-                "0".into(),
-                "1024x768x24".into(),
-                "-nolisten".into(),
-                "tcp".into(),
-            ])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .spawn()
-        {
-            Ok(c) => KillOnDrop(c, n),
-            Err(e) => {
-                return skip(&format!(
-                    "no DISPLAY and Xvfb cannot start ({e}); install xvfb"
-                ))
-            }
-        };
-        let t0 = Instant::now();
-        while t0.elapsed() < Duration::from_secs(10) {
-            if Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
-                return Some(Display {
-                    name: format!(":{n}"),
-                    _server: Some(child),
-                });
-            }
-            std::thread::sleep(Duration::from_millis(50));
-        }
-    }
-    skip("no DISPLAY and Xvfb did not come up")
-}
-
-/// Whether display `n` belongs to a live X server: its lock file names a running process.
-/// A lock left by a killed server does not count (Xvfb replaces a stale lock itself);
-/// neither does a socket without a lock.
-fn display_taken(n: u32) -> bool {
-    match std::fs::read_to_string(format!("/tmp/.X{n}-lock")) {
-        Ok(pid) => Path::new(&format!("/proc/{}", pid.trim())).exists(),
-        Err(_) => false,
-    }
-}
-
-/// What a viewer run left.
-struct Run {
-    ok: bool,
-    stdout: String,
-    stderr: String,
-}
-
-/// Run `arbvis view --demo DEMO --size SIZE` with `script`.
-fn run_viewer(display: &Display, dir: &Path, demo: &str, size: &str, script: &str) -> Run {
-    let script_path = dir.join("script.txt");
-    std::fs::write(&script_path, script).unwrap();
-    // A demo's name, or a scene file.
-    let source: Vec<&str> = if demo.ends_with(".toml") {
-        vec![demo]
-    } else {
-        vec!["--demo", demo]
-    };
-    let mut child = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .arg("view")
-        .args(source)
-        .args(["--size", size, "--screenshot-dir"])
-        .arg(dir)
-        .arg("--script")
-        .arg(&script_path)
-        .env("DISPLAY", &display.name)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    let t0 = Instant::now();
-    loop {
-        if let Some(status) = child.try_wait().unwrap() {
-            let out = child.wait_with_output().unwrap();
-            return Run {
-                ok: status.success(),
-                stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
-                stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
-            };
-        }
-        if t0.elapsed() > Duration::from_secs(120) {
-            let _ = child.kill();
-            panic!("viewer did not finish its script within 120 s");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    }
-}
-
-/// Run `script` in the viewer on `demo` (one test at a time) and return its screenshot
-/// folder and stdout, or `None` when the test is skipped for lack of a display. Fails if
-/// the viewer fails.
-fn run_script(name: &str, demo: &str, size: &str, script: &str) -> Option<(PathBuf, String)> {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let display = display()?;
-    let dir = temp_dir(name);
-    let run = run_viewer(&display, &dir, demo, size, script);
-    assert!(run.ok, "viewer failed: {}", run.stderr);
-    Some((dir, run.stdout))
-}
-
-/// Run scripts that must fail; returns each one's stderr (`None`: skipped).
-fn failing_scripts(name: &str, demo: &str, scripts: &[&str]) -> Option<Vec<String>> {
-    let _serial = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
-    let display = display()?;
-    let dir = temp_dir(name);
-    let errors = scripts
-        .iter()
-        .map(|script| {
-            let run = run_viewer(&display, &dir, demo, "160x160", script);
-            assert!(!run.ok, "script {script:?} should fail: {}", run.stdout);
-            run.stderr
-        })
-        .collect();
-    let _ = std::fs::remove_dir_all(&dir);
-    Some(errors)
-}
 
 /// The screenshot equals an offscreen render of the saved scene at its size, within one
 /// 8-bit level (same driver, same program).
@@ -212,7 +49,7 @@ fn frame_screenshot_and_program_switch() {
         "switch",
         "quad",
         "160x160",
-        "wait 2\nclick Screenshot\nwait 1\nclick GLSL\nwait 2\nclick Screenshot\nwait 1\nclick Save scene\nwait 1\n",
+        "resize 410 480\nwait 2\nclick Screenshot\nwait 1\nclick GLSL\nwait 2\nclick Screenshot\nwait 1\nclick Save scene\nwait 1\n",
     ) else {
         return;
     };
@@ -228,9 +65,10 @@ fn frame_screenshot_and_program_switch() {
     assert_eq!(programs(&arb_text).as_deref(), Some("arb"));
     assert_eq!(programs(&glsl_text).as_deref(), Some("glsl"));
 
-    // The view is the window minus the side panel; the quad fills it. Both screenshots
-    // match the CPU reference at the view's size within one 8-bit level.
-    assert_eq!(arb.width, 160, "view width = scene width");
+    // The view is the window (410 wide) minus the 250-point side panel; the quad fills it
+    // (it has no box or legends). Both screenshots match the CPU reference at the
+    // view's size within one 8-bit level.
+    assert_eq!(arb.width, 160, "view width = window width - panel");
     let want = reference_image(
         &QuadScene::default(),
         arb.width,
@@ -332,7 +170,7 @@ fn the_volume_stays_framed_at_two_window_aspects() {
         "framing",
         "v3o2-sum",
         "160x160",
-        "resize 880 640\nwait 2\ndrag 50 30\nclick Screenshot\n\
+        "resize 880 640\nset Box and labels false\nwait 2\ndrag 50 30\nclick Screenshot\n\
          resize 1200 460\nwait 2\ndrag -40 60\nclick Screenshot\nclick Save scene\n\
          key Home\nclick Save scene\n",
     ) else {
@@ -389,6 +227,7 @@ set inline section 10
 click Sections
 click Sections
 measure 2 interactive
+set Box and labels false
 click Screenshot
 click Save scene
 ";
@@ -433,6 +272,7 @@ click Remove isovalue 3
 click Add isovalue
 click Precise
 click Shading
+set Box and labels false
 click Screenshot
 click Save scene
 ";
@@ -451,6 +291,69 @@ click Save scene
     assert!((values[2] - 0.6).abs() < 1e-12, "{values:?}");
     assert!(c.shading);
     assert_eq!(saved.fidelity, arbvis::scene::Fidelity::Precise);
+    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_transfer_function_editor_reaches_the_saved_scene() {
+    // The spherical demo draws isosurfaces; switch to both, add a control point on the
+    // opacity curve (the table's alpha becomes points first), and set the unit distance,
+    // the faithful order and the table's length.
+    let script = "\
+resize 900 700
+wait 2
+click Mode both
+click-at TF opacity 0.5 0.25
+set Unit distance 0.25
+click Order centroid
+click Precise projected
+set Volume table length 32
+check layout
+set Box and labels false
+click Screenshot
+click Save scene
+";
+    let Some((dir, stdout)) = run_script("transfer", "cellproj-spherical", "160x120", script)
+    else {
+        return;
+    };
+    // The legends show the volume's colours and the isovalues, as both are drawn.
+    for want in ["overlay \"legend volume: ", "overlay \"legend isovalues"] {
+        assert!(stdout.contains(want), "{want} not in {stdout}");
+    }
+    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let TechniqueScene::Cellproj(c) = &saved.technique else {
+        panic!("saved scene is not cellproj");
+    };
+    assert_eq!(c.mode, Mode::Both);
+    let v = c.volume.as_ref().expect("the volume's settings are saved");
+    assert_eq!(v.unit_distance, 0.25);
+    assert_eq!(v.sort, Sort::Centroid);
+    assert_eq!(v.precise, Precise::Projected);
+    assert_eq!(v.table_size, [128, 32]);
+    // viridis' alpha ramps 0..1: the table became the points (0, 0) and (1, 1), and the
+    // click at x 0.5, y 0.25 (from the top) added (0.5, 0.75) between them.
+    let sa: Vec<[f64; 2]> = v.points.iter().map(|p| [p[0], p[4]]).collect();
+    assert_eq!(
+        sa,
+        vec![[0.0, 0.0], [0.5, 0.75], [1.0, 1.0]],
+        "{:?}",
+        v.points
+    );
+    // Each point has viridis' colour where it lies: s = 0.5 is halfway between entries
+    // 127 and 128; within 1e-3, the rounding of the written colours.
+    let viridis = ColorTable::builtin("viridis").unwrap().entries;
+    for (p, want) in v.points.iter().zip([
+        viridis[0].map(|e| e as f64 / 255.0),
+        std::array::from_fn(|c| (viridis[127][c] as f64 + viridis[128][c] as f64) / 510.0),
+        viridis[255].map(|e| e as f64 / 255.0),
+    ]) {
+        for c in 0..3 {
+            assert!((p[c + 1] - want[c]).abs() <= 1e-3, "{p:?} vs {want:?}");
+        }
+    }
     let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
     assert_screenshot_is_the_scene(&shot, &saved);
     let _ = std::fs::remove_dir_all(&dir);
@@ -477,6 +380,7 @@ click Draw tiles
 set Tile size 3
 click Volume mode
 set Threshold 0.01
+set Box and labels false
 click Screenshot
 click Save scene
 ";
@@ -537,6 +441,7 @@ set Clip block 16
 print Clip stats
 set Clip multires false
 print Clip stats
+set Box and labels false
 click Screenshot
 click Save scene
 ";
@@ -656,7 +561,7 @@ fn save_tables_writes_them_and_the_scene_uses_them() {
         "tables",
         "v3o2-product",
         "160x160",
-        "wait 2\nclick-at primary alpha 0.25 0.5\nclick Save tables\nclick Screenshot\nclick Save scene\nclick Transparent screenshots\nclick Screenshot\n",
+        "wait 2\nset Box and labels false\nclick-at primary alpha 0.25 0.5\nclick Save tables\nclick Screenshot\nclick Save scene\nclick Transparent screenshots\nclick Screenshot\n",
     ) else {
         return;
     };

@@ -27,6 +27,24 @@ pub enum Numbers {
     },
     /// One number per voxel (SEG-Y inline and crossline numbers).
     Listed(Vec<f64>),
+    /// A continuous span of file coordinates (a mesh's or a cloud's box): `lo` on the
+    /// box's low face, `hi` on its high face.
+    Span {
+        /// The coordinate at the low face.
+        lo: f64,
+        /// The coordinate at the high face.
+        hi: f64,
+    },
+}
+
+/// A tick on an axis: where along the box's edge (0 at the low face, 1 at the high
+/// face) and its label.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tick {
+    /// Fraction of the edge, 0..=1.
+    pub at: f64,
+    /// The number written there.
+    pub label: String,
 }
 
 /// One axis.
@@ -47,6 +65,26 @@ impl Axis {
         match &self.numbers {
             Numbers::Linear { start, step } => start + index as f64 * step,
             Numbers::Listed(v) => v.get(index).copied().unwrap_or(index as f64),
+            Numbers::Span { lo, hi } => {
+                let n = self.len.saturating_sub(1).max(1) as f64;
+                lo + (hi - lo) * index as f64 / n
+            }
+        }
+    }
+
+    /// About `count` ticks: at voxel centres for voxel axes ([`Axis::tick_indices`]),
+    /// at round numbers (1, 2 or 5 times a power of ten apart) for a span.
+    pub fn ticks(&self, count: usize) -> Vec<Tick> {
+        match self.numbers {
+            Numbers::Span { lo, hi } => span_ticks(lo, hi, count),
+            _ => self
+                .tick_indices(count)
+                .into_iter()
+                .map(|i| Tick {
+                    at: (i as f64 + 0.5) / self.len.max(1) as f64,
+                    label: self.label(i),
+                })
+                .collect(),
         }
     }
 
@@ -61,7 +99,7 @@ impl Axis {
     }
 
     /// About `count` voxel indices spread evenly from the first to the last.
-    pub fn ticks(&self, count: usize) -> Vec<usize> {
+    pub fn tick_indices(&self, count: usize) -> Vec<usize> {
         let last = self.len.saturating_sub(1);
         let count = count.clamp(2, self.len.max(2));
         let mut t: Vec<usize> = (0..count)
@@ -69,6 +107,63 @@ impl Axis {
             .collect();
         t.dedup();
         t
+    }
+}
+
+/// Round numbers from `lo` to `hi` (and up to half a percent of the span beyond), about
+/// `count` of them, labelled with the decimals their step needs.
+fn span_ticks(lo: f64, hi: f64, count: usize) -> Vec<Tick> {
+    let (a, b) = (lo.min(hi), lo.max(hi));
+    let width = b - a;
+    if !(width.is_finite() && width > 0.0) {
+        return vec![Tick {
+            at: 0.5,
+            label: number(lo, 0),
+        }];
+    }
+    let raw = width / count.max(2) as f64;
+    let power = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * power)
+        .find(|&s| s >= raw)
+        .unwrap_or(10.0 * power);
+    let decimals = (-step.log10().floor()).max(0.0) as usize;
+    // Round numbers within half a percent beyond the ends count (a cloud whose lowest
+    // point is -3999.9 m is labelled -4000).
+    let slack = width * 0.005;
+    let first = ((a - slack) / step).ceil() as i64;
+    let last = ((b + slack) / step).floor() as i64;
+    (first..=last)
+        .map(|k| {
+            let v = k as f64 * step;
+            Tick {
+                at: (v - lo) / (hi - lo),
+                label: number(v, decimals),
+            }
+        })
+        .collect()
+}
+
+/// `v` with `decimals` decimals, never `-0`.
+fn number(v: f64, decimals: usize) -> String {
+    let s = format!("{v:.decimals$}");
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        s.trim_start_matches('-').to_string()
+    } else {
+        s
+    }
+}
+
+/// A continuous axis named `name` from `lo` to `hi`.
+pub fn span(name: &str, lo: f64, hi: f64) -> Axis {
+    Axis {
+        name: name.to_string(),
+        len: 2,
+        numbers: Numbers::Span { lo, hi },
     }
 }
 
@@ -160,12 +255,46 @@ mod tests {
         };
         assert_eq!(a.label(3), "115");
         assert_eq!(a.value(99), 115.0, "clamped");
-        assert_eq!(a.ticks(3), vec![0, 2, 3]);
+        assert_eq!(a.tick_indices(3), vec![0, 2, 3]);
         let t = linear("time (ms)", 75, 4.0);
         assert_eq!(t.label(74), "296");
-        assert_eq!(t.ticks(5), vec![0, 19, 37, 56, 74]);
+        assert_eq!(t.tick_indices(5), vec![0, 19, 37, 56, 74]);
+        // Ticks at voxel centres: voxel 74 of 75 is 74.5 / 75 along the edge.
+        let last = t.ticks(5).pop().unwrap();
+        assert_eq!((last.at, last.label.as_str()), (74.5 / 75.0, "296"));
         assert_eq!(linear("x", 3, 0.25).label(1), "0.2");
-        assert_eq!(indices("i", 1).ticks(5), vec![0]);
+        assert_eq!(indices("i", 1).tick_indices(5), vec![0]);
+    }
+
+    #[test]
+    fn spans_tick_at_round_numbers() {
+        let labels =
+            |a: &Axis, n| -> Vec<String> { a.ticks(n).into_iter().map(|t| t.label).collect() };
+        // autzen's x in feet: 636,990 .. 638,982 in about 4 ticks: 500 apart.
+        let x = span("x (ft)", 636_990.0, 638_982.0);
+        assert_eq!(labels(&x, 4), ["637000", "637500", "638000", "638500"]);
+        let t = &x.ticks(4)[0];
+        assert!((t.at - 10.0 / 1992.0).abs() < 1e-12, "{t:?}");
+        // A section's depth, -4000 .. 0 m: five ticks 1000 apart, no "-0".
+        let z = span("z (m)", -4000.0, 0.0);
+        assert_eq!(labels(&z, 4), ["-4000", "-3000", "-2000", "-1000", "0"]);
+        // Small spans get decimals; a reversed span runs from its low face.
+        let s = span("s", 0.25, 0.0);
+        assert_eq!(labels(&s, 2), ["0.0", "0.2"]);
+        // 0.2 lies 0.05 from the high face: a fifth of the way from 0.25 (rounding only).
+        assert!((s.ticks(2)[1].at - 0.2).abs() < 1e-12);
+        // Round numbers just beyond the ends count: -3999.9 .. -0.1 has -4000 and 0.
+        let z = span("z (m)", -3999.9, -0.1);
+        assert_eq!(labels(&z, 2), ["-4000", "-2000", "0"]);
+        assert!(z.ticks(2)[0].at < 0.0 && z.ticks(2)[0].at > -1e-4);
+        // An empty span has one tick in the middle.
+        assert_eq!(
+            span("e", 3.0, 3.0).ticks(4),
+            vec![Tick {
+                at: 0.5,
+                label: "3".into()
+            }]
+        );
     }
 
     #[test]

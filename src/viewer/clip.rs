@@ -159,7 +159,7 @@ fn triple(
     speed: f64,
 ) -> bool {
     let mut changed = false;
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label(text);
         for (c, axis) in v.iter_mut().zip(["x", "y", "z"]) {
             changed |= w.drag_value(ui, &format!("{prefix} {axis}"), c, range.clone(), speed);
@@ -295,7 +295,7 @@ fn body(
     } else {
         kept.clone().unwrap_or_default()
     };
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("Shape");
         if w.choice(ui, "Clip shape", &mut kind, &options, 120.0) {
             let shape = match (&state.kept, kept.as_deref()) {
@@ -332,7 +332,7 @@ fn body(
         .zip(names.iter().map(String::as_str))
         .collect();
     ui.add_enabled_ui(clip.multires, |ui| {
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             ui.label("Block B");
             changed |= w.choice(ui, "Clip block", &mut clip.block, &options, 60.0);
         });

@@ -217,7 +217,7 @@ pub fn editor(
         plot.left_top() + Vec2::new(4.0, 2.0),
         egui::Align2::LEFT_TOP,
         hint,
-        egui::FontId::proportional(10.0),
+        super::layout::overlay_font(super::layout::MIN_TEXT),
         Color32::from_gray(160),
     );
     let _ = response.on_hover_text(label);

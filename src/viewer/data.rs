@@ -12,11 +12,15 @@
 use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
 
 use super::axes::{self, Axis};
+use super::summary::{cloud_units, data_box, CloudSummary, DataBox, MeshSummary};
 use crate::colortable::{ColorTable, TableSpec};
 use crate::gl::{GlError, Gpu, ProgramKind};
 use crate::scene::{Scene, TechniqueScene};
+use crate::techniques::cellproj::prepare::from_mesh;
+use crate::techniques::cellproj::CellprojRenderer;
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::Opacity3dRenderer;
+use crate::techniques::splats::SplatsRenderer;
 use crate::techniques::Renderer;
 
 /// The two axes a section at fixed `axis` shows: (across, down).
@@ -49,6 +53,10 @@ struct Section {
 pub struct ViewData {
     /// 3D-opacity data (none for other techniques).
     pub volume: Option<Volume3d>,
+    /// A cloud's box and key (splats).
+    pub cloud: Option<CloudSummary>,
+    /// A mesh's box and scalar (cell projection).
+    pub mesh: Option<MeshSummary>,
     /// Per attribute: the spec the table was built from, the table, its colours as a
     /// 256 x 1 texture.
     tables: [Option<(TableSpec, ColorTable, TextureHandle)>; 3],
@@ -63,9 +71,65 @@ pub fn build(
     kind: ProgramKind,
     data: &mut ViewData,
 ) -> Result<Box<dyn Renderer>, GlError> {
-    let TechniqueScene::Opacity3d(params) = &scene.technique else {
-        data.volume = None;
-        return crate::render::build(gpu, scene, kind);
+    let data_error = |e: String| GlError::Data(e);
+    let params = match &scene.technique {
+        TechniqueScene::Opacity3d(params) => params,
+        TechniqueScene::Splats(params) => {
+            // Prepared here (as `SplatsRenderer::new` would) to keep the cloud's key.
+            params.validate().map_err(|e| data_error(e.to_string()))?;
+            let (cloud, prepared) =
+                crate::techniques::splats::prepare::prepare(params, &scene.base)
+                    .map_err(data_error)?;
+            data.cloud = Some(CloudSummary::of(
+                &cloud,
+                &cloud_units(&params.cloud, &scene.base),
+            ));
+            return Ok(Box::new(SplatsRenderer::from_prepared(
+                gpu,
+                kind,
+                scene.fidelity,
+                params,
+                &scene.base,
+                cloud,
+                prepared,
+            )?));
+        }
+        TechniqueScene::Cellproj(params) => {
+            // Prepared here (as `cellproj::prepare::prepare` does) to keep the mesh's box
+            // in its file coordinates.
+            params.validate().map_err(|e| data_error(e.to_string()))?;
+            let mesh = params
+                .mesh
+                .load(&scene.base)
+                .map_err(|e| data_error(e.to_string()))?;
+            let scalars = params
+                .scalars
+                .evaluate(&mesh)
+                .map_err(|e| data_error(e.to_string()))?;
+            let prepared = from_mesh(&mesh, &scalars.values, scalars.name, scalars.range)
+                .map_err(data_error)?;
+            if let Some((lo, hi)) = mesh.bounds() {
+                let longest = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+                let scale = if longest > 0.0 { 2.0 / longest } else { 1.0 };
+                data.mesh = Some(MeshSummary {
+                    data_box: data_box(lo, hi, scale, &Default::default()),
+                    scalar: prepared.scalar_name.clone(),
+                    range: prepared.scalar_range,
+                    histogram: super::transfer::histogram(&scalars.values, prepared.scalar_range),
+                });
+            }
+            return Ok(Box::new(CellprojRenderer::from_prepared(
+                gpu,
+                kind,
+                scene.fidelity,
+                params,
+                prepared,
+            )?));
+        }
+        TechniqueScene::Quad(_) => {
+            data.volume = None;
+            return crate::render::build(gpu, scene, kind);
+        }
     };
     // A survey store is streamed: frames draw what is resident and refine.
     if crate::techniques::opacity3d::bricked::store_of(params)
@@ -125,6 +189,18 @@ pub fn build(
 }
 
 impl ViewData {
+    /// The box the overlay draws and its axes: the volume's, the cloud's or the mesh's.
+    pub fn data_box(&self) -> Option<DataBox> {
+        if let Some(v) = &self.volume {
+            return Some(DataBox {
+                half: v.prepared.half,
+                axes: v.axes.clone(),
+            });
+        }
+        let cloud = self.cloud.as_ref().map(|c| &c.data_box);
+        cloud.or(self.mesh.as_ref().map(|m| &m.data_box)).cloned()
+    }
+
     /// The table of attribute `a` as the scene now names it, and its colour texture
     /// (rebuilt when the spec changed; `None` for an absent attribute or a table that
     /// cannot be built).

@@ -51,7 +51,7 @@ pub fn editor(ui: &mut egui::Ui, scene: &mut CellprojScene, w: &mut Widgets) -> 
         changed = true;
     }
     ui.separator();
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("Exit point");
         for (label, exit) in [
             ("auto", Exit::Auto),

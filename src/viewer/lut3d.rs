@@ -21,6 +21,9 @@ use crate::techniques::opacity3d::{Combine, MAX_SLICES};
 /// Width of the editor's panel in points: the grid and curves fit without clipping.
 pub const WIDTH: f32 = 430.0;
 
+/// The panel width (points) under which the coefficients get a grid of their own.
+pub const GRID_WIDTH: f32 = 400.0;
+
 /// Names of the three attributes, as labelled in the panel.
 pub const ROLES: [&str; 3] = ["primary", "secondary", "tertiary"];
 
@@ -36,9 +39,11 @@ pub struct Lut3dEdit {
     pub save_tables: bool,
 }
 
-/// Draw the editor; `locks` is the per-table lock state (UI only).
+/// Draw the editor `width` points wide (the panel's; the curves take it, the grid may
+/// scroll sideways); `locks` is the per-table lock state (UI only).
 pub fn editor(
     ui: &mut egui::Ui,
+    width: f32,
     scene: &mut Scene,
     data: &mut ViewData,
     locks: &mut [bool; 3],
@@ -53,7 +58,7 @@ pub fn editor(
         return edit;
     };
     ui.heading("lut 3D");
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("combination:");
         edit.params |= widgets.radio(ui, "Sum", &mut o.combine, Combine::Sum);
         edit.params |= widgets.radio(ui, "Product", &mut o.combine, Combine::Product);
@@ -65,63 +70,58 @@ pub fn editor(
     edit.params |= widgets.slider(ui, "slices", &mut o.slices, 1..=MAX_SLICES, "slices", true);
     ui.add_space(4.0);
 
-    egui::Grid::new("lut3d coefficients")
-        .num_columns(7)
-        .spacing([6.0, 4.0])
-        .striped(true)
-        .show(ui, |ui| {
-            ui.label("");
-            ui.label("table");
-            ui.label("lock");
-            for c in COEFFICIENTS {
-                ui.label(c);
-            }
-            ui.end_row();
-            for (a, attr) in o.attributes_mut().into_iter().enumerate() {
-                let role = ROLES[a];
-                ui.label(role);
-                let Some(attr) = attr else {
-                    ui.label(RichText::new("none").weak());
-                    ui.end_row();
-                    continue;
-                };
-                let mut name = attr
-                    .table
-                    .file
-                    .as_ref()
-                    .map(|f| format!("file {}", f.display()))
-                    .unwrap_or_else(|| attr.table.builtin.clone());
-                let mut options: Vec<(String, &str)> =
-                    BUILTINS.iter().map(|b| (b.to_string(), *b)).collect();
-                let file_name = name.clone();
-                if attr.table.file.is_some() {
-                    options.push((file_name.clone(), file_name.as_str()));
+    // A narrow panel stacks the tables and locks over the coefficients.
+    let parts: &[(bool, bool)] = if width < GRID_WIDTH {
+        &[(true, false), (false, true)]
+    } else {
+        &[(true, true)]
+    };
+    for (g, &(tables, coefficients)) in parts.iter().enumerate() {
+        egui::Grid::new(("lut3d coefficients", g))
+            .spacing([6.0, 4.0])
+            .striped(true)
+            .show(ui, |ui| {
+                ui.label("");
+                if tables {
+                    ui.label("table");
+                    ui.label("lock");
                 }
-                if widgets.choice(ui, &format!("{role} table"), &mut name, &options, 90.0) {
-                    attr.table.builtin = name.clone();
-                    attr.table.file = None;
-                    edit.params = true;
-                }
-                let lock_label = format!("Lock {role}");
-                if widgets.checkbox(ui, &lock_label, &mut locks[a], "") && locks[a] {
-                    attr.coefficients = [attr.coefficients[0]; 4];
-                    edit.params = true;
-                }
-                for (c, name) in COEFFICIENTS.iter().enumerate() {
-                    let mut v = attr.coefficients[c];
-                    let label = format!("{role} {name}");
-                    if widgets.drag_value(ui, &label, &mut v, 0.0..=4.0, 0.005) {
-                        if locks[a] {
-                            attr.coefficients = [v; 4];
-                        } else {
-                            attr.coefficients[c] = v;
-                        }
-                        edit.params = true;
+                if coefficients {
+                    for c in COEFFICIENTS {
+                        ui.label(c);
                     }
                 }
                 ui.end_row();
-            }
-        });
+                for (a, attr) in o.attributes_mut().into_iter().enumerate() {
+                    let role = ROLES[a];
+                    ui.label(role);
+                    let Some(attr) = attr else {
+                        ui.label(RichText::new("none").weak());
+                        ui.end_row();
+                        continue;
+                    };
+                    if tables {
+                        edit.params |= table_and_lock(ui, role, attr, &mut locks[a], widgets);
+                    }
+                    if coefficients {
+                        for (c, name) in COEFFICIENTS.iter().enumerate() {
+                            let mut v = attr.coefficients[c];
+                            let label = format!("{role} {name}");
+                            if widgets.drag_value(ui, &label, &mut v, 0.0..=4.0, 0.005) {
+                                if locks[a] {
+                                    attr.coefficients = [v; 4];
+                                } else {
+                                    attr.coefficients[c] = v;
+                                }
+                                edit.params = true;
+                            }
+                        }
+                    }
+                    ui.end_row();
+                }
+            });
+        ui.add_space(2.0);
+    }
     ui.label(
         RichText::new("a ticked lock edits the table's four coefficients as one value")
             .small()
@@ -129,7 +129,7 @@ pub fn editor(
     );
     ui.separator();
 
-    let width = ui.available_width().min(WIDTH - 20.0);
+    let width = width.min(WIDTH - 20.0);
     for (a, attr) in o.attributes_mut().into_iter().enumerate() {
         let (Some(attr), Some((table, texture))) = (attr, &tables[a]) else {
             continue;
@@ -141,7 +141,7 @@ pub fn editor(
             .and_then(|v| v.prepared.ranges[a])
             .map(|(lo, hi)| format!("{} .. {}", short(lo), short(hi)))
             .unwrap_or_default();
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             ui.label(RichText::new(format!("{role}: {}", attr.attribute.name())).strong());
             ui.label(RichText::new(range).weak());
         });
@@ -159,7 +159,7 @@ pub fn editor(
         edit.params |= e.changed;
         ui.add_space(6.0);
     }
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         edit.save_tables = widgets.button(ui, "Save tables");
         ui.label(
             RichText::new("writes arbvis-table-ROLE.table")
@@ -168,6 +168,38 @@ pub fn editor(
         );
     });
     edit
+}
+
+/// An attribute's table choice and lock check box (grid cells); true when changed.
+fn table_and_lock(
+    ui: &mut egui::Ui,
+    role: &str,
+    attr: &mut crate::techniques::opacity3d::AttributeScene,
+    lock: &mut bool,
+    widgets: &mut Widgets,
+) -> bool {
+    let mut changed = false;
+    let mut name = attr
+        .table
+        .file
+        .as_ref()
+        .map(|f| format!("file {}", f.display()))
+        .unwrap_or_else(|| attr.table.builtin.clone());
+    let mut options: Vec<(String, &str)> = BUILTINS.iter().map(|b| (b.to_string(), *b)).collect();
+    let file_name = name.clone();
+    if attr.table.file.is_some() {
+        options.push((file_name.clone(), file_name.as_str()));
+    }
+    if widgets.choice(ui, &format!("{role} table"), &mut name, &options, 90.0) {
+        attr.table.builtin = name.clone();
+        attr.table.file = None;
+        changed = true;
+    }
+    if widgets.checkbox(ui, &format!("Lock {role}"), lock, "") && *lock {
+        attr.coefficients = [attr.coefficients[0]; 4];
+        changed = true;
+    }
+    changed
 }
 
 /// A value for a range label: integers plainly, others with 4 significant digits.

@@ -19,18 +19,26 @@
 //! scene's zoom is only lowered, never raised.
 
 pub mod axes;
+pub mod check;
 pub mod clip;
 pub mod curve;
 pub mod data;
 pub mod isovalues;
+pub mod layout;
+pub mod legend;
 pub mod lut3d;
+pub mod observed;
 mod options;
 pub mod overlay;
 pub mod panel;
 pub mod runner;
+pub mod screenshot;
 pub mod script;
 mod session;
 pub mod splats;
+pub mod summary;
+pub mod transfer;
+pub mod units;
 pub mod volume_view;
 pub mod widgets;
 
@@ -130,6 +138,7 @@ impl App {
                         .window()
                         .request_inner_size(winit::dpi::PhysicalSize::new(w, h));
                 }
+                Ok(ScriptStep::WindowShot) => r.request_window_shot(),
                 Ok(ScriptStep::Quit) => return self.shutdown(event_loop),
                 Err(e) => return self.fail(event_loop, e),
             }

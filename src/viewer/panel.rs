@@ -9,19 +9,16 @@
 use egui::{Rect, RichText, Sense, Vec2};
 
 use super::data::{section_axes, ViewData};
+use super::layout::{self, overlay_font};
+use super::legend;
 use super::lut3d;
-use super::overlay::{self, ColourBar, Projector, SECTION_COLOURS};
+use super::overlay::{self, Ink, Projector, SECTION_COLOURS};
 use super::volume_view::InteractiveQuality;
 use super::widgets::Widgets;
 use crate::camera::Projection;
 use crate::gl::{Caps, ProgramKind};
 use crate::scene::{Scene, TechniqueScene};
 use crate::vocab::Fidelity;
-
-/// Width of the left panel in points.
-pub const PANEL_WIDTH: f32 = 250.0;
-/// Height of the sections panel in points.
-pub const SECTIONS_HEIGHT: f32 = 220.0;
 
 /// What the user asked for this frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -89,10 +86,15 @@ pub struct PanelState {
     pub quality: InteractiveQuality,
     /// The sections.
     pub sections: SectionsState,
-    /// Draw the box, axis labels and colour bars over the view.
+    /// Draw the box, axis labels and legends over the view.
     pub overlay: bool,
+    /// What the overlay placed last frame: each label's and legend's text and rectangle
+    /// (points), for a script's `check layout`.
+    pub overlay_items: Vec<(String, Rect)>,
     /// The clip editor's state (3D opacity).
     pub clip: super::clip::ClipEditor,
+    /// The transfer-function editor's textures (cell-projection volumes).
+    pub transfer: super::transfer::TransferState,
 }
 
 impl Default for PanelState {
@@ -112,7 +114,9 @@ impl Default for PanelState {
                 index: [0; 3],
             },
             overlay: true,
+            overlay_items: Vec::new(),
             clip: super::clip::ClipEditor::default(),
+            transfer: Default::default(),
         }
     }
 }
@@ -121,8 +125,10 @@ impl Default for PanelState {
 pub struct PanelOutput {
     /// Requests, in the order made.
     pub actions: Vec<UiAction>,
-    /// The 3D view's rectangle (points).
+    /// The 3D picture's rectangle (points).
     pub view: Rect,
+    /// The whole view: the 3D picture and the legends' margin at its right (points).
+    pub shown: Rect,
     /// Pointer input on the view.
     pub input: ViewInput,
     /// Something the volume depends on was edited this frame (camera included).
@@ -141,23 +147,27 @@ pub fn show(
     state.widgets.begin_frame();
     let camera_before = scene.camera;
     let opacity3d = matches!(scene.technique, TechniqueScene::Opacity3d(_));
+    let sections_shown = opacity3d && state.sections.show && data.volume.is_some();
+    let sizes = layout::panels(ui.max_rect().size(), opacity3d, sections_shown);
 
     egui::Panel::left("controls")
-        .exact_size(PANEL_WIDTH)
+        .exact_size(sizes.left)
         .resizable(false)
         .show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| {
-                controls(ui, scene, state, caps, &mut actions);
+                controls(ui, scene, data, state, caps, &mut actions);
             });
         });
 
     if opacity3d {
         egui::Panel::right("lut 3D")
-            .exact_size(lut3d::WIDTH)
+            .exact_size(sizes.right)
             .resizable(false)
             .show(ui, |ui| {
-                egui::ScrollArea::vertical().show(ui, |ui| {
-                    let e = lut3d::editor(ui, scene, data, &mut state.locks, &mut state.widgets);
+                let width = ui.available_width();
+                egui::ScrollArea::both().show(ui, |ui| {
+                    let e =
+                        lut3d::editor(ui, width, scene, data, &mut state.locks, &mut state.widgets);
                     if e.params {
                         actions.push(UiAction::ParamsChanged);
                     }
@@ -166,20 +176,26 @@ pub fn show(
                     }
                 });
             });
-        if state.sections.show && data.volume.is_some() {
+        if sections_shown {
             egui::Panel::bottom("sections")
-                .exact_size(SECTIONS_HEIGHT)
+                .exact_size(sizes.bottom)
                 .resizable(false)
                 .show(ui, |ui| sections(ui, scene, data, state));
         }
     }
 
     let mut input = ViewInput::default();
-    let view = egui::CentralPanel::default()
+    let (view, shown) = egui::CentralPanel::default()
         .frame(egui::Frame::NONE)
         .show(ui, |ui| {
             let (rect, response) = ui.allocate_exact_size(ui.available_size(), Sense::drag());
-            state.widgets.record(ui, "3D view", rect, true);
+            let view = if state.overlay {
+                draw_overlay(ui, rect, scene, data, state)
+            } else {
+                state.overlay_items.clear();
+                rect
+            };
+            state.widgets.record(ui, "3D view", view, true);
             let pos = response.interact_pointer_pos();
             if response.drag_started() {
                 input.drag_start = pos;
@@ -190,10 +206,7 @@ pub fn show(
             if response.hovered() {
                 input.scroll = ui.input(|i| i.smooth_scroll_delta.y);
             }
-            if state.overlay {
-                draw_overlay(ui, rect, scene, data, state);
-            }
-            rect
+            (view, rect)
         })
         .inner;
 
@@ -219,6 +232,7 @@ pub fn show(
     PanelOutput {
         actions,
         view,
+        shown,
         input,
         edited,
     }
@@ -227,6 +241,7 @@ pub fn show(
 fn controls(
     ui: &mut egui::Ui,
     scene: &mut Scene,
+    data: &ViewData,
     state: &mut PanelState,
     caps: &Caps,
     actions: &mut Vec<UiAction>,
@@ -243,7 +258,7 @@ fn controls(
     }
     ui.separator();
 
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("Programs");
         for (kind, label, enabled) in [
             (ProgramKind::Arb, "ARB", caps.has_arb()),
@@ -256,7 +271,7 @@ fn controls(
             }
         }
     });
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("Fidelity");
         for (f, label) in [
             (Fidelity::Faithful, "Faithful"),
@@ -288,6 +303,11 @@ fn controls(
     }
     if let TechniqueScene::Cellproj(c) = &mut scene.technique {
         ui.separator();
+        let counts = data.mesh.as_ref().map(|m| m.histogram.as_slice());
+        if super::transfer::editor(ui, c, &scene.base, counts, &mut state.transfer, w) {
+            actions.push(UiAction::ParamsChanged);
+        }
+        ui.separator();
         if super::isovalues::editor(ui, c, w) {
             actions.push(UiAction::ParamsChanged);
         }
@@ -309,7 +329,7 @@ fn controls(
     ui.separator();
 
     ui.label("Camera: drag the view to turn, scroll to zoom");
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         for (p, label) in [
             (Projection::Orthographic, "Orthographic"),
             (Projection::Perspective, "Perspective"),
@@ -318,7 +338,7 @@ fn controls(
         }
     });
     w.slider(ui, "zoom", &mut scene.camera.zoom, 0.1..=10.0, "zoom", true);
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         if w.button(ui, "Reset camera") {
             actions.push(UiAction::ResetCamera);
         }
@@ -328,7 +348,7 @@ fn controls(
     });
     ui.separator();
 
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("Interactive quality");
         w.choice(
             ui,
@@ -347,7 +367,7 @@ fn controls(
         ui,
         "Box and labels",
         &mut state.overlay,
-        "Box, axis labels, colour bars",
+        "Box, axes and legends",
     );
     if matches!(scene.technique, TechniqueScene::Opacity3d(_)) {
         w.checkbox(ui, "Sections", &mut state.sections.show, "Sections");
@@ -360,7 +380,7 @@ fn controls(
     );
     ui.separator();
 
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         if w.button(ui, "Screenshot") {
             actions.push(UiAction::Screenshot);
         }
@@ -384,7 +404,7 @@ fn sections(ui: &mut egui::Ui, scene: &Scene, data: &mut ViewData, state: &mut P
         .map(|a| (a, lut3d::ROLES[a]))
         .collect();
     let w = &mut state.widgets;
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("Sections of");
         w.choice(
             ui,
@@ -422,36 +442,57 @@ fn sections(ui: &mut egui::Ui, scene: &Scene, data: &mut ViewData, state: &mut P
     });
 }
 
-fn draw_overlay(ui: &egui::Ui, rect: Rect, scene: &Scene, data: &mut ViewData, state: &PanelState) {
-    let painter = ui.painter_at(rect);
+/// Draw the legends in their margin at the right of `rect` and the box over the rest;
+/// returns the rest, the 3D picture's rectangle.
+fn draw_overlay(
+    ui: &egui::Ui,
+    rect: Rect,
+    scene: &Scene,
+    data: &mut ViewData,
+    state: &mut PanelState,
+) -> Rect {
     let ctx = ui.ctx().clone();
-    let Some(v) = &data.volume else { return };
-    let half = v.prepared.half;
-    let axes = v.axes.clone();
-    let ranges = v.prepared.ranges;
-    let shown = state.sections.show;
-    let sections = [0, 1, 2].map(|a| shown.then_some(state.sections.index[a]));
-    overlay::draw_box(
-        &painter,
-        &Projector::new(&scene.camera, rect),
-        half,
-        &axes,
-        sections,
+    let painter = ui.painter_at(rect);
+    let measure = |t: &str, size: f32| {
+        painter
+            .layout_no_wrap(t.to_string(), overlay_font(size), egui::Color32::WHITE)
+            .size()
+    };
+    let ink = Ink::on(scene.background);
+    let legends = legend::legends(&ctx, scene, data, state.transfer.colours());
+    let placed = legend::layout(rect, &legends, ink, &measure);
+    let view = placed.picture(rect);
+    legend::paint(&painter, &placed);
+    let mut items: Vec<(String, Rect)> = placed
+        .boxes
+        .iter()
+        .map(|(t, r)| (format!("legend {t}"), *r))
+        .collect();
+    items.extend(
+        placed
+            .texts
+            .iter()
+            .map(|t| (format!("legend text {}", t.text), t.rect)),
     );
-    let mut bars = Vec::new();
-    if let TechniqueScene::Opacity3d(o) = &scene.technique {
-        for (a, attr) in o.attributes().into_iter().enumerate() {
-            let (Some(attr), Some((lo, hi))) = (attr, ranges[a]) else {
-                continue;
-            };
-            if let Some((_, texture)) = data.table(&ctx, scene, a) {
-                bars.push(ColourBar {
-                    title: format!("{}: {}", lut3d::ROLES[a], attr.attribute.name()),
-                    texture: texture.id(),
-                    range: (lut3d::short(lo), lut3d::short(hi)),
-                });
-            }
-        }
+    if let Some(b) = data.data_box() {
+        let shown = state.sections.show && data.volume.is_some();
+        let sections = [0, 1, 2].map(|a| shown.then_some(state.sections.index[a]));
+        let laid = overlay::layout_box(
+            &Projector::new(&scene.camera, view),
+            view,
+            b.half,
+            &b.axes,
+            sections,
+            ink,
+            &measure,
+        );
+        overlay::paint(&ui.painter_at(view), &laid);
+        items.extend(
+            laid.texts
+                .iter()
+                .map(|t| (format!("label {}", t.text), t.rect)),
+        );
     }
-    overlay::draw_bars(&painter, rect, &bars);
+    state.overlay_items = items;
+    view
 }

@@ -5,10 +5,12 @@
 use std::time::{Duration, Instant};
 
 use anyhow::anyhow;
-use egui::{Event, Modifiers, PointerButton, Pos2, Rect};
+use egui::{Event, Modifiers, PointerButton, Pos2};
 
+use super::check::LayoutCheck;
+pub use super::observed::Observed;
 use super::script::{Action, ClickKind, MeasureMode, Script, Step};
-use super::widgets::{SetRequest, Widgets};
+use super::widgets::SetRequest;
 use crate::camera::Camera;
 
 /// Frames a step may wait for its widget to appear or take effect.
@@ -25,28 +27,10 @@ pub enum ScriptStep {
     Measure(MeasureMode),
     /// Resize the window to this many pixels, then draw.
     Resize(u32, u32),
+    /// Draw, and write the whole window as a picture after painting.
+    WindowShot,
     /// Close the viewer.
     Quit,
-}
-
-/// What the runner sees of the viewer between frames.
-pub struct Observed<'a> {
-    /// The labelled widgets of the last frame.
-    pub widgets: &'a mut Widgets,
-    /// The 3D view (points).
-    pub view: Rect,
-    /// Frames drawn so far.
-    pub frames: u64,
-    /// The scene's camera.
-    pub camera: Camera,
-    /// The window's inner size in pixels.
-    pub window: [u32; 2],
-    /// The 3D view's size in pixels.
-    pub view_px: [u32; 2],
-    /// An action of the last frame that failed (screenshot not written, ...).
-    pub action_error: Option<String>,
-    /// The interactive quality's name.
-    pub quality: &'static str,
 }
 
 /// Runs a script.
@@ -64,6 +48,7 @@ pub struct ScriptRunner {
     started: Option<Instant>,
     deadline: Option<Instant>,
     last_click: Option<Instant>,
+    layout: Option<LayoutCheck>,
 }
 
 fn press(pos: Pos2, button: PointerButton, pressed: bool) -> Event {
@@ -101,6 +86,7 @@ impl ScriptRunner {
         self.camera = None;
         self.started = None;
         self.deadline = None;
+        self.layout = None;
     }
 
     /// Find `label` on screen and the point at `at` (fractions; centre when `None`):
@@ -369,6 +355,20 @@ impl ScriptRunner {
                 }
                 None => {}
             },
+            Action::CheckLayout => {
+                let check = self.layout.get_or_insert_with(LayoutCheck::default);
+                match check.step(o) {
+                    Ok(finished) => done = finished,
+                    Err(e) => return Err(self.error(&step, e)),
+                }
+            }
+            Action::WindowShot => {
+                if self.phase == 0 {
+                    self.phase = 1;
+                    return Ok(ScriptStep::WindowShot);
+                }
+                done = true;
+            }
             Action::Measure(n, mode) => {
                 let now = Instant::now();
                 let t0 = *self.started.get_or_insert(now);

@@ -23,6 +23,12 @@
 //!                                 #     frames were drawn meanwhile (0 when the viewer waits)
 //! print Clip stats                # print a labelled text line to stdout as `print LABEL:
 //!                                 #     TEXT` (the clip editor's build time and memory)
+//! check layout                    # every control, scrolled into view in turn, lies whole
+//!                                 #     inside the window and the window inside the
+//!                                 #     screen; overlay labels and legends lie apart and
+//!                                 #     inside the view; prints each rectangle as
+//!                                 #     `layout: ...` lines
+//! window-shot                     # write the whole window as arbvis-window-NNN.png
 //! measure 20 full                 # draw 20 frames, printing frames per second to stdout:
 //!                                 #     `full` (the volume redrawn at full quality each
 //!                                 #     frame), `interactive` (at the interactive quality, as
@@ -84,6 +90,10 @@ pub enum Action {
     Measure(u32, MeasureMode),
     /// Print what the labelled text line shows.
     Print(String),
+    /// Check that every control fits the window and the overlay's items lie apart.
+    CheckLayout,
+    /// Write the whole window as a picture.
+    WindowShot,
     /// Close the viewer.
     Quit,
 }
@@ -165,7 +175,7 @@ pub enum ScriptError {
 }
 
 /// Every action word, for errors.
-const WORDS: &str = "wait, click, click-at, right-click-at, double-click-at, drag-on, drag, scroll, set, key, resize, idle, measure, print, quit";
+const WORDS: &str = "wait, click, click-at, right-click-at, double-click-at, drag-on, drag, scroll, set, key, resize, idle, measure, print, check layout, window-shot, quit";
 
 impl Script {
     /// Read a script file.
@@ -359,6 +369,10 @@ fn parse_action(line: &str) -> Result<Action, String> {
         }
         "print" if !rest.is_empty() => Action::Print(rest.to_string()),
         "print" => return Err("print needs a text label".into()),
+        "check" if rest == "layout" => Action::CheckLayout,
+        "check" => return Err(format!("check takes `layout`, got {rest:?}")),
+        "window-shot" if rest.is_empty() => Action::WindowShot,
+        "window-shot" => return Err("window-shot takes nothing".into()),
         "quit" => Action::Quit,
         other => {
             return Err(format!(
@@ -400,7 +414,7 @@ mod tests {
                  double-click-at x 1 0\ndrag-on secondary alpha 0.5 0.5 -30 12.5\n\
                  scroll -120\nset primary Cr 0.25\nset primary table magma\n\
                  key Home\nresize 1280 800\nidle 1000\nmeasure 20 interactive\n\
-                 print Clip stats\n"
+                 print Clip stats\ncheck layout\nwindow-shot\n"
             ),
             vec![
                 Action::Click {
@@ -437,6 +451,8 @@ mod tests {
                 Action::Idle(1000),
                 Action::Measure(20, MeasureMode::Interactive),
                 Action::Print("Clip stats".into()),
+                Action::CheckLayout,
+                Action::WindowShot,
             ]
         );
     }
@@ -472,6 +488,9 @@ mod tests {
             "measure 10 fast",
             "scroll inf",
             "print",
+            "check",
+            "check widgets",
+            "window-shot now",
         ] {
             let e = Script::parse(&format!("wait 1\n{bad}\n"), "s").unwrap_err();
             assert!(e.to_string().starts_with("s:2: "), "{bad}: {e}");

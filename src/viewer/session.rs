@@ -12,10 +12,12 @@ use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
 
 use super::data::{self, ViewData};
+use super::layout;
 use super::lut3d;
+use super::observed::Observed;
 use super::options::ViewerOptions;
-use super::panel::{self, PanelState, UiAction, PANEL_WIDTH, SECTIONS_HEIGHT};
-use super::runner::Observed;
+use super::panel::{self, PanelState, UiAction};
+use super::screenshot;
 use super::script::MeasureMode;
 use super::volume_view::{Key, Pending, VolumeView, SETTLE};
 use crate::camera::{Arcball, Camera, Projection};
@@ -56,9 +58,18 @@ pub(super) struct Running {
     last_edit: Option<Instant>,
     dragging: bool,
     generation: u64,
+    /// The number the next screenshot's name is looked for from.
     screenshots: u32,
     view_px: [i32; 4],
+    /// The whole view (the 3D picture and the legends' margin), GL pixels.
+    shown_px: [i32; 4],
     view_rect: egui::Rect,
+    /// The whole view in points.
+    shown_rect: egui::Rect,
+    /// The monitor's size in pixels, when winit knows it.
+    screen: Option<[u32; 2]>,
+    /// A script's `window-shot`: read the whole window after the next paint.
+    window_shot: bool,
     action_error: Option<String>,
     pub window: GlWindow,
 }
@@ -71,18 +82,27 @@ impl Running {
     ) -> anyhow::Result<Running> {
         let mut scene = options.scene.clone();
         let opacity3d = matches!(scene.technique, TechniqueScene::Opacity3d(_));
-        let [w, h] = scene.size.map(|v| v as f64);
-        // Room for the box labels and colour bars around a small volume.
-        let (right, below, min_view) = if opacity3d {
-            (lut3d::WIDTH as f64, SECTIONS_HEIGHT as f64, 420.0)
-        } else {
-            (0.0, 0.0, 0.0)
-        };
+        // The window fits the monitor (winit knows its size once the loop runs).
+        let monitor = event_loop
+            .primary_monitor()
+            .or_else(|| event_loop.available_monitors().next());
+        let screen = monitor.as_ref().map(|m| [m.size().width, m.size().height]);
+        let usable = monitor.as_ref().map(|m| {
+            let f = m.scale_factor().max(0.1);
+            let s = m.size();
+            layout::usable(egui::vec2(
+                (s.width as f64 / f) as f32,
+                (s.height as f64 / f) as f32,
+            ))
+        });
+        let size = layout::first_window(scene.size, opacity3d, usable);
+        let wanted = layout::first_window(scene.size, opacity3d, None);
         let attributes = Window::default_attributes()
             .with_title(format!("arbvis — {}", options.origin))
-            .with_inner_size(LogicalSize::new(
-                PANEL_WIDTH as f64 + w.max(min_view) + right,
-                (h.max(min_view) + below).max(480.0),
+            .with_inner_size(LogicalSize::new(size.x as f64, size.y as f64))
+            .with_min_inner_size(LogicalSize::new(
+                size.x.min(400.0) as f64,
+                size.y.min(300.0) as f64,
             ));
         let prefer_egl = std::env::var_os("ARBVIS_PREFER_EGL").is_some_and(|v| v == "1");
         let window = GlWindow::new(event_loop, attributes, prefer_egl)?;
@@ -92,16 +112,27 @@ impl Running {
         let renderer = data::build(gpu, &scene, kind, &mut data)?;
         let egui = EguiGlow::new(event_loop, gpu.glow().clone(), None, None, false);
         egui.egui_ctx.set_request_repaint_callback(repaint);
+        layout::style(&egui.egui_ctx);
         let mut panel = PanelState {
             kind: Some(kind),
             ..PanelState::default()
         };
+        if size != wanted {
+            if let Some([sw, sh]) = screen {
+                panel.status = format!(
+                    "the window fits the {sw}x{sh} screen: the view is smaller than the scene's {}x{}",
+                    scene.size[0], scene.size[1]
+                );
+            }
+        }
         if let Some(v) = &data.volume {
             panel.sections.index = v.prepared.dims.map(|d| d / 2);
-            let fit = fit_zoom(&scene.camera, v.prepared.half);
+        }
+        if let Some(b) = data.data_box() {
+            let fit = fit_zoom(&scene.camera, b.half);
             if scene.camera.zoom > fit {
                 panel.status = format!(
-                    "zoom {:.2} -> {fit:.2}: the whole volume in view",
+                    "zoom {:.2} -> {fit:.2}: the whole box in view",
                     scene.camera.zoom
                 );
                 scene.camera.zoom = fit;
@@ -119,9 +150,13 @@ impl Running {
             last_edit: None,
             dragging: false,
             generation: 0,
-            screenshots: 0,
+            screenshots: 1,
             view_px: [0, 0, 1, 1],
+            shown_px: [0, 0, 1, 1],
             view_rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1.0, 1.0)),
+            shown_rect: egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1.0, 1.0)),
+            screen,
+            window_shot: false,
             action_error: None,
             window,
         })
@@ -130,13 +165,20 @@ impl Running {
     /// What a script sees between frames.
     pub fn observed(&mut self, frames: u64) -> Observed<'_> {
         let size = self.window.window().inner_size();
+        let position = self.window.window().outer_position().ok();
+        let outer = self.window.window().outer_size();
         Observed {
             widgets: &mut self.panel.widgets,
             view: self.view_rect,
+            shown: self.shown_rect,
             frames,
             camera: self.scene.camera,
             window: [size.width, size.height],
+            outer: position.map(|p| [p.x, p.y, outer.width as i32, outer.height as i32]),
+            screen: self.screen,
+            pixels_per_point: self.egui.egui_ctx.pixels_per_point(),
             view_px: [self.view_px[2] as u32, self.view_px[3] as u32],
+            overlay: &self.panel.overlay_items,
             action_error: self.action_error.take(),
             quality: self.panel.quality.name(),
         }
@@ -173,6 +215,7 @@ impl Running {
         });
         let out = out.ok_or_else(|| anyhow!("egui produced no UI"))?;
         self.view_rect = out.view;
+        self.shown_rect = out.shown;
 
         // Camera from pointer input on the view.
         let view_size = DVec2::new(out.view.width() as f64, out.view.height() as f64);
@@ -231,12 +274,16 @@ impl Running {
         // follows it.
         let ppp = self.egui.egui_ctx.pixels_per_point();
         let win = self.window.window().inner_size();
-        let x = (out.view.min.x * ppp).round() as i32;
-        let w = ((out.view.width() * ppp).round() as i32).max(1);
-        let h = ((out.view.height() * ppp).round() as i32).max(1);
-        let y = win.height as i32 - (out.view.max.y * ppp).round() as i32;
-        self.view_px = [x, y, w, h];
-        self.scene.size = [w as u32, h as u32];
+        let to_px = |r: egui::Rect| {
+            let x = (r.min.x * ppp).round() as i32;
+            let w = ((r.max.x * ppp).round() as i32 - x).max(1);
+            let top = (r.min.y * ppp).round() as i32;
+            let h = ((r.max.y * ppp).round() as i32 - top).max(1);
+            [x, win.height as i32 - top - h, w, h]
+        };
+        self.view_px = to_px(out.view);
+        self.shown_px = to_px(out.shown);
+        self.scene.size = [self.view_px[2] as u32, self.view_px[3] as u32];
 
         if out.edited || out.input.scroll != 0.0 || out.input.drag_end {
             self.last_edit = Some(now);
@@ -244,7 +291,9 @@ impl Running {
         let settling = self
             .last_edit
             .is_some_and(|t| now.duration_since(t) < SETTLE);
-        let interacting = self.dragging || settling || measure == Some(MeasureMode::Interactive);
+        // A screenshot shows the full-quality picture, drawn now if need be.
+        let interacting =
+            !screenshot && (self.dragging || settling || measure == Some(MeasureMode::Interactive));
         let key = Key::of(&self.scene, self.scene.size, self.generation);
         let gpu = self.window.gpu();
         // A store's bricks keep arriving: draw the full picture again until none is due.
@@ -259,7 +308,7 @@ impl Running {
             &key,
             interacting,
             self.panel.quality,
-            measure == Some(MeasureMode::Full),
+            screenshot || measure == Some(MeasureMode::Full),
         )?;
         self.panel.volume_info = format!(
             "picture: {:.0} ms full ({} part{}), {:.0} ms interactive{}",
@@ -277,12 +326,20 @@ impl Running {
             Surface::Window([0, 0, win.width as i32, win.height as i32]),
             [0.1, 0.1, 0.1, 1.0],
         )?;
-        gl::clear(gpu, Surface::Window(self.view_px), self.scene.background)?;
+        gl::clear(gpu, Surface::Window(self.shown_px), self.scene.background)?;
         self.volume.show(gpu, self.view_px)?;
-        if screenshot {
-            self.screenshot(options, &key);
-        }
+        // The view before egui paints over it, to tell its marks from the picture's.
+        let bare = match screenshot && self.panel.overlay {
+            true => Some(gl::read_window(gpu, self.shown_px)?),
+            false => None,
+        };
         self.egui.paint(self.window.window());
+        if screenshot {
+            self.screenshot(options, &key, bare);
+        }
+        if std::mem::take(&mut self.window_shot) {
+            self.save_window(options);
+        }
         self.window.swap_buffers()?;
         Ok(match pending {
             Pending::Done if streaming => Some(Instant::now()),
@@ -292,10 +349,36 @@ impl Running {
         })
     }
 
-    /// Zoom so that the whole volume stays in view.
+    /// Zoom so that the whole volume (mesh, cloud) stays in view.
     fn fit(&mut self) {
-        if let Some(v) = &self.data.volume {
-            self.scene.camera.zoom = fit_zoom(&self.scene.camera, v.prepared.half);
+        if let Some(b) = self.data.data_box() {
+            self.scene.camera.zoom = fit_zoom(&self.scene.camera, b.half);
+        }
+    }
+
+    /// A script's `window-shot`: read the whole window after the next paint.
+    pub fn request_window_shot(&mut self) {
+        self.window_shot = true;
+    }
+
+    /// Write the whole window as `arbvis-window-NNN.png` (for looking at the layout).
+    fn save_window(&mut self, options: &ViewerOptions) {
+        let win = self.window.window().inner_size();
+        let rect = [0, 0, win.width as i32, win.height as i32];
+        let result = gl::read_window(self.window.gpu(), rect)
+            .map_err(anyhow::Error::from)
+            .and_then(|image| {
+                let bytes = png_io::encode_png("window", &image, &[])?;
+                Ok(screenshot::write_next(
+                    &options.screenshot_dir,
+                    screenshot::WINDOW_PREFIX,
+                    1,
+                    &bytes,
+                )?)
+            });
+        match result {
+            Ok((p, _)) => self.panel.status = format!("saved {}", p.display()),
+            Err(e) => self.fail_action(format!("window shot failed: {e}")),
         }
     }
 
@@ -343,12 +426,34 @@ impl Running {
         Ok(self.scene.picture(&target.read(gpu)?))
     }
 
-    fn screenshot(&mut self, options: &ViewerOptions, key: &Key) {
-        let result = self.picture(key).and_then(|image| {
-            self.screenshots += 1;
-            let path = options
-                .screenshot_dir
-                .join(format!("arbvis-screenshot-{:03}.png", self.screenshots));
+    /// Write the view as the next free `arbvis-screenshot-NNN.png`: the picture, with
+    /// what egui drew over it when `bare` (the view before egui painted) is given.
+    fn screenshot(
+        &mut self,
+        options: &ViewerOptions,
+        key: &Key,
+        bare: Option<crate::image::Image>,
+    ) {
+        let result = self.picture(key).and_then(|picture| {
+            let image = match bare {
+                Some(bare) => {
+                    let painted = gl::read_window(self.window.gpu(), self.shown_px)?;
+                    let [vx, vy, _, vh] = self.view_px;
+                    let [sx, sy, _, sh] = self.shown_px;
+                    let at = [
+                        (vx - sx).max(0) as u32,
+                        ((sy + sh) - (vy + vh)).max(0) as u32,
+                    ];
+                    let margin = if self.scene.transparent {
+                        [0.0; 4]
+                    } else {
+                        let [r, g, b, _] = self.scene.background;
+                        [r, g, b, 1.0]
+                    };
+                    screenshot::compose(&picture, at, &bare, &painted, margin)
+                }
+                None => picture,
+            };
             let caps = self.window.gpu().caps();
             let text = [
                 ("Software", format!("arbvis {}", env!("CARGO_PKG_VERSION"))),
@@ -362,8 +467,24 @@ impl Running {
                     "arbvis:renderer",
                     format!("{} | {} | {}", caps.vendor, caps.renderer, caps.version),
                 ),
+                (
+                    "arbvis:overlay",
+                    if self.panel.overlay {
+                        "box, axes and legends"
+                    } else {
+                        "none"
+                    }
+                    .to_string(),
+                ),
             ];
-            png_io::write_png(&path, &image, &text)?;
+            let bytes = png_io::encode_png("screenshot", &image, &text)?;
+            let (path, n) = screenshot::write_next(
+                &options.screenshot_dir,
+                screenshot::PREFIX,
+                self.screenshots,
+                &bytes,
+            )?;
+            self.screenshots = n + 1;
             Ok(path)
         });
         match result {

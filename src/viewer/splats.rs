@@ -85,7 +85,7 @@ pub fn editor(
         true,
     );
     changed |= w.slider(ui, "Factor", &mut scene.factor, 0.1..=10.0, "factor", true);
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("Kernel");
         for (k, label) in [
             (Kernel::Gaussian, "Gaussian"),
@@ -108,7 +108,7 @@ pub fn editor(
         &mut scene.lighting,
         "Lighting (normals per layer)",
     );
-    ui.horizontal(|ui| {
+    ui.horizontal_wrapped(|ui| {
         ui.label("Sort");
         for (s, label) in [
             (SortChoice::Radix, "radix"),
@@ -122,7 +122,7 @@ pub fn editor(
     });
     // Tiles composite the precise footprints: faithful mode draws the seed's points.
     ui.add_enabled_ui(fidelity == Fidelity::Precise, |ui| {
-        ui.horizontal(|ui| {
+        ui.horizontal_wrapped(|ui| {
             ui.label("Draw");
             for (d, label) in [(DrawChoice::Points, "points"), (DrawChoice::Tiles, "tiles")] {
                 let r = ui.radio_value(&mut scene.draw, d, label);

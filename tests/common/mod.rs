@@ -3,6 +3,8 @@
 
 pub mod hostile_files;
 pub mod splats;
+#[cfg(feature = "viewer")]
+pub mod viewer;
 
 use std::path::{Path, PathBuf};
 

@@ -1,0 +1,189 @@
+//! What the overlays know of a mesh or a cloud, taken once when the viewer prepares it:
+//! the box in object space with its axes in the file's coordinates and units, and, for a
+//! cloud, the ids (facies, layers, classes) and attribute ranges its key shows.
+//!
+//! Units: the generated section is in metres (its module says so); a LAS/LAZ file's
+//! come from its projection records ([`super::units`]); `.dat` text, PLY files and
+//! meshes say nothing of units, so their axes are plain `x`, `y`, `z`.
+
+use std::collections::BTreeSet;
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::axes::{span, Axis};
+use super::units::{las_units, Units};
+use crate::points::{PointCloud, PointSource, FACIES, FAULT, LAYER};
+
+/// Most distinct ids a key lists (beyond, it says how many more there are).
+pub const MAX_IDS: usize = 64;
+
+/// A data box: half-extents in object space and the three axes along x, y, z.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DataBox {
+    /// Half-extents in object space (the box is centred on the origin).
+    pub half: DVec3,
+    /// The axes, in the file's coordinates.
+    pub axes: [Axis; 3],
+}
+
+/// The box of file coordinates `lo`..`hi` scaled into object space by `scale` (object
+/// units per file unit), axes named `x`, `y`, `z` with `units`.
+pub fn data_box(lo: [f64; 3], hi: [f64; 3], scale: f64, units: &Units) -> DataBox {
+    let name = |a: usize| {
+        let unit = if a == 2 {
+            &units.vertical
+        } else {
+            &units.horizontal
+        };
+        let n = ["x", "y", "z"][a];
+        match unit {
+            Some(u) => format!("{n} ({u})"),
+            None => n.to_string(),
+        }
+    };
+    DataBox {
+        half: DVec3::from_array(std::array::from_fn(|a| {
+            ((hi[a] - lo[a]) * scale / 2.0).max(1e-9)
+        })),
+        axes: std::array::from_fn(|a| span(&name(a), lo[a], hi[a])),
+    }
+}
+
+/// The units of a cloud's source (relative paths from `base`).
+pub fn cloud_units(source: &PointSource, base: &Path) -> Units {
+    match source {
+        PointSource::Section(_) => Units {
+            horizontal: Some("m".into()),
+            vertical: Some("m".into()),
+        },
+        PointSource::Las(p) => las_units(&base.join(p)),
+        PointSource::Dat(_) | PointSource::Ply(_) => Units::default(),
+    }
+}
+
+/// What a cloud's key and box need.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CloudSummary {
+    /// The box and axes.
+    pub data_box: DataBox,
+    /// Distinct facies ids, ascending (at most [`MAX_IDS`]).
+    pub facies: Vec<i32>,
+    /// Distinct layer ids, ascending (at most [`MAX_IDS`]).
+    pub layers: Vec<i32>,
+    /// Distinct classification codes, ascending (at most [`MAX_IDS`]).
+    pub classes: Vec<i32>,
+    /// Ids beyond [`MAX_IDS`], per list (facies, layers, classes).
+    pub more: [usize; 3],
+    /// Some point lies on a fault.
+    pub faults: bool,
+    /// Each attribute's name and finite range.
+    pub ranges: Vec<(String, [f64; 2])>,
+}
+
+fn distinct(values: Option<&[i32]>) -> (Vec<i32>, usize) {
+    let set: BTreeSet<i32> = values.unwrap_or(&[]).iter().copied().collect();
+    let more = set.len().saturating_sub(MAX_IDS);
+    (set.into_iter().take(MAX_IDS).collect(), more)
+}
+
+impl CloudSummary {
+    /// The summary of `cloud`, whose coordinates are in `units`.
+    pub fn of(cloud: &PointCloud, units: &Units) -> CloudSummary {
+        let [lo, hi] = cloud.bounds;
+        let (facies, f) = distinct(cloud.ints(FACIES));
+        let (layers, l) = distinct(cloud.ints(LAYER));
+        let (classes, c) = distinct(cloud.ints("classification"));
+        CloudSummary {
+            data_box: data_box(lo, hi, 1.0 / cloud.scale, units),
+            facies,
+            layers,
+            classes,
+            more: [f, l, c],
+            faults: cloud.ints(FAULT).is_some_and(|v| v.iter().any(|&x| x >= 0)),
+            ranges: cloud
+                .attributes
+                .iter()
+                .map(|a| (a.name.clone(), [a.stats.min, a.stats.max]))
+                .collect(),
+        }
+    }
+
+    /// The finite range of attribute `name`.
+    pub fn range(&self, name: &str) -> Option<[f64; 2]> {
+        self.ranges
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, r)| *r)
+            .filter(|r| r[0].is_finite() && r[1].is_finite())
+    }
+}
+
+/// What a mesh's key and box need.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshSummary {
+    /// The box and axes.
+    pub data_box: DataBox,
+    /// The scalar's name.
+    pub scalar: String,
+    /// The scalar values mapped to 0 and 1.
+    pub range: [f64; 2],
+    /// The normalized scalar's histogram, 256 bins (the transfer-function editor's).
+    pub histogram: Vec<u32>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::points::section::{generate, SectionSpec};
+
+    #[test]
+    fn a_section_has_metres_and_its_ids() {
+        let cloud = generate(&SectionSpec {
+            points: 5000,
+            seed: 3,
+        })
+        .unwrap();
+        let s = CloudSummary::of(
+            &cloud,
+            &cloud_units(
+                &PointSource::Section(SectionSpec { points: 1, seed: 1 }),
+                Path::new("."),
+            ),
+        );
+        let names: Vec<&str> = s.data_box.axes.iter().map(|a| a.name.as_str()).collect();
+        assert_eq!(names, ["x (m)", "y (m)", "z (m)"]);
+        // Layers 0..7 all occur in 5000 points (each is about 500 m of 4000).
+        assert_eq!(s.layers, (0..8).collect::<Vec<_>>());
+        assert!(
+            s.facies.contains(&-999) && s.facies.len() >= 4,
+            "{:?}",
+            s.facies
+        );
+        assert!(s.faults);
+        assert!(s.classes.is_empty());
+        // The box: x spans 12 km, the longest side, so its half-extent is 1 in object
+        // space; z spans 4 km of it (within the points' spread of a few metres).
+        assert!(
+            (s.data_box.half.x - 1.0).abs() < 1e-3,
+            "{:?}",
+            s.data_box.half
+        );
+        assert!(
+            (s.data_box.half.z - 4.0 / 12.0).abs() < 2e-3,
+            "{:?}",
+            s.data_box.half
+        );
+        let [lo, hi] = s.range("porosity").unwrap();
+        assert!(lo >= 0.0 && hi > lo && hi < 0.05, "{lo} {hi}");
+        assert_eq!(s.range("no such"), None);
+    }
+
+    #[test]
+    fn ids_beyond_the_limit_are_counted() {
+        let many: Vec<i32> = (0..100).rev().collect();
+        let (ids, more) = distinct(Some(&many));
+        assert_eq!((ids.len(), ids[0], more), (MAX_IDS, 0, 100 - MAX_IDS));
+        assert_eq!(distinct(None), (vec![], 0));
+    }
+}
