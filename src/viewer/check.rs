@@ -8,8 +8,12 @@ use egui::{Pos2, Rect};
 
 use super::observed::Observed;
 
-/// Frames a control may take to scroll whole into view.
+/// Frames a control may take to scroll whole into view...
 const PATIENCE: u32 = 30;
+
+/// ...and time: egui's scrolling is animated over time, so on a loaded machine (the test
+/// suite's parallel viewers under Xvfb) 30 frames can pass before it settles.
+const PATIENCE_TIME: std::time::Duration = std::time::Duration::from_secs(5);
 
 /// The check in progress.
 #[derive(Debug, Default)]
@@ -21,6 +25,8 @@ pub struct LayoutCheck {
     lines: Vec<String>,
     /// Frames spent on the current label.
     waited: u32,
+    /// When the current label's wait began.
+    since: Option<std::time::Instant>,
 }
 
 fn rect(r: Rect) -> String {
@@ -79,8 +85,15 @@ impl LayoutCheck {
                         .push(format!("layout: control {label:?} {}", rect(seen.rect)));
                     self.pending.pop();
                     self.waited = 0;
+                    self.since = None;
                 }
-                _ if self.waited < PATIENCE => {
+                _ if self.waited < PATIENCE
+                    || self
+                        .since
+                        .get_or_insert_with(std::time::Instant::now)
+                        .elapsed()
+                        < PATIENCE_TIME =>
+                {
                     self.waited += 1;
                     return Ok(false);
                 }
