@@ -649,7 +649,7 @@ fn faithful_loses_isosurfaces_on_shared_faces_as_the_seeds_table_does() {
             // apart): measured 0 to 43 % (0.5) and 0.03 to 43 % (0.5 + 1e-3) over these
             // twelve views, a quarter to two fifths in all but one. Pinned loosely: a
             // fifth or more in the worst view, at most 3 % in the best, never over half.
-            assert!(worst >= 0.2 && worst <= 0.5, "{offset}: worst {worst}");
+            assert!((0.2..=0.5).contains(&worst), "{offset}: worst {worst}");
             assert!(best <= 0.03, "{offset}: best {best}");
         } else {
             // A texel and more off the face, the surface lies inside tetrahedra and only
