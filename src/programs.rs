@@ -78,14 +78,18 @@ pub const CELLPROJ_VOLUME_INTEGRAL_GLSL: ProgramText = program!("cellproj/volume
 pub const SPLATS_VERT: ProgramText = program!("splats/splat.vert");
 /// Splats: the seed's fragment functions as written.
 pub const SPLATS_SEED_FRAG: ProgramText = program!("splats/seed.frag");
-/// Splats: the corrected fragment stage.
+/// Splats: the corrected fragment stage (footprint from `gl_FragCoord`).
 pub const SPLATS_PRECISE_FRAG: ProgramText = program!("splats/precise.frag");
+/// Splats, precise: [`SPLATS_VERT`] plus each splat's window position and size.
+pub const SPLATS_PRECISE_VERT: ProgramText = program!("splats/precise.vert");
 /// ARB twin of [`SPLATS_VERT`] (`result.pointsize`, the `if`s as selects).
 pub const SPLATS_ARBVP: ProgramText = program!("splats/splat.arbvp");
 /// ARB twin of [`SPLATS_SEED_FRAG`] (the sprite coordinate as `fragment.texcoord[0]`).
 pub const SPLATS_SEED_ARBFP: ProgramText = program!("splats/seed.arbfp");
 /// ARB twin of [`SPLATS_PRECISE_FRAG`].
 pub const SPLATS_PRECISE_ARBFP: ProgramText = program!("splats/precise.arbfp");
+/// ARB twin of [`SPLATS_PRECISE_VERT`].
+pub const SPLATS_PRECISE_ARBVP: ProgramText = program!("splats/precise.arbvp");
 /// Weighted blended OIT's composite of the splats (ARB, over the common transform).
 pub const SPLATS_OIT_COMPOSITE_ARBFP: ProgramText = program!("splats/oit_composite.arbfp");
 /// GLSL twin of [`SPLATS_OIT_COMPOSITE_ARBFP`].
@@ -180,9 +184,11 @@ pub fn all_texts() -> Vec<ProgramText> {
         SPLATS_VERT,
         SPLATS_SEED_FRAG,
         SPLATS_PRECISE_FRAG,
+        SPLATS_PRECISE_VERT,
         SPLATS_ARBVP,
         SPLATS_SEED_ARBFP,
         SPLATS_PRECISE_ARBFP,
+        SPLATS_PRECISE_ARBVP,
         SPLATS_OIT_COMPOSITE_ARBFP,
         SPLATS_OIT_COMPOSITE_FRAG,
         SPLATS_TILES_FRAG,

@@ -549,3 +549,114 @@ fn view_order_and_entry_depth_draw_the_same_picture_from_fewer_vertices() {
         );
     }
 }
+
+/// Of the interior pixels (away from the silhouette) where the f64 reference crosses an
+/// isovalue, the fraction `image` leaves at the background; and how many there are.
+fn lost_fraction(
+    prepared: &Prepared,
+    isos: &[Isovalue],
+    image: &Image,
+    camera: &Camera,
+    size: [u32; 2],
+) -> (f64, usize) {
+    let hits = reference(prepared, isos, camera, size);
+    let silhouette = silhouette_pixels(prepared, camera, size, 1.5);
+    let (mut crossed, mut lost) = (0usize, 0usize);
+    for (n, px) in image.data.chunks_exact(4).enumerate() {
+        if hits[n].is_some() && !silhouette[n] {
+            crossed += 1;
+            lost += (px[..3] == BACKGROUND[..3]) as usize;
+        }
+    }
+    (lost as f64 / crossed.max(1) as f64, crossed)
+}
+
+/// Views of the planar field's isosurface x = 0.5 from several sides (none edge-on).
+fn planar_views() -> Vec<Camera> {
+    let rotations = [
+        [0.2391, 0.3696, 0.0990, 0.8924],
+        [0.0, 0.3827, 0.0, 0.9239],
+        [0.1, 0.5, 0.0, 0.86],
+        [-0.3, 0.2, 0.4, 0.84],
+        [0.35, -0.45, 0.1, 0.81],
+        [0.05, 0.62, -0.2, 0.75],
+    ];
+    let mut views = Vec::new();
+    for projection in [Projection::Orthographic, Projection::Perspective] {
+        for r in rotations {
+            let norm = r.iter().map(|v: &f64| v * v).sum::<f64>().sqrt();
+            views.push(Camera {
+                projection,
+                rotation: r.map(|v| v / norm),
+                zoom: 0.9,
+                ..Camera::default()
+            });
+        }
+    }
+    views
+}
+
+#[test]
+fn faithful_loses_isosurfaces_on_shared_faces_as_the_seeds_table_does() {
+    // x on the 17-point grid: 0.5 is the middle layer of vertices, so its isosurface lies
+    // on faces shared by two tetrahedra. The table decides crossings at texel centres
+    // (sf, sb) = ((i + 1/2) / 256, (j + 1/2) / 256): the tetrahedron behind the plane
+    // draws it only if its extrapolated exit scalar sb rounds to at least 0.5, the one
+    // in front only if its interpolated entry sf rounds below 0.5; where the first
+    // rounds down and the second up, neither does.
+    let h = headless(Backend::Egl);
+    let prepared = seed_mesh(Field::Planar);
+    for offset in [0.0, 1e-3, 1e-2] {
+        let isos = vec![Isovalue {
+            value: 0.5 + offset,
+            color: [0.0, 1.0, 0.0, 1.0],
+        }];
+        let p = params(Field::Planar, isos.clone());
+        let mut faithful = Vec::new();
+        for cam in planar_views() {
+            let (image, _) = draw(
+                &h,
+                &p,
+                prepared.clone(),
+                Fidelity::Faithful,
+                ProgramKind::Arb,
+                cam,
+                SIZE,
+            );
+            let (lost, crossed) = lost_fraction(&prepared, &isos, &image, &cam, SIZE);
+            let (image, _) = draw_precise(&h, &p, prepared.clone(), cam, SIZE);
+            let (precise, _) = lost_fraction(&prepared, &isos, &image, &cam, SIZE);
+            eprintln!(
+                "iso 0.5 + {offset}, {:?} {:?}: {crossed} pixels cross it; faithful loses \
+                 {lost:.4}, precise {precise:.4}",
+                cam.projection, cam.rotation
+            );
+            // Precise finds the exact crossing (the half-open rule gives it to exactly
+            // one of the two tetrahedra). Measured: none lost but in one view, 5 of
+            // 10,020 pixels (5e-4); 2e-3 is that with room, far below faithful's loss.
+            assert!(precise < 2e-3, "{offset} {cam:?}: precise lost {precise}");
+            assert!(
+                crossed > 2000,
+                "{cam:?}: the isosurface covers {crossed} pixels"
+            );
+            faithful.push(lost);
+        }
+        let worst = faithful.iter().copied().fold(0.0, f64::max);
+        let best = faithful.iter().copied().fold(1.0, f64::min);
+        eprintln!("iso 0.5 + {offset}: faithful loses {best:.4} to {worst:.4}");
+        if offset < 1.0 / 512.0 {
+            // On the face, or nearer to it than half a texel (the table cannot tell them
+            // apart): measured 0 to 43 % (0.5) and 0.03 to 43 % (0.5 + 1e-3) over these
+            // twelve views, a quarter to two fifths in all but one. Pinned loosely: a
+            // fifth or more in the worst view, at most 3 % in the best, never over half.
+            assert!((0.2..=0.5).contains(&worst), "{offset}: worst {worst}");
+            assert!(best <= 0.03, "{offset}: best {best}");
+        } else {
+            // A texel and more off the face, the surface lies inside tetrahedra and only
+            // the table's quantization is left (as in
+            // faithful_agrees_with_the_reference_within_its_table_quantization):
+            // measured at most 0.33 % lost.
+            assert!(worst <= 0.01, "{offset}: worst {worst}");
+        }
+    }
+}

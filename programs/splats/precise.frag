@@ -3,11 +3,17 @@
 // (value - min) / (max - min), clamped, 0 for an empty range; the footprints fall off
 // from the centre (smoothstep(0, 1, 1 - n_dist), exp(-n_dist^2 / (2 width)), a width of 0
 // giving a single opaque pixel at the centre). Uniforms as seed.frag. ARB twin: precise.arbfp.
+// The footprint is taken from gl_FragCoord and the splat's window position and size
+// (v_window, from precise.vert), not from gl_PointCoord: the pixel centre must lie in the
+// half-open square of side `size` around the position (the rasterizer's square, which
+// precise.vert widens, is only a superset) and n_dist = |d| (1 / (size / 2)), the f64
+// reference's |d| / (size / 2) with the ARB twin's reciprocal.
 uniform vec4 program_local[6];
 in vec3 v_color;
 in float v_value;
 in vec2 v_light;
 in float v_z;
+flat in vec3 v_window;
 out vec4 FragColor;
 const float PI = 3.14159265358979;
 
@@ -17,8 +23,12 @@ float normalized(float value, float min_value, float max_value) {
 }
 
 void main() {
-    float n_dist = 2.0 * length(gl_PointCoord - vec2(0.5));
-    if (n_dist > 1.0) discard;
+    vec2 d = gl_FragCoord.xy - v_window.xy;
+    float half_size = 0.5 * v_window.z;
+    if (any(lessThan(d, vec2(-half_size))) || any(greaterThanEqual(d, vec2(half_size))))
+        discard;
+    float n_dist = length(d) * (1.0 / half_size);
+    if (!(n_dist <= 1.0)) discard;
     float min_value = program_local[0].y;
     float max_value = program_local[0].z;
     float n = normalized(v_value, min_value, max_value);

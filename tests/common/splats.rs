@@ -59,6 +59,19 @@ pub fn draw_with(
     fidelity: Fidelity,
     camera: Camera,
 ) -> Image {
+    draw_sized(h, kind, cloud, params, fidelity, camera, SIZE)
+}
+
+/// [`draw_with`] on a `size` target.
+pub fn draw_sized(
+    h: &Headless,
+    kind: ProgramKind,
+    cloud: &PointCloud,
+    params: &SplatsScene,
+    fidelity: Fidelity,
+    camera: Camera,
+    size: [u32; 2],
+) -> Image {
     let gpu = h.gpu();
     let normals = normals_for(cloud, params);
     let prepared = from_cloud(cloud, params, normals).unwrap();
@@ -72,12 +85,12 @@ pub fn draw_with(
         prepared,
     )
     .unwrap();
-    let target = Target::new(gpu, SIZE[0], SIZE[1], TargetFormat::Rgba32f).unwrap();
+    let target = Target::new(gpu, size[0], size[1], TargetFormat::Rgba32f).unwrap();
     target.clear(gpu, BACKGROUND).unwrap();
     let frame = Frame {
         camera,
-        width: SIZE[0],
-        height: SIZE[1],
+        width: size[0],
+        height: size[1],
     };
     r.draw(gpu, Surface::Target(&target), &frame).unwrap();
     assert_eq!(r.program_kind(), kind);
@@ -94,7 +107,7 @@ pub fn reference(
     reference_of(cloud, params, fidelity, camera, false)
 }
 
-/// The f64 reference, in exact order or weighted blended (the GPU's weight).
+/// The f64 reference, in the renderer's order or weighted blended (the GPU's weight).
 pub fn reference_of(
     cloud: &PointCloud,
     params: &SplatsScene,
@@ -102,6 +115,22 @@ pub fn reference_of(
     camera: &Camera,
     oit: bool,
 ) -> Image {
+    let (positions, rgba) = reference_points(cloud, params, fidelity, camera);
+    let scene = reference_scene(&positions, &rgba, params, fidelity);
+    if oit {
+        weighted_blended(&scene, OIT_WEIGHT, camera, SIZE)
+    } else {
+        composite(&scene, camera, SIZE)
+    }
+}
+
+/// The drawn points' positions and f64 RGBA as the reference takes them.
+pub fn reference_points(
+    cloud: &PointCloud,
+    params: &SplatsScene,
+    fidelity: Fidelity,
+    camera: &Camera,
+) -> (Vec<[f32; 3]>, Vec<[f64; 4]>) {
     let normals = normals_for(cloud, params);
     let prepared = from_cloud(cloud, params, normals).unwrap();
     let rgba = point_rgba(
@@ -111,9 +140,19 @@ pub fn reference_of(
         eye_position(camera),
         view_direction(camera),
     );
-    let scene = SplatScene {
-        positions: &prepared.positions,
-        rgba: &rgba,
+    (prepared.positions, rgba)
+}
+
+/// The reference's scene of those points.
+pub fn reference_scene<'a>(
+    positions: &'a [[f32; 3]],
+    rgba: &'a [[f64; 4]],
+    params: &SplatsScene,
+    fidelity: Fidelity,
+) -> SplatScene<'a> {
+    SplatScene {
+        positions,
+        rgba,
         params: SplatParams {
             point_size: params.point_size,
             factor: params.factor,
@@ -121,11 +160,6 @@ pub fn reference_of(
             size_range: [1.0, 255.0],
         },
         background: BACKGROUND.map(f64::from),
-    };
-    if oit {
-        weighted_blended(&scene, OIT_WEIGHT, camera, SIZE)
-    } else {
-        composite(&scene, camera, SIZE)
     }
 }
 

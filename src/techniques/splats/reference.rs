@@ -17,10 +17,19 @@
 //! 3. Point-sprite rasterization: fragments for the pixels whose centres lie in the
 //!    square of side `size` centred on the window position, half-open
 //!    (`x_w - size/2 ≤ x + 0.5 < x_w + size/2`, the same in y).
-//! 4. The fragment shader's `n_dist = 2 |gl_PointCoord - 0.5|`: 0 at the centre, 1 on
-//!    the inscribed circle; fragments with `n_dist > 1` are discarded. Alpha is the
+//! 4. The fragment shader's `n_dist = 2 |gl_PointCoord - 0.5|`, here `|d| / (size / 2)`
+//!    with `d` from the splat's window position to the pixel centre: 0 at the centre, 1
+//!    on the inscribed circle; fragments with `n_dist > 1` are discarded. Alpha is the
 //!    point's alpha times the [`Footprint`] at `n_dist`; colour and alpha are clamped
 //!    to [0, 1] (a fixed-point target clamps them) and a NaN alpha counts as 0.
+//!
+//! The precise programs compute steps 3 and 4 as written here, in f32, from the
+//! fragment's window position (`precise.frag`; the tiles' gather likewise), so they
+//! differ from this reference by f32 rounding except at pixel centres within that
+//! rounding of a splat's rim, where a fragment can fall on either side of `n_dist = 1`
+//! and the pixel moves by up to the footprint's rim value ([`rim_allowance`] marks those
+//! pixels). The faithful programs use `gl_PointCoord`, which llvmpipe computes from the
+//! rasterizer's fixed-point position, about 2e-3 px off: their rim pixels move more.
 //! 5. Blending: colour `SRC_ALPHA, ONE_MINUS_SRC_ALPHA` as the seed's `glBlendFunc`;
 //!    alpha `ONE, ONE_MINUS_SRC_ALPHA` (arbvis's `Blend::Over`), so the alpha channel is
 //!    coverage, `a + dst.a (1 - a)`.
@@ -43,10 +52,19 @@
 //!
 //! # Order
 //!
-//! [`composite`] sorts by the f64 distance to the eye (perspective) or f64 depth along
-//! the viewing direction (orthographic), farthest first, ties in index order, the same
-//! rule as [`super::sort`] in f32; [`composite_in_order`] takes any order (the
-//! renderer's own, to separate rasterization from sorting).
+//! [`composite`] draws in [`key_order`]: the renderer's order, computed as the renderer
+//! computes it: [`View::key`] in f32 (squared distance to the f32 eye in perspective,
+//! `p·v` along the f32 viewing direction in orthographic), farthest first, equal keys
+//! in point index order (the rule of [`super::sort`]'s `Keys` and `Radix` methods and
+//! of every tile list). So the reference and the renderer composite the same fragments
+//! in the same sequence, and what they are scored on is placement, footprint and
+//! blending. The key is exact to its f32 rounding only: where the true depths of two
+//! overlapping splats differ by less than the rounding of their keys (about 2^-23 of the
+//! key: 1e-7 of the depth, more in perspective where the key is a sum of squares), the
+//! key's order, not the true order, is drawn, by both. [`exact_order`] gives the true
+//! order in f64 and [`composite_in_order`] any order, to measure what that costs
+//! (single pixels by up to the difference of the two splats' colours, times their
+//! alphas, in a cloud built to have such pairs).
 //!
 //! # Weighted blended OIT
 //!
@@ -62,6 +80,7 @@
 use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 
+use super::sort::{keys_order, View};
 use crate::camera::{Camera, Projection};
 use crate::image::Image;
 use crate::vocab::TargetFormat;
@@ -377,10 +396,49 @@ pub fn exact_order(positions: &[[f32; 3]], camera: &Camera) -> Vec<u32> {
     order.into_iter().map(|(_, i)| i).collect()
 }
 
-/// The reference image: the splats in exact back-to-front order, blended in f64.
+/// The renderer's back-to-front order (see the module doc): the f32 [`View::key`] of
+/// `camera`'s view, farthest first, ties in index order.
+pub fn key_order(positions: &[[f32; 3]], camera: &Camera) -> Vec<u32> {
+    keys_order(positions, View::of_camera(camera))
+}
+
+/// The reference image: the splats in the renderer's back-to-front order
+/// ([`key_order`]), blended in f64.
 pub fn composite(scene: &SplatScene, camera: &Camera, size: [u32; 2]) -> Image {
-    let order = exact_order(&scene.positions[..scene.len()], camera);
+    let order = key_order(&scene.positions[..scene.len()], camera);
     composite_in_order(scene, &order, camera, size)
+}
+
+/// Per pixel (top row first, as an [`Image`]), the most a renderer placing splats in
+/// f32 can differ from [`composite`] there by a rim fragment falling on the other side
+/// of `n_dist = 1`: the sum, over the splats whose rim passes within `delta` pixels of
+/// the pixel's centre, of the alpha of their rim (the point's alpha times the footprint
+/// at 1). 0 where no rim passes that close.
+pub fn rim_allowance(scene: &SplatScene, camera: &Camera, size: [u32; 2], delta: f64) -> Vec<f64> {
+    let projector = Projector::new(camera, size);
+    let splats: Vec<Screen> = (0..scene.len())
+        .filter_map(|i| projector.project(scene, i))
+        .collect();
+    let rim = scene.params.footprint.alpha(1.0);
+    let [width, height] = size;
+    let mut pixels = vec![0.0f64; width as usize * height as usize];
+    for s in &splats {
+        let h = s.size / 2.0;
+        let (y0, y1) = covered(s.y, h + delta, height);
+        let (x0, x1) = covered(s.x, h + delta, width);
+        for j in y0..y1 {
+            let dy = j as f64 + 0.5 - s.y;
+            for i in x0..x1 {
+                let dx = i as f64 + 0.5 - s.x;
+                if ((dx * dx + dy * dy).sqrt() - h).abs() <= delta {
+                    // GL rows count up; images count down.
+                    let k = (height as i64 - 1 - j) as usize * width as usize + i as usize;
+                    pixels[k] += clamp01(s.alpha * rim);
+                }
+            }
+        }
+    }
+    pixels
 }
 
 /// The splats drawn in `order` (indices past the points are skipped), blended in f64.

@@ -4,9 +4,18 @@
 //! draw of point sprites blended `SRC_ALPHA, ONE_MINUS_SRC_ALPHA` without depth test.
 //! `sort = "oit"` draws the visible points in file order through [`OitPass`] instead.
 //!
-//! Programs: ARB (`splats/splat.arbvp` with `seed.arbfp` or `precise.arbfp`) or their
-//! GLSL twins, as the scene's `programs` resolves; point sprites work under both (the
-//! ARB fragment programs read the sprite coordinate from `fragment.texcoord[0]`).
+//! Programs: ARB (`splats/splat.arbvp` with `seed.arbfp`, or `precise.arbvp` with
+//! `precise.arbfp`) or their GLSL twins, as the scene's `programs` resolves; point
+//! sprites work under both (the seed's ARB fragment program reads the sprite coordinate
+//! from `fragment.texcoord[0]`).
+//!
+//! Faithful programs take a fragment's place in its splat from the point sprite's
+//! coordinate (`gl_PointCoord`), as the seed did. The precise ones take it from the
+//! fragment's window position and the splat's (vertex locals 9 and 10: the viewport,
+//! the size range and [`POINT_MARGIN`]), so a precise splat covers the pixels and takes
+//! the footprint that [`reference`](super::reference) gives, to f32 rounding: on
+//! llvmpipe `gl_PointCoord` is about 2e-3 px off that, which moved rim pixels of a
+//! Gaussian of width 0.35 by up to 0.2.
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -33,14 +42,20 @@ use crate::programs::{self, ProgramPair};
 use crate::techniques::{Frame, Params, Renderer};
 use crate::vocab::Fidelity;
 
+/// Pixels the precise programs widen a point's size by (half on each side): the
+/// rasterizer's square (its centre snapped to fixed point) then holds every pixel whose
+/// centre lies in the exact square, and the program decides. Lost only at the top of the
+/// size range (255 px), where GL clamps the widened size.
+pub const POINT_MARGIN: f64 = 1.0;
+
 /// The program pair of a fidelity and kind.
 pub fn program_pair(fidelity: Fidelity, kind: ProgramKind) -> ProgramPair {
     use programs::*;
     let (vertex, fragment) = match (kind, fidelity) {
         (ProgramKind::Arb, Fidelity::Faithful) => (SPLATS_ARBVP, SPLATS_SEED_ARBFP),
-        (ProgramKind::Arb, Fidelity::Precise) => (SPLATS_ARBVP, SPLATS_PRECISE_ARBFP),
+        (ProgramKind::Arb, Fidelity::Precise) => (SPLATS_PRECISE_ARBVP, SPLATS_PRECISE_ARBFP),
         (ProgramKind::Glsl, Fidelity::Faithful) => (SPLATS_VERT, SPLATS_SEED_FRAG),
-        (ProgramKind::Glsl, Fidelity::Precise) => (SPLATS_VERT, SPLATS_PRECISE_FRAG),
+        (ProgramKind::Glsl, Fidelity::Precise) => (SPLATS_PRECISE_VERT, SPLATS_PRECISE_FRAG),
     };
     ProgramPair {
         kind,
@@ -334,6 +349,8 @@ impl SplatsRenderer {
         };
         prog.set_vertex_local(gpu, 6, [p.point_size, p.factor, lighting, 0.0])?;
         prog.set_vertex_local(gpu, 7, PHONG)?;
+        let [lo, hi] = self.splat_params().size_range;
+        prog.set_vertex_local(gpu, 10, [lo, hi, POINT_MARGIN, 0.0])?;
         Ok(())
     }
 }
@@ -372,6 +389,13 @@ impl Renderer for SplatsRenderer {
             .set_vertex_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
         self.program
             .set_vertex_local(gpu, 8, z_row(camera).to_array())?;
+        // The viewport in window coordinates (the precise programs' splat positions):
+        // OIT draws into its own targets, whose corner is the origin.
+        let viewport = match surface {
+            Surface::Window(v) if self.params.sort != SortChoice::Oit => v.map(f64::from),
+            _ => [0.0, 0.0, frame.width as f64, frame.height as f64],
+        };
+        self.program.set_vertex_local(gpu, 9, viewport)?;
         if self.params.sort == SortChoice::Oit {
             let (w, h) = (frame.width, frame.height);
             if !self.oit.as_ref().is_some_and(|o| o.fits(w, h)) {
@@ -473,9 +497,9 @@ pub fn program_pairs() -> Vec<ProgramPair> {
     use programs::*;
     let mut pairs: Vec<ProgramPair> = [
         (ProgramKind::Arb, SPLATS_ARBVP, SPLATS_SEED_ARBFP),
-        (ProgramKind::Arb, SPLATS_ARBVP, SPLATS_PRECISE_ARBFP),
+        (ProgramKind::Arb, SPLATS_PRECISE_ARBVP, SPLATS_PRECISE_ARBFP),
         (ProgramKind::Glsl, SPLATS_VERT, SPLATS_SEED_FRAG),
-        (ProgramKind::Glsl, SPLATS_VERT, SPLATS_PRECISE_FRAG),
+        (ProgramKind::Glsl, SPLATS_PRECISE_VERT, SPLATS_PRECISE_FRAG),
         (ProgramKind::Glsl, TRANSFORM_VERT, SPLATS_TILES_FRAG),
     ]
     .map(|(kind, vertex, fragment)| ProgramPair {

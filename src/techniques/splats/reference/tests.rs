@@ -410,3 +410,63 @@ fn oit_weights() {
             < 1e-12
     );
 }
+
+#[test]
+fn composite_draws_the_f32_keys_order_ties_by_index() {
+    // Orthographic along -z (the key is -z, larger is farther): points 0 and 1 have
+    // equal keys (same z, nearer than point 2), so the lower index is drawn first.
+    let camera = Camera::default();
+    let positions = [[0.0, 0.0, 0.3], [0.001, 0.0, 0.3], [0.0, 0.0, 0.2]];
+    let rgba = [
+        [1.0, 0.0, 0.0, 0.7],
+        [0.0, 1.0, 0.0, 0.7],
+        [0.0, 0.0, 1.0, 0.2],
+    ];
+    let s = scene(&positions, &rgba, params(Footprint::Disc, 5.0), BG);
+    let order = key_order(&positions, &camera);
+    assert_eq!(order, vec![2, 0, 1]);
+    assert_eq!(order, keys_order(&positions, View::of_camera(&camera)));
+    assert_eq!(
+        composite(&s, &camera, [9, 9]),
+        composite_in_order(&s, &order, &camera, [9, 9])
+    );
+    // A rotated view and a pair a few ulps apart that the f32 key orders otherwise than
+    // their f64 depths: composite follows the key, not the f64 order.
+    let camera = Camera {
+        rotation: [0.31, -0.22, 0.12, 0.917],
+        ..Camera::default()
+    };
+    let mut rng = SplitMix64::new(3);
+    let found = (0..10_000).find_map(|_| {
+        let p: [f32; 3] = [0, 1, 2].map(|_| rng.range(-0.5, 0.5) as f32);
+        let q = p
+            .map(|v| f32::from_bits((v.to_bits() as i32 + (rng.next_u64() % 7) as i32 - 3) as u32));
+        let pair = [p, q];
+        (key_order(&pair, &camera) != exact_order(&pair, &camera)).then_some(pair)
+    });
+    let pair = found.expect("a pair the f32 key misorders");
+    let rgba = [[1.0, 0.0, 0.0, 0.9], [0.0, 0.0, 1.0, 0.9]];
+    let s = scene(&pair, &rgba, params(Footprint::Disc, 5.0), BG);
+    let by_key = composite_in_order(&s, &key_order(&pair, &camera), &camera, [9, 9]);
+    let by_depth = composite_in_order(&s, &exact_order(&pair, &camera), &camera, [9, 9]);
+    assert_eq!(composite(&s, &camera, [9, 9]), by_key);
+    assert!(by_key.compare(&by_depth, 0.0).unwrap().max_abs > 0.5);
+}
+
+#[test]
+fn rim_allowance_marks_pixel_centres_near_rims() {
+    // Orthographic, 9 x 9: the origin on the centre of pixel (4, 4); a 4-pixel splat's
+    // rim (radius 2) passes through the centres of pixels (2, 4), (6, 4), (4, 2) and
+    // (4, 6) and no other (the nearest others are sqrt(5) - 2 = 0.24 px off it).
+    let rgba = [[1.0, 1.0, 1.0, 0.5]];
+    let footprint = Footprint::Gaussian { width: 0.35 };
+    let s = scene(&[[0.0; 3]], &rgba, params(footprint, 4.0), BG);
+    let allowance = rim_allowance(&s, &Camera::default(), [9, 9], 1e-3);
+    let rim = 0.5 * (-1.0f64 / 0.7).exp();
+    let marked: Vec<(usize, usize)> = (0..81)
+        .filter(|&k| allowance[k] > 0.0)
+        .map(|k| (k % 9, k / 9))
+        .collect();
+    assert_eq!(marked, vec![(4, 2), (2, 4), (6, 4), (4, 6)]);
+    assert!(marked.iter().all(|&(i, j)| allowance[j * 9 + i] == rim));
+}
