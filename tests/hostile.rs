@@ -16,27 +16,15 @@ mod common;
 const REFUSAL_TIME: Duration = Duration::from_secs(20);
 
 fn render(scene: &Path, png: &Path) -> (Output, Duration) {
-    let t0 = Instant::now();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args([
+    arbvis(
+        &[
             "render",
             scene.to_str().unwrap(),
             "-o",
             png.to_str().unwrap(),
-        ])
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    // A hang must fail the test, not the suite.
-    while child.try_wait().unwrap().is_none() {
-        if t0.elapsed() > REFUSAL_TIME * 2 {
-            let _ = child.kill();
-            panic!("{} hung", scene.display());
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    (child.wait_with_output().unwrap(), t0.elapsed())
+        ],
+        &[],
+    )
 }
 
 /// Render `scene_text` (written to DIR/scene.toml) and expect a refusal containing every
@@ -342,8 +330,8 @@ fn the_budget_comes_from_the_flag_then_the_environment_then_the_scene() {
 #[path = "../src/mesh/tests/hostile_files.rs"]
 mod mesh_hostile;
 
-/// Run `arbvis ARGS` with `env`, killing it (and failing) if it runs past twice
-/// [`REFUSAL_TIME`]; its output and how long it took.
+/// Run `arbvis ARGS` with `env`, killing it (and failing: a hang must fail the test, not
+/// the suite) if it runs past twice [`REFUSAL_TIME`]; its output and how long it took.
 fn arbvis(args: &[&str], env: &[(&str, &str)]) -> (Output, Duration) {
     let t0 = Instant::now();
     let mut child = Command::new(env!("CARGO_BIN_EXE_arbvis"))
@@ -695,29 +683,15 @@ fn small_file_time() -> Duration {
     }
 }
 
-/// `arbvis inspect PATH` (with `args` before it), killed past twice the bound; its
-/// output, whether it succeeded, and how long it took.
+/// `arbvis inspect PATH` (with `args` before it), killed past twice [`REFUSAL_TIME`];
+/// whether it succeeded, its output, and how long it took.
 fn inspect(path: &Path, args: &[&str]) -> (bool, String, Duration) {
-    let t0 = Instant::now();
-    let mut child = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args(args)
-        .arg("inspect")
-        .arg(path)
-        .stdout(std::process::Stdio::piped())
-        .stderr(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    while child.try_wait().unwrap().is_none() {
-        if t0.elapsed() > small_file_time() * 2 {
-            let _ = child.kill();
-            panic!("{} hung", path.display());
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let out = child.wait_with_output().unwrap();
+    let mut all = args.to_vec();
+    all.extend(["inspect", path.to_str().unwrap()]);
+    let (out, took) = arbvis(&all, &[]);
     let text =
         String::from_utf8_lossy(&out.stdout).to_string() + &String::from_utf8_lossy(&out.stderr);
-    (out.status.success(), text, t0.elapsed())
+    (out.status.success(), text, took)
 }
 
 /// Write `bytes` as DIR/NAME and inspect it: it must be refused (or accepted, `ok`) with
