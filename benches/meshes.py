@@ -22,22 +22,8 @@ import sys
 
 import numpy as np
 
-
-def kuhn(n):
-    i, j, k = np.meshgrid(np.arange(n), np.arange(n), np.arange(n), indexing="ij")
-    pts = np.stack([i, j, k], axis=-1).transpose(2, 1, 0, 3).reshape(-1, 3) / (n - 1.0)
-    idx = lambda a, b, d: a + n * (b + n * d)  # noqa: E731
-    ci, cj, ck = np.meshgrid(np.arange(n - 1), np.arange(n - 1), np.arange(n - 1), indexing="ij")
-    ci, cj, ck = ci.ravel(), cj.ravel(), ck.ravel()
-    tets = []
-    for order in ([0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]):
-        o = np.zeros(3, dtype=int)
-        corners = [idx(ci, cj, ck)]
-        for axis in order:
-            o[axis] += 1
-            corners.append(idx(ci + o[0], cj + o[1], ck + o[2]))
-        tets.append(np.stack(corners, axis=1))
-    return pts, np.concatenate(tets)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "peers"))
+from peer_common import kuhn_tets  # noqa: E402
 
 
 def fix_orientation(pts, tets):
@@ -68,11 +54,11 @@ def write_vtu(path, pts, tets, name, values):
 def main():
     out = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "target", "meshes")
     os.makedirs(out, exist_ok=True)
-    pts, tets = kuhn(33)
+    pts, tets = kuhn_tets(33)
     field = np.linalg.norm(pts - 0.5, axis=1)
     write_vtu(os.path.join(out, "kuhn-200k.vtu"), pts, fix_orientation(pts, tets), "spherical", field)
     print(f"kuhn-200k.vtu: {len(tets)} tetrahedra", file=sys.stderr)
-    pts, tets = kuhn(56)
+    pts, tets = kuhn_tets(56)
     c = pts[tets].mean(axis=1)
     hole_cyl = (c[:, 0] - 0.3) ** 2 + (c[:, 2] - 0.5) ** 2 < 0.15 ** 2
     hole_sph = np.linalg.norm(c - [0.7, 0.5, 0.5], axis=1) < 0.2

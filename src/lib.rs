@@ -11,6 +11,11 @@
 
 #![deny(unsafe_code)]
 
+// Test fixtures shared with tests/ (tests/common/hostile_files.rs, included by the LAS
+// unit tests) name the crate as `arbvis::`, as an integration test does.
+#[cfg(test)]
+extern crate self as arbvis;
+
 pub mod budget;
 pub mod camera;
 pub mod catalog;

@@ -358,6 +358,25 @@ fn inspect_file(dir: &Path, name: &str, bytes: &[u8], env: &[(&str, &str)]) -> (
     arbvis(&["inspect", path.to_str().unwrap()], env)
 }
 
+/// `arbvis inspect` must read DIR/name (written from `bytes`) and print every `expect`
+/// string; its output.
+fn inspect_read(dir: &Path, name: &str, bytes: &[u8], expect: &[&str]) -> String {
+    let (out, _) = inspect_file(dir, name, bytes, &[]);
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for want in expect {
+        assert!(
+            stdout.contains(want),
+            "{name}: missing {want:?} in {stdout}"
+        );
+    }
+    stdout
+}
+
 /// `arbvis inspect` must refuse, within the bound, naming the file and containing every
 /// `expect` string.
 fn inspect_refused(dir: &Path, name: &str, bytes: &[u8], env: &[(&str, &str)], expect: &[&str]) {
@@ -379,20 +398,16 @@ fn mesh_scene(mesh: &str) -> String {
 #[test]
 fn issue17_mesh_sections_in_any_order_are_checked_against_each_other() {
     let dir = temp_dir("i17-order");
-    let (out, _) = inspect_file(&dir, "first.msh", &mesh_hostile::gmsh_data_first(), &[]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    inspect_read(
+        &dir,
+        "first.msh",
+        &mesh_hostile::gmsh_data_first(),
+        &[
+            "tetrahedra: 2\n",
+            "point array \"t\": 1 component, range [-1.5, 7]",
+            "cell array \"m\": 1 component, range [40, 41]",
+        ],
     );
-    for want in [
-        "tetrahedra: 2\n",
-        "point array \"t\": 1 component, range [-1.5, 7]",
-        "cell array \"m\": 1 component, range [40, 41]",
-    ] {
-        assert!(stdout.contains(want), "missing {want:?} in {stdout}");
-    }
     // A $NodeData entry for a node no $Nodes section has, before the nodes.
     let bad = String::from_utf8(mesh_hostile::gmsh_data_first())
         .unwrap()
@@ -563,31 +578,22 @@ fn issue17_mesh_messages_name_the_file_the_position_and_the_cause() {
         )],
     );
     file.extend(b"\n</AppendedData>\n</VTKFile>\n");
-    let (out, _) = inspect_file(&dir, "whole.vtu", &file, &[]);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    inspect_read(&dir, "whole.vtu", &file, &[]);
 }
 
 #[test]
 fn issue17_coordinates_near_the_largest_f64_are_inspected_and_drawn() {
     let dir = temp_dir("i17-huge");
-    let (out, _) = inspect_file(&dir, "huge.vtk", &mesh_hostile::huge_coordinates(), &[]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let stdout = inspect_read(
+        &dir,
+        "huge.vtk",
+        &mesh_hostile::huge_coordinates(),
+        &[
+            "bounds: x [-1.7e308, 1.7e308] y [-1.7e308, 1.7e308] z [-1.7e308, 1.7e308]",
+            // (3.4e308)^3 x (1/6 + 1/3): beyond the f64 range, written from its scaled form.
+            "volume: total 1.965200e925, smallest tetrahedron 6.550667e924",
+        ],
     );
-    for want in [
-        "bounds: x [-1.7e308, 1.7e308] y [-1.7e308, 1.7e308] z [-1.7e308, 1.7e308]",
-        // (3.4e308)^3 x (1/6 + 1/3): beyond the f64 range, written from its scaled form.
-        "volume: total 1.965200e925, smallest tetrahedron 6.550667e924",
-    ] {
-        assert!(stdout.contains(want), "missing {want:?} in {stdout}");
-    }
     assert!(
         !stdout.contains("NaN") && !stdout.contains("inf"),
         "{stdout}"

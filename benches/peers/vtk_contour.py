@@ -20,6 +20,7 @@ import argparse
 import json
 import os
 import statistics
+import sys
 import time
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
@@ -28,29 +29,16 @@ import numpy as np  # noqa: E402
 import vtk  # noqa: E402
 from vtk.util import numpy_support  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from peer_common import kuhn_tets  # noqa: E402
+
 
 def grid_mesh(n):
     """The n^3-point Kuhn grid of src/mesh/grid.rs with its spherical field."""
-    step = 1.0 / (n - 1)
-    i, j, k = np.meshgrid(np.arange(n), np.arange(n), np.arange(n), indexing="ij")
-    # Point (i, j, k) has index i + n (j + n k): order the arrays k, j, i (i fastest).
-    pts = np.stack([i, j, k], axis=-1).transpose(2, 1, 0, 3).reshape(-1, 3) * step
+    pts, tets = kuhn_tets(n)
     c = 0.5  # the box [0, 1]^3 has its centre at 0.5 on every axis
     f = np.linalg.norm(pts - c, axis=1)
     f = (f - f.min()) / (f.max() - f.min())
-    # Corner offsets of a cube and the 6 Kuhn paths (one per axis ordering).
-    idx = lambda a, b, d: a + n * (b + n * d)  # noqa: E731
-    ci, cj, ck = np.meshgrid(np.arange(n - 1), np.arange(n - 1), np.arange(n - 1), indexing="ij")
-    ci, cj, ck = ci.ravel(), cj.ravel(), ck.ravel()
-    tets = []
-    for order in ([0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]):
-        o = np.zeros(3, dtype=int)
-        corners = [idx(ci, cj, ck)]
-        for axis in order:
-            o[axis] += 1
-            corners.append(idx(ci + o[0], cj + o[1], ck + o[2]))
-        tets.append(np.stack(corners, axis=1))
-    tets = np.concatenate(tets)
     ug = vtk.vtkUnstructuredGrid()
     p = vtk.vtkPoints()
     p.SetData(numpy_support.numpy_to_vtk(pts.astype(np.float64), deep=True))

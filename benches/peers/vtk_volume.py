@@ -44,6 +44,9 @@ import numpy as np  # noqa: E402
 import vtk  # noqa: E402
 from vtk.util import numpy_support  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from peer_common import offscreen_window, timed_frame  # noqa: E402
+
 
 def arbvis_bench(args, extra, score):
     """Run `arbvis bench` once and return its JSON report."""
@@ -124,32 +127,11 @@ class VtkPeer:
 
         renderer = vtk.vtkRenderer()
         renderer.AddVolume(volume)
-        renderer.SetBackground(*scene["background"][:3])
-        cam = renderer.GetActiveCamera()
-        c = scene["camera"]
-        cam.SetFocalPoint(*c["focal_point"])
-        cam.SetPosition(*c["position"])
-        cam.SetViewUp(*c["view_up"])
-        distance = float(np.linalg.norm(c["position"]))
-        if c["projection"] == "orthographic":
-            cam.ParallelProjectionOn()
-            cam.SetParallelScale(c["parallel_scale"])
-        else:
-            cam.ParallelProjectionOff()
-            cam.SetViewAngle(c["view_angle"])
-        cam.SetClippingRange(max(distance - 2.0, 1e-3), distance + 2.0)
-        window = vtk.vtkRenderWindow()
-        window.SetOffScreenRendering(1)
-        window.SetSize(*scene["size"])
-        window.AddRenderer(renderer)
-        self.window = window
+        self.window = offscreen_window(renderer, scene)
         self.renderer = renderer
 
     def frame(self):
-        t0 = time.perf_counter()
-        self.window.Render()
-        self.window.WaitForCompletion()
-        return (time.perf_counter() - t0) * 1e3
+        return timed_frame(self.window)
 
     def set_sample_distance(self, voxels):
         self.mapper.SetSampleDistance(voxels * self.scene["reference_spacing"])

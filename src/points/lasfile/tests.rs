@@ -652,26 +652,10 @@ fn extreme_scales_and_offsets() {
         .contains("positions stored as f32 in [-1, 1]^3"));
 }
 
-/// A LAZ file of `n` equal points (format 3): about 85 points a compressed byte.
-pub(crate) fn equal_points(n: usize) -> Vec<u8> {
-    let mut b = Builder::from((1, 2));
-    b.point_format = Format::new(3).unwrap();
-    b.point_format.is_compressed = true;
-    let mut w = Writer::new(Cursor::new(Vec::new()), b.into_header().unwrap()).unwrap();
-    let p = Point {
-        x: 1.0,
-        y: 2.0,
-        z: 3.0,
-        color: Some(Color::new(1, 2, 3)),
-        gps_time: Some(0.0),
-        ..Default::default()
-    };
-    for _ in 0..n {
-        w.write_point(p.clone()).unwrap();
-    }
-    w.close().unwrap();
-    w.into_inner().unwrap().into_inner()
-}
+/// The hostile clouds the integration tests share (equal points and the like).
+#[path = "../../../tests/common/hostile_files.rs"]
+mod hostile_files;
+use hostile_files::equal_points_laz as equal_points;
 
 /// A LAZ 1.4 file (format 6) of `n` equal points with `extras` one-byte attributes.
 fn equal_points_with_extras(n: usize, extras: usize) -> Vec<u8> {

@@ -153,6 +153,18 @@ fn table_texture(gpu: &Gpu, tf: &Transfer, spec: &VolumeSpec, longest: f64) -> G
     )
 }
 
+/// The transfer function as a float texture of its control points (see [`tf_texels`]).
+fn tf_texture(gpu: &Gpu, transfer: &Transfer) -> GlResult<Texture> {
+    Texture::new(
+        gpu,
+        "cellproj volume transfer function",
+        Extent::D2(transfer.s.len() as u32, 2),
+        TexelFormat::Rgba32f,
+        Filter::Nearest,
+        TexelData::F32(&tf_texels(transfer)),
+    )
+}
+
 /// The transfer function as `count x 2` RGBA32F texels (row 0 colour and opacity value,
 /// row 1 positions).
 fn tf_texels(tf: &Transfer) -> Vec<f32> {
@@ -252,15 +264,7 @@ impl VolumeRenderer {
             &VERTEX_COMPONENTS,
             &prepared.face_vertices(),
         )?;
-        let tf_data = tf_texels(&self.transfer);
-        let table = Texture::new(
-            gpu,
-            "cellproj volume transfer function",
-            Extent::D2(self.transfer.s.len() as u32, 2),
-            TexelFormat::Rgba32f,
-            Filter::Nearest,
-            TexelData::F32(&tf_data),
-        )?;
+        let table = tf_texture(gpu, &self.transfer)?;
         Ok(Faithful {
             program,
             faces,
@@ -311,15 +315,7 @@ impl VolumeRenderer {
             TexelData::U32(&nb),
             n,
         )?;
-        let tf_data = tf_texels(&self.transfer);
-        let tf = Texture::new(
-            gpu,
-            "cellproj volume transfer function",
-            Extent::D2(self.transfer.s.len() as u32, 2),
-            TexelFormat::Rgba32f,
-            Filter::Nearest,
-            TexelData::F32(&tf_data),
-        )?;
+        let tf = tf_texture(gpu, &self.transfer)?;
         let iso_count = isovalues.len();
         let mut list = super::prepare::iso_list(isovalues);
         list.resize(iso_count.max(1) * 8, 0.0);

@@ -46,7 +46,8 @@ use serde::{Deserialize, Serialize};
 
 use super::prepare::CHANNEL;
 use super::programs::faithful_pair;
-use super::renderer::{eye, model_view_projection, toward_viewer};
+use super::renderer::{eye, model_view_projection, neutral_table, toward_viewer};
+use super::slicing::{polygon, EDGES};
 use super::{coefficients, Combine, Opacity3dScene, ATTRIBUTE_NAMES};
 use crate::camera::Projection;
 use crate::colortable::ColorTable;
@@ -332,14 +333,7 @@ impl BrickedRenderer {
         }
         let missing = self.tables.iter().any(Option::is_none);
         self.neutral = if missing && self.params.combine == Combine::Product {
-            Some(Texture::new(
-                gpu,
-                "opacity3d neutral table (absent attribute in a product)",
-                Extent::D2(1, 1),
-                TexelFormat::Rgba8,
-                Filter::Nearest,
-                TexelData::U8(&[255; 4]),
-            )?)
+            Some(neutral_table(gpu)?)
         } else {
             None
         };
@@ -536,22 +530,6 @@ fn corner(b: [DVec3; 2], i: usize) -> DVec3 {
     )
 }
 
-/// Edges of a box, lower corner first (bit 0 = x, 1 = y, 2 = z).
-const EDGES: [(usize, usize); 12] = [
-    (0, 1),
-    (2, 3),
-    (4, 5),
-    (6, 7),
-    (0, 2),
-    (1, 3),
-    (4, 6),
-    (5, 7),
-    (0, 4),
-    (1, 5),
-    (2, 6),
-    (3, 7),
-];
-
 /// The polygon where the plane `n·p = t` meets box `b` (`d` = `n·corner`), counter-
 /// clockwise about `n = u × v`. Vertices are computed from absolute corners, lower corner
 /// first, so two boxes sharing an edge give that edge's crossing bit for bit.
@@ -565,22 +543,7 @@ fn cut(b: [DVec3; 2], d: &[f64], t: f64, u: DVec3, v: DVec3) -> Vec<DVec3> {
             points.push((pa + (pc - pa) * s).clamp(b[0], b[1]));
         }
     }
-    let eps = 1e-12;
-    let mut unique: Vec<DVec3> = Vec::with_capacity(points.len());
-    for p in points {
-        if unique.iter().all(|q| q.distance(p) > eps) {
-            unique.push(p);
-        }
-    }
-    if unique.len() < 3 {
-        return Vec::new();
-    }
-    let centre = unique.iter().copied().sum::<DVec3>() / unique.len() as f64;
-    unique.sort_by(|a, b| {
-        let angle = |p: &DVec3| (p - centre).dot(v).atan2((p - centre).dot(u));
-        angle(a).total_cmp(&angle(b))
-    });
-    unique
+    polygon(points, 1e-12, u, v)
 }
 
 impl Renderer for BrickedRenderer {

@@ -365,14 +365,7 @@ impl Opacity3dRenderer {
             && self.params.combine == Combine::Product
             && self.fidelity == Fidelity::Faithful
         {
-            Some(Texture::new(
-                gpu,
-                "opacity3d neutral table (absent attribute in a product)",
-                Extent::D2(1, 1),
-                TexelFormat::Rgba8,
-                Filter::Nearest,
-                TexelData::U8(&[255; 4]),
-            )?)
+            Some(neutral_table(gpu)?)
         } else {
             None
         };
@@ -772,4 +765,16 @@ impl Renderer for Opacity3dRenderer {
     fn clip_stats(&self) -> Option<ClipStats> {
         self.clip.as_ref().map(|c| c.stats)
     }
+}
+
+/// The white table a product reads for an absent attribute (so it multiplies by one).
+pub(super) fn neutral_table(gpu: &Gpu) -> GlResult<Texture> {
+    Texture::new(
+        gpu,
+        "opacity3d neutral table (absent attribute in a product)",
+        Extent::D2(1, 1),
+        TexelFormat::Rgba8,
+        Filter::Nearest,
+        TexelData::U8(&[255; 4]),
+    )
 }

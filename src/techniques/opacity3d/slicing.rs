@@ -31,8 +31,9 @@ pub struct Slices {
     pub spacing: f64,
 }
 
-/// The 12 edges of a box, as pairs of corner indices (bit 0 = x, 1 = y, 2 = z).
-const EDGES: [(usize, usize); 12] = [
+/// The 12 edges of a box, as pairs of corner indices (bit 0 = x, 1 = y, 2 = z), lower
+/// corner first.
+pub(super) const EDGES: [(usize, usize); 12] = [
     (0, 1),
     (2, 3),
     (4, 5),
@@ -109,8 +110,13 @@ fn cut(half: DVec3, t: f64, depths: &[f64], u: DVec3, v: DVec3) -> Vec<DVec3> {
             points.push(p.clamp(-half, half));
         }
     }
-    // Coincident points (plane through a corner) are merged.
-    let eps = 1e-12 * half.max_element();
+    polygon(points, 1e-12 * half.max_element(), u, v)
+}
+
+/// The convex polygon through `points` (a plane's crossings of a box's edges): points
+/// closer than `eps` merged (a plane through a corner), sorted counter-clockwise about
+/// `u × v`; empty when fewer than three remain.
+pub(super) fn polygon(points: Vec<DVec3>, eps: f64, u: DVec3, v: DVec3) -> Vec<DVec3> {
     let mut unique: Vec<DVec3> = Vec::with_capacity(points.len());
     for p in points {
         if unique.iter().all(|q| q.distance(p) > eps) {

@@ -1,0 +1,66 @@
+"""What the VTK peer scripts share: the Kuhn grid arbvis generates, the exported camera
+applied to a VTK renderer in an offscreen window, and one timed frame.
+
+Imported by vtk_volume.py, vtk_unstructured.py, vtk_contour.py and benches/meshes.py; it
+imports vtk only inside the functions that need it, so meshes.py runs with numpy alone.
+"""
+
+import time
+
+import numpy as np
+
+
+def kuhn_tets(n):
+    """The n^3-point Kuhn grid of src/mesh/grid.rs: points in [0, 1]^3 (point (i, j, k) is
+    index i + n (j + n k)) and its 6 (n - 1)^3 tetrahedra, one per axis ordering of
+    each cube."""
+    i, j, k = np.meshgrid(np.arange(n), np.arange(n), np.arange(n), indexing="ij")
+    pts = np.stack([i, j, k], axis=-1).transpose(2, 1, 0, 3).reshape(-1, 3) / (n - 1.0)
+    idx = lambda a, b, d: a + n * (b + n * d)  # noqa: E731
+    ci, cj, ck = np.meshgrid(np.arange(n - 1), np.arange(n - 1), np.arange(n - 1), indexing="ij")
+    ci, cj, ck = ci.ravel(), cj.ravel(), ck.ravel()
+    tets = []
+    for order in ([0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]):
+        o = np.zeros(3, dtype=int)
+        corners = [idx(ci, cj, ck)]
+        for axis in order:
+            o[axis] += 1
+            corners.append(idx(ci + o[0], cj + o[1], ck + o[2]))
+        tets.append(np.stack(corners, axis=1))
+    return pts, np.concatenate(tets)
+
+
+def offscreen_window(renderer, scene):
+    """Point the renderer's camera as the exported scene says (focal point, position,
+    view up, parallel scale or view angle, near and far around the object) and put it
+    in an offscreen window of the scene's size and background."""
+    import vtk
+
+    renderer.SetBackground(*scene["background"][:3])
+    cam = renderer.GetActiveCamera()
+    c = scene["camera"]
+    cam.SetFocalPoint(*c["focal_point"])
+    cam.SetPosition(*c["position"])
+    cam.SetViewUp(*c["view_up"])
+    distance = float(np.linalg.norm(c["position"]))
+    if c["projection"] == "orthographic":
+        cam.ParallelProjectionOn()
+        cam.SetParallelScale(c["parallel_scale"])
+    else:
+        cam.ParallelProjectionOff()
+        cam.SetViewAngle(c["view_angle"])
+    cam.SetClippingRange(max(distance - 2.0, 1e-3), distance + 2.0)
+    window = vtk.vtkRenderWindow()
+    window.SetOffScreenRendering(1)
+    window.SetSize(*scene["size"])
+    window.AddRenderer(renderer)
+    return window
+
+
+def timed_frame(window):
+    """One frame in milliseconds: Render, then WaitForCompletion (glFinish), as arbvis
+    times clear + draw + glFinish."""
+    t0 = time.perf_counter()
+    window.Render()
+    window.WaitForCompletion()
+    return (time.perf_counter() - t0) * 1e3
