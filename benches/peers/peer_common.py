@@ -64,3 +64,41 @@ def timed_frame(window):
     window.Render()
     window.WaitForCompletion()
     return (time.perf_counter() - t0) * 1e3
+
+
+def load_export(folder):
+    """The scene an `arbvis bench --export FOLDER` wrote (scene.json) and its f64
+    reference as an (h, w, 3) array; exits naming the folder if the sizes disagree."""
+    import json
+    import os
+    import sys
+
+    with open(os.path.join(folder, "scene.json")) as f:
+        scene = json.load(f)
+    w, h = scene["size"]
+    ref = np.fromfile(os.path.join(folder, scene["reference"]), dtype="<f4")
+    if ref.size != w * h * 3:
+        sys.exit(f"{folder}: reference holds {ref.size} floats, expected {w * h * 3}")
+    return scene, ref.reshape(h, w, 3)
+
+
+def window_rgb(window):
+    """The window's back buffer as RGB in [0, 1], top row first."""
+    import vtk
+    from vtk.util import numpy_support
+
+    grab = vtk.vtkWindowToImageFilter()
+    grab.SetInput(window)
+    grab.SetInputBufferTypeToRGB()
+    grab.ReadFrontBufferOff()
+    grab.Update()
+    out = grab.GetOutput()
+    w, h, _ = out.GetDimensions()
+    pixels = numpy_support.vtk_to_numpy(out.GetPointData().GetScalars())
+    return pixels.reshape(h, w, 3)[::-1].astype(np.float64) / 255.0
+
+
+def rgb_error(image, reference):
+    """Largest channel difference and RMSE of two RGB arrays."""
+    d = image - reference
+    return float(np.abs(d).max()), float(np.sqrt(np.mean(d * d)))

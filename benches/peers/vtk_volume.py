@@ -36,7 +36,6 @@ import os
 import statistics
 import subprocess
 import sys
-import time
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
@@ -45,7 +44,7 @@ import vtk  # noqa: E402
 from vtk.util import numpy_support  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from peer_common import offscreen_window, timed_frame  # noqa: E402
+from peer_common import load_export, offscreen_window, rgb_error, timed_frame, window_rgb  # noqa: E402
 
 
 def arbvis_bench(args, extra, score):
@@ -57,16 +56,6 @@ def arbvis_bench(args, extra, score):
         cmd.append("--score")
     out = subprocess.run(cmd, check=True, capture_output=True, text=True)
     return json.loads(out.stdout)
-
-
-def load_export(folder):
-    with open(os.path.join(folder, "scene.json")) as f:
-        scene = json.load(f)
-    w, h = scene["size"]
-    ref = np.fromfile(os.path.join(folder, scene["reference"]), dtype="<f4")
-    if ref.size != w * h * 3:
-        sys.exit(f"{folder}: reference holds {ref.size} floats, expected {w * h * 3}")
-    return scene, ref.reshape(h, w, 3)
 
 
 def transfer_functions(scene, attribute):
@@ -137,20 +126,7 @@ class VtkPeer:
         self.mapper.SetSampleDistance(voxels * self.scene["reference_spacing"])
 
     def rgb(self):
-        grab = vtk.vtkWindowToImageFilter()
-        grab.SetInput(self.window)
-        grab.SetInputBufferTypeToRGB()
-        grab.ReadFrontBufferOff()
-        grab.Update()
-        out = grab.GetOutput()
-        w, h, _ = out.GetDimensions()
-        pixels = numpy_support.vtk_to_numpy(out.GetPointData().GetScalars())
-        return pixels.reshape(h, w, 3)[::-1].astype(np.float64) / 255.0
-
-
-def rgb_error(image, reference):
-    d = image - reference
-    return float(np.abs(d).max()), float(np.sqrt(np.mean(d * d)))
+        return window_rgb(self.window)
 
 
 def main():
