@@ -72,13 +72,9 @@ fn scene(mode: Mode, volume: VolumeSpec, isovalues: Vec<Isovalue>) -> CellprojSc
     }
 }
 
+/// A rotated camera that sees all three axes (no face is edge-on).
 fn camera(projection: Projection) -> Camera {
-    Camera {
-        projection,
-        rotation: [0.2391, 0.3696, 0.0990, 0.8924],
-        zoom: 0.9,
-        ..Camera::default()
-    }
+    common::seed_grid_camera(projection)
 }
 
 fn draw(

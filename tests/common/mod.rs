@@ -162,3 +162,14 @@ pub fn opacity3d_mut(scene: &mut Scene) -> &mut Opacity3dScene {
         _ => panic!("not an opacity3d scene"),
     }
 }
+
+/// The cell-projection tests' rotated camera: it sees all three axes of the seed's grid
+/// (no face is edge-on) with a margin.
+pub fn seed_grid_camera(projection: arbvis::camera::Projection) -> arbvis::camera::Camera {
+    arbvis::camera::Camera {
+        projection,
+        rotation: [0.2391, 0.3696, 0.0990, 0.8924],
+        zoom: 0.9,
+        ..arbvis::camera::Camera::default()
+    }
+}

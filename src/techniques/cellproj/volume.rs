@@ -153,6 +153,16 @@ fn table_texture(gpu: &Gpu, tf: &Transfer, spec: &VolumeSpec, longest: f64) -> G
     )
 }
 
+/// The four faces of every tetrahedron, as the faithful and projected paths draw them.
+fn face_mesh(gpu: &Gpu, prepared: &Prepared) -> GlResult<Mesh> {
+    Mesh::new(
+        gpu,
+        "cellproj volume faces (4 per tetrahedron)",
+        &VERTEX_COMPONENTS,
+        &prepared.face_vertices(),
+    )
+}
+
 /// The transfer function as a float texture of its control points (see [`tf_texels`]).
 fn tf_texture(gpu: &Gpu, transfer: &Transfer) -> GlResult<Texture> {
     Texture::new(
@@ -232,12 +242,7 @@ impl VolumeRenderer {
     ) -> GlResult<Faithful> {
         let pair = faithful_pair(kind);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
-        let faces = Mesh::new(
-            gpu,
-            "cellproj volume faces (4 per tetrahedron)",
-            &VERTEX_COMPONENTS,
-            &prepared.face_vertices(),
-        )?;
+        let faces = face_mesh(gpu, prepared)?;
         let longest = prepared.longest_edge().max(1e-12);
         let table = table_texture(gpu, &self.transfer, &self.spec, longest)?;
         let [n, m] = self.spec.table_size.map(|v| v as f64);
@@ -258,12 +263,7 @@ impl VolumeRenderer {
     fn build_projected(&self, gpu: &Gpu, prepared: &Prepared) -> GlResult<Faithful> {
         let pair = &precise_pairs()[2];
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
-        let faces = Mesh::new(
-            gpu,
-            "cellproj volume faces (4 per tetrahedron)",
-            &VERTEX_COMPONENTS,
-            &prepared.face_vertices(),
-        )?;
+        let faces = face_mesh(gpu, prepared)?;
         let table = tf_texture(gpu, &self.transfer)?;
         Ok(Faithful {
             program,
