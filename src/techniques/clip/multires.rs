@@ -54,6 +54,7 @@ use rayon::prelude::*;
 
 use super::error::ClipError;
 use super::texture::{trilinear, ClipTexture};
+use crate::volume::index_data::{self, SlotGrid};
 
 /// Largest DATA texture built (texels; 2 GiB of f32).
 pub const MAX_DATA_TEXELS: usize = 1 << 29;
@@ -135,40 +136,17 @@ fn ceil_div(a: usize, b: usize) -> usize {
     a.div_ceil(b)
 }
 
-/// The near-cubic slot arrangement for `count` slots of side `side` texels within
-/// `max_size` texels per axis.
+/// The near-cubic slot arrangement for `count` boundary blocks' slots of side `side`
+/// texels within `max_size` texels per axis (the atlas layout the store's bricks share:
+/// [`SlotGrid::arrange`]).
 pub fn arrange_slots(count: usize, side: usize, max_size: usize) -> Result<[usize; 3], ClipError> {
-    if count == 0 {
-        return Ok([0; 3]);
-    }
-    let cap = max_size / side;
-    let mut m = (count as f64).cbrt().ceil() as usize;
-    while m.saturating_pow(3) < count {
-        m += 1;
-    }
-    while m > 1 && (m - 1).pow(3) >= count {
-        m -= 1;
-    }
-    if m > cap {
-        return Err(ClipError::Invalid(format!(
-            "{count} boundary blocks of {side}³ texels do not fit a DATA texture of at most {max_size}³ texels (at most {cap} slots per side, {} in all): use a larger block or a coarser clip resolution",
-            cap.saturating_pow(3)
-        )));
-    }
-    let mut best = [m, m, m];
-    for sx in 1..=m {
-        for sy in 1..=m {
-            let sz = ceil_div(count, sx * sy);
-            if sz > m {
-                continue;
-            }
-            let key = |s: [usize; 3]| (s[0] * s[1] * s[2], s[0].max(s[1]).max(s[2]));
-            if key([sx, sy, sz]) < key(best) {
-                best = [sx, sy, sz];
-            }
-        }
-    }
-    Ok(best)
+    SlotGrid::arrange(count, side, max_size)
+        .map(|g| g.slots)
+        .map_err(|e| {
+            ClipError::Invalid(format!(
+                "{e}: {count} boundary blocks need a larger block or a coarser clip resolution"
+            ))
+        })
 }
 
 impl MultiRes {
@@ -288,13 +266,11 @@ impl MultiRes {
 
     /// Normalized DATA coordinate of slot `s`'s centre.
     pub fn slot_centre(&self, s: u32) -> DVec3 {
-        let g = self.slot_grid;
-        let s = s as usize;
-        let idx = [s % g[0], (s / g[0]) % g[1], s / (g[0] * g[1])];
-        let side = (self.block + 2) as f64;
-        DVec3::from_array(
-            [0, 1, 2].map(|a| (idx[a] as f64 + 0.5) * side / self.data_dims[a] as f64),
-        )
+        let grid = SlotGrid {
+            slots: self.slot_grid,
+            side: self.block + 2,
+        };
+        grid.slot_centre(s as usize)
     }
 
     /// Normalized volume coordinate of block `(bi, bj, bk)`'s centre (`(b B + B/2) / n`;
@@ -344,7 +320,7 @@ impl MultiRes {
                                 (b / nb[0]) % nb[1],
                                 b / (nb[0] * nb[1]),
                             ]);
-                            centre - bc * self.data_scale()
+                            index_data::offset(centre, bc, self.data_scale())
                         }
                     };
                     [rgb.x as f32, rgb.y as f32, rgb.z as f32, 0.5]
@@ -422,29 +398,5 @@ impl MultiRes {
             }
         }
         worst
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn arrangement_is_near_cubic_and_bounded() {
-        assert_eq!(arrange_slots(0, 10, 2048).unwrap(), [0, 0, 0]);
-        assert_eq!(arrange_slots(1, 10, 2048).unwrap(), [1, 1, 1]);
-        let g = arrange_slots(2600, 10, 2048).unwrap();
-        assert!(
-            g.iter().all(|&s| s <= 14) && g.iter().product::<usize>() >= 2600,
-            "{g:?}"
-        );
-        assert!(g.iter().product::<usize>() < 2600 + 14 * 14, "{g:?}");
-        // 204 slots of 10 texels per side fit 2048; 204³ + 1 slots do not.
-        assert_eq!(arrange_slots(204usize.pow(3), 10, 2048).unwrap(), [204; 3]);
-        let e = arrange_slots(204usize.pow(3) + 1, 10, 2048)
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("do not fit") && e.contains("2048"), "{e}");
-        assert!(arrange_slots(1, 3000, 2048).is_err());
     }
 }
