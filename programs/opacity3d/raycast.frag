@@ -16,9 +16,19 @@
 //  - empty-space skipping (tag skip, point sampling only): texture5 holds, per brick, 1
 //    where some sample can have alpha > 0 (levels over the brick and one voxel around it
 //    against the tables' alpha), so samples in an empty brick are skipped exactly.
+//  - paged (tag paged: a survey from a store): texture0 is the brick atlas, texture7 the
+//    page table, one RGBA32F entry per level-0 brick of the window (the INDEX of seed
+//    002's INDEX-DATA: see src/volume/index_data.rs): w = 2^-level of the resident brick
+//    that covers it (0: nothing to draw there), xyz its offset, so that level-0 voxel
+//    coordinate v reads the atlas at v * w / atlas + xyz (one MAD, as the clip's offset
+//    encoding). Steps are the base steps' lattice; in a level-l page a sample stands for
+//    2^l of them (its opacity corrected for that length), at their middle; empty pages
+//    are skipped to the first step past them.
 // Locals: 1..3 coefficients; 4 = (1/reference or 0, step length, 0 or 1, 0); 5 = lookup;
 // 6 = box size; 7 = box half size; 8 = orthographic: the ray direction (unit) /
-// perspective: the eye; 9 = (bricks per unit texture coordinate, stop alpha).
+// perspective: the eye; 9 = (bricks per unit texture coordinate, stop alpha); paged:
+// 10 = (window size in level-0 voxels, brick side), 11 = (window's first voxel, 0),
+// 12 = (1 / atlas size in texels, 0), 13 = (first page of the table, 0).
 // Output: premultiplied colour and coverage, blended ONE, ONE_MINUS_SRC_ALPHA.
 in vec4 v_texcoord0;
 uniform sampler3D texture0;
@@ -28,7 +38,9 @@ uniform sampler2D texture4;  // [tertiary]
 uniform sampler3D texture5;  // [skip]
 uniform sampler2D texture6;  // [preint]
 uniform sampler1D texture6;  // [baked]
-uniform vec4 program_local[10];
+uniform vec4 program_local[10];  // [!paged]
+uniform vec4 program_local[14];  // [paged]
+uniform sampler3D texture7;  // [paged]
 out vec4 frag_color;
 
 vec4 classify(vec3 tc) {
@@ -70,9 +82,41 @@ void main() {
     vec3 bricks = program_local[9].xyz;  // [skip]
     ivec3 last = textureSize(texture5, 0) - 1;  // [skip]
     vec3 safe = mix(delta, vec3(1e-30), equal(delta, vec3(0.0)));  // [skip]
-    int j = 0;  // [!preint !jitter]
-    while (j < steps && acc.a < stop) {  // [!preint !jitter]
-        int end = steps;  // [!preint !jitter]
+    vec3 voxels = program_local[10].xyz;  // [paged]
+    float side = program_local[10].w;  // [paged]
+    vec3 first_voxel = program_local[11].xyz;  // [paged]
+    vec3 per_texel = program_local[12].xyz;  // [paged]
+    ivec3 first_page = ivec3(program_local[13].xyz);  // [paged]
+    ivec3 last_page = textureSize(texture7, 0) - 1;  // [paged]
+    vec3 safe = mix(delta, vec3(1e-30), equal(delta, vec3(0.0)));  // [paged]
+    int j = 0;  // [paged]
+    while (j < steps && acc.a < stop) {  // [paged]
+        vec3 v = (start + delta * float(j)) * voxels + first_voxel;  // [paged]
+        ivec3 page = clamp(ivec3(floor(v / side)) - first_page, ivec3(0), last_page);  // [paged]
+        vec4 entry = texelFetch(texture7, page, 0);  // [paged]
+        if (entry.w == 0.0) {  // [paged]
+            // Nothing here: on to the first step whose middle is past this page.
+            vec3 lo = (vec3(page + first_page) * side - first_voxel) / voxels;  // [paged]
+            vec3 hi = (vec3(page + first_page + 1) * side - first_voxel) / voxels;  // [paged]
+            vec3 bound = (mix(lo, hi, greaterThan(delta, vec3(0.0))) - start) / safe;  // [paged]
+            bound = mix(bound, vec3(1e30), equal(delta, vec3(0.0)));  // [paged]
+            j = int(clamp(ceil(min(min(bound.x, bound.y), bound.z) - 1e-3), float(j + 1), float(steps)));  // [paged]
+            continue;  // [paged]
+        }  // [paged]
+        int m = min(int(1.0 / entry.w + 0.5), steps - j);  // [paged]
+        vec3 at = start + delta * (float(j) + 0.5 * float(m - 1));  // [paged]
+        v = at * voxels + first_voxel;  // [paged]
+        page = clamp(ivec3(floor(v / side)) - first_page, ivec3(0), last_page);  // [paged]
+        entry = texelFetch(texture7, page, 0);  // [paged]
+        j += m;  // [paged]
+        if (entry.w == 0.0) continue;  // [paged]
+        vec4 col = classify(v * (entry.w * per_texel) + entry.xyz);  // [paged]
+        float a = 1.0 - pow(1.0 - col.a, k * float(m));  // [paged]
+        acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [paged]
+    }  // [paged]
+    int j = 0;  // [!preint !jitter !paged]
+    while (j < steps && acc.a < stop) {  // [!preint !jitter !paged]
+        int end = steps;  // [!preint !jitter !paged]
         vec3 cell = floor((start + delta * float(j)) * bricks);  // [skip]
         // First sample past this brick along each axis (a little early is harmless).
         vec3 lo = cell / bricks;  // [skip]
@@ -83,12 +127,12 @@ void main() {
         end = int(clamp(first, float(j + 1), float(steps)));  // [skip]
         bool empty = texelFetch(texture5, clamp(ivec3(cell), ivec3(0), last), 0).r == 0.0;  // [skip]
         if (empty) { j = end; continue; }  // [skip]
-        for (; j < end && acc.a < stop; j++) {  // [!preint !jitter]
-            vec4 col = classify(start + delta * float(j));  // [!preint !jitter]
-            float a = 1.0 - pow(1.0 - col.a, k);  // [!preint !jitter]
-            acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [!preint !jitter]
-        }  // [!preint !jitter]
-    }  // [!preint !jitter]
+        for (; j < end && acc.a < stop; j++) {  // [!preint !jitter !paged]
+            vec4 col = classify(start + delta * float(j));  // [!preint !jitter !paged]
+            float a = 1.0 - pow(1.0 - col.a, k);  // [!preint !jitter !paged]
+            acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [!preint !jitter !paged]
+        }  // [!preint !jitter !paged]
+    }  // [!preint !jitter !paged]
     // Jitter: steps of the step length h, the first one ending at u h with u in (0, 1]
     // per pixel, so that steps whose length divides the voxel spacing do not sample every
     // ray at the same place in its cells; the first and last steps by their midpoints with

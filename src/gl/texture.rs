@@ -239,6 +239,30 @@ impl Texture {
                 kind.name()
             )));
         }
+        Texture::create(gpu, label, extent, format, filter, Some(bytes))
+    }
+
+    /// A 3D texture of `dims` texels of `format` whose texels are filled later
+    /// ([`Texture::update_region`]): no copy of zeros in memory first.
+    pub fn empty_3d(
+        gpu: &Gpu,
+        label: &str,
+        dims: [usize; 3],
+        format: TexelFormat,
+        filter: Filter,
+    ) -> GlResult<Texture> {
+        let [w, h, d] = dims.map(|v| v as u32);
+        Texture::create(gpu, label, Extent::D3(w, h, d), format, filter, None)
+    }
+
+    fn create(
+        gpu: &Gpu,
+        label: &str,
+        extent: Extent,
+        format: TexelFormat,
+        filter: Filter,
+        bytes: Option<&[u8]>,
+    ) -> GlResult<Texture> {
         let gl = gpu.glow().clone();
         let target = extent.target();
         let (internal, fmt, ty) = format.gl();
@@ -246,7 +270,7 @@ impl Texture {
             Filter::Nearest => glow::NEAREST,
             Filter::Linear => glow::LINEAR,
         } as i32;
-        // SAFETY: sizes checked above; the texture is bound to its own target only while
+        // SAFETY: sizes checked by the callers (or no data: GL allocates); the texture is bound to its own target only while
         // being filled, and the previous binding of unit 0's target is restored.
         let raw = unsafe {
             let raw = gl.create_texture().map_err(GlError::Invalid)?;
@@ -260,7 +284,7 @@ impl Texture {
             let prev = gl.get_parameter_texture(binding);
             gl.bind_texture(target, Some(raw));
             gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
-            let src = glow::PixelUnpackData::Slice(Some(bytes));
+            let src = glow::PixelUnpackData::Slice(bytes);
             match extent {
                 Extent::D1(w) => {
                     gl.tex_image_1d(target, 0, internal as i32, w as i32, 0, fmt, ty, src)
@@ -420,6 +444,61 @@ impl Texture {
                 ),
             }
             gl.bind_texture(target, None);
+            gl.active_texture(prev_active);
+        }
+        crate::gl_check!(gpu)
+    }
+
+    /// Replace all texels (same size and format) from typed data.
+    pub fn update_data(&self, gpu: &Gpu, data: TexelData<'_>) -> GlResult<()> {
+        let (bytes, kind) = data.bytes();
+        if kind != self.format.source_kind() {
+            return Err(GlError::Invalid(format!(
+                "texture update: {} data for a {} texture",
+                kind.name(),
+                self.format.source_kind().name()
+            )));
+        }
+        self.update(gpu, bytes)
+    }
+
+    /// Replace the box of `size` texels at `offset` of a 3D texture (a brick atlas's slot)
+    /// with `data`, i fastest.
+    pub fn update_region(
+        &self,
+        gpu: &Gpu,
+        offset: [usize; 3],
+        size: [usize; 3],
+        data: &[u8],
+    ) -> GlResult<()> {
+        let Extent::D3(w, h, d) = self.extent else {
+            return Err(GlError::Invalid(format!(
+                "update_region on a {:?} texture",
+                self.extent
+            )));
+        };
+        let dims = [w as usize, h as usize, d as usize];
+        let expected = size.iter().product::<usize>() * self.format.source_bytes();
+        if data.len() != expected || (0..3).any(|a| offset[a] + size[a] > dims[a]) {
+            return Err(GlError::Invalid(format!(
+                "texture region update: {size:?} texels at {offset:?} in {dims:?} need {expected} bytes, got {}",
+                data.len()
+            )));
+        }
+        let (_, fmt, ty) = self.format.gl();
+        let gl = &self.gl;
+        // SAFETY: region and size checked above; the texture is bound on unit 0 only while
+        // filled (unbound after), and the active unit is restored.
+        unsafe {
+            let prev_active = gl.get_parameter_i32(glow::ACTIVE_TEXTURE) as u32;
+            gl.active_texture(glow::TEXTURE0);
+            gl.bind_texture(glow::TEXTURE_3D, Some(self.raw));
+            gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 1);
+            let [x, y, z] = offset.map(|v| v as i32);
+            let [sw, sh, sd] = size.map(|v| v as i32);
+            let src = glow::PixelUnpackData::Slice(Some(data));
+            gl.tex_sub_image_3d(glow::TEXTURE_3D, 0, x, y, z, sw, sh, sd, fmt, ty, src);
+            gl.bind_texture(glow::TEXTURE_3D, None);
             gl.active_texture(prev_active);
         }
         crate::gl_check!(gpu)

@@ -15,7 +15,14 @@
 //! - [`BrickCache::ensure`] is the blocking form for offscreen renders: it waits until the
 //!   given bricks are resident (or failed).
 //!
-//! The renderers see only resident bricks: [`BrickCache::texture`] of a brick id.
+//! Two layouts of the slots: one texture per brick ([`BrickCache::new`], what the faithful
+//! brick-by-brick renderer binds, one brick a draw, as 2004's bricked renderers did), or
+//! one atlas texture of slots ([`BrickCache::atlas`], the INDEX-DATA layout of
+//! [`crate::volume::index_data`], which the precise one-pass ray caster reads through its
+//! page table).
+//!
+//! The renderers see only resident bricks: [`BrickCache::texture`] or
+//! [`BrickCache::slot`] of a brick id.
 
 use std::collections::{HashMap, HashSet};
 use std::sync::mpsc::{channel, Receiver, Sender};
@@ -26,6 +33,7 @@ use std::time::Duration;
 use super::lod::BrickId;
 use super::reader::Store;
 use crate::gl::{Extent, Filter, GlResult, Gpu, TexelData, TexelFormat, Texture};
+use crate::volume::index_data::SlotGrid;
 use crate::volume::quantize::quantize_value;
 
 /// How a brick's attributes become texels: per texture channel (R, G, B), the store's
@@ -72,9 +80,16 @@ enum Reply {
 }
 
 struct Slot {
-    texture: Texture,
+    /// The brick's own texture (none in an atlas).
+    texture: Option<Texture>,
     brick: Option<BrickId>,
     used: u64,
+}
+
+/// An atlas's texture (made at the first upload) and its slot layout.
+struct Atlas {
+    texture: Option<Texture>,
+    grid: SlotGrid,
 }
 
 /// The cache.
@@ -90,9 +105,11 @@ pub struct BrickCache {
     replies: Receiver<Reply>,
     thread: Option<JoinHandle<()>>,
     filter: Filter,
+    format: TexelFormat,
     uploaded: u64,
     evicted: u64,
     levels: usize,
+    atlas: Option<Atlas>,
 }
 
 impl BrickCache {
@@ -120,10 +137,56 @@ impl BrickCache {
             replies: rep_rx,
             thread,
             filter,
+            format: TexelFormat::Rgb8,
             uploaded: 0,
             evicted: 0,
             levels,
+            atlas: None,
         }
+    }
+
+    /// A cache whose slots share one atlas texture of 16-bit unorm texels (the same
+    /// 8-bit levels, filtered in float, as the precise volume): the budget's slots (at
+    /// that texel size), at most `most` (the bricks there are), in a near-cubic grid
+    /// within `max_side` texels per axis (fewer slots when the budget's do not fit).
+    pub fn atlas(
+        store: Arc<Store>,
+        packing: Packing,
+        budget: u64,
+        filter: Filter,
+        max_side: usize,
+        most: usize,
+    ) -> BrickCache {
+        // 16-bit texels are twice the RGB8 slot's bytes.
+        let mut cache = BrickCache::new(store, packing, budget / 2, filter);
+        cache.format = TexelFormat::Rgb16FromU8;
+        let side = cache.side;
+        let cap = (max_side / side).max(1);
+        let count = cache.capacity.min(most.max(1)).min(cap.pow(3));
+        // `count` fits by construction (at most cap³ slots of `side` in `max_side`).
+        let grid = SlotGrid::arrange(count, side, max_side).unwrap_or(SlotGrid {
+            slots: [1, 1, 1],
+            side,
+        });
+        cache.capacity = count;
+        cache.atlas = Some(Atlas {
+            texture: None,
+            grid,
+        });
+        cache
+    }
+
+    /// The atlas texture (once a brick is resident) and its slot layout.
+    pub fn atlas_texture(&self) -> Option<(&Texture, SlotGrid)> {
+        let a = self.atlas.as_ref()?;
+        Some((a.texture.as_ref()?, a.grid))
+    }
+
+    /// The atlas slot of resident brick `id`, marked used in this frame.
+    pub fn slot(&mut self, id: BrickId) -> Option<usize> {
+        let s = *self.resident.get(&id)?;
+        self.slots[s].used = self.frame;
+        Some(s)
     }
 
     /// Bricks the budget holds.
@@ -150,7 +213,7 @@ impl BrickCache {
     pub fn texture(&mut self, id: BrickId) -> Option<&Texture> {
         let s = *self.resident.get(&id)?;
         self.slots[s].used = self.frame;
-        Some(&self.slots[s].texture)
+        self.slots[s].texture.as_ref()
     }
 
     /// Mark `id` used in this frame (kept over older bricks).
@@ -181,10 +244,12 @@ impl BrickCache {
         }
     }
 
-    /// Upload at most `max` bricks that have arrived (without waiting); returns how many.
-    pub fn receive(&mut self, gpu: &Gpu, max: usize) -> GlResult<usize> {
+    /// Upload bricks that have arrived (without waiting) until `time` has passed;
+    /// returns how many.
+    pub fn receive(&mut self, gpu: &Gpu, time: Duration) -> GlResult<usize> {
+        let start = std::time::Instant::now();
         let mut n = 0;
-        while n < max {
+        while n == 0 || start.elapsed() < time {
             match self.replies.try_recv() {
                 Ok(reply) => {
                     self.take(gpu, reply)?;
@@ -243,7 +308,17 @@ impl BrickCache {
                     // Every slot is in use by this frame: drop it (asked again later).
                     return Ok(());
                 };
-                self.slots[slot].texture.update(gpu, &texels)?;
+                match (&self.slots[slot].texture, &self.atlas) {
+                    (Some(t), _) => t.update(gpu, &texels)?,
+                    (
+                        None,
+                        Some(Atlas {
+                            texture: Some(t),
+                            grid,
+                        }),
+                    ) => t.update_region(gpu, grid.slot_corner(slot), [self.side; 3], &texels)?,
+                    (None, _) => {}
+                }
                 if let Some(old) = self.slots[slot].brick.replace(id) {
                     self.resident.remove(&old);
                     self.evicted += 1;
@@ -261,14 +336,28 @@ impl BrickCache {
     fn free_slot(&mut self, gpu: &Gpu) -> GlResult<Option<usize>> {
         if self.slots.len() < self.capacity {
             let s = self.side as u32;
-            let texture = Texture::new(
-                gpu,
-                &format!("store brick slot {}", self.slots.len()),
-                Extent::D3(s, s, s),
-                TexelFormat::Rgb8,
-                self.filter,
-                TexelData::U8(&vec![0u8; Packing::brick_bytes(self.side)]),
-            )?;
+            let texture = match &mut self.atlas {
+                Some(atlas) => {
+                    if atlas.texture.is_none() {
+                        atlas.texture = Some(Texture::empty_3d(
+                            gpu,
+                            &format!("store brick atlas of {:?} slots", atlas.grid.slots),
+                            atlas.grid.texels(),
+                            self.format,
+                            self.filter,
+                        )?);
+                    }
+                    None
+                }
+                None => Some(Texture::new(
+                    gpu,
+                    &format!("store brick slot {}", self.slots.len()),
+                    Extent::D3(s, s, s),
+                    TexelFormat::Rgb8,
+                    self.filter,
+                    TexelData::U8(&vec![0u8; Packing::brick_bytes(self.side)]),
+                )?),
+            };
             self.slots.push(Slot {
                 texture,
                 brick: None,
@@ -301,7 +390,7 @@ impl BrickCache {
         CacheStats {
             resident: self.resident.len(),
             per_level,
-            bytes: (self.resident.len() * Packing::brick_bytes(self.side)) as u64,
+            bytes: (self.resident.len() * self.side.pow(3) * self.format.bytes()) as u64,
             capacity: self.capacity,
             uploaded: self.uploaded,
             evicted: self.evicted,

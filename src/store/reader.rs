@@ -312,33 +312,34 @@ impl Store {
         let mut out = vec![0f32; side * side * side];
         // Own voxels present: c B .. min((c + 1) B, n) - 1 per axis.
         let own_hi: [usize; 3] = std::array::from_fn(|a| ((c[a] + 1) * b).min(n[a]) - 1);
-        let mut neighbours: std::collections::HashMap<[usize; 3], Option<Arc<Vec<f32>>>> =
-            std::collections::HashMap::new();
-        for z in 0..side {
-            for y in 0..side {
-                for x in 0..side {
-                    let t = [x, y, z];
-                    let g: [usize; 3] = std::array::from_fn(|a| {
-                        ((c[a] * b + t[a]) as i64 - 1).clamp(0, n[a] as i64 - 1) as usize
+        // Per axis and texel: which neighbour (0 below, 1 own, 2 above) and the voxel
+        // within its chunk, or (where that chunk cannot be read) within the own chunk.
+        let axis = |a: usize| -> Vec<(usize, usize, usize)> {
+            (0..side)
+                .map(|t| {
+                    let g = ((c[a] * b + t) as i64 - 1).clamp(0, n[a] as i64 - 1) as usize;
+                    let d = (g / b + 1).saturating_sub(c[a]).min(2);
+                    (d, g % b, g.clamp(c[a] * b, own_hi[a]) % b)
+                })
+                .collect()
+        };
+        let (ax, ay, az) = (axis(0), axis(1), axis(2));
+        // The 27 chunks around the own one, read when a texel needs them.
+        let mut near: [Option<Option<Arc<Vec<f32>>>>; 27] = std::array::from_fn(|_| None);
+        near[13] = Some(Some(own.clone()));
+        for (z, &(dz, kz, oz)) in az.iter().enumerate() {
+            for (y, &(dy, ky, oy)) in ay.iter().enumerate() {
+                let row = side * (y + side * z);
+                for (x, &(dx, kx, ox)) in ax.iter().enumerate() {
+                    let slot = dx + 3 * (dy + 3 * dz);
+                    let chunk = near[slot].get_or_insert_with(|| {
+                        let cc = [c[0] + dx, c[1] + dy, c[2] + dz].map(|v| v.wrapping_sub(1));
+                        self.chunk(attr, level, cc).ok()
                     });
-                    let cc = g.map(|v| v / b);
-                    let value = if cc == c {
-                        own[(g[0] % b) + b * ((g[1] % b) + b * (g[2] % b))]
-                    } else {
-                        let chunk = neighbours
-                            .entry(cc)
-                            .or_insert_with(|| self.chunk(attr, level, cc).ok())
-                            .clone();
-                        match chunk {
-                            Some(ch) => ch[(g[0] % b) + b * ((g[1] % b) + b * (g[2] % b))],
-                            None => {
-                                let q: [usize; 3] =
-                                    std::array::from_fn(|a| g[a].clamp(c[a] * b, own_hi[a]) % b);
-                                own[q[0] + b * (q[1] + b * q[2])]
-                            }
-                        }
+                    out[x + row] = match chunk {
+                        Some(ch) => ch[kx + b * (ky + b * kz)],
+                        None => own[ox + b * (oy + b * oz)],
                     };
-                    out[x + side * (y + side * z)] = value;
                 }
             }
         }

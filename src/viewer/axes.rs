@@ -15,6 +15,15 @@ use std::path::Path;
 use crate::volume::segy::{self, ReadOptions};
 use crate::volume::{nifti_file, Limits, VolumeSource};
 
+/// The two axes a section at fixed `axis` shows: (across, down).
+pub fn section_axes(axis: usize) -> (usize, usize) {
+    match axis {
+        0 => (1, 2), // time slice: crossline across, inline down
+        1 => (2, 0), // crossline section: inline across, time down
+        _ => (1, 0), // inline section: crossline across, time down
+    }
+}
+
 /// How an axis numbers its voxels.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Numbers {

@@ -7,11 +7,14 @@
 //! [`Opacity3dRenderer::from_prepared`], so switching programs or fidelity re-uploads
 //! without reading files again, and histograms and sections read the same bytes the GPU
 //! samples. Sections show the table's colour opaque (its alpha would hide the section where
-//! the volume is clear); pixels are voxels, stretched to the box's physical aspect.
+//! the volume is clear); pixels are voxels, stretched to the box's physical aspect. A survey
+//! streamed from a store has no prepared voxels: its sections are read from the store at
+//! level 0 ([`super::store_sections`]).
 
 use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
 
-use super::axes::{self, Axis};
+use super::axes::{self, section_axes, Axis};
+use super::store_sections::{SectionKey, StoreSections};
 use super::summary::{cloud_units, data_box, CloudSummary, DataBox, MeshSummary};
 use crate::colortable::{ColorTable, TableSpec};
 use crate::gl::{GlError, Gpu, ProgramKind};
@@ -22,15 +25,6 @@ use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::Opacity3dRenderer;
 use crate::techniques::splats::SplatsRenderer;
 use crate::techniques::Renderer;
-
-/// The two axes a section at fixed `axis` shows: (across, down).
-pub fn section_axes(axis: usize) -> (usize, usize) {
-    match axis {
-        0 => (1, 2), // time slice: crossline across, inline down
-        1 => (2, 0), // crossline section: inline across, time down
-        _ => (1, 0), // inline section: crossline across, time down
-    }
-}
 
 /// The 3D-opacity data behind the panels.
 pub struct Volume3d {
@@ -62,6 +56,23 @@ pub struct ViewData {
     tables: [Option<(TableSpec, ColorTable, TextureHandle)>; 3],
     sections: [Option<Section>; 3],
     histograms: [Option<TextureHandle>; 3],
+    /// A store's sections (3D opacity drawn from a store).
+    pub store: Option<StoreSections>,
+    /// Per axis, the last section read from the store and its levels.
+    store_levels: [Option<(SectionKey, Vec<u8>)>; 3],
+}
+
+/// What the sections panel needs to know of the data: axes, voxels per axis, the box's
+/// half extents, and the attributes present.
+pub struct SectionGrid {
+    /// The axes in the data's numbers.
+    pub axes: [Axis; 3],
+    /// Voxels per axis.
+    pub dims: [usize; 3],
+    /// Half extents of the box.
+    pub half: glam::DVec3,
+    /// Attributes present (0 primary, 1 secondary, 2 tertiary).
+    pub present: Vec<usize>,
 }
 
 /// Build the scene's renderer with programs of `kind`, keeping its prepared data.
@@ -140,8 +151,12 @@ pub fn build(
         data.volume = None;
         let mut r = crate::render::build(gpu, scene, kind)?;
         r.set_streaming(true);
+        data.store = StoreSections::open(params, &scene.base).map_err(GlError::Data)?;
+        data.store_levels = [None, None, None];
+        data.sections = [None, None, None];
         return Ok(r);
     }
+    data.store = None;
     if data.volume.is_none() {
         params
             .validate()
@@ -191,10 +206,10 @@ pub fn build(
 impl ViewData {
     /// The box the overlay draws and its axes: the volume's, the cloud's or the mesh's.
     pub fn data_box(&self) -> Option<DataBox> {
-        if let Some(v) = &self.volume {
+        if let Some(g) = self.section_grid() {
             return Some(DataBox {
-                half: v.prepared.half,
-                axes: v.axes.clone(),
+                half: g.half,
+                axes: g.axes,
             });
         }
         let cloud = self.cloud.as_ref().map(|c| &c.data_box);
@@ -240,6 +255,72 @@ impl ViewData {
         self.histograms[a].as_ref().map(|t| t.id())
     }
 
+    /// The grid the sections cut: the prepared volume's, or the store's window.
+    pub fn section_grid(&self) -> Option<SectionGrid> {
+        if let Some(v) = &self.volume {
+            return Some(SectionGrid {
+                axes: v.axes.clone(),
+                dims: v.prepared.dims,
+                half: v.prepared.half,
+                present: (0..3).filter(|&a| v.prepared.tables[a].is_some()).collect(),
+            });
+        }
+        let s = self.store.as_ref()?;
+        Some(SectionGrid {
+            axes: s.axes.clone(),
+            dims: s.dims,
+            half: s.half,
+            present: (0..3).filter(|&a| s.attributes[a].is_some()).collect(),
+        })
+    }
+
+    /// The section at `index` along `axis` of attribute `a` from the store, read at
+    /// level 0 by the reader thread: the newest one read for this axis meanwhile.
+    fn store_section(
+        &mut self,
+        ctx: &egui::Context,
+        entries: Vec<[u8; 4]>,
+        axis: usize,
+        index: usize,
+        a: usize,
+    ) -> Option<TextureHandle> {
+        let store = self.store.as_mut()?;
+        let index = index.min(store.dims[axis].saturating_sub(1));
+        store.ask((axis, index, a));
+        for (key, levels) in store.arrived() {
+            match levels {
+                Ok(levels) => self.store_levels[key.0] = Some((key, levels)),
+                Err(e) => eprintln!("section {key:?}: {e}"),
+            }
+        }
+        let (key, levels) = self.store_levels[axis].as_ref()?;
+        let full = (key.0, key.1, key.2, entries);
+        if let Some(s) = &self.sections[axis] {
+            if s.key == full {
+                return Some(s.texture.clone());
+            }
+        }
+        let (u, w) = section_axes(axis);
+        let (nu, nw) = (self.store.as_ref()?.dims[u], self.store.as_ref()?.dims[w]);
+        if levels.len() != nu * nw {
+            return None;
+        }
+        let pixels = levels
+            .iter()
+            .map(|&l| {
+                let e = full.3[l as usize];
+                Color32::from_rgb(e[0], e[1], e[2])
+            })
+            .collect();
+        let image = ColorImage::new([nu, nw], pixels);
+        let texture = ctx.load_texture(format!("section {axis}"), image, TextureOptions::NEAREST);
+        self.sections[axis] = Some(Section {
+            key: full,
+            texture: texture.clone(),
+        });
+        Some(texture)
+    }
+
     /// The section at `index` along `axis` of attribute `a`, coloured by its table.
     pub fn section(
         &mut self,
@@ -250,6 +331,9 @@ impl ViewData {
         a: usize,
     ) -> Option<TextureHandle> {
         let entries = self.table(ctx, scene, a)?.0.entries.clone();
+        if self.volume.is_none() {
+            return self.store_section(ctx, entries, axis, index, a);
+        }
         let v = self.volume.as_ref()?;
         let p = &v.prepared;
         let index = index.min(p.dims[axis].saturating_sub(1));

@@ -36,6 +36,7 @@ pub mod screenshot;
 pub mod script;
 mod session;
 pub mod splats;
+pub mod store_sections;
 pub mod summary;
 pub mod transfer;
 pub mod units;

@@ -318,7 +318,7 @@ pub fn layout_box(
     }
     for (a, index) in sections.iter().enumerate() {
         let Some(index) = *index else { continue };
-        let (u, w) = super::data::section_axes(a);
+        let (u, w) = super::axes::section_axes(a);
         let quad = [
             (-1.0, -1.0),
             (1.0, -1.0),

@@ -8,7 +8,8 @@
 
 use egui::{Rect, RichText, Sense, Vec2};
 
-use super::data::{section_axes, ViewData};
+use super::axes::section_axes;
+use super::data::ViewData;
 use super::layout::{self, overlay_font};
 use super::legend;
 use super::lut3d;
@@ -147,7 +148,7 @@ pub fn show(
     state.widgets.begin_frame();
     let camera_before = scene.camera;
     let opacity3d = matches!(scene.technique, TechniqueScene::Opacity3d(_));
-    let sections_shown = opacity3d && state.sections.show && data.volume.is_some();
+    let sections_shown = opacity3d && state.sections.show && data.section_grid().is_some();
     let sizes = layout::panels(ui.max_rect().size(), opacity3d, sections_shown);
 
     egui::Panel::left("controls")
@@ -395,14 +396,13 @@ fn controls(
 
 /// The three sections of one attribute, each with its index slider.
 fn sections(ui: &mut egui::Ui, scene: &Scene, data: &mut ViewData, state: &mut PanelState) {
-    let Some(v) = &data.volume else { return };
-    let axes = v.axes.clone();
-    let dims = v.prepared.dims;
-    let half = v.prepared.half;
-    let present: Vec<(usize, &str)> = (0..3)
-        .filter(|&a| v.prepared.tables[a].is_some())
-        .map(|a| (a, lut3d::ROLES[a]))
-        .collect();
+    let Some(grid) = data.section_grid() else {
+        return;
+    };
+    let axes = grid.axes;
+    let dims = grid.dims;
+    let half = grid.half;
+    let present: Vec<(usize, &str)> = grid.present.iter().map(|&a| (a, lut3d::ROLES[a])).collect();
     let w = &mut state.widgets;
     ui.horizontal_wrapped(|ui| {
         ui.label("Sections of");
@@ -475,7 +475,7 @@ fn draw_overlay(
             .map(|t| (format!("legend text {}", t.text), t.rect)),
     );
     if let Some(b) = data.data_box() {
-        let shown = state.sections.show && data.volume.is_some();
+        let shown = state.sections.show && data.section_grid().is_some();
         let sections = [0, 1, 2].map(|a| shown.then_some(state.sections.index[a]));
         let laid = overlay::layout_box(
             &Projector::new(&scene.camera, view),

@@ -125,8 +125,8 @@ impl Running {
                 );
             }
         }
-        if let Some(v) = &data.volume {
-            panel.sections.index = v.prepared.dims.map(|d| d / 2);
+        if let Some(g) = data.section_grid() {
+            panel.sections.index = g.dims.map(|d| d / 2);
         }
         if let Some(b) = data.data_box() {
             let fit = fit_zoom(&scene.camera, b.half);

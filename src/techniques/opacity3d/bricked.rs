@@ -30,6 +30,9 @@
 //! line can rarely be drawn twice or missed). Opacity per slice is the seed's, and the
 //! spacing is the same, so a level transition changes colours, not opacity scale.
 //!
+//! # Precise
+//! Precise mode draws the store in one pass through a page table: [`super::paged`].
+//!
 //! # Budget
 //! Offscreen (`arbvis render`), a frame waits for the bricks it wants at full quality; when
 //! they are more than the GPU budget holds, it draws them in back-to-front batches that
@@ -44,6 +47,7 @@ use std::sync::Arc;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
+use super::paged::{PageTable, PagedPass};
 use super::prepare::CHANNEL;
 use super::programs::faithful_pair;
 use super::renderer::{eye, model_view_projection, neutral_table, toward_viewer};
@@ -53,7 +57,7 @@ use crate::camera::Projection;
 use crate::colortable::ColorTable;
 use crate::gl::{
     self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
-    Surface, TexelData, TexelFormat, Texture,
+    Surface, TexelData, Texture,
 };
 use crate::store::cache::{BrickCache, Packing};
 use crate::store::lod::{self, BrickId, Pyramid, View};
@@ -139,12 +143,18 @@ pub fn store_of(params: &Opacity3dScene) -> Result<Option<PathBuf>, String> {
     }
 }
 
-/// Uploads per frame while streaming (a brick of 66³ RGB8 is 0.86 MB).
-const UPLOADS_PER_FRAME: usize = 8;
+/// Time a streaming frame spends uploading what has arrived (a brick of 66³ RGB8 is
+/// 0.86 MB, about a millisecond on llvmpipe): the frame stays interactive, and once the
+/// camera stops a frame takes in everything the loader has read since the last one
+/// (8 bricks a frame made the full picture of a 1 GB survey take 113 frames, 110 s).
+const UPLOAD_TIME: std::time::Duration = std::time::Duration::from_millis(30);
 
 /// The bricked 3D-opacity renderer.
 pub struct BrickedRenderer {
     kind: ProgramKind,
+    fidelity: Fidelity,
+    /// Precise: the one-pass ray caster through the page table.
+    paged: Option<PagedPass>,
     base: PathBuf,
     params: Opacity3dScene,
     view: StoreView,
@@ -161,12 +171,18 @@ pub struct BrickedRenderer {
     last: (usize, usize, usize),
 }
 
-fn table_texture(gpu: &Gpu, label: &str, table: &ColorTable, filter: Filter) -> GlResult<Texture> {
+fn table_texture(
+    gpu: &Gpu,
+    label: &str,
+    table: &ColorTable,
+    filter: Filter,
+    fidelity: Fidelity,
+) -> GlResult<Texture> {
     Texture::new(
         gpu,
         label,
         Extent::D2(256, 1),
-        TexelFormat::Rgba8,
+        super::renderer::texel_formats(fidelity, 1).1,
         filter,
         TexelData::U8(&table.texels()),
     )
@@ -186,9 +202,9 @@ impl BrickedRenderer {
         params
             .validate()
             .map_err(|e| GlError::Data(e.to_string()))?;
-        if fidelity != Fidelity::Faithful {
+        if fidelity == Fidelity::Precise && kind == ProgramKind::Arb {
             return Err(GlError::Unsupported(
-                "a store is drawn faithfully (brick by brick with the verbatim programs); the precise ray caster through the page table is not built yet: use fidelity = \"faithful\"".into(),
+                "a store in precise mode is drawn by a ray caster through its page table, which is GLSL only (ARB fragment programs have no loops): use programs = \"glsl\" or fidelity = \"faithful\"".into(),
             ));
         }
         if params.clip.is_some() {
@@ -242,12 +258,27 @@ impl BrickedRenderer {
             Some(b) => b,
             None => crate::budget::parse(&view.gpu_memory).map_err(GlError::Data)?,
         };
-        let cache = BrickCache::new(
-            store.clone(),
-            Packing { channels },
-            budget,
-            params.volume_filter,
-        );
+        let cache = match fidelity {
+            Fidelity::Faithful => BrickCache::new(
+                store.clone(),
+                Packing { channels },
+                budget,
+                params.volume_filter,
+            ),
+            Fidelity::Precise => {
+                let bricks = (0..meta.levels)
+                    .map(|l| meta.brick_counts(l).iter().product::<usize>())
+                    .sum();
+                BrickCache::atlas(
+                    store.clone(),
+                    Packing { channels },
+                    budget,
+                    params.volume_filter,
+                    gpu.caps().max_3d_texture_size.max(1) as usize,
+                    bricks,
+                )
+            }
+        };
         // Brick ranges as levels, grown by the neighbours (a brick's border voxels).
         let mut levels = Vec::with_capacity(meta.levels);
         for level in 0..meta.levels {
@@ -287,10 +318,47 @@ impl BrickedRenderer {
             }
             levels.push(per);
         }
+        // A coarse level is the mean of the one below, so its range can be narrower than
+        // its children's (a reflection's peak averages away): a parent takes the union of
+        // its children's ranges, so that leaving out a brick that looks transparent never
+        // leaves out a visible brick under it.
+        for level in 1..levels.len() {
+            let (below, here) = levels.split_at_mut(level);
+            let (fine, coarse) = (&below[level - 1], &mut here[0]);
+            let fc = meta.brick_counts(level - 1);
+            let cc = meta.brick_counts(level);
+            for k in 0..cc[2] {
+                for j in 0..cc[1] {
+                    for i in 0..cc[0] {
+                        let at = i + cc[0] * (j + cc[1] * k);
+                        for (dk, dj, di) in (0..8).map(|n| (n >> 2, (n >> 1) & 1, n & 1)) {
+                            let c = [2 * i + di, 2 * j + dj, 2 * k + dk];
+                            if (0..3).any(|a| c[a] >= fc[a]) {
+                                continue;
+                            }
+                            let child = fine[c[0] + fc[0] * (c[1] + fc[1] * c[2])];
+                            for a in 0..3 {
+                                let (lo, hi) = child[a];
+                                if lo <= hi {
+                                    let r = &mut coarse[at][a];
+                                    *r = (r.0.min(lo), r.1.max(hi));
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
         let pair = faithful_pair(kind, params.combine);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
+        let paged = match fidelity {
+            Fidelity::Precise => Some(PagedPass::new(gpu, params)?),
+            Fidelity::Faithful => None,
+        };
         let mut r = BrickedRenderer {
             kind,
+            fidelity,
+            paged,
             base: base.to_path_buf(),
             params: params.clone(),
             view,
@@ -323,6 +391,7 @@ impl BrickedRenderer {
                         &format!("opacity3d {} table", ATTRIBUTE_NAMES[a]),
                         &t,
                         self.params.table_filter,
+                        self.fidelity,
                     )?);
                 }
                 None => {
@@ -331,8 +400,12 @@ impl BrickedRenderer {
                 }
             }
         }
+        // The precise program leaves absent attributes out; the verbatim product reads all.
         let missing = self.tables.iter().any(Option::is_none);
-        self.neutral = if missing && self.params.combine == Combine::Product {
+        self.neutral = if missing
+            && self.params.combine == Combine::Product
+            && self.fidelity == Fidelity::Faithful
+        {
             Some(neutral_table(gpu)?)
         } else {
             None
@@ -380,6 +453,16 @@ impl BrickedRenderer {
             eye: (frame.camera.projection == Projection::Perspective).then(|| eye(frame)),
             toward: toward_viewer(frame),
         }
+    }
+
+    /// Bricks a streaming frame may want: the slots less the roots (always asked for, the
+    /// stand-ins of last resort) and an eighth for the resident ancestors that stand in
+    /// while the wanted bricks load. Wanting every slot livelocked: each arriving brick
+    /// evicted another one the frame wanted (seen on an 18 GB survey at 1280x800).
+    fn streaming_room(&self) -> usize {
+        let capacity = self.cache.capacity();
+        let roots = self.pyramid.roots().len();
+        capacity.saturating_sub(roots + capacity / 8).max(1)
     }
 
     /// The bricks a full-quality frame wants, back to front.
@@ -505,6 +588,95 @@ impl BrickedRenderer {
         Ok(())
     }
 
+    /// Precise: one pass through the page table over what is resident (streaming), or
+    /// over the full cut, chosen to fit the atlas (offscreen).
+    fn draw_paged(
+        &mut self,
+        gpu: &Gpu,
+        surface: Surface<'_>,
+        frame: &Frame,
+        view: &View,
+    ) -> GlResult<()> {
+        let capacity = self.cache.capacity();
+        self.cache.begin_frame();
+        let drawn = if self.streaming {
+            self.cache.receive(gpu, UPLOAD_TIME)?;
+            let wanted = self.wanted(view, self.streaming_room());
+            // The page table may overlap: each missing brick's nearest resident ancestor
+            // stands in for it alone (finer resident bricks overwrite its pages), where
+            // the painter's cut must give up every brick under a stand-in.
+            let mut order: Vec<BrickId> = Vec::with_capacity(wanted.len());
+            let mut stand_ins: HashSet<BrickId> = HashSet::new();
+            for &id in &wanted {
+                if self.cache.is_resident(id) {
+                    order.push(id);
+                    continue;
+                }
+                let mut a = self.pyramid.parent(id);
+                while let Some(p) = a {
+                    if self.cache.is_resident(p) {
+                        stand_ins.insert(p);
+                        break;
+                    }
+                    a = self.pyramid.parent(p);
+                }
+            }
+            order.extend(stand_ins);
+            let missing = wanted
+                .iter()
+                .filter(|&&id| !self.cache.is_resident(id) && !self.cache.has_failed(id))
+                .count();
+            let mut ask: Vec<BrickId> = self.pyramid.roots();
+            ask.extend(wanted.iter().copied());
+            self.cache.request(&ask);
+            self.last = (wanted.len(), order.len(), missing);
+            order
+        } else {
+            let wanted = self.wanted(view, capacity);
+            if wanted.len() > capacity {
+                return Err(GlError::Data(format!(
+                    "the precise ray caster draws in one pass and needs its {} bricks resident at once, more than the {capacity} the GPU budget holds: raise --gpu-memory (or store.gpu_memory), or draw a coarser level",
+                    wanted.len()
+                )));
+            }
+            self.cache.ensure(gpu, &wanted)?;
+            if let Some(id) = wanted.iter().find(|&&id| self.cache.has_failed(id)) {
+                return Err(GlError::Data(
+                    self.cache
+                        .error(*id)
+                        .unwrap_or("a brick failed")
+                        .to_string(),
+                ));
+            }
+            self.last = (wanted.len(), wanted.len(), 0);
+            wanted
+        };
+        let Some((_, grid)) = self.cache.atlas_texture() else {
+            return Ok(());
+        };
+        let cache = &mut self.cache;
+        let table = PageTable::build(&self.pyramid, grid, &drawn, &mut |id| cache.slot(id));
+        let mut tables: Vec<(u32, &Texture)> = Vec::with_capacity(3);
+        for (a, t) in self.tables.iter().enumerate() {
+            if let Some(t) = t {
+                tables.push((super::renderer::TABLE_UNITS[a], t));
+            }
+        }
+        let (Some(paged), Some(atlas)) = (&mut self.paged, self.cache.atlas_texture()) else {
+            return Ok(());
+        };
+        paged.draw(
+            gpu,
+            surface,
+            frame,
+            &self.params,
+            &self.pyramid,
+            atlas,
+            &table,
+            &tables,
+        )
+    }
+
     /// The cache's counts.
     pub fn cache_stats(&self) -> crate::store::cache::CacheStats {
         self.cache.stats()
@@ -549,10 +721,13 @@ fn cut(b: [DVec3; 2], d: &[f64], t: f64, u: DVec3, v: DVec3) -> Vec<DVec3> {
 impl Renderer for BrickedRenderer {
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
         let view = self.view_of(frame);
+        if self.paged.is_some() {
+            return self.draw_paged(gpu, surface, frame, &view);
+        }
         if self.streaming {
             self.cache.begin_frame();
-            self.cache.receive(gpu, UPLOADS_PER_FRAME)?;
-            let wanted = self.wanted(&view, self.cache.capacity());
+            self.cache.receive(gpu, UPLOAD_TIME)?;
+            let wanted = self.wanted(&view, self.streaming_room());
             let resident = |id: BrickId| self.cache.is_resident(id);
             let (order, _) = lod::drawable(&self.pyramid, &view, &wanted, &resident);
             // Still to come: wanted, not resident, not failed (a failed brick never comes).
@@ -605,20 +780,18 @@ impl Renderer for BrickedRenderer {
         };
         if data(&self.params) != data(new) {
             let streaming = self.streaming;
-            *self = BrickedRenderer::new(
-                gpu,
-                self.kind,
-                Fidelity::Faithful,
-                new,
-                &self.base.clone(),
-                None,
-            )?;
+            *self =
+                BrickedRenderer::new(gpu, self.kind, self.fidelity, new, &self.base.clone(), None)?;
             self.streaming = streaming;
             return Ok(());
         }
         let combine_changed = new.combine != self.params.combine;
         self.params = new.clone();
         self.build_tables(gpu)?;
+        if let Some(paged) = &mut self.paged {
+            paged.program_for(gpu, &self.params)?;
+            return Ok(());
+        }
         if combine_changed {
             let pair = faithful_pair(self.kind, self.params.combine);
             self.program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
@@ -630,7 +803,10 @@ impl Renderer for BrickedRenderer {
     }
 
     fn program_kind(&self) -> ProgramKind {
-        self.program.kind()
+        match self.paged {
+            Some(_) => ProgramKind::Glsl,
+            None => self.program.kind(),
+        }
     }
 
     fn set_streaming(&mut self, streaming: bool) {

@@ -52,6 +52,7 @@ pub mod bricked;
 pub mod bricks;
 pub mod clipping;
 pub mod mirror;
+pub mod paged;
 pub mod preint;
 pub mod prepare;
 pub mod programs;

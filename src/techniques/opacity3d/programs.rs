@@ -11,7 +11,8 @@
 //! lines. Tags: `sum` / `product`, `secondary`, `tertiary`, `orthographic` /
 //! `perspective`, `skip` (the ray caster's empty-space skipping), `preint` (its
 //! pre-integrated classification), `jitter` (its per-pixel step offset), `baked` (its
-//! one-attribute table of step colour and opacity).
+//! one-attribute table of step colour and opacity), `paged` (a store's bricks through
+//! its page table, [`super::bricked`]).
 //!
 //! Which paths exist in which language: faithful slicing (verbatim ARB, GLSL port),
 //! precise slicing (ARB and GLSL), the precise ray caster (GLSL only: ARB fragment
@@ -41,6 +42,9 @@ pub struct Variant {
     pub jitter: bool,
     /// Ray caster only, with jitter: one attribute's steps from the baked table.
     pub baked: bool,
+    /// Ray caster only: a store's bricks through the page table (point sampling, no
+    /// jitter; the atlas holds v3o2's packing, G primary, B secondary, R tertiary).
+    pub paged: bool,
 }
 
 impl Variant {
@@ -72,11 +76,17 @@ impl Variant {
         if self.baked {
             tags.push("baked");
         }
+        if self.paged {
+            tags.push("paged");
+        }
         tags
     }
 
     /// Channel letter of each attribute in the precise volume (present ones, in order).
     pub fn channels(&self) -> [char; 3] {
+        if self.paged {
+            return ['g', 'b', 'r'];
+        }
         let mut out = ['r'; 3];
         let mut next = 0;
         for (a, c) in out.iter_mut().enumerate() {
@@ -186,6 +196,7 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
                         preint,
                         jitter,
                         baked,
+                        paged: false,
                     };
                     if !(skip || preint || jitter) {
                         pairs.push(slicing_pair(ProgramKind::Arb, v));
@@ -194,6 +205,9 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
                     // Pre-integration and the baked table are for one attribute.
                     if !(preint || baked) || present == [true, false, false] {
                         pairs.push(raycast_pair(v));
+                    }
+                    if !(skip || preint || jitter) {
+                        pairs.push(raycast_pair(Variant { paged: true, ..v }));
                     }
                 }
             }
@@ -235,6 +249,7 @@ mod tests {
             preint: false,
             jitter: false,
             baked: false,
+            paged: false,
         }
     }
 

@@ -551,6 +551,7 @@ fn make_program(
         preint,
         jitter: params.raycast.is_some_and(|r| r.jitter) && !preint,
         baked,
+        paged: false,
     };
     let pair = match (fidelity, path(params, fidelity)) {
         (Fidelity::Faithful, _) => faithful_pair(kind, params.combine),

@@ -1,0 +1,208 @@
+//! Sections of a survey streamed from a store: the inline, crossline and time sections
+//! are read from the store at level 0 (full resolution), whatever the brick cache holds
+//! on the GPU, by a reader thread so that the frame never waits for the disk; until a
+//! section arrives the panel shows the previous one.
+//!
+//! Decisions: a section is one voxel thick, read with [`Store::window`] (every chunk the
+//! plane crosses, decompressed whole: a time slice of a 2,200 x 2,200 survey in bricks of
+//! 64 is 1,225 chunks), quantized over the scene's range for the attribute as the brick
+//! cache quantizes it, so the section and the 3D view show the same levels. The axes come
+//! from the store's geometry (SEG-Y time, crossline and inline numbers).
+
+use std::path::Path;
+use std::sync::mpsc::{channel, Receiver, Sender};
+use std::sync::Arc;
+
+use glam::DVec3;
+
+use super::axes::{Axis, Numbers};
+use crate::store::lod::Pyramid;
+use crate::store::Store;
+use crate::techniques::opacity3d::bricked::store_of;
+use crate::techniques::opacity3d::Opacity3dScene;
+use crate::volume::quantize::{quantize_value, Quantization};
+
+/// A request: (axis, index, attribute).
+pub type SectionKey = (usize, usize, usize);
+
+/// The store behind the sections, its geometry and the reader thread.
+pub struct StoreSections {
+    /// Level-0 voxels of the window shown.
+    pub dims: [usize; 3],
+    /// The box's half extents (as the 3D view's).
+    pub half: DVec3,
+    /// The axes, in the survey's numbers.
+    pub axes: [Axis; 3],
+    /// Per scene attribute: the store's attribute index and the quantization range.
+    pub attributes: [Option<(usize, f64, f64)>; 3],
+    window: [[usize; 3]; 2],
+    requests: Sender<Request>,
+    replies: Receiver<Reply>,
+    asked: Option<SectionKey>,
+}
+
+impl StoreSections {
+    /// The sections of the store `params` names (relative to `base`), if it names one.
+    pub fn open(params: &Opacity3dScene, base: &Path) -> Result<Option<StoreSections>, String> {
+        let Some(path) = store_of(params)? else {
+            return Ok(None);
+        };
+        let store = Arc::new(Store::open(&base.join(path)).map_err(|e| e.to_string())?);
+        let meta = &store.meta;
+        let view = params.store.clone().unwrap_or_default();
+        let window = view.window.unwrap_or([[0; 3], meta.dims]);
+        let dims: [usize; 3] = std::array::from_fn(|a| window[1][a].saturating_sub(window[0][a]));
+        let pyramid = Pyramid {
+            dims: meta.dims,
+            brick: meta.brick,
+            levels: meta.levels,
+            window,
+            spacing: params.spacing.unwrap_or(meta.spacing),
+        };
+        let mut attributes = [None; 3];
+        for (a, attr) in params.attributes().iter().enumerate() {
+            let Some(attr) = attr else { continue };
+            let index = store
+                .attribute_index(attr.attribute.name())
+                .map_err(|e| e.to_string())?;
+            let am = &meta.attributes[index];
+            let (low, high) = match attr.quantize {
+                Quantization::Range([l, h]) => (l, h),
+                _ => (am.min.unwrap_or(0.0), am.max.unwrap_or(0.0)),
+            };
+            attributes[a] = Some((index, low, high));
+        }
+        let axes = store_axes(meta, window);
+        let (req_tx, req_rx) = channel();
+        let (rep_tx, rep_rx) = channel();
+        let reader = store.clone();
+        std::thread::Builder::new()
+            .name("arbvis section reader".into())
+            .spawn(move || read_sections(&reader, req_rx, rep_tx))
+            .map_err(|e| e.to_string())?;
+        Ok(Some(StoreSections {
+            dims,
+            half: pyramid.half(),
+            axes,
+            attributes,
+            window,
+            requests: req_tx,
+            replies: rep_rx,
+            asked: None,
+        }))
+    }
+
+    /// Ask for section `key` (axis, index within the window, scene attribute) unless it
+    /// is the one already asked for.
+    pub fn ask(&mut self, key: SectionKey) {
+        if self.asked == Some(key) {
+            return;
+        }
+        let Some((attr, low, high)) = self.attributes[key.2] else {
+            return;
+        };
+        self.asked = Some(key);
+        let _ = self
+            .requests
+            .send((key, plane(self.window, key.0, key.1), attr, low, high));
+    }
+
+    /// The sections read since the last call: key and its quantized levels (across
+    /// fastest, as [`super::axes::section_axes`] orders them), or the error.
+    pub fn arrived(&mut self) -> Vec<Reply> {
+        self.replies.try_iter().collect()
+    }
+}
+
+/// Voxels `lo .. hi` of the section at `index` along `axis` of `window`.
+pub fn plane(window: [[usize; 3]; 2], axis: usize, index: usize) -> [[usize; 3]; 2] {
+    let mut lo = window[0];
+    let mut hi = window[1];
+    let at = (window[0][axis] + index).min(window[1][axis].saturating_sub(1));
+    lo[axis] = at;
+    hi[axis] = at + 1;
+    [lo, hi]
+}
+
+/// Level-0 values of `attr` over `region` (one voxel thick) quantized over `low..high`,
+/// ordered as the section shows them: across fastest, then down.
+pub fn section_levels(
+    store: &Store,
+    attr: usize,
+    axis: usize,
+    region: [[usize; 3]; 2],
+    low: f64,
+    high: f64,
+) -> Result<Vec<u8>, String> {
+    let v = store
+        .window(attr, region[0], region[1])
+        .map_err(|e| e.to_string())?;
+    let (u, w) = super::axes::section_axes(axis);
+    let (nu, nw) = (v.dims[u], v.dims[w]);
+    let mut out = Vec::with_capacity(nu * nw);
+    for y in 0..nw {
+        for x in 0..nu {
+            let mut ijk = [0usize; 3];
+            ijk[u] = x;
+            ijk[w] = y;
+            out.push(quantize_value(
+                v.values[v.index(ijk[0], ijk[1], ijk[2])],
+                low,
+                high,
+            ));
+        }
+    }
+    Ok(out)
+}
+
+/// A section to read: key, voxel region, store attribute, quantization range.
+type Request = (SectionKey, [[usize; 3]; 2], usize, f64, f64);
+/// A section read: key and levels, or the error.
+type Reply = (SectionKey, Result<Vec<u8>, String>);
+
+fn read_sections(store: &Store, requests: Receiver<Request>, replies: Sender<Reply>) {
+    while let Ok(mut next) = requests.recv() {
+        // Only the newest request matters (the slider moved on).
+        while let Ok(newer) = requests.try_recv() {
+            next = newer;
+        }
+        let (key, region, attr, low, high) = next;
+        let levels = section_levels(store, attr, key.0, region, low, high);
+        if replies.send((key, levels)).is_err() {
+            return;
+        }
+    }
+}
+
+/// The axes of a store's window: SEG-Y time in ms, crossline and inline numbers from the
+/// source's first and step; plain indices otherwise.
+pub fn store_axes(meta: &crate::store::meta::StoreMeta, window: [[usize; 3]; 2]) -> [Axis; 3] {
+    let len = |a: usize| window[1][a].saturating_sub(window[0][a]);
+    let numbered = |name: &str, a: usize, first_step: Option<[i64; 2]>, unit: f64| {
+        let (start, step) = match first_step {
+            Some([first, step]) => (first as f64, step as f64),
+            None => (0.0, unit),
+        };
+        Axis {
+            name: name.to_string(),
+            len: len(a),
+            numbers: Numbers::Linear {
+                start: start + window[0][a] as f64 * step,
+                step,
+            },
+        }
+    };
+    let s = &meta.source;
+    match s.interval_us {
+        Some(us) => [
+            numbered("time (ms)", 0, None, us as f64 / 1000.0),
+            numbered("crossline", 1, s.crosslines, 1.0),
+            numbered("inline", 2, s.inlines, 1.0),
+        ],
+        None => [
+            numbered("i", 0, None, 1.0),
+            numbered("j", 1, None, 1.0),
+            numbered("k", 2, None, 1.0),
+        ],
+    }
+}
