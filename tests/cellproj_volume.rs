@@ -412,3 +412,62 @@ fn malformed_transfer_functions_are_refused_at_their_line_and_column() {
     );
     assert!(ok.is_ok(), "{ok:?}");
 }
+
+/// The viewer's edits: a transfer-function change through `update` keeps the mesh's
+/// textures and remakes only the table, the coarse table of interactive frames and the
+/// scene's swap without integrating again; each picture is exactly what a renderer made
+/// fresh for that spec draws (faithful and precise, both sorts).
+#[test]
+fn transfer_function_edits_draw_what_a_fresh_renderer_draws() {
+    let h = headless(Backend::Egl);
+    let gpu = h.gpu();
+    let prepared = prepared_of(&grid(9, Field::Spherical));
+    let cam = camera(Projection::Perspective);
+    let frame = Frame {
+        camera: cam,
+        width: SIZE[0],
+        height: SIZE[1],
+    };
+    let first = spec(Sort::Centroid);
+    // Another function (the band moved and recoloured), another unit, MPVONC.
+    let mut second = spec(Sort::Mpvonc);
+    second.points[2] = [0.48, 0.2, 1.0, 0.4, 0.8];
+    second.unit_distance = 0.4;
+    // What the viewer draws while the user drags: the table an eighth of each side.
+    let mut coarse = second.clone();
+    coarse.table_size = coarse.table_size.map(|s| s / 8);
+    for fidelity in [Fidelity::Faithful, Fidelity::Precise] {
+        let format = match fidelity {
+            Fidelity::Faithful => TargetFormat::Rgba8,
+            Fidelity::Precise => TargetFormat::Rgba32f,
+        };
+        let target = Target::with_depth(gpu, SIZE[0], SIZE[1], format).unwrap();
+        let mut r = CellprojRenderer::from_prepared(
+            gpu,
+            ProgramKind::Glsl,
+            fidelity,
+            &scene(Mode::Volume, first.clone(), vec![]),
+            prepared.clone(),
+        )
+        .unwrap();
+        let picture = |r: &mut CellprojRenderer| {
+            target.clear(gpu, BACKGROUND).unwrap();
+            r.draw(gpu, Surface::Target(&target), &frame).unwrap();
+            target.read(gpu).unwrap()
+        };
+        picture(&mut r);
+        for step in [&second, &coarse, &second, &coarse, &first, &second] {
+            let params = scene(Mode::Volume, step.clone(), vec![]);
+            r.update(gpu, arbvis::techniques::Params::of(&params))
+                .unwrap();
+            let edited = picture(&mut r);
+            let fresh = draw(&h, &params, &prepared, fidelity, ProgramKind::Glsl, cam);
+            assert!(
+                edited.data == fresh.data,
+                "{fidelity:?}: table {:?}, unit {}: the edited renderer differs from a fresh one",
+                step.table_size,
+                step.unit_distance
+            );
+        }
+    }
+}

@@ -405,13 +405,30 @@ impl Renderer for CellprojRenderer {
         let volume_changed = new.mode != self.params.mode
             || new.volume != self.params.volume
             || (new.mode == super::Mode::Both && new.isovalues != self.params.isovalues);
+        // An edit of the transfer function alone keeps the mesh's textures and programs.
+        let transfer_only = volume_changed
+            && self.volume.is_some()
+            && new.mode == self.params.mode
+            && (new.mode != super::Mode::Both || new.isovalues == self.params.isovalues)
+            && super::volume::VolumeRenderer::transfer_only(
+                &self.params.volume_spec(),
+                &new.volume_spec(),
+            );
         let iso_mesh_changed = new.mode.isosurfaces() != self.params.mode.isosurfaces();
         self.params = new.clone();
         if iso_mesh_changed && !order_changed {
             (self.mesh, self.faces) = face_mesh(gpu, &self.prepared, self.params.order)?;
             self.select_active(gpu)?;
         }
-        if volume_changed {
+        if transfer_only {
+            let spec = self.params.volume_spec();
+            let transfer = spec
+                .build(&self.base, self.prepared.scale)
+                .map_err(GlError::Data)?;
+            if let Some(v) = &mut self.volume {
+                v.set_transfer(&spec, transfer);
+            }
+        } else if volume_changed {
             self.build_volume(gpu)?;
         }
         if order_changed {

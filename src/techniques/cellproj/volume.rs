@@ -138,6 +138,16 @@ pub struct VolumeRenderer {
     precise: Option<Precise>,
     times: VolumeTimes,
     tets: usize,
+    /// The transfer function changed since its textures were made (remade at the next
+    /// draw, so that an edit followed by another before any draw builds one table).
+    stale: bool,
+    longest: f64,
+    /// The faithful table made before the current one, with its spec: the viewer
+    /// alternates a coarse table while the user interacts with the scene's when still,
+    /// and swaps them instead of integrating again.
+    spare: Option<(VolumeSpec, Texture, [[f64; 4]; 2])>,
+    /// The spec the current textures were made for, while they are stale.
+    made_for: Option<VolumeSpec>,
 }
 
 fn table_texture(gpu: &Gpu, tf: &Transfer, spec: &VolumeSpec, longest: f64) -> GlResult<Texture> {
@@ -151,6 +161,26 @@ fn table_texture(gpu: &Gpu, tf: &Transfer, spec: &VolumeSpec, longest: f64) -> G
         Filter::Linear,
         TexelData::U8(&data),
     )
+}
+
+/// `(sf, sb, length)` to the pre-integrated table's texture coordinates: scale and offset
+/// (texel centres at both ends).
+fn table_map(spec: &VolumeSpec, longest: f64) -> [[f64; 4]; 2] {
+    let [n, m] = spec.table_size.map(|v| v as f64);
+    [
+        [(n - 1.0) / n, (n - 1.0) / n, (m - 1.0) / m / longest, 0.0],
+        [0.5 / n, 0.5 / n, 0.5 / m, 0.0],
+    ]
+}
+
+/// Entry layers the precise walk peels: the scene's, else one for a convex boundary and
+/// four otherwise.
+fn entry_layers(spec: &VolumeSpec, convex: bool) -> usize {
+    match spec.entries {
+        0 if convex => 1,
+        0 => 4,
+        e => e as usize,
+    }
 }
 
 /// The four faces of every tetrahedron, as the faithful and projected paths draw them.
@@ -223,6 +253,10 @@ impl VolumeRenderer {
             precise: None,
             times: VolumeTimes::default(),
             tets: prepared.tets.len(),
+            stale: false,
+            longest: prepared.longest_edge().max(1e-12),
+            spare: None,
+            made_for: None,
         };
         match fidelity {
             Fidelity::Faithful => r.faithful = Some(r.build_faithful(gpu, kind, prepared)?),
@@ -243,13 +277,8 @@ impl VolumeRenderer {
         let pair = faithful_pair(kind);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         let faces = face_mesh(gpu, prepared)?;
-        let longest = prepared.longest_edge().max(1e-12);
-        let table = table_texture(gpu, &self.transfer, &self.spec, longest)?;
-        let [n, m] = self.spec.table_size.map(|v| v as f64);
-        let map = [
-            [(n - 1.0) / n, (n - 1.0) / n, (m - 1.0) / m / longest, 0.0],
-            [0.5 / n, 0.5 / n, 0.5 / m, 0.0],
-        ];
+        let table = table_texture(gpu, &self.transfer, &self.spec, self.longest)?;
+        let map = table_map(&self.spec, self.longest);
         Ok(Faithful {
             program,
             faces,
@@ -351,11 +380,7 @@ impl VolumeRenderer {
         .flat_map(|&(x, y)| [x, y, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])
         .collect();
         let quad = Mesh::new(gpu, "cellproj volume full-screen quad", &[4, 4], &quad)?;
-        let entries = match self.spec.entries {
-            0 if self.convex => 1,
-            0 => 4,
-            e => e as usize,
-        };
+        let entries = entry_layers(&self.spec, self.convex);
         Ok(Precise {
             peel,
             walk,
@@ -369,6 +394,68 @@ impl VolumeRenderer {
             layers: Vec::new(),
             entries,
         })
+    }
+
+    /// A new transfer function, unit distance, table size or order with the same mesh,
+    /// fidelity and method: only what depends on them is remade, the textures at the
+    /// next draw (the viewer's edits).
+    pub fn set_transfer(&mut self, spec: &VolumeSpec, transfer: Transfer) {
+        if spec.sort != self.spec.sort {
+            if let Some(f) = &mut self.faithful {
+                f.built_for = None;
+            }
+        }
+        self.transfer = transfer;
+        if let Some(p) = &mut self.precise {
+            let entries = entry_layers(spec, self.convex);
+            if entries != p.entries {
+                p.entries = entries;
+                p.layers.clear();
+            }
+        }
+        // The spec the textures were made for moves aside with them (see `refresh`).
+        if !self.stale {
+            self.made_for = Some(std::mem::replace(&mut self.spec, spec.clone()));
+        }
+        self.spec = spec.clone();
+        self.stale = true;
+    }
+
+    /// Whether `old` and `new` differ only in what [`VolumeRenderer::set_transfer`] takes.
+    pub fn transfer_only(old: &VolumeSpec, new: &VolumeSpec) -> bool {
+        old.precise == new.precise
+    }
+
+    fn refresh(&mut self, gpu: &Gpu) -> GlResult<()> {
+        if !self.stale {
+            return Ok(());
+        }
+        let made_for = self.made_for.take();
+        self.stale = false;
+        if made_for.as_ref() == Some(&self.spec) {
+            // Changed and changed back before a draw: the textures are right.
+            return Ok(());
+        }
+        if let Some(f) = &mut self.faithful {
+            if f.exact {
+                f.table = tf_texture(gpu, &self.transfer)?;
+            } else {
+                let (table, map) = match self.spare.take() {
+                    Some((spec, table, map)) if spec == self.spec => (table, map),
+                    _ => (
+                        table_texture(gpu, &self.transfer, &self.spec, self.longest)?,
+                        table_map(&self.spec, self.longest),
+                    ),
+                };
+                let old_table = std::mem::replace(&mut f.table, table);
+                let old_map = std::mem::replace(&mut f.map, map);
+                self.spare = made_for.map(|spec| (spec, old_table, old_map));
+            }
+        }
+        if let Some(p) = &mut self.precise {
+            p.tf = tf_texture(gpu, &self.transfer)?;
+        }
+        Ok(())
     }
 
     /// Whether the mesh's boundary is convex (one entry per ray).
@@ -400,6 +487,7 @@ impl VolumeRenderer {
         prepared: &Prepared,
         depth_test: bool,
     ) -> GlResult<()> {
+        self.refresh(gpu)?;
         if self.faithful.is_some() {
             self.draw_faithful(gpu, surface, frame, prepared, depth_test)
         } else {
