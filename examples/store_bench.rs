@@ -5,12 +5,16 @@
 //!   samples (reflectors folded over the survey, two normal faults, a Ricker wavelet,
 //!   noise; deterministic) written trace by trace with arbvis's SEG-Y writer
 //!   ([`arbvis::volume::segy::TraceWriter`], IEEE float), inlines generated in parallel.
-//! - `view STORE WxH`: open-to-first-picture, frames while turning at interactive quality
+//! - `view STORE WxH [precise]`: open-to-first-picture, frames while turning at interactive quality
 //!   (half the window's side, 1° a frame), the full-quality picture's time after the turn
 //!   stops, the process's peak memory; the same turning frames of the 256³ demo
-//!   (`v3o2-sum`) at the same size, interleaved; a picture of the survey.
+//!   (`scenes/bench/v3o2-sum-256.toml`, three attributes) at the same size, camera, slice
+//!   count and fidelity, interleaved; a picture of the survey.
+//!   `precise`: the one-pass ray caster through the page table (the demo then ray casts
+//!   too, without jitter, as the page table's ray caster does).
 //! - `error STORE N`: on a window of N³ voxels at the survey's centre, the f64 reference
-//!   integral of the full-resolution data against each LOD policy (RMSE and max, RGB).
+//!   integral of the full-resolution data against each LOD policy (RMSE and max, RGB),
+//!   faithful and precise.
 
 use std::io::BufWriter;
 use std::time::Instant;
@@ -33,9 +37,10 @@ fn main() -> Result<()> {
                 .collect::<Result<_, _>>()?;
             generate(&args[1], [n[0], n[1], n[2]])
         }
-        Some("view") if args.len() == 3 => view(&args[1], &args[2]),
+        Some("view") if args.len() == 3 => view(&args[1], &args[2], false),
+        Some("view") if args.len() == 4 && args[3] == "precise" => view(&args[1], &args[2], true),
         Some("error") if args.len() == 3 => error(&args[1], args[2].parse()?),
-        _ => bail!("usage: store_bench generate OUT.sgy NS NX NI | view STORE WxH | error STORE N"),
+        _ => bail!("usage: store_bench generate OUT.sgy NS NX NI | view STORE WxH [precise] | error STORE N"),
     }
 }
 
@@ -201,6 +206,20 @@ table = {{ builtin = "seismic", alpha = [[0.0, 0.8], [0.4, 0.0], [0.6, 0.0], [1.
     Ok(Scene::parse(&text, "store_bench")?)
 }
 
+/// `scene` drawn precisely: GLSL, the point-sampling ray caster without jitter (the page
+/// table's ray caster has none).
+fn make_precise(scene: &mut Scene) {
+    scene.fidelity = arbvis::vocab::Fidelity::Precise;
+    scene.programs = arbvis::gl::ProgramChoice::Glsl;
+    if let arbvis::scene::TechniqueScene::Opacity3d(p) = &mut scene.technique {
+        p.raycast = Some(arbvis::techniques::opacity3d::Raycast {
+            jitter: false,
+            bake: false,
+            ..Default::default()
+        });
+    }
+}
+
 fn parse_size(s: &str) -> Result<[u32; 2]> {
     let (w, h) = s.split_once('x').context("size WxH")?;
     Ok([w.parse()?, h.parse()?])
@@ -213,12 +232,16 @@ fn turned(scene: &Scene, degrees: f64) -> arbvis::camera::Camera {
     c
 }
 
-fn view(store: &str, size: &str) -> Result<()> {
+fn view(store: &str, size: &str, precise: bool) -> Result<()> {
     let size = parse_size(size)?;
     let half = [size[0] / 2, size[1] / 2];
     let h = Headless::new(Backend::Egl)?;
     let gpu = h.gpu();
-    let scene = store_scene(store, size, "gpu_memory = \"512M\"")?;
+    let mut scene = store_scene(store, size, "gpu_memory = \"512M\"")?;
+    if precise {
+        make_precise(&mut scene);
+    }
+    println!("fidelity: {:?}", scene.fidelity);
     let kind = scene.programs.resolve(gpu);
     let target = Target::create(gpu, size[0], size[1], scene.target_format(), false)?;
     let small = Target::create(gpu, half[0], half[1], scene.target_format(), false)?;
@@ -247,8 +270,22 @@ fn view(store: &str, size: &str) -> Result<()> {
     println!("open to first picture: {:.3} s ({frames} frames)", first);
     // Turning at interactive quality (half the side), 1° a frame, interleaved with the
     // 256³ demo at the same size.
-    let mut demo = Scene::demo("v3o2-sum")?;
+    // Today's 256³ demo (scenes/bench/v3o2-sum-256.toml: three attributes, sum) at the
+    // store scene's window, camera and slice count, at the same fidelity.
+    let mut demo = Scene::load(std::path::Path::new("scenes/bench/v3o2-sum-256.toml"))?;
     demo.size = half;
+    demo.camera = scene.camera;
+    demo.fidelity = arbvis::vocab::Fidelity::Faithful;
+    if let (
+        arbvis::scene::TechniqueScene::Opacity3d(d),
+        arbvis::scene::TechniqueScene::Opacity3d(s),
+    ) = (&mut demo.technique, &scene.technique)
+    {
+        d.slices = s.slices;
+    }
+    if precise {
+        make_precise(&mut demo);
+    }
     let mut dr = arbvis::render::build(gpu, &demo, demo.programs.resolve(gpu))?;
     let (mut store_ms, mut demo_ms) = (Vec::new(), Vec::new());
     for step in 0..40 {
@@ -280,7 +317,7 @@ fn view(store: &str, size: &str) -> Result<()> {
     };
     let (s, d) = (median(&mut store_ms), median(&mut demo_ms));
     println!(
-        "turning at {}x{} (interactive, half of {}x{}): store {s:.1} ms, 256³ demo {d:.1} ms, ratio {:.2}",
+        "turning at {}x{} (interactive, half of {}x{}): store {s:.1} ms, 256³ demo (v3o2-sum-256) {d:.1} ms, ratio {:.2}",
         half[0], half[1], size[0], size[1], s / d
     );
     println!("{}", r.status().unwrap_or_default());
@@ -310,7 +347,8 @@ fn view(store: &str, size: &str) -> Result<()> {
     let image = target.read(gpu)?;
     let mut picture_scene = scene.clone();
     picture_scene.camera = camera;
-    let out = std::path::Path::new(store).with_extension("png");
+    let out =
+        std::path::Path::new(store).with_extension(if precise { "precise.png" } else { "png" });
     arbvis::png_io::write_png(&out, &picture_scene.picture(&image), &[])?;
     println!("picture: {}", out.display());
     println!("peak memory while viewing: {:.0} MB", peak_rss_mb());
@@ -357,15 +395,23 @@ fn error(store: &str, n: usize) -> Result<()> {
         t.elapsed().as_secs_f64()
     );
     let h = Headless::new(Backend::Egl)?;
-    for (name, policy) in [
+    let policies = [
         ("level 0", "level = 0"),
         ("level 1", "level = 1"),
         ("level 2", "level = 2"),
         ("full quality (1 px)", "pixels = 1.0"),
         ("interactive (2 px)", "pixels = 2.0"),
         ("interactive (4 px)", "pixels = 4.0"),
-    ] {
+    ];
+    for (precise, (name, policy)) in [false, true]
+        .into_iter()
+        .flat_map(|p| policies.iter().map(move |x| (p, x)))
+    {
         let mut scene = store_scene(store, size, &format!("{extra}{policy}\n"))?;
+        if precise {
+            make_precise(&mut scene);
+        }
+        let name = format!("{} {name}", if precise { "precise" } else { "faithful" });
         if let arbvis::scene::TechniqueScene::Opacity3d(p) = &mut scene.technique {
             p.primary.quantize = range;
         }

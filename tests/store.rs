@@ -462,6 +462,46 @@ fn precise_through_the_page_table_is_the_whole_volume_ray_caster_at_level_zero()
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Levels are means of the level below, so a coarse brick's own range is narrower than
+/// its children's: a table clear over the middle must not prune a coarse brick whose
+/// children reach the opaque ends.
+#[test]
+fn a_table_clear_in_the_middle_keeps_the_bricks_whose_children_reach_its_ends() {
+    let h: Headless = headless(Backend::Egl);
+    let (dir, _) = fixture("store-ranges", [40, 28, 24], 8);
+    let store = Store::open(&dir.join("s.zarr")).unwrap();
+    let m = &store.meta;
+    let (lo, hi) = (m.attributes[0].min.unwrap(), m.attributes[0].max.unwrap());
+    // The premise: the top level's range stays inside the middle 60 % of the survey's.
+    let top = store.ranges(0, m.levels - 1).unwrap();
+    let inner = |v: f32| ((v as f64 - lo) / (hi - lo) - 0.5).abs() < 0.3;
+    assert!(top.iter().all(|r| inner(r[0]) && inner(r[1])), "{top:?}");
+    // Opaque only over the outer 15 % at each end, at the LOD's own choice of level.
+    let text = format!(
+        r#"size = [64, 64]
+background = [0.0, 0.0, 0.0, 1.0]
+[camera]
+rotation = [0.2241, -0.3696, 0.0747, 0.8986]
+[technique.opacity3d]
+slices = 64
+[technique.opacity3d.primary]
+volume = {{ store = "s.zarr" }}
+attribute = "amplitude"
+table = {{ builtin = "seismic", alpha = [[0.0, 0.9], [0.15, 0.0], [0.85, 0.0], [1.0, 0.9]] }}
+"#
+    );
+    let mut scene = Scene::parse(&text, "test").unwrap();
+    scene.base = dir.clone();
+    let r = render_on(&h, &scene).unwrap();
+    let status = r.status.unwrap();
+    assert!(!status.contains("MB; 0 drawn"), "{status}");
+    let lit = (0..64 * 64)
+        .filter(|&p| r.image.pixel_u8(p % 64, p / 64)[..3] != [0, 0, 0])
+        .count();
+    assert!(lit > 64, "{lit} pixels lit: {status}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// The viewer's sections of a store: read at level 0 by the reader thread, in the
 /// survey's numbers, the same levels as the whole volume quantized over the same range.
 #[cfg(feature = "viewer")]
