@@ -477,20 +477,18 @@ fn a_table_clear_in_the_middle_keeps_the_bricks_whose_children_reach_its_ends() 
     let inner = |v: f32| ((v as f64 - lo) / (hi - lo) - 0.5).abs() < 0.3;
     assert!(top.iter().all(|r| inner(r[0]) && inner(r[1])), "{top:?}");
     // Opaque only over the outer 15 % at each end, at the LOD's own choice of level.
-    let text = format!(
-        r#"size = [64, 64]
+    let text = r#"size = [64, 64]
 background = [0.0, 0.0, 0.0, 1.0]
 [camera]
 rotation = [0.2241, -0.3696, 0.0747, 0.8986]
 [technique.opacity3d]
 slices = 64
 [technique.opacity3d.primary]
-volume = {{ store = "s.zarr" }}
+volume = { store = "s.zarr" }
 attribute = "amplitude"
-table = {{ builtin = "seismic", alpha = [[0.0, 0.9], [0.15, 0.0], [0.85, 0.0], [1.0, 0.9]] }}
-"#
-    );
-    let mut scene = Scene::parse(&text, "test").unwrap();
+table = { builtin = "seismic", alpha = [[0.0, 0.9], [0.15, 0.0], [0.85, 0.0], [1.0, 0.9]] }
+"#;
+    let mut scene = Scene::parse(text, "test").unwrap();
     scene.base = dir.clone();
     let r = render_on(&h, &scene).unwrap();
     let status = r.status.unwrap();

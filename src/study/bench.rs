@@ -282,6 +282,14 @@ fn cellproj_settings(
                 s.fidelity = Fidelity::Precise;
                 volume.precise = crate::techniques::cellproj::transfer::Precise::Projected;
             }
+            "table" => {
+                s.fidelity = Fidelity::Precise;
+                volume.precise = crate::techniques::cellproj::transfer::Precise::Table;
+                let n: u32 = size
+                    .parse()
+                    .with_context(|| format!("--cellproj {name}: the table size after ':'"))?;
+                volume.table_size = [n, (n / 2).max(2)];
+            }
             "centroid" | "mpvonc" => {
                 s.fidelity = Fidelity::Faithful;
                 volume.sort = if kind == "centroid" {
@@ -294,7 +302,9 @@ fn cellproj_settings(
                     .with_context(|| format!("--cellproj {name}: the table size after ':'"))?;
                 volume.table_size = [n, (n / 2).max(2)];
             }
-            _ => bail!("--cellproj {name}: centroid:N, mpvonc:N, precise (the walk) or projected"),
+            _ => bail!(
+                "--cellproj {name}: centroid:N, mpvonc:N, precise (the walk), projected or table:N"
+            ),
         }
         c.volume = Some(volume);
         c.validate()

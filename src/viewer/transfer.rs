@@ -218,7 +218,11 @@ pub fn editor(
     });
     ui.horizontal_wrapped(|ui| {
         ui.label("Exact order (precise)");
-        for (p, label) in [(Precise::Walk, "walk"), (Precise::Projected, "projected")] {
+        for (p, label) in [
+            (Precise::Walk, "walk"),
+            (Precise::Projected, "projected"),
+            (Precise::Table, "table"),
+        ] {
             changed |= w.radio(ui, &format!("Precise {label}"), &mut spec.precise, p);
         }
     });

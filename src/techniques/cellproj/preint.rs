@@ -67,10 +67,27 @@ impl<'a> Integrals<'a> {
 /// The table: `n x n x m` RGBA8 texels, `sf` fastest, then `sb`, then the length;
 /// `longest` is the length of the last layer (object units).
 pub fn table(tf: &Transfer, n: usize, m: usize, longest: f64, build: Build) -> Vec<u8> {
+    texels(tf, n, m, longest, build, |v| {
+        (v.clamp(0.0, 1.0) * 255.0).round() as u8
+    })
+}
+
+/// [`table`] in float (precise mode's `table` method): the same texels, unrounded.
+pub fn table_f32(tf: &Transfer, n: usize, m: usize, longest: f64, build: Build) -> Vec<f32> {
+    texels(tf, n, m, longest, build, |v| v.clamp(0.0, 1.0) as f32)
+}
+
+fn texels<T: Send>(
+    tf: &Transfer,
+    n: usize,
+    m: usize,
+    longest: f64,
+    build: Build,
+    texel: impl Fn(f64) -> T + Sync + Send + Copy,
+) -> Vec<T> {
     let integrals = Integrals::new(tf);
     let s_at = |i: usize| i as f64 / (n - 1).max(1) as f64;
     let at: Vec<[f64; 4]> = (0..n).map(|i| integrals.at(s_at(i))).collect();
-    let byte = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
     (0..m)
         .into_par_iter()
         .flat_map_iter(|k| {
@@ -83,7 +100,7 @@ pub fn table(tf: &Transfer, n: usize, m: usize, longest: f64, build: Build) -> V
                     Build::Exact => tf.segment(sf, sb, length),
                     Build::Engel => engel(integrals, at[i], at[j], sf, sb, length),
                 };
-                rgba.map(byte)
+                rgba.map(texel)
             })
         })
         .collect()

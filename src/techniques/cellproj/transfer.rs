@@ -78,6 +78,10 @@ pub enum Precise {
     /// The faithful projection (MPVONC order) with the exact integral per fragment into a
     /// float target: exact where the order is.
     Projected,
+    /// The faithful projection (MPVONC order) through the pre-integrated table in float
+    /// (RGBA32F table, float target): the era's method without its 8-bit losses, fast;
+    /// its error is the table's resolution (and the order's, on non-convex meshes).
+    Table,
 }
 
 /// How the table is built.

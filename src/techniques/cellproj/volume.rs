@@ -109,6 +109,8 @@ struct Faithful {
     table: Texture,
     /// Precise projected: exact integral per fragment.
     exact: bool,
+    /// Precise `table`: the pre-integrated table in float.
+    float: bool,
     /// `(sf, sb, length)` to texture coordinates: scale and offset.
     map: [[f64; 4]; 2],
     built_for: Option<Viewer>,
@@ -142,6 +144,8 @@ pub struct VolumeRenderer {
     /// draw, so that an edit followed by another before any draw builds one table).
     stale: bool,
     longest: f64,
+    /// Precise `table`: the faithful projection with a float table.
+    float_table: bool,
     /// The faithful table made before the current one, with its spec: the viewer
     /// alternates a coarse table while the user interacts with the scene's when still,
     /// and swaps them instead of integrating again.
@@ -150,12 +154,32 @@ pub struct VolumeRenderer {
     made_for: Option<VolumeSpec>,
 }
 
-fn table_texture(gpu: &Gpu, tf: &Transfer, spec: &VolumeSpec, longest: f64) -> GlResult<Texture> {
+/// The pre-integrated table: RGBA8 (faithful), or RGBA32F (precise `table`).
+fn table_texture(
+    gpu: &Gpu,
+    tf: &Transfer,
+    spec: &VolumeSpec,
+    longest: f64,
+    float: bool,
+) -> GlResult<Texture> {
     let [n, m] = spec.table_size;
-    let data = preint::table(tf, n as usize, m as usize, longest, spec.build);
+    let (nu, mu) = (n as usize, m as usize);
+    let label = "cellproj volume pre-integrated table (sf, sb, length)";
+    if float {
+        let data = preint::table_f32(tf, nu, mu, longest, spec.build);
+        return Texture::new(
+            gpu,
+            label,
+            Extent::D3(n, n, m),
+            TexelFormat::Rgba32f,
+            Filter::Linear,
+            TexelData::F32(&data),
+        );
+    }
+    let data = preint::table(tf, nu, mu, longest, spec.build);
     Texture::new(
         gpu,
-        "cellproj volume pre-integrated table (sf, sb, length)",
+        label,
         Extent::D3(n, n, m),
         TexelFormat::Rgba8,
         Filter::Linear,
@@ -255,6 +279,7 @@ impl VolumeRenderer {
             tets: prepared.tets.len(),
             stale: false,
             longest: prepared.longest_edge().max(1e-12),
+            float_table: false,
             spare: None,
             made_for: None,
         };
@@ -262,6 +287,10 @@ impl VolumeRenderer {
             Fidelity::Faithful => r.faithful = Some(r.build_faithful(gpu, kind, prepared)?),
             Fidelity::Precise if spec.precise == super::transfer::Precise::Projected => {
                 r.faithful = Some(r.build_projected(gpu, prepared)?)
+            }
+            Fidelity::Precise if spec.precise == super::transfer::Precise::Table => {
+                r.float_table = true;
+                r.faithful = Some(r.build_faithful(gpu, ProgramKind::Glsl, prepared)?)
             }
             Fidelity::Precise => r.precise = Some(r.build_precise(gpu, prepared, isovalues)?),
         }
@@ -277,13 +306,15 @@ impl VolumeRenderer {
         let pair = faithful_pair(kind);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         let faces = face_mesh(gpu, prepared)?;
-        let table = table_texture(gpu, &self.transfer, &self.spec, self.longest)?;
+        let float = kind == ProgramKind::Glsl && self.float_table;
+        let table = table_texture(gpu, &self.transfer, &self.spec, self.longest, float)?;
         let map = table_map(&self.spec, self.longest);
         Ok(Faithful {
             program,
             faces,
             table,
             exact: false,
+            float,
             map,
             built_for: None,
         })
@@ -299,6 +330,7 @@ impl VolumeRenderer {
             faces,
             table,
             exact: true,
+            float: true,
             map: [[0.0; 4]; 2],
             built_for: None,
         })
@@ -443,7 +475,7 @@ impl VolumeRenderer {
                 let (table, map) = match self.spare.take() {
                     Some((spec, table, map)) if spec == self.spec => (table, map),
                     _ => (
-                        table_texture(gpu, &self.transfer, &self.spec, self.longest)?,
+                        table_texture(gpu, &self.transfer, &self.spec, self.longest, f.float)?,
                         table_map(&self.spec, self.longest),
                     ),
                 };
