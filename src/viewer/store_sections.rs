@@ -11,16 +11,14 @@
 
 use std::path::Path;
 use std::sync::mpsc::{channel, Receiver, Sender};
-use std::sync::Arc;
 
 use glam::DVec3;
 
 use super::axes::{Axis, Numbers};
-use crate::store::lod::Pyramid;
 use crate::store::Store;
-use crate::techniques::opacity3d::bricked::store_of;
+use crate::techniques::opacity3d::bricked::StoreScene;
 use crate::techniques::opacity3d::Opacity3dScene;
-use crate::volume::quantize::{quantize_value, Quantization};
+use crate::volume::quantize::quantize_value;
 
 /// A request: (axis, index, attribute).
 pub type SectionKey = (usize, usize, usize);
@@ -44,34 +42,18 @@ pub struct StoreSections {
 impl StoreSections {
     /// The sections of the store `params` names (relative to `base`), if it names one.
     pub fn open(params: &Opacity3dScene, base: &Path) -> Result<Option<StoreSections>, String> {
-        let Some(path) = store_of(params)? else {
+        let Some(StoreScene {
+            store,
+            pyramid,
+            attributes,
+            ..
+        }) = StoreScene::open(params, base)?
+        else {
             return Ok(None);
         };
-        let store = Arc::new(Store::open(&base.join(path)).map_err(|e| e.to_string())?);
         let meta = &store.meta;
-        let view = params.store.clone().unwrap_or_default();
-        let window = view.window.unwrap_or([[0; 3], meta.dims]);
+        let window = pyramid.window;
         let dims: [usize; 3] = std::array::from_fn(|a| window[1][a].saturating_sub(window[0][a]));
-        let pyramid = Pyramid {
-            dims: meta.dims,
-            brick: meta.brick,
-            levels: meta.levels,
-            window,
-            spacing: params.spacing.unwrap_or(meta.spacing),
-        };
-        let mut attributes = [None; 3];
-        for (a, attr) in params.attributes().iter().enumerate() {
-            let Some(attr) = attr else { continue };
-            let index = store
-                .attribute_index(attr.attribute.name())
-                .map_err(|e| e.to_string())?;
-            let am = &meta.attributes[index];
-            let (low, high) = match attr.quantize {
-                Quantization::Range([l, h]) => (l, h),
-                _ => (am.min.unwrap_or(0.0), am.max.unwrap_or(0.0)),
-            };
-            attributes[a] = Some((index, low, high));
-        }
         let axes = store_axes(meta, window);
         let (req_tx, req_rx) = channel();
         let (rep_tx, rep_rx) = channel();

@@ -50,14 +50,12 @@ use serde::{Deserialize, Serialize};
 use super::paged::{PageTable, PagedPass};
 use super::prepare::CHANNEL;
 use super::programs::faithful_pair;
-use super::renderer::{eye, model_view_projection, neutral_table, toward_viewer};
+use super::renderer::{eye, model_view_projection, neutral_table, table_texture, toward_viewer};
 use super::slicing::{polygon, EDGES};
 use super::{coefficients, Combine, Opacity3dScene, ATTRIBUTE_NAMES};
 use crate::camera::Projection;
-use crate::colortable::ColorTable;
 use crate::gl::{
-    self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
-    Surface, TexelData, Texture,
+    self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface, Texture,
 };
 use crate::store::cache::{BrickCache, Packing};
 use crate::store::lod::{self, BrickId, Pyramid, View};
@@ -143,6 +141,71 @@ pub fn store_of(params: &Opacity3dScene) -> Result<Option<PathBuf>, String> {
     }
 }
 
+/// A scene's store opened: its view settings, the window's pyramid, and per scene
+/// attribute the store's attribute index and quantization range (what the renderers and
+/// the viewer's sections share).
+pub struct StoreScene {
+    /// The store.
+    pub store: Arc<Store>,
+    /// `[technique.opacity3d.store]`.
+    pub view: StoreView,
+    /// The levels over the window drawn.
+    pub pyramid: Pyramid,
+    /// Per attribute (primary, secondary, tertiary): store index, low, high.
+    pub attributes: [Option<(usize, f64, f64)>; 3],
+}
+
+impl StoreScene {
+    /// Open the store `params` names (relative to `base`), if it names one.
+    pub fn open(params: &Opacity3dScene, base: &Path) -> Result<Option<StoreScene>, String> {
+        let Some(path) = store_of(params)? else {
+            return Ok(None);
+        };
+        let store = Arc::new(Store::open(&base.join(&path)).map_err(|e| e.to_string())?);
+        let view = params.store.clone().unwrap_or_default();
+        let meta = &store.meta;
+        let window = view.window.unwrap_or([[0; 3], meta.dims]);
+        if (0..3).any(|a| window[1][a] > meta.dims[a]) {
+            return Err(format!(
+                "store.window {window:?} reaches beyond the survey's {:?} voxels",
+                meta.dims
+            ));
+        }
+        let pyramid = Pyramid {
+            dims: meta.dims,
+            brick: meta.brick,
+            levels: meta.levels,
+            window,
+            spacing: params.spacing.unwrap_or(meta.spacing),
+        };
+        let mut attributes = [None; 3];
+        for (a, attr) in params.attributes().iter().enumerate() {
+            let Some(attr) = attr else { continue };
+            let index = store
+                .attribute_index(attr.attribute.name())
+                .map_err(|e| format!("{}: {e}", ATTRIBUTE_NAMES[a]))?;
+            let am = &meta.attributes[index];
+            let (low, high) = match attr.quantize {
+                Quantization::MinMax => (am.min.unwrap_or(0.0), am.max.unwrap_or(0.0)),
+                Quantization::Range([l, h]) => (l, h),
+                Quantization::Percentile(_) => {
+                    return Err(format!(
+                        "{}.quantize: percentiles of a store are not computed; use \"min-max\" or {{ range = [low, high] }}",
+                        ATTRIBUTE_NAMES[a]
+                    ))
+                }
+            };
+            attributes[a] = Some((index, low, high));
+        }
+        Ok(Some(StoreScene {
+            store,
+            view,
+            pyramid,
+            attributes,
+        }))
+    }
+}
+
 /// Time a streaming frame spends uploading what has arrived (a brick of 66³ RGB8 is
 /// 0.86 MB, about a millisecond on llvmpipe): the frame stays interactive, and once the
 /// camera stops a frame takes in everything the loader has read since the last one
@@ -171,23 +234,6 @@ pub struct BrickedRenderer {
     last: (usize, usize, usize),
 }
 
-fn table_texture(
-    gpu: &Gpu,
-    label: &str,
-    table: &ColorTable,
-    filter: Filter,
-    fidelity: Fidelity,
-) -> GlResult<Texture> {
-    Texture::new(
-        gpu,
-        label,
-        Extent::D2(256, 1),
-        super::renderer::texel_formats(fidelity, 1).1,
-        filter,
-        TexelData::U8(&table.texels()),
-    )
-}
-
 impl BrickedRenderer {
     /// Open the store the scene names and set up the cache (`gpu_memory` overrides the
     /// scene's budget).
@@ -212,47 +258,22 @@ impl BrickedRenderer {
                 "a clip object on a store is not supported".into(),
             ));
         }
-        let path = store_of(params)
+        let StoreScene {
+            store,
+            view,
+            pyramid,
+            attributes,
+        } = StoreScene::open(params, base)
             .map_err(GlError::Data)?
             .ok_or_else(|| GlError::Data("the scene names no store".into()))?;
-        let store =
-            Arc::new(Store::open(&base.join(&path)).map_err(|e| GlError::Data(e.to_string()))?);
-        let view = params.store.clone().unwrap_or_default();
         let meta = &store.meta;
-        let window = view.window.unwrap_or([[0; 3], meta.dims]);
-        if (0..3).any(|a| window[1][a] > meta.dims[a]) {
-            return Err(GlError::Data(format!(
-                "store.window {window:?} reaches beyond the survey's {:?} voxels",
-                meta.dims
-            )));
-        }
-        let pyramid = Pyramid {
-            dims: meta.dims,
-            brick: meta.brick,
-            levels: meta.levels,
-            window,
-            spacing: params.spacing.unwrap_or(meta.spacing),
-        };
         let mut channels = [None; 3];
         let mut attrs = [None; 3];
-        for (a, attr) in params.attributes().iter().enumerate() {
-            let Some(attr) = attr else { continue };
-            let index = store
-                .attribute_index(attr.attribute.name())
-                .map_err(|e| GlError::Data(format!("{}: {e}", ATTRIBUTE_NAMES[a])))?;
-            let am = &meta.attributes[index];
-            let (low, high) = match attr.quantize {
-                Quantization::MinMax => (am.min.unwrap_or(0.0), am.max.unwrap_or(0.0)),
-                Quantization::Range([l, h]) => (l, h),
-                Quantization::Percentile(_) => {
-                    return Err(GlError::Data(format!(
-                        "{}.quantize: percentiles of a store are not computed; use \"min-max\" or {{ range = [low, high] }}",
-                        ATTRIBUTE_NAMES[a]
-                    )))
-                }
-            };
-            channels[CHANNEL[a]] = Some((index, low, high));
-            attrs[a] = Some((index, low, high, am.non_finite > 0));
+        for (a, at) in attributes.iter().enumerate() {
+            if let Some((index, low, high)) = *at {
+                channels[CHANNEL[a]] = Some((index, low, high));
+                attrs[a] = Some((index, low, high, meta.attributes[index].non_finite > 0));
+            }
         }
         let budget = match gpu_memory {
             Some(b) => b,
@@ -455,6 +476,20 @@ impl BrickedRenderer {
         }
     }
 
+    /// Ask the loader for the roots and `wanted` (coarse first: the top level stands in
+    /// for everything until finer arrives); returns how many of `wanted` are still to come
+    /// (not resident, not failed: a failed brick never comes).
+    fn ask_for(&mut self, wanted: &[BrickId]) -> usize {
+        let missing = wanted
+            .iter()
+            .filter(|&&id| !self.cache.is_resident(id) && !self.cache.has_failed(id))
+            .count();
+        let mut ask: Vec<BrickId> = self.pyramid.roots();
+        ask.extend(wanted.iter().copied());
+        self.cache.request(&ask);
+        missing
+    }
+
     /// Bricks a streaming frame may want: the slots less the roots (always asked for, the
     /// stand-ins of last resort) and an eighth for the resident ancestors that stand in
     /// while the wanted bricks load. Wanting every slot livelocked: each arriving brick
@@ -622,13 +657,7 @@ impl BrickedRenderer {
                 }
             }
             order.extend(stand_ins);
-            let missing = wanted
-                .iter()
-                .filter(|&&id| !self.cache.is_resident(id) && !self.cache.has_failed(id))
-                .count();
-            let mut ask: Vec<BrickId> = self.pyramid.roots();
-            ask.extend(wanted.iter().copied());
-            self.cache.request(&ask);
+            let missing = self.ask_for(&wanted);
             self.last = (wanted.len(), order.len(), missing);
             order
         } else {
@@ -730,15 +759,7 @@ impl Renderer for BrickedRenderer {
             let wanted = self.wanted(&view, self.streaming_room());
             let resident = |id: BrickId| self.cache.is_resident(id);
             let (order, _) = lod::drawable(&self.pyramid, &view, &wanted, &resident);
-            // Still to come: wanted, not resident, not failed (a failed brick never comes).
-            let missing = wanted
-                .iter()
-                .filter(|&&id| !self.cache.is_resident(id) && !self.cache.has_failed(id))
-                .count();
-            // Coarse first: the top level stands in for everything until finer arrives.
-            let mut ask: Vec<BrickId> = self.pyramid.roots();
-            ask.extend(wanted.iter().copied());
-            self.cache.request(&ask);
+            let missing = self.ask_for(&wanted);
             for &id in &order {
                 self.cache.touch(id);
             }

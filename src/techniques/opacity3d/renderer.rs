@@ -214,7 +214,7 @@ pub struct Opacity3dRenderer {
     clip: Option<Clip>,
 }
 
-fn table_texture(
+pub(super) fn table_texture(
     gpu: &Gpu,
     label: &str,
     table: &ColorTable,
