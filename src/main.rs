@@ -111,11 +111,13 @@ enum Command {
     ///
     /// --technique cellproj-volume: cell projection's volume rendering on the --grids
     /// meshes and any --scenes, orthographic and perspective: faithful (MPVONC at table
-    /// sizes 32-256, centroid order at 128) and precise (the walk, projected); frame time
+    /// sizes 32-256, centroid order at 128) and precise (the walk, projected, the float
+    /// table at 128); frame time
     /// with the camera still and turning, the sort's and upload's share, RGB RMSE against
     /// the f64 reference (meshes up to 250,000 tetrahedra; larger ones print "unscored").
     /// Writes cellproj-volume.csv and cellproj-volume-MESH.png per scored mesh (RMSE
-    /// against ms). About 10 minutes.
+    /// against ms). About 5 minutes (4 min 26 s with the bracket on an idle 2-core
+    /// machine).
     ///
     /// --technique clip: volume clipping. Textures: each --clip-sizes grid x shape
     /// (sphere, torus mesh, open half-torus, cow.obj where ../shared has it) x --blocks B:

@@ -95,7 +95,7 @@ pub struct Score {
 }
 
 /// The settings of one mesh and projection: faithful MPVONC at each table size, centroid
-/// at 128, the precise walk and precise projected.
+/// at 128, the precise walk, precise projected, and precise `table` at 128.
 fn settings(base: &VolumeSpec, options: &Options) -> Vec<(String, Fidelity, VolumeSpec)> {
     let mut settings: Vec<(String, Fidelity, VolumeSpec)> = Vec::new();
     for &n in &options.tables {
@@ -117,6 +117,14 @@ fn settings(base: &VolumeSpec, options: &Options) -> Vec<(String, Fidelity, Volu
         "precise projected (mpvonc)".into(),
         Fidelity::Precise,
         projected,
+    ));
+    let mut table = base.clone();
+    table.precise = super::super::transfer::Precise::Table;
+    table.table_size = [128, 64];
+    settings.push((
+        "precise table 128x128x64 (mpvonc)".into(),
+        Fidelity::Precise,
+        table,
     ));
     settings
 }
