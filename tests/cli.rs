@@ -591,7 +591,7 @@ fn inspect_times_loading_when_asked() {
 
 #[test]
 fn study_of_the_cell_projection_volume_writes_csv_and_a_plot_per_scored_mesh() {
-    // The 3-point grid (48 tetrahedra): 7 settings x 2 projections, scored.
+    // The 3-point grid (48 tetrahedra): 8 settings x 2 projections, scored.
     let (dir, _) = study(
         "study-cellproj-volume",
         &[
@@ -604,7 +604,7 @@ fn study_of_the_cell_projection_volume_writes_csv_and_a_plot_per_scored_mesh() {
         ],
     );
     let csv = std::fs::read_to_string(dir.join("cellproj-volume.csv")).unwrap();
-    assert_eq!(csv.lines().count(), 1 + 14, "{csv}");
+    assert_eq!(csv.lines().count(), 1 + 16, "{csv}");
     for line in csv.lines().skip(1) {
         let rmse: f64 = line.rsplit(',').nth(3).unwrap().parse().unwrap();
         // A real score (not a placeholder): below 0.2 of full scale.
