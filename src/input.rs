@@ -133,6 +133,27 @@ pub fn shorten(text: &str, max_chars: usize) -> String {
     format!("{head}… ({} more characters)", count - max_chars)
 }
 
+/// Tests only: a file under `../shared/data/` (real files no one here wrote), or `None`
+/// with a "SKIPPED" line when this clone has none; `ARBVIS_NO_SKIP=1` (set by `.ci/run`)
+/// turns the skip into a failure, as `tests/common` does for the integration tests.
+#[cfg(test)]
+pub(crate) fn shared_data(relative: &str) -> Option<std::path::PathBuf> {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data")
+        .join(relative);
+    if path.exists() {
+        return Some(path);
+    }
+    if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
+        panic!("ARBVIS_NO_SKIP=1 but {} is missing", path.display());
+    }
+    eprintln!(
+        "SKIPPED: {} is missing (no ../shared/data in this clone)",
+        path.display()
+    );
+    None
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

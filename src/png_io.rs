@@ -184,12 +184,8 @@ static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 /// The marker in temporary names: `.NAME.arbvis-tmp.PID`.
 const TMP_MARK: &str = ".arbvis-tmp.";
 
-/// Write bytes to `path` atomically: a temporary file in the same folder, synced, then
-/// renamed over `path`. Nothing is left behind on error; on SIGINT/SIGTERM the handler
-/// installed by [`remove_temporaries_on_signals`] removes the temporary; a temporary left
-/// by a process that died harder (SIGKILL, power loss) is removed by the next write to
-/// the same path, once its process is gone.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+/// `path`'s folder (`.` for a bare name) and file name.
+fn dir_and_name(path: &Path) -> std::io::Result<(PathBuf, String)> {
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
         _ => PathBuf::from("."),
@@ -199,6 +195,16 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         .ok_or_else(|| crate::input::invalid("not a file path"))?
         .to_string_lossy()
         .to_string();
+    Ok((dir, file_name))
+}
+
+/// Write bytes to `path` atomically: a temporary file in the same folder, synced, then
+/// renamed over `path`. Nothing is left behind on error; on SIGINT/SIGTERM the handler
+/// installed by [`remove_temporaries_on_signals`] removes the temporary; a temporary left
+/// by a process that died harder (SIGKILL, power loss) is removed by the next write to
+/// the same path, once its process is gone.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let (dir, file_name) = dir_and_name(path)?;
     remove_stale(&dir, &file_name);
     let tmp = dir.join(format!(".{file_name}{TMP_MARK}{}", std::process::id()));
     lock_temporaries().push(tmp.clone());
@@ -223,15 +229,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
 /// temporary renamed over it.
 pub fn write_new(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-        _ => PathBuf::from("."),
-    };
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| crate::input::invalid("not a file path"))?
-        .to_string_lossy()
-        .to_string();
+    let (dir, file_name) = dir_and_name(path)?;
     remove_stale(&dir, &file_name);
     let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     let tmp = dir.join(format!(".{file_name}{TMP_MARK}{}.{n}", std::process::id()));

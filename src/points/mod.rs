@@ -281,25 +281,8 @@ pub fn inspect(path: &Path) -> Result<String, PointsError> {
     Ok(format!("{}\n{format}{}", path.display(), cloud.describe()))
 }
 
-/// A file under `../shared/data/`, or `None` with a "SKIPPED" note when this clone has
-/// none; `ARBVIS_NO_SKIP=1` turns the skip into a failure (as `tests/common` does).
 #[cfg(test)]
-pub(crate) fn shared_data(relative: &str) -> Option<PathBuf> {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(relative);
-    if path.exists() {
-        return Some(path);
-    }
-    if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
-        panic!("ARBVIS_NO_SKIP=1 but {} is missing", path.display());
-    }
-    eprintln!(
-        "SKIPPED: {} is missing (no ../shared/data in this clone)",
-        path.display()
-    );
-    None
-}
+pub(crate) use crate::input::shared_data;
 
 #[cfg(test)]
 mod tests;

@@ -290,19 +290,7 @@ mod tests {
         Path::new("t.obj")
     }
 
-    fn shared(relative: &str) -> Option<std::path::PathBuf> {
-        let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("../shared/data")
-            .join(relative);
-        if p.exists() {
-            return Some(p);
-        }
-        if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
-            panic!("ARBVIS_NO_SKIP=1 but {} is missing", p.display());
-        }
-        eprintln!("SKIPPED: {} is missing", p.display());
-        None
-    }
+    use crate::input::shared_data as shared;
 
     #[test]
     fn quads_pentagons_and_negative_indices() {

@@ -550,15 +550,9 @@ mod tests {
 
     #[test]
     fn the_real_binary_stl() {
-        let p =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/surfaces/42400-IDGH.stl");
-        if !p.exists() {
-            if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
-                panic!("ARBVIS_NO_SKIP=1 but {} is missing", p.display());
-            }
-            eprintln!("SKIPPED: {} is missing", p.display());
+        let Some(p) = crate::input::shared_data("surfaces/42400-IDGH.stl") else {
             return;
-        }
+        };
         let m = crate::surface::read(&p).unwrap();
         assert_eq!(m.triangles.len(), 11_036);
         let r = inspect(&m);

@@ -24,6 +24,27 @@ pub fn section_axes(axis: usize) -> (usize, usize) {
     }
 }
 
+/// The section at `index` along `axis` of a `dims` grid as it shows it: its size (across,
+/// down) and its voxels `[i, j, k]`, across fastest, then down ([`section_axes`]).
+pub fn section_voxels(
+    dims: [usize; 3],
+    axis: usize,
+    index: usize,
+) -> ([usize; 2], impl Iterator<Item = [usize; 3]>) {
+    let (u, w) = section_axes(axis);
+    let (nu, nw) = (dims[u], dims[w]);
+    let voxels = (0..nw).flat_map(move |y| {
+        (0..nu).map(move |x| {
+            let mut ijk = [0usize; 3];
+            ijk[axis] = index;
+            ijk[u] = x;
+            ijk[w] = y;
+            ijk
+        })
+    });
+    ([nu, nw], voxels)
+}
+
 /// How an axis numbers its voxels.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Numbers {
@@ -318,16 +339,9 @@ mod tests {
 
     #[test]
     fn segy_axes_from_f3() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/seismic/f3.sgy");
-        if !path.exists() {
-            assert!(
-                std::env::var_os("ARBVIS_NO_SKIP").is_none_or(|v| v != "1"),
-                "ARBVIS_NO_SKIP=1 but {} is missing",
-                path.display()
-            );
-            eprintln!("SKIPPED: {} is missing", path.display());
+        let Some(path) = crate::input::shared_data("seismic/f3.sgy") else {
             return;
-        }
+        };
         let source = VolumeSource::Segy(segy::SegySource {
             path,
             prestack: Default::default(),

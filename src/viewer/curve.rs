@@ -59,6 +59,21 @@ pub fn curve_from_table(table: &ColorTable) -> Vec<[f64; 2]> {
 /// Height in texels of a histogram image.
 const HISTOGRAM_ROWS: usize = 64;
 
+/// A 256 x 1 texture of a table's colours (opaque), for colour strips under editors and
+/// in legends.
+pub fn colour_strip(
+    ctx: &egui::Context,
+    name: impl Into<String>,
+    entries: &[[u8; 4]],
+    options: egui::TextureOptions,
+) -> egui::TextureHandle {
+    let pixels = entries
+        .iter()
+        .map(|e| egui::Color32::from_rgb(e[0], e[1], e[2]))
+        .collect();
+    ctx.load_texture(name, egui::ColorImage::new([256, 1], pixels), options)
+}
+
 /// A histogram of 256 counts as a 256-wide image of grey bars on a clear background
 /// (square-root scale), drawn behind the curve as one texture.
 pub fn histogram_image(counts: &[u32]) -> egui::ColorImage {

@@ -13,7 +13,7 @@
 
 use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
 
-use super::axes::{self, section_axes, Axis};
+use super::axes::{self, section_axes, section_voxels, Axis};
 use super::store_sections::{SectionKey, StoreSections};
 use super::summary::{cloud_units, data_box, CloudSummary, DataBox, MeshSummary};
 use crate::colortable::{ColorTable, TableSpec};
@@ -232,13 +232,12 @@ impl ViewData {
         let stale = self.tables[a].as_ref().is_none_or(|(s, _, _)| s != spec);
         if stale {
             let table = spec.build(&scene.base).ok()?;
-            let pixels = table
-                .entries
-                .iter()
-                .map(|e| Color32::from_rgb(e[0], e[1], e[2]))
-                .collect();
-            let image = ColorImage::new([256, 1], pixels);
-            let texture = ctx.load_texture(format!("table {a}"), image, TextureOptions::NEAREST);
+            let texture = super::curve::colour_strip(
+                ctx,
+                format!("table {a}"),
+                &table.entries,
+                TextureOptions::NEAREST,
+            );
             self.tables[a] = Some((spec.clone(), table, texture));
         }
         self.tables[a].as_ref().map(|(_, t, x)| (t, x))
@@ -343,20 +342,14 @@ impl ViewData {
                 return Some(s.texture.clone());
             }
         }
-        let (u, w) = section_axes(axis);
-        let (nu, nw) = (p.dims[u], p.dims[w]);
-        let mut pixels = Vec::with_capacity(nu * nw);
-        for y in 0..nw {
-            for x in 0..nu {
-                let mut ijk = [0usize; 3];
-                ijk[axis] = index;
-                ijk[u] = x;
-                ijk[w] = y;
+        let ([nu, nw], voxels) = section_voxels(p.dims, axis, index);
+        let pixels = voxels
+            .map(|ijk| {
                 let voxel = ijk[0] + p.dims[0] * (ijk[1] + p.dims[1] * ijk[2]);
                 let e = key.3[p.byte(voxel, a) as usize];
-                pixels.push(Color32::from_rgb(e[0], e[1], e[2]));
-            }
-        }
+                Color32::from_rgb(e[0], e[1], e[2])
+            })
+            .collect();
         let image = ColorImage::new([nu, nw], pixels);
         let texture = ctx.load_texture(format!("section {axis}"), image, TextureOptions::NEAREST);
         self.sections[axis] = Some(Section {

@@ -119,21 +119,11 @@ pub fn section_levels(
     let v = store
         .window(attr, region[0], region[1])
         .map_err(|e| e.to_string())?;
-    let (u, w) = super::axes::section_axes(axis);
-    let (nu, nw) = (v.dims[u], v.dims[w]);
-    let mut out = Vec::with_capacity(nu * nw);
-    for y in 0..nw {
-        for x in 0..nu {
-            let mut ijk = [0usize; 3];
-            ijk[u] = x;
-            ijk[w] = y;
-            out.push(quantize_value(
-                v.values[v.index(ijk[0], ijk[1], ijk[2])],
-                low,
-                high,
-            ));
-        }
-    }
+    // The window is one voxel thick along `axis`: its voxel 0 there.
+    let (_, voxels) = super::axes::section_voxels(v.dims, axis, 0);
+    let out = voxels
+        .map(|[i, j, k]| quantize_value(v.values[v.index(i, j, k)], low, high))
+        .collect();
     Ok(out)
 }
 

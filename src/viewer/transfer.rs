@@ -14,7 +14,7 @@
 
 use std::path::Path;
 
-use egui::{Color32, ColorImage, TextureHandle, TextureOptions, Vec2};
+use egui::{TextureHandle, TextureOptions, Vec2};
 
 use super::curve;
 use super::widgets::Widgets;
@@ -153,13 +153,12 @@ pub fn editor(
         .as_ref()
         .is_none_or(|(e, _)| *e != table.entries)
     {
-        let pixels = table
-            .entries
-            .iter()
-            .map(|e| Color32::from_rgb(e[0], e[1], e[2]))
-            .collect();
-        let image = ColorImage::new([256, 1], pixels);
-        let texture = ctx.load_texture("transfer colours", image, TextureOptions::LINEAR);
+        let texture = curve::colour_strip(
+            &ctx,
+            "transfer colours",
+            &table.entries,
+            TextureOptions::LINEAR,
+        );
         state.colours = Some((table.entries.clone(), texture));
     }
     if state.histogram.is_none() {

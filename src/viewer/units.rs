@@ -225,17 +225,9 @@ mod tests {
 
     #[test]
     fn autzen_is_in_feet() {
-        let path =
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/points/autzen_trim.laz");
-        if !path.exists() {
-            assert!(
-                std::env::var_os("ARBVIS_NO_SKIP").is_none_or(|v| v != "1"),
-                "ARBVIS_NO_SKIP=1 but {} is missing",
-                path.display()
-            );
-            eprintln!("SKIPPED: {} is missing", path.display());
+        let Some(path) = crate::input::shared_data("points/autzen_trim.laz") else {
             return;
-        }
+        };
         assert_eq!(las_units(&path).horizontal.as_deref(), Some("ft"));
     }
 }

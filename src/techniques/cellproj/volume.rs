@@ -164,26 +164,21 @@ fn table_texture(
 ) -> GlResult<Texture> {
     let [n, m] = spec.table_size;
     let (nu, mu) = (n as usize, m as usize);
-    let label = "cellproj volume pre-integrated table (sf, sb, length)";
-    if float {
-        let data = preint::table_f32(tf, nu, mu, longest, spec.build);
-        return Texture::new(
-            gpu,
-            label,
-            Extent::D3(n, n, m),
-            TexelFormat::Rgba32f,
-            Filter::Linear,
-            TexelData::F32(&data),
-        );
-    }
-    let data = preint::table(tf, nu, mu, longest, spec.build);
+    let (floats, bytes);
+    let (format, data) = if float {
+        floats = preint::table_f32(tf, nu, mu, longest, spec.build);
+        (TexelFormat::Rgba32f, TexelData::F32(&floats))
+    } else {
+        bytes = preint::table(tf, nu, mu, longest, spec.build);
+        (TexelFormat::Rgba8, TexelData::U8(&bytes))
+    };
     Texture::new(
         gpu,
-        label,
+        "cellproj volume pre-integrated table (sf, sb, length)",
         Extent::D3(n, n, m),
-        TexelFormat::Rgba8,
+        format,
         Filter::Linear,
-        TexelData::U8(&data),
+        data,
     )
 }
 

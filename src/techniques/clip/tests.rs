@@ -409,19 +409,7 @@ fn an_open_mesh_is_decided_by_the_winding_number() {
     assert_eq!(wrong, 0);
 }
 
-fn shared(relative: &str) -> Option<std::path::PathBuf> {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
-        .join(relative);
-    if p.exists() {
-        return Some(p);
-    }
-    if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
-        panic!("ARBVIS_NO_SKIP=1 but {} is missing", p.display());
-    }
-    eprintln!("SKIPPED: {} is missing", p.display());
-    None
-}
+use crate::input::shared_data as shared;
 
 /// Place `mesh` to fill about 80 % of `[-half, half]`.
 fn fit(mesh: &TriangleMesh, half: [f64; 3]) -> MeshShape {
