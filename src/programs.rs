@@ -63,6 +63,13 @@ pub const CELLPROJ_PRECISE_FRAG: ProgramText = program!("cellproj/precise.frag")
 pub const CELLPROJ_VOLUME_ARBFP: ProgramText = program!("cellproj/volume.arbfp");
 /// GLSL twin of [`CELLPROJ_VOLUME_ARBFP`].
 pub const CELLPROJ_VOLUME_FRAG: ProgramText = program!("cellproj/volume.frag");
+/// Volume, faithful, orthographic: the exit parameters from the vertices
+/// ([`CELLPROJ_ORTHOGRAPHIC_ARBVP`]), then the pre-integrated 3D table.
+pub const CELLPROJ_VOLUME_ORTHOGRAPHIC_ARBFP: ProgramText =
+    program!("cellproj/volume_orthographic.arbfp");
+/// GLSL twin of [`CELLPROJ_VOLUME_ORTHOGRAPHIC_ARBFP`].
+pub const CELLPROJ_VOLUME_ORTHOGRAPHIC_FRAG: ProgramText =
+    program!("cellproj/volume_orthographic.frag");
 /// Volume, precise: the boundary faces for the entry layers (vertex stage).
 pub const CELLPROJ_VOLUME_PEEL_VERT: ProgramText = program!("cellproj/volume_peel.vert");
 /// Volume, precise: one entry layer (depth peeling of the boundary).
@@ -176,6 +183,8 @@ pub fn all_texts() -> Vec<ProgramText> {
         CELLPROJ_PRECISE_FRAG,
         CELLPROJ_VOLUME_ARBFP,
         CELLPROJ_VOLUME_FRAG,
+        CELLPROJ_VOLUME_ORTHOGRAPHIC_ARBFP,
+        CELLPROJ_VOLUME_ORTHOGRAPHIC_FRAG,
         CELLPROJ_VOLUME_PEEL_VERT,
         CELLPROJ_VOLUME_PEEL_FRAG,
         CELLPROJ_VOLUME_WALK_FRAG,

@@ -16,7 +16,7 @@ use arbvis::techniques::cellproj::prepare::{from_mesh, Prepared};
 use arbvis::techniques::cellproj::reference::silhouette_pixels;
 use arbvis::techniques::cellproj::transfer::{Sort, VolumeSpec};
 use arbvis::techniques::cellproj::volume_reference::{interior_mask, reference, score};
-use arbvis::techniques::cellproj::{CellprojRenderer, CellprojScene, Isovalue, Mode};
+use arbvis::techniques::cellproj::{CellprojRenderer, CellprojScene, Exit, Isovalue, Mode};
 use arbvis::techniques::{Frame, Renderer};
 use common::headless;
 
@@ -224,31 +224,89 @@ fn faithful_is_within_its_table_and_target_quantization_and_arb_equals_glsl() {
     let h = headless(Backend::Egl);
     let mesh = grid(9, Field::Spherical);
     let prepared = prepared_of(&mesh);
-    let p = scene(Mode::Volume, spec(Sort::Mpvonc), Vec::new());
-    let cam = camera(Projection::Orthographic);
-    let arb = draw(&h, &p, &prepared, Fidelity::Faithful, ProgramKind::Arb, cam);
-    let glsl = draw(
-        &h,
-        &p,
-        &prepared,
-        Fidelity::Faithful,
-        ProgramKind::Glsl,
-        cam,
-    );
-    let (all, inner) = scored(&p, &prepared, &arb, cam);
-    eprintln!("faithful: all {all:?} interior {inner:?}");
-    // 8-bit table entries (1/510 each), linear interpolation across a 128 x 128 x 64
-    // table whose band (0.45..0.55) spans 13 texels, and about 16 segments per ray each
-    // rounded to 8 bits when blended: a few levels of RMSE. Measured on llvmpipe: see the
-    // printout; 0.03 leaves room.
-    assert!(all.0 < 0.03, "{all:?}");
-    let d = arb.compare(&glsl, 2.0 / 255.0).unwrap();
-    // Same arithmetic in f32 (RCP/RSQ against 1/x and length): a level on a few pixels.
+    let base = scene(Mode::Volume, spec(Sort::Mpvonc), Vec::new());
+    let per_fragment = CellprojScene {
+        exit: Exit::Fragment,
+        ..base.clone()
+    };
+    // Orthographic draws with the exit per vertex (the seed's orthographic case) unless
+    // the scene asks for it per fragment; perspective per fragment.
+    let cases = [
+        (
+            "orthographic, exit per vertex",
+            &base,
+            Projection::Orthographic,
+        ),
+        (
+            "orthographic, exit per fragment",
+            &per_fragment,
+            Projection::Orthographic,
+        ),
+        (
+            "perspective, exit per fragment",
+            &base,
+            Projection::Perspective,
+        ),
+    ];
+    let mut ortho = Vec::new();
+    for (name, p, projection) in cases {
+        let cam = camera(projection);
+        let arb = draw(&h, p, &prepared, Fidelity::Faithful, ProgramKind::Arb, cam);
+        let glsl = draw(&h, p, &prepared, Fidelity::Faithful, ProgramKind::Glsl, cam);
+        let (all, inner) = scored(p, &prepared, &arb, cam);
+        eprintln!("faithful {name}: all {all:?} interior {inner:?}");
+        // 8-bit table entries (1/510 each), linear interpolation across a 128 x 128 x 64
+        // table whose band (0.45..0.55) spans 13 texels, and about 16 segments per ray
+        // each rounded to 8 bits when blended: a few levels of RMSE. Measured on
+        // llvmpipe: see the printout; 0.03 leaves room.
+        assert!(all.0 < 0.03, "{name}: {all:?}");
+        let d = arb.compare(&glsl, 2.0 / 255.0).unwrap();
+        // Same arithmetic in f32 (RCP/RSQ against 1/x and length): a level on a few
+        // pixels.
+        assert!(
+            d.pixels_over * 100 <= (SIZE[0] * SIZE[1]) as usize,
+            "{name}: {} pixels differ by more than 2 levels",
+            d.pixels_over
+        );
+        if projection == Projection::Orthographic {
+            ortho.push(arb);
+        }
+    }
+    // The same exit two ways: interpolated t_i against t_i from an eye 10^6 box units
+    // back (a direction off by ~1e-6, then f32 rounding): each segment's table lookup
+    // may round to the other 8-bit level, and ~16 segments blend per ray.
+    let d = ortho[0].compare(&ortho[1], 3.0 / 255.0).unwrap();
     assert!(
         d.pixels_over * 100 <= (SIZE[0] * SIZE[1]) as usize,
-        "{} pixels differ by more than 2 levels",
-        d.pixels_over
+        "exit per vertex and per fragment: {} pixels differ by more than 3 levels (max {})",
+        d.pixels_over,
+        d.max_abs
     );
+    // Per vertex in perspective is the seed's own caveat: refused, not drawn wrong.
+    let per_vertex = CellprojScene {
+        exit: Exit::Vertex,
+        ..base
+    };
+    let gpu = h.gpu();
+    let mut r = CellprojRenderer::from_prepared(
+        gpu,
+        ProgramKind::Arb,
+        Fidelity::Faithful,
+        &per_vertex,
+        prepared.clone(),
+    )
+    .unwrap();
+    let target = Target::with_depth(gpu, SIZE[0], SIZE[1], TargetFormat::Rgba8).unwrap();
+    let frame = Frame {
+        camera: camera(Projection::Perspective),
+        width: SIZE[0],
+        height: SIZE[1],
+    };
+    let err = r
+        .draw(gpu, Surface::Target(&target), &frame)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("orthographic"), "{err}");
 }
 
 /// A non-convex mesh of very unequal tetrahedra: the 7³ grid with a slot cut through it

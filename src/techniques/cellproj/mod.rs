@@ -91,6 +91,7 @@ pub mod volume_reference;
 
 use serde::{Deserialize, Serialize};
 
+use crate::camera::Projection;
 use crate::mesh::scalars::ScalarSpec;
 use crate::mesh::MeshSource;
 use crate::vocab::FieldError;
@@ -118,6 +119,20 @@ pub enum Exit {
     Vertex,
     /// Per fragment.
     Fragment,
+}
+
+impl Exit {
+    /// Whether the exit is computed per vertex for `projection`; per vertex in perspective
+    /// is an error (the seed's own caveat).
+    pub fn per_vertex(self, projection: Projection) -> Result<bool, String> {
+        match (self, projection) {
+            (Exit::Fragment, _) | (Exit::Auto, Projection::Perspective) => Ok(false),
+            (Exit::Auto | Exit::Vertex, Projection::Orthographic) => Ok(true),
+            (Exit::Vertex, Projection::Perspective) => Err(
+                "exit = \"vertex\" needs an orthographic camera: in perspective the ray direction varies over a face, so the exit parameters are not affine (the seed computes them per fragment there)".into(),
+            ),
+        }
+    }
 }
 
 /// The order the faces are drawn in.

@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use super::prepare::{iso_list, iso_table, prepare, Prepared, Viewer, VERTEX_COMPONENTS};
-use super::{CellprojScene, Depth, Exit, Order};
+use super::{CellprojScene, Depth, Order};
 use crate::camera::Projection;
 use crate::gl::{
     self, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
@@ -45,14 +45,11 @@ pub fn variant(
     if fidelity == Fidelity::Precise {
         return Ok(Variant::Precise);
     }
-    Ok(match (params.exit, projection) {
-        (Exit::Fragment, _) | (Exit::Auto, Projection::Perspective) => Variant::PerFragment,
-        (Exit::Auto | Exit::Vertex, Projection::Orthographic) => Variant::PerVertex,
-        (Exit::Vertex, Projection::Perspective) => {
-            return Err(GlError::Data(
-                "exit = \"vertex\" needs an orthographic camera: in perspective the ray direction varies over a face, so the exit parameters are not affine (the seed computes them per fragment there)".into(),
-            ))
-        }
+    let per_vertex = params.exit.per_vertex(projection).map_err(GlError::Data)?;
+    Ok(if per_vertex {
+        Variant::PerVertex
+    } else {
+        Variant::PerFragment
     })
 }
 
@@ -246,15 +243,18 @@ impl CellprojRenderer {
         } else {
             Vec::new()
         };
-        self.volume = Some(super::volume::VolumeRenderer::new(
-            gpu,
-            self.kind,
-            self.fidelity,
-            &spec,
-            transfer,
-            &self.prepared,
-            &isos,
-        )?);
+        self.volume = Some(
+            super::volume::VolumeRenderer::new(
+                gpu,
+                self.kind,
+                self.fidelity,
+                &spec,
+                transfer,
+                &self.prepared,
+                &isos,
+            )?
+            .with_exit(self.params.exit),
+        );
         Ok(())
     }
 
@@ -512,8 +512,10 @@ pub fn program_pairs() -> Vec<ProgramPair> {
     })
     .into_iter()
     .chain([
-        super::volume::faithful_pair(ProgramKind::Arb),
-        super::volume::faithful_pair(ProgramKind::Glsl),
+        super::volume::faithful_pair(ProgramKind::Arb, false),
+        super::volume::faithful_pair(ProgramKind::Glsl, false),
+        super::volume::faithful_pair(ProgramKind::Arb, true),
+        super::volume::faithful_pair(ProgramKind::Glsl, true),
     ])
     .chain(super::volume::precise_pairs())
     .collect()

@@ -23,6 +23,7 @@ use super::order::{boundary_is_convex, centroid_order, mpvonc_order, neighbours,
 use super::preint;
 use super::prepare::{gradient, normal, Prepared, Viewer, FACES, VERTEX_COMPONENTS};
 use super::transfer::{Sort, Transfer, VolumeSpec};
+use super::Exit;
 use crate::camera::Projection;
 use crate::gl::ProgramText;
 use crate::gl::{
@@ -48,12 +49,22 @@ pub struct VolumeTimes {
     pub cycles: usize,
 }
 
-/// The faithful program pair: the seed's vertex program and `volume.arbfp` (or GLSL twins).
-pub fn faithful_pair(kind: ProgramKind) -> ProgramPair {
+/// The faithful program pair: the seed's vertex program and `volume.arbfp` (or GLSL
+/// twins); with `per_vertex` the seed's orthographic vertex program (exit parameters per
+/// vertex) and `volume_orthographic.arbfp`.
+pub fn faithful_pair(kind: ProgramKind, per_vertex: bool) -> ProgramPair {
     use programs::*;
-    let (vertex, fragment) = match kind {
-        ProgramKind::Arb => (CELLPROJ_PERSPECTIVE_ARBVP, CELLPROJ_VOLUME_ARBFP),
-        ProgramKind::Glsl => (CELLPROJ_PERSPECTIVE_VERT, CELLPROJ_VOLUME_FRAG),
+    let (vertex, fragment) = match (kind, per_vertex) {
+        (ProgramKind::Arb, false) => (CELLPROJ_PERSPECTIVE_ARBVP, CELLPROJ_VOLUME_ARBFP),
+        (ProgramKind::Glsl, false) => (CELLPROJ_PERSPECTIVE_VERT, CELLPROJ_VOLUME_FRAG),
+        (ProgramKind::Arb, true) => (
+            CELLPROJ_ORTHOGRAPHIC_ARBVP,
+            CELLPROJ_VOLUME_ORTHOGRAPHIC_ARBFP,
+        ),
+        (ProgramKind::Glsl, true) => (
+            CELLPROJ_ORTHOGRAPHIC_VERT,
+            CELLPROJ_VOLUME_ORTHOGRAPHIC_FRAG,
+        ),
     };
     ProgramPair {
         kind,
@@ -102,7 +113,10 @@ pub fn precise_pairs() -> [ProgramPair; 3] {
 }
 
 struct Faithful {
+    /// Exit per fragment (perspective, or a scene's `exit = "fragment"`).
     program: Program,
+    /// Exit per vertex (orthographic; none for the projected precise variant).
+    per_vertex: Option<Program>,
     faces: Mesh,
     /// The pre-integrated table (unit 0), or for the projected precise variant the
     /// transfer function (unit 2).
@@ -152,6 +166,8 @@ pub struct VolumeRenderer {
     spare: Option<(VolumeSpec, Texture, [[f64; 4]; 2])>,
     /// The spec the current textures were made for, while they are stale.
     made_for: Option<VolumeSpec>,
+    /// Where faithful computes the exit (the scene's `exit`).
+    exit: Exit,
 }
 
 /// The pre-integrated table: RGBA8 (faithful), or RGBA32F (precise `table`).
@@ -277,6 +293,7 @@ impl VolumeRenderer {
             float_table: false,
             spare: None,
             made_for: None,
+            exit: Exit::Auto,
         };
         match fidelity {
             Fidelity::Faithful => r.faithful = Some(r.build_faithful(gpu, kind, prepared)?),
@@ -292,20 +309,31 @@ impl VolumeRenderer {
         Ok(r)
     }
 
+    /// Where faithful computes the exit parameters (default: per vertex for orthographic
+    /// cameras, per fragment for perspective ones, as the isosurfaces).
+    pub fn with_exit(mut self, exit: Exit) -> VolumeRenderer {
+        self.exit = exit;
+        self
+    }
+
     fn build_faithful(
         &self,
         gpu: &Gpu,
         kind: ProgramKind,
         prepared: &Prepared,
     ) -> GlResult<Faithful> {
-        let pair = faithful_pair(kind);
-        let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
+        let [program, per_vertex] = [false, true].map(|v| {
+            let pair = faithful_pair(kind, v);
+            Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)
+        });
+        let (program, per_vertex) = (program?, Some(per_vertex?));
         let faces = face_mesh(gpu, prepared)?;
         let float = kind == ProgramKind::Glsl && self.float_table;
         let table = table_texture(gpu, &self.transfer, &self.spec, self.longest, float)?;
         let map = table_map(&self.spec, self.longest);
         Ok(Faithful {
             program,
+            per_vertex,
             faces,
             table,
             exact: false,
@@ -322,6 +350,7 @@ impl VolumeRenderer {
         let table = tf_texture(gpu, &self.transfer)?;
         Ok(Faithful {
             program,
+            per_vertex: None,
             faces,
             table,
             exact: true,
@@ -564,20 +593,36 @@ impl VolumeRenderer {
         let mvp = frame.camera.view_projection(frame.aspect());
         let (eye, dir) = eye_and_direction(frame);
         let perspective = frame.camera.projection == Projection::Perspective;
-        f.program.set_transform(gpu, mvp)?;
+        let per_vertex = match &f.per_vertex {
+            Some(p)
+                if self
+                    .exit
+                    .per_vertex(frame.camera.projection)
+                    .map_err(GlError::Data)? =>
+            {
+                Some(p)
+            }
+            _ => None,
+        };
+        let program = per_vertex.unwrap_or(&f.program);
+        program.set_transform(gpu, mvp)?;
         if f.exact {
             let w = if perspective { 1.0 } else { 0.0 };
-            f.program.set_local(gpu, 4, [eye.x, eye.y, eye.z, w])?;
-            f.program.set_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
+            program.set_local(gpu, 4, [eye.x, eye.y, eye.z, w])?;
+            program.set_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
             let points = self.transfer.s.len() as f64;
-            f.program
-                .set_local(gpu, 6, [points, 1.0 / self.transfer.unit, 0.0, 0.0])?;
+            program.set_local(gpu, 6, [points, 1.0 / self.transfer.unit, 0.0, 0.0])?;
         } else {
-            let eye = if perspective { eye } else { -dir * 1.0e6 };
-            f.program
-                .set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, 1.0])?;
-            f.program.set_local(gpu, 0, f.map[0])?;
-            f.program.set_local(gpu, 1, f.map[1])?;
+            // Per vertex: D, normalized (the length is then t). Per fragment: the seed's
+            // eye; for a parallel view 10^6 box units back, so `vertex - EyePos` is D.
+            let local = match (per_vertex, perspective) {
+                (Some(_), _) => [dir.x, dir.y, dir.z, 0.0],
+                (None, true) => [eye.x, eye.y, eye.z, 1.0],
+                (None, false) => (-dir * 1.0e6).extend(1.0).to_array(),
+            };
+            program.set_vertex_local(gpu, 4, local)?;
+            program.set_local(gpu, 0, f.map[0])?;
+            program.set_local(gpu, 1, f.map[1])?;
         }
         let unit = if f.exact { 2 } else { 0 };
         gl::draw(
@@ -588,7 +633,7 @@ impl VolumeRenderer {
                 blend: Blend::PremultipliedOver,
                 depth_test,
                 cull_back: true,
-                ..DrawCall::new(&f.program, &f.faces)
+                ..DrawCall::new(program, &f.faces)
             },
         )
     }
