@@ -21,5 +21,11 @@ void main() {
     v_ti = vec3(dot(aux1, normal0) * (1.0 / dot(D, normal0)),
                 dot(aux1, normal1) * (1.0 / dot(D, normal1)),
                 dot(aux1, normal2) * (1.0 / dot(D, normal2)));
+#ifdef GUARDED_EXIT
+    // The volume's precise `table`: a plane the ray enters through (D.N <= 0, normals
+    // outward) is never its exit (volume_orthographic.frag).
+    v_ti = mix(v_ti, vec3(1e30), lessThanEqual(vec3(dot(D, normal0), dot(D, normal1),
+                                                    dot(D, normal2)), vec3(0.0)));
+#endif
     v_gd = dot(gradient, D);
 }

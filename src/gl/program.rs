@@ -96,6 +96,18 @@ impl ProgramText {
             text: Cow::Borrowed(text),
         }
     }
+
+    /// A GLSL text with `#define NAME` after its first line (the `#version`), named
+    /// `name (NAME)`.
+    pub fn with_define(&self, define: &str) -> ProgramText {
+        ProgramText {
+            name: format!("{} ({define})", self.name).into(),
+            text: self
+                .text
+                .replacen('\n', &format!("\n#define {define}\n"), 1)
+                .into(),
+        }
+    }
 }
 
 enum Stages {

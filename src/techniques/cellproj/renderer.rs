@@ -56,11 +56,7 @@ pub fn variant(
 /// The precise fragment program writing the entry depth: `precise.frag` with
 /// `ENTRY_DEPTH` defined, which leaves out its `gl_FragDepth`.
 pub fn entry_depth_fragment(fragment: &ProgramText) -> ProgramText {
-    let text = fragment.text.replacen('\n', "\n#define ENTRY_DEPTH\n", 1);
-    ProgramText {
-        name: format!("{} (ENTRY_DEPTH)", fragment.name).into(),
-        text: text.into(),
-    }
+    fragment.with_define("ENTRY_DEPTH")
 }
 
 /// The program pair of a variant (precise exists only in GLSL: it loops).

@@ -324,7 +324,15 @@ impl VolumeRenderer {
     ) -> GlResult<Faithful> {
         let [program, per_vertex] = [false, true].map(|v| {
             let pair = faithful_pair(kind, v);
-            Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)
+            // Precise `table` guards the exit (see `volume.frag`); faithful is the seed's.
+            let (vertex, fragment) = match self.float_table {
+                true => (
+                    pair.vertex.with_define("GUARDED_EXIT"),
+                    pair.fragment.with_define("GUARDED_EXIT"),
+                ),
+                false => (pair.vertex, pair.fragment),
+            };
+            Program::new(gpu, pair.kind, &vertex, &fragment)
         });
         let (program, per_vertex) = (program?, Some(per_vertex?));
         let faces = face_mesh(gpu, prepared)?;
