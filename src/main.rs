@@ -112,9 +112,9 @@ enum Command {
     /// --technique cellproj-volume: cell projection's volume rendering on the --grids
     /// meshes and any --scenes, orthographic and perspective: faithful (MPVONC at table
     /// sizes 32-256, centroid order at 128) and precise (the walk, projected, the float
-    /// table at 128); frame time
-    /// with the camera still and turning, the sort's and upload's share, RGB RMSE against
-    /// the f64 reference (meshes up to 250,000 tetrahedra; larger ones print "unscored").
+    /// table at 128); frame time with the camera still and turning, the sort's and
+    /// upload's share, RGB RMSE against the f64 reference (meshes up to --score-up-to;
+    /// larger ones print "unscored").
     /// Writes cellproj-volume.csv and cellproj-volume-MESH.png per scored mesh (RMSE
     /// against ms). About 5 minutes (4 min 26 s with the bracket on an idle 2-core
     /// machine).
@@ -155,9 +155,11 @@ enum Command {
         #[arg(long, value_delimiter = ',', default_values_t = [17, 25, 33, 45, 56])]
         grids: Vec<usize>,
         /// Cell projection: score meshes up to this many grid points per side against the
-        /// f64 reference (larger meshes are timed only and print "unscored").
-        #[arg(long, value_name = "POINTS", default_value_t = arbvis::techniques::cellproj::study::Options::default().score_up_to)]
-        score_up_to: usize,
+        /// f64 reference (larger meshes are timed only and print "unscored"; the volume
+        /// study scores any mesh of at most as many tetrahedra as such a grid has).
+        /// Default: 64 for the isosurfaces, 1,100,000 tetrahedra for the volume (the 56-point grid).
+        #[arg(long, value_name = "POINTS")]
+        score_up_to: Option<usize>,
         /// Cell projection's volume: cell-projection scenes whose meshes and transfer
         /// functions to add to the grids.
         #[arg(long, value_delimiter = ',')]
@@ -735,6 +737,7 @@ fn run(cli: Cli) -> Result<()> {
             technique: StudyTechnique::CellprojVolume,
             grids,
             scenes,
+            score_up_to,
             out,
             ..
         } => {
@@ -760,9 +763,13 @@ fn run(cli: Cli) -> Result<()> {
                     .map_or("scene".into(), |s| s.to_string_lossy().to_string());
                 cases.push(volume_case(&name, &scene)?);
             }
+            let defaults = volume::Options::default();
             let options = volume::Options {
                 frames: sweep.frames.max(1),
-                ..Default::default()
+                // A grid of n points per side has 6 (n - 1)³ tetrahedra.
+                score_up_to: score_up_to
+                    .map_or(defaults.score_up_to, |n| 6 * n.saturating_sub(1).pow(3)),
+                ..defaults
             };
             let rows = volume::run(&headless, &cases, &options, arbvis::progress::line)?;
             write_study(&out, [("cellproj-volume.csv", volume::to_csv(&rows))])?;
@@ -789,7 +796,8 @@ fn run(cli: Cli) -> Result<()> {
             let options = arbvis::techniques::cellproj::study::Options {
                 grids,
                 frames: sweep.frames.max(1),
-                score_up_to,
+                score_up_to: score_up_to
+                    .unwrap_or(arbvis::techniques::cellproj::study::Options::default().score_up_to),
                 ..Default::default()
             };
             if options.grids.iter().any(|&g| !(2..=128).contains(&g)) {

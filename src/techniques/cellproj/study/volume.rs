@@ -52,7 +52,7 @@ impl Default for Options {
             size: [320, 240],
             frames: 3,
             tables: vec![32, 64, 128, 256],
-            score_up_to: 250_000,
+            score_up_to: 1_100_000,
         }
     }
 }
