@@ -27,3 +27,10 @@ if [ -d ../shared/data ]; then
   "$arbvis" render scenes/data/bracket-volume.toml --fidelity faithful -o "$out/data-bracket-volume-faithful.png"
 fi
 "$arbvis" render scenes/bench/cellproj-seed-volume.toml -o "$out/cellproj-seed-volume.png"
+# NASA's CFD meshes (`python3 benches/meshes.py nasa` downloads them into target/meshes).
+if [ -f target/meshes/bluntfin.vtk ] && [ -f target/meshes/oxygen-post.vtk ]; then
+  "$arbvis" render scenes/meshes/bluntfin-volume.toml -o "$out/nasa-bluntfin-volume.png"
+  "$arbvis" render scenes/meshes/bluntfin-volume.toml --fidelity faithful \
+    -o "$out/nasa-bluntfin-volume-faithful.png"
+  "$arbvis" render scenes/meshes/oxygen-post-volume.toml -o "$out/nasa-oxygen-post-volume.png"
+fi

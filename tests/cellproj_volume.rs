@@ -207,7 +207,8 @@ fn precise_table_is_faithful_without_its_8_bit_losses() {
             "{n}: table {all:?} not below faithful {fall:?}"
         );
         // The band (0.45..0.55 of the scalar) spans n/10 texels: at 32 a few texels, its
-        // peak cut by interpolation; at 256 some 25, the error a few thousandths.
+        // peak cut by interpolation (RMSE 0.0057 measured); at 256 some 25, the error a
+        // few ten-thousandths (3.5e-4 measured, with the guarded exit).
         if projection == Projection::Orthographic {
             assert!(
                 all.0 < last,
@@ -216,7 +217,9 @@ fn precise_table_is_faithful_without_its_8_bit_losses() {
             last = all.0;
         }
     }
-    assert!(last < 5e-3, "256² x 128: RMSE {last}");
+    // Three times the measured 3.5e-4 (other drivers round the float table's reads
+    // differently); a wrong segment on one pixel in 6912 alone would be ~2e-3.
+    assert!(last < 1e-3, "256² x 128: RMSE {last}");
 }
 
 #[test]

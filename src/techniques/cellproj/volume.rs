@@ -6,8 +6,17 @@
 //! ([`Sort`]: MPVONC or centroid) and an index buffer lists, in that order, the faces of
 //! each that face the viewer. `volume.arbfp` computes `sf`, `sb` and the length with the
 //! seed's exit computation and reads the segment from the 3D table ([`super::preint`]),
-//! blended `ONE, ONE_MINUS_SRC_ALPHA`. No depth test (volume alone) or the isosurfaces'
-//! depth (`mode = "both"`, drawn after them).
+//! blended `ONE, ONE_MINUS_SRC_ALPHA`. In orthographic views the exit parameters come
+//! per vertex as in the seed's orthographic case (`orthographic.arbvp` and
+//! `volume_orthographic.arbfp`: 3 varyings instead of 8, 13 fragment instructions
+//! instead of 30; the scene's `exit` as for the isosurfaces). No depth test (volume
+//! alone) or the isosurfaces' depth (`mode = "both"`, drawn after them).
+//!
+//! **Precise `table`**: the same projection (GLSL) with the table in float into a float
+//! target, and the exit guarded (`GUARDED_EXIT`): the nearest plane the ray leaves
+//! through (`D·N > 0`), clamped to `t >= 0`, instead of the seed's smallest positive
+//! `t_i`, which takes a far plane when rounding puts a sliver's near exit just behind
+//! the entry (single bright pixels, the faithful pictures' speckle).
 //!
 //! **Precise** (GLSL, float target): the mesh in textures (face planes, scalar, face
 //! neighbours); `entries` passes peel the boundary faces through which rays enter the
