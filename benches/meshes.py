@@ -82,11 +82,18 @@ NASA_MESHES = [("bluntfin.vtk", "bluntfin"), ("oxygen-post.vtk", "post"), ("comb
 def nasa_bytes(name, source):
     """A PLOT3D file's bytes from `source` (a folder) or downloaded, checked against its hash."""
     if source:
-        with open(os.path.join(source, name), "rb") as f:
-            data = f.read()
+        try:
+            with open(os.path.join(source, name), "rb") as f:
+                data = f.read()
+        except OSError as e:
+            sys.exit(f"{os.path.join(source, name)}: {e.strerror}")
     else:
-        with urllib.request.urlopen(NASA_URL + name, timeout=60) as r:
-            data = r.read()
+        try:
+            with urllib.request.urlopen(NASA_URL + name, timeout=60) as r:
+                data = r.read()
+        except OSError as e:
+            sys.exit(f"{NASA_URL + name}: {e} (without a network, fetch pyvista/vtk-data's "
+                     f"Data/{name} at {NASA_COMMIT} some other way and pass --source DIR)")
     digest = hashlib.sha256(data).hexdigest()
     if digest != NASA_FILES[name]:
         sys.exit(f"{name}: SHA-256 {digest}, expected {NASA_FILES[name]} (a different file)")
