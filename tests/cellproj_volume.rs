@@ -556,6 +556,82 @@ fn precise_table_takes_the_nearest_exit_on_slivers() {
 }
 
 #[test]
+fn a_spike_narrower_than_a_table_texel_is_not_missed() {
+    let h = headless(Backend::Egl);
+    let prepared = prepared_of(&grid(9, Field::Spherical));
+    // Opacity only within 0.001 of s = 0.5: a fifth of one texel of the 128-wide table
+    // (1/127), never at a vertex of the 9³ grid; every segment that crosses it must get
+    // its integral (pre-integration's reason to exist), not the transfer function at the
+    // segment's ends (zero at both).
+    let spike = VolumeSpec {
+        points: vec![
+            [0.0, 1.0, 0.9, 0.2, 0.0],
+            [0.499, 1.0, 0.9, 0.2, 0.0],
+            [0.5, 1.0, 0.9, 0.2, 1.0],
+            [0.501, 1.0, 0.9, 0.2, 0.0],
+            [1.0, 1.0, 0.9, 0.2, 0.0],
+        ],
+        unit_distance: 0.001,
+        table_size: [128, 64],
+        ..spec(Sort::Mpvonc)
+    };
+    let p = scene(Mode::Volume, spike, Vec::new());
+    let cam = camera(Projection::Orthographic);
+    let bg = BACKGROUND.map(|v| v as f64);
+    // Mean distance from the background over RGB: how much of the shell a picture shows.
+    let signal = |image: &Image| {
+        let n = image.data.len() / 4;
+        image
+            .data
+            .chunks(4)
+            .map(|px| (0..3).map(|c| (px[c] as f64 - bg[c]).abs()).sum::<f64>())
+            .sum::<f64>()
+            / n as f64
+    };
+    let spec = p.volume_spec();
+    let tf = spec
+        .build(std::path::Path::new("."), prepared.scale)
+        .unwrap();
+    let want = reference(&prepared, &tf, &[], &cam, SIZE, bg);
+    let want_signal = signal(&want);
+    // The shell is there: a third of an RGB unit on average over the whole image.
+    assert!(want_signal > 0.2, "reference signal {want_signal}");
+    let mut table = p.clone();
+    if let Some(v) = &mut table.volume {
+        v.precise = Precise::Table;
+    }
+    for (name, p, fidelity, kind) in [
+        ("faithful", &p, Fidelity::Faithful, ProgramKind::Arb),
+        (
+            "precise table",
+            &table,
+            Fidelity::Precise,
+            ProgramKind::Glsl,
+        ),
+        ("precise walk", &p, Fidelity::Precise, ProgramKind::Glsl),
+    ] {
+        let image = draw(&h, p, &prepared, fidelity, kind, cam);
+        let (all, _) = scored(p, &prepared, &image, cam);
+        let got = signal(&image);
+        eprintln!("spike, {name}: {all:?}, signal {got} of {want_signal}");
+        // Both tables catch every segment that crosses the spike, but one that starts or
+        // ends within the spike's texel reads an interpolation between a texel whose
+        // segment crosses it and one whose does not: RMSE 0.025 and single pixels up to
+        // 0.77 off measured, in float as in 8 bits (the table's limit, not the
+        // rounding), with 98 % of the shell's signal. The walk is exact: the 1e-3 goal.
+        let (bound, kept) = match name {
+            "faithful" | "precise table" => (0.04, 0.95),
+            _ => (1e-3, 0.999),
+        };
+        assert!(all.0 < bound, "{name}: {all:?}");
+        assert!(
+            got > kept * want_signal,
+            "{name}: signal {got} of {want_signal}"
+        );
+    }
+}
+
+#[test]
 fn malformed_transfer_functions_are_refused_at_their_line_and_column() {
     let text = |volume: &str| {
         format!(
