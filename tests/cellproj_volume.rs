@@ -103,13 +103,8 @@ fn draw(
     target.read(gpu).unwrap()
 }
 
-/// ((RMSE, max) over the image, (RMSE, max) over interior pixels) against the reference.
-fn scored(
-    params: &CellprojScene,
-    prepared: &Prepared,
-    image: &Image,
-    camera: Camera,
-) -> ((f64, f64), (f64, f64)) {
+/// The f64 reference picture of a scene (its volume, and its isosurfaces in `mode = "both"`).
+fn reference_image(params: &CellprojScene, prepared: &Prepared, camera: Camera) -> Image {
     let spec = params.volume_spec();
     let tf = spec
         .build(std::path::Path::new("."), prepared.scale)
@@ -120,7 +115,17 @@ fn scored(
         Vec::new()
     };
     let bg = BACKGROUND.map(|v| v as f64);
-    let want = reference(prepared, &tf, &isos, &camera, SIZE, bg);
+    reference(prepared, &tf, &isos, &camera, SIZE, bg)
+}
+
+/// ((RMSE, max) over the image, (RMSE, max) over interior pixels) against the reference.
+fn scored(
+    params: &CellprojScene,
+    prepared: &Prepared,
+    image: &Image,
+    camera: Camera,
+) -> ((f64, f64), (f64, f64)) {
+    let want = reference_image(params, prepared, camera);
     let silhouette = silhouette_pixels(prepared, &camera, SIZE, 1.5);
     let mask = interior_mask(prepared, &camera, SIZE, &silhouette);
     score(image, &want, &mask)
@@ -588,11 +593,7 @@ fn a_spike_narrower_than_a_table_texel_is_not_missed() {
             .sum::<f64>()
             / n as f64
     };
-    let spec = p.volume_spec();
-    let tf = spec
-        .build(std::path::Path::new("."), prepared.scale)
-        .unwrap();
-    let want = reference(&prepared, &tf, &[], &cam, SIZE, bg);
+    let want = reference_image(&p, &prepared, cam);
     let want_signal = signal(&want);
     // The shell is there: a third of an RGB unit on average over the whole image.
     assert!(want_signal > 0.2, "reference signal {want_signal}");
