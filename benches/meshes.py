@@ -10,7 +10,7 @@ Generated:
 - `kuhn-200k.vtu`: the seed's Kuhn grid at 33^3 points (196,608 tetrahedra), the spherical
   field (`arbvis study --technique cellproj-volume --grids 33` makes the same one in memory).
 - `bracket-like-1m.vtu`: about a million tetrahedra of a non-convex part, a box with a
-  cylindrical and a spherical hole like the gmsh bracket in ../shared/data/tets (which was
+  cylindrical and a spherical hole like the gmsh bracket in data/tets (which was
   written by gmsh from a short geometry script: 40,710 tetrahedra), made here by cutting the
   holes out of a 56^3 Kuhn grid (a staircase boundary, which is what order errors need), with
   a "temperature" field falling off from one face.

@@ -11,8 +11,11 @@
 //! 1. the command line's `--memory-budget SIZE` (or a library caller's [`set`]);
 //! 2. the environment variable `ARBVIS_MEMORY_BUDGET=SIZE`;
 //! 3. a scene's top-level `memory_budget = "SIZE"`;
-//! 4. the default: half of the machine's physical memory (the smaller of `MemTotal` in
-//!    `/proc/meminfo` and a cgroup limit), 4 GiB where neither can be read.
+//! 4. the default: half of the memory this process may use: the smallest of `MemTotal` in
+//!    `/proc/meminfo`, a cgroup limit, and the process's own limits (`ulimit -v`, the
+//!    address space, and `ulimit -d`, the data segment; of the address space, only what
+//!    is left after the 1 GiB that the GL driver and the program's code map); 4 GiB where
+//!    none can be read.
 //!
 //! SIZE is bytes with an optional unit (`512M`, `16G`, `1.5T`; K/M/G/T are powers of 1024,
 //! an optional `iB`/`B` is accepted) or a share of physical memory (`75%`).
@@ -50,7 +53,7 @@ pub enum Source {
 impl Source {
     fn describe(self) -> String {
         match self {
-            Source::Default => "the default, half of physical memory".into(),
+            Source::Default => format!("the default, half of {}", default_limit().1),
             Source::Environment => "from ARBVIS_MEMORY_BUDGET".into(),
             Source::Scene => "from the scene's memory_budget".into(),
             Source::Explicit => "from --memory-budget".into(),
@@ -167,9 +170,58 @@ fn initial() -> Budget {
     })
 }
 
-/// Half of physical memory, 4 GiB where it cannot be read.
+/// Half of the memory this process may use ([`default_limit`]).
 pub fn default_bytes() -> u64 {
-    physical_memory().map_or(4 << 30, |m| m / 2)
+    default_limit().0 / 2
+}
+
+/// Address space the GL driver, its threads and the program's code take before any data
+/// (llvmpipe maps several hundred MiB): what `ulimit -v` leaves for data is its limit
+/// less this.
+const MAPPED_BEFORE_DATA: u64 = 1 << 30;
+
+/// The memory this process may use and what bounds it: physical memory (or the cgroup's
+/// limit), or the process's own limits where smaller; 8 GiB where none can be read.
+pub fn default_limit() -> (u64, &'static str) {
+    static LIMIT: OnceLock<(u64, &'static str)> = OnceLock::new();
+    *LIMIT.get_or_init(|| {
+        let mut best = (8u64 << 30, "8 GiB (no memory size could be read)");
+        if let Some(m) = physical_memory() {
+            best = (m, "physical memory (or the cgroup's limit)");
+        }
+        let (address, data) = process_limits();
+        if let Some(a) = address {
+            let usable = a.saturating_sub(MAPPED_BEFORE_DATA);
+            if usable < best.0 {
+                best = (
+                    usable,
+                    "the address space `ulimit -v` allows, less 1 GiB for the driver and code",
+                );
+            }
+        }
+        if let Some(d) = data {
+            if d < best.0 {
+                best = (d, "the data size `ulimit -d` allows");
+            }
+        }
+        best
+    })
+}
+
+/// The soft limits on address space and data size (`/proc/self/limits`), where set.
+fn process_limits() -> (Option<u64>, Option<u64>) {
+    let Ok(text) = std::fs::read_to_string("/proc/self/limits") else {
+        return (None, None);
+    };
+    let soft = |name: &str| {
+        let line = text.lines().find(|l| l.starts_with(name))?;
+        line[name.len()..]
+            .split_whitespace()
+            .next()?
+            .parse::<u64>()
+            .ok()
+    };
+    (soft("Max address space"), soft("Max data size"))
 }
 
 /// The machine's memory as this process may use it: the smaller of `MemTotal` and the

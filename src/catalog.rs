@@ -103,6 +103,14 @@ pub fn build(
                 .map_err(crate::gl::GlError::Data)?
                 .is_some() =>
         {
+            // Precise draws a store with a GLSL ray caster: `auto` takes GLSL there.
+            let kind = if fidelity == crate::vocab::Fidelity::Precise
+                && programs == crate::gl::ProgramChoice::Auto
+            {
+                crate::gl::ProgramKind::Glsl
+            } else {
+                kind
+            };
             Box::new(opacity3d::bricked::BrickedRenderer::new(
                 gpu, kind, fidelity, params, base, None,
             )?)

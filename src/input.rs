@@ -133,25 +133,15 @@ pub fn shorten(text: &str, max_chars: usize) -> String {
     format!("{head}… ({} more characters)", count - max_chars)
 }
 
-/// Tests only: a file under `../shared/data/` (real files no one here wrote), or `None`
-/// with a "SKIPPED" line when this clone has none; `ARBVIS_NO_SKIP=1` (set by `.ci/run`)
-/// turns the skip into a failure, as `tests/common` does for the integration tests.
+/// Tests only: a file under the project's `data/` (real files no one here wrote, which
+/// travel with the clone; `data/README.md` gives their sources and licences).
 #[cfg(test)]
-pub(crate) fn shared_data(relative: &str) -> Option<std::path::PathBuf> {
+pub(crate) fn data_file(relative: &str) -> std::path::PathBuf {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../shared/data")
+        .join("data")
         .join(relative);
-    if path.exists() {
-        return Some(path);
-    }
-    if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
-        panic!("ARBVIS_NO_SKIP=1 but {} is missing", path.display());
-    }
-    eprintln!(
-        "SKIPPED: {} is missing (no ../shared/data in this clone)",
-        path.display()
-    );
-    None
+    assert!(path.is_file(), "{} is missing from data/", path.display());
+    path
 }
 
 #[cfg(test)]

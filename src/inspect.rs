@@ -6,7 +6,7 @@ use std::io::Read;
 use std::path::Path;
 
 /// What `inspect` reads, for the message about a file it does not.
-pub const READS: &str = "volumes: SEG-Y (.sgy, .segy), NIfTI-1 (.nii, .nii.gz); tetrahedral meshes: VTK legacy (.vtk), VTK XML (.vtu), gmsh (.msh); point clouds: LAS/LAZ (.las, .laz), PLY (.ply), the seed's text (.dat); surfaces: OBJ (.obj), STL (.stl)";
+pub const READS: &str = "volumes: SEG-Y (.sgy, .segy), NIfTI-1 (.nii, .nii.gz); tetrahedral meshes: VTK legacy (.vtk), VTK XML (.vtu), gmsh (.msh); point clouds: LAS/LAZ (.las, .laz), PLY (.ply), ReconMS text (.dat); surfaces: OBJ (.obj), STL (.stl); survey stores (a folder, from `arbvis convert`)";
 
 /// The kinds of file `inspect` knows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -46,6 +46,9 @@ pub enum InspectError {
     /// A surface reader's error.
     #[error(transparent)]
     Surface(#[from] crate::surface::SurfaceError),
+    /// A store's error.
+    #[error(transparent)]
+    Store(#[from] crate::store::StoreError),
     /// Not a format arbvis reads.
     #[error("{path}: {what}; arbvis inspect reads {READS}")]
     Unknown {
@@ -146,6 +149,15 @@ pub fn inspect(path: &Path) -> Result<String, InspectError> {
         path: path.display().to_string(),
         error,
     };
+    if path.is_dir() {
+        if std::fs::symlink_metadata(path.join("zarr.json")).is_ok() {
+            return Ok(crate::store::describe::describe(path)?);
+        }
+        return Err(InspectError::Unknown {
+            path: path.display().to_string(),
+            what: "a folder without zarr.json (not a store)".into(),
+        });
+    }
     let (file, _) = crate::input::open_regular(path).map_err(io)?;
     let mut head = Vec::new();
     file.take(4096).read_to_end(&mut head).map_err(io)?;

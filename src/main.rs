@@ -22,9 +22,15 @@ struct Cli {
     /// The memory budget: the most one file, scene or computation may make arbvis
     /// allocate, checked before each large allocation (bytes with K/M/G/T, or a share of
     /// physical memory such as 75%). Default: ARBVIS_MEMORY_BUDGET, else the scene's
-    /// memory_budget, else half of physical memory.
+    /// memory_budget, else half of the memory the process may use (physical
+    /// memory, a cgroup or `ulimit -v`/`-d` limit).
     #[arg(long, global = true, value_name = "SIZE", value_parser = arbvis::budget::parse)]
     memory_budget: Option<u64>,
+    /// Check the command without running it: parse its flags, load its scene (every key
+    /// checked, errors with line and column) and confirm that the files it reads exist;
+    /// nothing is rendered, converted or written.
+    #[arg(long, global = true)]
+    dry_run: bool,
 }
 
 #[derive(Subcommand)]
@@ -55,9 +61,10 @@ enum Command {
     /// Print what the loaders see in a file: volumes (SEG-Y, NIfTI: dimensions, ranges,
     /// sample type, byte order, statistics), meshes (VTK legacy, .vtu, gmsh: points, cells
     /// by type, bounds, arrays, flat tetrahedra), point clouds (.dat, LAS/LAZ, PLY: count,
-    /// bounds, attributes) and surfaces (OBJ, STL).
+    /// bounds, attributes), surfaces (OBJ, STL) and survey stores (format, dimensions with
+    /// their coordinates, attributes, levels, completeness, size on disk).
     Inspect {
-        /// A volume, mesh, point cloud or surface file.
+        /// A volume, mesh, point cloud or surface file, or a survey store (a folder).
         file: PathBuf,
         /// Also read and inspect it this many more times and print the median time (what
         /// loading the file costs).
@@ -120,7 +127,7 @@ enum Command {
     /// machine).
     ///
     /// --technique clip: volume clipping. Textures: each --clip-sizes grid x shape
-    /// (sphere, torus mesh, open half-torus, cow.obj where ../shared has it) x --blocks B:
+    /// (sphere, torus mesh, open half-torus, cow.obj from data/) x --blocks B:
     /// bytes of INDEX-DATA against the single texture and build time (clip-textures.csv).
     /// Frames: the clipped --volume³ cube at --size², no clip / single texture /
     /// INDEX-DATA at each B, with RMSE against the clipped f64 reference and the largest
@@ -201,9 +208,9 @@ enum Command {
         /// zstd level of the chunks (0: uncompressed).
         #[arg(long, default_value_t = 1)]
         zstd: i32,
-        /// A raw input's dimensions I,J,K (i fastest).
-        #[arg(long, value_delimiter = ',', num_args = 3)]
-        raw_dims: Option<Vec<usize>>,
+        /// A raw input's dimensions I,J,K (i fastest), e.g. 512,400,300.
+        #[arg(long, value_name = "I,J,K", value_parser = parse_dims)]
+        raw_dims: Option<[usize; 3]>,
         /// A raw input's sample type (u8, i8, u16, i16, u32, i32, f32, f64).
         #[arg(long, default_value = "f32")]
         raw_type: String,
@@ -267,6 +274,35 @@ impl Command {
             _ => None,
         }
     }
+}
+
+/// `--dry-run`: the command's scene loaded and the files it reads found, nothing run.
+fn dry_run(command: &Command) -> Result<()> {
+    let exists = |path: &Path| -> Result<()> {
+        if path.exists() {
+            Ok(())
+        } else {
+            bail!("{}: no such file or folder", path.display())
+        }
+    };
+    if let Some(args) = command.scene_args() {
+        args.load()?;
+    }
+    match command {
+        Command::Inspect { file, .. } => exists(file)?,
+        Command::Convert { input, .. } => exists(input)?,
+        Command::Study { from, scenes, .. } => {
+            for path in from {
+                exists(path)?;
+            }
+            for path in scenes {
+                Scene::load(path)?;
+            }
+        }
+        _ => {}
+    }
+    println!("dry run: the command, its scene and its files check out; nothing was run");
+    Ok(())
 }
 
 /// What a build without the viewer answers to `arbvis view`.
@@ -453,6 +489,19 @@ impl SceneArgs {
     }
 }
 
+/// `I,J,K`: three positive sizes.
+fn parse_dims(s: &str) -> Result<[usize; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let sizes: Vec<usize> = parts
+        .iter()
+        .map(|p| p.parse::<usize>().ok().filter(|&n| n > 0))
+        .collect::<Option<_>>()
+        .ok_or_else(|| format!("{s:?}: expected three positive sizes I,J,K, e.g. 512,400,300"))?;
+    sizes
+        .try_into()
+        .map_err(|_| format!("{s:?}: expected three sizes I,J,K, e.g. 512,400,300"))
+}
+
 /// A demo's name, or "" (`--demo` alone: list them).
 fn demo_name(s: &str) -> Result<String, String> {
     if s.is_empty() || arbvis::scene::DEMOS.iter().any(|d| d.0 == s) {
@@ -513,6 +562,9 @@ fn run(cli: Cli) -> Result<()> {
         println!("{}", demo_list("\n"));
         return Ok(());
     }
+    if cli.dry_run {
+        return dry_run(&cli.command);
+    }
     match cli.command {
         Command::Info { backend, json } => {
             let headless = Headless::new(backend)?;
@@ -533,8 +585,9 @@ fn run(cli: Cli) -> Result<()> {
                 bail!("render needs an output file: -o OUT.png");
             };
             let (scene, origin) = scene.load()?;
-            let rendered = arbvis::render::render(&scene, backend)
-                .with_context(|| format!("rendering {origin}"))?;
+            let rendered = arbvis::render::render(&scene, backend).map_err(|e| {
+                anyhow::anyhow!(scene.explain_missing(format!("rendering {origin}: {e:#}")))
+            })?;
             arbvis::png_io::write_png(
                 &output,
                 &scene.picture(&rendered.image),
@@ -583,9 +636,9 @@ fn run(cli: Cli) -> Result<()> {
                 }
             }
             let raw = match raw_dims {
-                Some(d) => Some(arbvis::volume::raw::RawSpec {
+                Some(dims) => Some(arbvis::volume::raw::RawSpec {
                     path: input.clone(),
-                    dims: [d[0], d[1], d[2]],
+                    dims,
                     sample: serde_json::from_value(serde_json::json!(raw_type)).map_err(|_| {
                         anyhow::anyhow!(
                             "--raw-type {raw_type}: one of u8, i8, u16, i16, u32, i32, f32, f64"
@@ -628,7 +681,9 @@ fn run(cli: Cli) -> Result<()> {
                 &options,
                 arbvis::progress::line,
             )
-            .with_context(|| format!("benchmarking {origin}"))?;
+            .map_err(|e| {
+                anyhow::anyhow!(scene.explain_missing(format!("benchmarking {origin}: {e:#}")))
+            })?;
             if json {
                 println!("{}", serde_json::to_string_pretty(&report)?);
             } else {
@@ -879,12 +934,14 @@ fn run(cli: Cli) -> Result<()> {
                 Some(p) => Some(arbvis::viewer::script::Script::load(&p)?),
                 None => None,
             };
+            let explain = scene.clone();
             arbvis::viewer::run(arbvis::viewer::ViewerOptions {
                 scene,
                 origin,
                 screenshot_dir,
                 script,
-            })?;
+            })
+            .map_err(|e| anyhow::anyhow!(explain.explain_missing(format!("{e:#}"))))?;
         }
     }
     Ok(())

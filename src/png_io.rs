@@ -182,7 +182,8 @@ pub fn read_png(path: &Path) -> Result<(Image, Vec<(String, String)>), PngError>
 static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
 /// The marker in temporary names: `.NAME.arbvis-tmp.PID`.
-const TMP_MARK: &str = ".arbvis-tmp.";
+/// What marks a temporary file of an atomic write (`.NAME.arbvis-tmp.PID`).
+pub const TMP_MARK: &str = ".arbvis-tmp.";
 
 /// `path`'s folder (`.` for a bare name) and file name.
 fn dir_and_name(path: &Path) -> std::io::Result<(PathBuf, String)> {

@@ -159,6 +159,61 @@ impl Drop for Bar {
     }
 }
 
+/// Plain progress lines for long work whose bar is not drawn (stderr is a file or a
+/// pipe, or CI): after `first`, a line of how far it got and the time left, then one
+/// every `every`. Silent where a bar shows the same. Counting is thread-safe.
+pub struct Lines {
+    what: String,
+    total: u64,
+    done: std::sync::atomic::AtomicU64,
+    start: Instant,
+    /// Milliseconds after `start` when the next line is due.
+    next_ms: std::sync::atomic::AtomicU64,
+    every: Duration,
+}
+
+impl Lines {
+    /// Lines for `total` units of `unit_name` of `what`.
+    pub fn new(what: &str, total: u64, first: Duration, every: Duration) -> Lines {
+        Lines {
+            what: what.to_string(),
+            total,
+            done: std::sync::atomic::AtomicU64::new(0),
+            start: Instant::now(),
+            next_ms: std::sync::atomic::AtomicU64::new(first.as_millis() as u64),
+            every,
+        }
+    }
+
+    /// `n` more units done; prints a line when one is due.
+    pub fn inc(&self, n: u64) {
+        let done = self.done.fetch_add(n, Ordering::Relaxed) + n;
+        if enabled() {
+            return;
+        }
+        let elapsed = self.start.elapsed();
+        let ms = elapsed.as_millis() as u64;
+        let due = self.next_ms.load(Ordering::Relaxed);
+        if ms < due || done >= self.total {
+            return;
+        }
+        let next = ms + self.every.as_millis() as u64;
+        if self
+            .next_ms
+            .compare_exchange(due, next, Ordering::Relaxed, Ordering::Relaxed)
+            .is_ok()
+        {
+            let left = elapsed.as_secs_f64() * (self.total - done) as f64 / done.max(1) as f64;
+            line(&format!(
+                "{}: {done} of {} done in {:.0} s, about {left:.0} s left",
+                self.what,
+                self.total,
+                elapsed.as_secs_f64()
+            ));
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

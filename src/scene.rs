@@ -41,12 +41,28 @@ pub struct Scene {
     /// `--memory-budget` nor `ARBVIS_MEMORY_BUDGET` sets one ([`crate::budget`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub memory_budget: Option<String>,
+    /// How to get the scene's data where it is not in the clone (a download or a
+    /// conversion command), said when a file the scene reads is missing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub data_from: Option<String>,
     /// The technique and its parameters.
     pub technique: TechniqueScene,
     /// Folder that relative data paths are read from: the scene file's folder, or the
     /// current folder for demos and scenes given as text.
     #[serde(skip)]
     pub base: std::path::PathBuf,
+}
+
+impl Scene {
+    /// `error` with the scene's `data_from` hint added when a file it reads is missing.
+    pub fn explain_missing(&self, error: String) -> String {
+        match &self.data_from {
+            Some(how) if error.contains("no such file") || error.contains("No such file") => {
+                format!("{error}\n  this scene's data is not in the clone: {how}")
+            }
+            _ => error,
+        }
+    }
 }
 
 fn default_size() -> [u32; 2] {

@@ -1,5 +1,5 @@
 //! The fuzz harness: every loader and the scene parser, fed mutated copies of a corpus
-//! (the real files in ../shared/data and fixtures generated here), must return a value or
+//! (the real files in data/ and fixtures generated here), must return a value or
 //! an error: no panic, no allocation beyond a cap, no case slower than a bound.
 //!
 //! `cargo test --test fuzz` runs a fixed number of cases per target (deterministic: case
@@ -26,6 +26,7 @@
 //! allocation aborts the test with "memory allocation of N bytes failed"). The memory
 //! budget (`arbvis::budget`) is set to [`FUZZ_BUDGET`] so that loaders refuse first.
 
+#[path = "it/common/mod.rs"]
 mod common;
 #[path = "../src/mesh/tests/fixtures.rs"]
 mod mesh_fixtures;
@@ -262,9 +263,7 @@ fn fuzz_limits() -> Limits {
 fn segy_corpus() -> Vec<Vec<u8>> {
     let mut corpus = Vec::new();
     for name in ["f3.sgy", "small.sgy", "tiny.sgy", "broken.sgy"] {
-        if let Some(p) = common::shared_data(&format!("seismic/{name}")) {
-            corpus.push(std::fs::read(p).unwrap());
-        }
+        corpus.push(std::fs::read(common::data_file(&format!("seismic/{name}"))).unwrap());
     }
     let v = Volume::new([6, 3, 2], [1.0; 3], (0..36).map(|n| n as f32).collect()).unwrap();
     for code in [1, 3, 5, 16] {
@@ -331,9 +330,7 @@ fn mesh_corpus(ext: &str) -> Vec<Vec<u8>> {
         if !name.ends_with(&suffix) {
             continue;
         }
-        if let Some(p) = common::shared_data(&format!("tets/{name}")) {
-            corpus.push(std::fs::read(p).unwrap());
-        }
+        corpus.push(std::fs::read(common::data_file(&format!("tets/{name}"))).unwrap());
     }
     corpus
 }
@@ -461,9 +458,7 @@ fn ply_corpus() -> Vec<Vec<u8>> {
 
 fn obj_corpus() -> Vec<Vec<u8>> {
     let mut corpus = vec![b"# a cube\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n".to_vec()];
-    if let Some(p) = common::shared_data("surfaces/cow.obj") {
-        corpus.push(std::fs::read(p).unwrap());
-    }
+    corpus.push(std::fs::read(common::data_file("surfaces/cow.obj")).unwrap());
     corpus
 }
 
@@ -623,6 +618,40 @@ fn targets() -> Vec<Target> {
             },
         },
         Target {
+            name: "store-meta",
+            text: true,
+            sections: false,
+            corpus: vec![template_file("zarr.json")],
+            run: |b| store_case("zarr.json", b),
+        },
+        Target {
+            name: "store-array",
+            text: true,
+            sections: false,
+            corpus: vec![
+                template_file("amplitude/0/zarr.json"),
+                template_file("envelope/range/1/zarr.json"),
+            ],
+            run: |b| store_case("amplitude/0/zarr.json", b),
+        },
+        Target {
+            name: "store-chunk",
+            text: false,
+            sections: false,
+            corpus: vec![
+                template_file("amplitude/0/c/0/0/0"),
+                template_file("envelope/0/c/1/0/1"),
+            ],
+            run: |b| store_case("amplitude/0/c/0/0/0", b),
+        },
+        Target {
+            name: "store-log",
+            text: true,
+            sections: false,
+            corpus: vec![template_log()],
+            run: log_case,
+        },
+        Target {
             name: "table",
             text: true,
             sections: false,
@@ -635,6 +664,129 @@ fn targets() -> Vec<Target> {
             },
         },
     ]
+}
+
+// --- stores: a small converted survey whose files the store targets mutate ---
+
+/// The template: a 9 x 7 x 5 survey in 4³ bricks with envelope (3 x 2 x 2 bricks, 2
+/// levels), converted whole into `complete.zarr` and stopped after two columns into
+/// `part.zarr`, made once (outside the caps) when the corpus is built.
+fn store_template() -> &'static Path {
+    static DIR: std::sync::OnceLock<std::path::PathBuf> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        use arbvis::store::convert::{convert, ConvertOptions};
+        let dir = std::env::temp_dir().join(format!("arbvis-fuzz-store-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let v = Volume::new(
+            [9, 7, 5],
+            [1.0; 3],
+            (0..315).map(|n| ((n * 37) % 23) as f32 - 11.0).collect(),
+        )
+        .unwrap();
+        let sgy = dir.join("s.sgy");
+        let w = segy::WriteOptions {
+            format: segy::SampleFormat::IeeeFloat,
+            big_endian: true,
+            revision: 1,
+            first_inline: 1,
+            first_crossline: 1,
+            interval_us: 4000,
+        };
+        std::fs::write(&sgy, segy::write(&v, &w)).unwrap();
+        let o = ConvertOptions {
+            brick: 4,
+            derived: vec![arbvis::volume::attributes::Attribute::Envelope],
+            progress: false,
+            ..Default::default()
+        };
+        convert(&sgy, &dir.join("complete.zarr"), &o).unwrap();
+        let stop = ConvertOptions {
+            stop_after: Some(2),
+            ..o
+        };
+        assert!(convert(&sgy, &dir.join("part.zarr"), &stop).is_err());
+        dir
+    })
+}
+
+fn template_file(name: &str) -> Vec<u8> {
+    std::fs::read(store_template().join("complete.zarr").join(name)).unwrap()
+}
+
+fn template_log() -> Vec<u8> {
+    std::fs::read(
+        store_template()
+            .join("part.zarr")
+            .join(arbvis::store::progress::PROGRESS_LOG),
+    )
+    .unwrap()
+}
+
+/// Write `bytes` as `name` of the complete store, open it and read every range and chunk,
+/// then put the file back.
+fn store_case(name: &str, bytes: &[u8]) {
+    let store = store_template().join("complete.zarr");
+    let file = store.join(name);
+    let original = std::fs::read(&file).unwrap();
+    std::fs::write(&file, bytes).unwrap();
+    if let Ok(s) = arbvis::store::Store::open(&store) {
+        for a in 0..s.meta.attributes.len() {
+            for level in 0..s.meta.levels {
+                let _ = s.ranges(a, level);
+                let c = s.meta.brick_counts(level);
+                for k in 0..c[2] {
+                    for j in 0..c[1] {
+                        for i in 0..c[0] {
+                            let _ = s.brick(a, level, [i, j, k]);
+                        }
+                    }
+                }
+            }
+        }
+        let _ = arbvis::store::describe::describe(&store);
+    }
+    std::fs::write(&file, original).unwrap();
+}
+
+/// Copy the interrupted conversion, give it `bytes` as its progress log, and resume it.
+fn log_case(bytes: &[u8]) {
+    use arbvis::store::convert::{convert, ConvertOptions};
+    let from = store_template().join("part.zarr");
+    let to = store_template().join("resumed.zarr");
+    let _ = std::fs::remove_dir_all(&to);
+    copy_tree(&from, &to);
+    std::fs::write(to.join(arbvis::store::progress::PROGRESS_LOG), bytes).unwrap();
+    let o = ConvertOptions {
+        brick: 4,
+        derived: vec![arbvis::volume::attributes::Attribute::Envelope],
+        progress: false,
+        ..Default::default()
+    };
+    if convert(&store_template().join("s.sgy"), &to, &o).is_ok() {
+        // A resumed store is whole: every chunk reads.
+        let s = arbvis::store::Store::open(&to).expect("a finished conversion opens");
+        for a in 0..s.meta.attributes.len() {
+            let c = s.meta.brick_counts(0);
+            for i in 0..c[0] {
+                s.chunk(a, 0, [i, 0, 0])
+                    .expect("a resumed conversion wrote every chunk");
+            }
+        }
+    }
+}
+
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).unwrap();
+        }
+    }
 }
 
 /// What one capped run of an input did.

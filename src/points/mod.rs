@@ -282,7 +282,4 @@ pub fn inspect(path: &Path) -> Result<String, PointsError> {
 }
 
 #[cfg(test)]
-pub(crate) use crate::input::shared_data;
-
-#[cfg(test)]
 mod tests;

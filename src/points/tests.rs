@@ -2,6 +2,7 @@
 //! `inspect`, the scene syntax and a seeded mutation test of every parser.
 
 use super::*;
+use crate::input::data_file;
 use crate::points::section::SplitMix64;
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -132,9 +133,7 @@ fn statistics_as_the_seed_computed_them() {
 
 #[test]
 fn bunny_vertices() {
-    let Some(path) = shared_data("points/bunny.ply") else {
-        return;
-    };
+    let path = data_file("points/bunny.ply");
     let p = plycloud::read(&path).unwrap();
     let c = &p.cloud;
     assert_eq!(c.len(), 35_947);
@@ -166,31 +165,27 @@ fn bunny_vertices() {
 
 #[test]
 fn inspect_reports_format_bounds_origin_and_attributes() {
-    if let Some(path) = shared_data("points/autzen_trim.laz") {
-        let s = inspect(&path).unwrap();
-        for line in [
-            "format: LAS 1.2, point format 3, compressed (LAZ), 34-byte records",
-            "header: 110000 points, scale 0.01 0.01 0.01",
-            "points: 110000",
-            "bounds: x 636001.76 .. 637179.22",
-            "colour: RGB, 16 bits per channel (largest value 236)",
-            "attribute intensity (int): min 0 max 254 median 107",
-            "attribute classification (int): min 1 max 2 median 1",
-        ] {
-            assert!(s.contains(line), "{line}\n{s}");
-        }
+    let s = inspect(&data_file("points/autzen_trim.laz")).unwrap();
+    for line in [
+        "format: LAS 1.2, point format 3, compressed (LAZ), 34-byte records",
+        "header: 110000 points, scale 0.01 0.01 0.01",
+        "points: 110000",
+        "bounds: x 636001.76 .. 637179.22",
+        "colour: RGB, 16 bits per channel (largest value 236)",
+        "attribute intensity (int): min 0 max 254 median 107",
+        "attribute classification (int): min 1 max 2 median 1",
+    ] {
+        assert!(s.contains(line), "{line}\n{s}");
     }
-    if let Some(path) = shared_data("points/bunny.ply") {
-        let s = inspect(&path).unwrap();
-        for line in [
-            "format: PLY 1.0 ascii",
-            "elements: vertex 35947, face 69451",
-            "comment: zipper output",
-            "points: 35947",
-            "attribute confidence (float): min 0 max 0.99923",
-        ] {
-            assert!(s.contains(line), "{line}\n{s}");
-        }
+    let s = inspect(&data_file("points/bunny.ply")).unwrap();
+    for line in [
+        "format: PLY 1.0 ascii",
+        "elements: vertex 35947, face 69451",
+        "comment: zipper output",
+        "points: 35947",
+        "attribute confidence (float): min 0 max 0.99923",
+    ] {
+        assert!(s.contains(line), "{line}\n{s}");
     }
     let dir = temp_dir("inspect");
     let path = dir.join("s.dat");

@@ -30,7 +30,7 @@
 
 use std::collections::{BTreeMap, HashMap};
 use std::fs::{File, OpenOptions};
-use std::io::{BufRead, BufReader, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
@@ -38,7 +38,6 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use rustfft::FftPlanner;
-use serde::{Deserialize, Serialize};
 use zarrs::array::codec::ZstdCodec;
 use zarrs::array::{data_type, Array, ArrayBuilder, CodecOptions};
 use zarrs::filesystem::FilesystemStore;
@@ -46,13 +45,13 @@ use zarrs::group::GroupBuilder;
 
 use super::input::Input;
 use super::meta::{AttributeMeta, StoreMeta, FORMAT, VERSION};
+use super::progress::{holds_nothing, read_log, start_log, Job, StoreLock, Unit};
 use super::reader::Store;
 use super::StoreError;
 use crate::volume::attributes::{derive_trace, Attribute};
 use crate::volume::raw::RawSpec;
 
-/// The progress log's name inside the store.
-pub const PROGRESS_LOG: &str = "arbvis-progress.log";
+pub use super::progress::PROGRESS_LOG;
 
 /// How to convert.
 #[derive(Debug, Clone)]
@@ -118,27 +117,6 @@ pub fn dtype(a: Attribute) -> &'static str {
     }
 }
 
-/// The job, as the progress log's first line (a resumed run must match it).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-struct Job {
-    input: String,
-    bytes: u64,
-    modified: u64,
-    brick: usize,
-    attributes: Vec<String>,
-    zstd: i32,
-    raw: Option<String>,
-}
-
-/// One finished column: `u` = `[level, j brick, k brick]`; per attribute, the ranges of
-/// its bricks along i and `[sum, finite count, non-finite count]`.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-struct Unit {
-    u: [usize; 3],
-    ranges: Vec<Vec<[f32; 2]>>,
-    sums: Vec<[f64; 3]>,
-}
-
 struct Log {
     file: Mutex<File>,
 }
@@ -198,8 +176,8 @@ pub fn convert(
         bound,
     )
     .map_err(|e| StoreError::Budget(e.to_string()))?;
+    check_work(input, &src, dims, b, attributes.len())?;
     let log_path = store.join(PROGRESS_LOG);
-    let mut done: HashMap<[usize; 3], Unit> = HashMap::new();
     let meta = StoreMeta {
         format: FORMAT.into(),
         version: VERSION,
@@ -227,31 +205,31 @@ pub fn convert(
         },
         complete: false,
     };
-    let storage = if log_path.is_file() {
-        done = read_log(&log_path, &job)?;
-        Arc::new(FilesystemStore::new(store).map_err(|e| StoreError::io(store, e))?)
+    if store.exists() && !store.is_dir() {
+        return Err(StoreError::invalid(
+            store,
+            "exists and is not a folder: name a new store",
+        ));
+    }
+    std::fs::create_dir_all(store).map_err(|e| StoreError::io(store, e))?;
+    // One writer at a time; the lock goes when this function returns.
+    let _lock = StoreLock::acquire(store)?;
+    let mut done: HashMap<[usize; 3], Unit> = if log_path.exists() {
+        read_log(&log_path, &job, &meta)?
+    } else if holds_nothing(store)? {
+        // A new store, or one killed before its log existed: the log first, whole, so
+        // that from here on any interruption can be resumed.
+        start_log(&log_path, &job)?;
+        HashMap::new()
     } else {
-        if store.exists() {
-            let empty = std::fs::read_dir(store)
-                .map(|mut d| d.next().is_none())
-                .unwrap_or(false);
-            if !empty {
-                return Err(StoreError::invalid(
-                    store,
-                    "already exists and holds no interrupted conversion: name a new store (arbvis never overwrites one)",
-                ));
-            }
-        }
-        std::fs::create_dir_all(store).map_err(|e| StoreError::io(store, e))?;
-        let storage = Arc::new(FilesystemStore::new(store).map_err(|e| StoreError::io(store, e))?);
-        create_arrays(&storage, store, &meta, o)?;
-        let mut f = File::create(&log_path).map_err(|e| StoreError::io(&log_path, e))?;
-        let line = serde_json::to_string(&job).map_err(|e| StoreError::io(&log_path, e))?;
-        writeln!(f, "{line}")
-            .and_then(|_| f.sync_all())
-            .map_err(|e| StoreError::io(&log_path, e))?;
-        storage
+        return Err(StoreError::invalid(
+            store,
+            "already exists and holds no interrupted conversion: name a new store (arbvis never overwrites one)",
+        ));
     };
+    let storage = Arc::new(FilesystemStore::new(store).map_err(|e| StoreError::io(store, e))?);
+    // Every zarr.json, written whole (again on a resume: a kill may have cut one).
+    create_arrays(&storage, store, &meta, o)?;
     let log = Log {
         file: Mutex::new(
             OpenOptions::new()
@@ -326,44 +304,6 @@ pub fn convert(
     })
 }
 
-fn read_log(path: &Path, job: &Job) -> Result<HashMap<[usize; 3], Unit>, StoreError> {
-    let f = File::open(path).map_err(|e| StoreError::io(path, e))?;
-    let mut lines = BufReader::new(f).lines();
-    let first = lines
-        .next()
-        .transpose()
-        .map_err(|e| StoreError::io(path, e))?
-        .unwrap_or_default();
-    let was: Job = serde_json::from_str(&first).map_err(|e| {
-        StoreError::invalid(path, format!("line 1 is not the job's description: {e}"))
-    })?;
-    if &was != job {
-        return Err(StoreError::invalid(
-            path,
-            format!(
-                "the interrupted conversion here was of {} ({} bytes, brick {}, attributes {}, zstd {}); this one is of {} ({} bytes, brick {}, attributes {}, zstd {}): run the same command to resume, or name a new store",
-                was.input, was.bytes, was.brick, was.attributes.join(","), was.zstd,
-                job.input, job.bytes, job.brick, job.attributes.join(","), job.zstd
-            ),
-        ));
-    }
-    let mut done = HashMap::new();
-    let all: Vec<String> = lines
-        .collect::<Result<_, _>>()
-        .map_err(|e| StoreError::io(path, e))?;
-    for (n, line) in all.iter().enumerate() {
-        match serde_json::from_str::<Unit>(line) {
-            Ok(u) => {
-                done.insert(u.u, u);
-            }
-            // A line torn by the interruption: its column is done again.
-            Err(_) if n + 1 == all.len() => {}
-            Err(e) => return Err(StoreError::invalid(path, format!("line {}: {e}", n + 2))),
-        }
-    }
-    Ok(done)
-}
-
 fn create_arrays(
     storage: &Arc<FilesystemStore>,
     store: &Path,
@@ -377,19 +317,17 @@ fn create_arrays(
         "arbvis".into(),
         serde_json::to_value(meta).map_err(|e| StoreError::io(store, e))?,
     );
-    group
-        .store_metadata()
-        .map_err(|e| StoreError::io(store, e))?;
+    write_json(store, "/", group.metadata())?;
     let b = meta.brick as u64;
     for (a, am) in meta.attributes.iter().enumerate() {
         let g = GroupBuilder::new()
             .build(storage.clone(), &format!("/{}", am.name))
             .map_err(|e| StoreError::io(store, e))?;
-        g.store_metadata().map_err(|e| StoreError::io(store, e))?;
+        write_json(store, g.path().as_str(), g.metadata())?;
         let g = GroupBuilder::new()
             .build(storage.clone(), &format!("/{}/range", am.name))
             .map_err(|e| StoreError::io(store, e))?;
-        g.store_metadata().map_err(|e| StoreError::io(store, e))?;
+        write_json(store, g.path().as_str(), g.metadata())?;
         for level in 0..meta.levels {
             let d = meta.level_dims(level);
             let shape = vec![d[2] as u64, d[1] as u64, d[0] as u64];
@@ -406,9 +344,7 @@ fn create_arrays(
             let array = builder
                 .build(storage.clone(), &p)
                 .map_err(|e| StoreError::io(store, e))?;
-            array
-                .store_metadata()
-                .map_err(|e| StoreError::io(store, e))?;
+            write_json(store, &p, array.metadata())?;
             let c = meta.brick_counts(level);
             let rshape = vec![c[2] as u64, c[1] as u64, c[0] as u64, 2];
             let mut rb = ArrayBuilder::new(rshape.clone(), rshape, data_type::float32(), f32::NAN);
@@ -418,13 +354,28 @@ fn create_arrays(
                 "sample_brick",
                 "min_max",
             ]));
+            let rp = Store::range_path(meta, a, level);
             let r = rb
-                .build(storage.clone(), &Store::range_path(meta, a, level))
+                .build(storage.clone(), &rp)
                 .map_err(|e| StoreError::io(store, e))?;
-            r.store_metadata().map_err(|e| StoreError::io(store, e))?;
+            write_json(store, &rp, r.metadata())?;
         }
     }
     Ok(())
+}
+
+/// Write the `zarr.json` of the node at zarr path `node` whole: a temporary renamed into
+/// place, so that a kill leaves the old file or the new one, never a cut one.
+fn write_json(
+    store: &Path,
+    node: &str,
+    metadata: &impl serde::Serialize,
+) -> Result<(), StoreError> {
+    let folder = store.join(node.trim_start_matches('/'));
+    std::fs::create_dir_all(&folder).map_err(|e| StoreError::io(&folder, e))?;
+    let file = folder.join("zarr.json");
+    let json = serde_json::to_vec_pretty(metadata).map_err(|e| StoreError::io(&file, e))?;
+    crate::png_io::write_atomic(&file, &json).map_err(|e| StoreError::io(&file, e))
 }
 
 type Arrays = Vec<Vec<Array<FilesystemStore>>>;
@@ -683,6 +634,53 @@ pub fn filter(attribute: Attribute, get: impl Fn(usize, usize, usize) -> Option<
     }
 }
 
+/// Most chunk files a conversion may write for an input of `bytes` (at least 65,536): a
+/// thin volume in cubic bricks is mostly padding, and `1 x 1 x 2^21` samples in 64³ bricks
+/// would be 32,768 chunks per attribute and level for 2 MB.
+pub fn max_chunks(bytes: u64) -> u64 {
+    (bytes / 1024).max(1 << 16)
+}
+
+/// The chunk files the store of `dims` in `brick`³ bricks holds with `attributes`.
+pub fn chunk_count(dims: [usize; 3], brick: usize, attributes: usize) -> u64 {
+    let levels = super::level_count(dims, brick);
+    (0..levels)
+        .map(|l| {
+            let c = super::brick_counts(super::level_dims(dims, l), brick);
+            (c[0] as u64)
+                .saturating_mul(c[1] as u64)
+                .saturating_mul(c[2] as u64)
+        })
+        .fold(0u64, u64::saturating_add)
+        .saturating_mul(attributes as u64)
+}
+
+/// Refuse work that grows faster than the input: more chunk files than [`max_chunks`].
+fn check_work(
+    input: &Path,
+    src: &Input,
+    dims: [usize; 3],
+    brick: usize,
+    attributes: usize,
+) -> Result<(), StoreError> {
+    let bytes = src
+        .bytes_per_trace()
+        .saturating_mul((dims[1] * dims[2]) as u64);
+    let chunks = chunk_count(dims, brick, attributes);
+    let most = max_chunks(bytes);
+    if chunks > most {
+        return Err(StoreError::invalid(
+            input,
+            format!(
+                "{} x {} x {} voxels in {brick}³ bricks would make {chunks} chunk files for a {:.1} MB survey (at most {most}): bricks are cubes, so a volume this thin would be mostly padding; draw it from the file itself (a scene's {{ raw = ... }} or {{ segy = ... }} volume) instead of a store",
+                dims[0], dims[1], dims[2],
+                bytes as f64 / 1e6,
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Write the ranges and statistics from every column's record, and mark the store complete.
 fn finish_store(
     storage: &Arc<FilesystemStore>,
@@ -744,15 +742,14 @@ fn finish_store(
         am.non_finite = t[2] as u64;
     }
     meta.complete = true;
-    let mut group =
-        zarrs::group::Group::open(storage.clone(), "/").map_err(|e| StoreError::io(store, e))?;
+    let mut group = GroupBuilder::new()
+        .build(storage.clone(), "/")
+        .map_err(|e| StoreError::io(store, e))?;
     group.attributes_mut().insert(
         "arbvis".into(),
         serde_json::to_value(&meta).map_err(|e| StoreError::io(store, e))?,
     );
-    group
-        .store_metadata()
-        .map_err(|e| StoreError::io(store, e))?;
+    write_json(store, "/", group.metadata())?;
     Ok(meta)
 }
 

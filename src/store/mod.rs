@@ -23,19 +23,28 @@
 //! ±180°: phase keeps the first voxel of each 2x2x2 cell (decimation).
 //!
 //! # Modules
-//! - [`meta`]: the group's attributes.
+//! - [`meta`]: the group's attributes; [`check`]: every number in them and every array
+//!   checked at open.
+//! - [`zarr`]: zarr v3 metadata and chunks read as bounded input (regular files only,
+//!   sizes checked, chunks decoded into their known size).
 //! - [`input`]: the sources read in columns (SEG-Y, NIfTI, raw), never whole.
-//! - [`convert`]: `arbvis convert` (streamed, parallel, resumable; memory bound).
+//! - [`convert`]: `arbvis convert` (streamed, parallel, resumable; memory bound);
+//!   [`progress`]: its lock and progress log.
+//! - [`describe`]: `arbvis inspect STORE`.
 //! - [`reader`]: chunks, bricks with their one-voxel border, and level-0 windows read back.
 //! - [`lod`]: which bricks a view needs (screen-space error), in visibility order (no GL).
 //! - [`cache`]: the GPU brick cache (fixed texture budget, LRU, a loader thread).
 
 pub mod cache;
+pub mod check;
 pub mod convert;
+pub mod describe;
 pub mod input;
 pub mod lod;
 pub mod meta;
+pub mod progress;
 pub mod reader;
+pub mod zarr;
 
 use std::path::{Path, PathBuf};
 

@@ -2,23 +2,25 @@
 //! grown by one voxel on every side (clamped at the survey's faces, as CLAMP_TO_EDGE), the
 //! per-brick ranges, and level-0 windows as a [`Volume`] (sections, references).
 //!
-//! Every error names the store and, for a chunk, its file and indices: a missing chunk
-//! file is corruption (the conversion writes every chunk, empty ones included).
+//! Every file is read through [`super::zarr`] (bounded, regular files only) and every
+//! array checked against the store's metadata at open ([`super::check`]). Every error
+//! names the store and, for a chunk, its file and indices. An absent chunk is zarr's
+//! "all fill value" where the store's own ranges agree (zarr-python does not write such
+//! chunks); where the ranges say the brick holds other values, or while a conversion is
+//! still writing the store (it writes every chunk before it logs the column), an absent
+//! chunk is corruption.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use zarrs::array::Array;
-use zarrs::filesystem::FilesystemStore;
-use zarrs::group::Group;
-
-use super::meta::{StoreMeta, FORMAT, VERSION};
+use super::meta::StoreMeta;
+use super::zarr::ArrayMeta;
 use super::StoreError;
 use crate::volume::Volume;
 
-/// The opened arrays, by (attribute, level).
-type OpenArrays = HashMap<(usize, usize), Arc<Array<FilesystemStore>>>;
+/// Per-brick ranges read so far, by (attribute, level).
+type RangeTables = HashMap<(usize, usize), Arc<Vec<[f32; 2]>>>;
 
 /// A decoded chunk, by (attribute, level, chunk index), with its last use.
 type CachedChunks = HashMap<(usize, usize, [usize; 3]), (Arc<Vec<f32>>, u64)>;
@@ -29,9 +31,14 @@ pub struct Store {
     pub path: PathBuf,
     /// Its description.
     pub meta: StoreMeta,
-    storage: Arc<FilesystemStore>,
-    arrays: Mutex<OpenArrays>,
+    /// The data arrays, by attribute and level.
+    arrays: Vec<Vec<ArrayMeta>>,
+    /// The per-brick range arrays, by attribute and level.
+    range_arrays: Vec<Vec<ArrayMeta>>,
+    ranges: Mutex<RangeTables>,
     cache: Mutex<ChunkCache>,
+    /// Being written by a conversion: every chunk it logged must be present.
+    incomplete: bool,
 }
 
 /// Decoded chunks kept for neighbouring bricks' borders, least recently used first out.
@@ -71,90 +78,46 @@ impl ChunkCache {
 pub const CHUNK_CACHE: usize = 64;
 
 impl Store {
-    /// Open the store at `path` and check its description.
+    /// Open the store at `path`: its description and every array checked.
     pub fn open(path: &Path) -> Result<Store, StoreError> {
-        if !path.join("zarr.json").is_file() {
-            return Err(StoreError::invalid(
-                path,
-                "no zarr.json: not a zarr v3 store (make one with `arbvis convert SURVEY STORE`)",
-            ));
+        if !path.is_dir() {
+            let why = if path.exists() {
+                "not a folder: a store is a folder (make one with `arbvis convert SURVEY STORE`)"
+            } else {
+                "no such store: no such file or folder (make one with `arbvis convert SURVEY STORE`)"
+            };
+            return Err(StoreError::invalid(path, why));
         }
-        let storage = Arc::new(FilesystemStore::new(path).map_err(|e| StoreError::io(path, e))?);
-        let group = Group::open(storage.clone(), "/").map_err(|e| {
-            StoreError::invalid(&path.join("zarr.json"), format!("not a zarr group: {e}"))
-        })?;
-        let meta = Store::meta_of(path, group.attributes())?;
+        let meta = super::check::read_meta(path)?;
         if !meta.complete {
             return Err(StoreError::invalid(
                 path,
                 "the conversion has not finished (run the same `arbvis convert` again to resume it)",
             ));
         }
-        Ok(Store::with_meta(path, meta, storage))
+        Store::with_meta(path, meta, false)
     }
 
     /// A store being written (the conversion reads the level below back).
     pub(crate) fn open_incomplete(path: &Path, meta: StoreMeta) -> Result<Store, StoreError> {
-        let storage = Arc::new(FilesystemStore::new(path).map_err(|e| StoreError::io(path, e))?);
-        Ok(Store::with_meta(path, meta, storage))
+        Store::with_meta(path, meta, true)
     }
 
-    fn with_meta(path: &Path, meta: StoreMeta, storage: Arc<FilesystemStore>) -> Store {
-        Store {
+    fn with_meta(path: &Path, meta: StoreMeta, incomplete: bool) -> Result<Store, StoreError> {
+        let (arrays, range_arrays) = super::check::open_arrays(path, &meta)?;
+        Ok(Store {
             path: path.to_path_buf(),
             meta,
-            storage,
-            arrays: Mutex::new(HashMap::new()),
+            arrays,
+            range_arrays,
+            ranges: Mutex::new(HashMap::new()),
             cache: Mutex::new(ChunkCache {
                 chunks: HashMap::new(),
                 tick: 0,
                 capacity: CHUNK_CACHE,
             }),
-        }
-    }
-
-    /// The `arbvis` attribute of a group's attributes.
-    pub fn meta_of(
-        path: &Path,
-        attributes: &serde_json::Map<String, serde_json::Value>,
-    ) -> Result<StoreMeta, StoreError> {
-        let value = attributes.get("arbvis").ok_or_else(|| {
-            StoreError::invalid(
-                &path.join("zarr.json"),
-                "no `arbvis` attribute: a zarr group that arbvis did not write",
-            )
-        })?;
-        let meta: StoreMeta = serde_json::from_value(value.clone()).map_err(|e| {
-            StoreError::invalid(&path.join("zarr.json"), format!("attribute `arbvis`: {e}"))
-        })?;
-        if meta.format != FORMAT || meta.version != VERSION {
-            return Err(StoreError::invalid(
-                &path.join("zarr.json"),
-                format!(
-                    "format {:?} version {}: arbvis reads {FORMAT:?} version {VERSION}",
-                    meta.format, meta.version
-                ),
-            ));
-        }
-        let bad = meta.brick == 0
-            || meta.dims.contains(&0)
-            || meta.levels == 0
-            || meta.levels > 40
-            || meta.attributes.is_empty()
-            || meta.dims.iter().any(|&d| d > 1 << 30);
-        if bad {
-            return Err(StoreError::invalid(
-                &path.join("zarr.json"),
-                format!(
-                    "dims {:?}, brick {}, {} levels, {} attributes: not a survey",
-                    meta.dims,
-                    meta.brick,
-                    meta.levels,
-                    meta.attributes.len()
-                ),
-            ));
-        }
-        Ok(meta)
+            incomplete,
+        })
     }
 
     /// The zarr path of attribute `attr`'s level `level` (`/amplitude/0`).
@@ -167,26 +130,9 @@ impl Store {
         format!("/{}/range/{level}", meta.attributes[attr].name)
     }
 
-    fn array(&self, attr: usize, level: usize) -> Result<Arc<Array<FilesystemStore>>, StoreError> {
-        let mut arrays = self.arrays.lock().expect("array table");
-        if let Some(a) = arrays.get(&(attr, level)) {
-            return Ok(a.clone());
-        }
-        let p = Store::array_path(&self.meta, attr, level);
-        let a = Array::open(self.storage.clone(), &p).map_err(|e| {
-            StoreError::invalid(&self.path.join(&p[1..]).join("zarr.json"), e.to_string())
-        })?;
-        let a = Arc::new(a);
-        arrays.insert((attr, level), a.clone());
-        Ok(a)
-    }
-
     /// The file of chunk `c` (`[i, j, k]` brick indices) of `attr` at `level`.
     pub fn chunk_file(&self, attr: usize, level: usize, c: [usize; 3]) -> PathBuf {
-        let p = Store::array_path(&self.meta, attr, level);
-        self.path
-            .join(&p[1..])
-            .join(format!("c/{}/{}/{}", c[2], c[1], c[0]))
+        self.arrays[attr][level].chunk_file(&[c[2] as u64, c[1] as u64, c[0] as u64])
     }
 
     /// Chunk `c` (`[i, j, k]` brick indices) of `attr` at `level`: `B³` values, i fastest
@@ -201,7 +147,6 @@ impl Store {
         if let Some(hit) = self.cache.lock().expect("chunk cache").get(&key) {
             return Ok(hit);
         }
-        let array = self.array(attr, level)?;
         let index = [c[2] as u64, c[1] as u64, c[0] as u64];
         let fail = |message: String| StoreError::Chunk {
             path: self.chunk_file(attr, level, c),
@@ -209,27 +154,20 @@ impl Store {
             chunk: index,
             message,
         };
-        let values: Option<Vec<f32>> = if self.meta.attributes[attr].dtype == "float16" {
-            array
-                .retrieve_chunk_if_exists::<Vec<half::f16>>(&index)
-                .map_err(|e| fail(format!("cannot be decoded: {e}")))?
-                .map(|v| v.into_iter().map(f32::from).collect())
-        } else {
-            array
-                .retrieve_chunk_if_exists::<Vec<f32>>(&index)
-                .map_err(|e| fail(format!("cannot be decoded: {e}")))?
-        };
-        let values = values.ok_or_else(|| {
-            fail("missing: the conversion writes every chunk, so the store is damaged (convert again into a new store)".into())
-        })?;
-        let b = self.meta.brick;
-        if values.len() != b * b * b {
+        let counts = self.meta.brick_counts(level);
+        if (0..3).any(|a| c[a] >= counts[a]) {
             return Err(fail(format!(
-                "holds {} values, not {}",
-                values.len(),
-                b * b * b
+                "outside the level's {counts:?} bricks (sample, crossline, inline)"
             )));
         }
+        let array = &self.arrays[attr][level];
+        let values = match array.read_chunk(&index).map_err(fail)? {
+            Some(values) => values,
+            None => {
+                self.absent_chunk_is_fill(attr, level, c).map_err(fail)?;
+                vec![array.fill_value as f32; array.chunk_elements()]
+            }
+        };
         let values = Arc::new(values);
         self.cache
             .lock()
@@ -238,25 +176,55 @@ impl Store {
         Ok(values)
     }
 
+    /// Why an absent chunk may not be read as the fill value, if it may not: a store
+    /// being converted (its chunks are all written before their column is logged), or a
+    /// brick whose recorded range is not the fill value's.
+    fn absent_chunk_is_fill(&self, attr: usize, level: usize, c: [usize; 3]) -> Result<(), String> {
+        if self.incomplete {
+            return Err("missing, though the conversion wrote it: the store is damaged (convert again into a new store)".into());
+        }
+        let ranges = self.range_table(attr, level).map_err(|e| e.to_string())?;
+        let counts = self.meta.brick_counts(level);
+        let r = ranges[c[0] + counts[0] * (c[1] + counts[1] * c[2])];
+        let fill = self.arrays[attr][level].fill_value as f32;
+        let only_fill = r[0].is_nan() || (r[0] == fill && r[1] == fill);
+        if only_fill {
+            Ok(())
+        } else {
+            Err(format!(
+                "missing, but the store's ranges say it holds values in [{}, {}]: the store is damaged (convert again into a new store)",
+                r[0], r[1]
+            ))
+        }
+    }
+
     /// Per-brick `[min, max]` of `attr` at `level`, i fastest.
     pub fn ranges(&self, attr: usize, level: usize) -> Result<Vec<[f32; 2]>, StoreError> {
-        let p = Store::range_path(&self.meta, attr, level);
-        let file = self.path.join(&p[1..]);
-        let array = Array::open(self.storage.clone(), &p)
-            .map_err(|e| StoreError::invalid(&file.join("zarr.json"), e.to_string()))?;
-        let counts = self.meta.brick_counts(level);
-        let n = counts.iter().product::<usize>();
-        let values: Vec<f32> = array
-            .retrieve_chunk_if_exists::<Vec<f32>>(&[0, 0, 0, 0])
-            .map_err(|e| StoreError::invalid(&file, e.to_string()))?
-            .ok_or_else(|| StoreError::invalid(&file, "the brick ranges are missing"))?;
-        if values.len() != 2 * n {
-            return Err(StoreError::invalid(
-                &file,
-                format!("{} values for {n} bricks", values.len()),
-            ));
+        Ok(self.range_table(attr, level)?.as_ref().clone())
+    }
+
+    fn range_table(&self, attr: usize, level: usize) -> Result<Arc<Vec<[f32; 2]>>, StoreError> {
+        if let Some(t) = self
+            .ranges
+            .lock()
+            .expect("range tables")
+            .get(&(attr, level))
+        {
+            return Ok(t.clone());
         }
-        Ok(values.chunks_exact(2).map(|p| [p[0], p[1]]).collect())
+        let array = &self.range_arrays[attr][level];
+        let file = array.chunk_file(&[0, 0, 0, 0]);
+        let values = array
+            .read_chunk(&[0, 0, 0, 0])
+            .map_err(|e| StoreError::invalid(&file, e))?
+            .ok_or_else(|| StoreError::invalid(&file, "the brick ranges are missing"))?;
+        let table: Vec<[f32; 2]> = values.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
+        let table = Arc::new(table);
+        self.ranges
+            .lock()
+            .expect("range tables")
+            .insert((attr, level), table.clone());
+        Ok(table)
     }
 
     /// The values of `attr` at `level` over the box `lo .. lo + size` (voxel indices, i

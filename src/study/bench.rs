@@ -395,6 +395,19 @@ pub fn run(
     mut progress: impl FnMut(&str),
 ) -> Result<Report> {
     let gpu = headless.gpu();
+    if let TechniqueScene::Opacity3d(p) = &scene.technique {
+        if crate::techniques::opacity3d::bricked::store_of(p)
+            .map_err(anyhow::Error::msg)?
+            .is_some()
+        {
+            bail!(
+                "bench sweeps and scores scenes whose volume is loaded whole; this scene streams a store, \
+                 whose frames depend on what is resident: time it with `arbvis render SCENE --stats` (build \
+                 and draw times of the full picture) or `bash benches/store/run.sh` (first picture, turning \
+                 frames, memory)"
+            );
+        }
+    }
     let settings = settings(scene, options)?;
     let prepared = match &scene.technique {
         TechniqueScene::Opacity3d(p) => {

@@ -416,9 +416,7 @@ mod tests {
 
     #[test]
     fn the_bunny_is_a_ply_surface() {
-        let Some(path) = crate::points::shared_data("points/bunny.ply") else {
-            return;
-        };
+        let path = crate::input::data_file("points/bunny.ply");
         let m = read(&path).unwrap();
         assert_eq!((m.vertices.len(), m.triangles.len()), (35_947, 69_451));
     }

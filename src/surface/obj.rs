@@ -290,7 +290,7 @@ mod tests {
         Path::new("t.obj")
     }
 
-    use crate::input::shared_data as shared;
+    use crate::input::data_file;
 
     #[test]
     fn quads_pentagons_and_negative_indices() {
@@ -415,9 +415,7 @@ mod tests {
 
     #[test]
     fn the_cow() {
-        let Some(path) = shared("surfaces/cow.obj") else {
-            return;
-        };
+        let path = data_file("surfaces/cow.obj");
         let m = crate::surface::read(&path).unwrap();
         // 734 triangles, 2519 quads, 8 pentagons, 2 hexagons.
         assert_eq!(m.triangles.len(), 734 + 2 * 2519 + 3 * 8 + 4 * 2);

@@ -550,9 +550,7 @@ mod tests {
 
     #[test]
     fn the_real_binary_stl() {
-        let Some(p) = crate::input::shared_data("surfaces/42400-IDGH.stl") else {
-            return;
-        };
+        let p = crate::input::data_file("surfaces/42400-IDGH.stl");
         let m = crate::surface::read(&p).unwrap();
         assert_eq!(m.triangles.len(), 11_036);
         let r = inspect(&m);

@@ -1,14 +1,16 @@
 //! Pixel rays for the CPU references: one ray per pixel centre, in object space, from
 //! the near plane to the far plane of the camera's projection (so orthographic and
-//! perspective views are handled alike), traced in parallel rows, with a progress bar
-//! ([`crate::progress`]) when a reference runs longer than a couple of seconds.
+//! perspective views are handled alike), traced in parallel rows. A large reference is
+//! announced with its estimated time before it starts (timed on 1 pixel in 256), and
+//! shows a progress bar ([`crate::progress`]), or plain lines where no bar is drawn,
+//! when it runs longer than a couple of seconds.
 
 use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 
 use crate::camera::Camera;
 use crate::image::Image;
-use crate::progress::{Bar, Unit};
+use crate::progress::{Bar, Lines, Unit};
 use crate::vocab::TargetFormat;
 
 /// A pixel's ray in object space: origin on the near plane, direction toward the far
@@ -67,8 +69,14 @@ pub fn trace_rays<T: Send>(
     let [width, height] = size;
     let aspect = width as f64 / height.max(1) as f64;
     let inverse = camera.view_projection(aspect).inverse();
-    // A bar (rows done, time left) for references that run past a couple of seconds.
+    announce_cost(size, &|x, y| {
+        let (origin, dir) = pixel_ray(&inverse, x, y, width, height);
+        shade(origin, dir);
+    });
+    // A bar (rows done, time left) for references that run past a couple of seconds, or
+    // plain lines where no bar is drawn.
     let bar = Bar::delayed(height as u64, "f64 reference", Unit::Rows, BAR_AFTER);
+    let lines = Lines::new("f64 reference, rows", height as u64, BAR_AFTER, LINE_EVERY);
     (0..height)
         .into_par_iter()
         .flat_map_iter(|y| {
@@ -79,9 +87,46 @@ pub fn trace_rays<T: Send>(
                 })
                 .collect();
             bar.inc(1);
+            lines.inc(1);
             row
         })
         .collect()
+}
+
+/// How often a plain progress line is printed while a reference runs.
+const LINE_EVERY: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// References estimated to take longer than this are announced before they start.
+const ANNOUNCE_ABOVE_S: f64 = 5.0;
+
+/// Before a large reference: trace every 16th pixel of every 16th row (1/256 of the work,
+/// spread over the image), and if the whole would take more than [`ANNOUNCE_ABOVE_S`], say
+/// how long before starting it.
+fn announce_cost(size: [u32; 2], trace: &(impl Fn(u32, u32) + Sync)) {
+    let [width, height] = size;
+    const STRIDE: u32 = 16;
+    let pixels = width as u64 * height as u64;
+    if pixels < 256 * 256 {
+        return;
+    }
+    let t0 = std::time::Instant::now();
+    let samples: u64 = (0..height)
+        .into_par_iter()
+        .step_by(STRIDE as usize)
+        .map(|y| {
+            (0..width)
+                .step_by(STRIDE as usize)
+                .for_each(|x| trace(x, y));
+            width.div_ceil(STRIDE) as u64
+        })
+        .sum();
+    let estimate = t0.elapsed().as_secs_f64() * pixels as f64 / samples.max(1) as f64;
+    if estimate > ANNOUNCE_ABOVE_S {
+        crate::progress::line(&format!(
+            "f64 reference at {width}x{height}: about {estimate:.0} s on this machine (timed on 1 pixel in {}); its progress follows",
+            STRIDE * STRIDE
+        ));
+    }
 }
 
 #[cfg(test)]

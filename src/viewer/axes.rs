@@ -339,9 +339,7 @@ mod tests {
 
     #[test]
     fn segy_axes_from_f3() {
-        let Some(path) = crate::input::shared_data("seismic/f3.sgy") else {
-            return;
-        };
+        let path = crate::input::data_file("seismic/f3.sgy");
         let source = VolumeSource::Segy(segy::SegySource {
             path,
             prestack: Default::default(),

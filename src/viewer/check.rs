@@ -113,6 +113,19 @@ impl LayoutCheck {
             }
         }
         o.widgets.focus = None;
+        // A panel taller than its window shows a scroll bar without being hovered.
+        for (name, content, shown, floating) in &o.widgets.scrolls {
+            let overflows = *content > *shown + 0.5;
+            self.lines.push(format!(
+                "layout: scroll {name:?} content {content:.1} shown {shown:.1} {}",
+                if overflows { "overflows" } else { "fits" }
+            ));
+            if overflows && *floating {
+                return Err(format!(
+                    "the {name} overflows ({content:.0} points in {shown:.0}) behind a floating scroll bar, hidden until hovered"
+                ));
+            }
+        }
         let problems = overlay_problems(o.view, o.shown, o.overlay);
         if let Some(p) = problems.first() {
             return Err(format!("overlay: {p} ({} problems)", problems.len()));

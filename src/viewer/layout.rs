@@ -111,6 +111,9 @@ pub fn style(ctx: &egui::Context) {
             font.size = font.size.max(MIN_TEXT);
         }
         style.visuals.weak_text_color = Some(egui::Color32::from_gray(160));
+        // Scroll bars drawn whenever a panel's content overflows, not only on hover: a
+        // floating bar hides that "Save tables" lies below the window's edge.
+        style.spacing.scroll = egui::style::ScrollStyle::solid();
     });
 }
 

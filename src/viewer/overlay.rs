@@ -79,7 +79,8 @@ impl Ink {
                 text: Color32::from_gray(25),
                 name: Color32::from_rgb(110, 50, 0),
                 line: Color32::from_rgba_unmultiplied(40, 40, 40, 170),
-                frame: Color32::from_gray(120),
+                // Dark enough that a white swatch (splats' faults) reads as a box.
+                frame: Color32::from_gray(70),
             }
         }
     }

@@ -155,9 +155,10 @@ pub fn show(
         .exact_size(sizes.left)
         .resizable(false)
         .show(ui, |ui| {
-            egui::ScrollArea::vertical().show(ui, |ui| {
+            let out = egui::ScrollArea::vertical().show(ui, |ui| {
                 controls(ui, scene, data, state, caps, &mut actions);
             });
+            state.widgets.note_scroll(ui, "left panel", &out);
         });
 
     if opacity3d {
@@ -165,8 +166,10 @@ pub fn show(
             .exact_size(sizes.right)
             .resizable(false)
             .show(ui, |ui| {
-                let width = ui.available_width();
-                egui::ScrollArea::both().show(ui, |ui| {
+                // The editor's width leaves room for the vertical scroll bar, which is
+                // solid (always shown when the panel overflows) and takes its own width.
+                let width = ui.available_width() - ui.spacing().scroll.allocated_width();
+                let out = egui::ScrollArea::both().show(ui, |ui| {
                     let e =
                         lut3d::editor(ui, width, scene, data, &mut state.locks, &mut state.widgets);
                     if e.params {
@@ -176,6 +179,7 @@ pub fn show(
                         actions.push(UiAction::SaveTables);
                     }
                 });
+                state.widgets.note_scroll(ui, "lut 3D panel", &out);
             });
         if sections_shown {
             egui::Panel::bottom("sections")

@@ -46,35 +46,41 @@ pub fn editor(
         &mut scene.faults_white,
         "Faults in white",
     );
-    changed |= w.choice(
-        ui,
-        "Colour",
-        &mut scene.colour,
-        &[
-            (ColourMode::Facies, "facies"),
-            (ColourMode::Layer, "layer"),
-            (ColourMode::Property, "property"),
-            (ColourMode::Rgb, "rgb"),
-            (ColourMode::Intensity, "intensity"),
-            (ColourMode::Classification, "classification"),
-        ],
-        140.0,
-    );
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Colour by");
+        changed |= w.choice(
+            ui,
+            "Colour",
+            &mut scene.colour,
+            &[
+                (ColourMode::Facies, "facies"),
+                (ColourMode::Layer, "layer"),
+                (ColourMode::Property, "property"),
+                (ColourMode::Rgb, "rgb"),
+                (ColourMode::Intensity, "intensity"),
+                (ColourMode::Classification, "classification"),
+            ],
+            120.0,
+        );
+    });
     let mut property = scene.property.clone();
-    if w.choice(
-        ui,
-        "Property",
-        &mut property,
-        &[
-            ("porosity".to_string(), "porosity"),
-            ("amplitude".to_string(), "amplitude"),
-            ("joint_dip".to_string(), "joint_dip"),
-        ],
-        140.0,
-    ) {
-        scene.property = property;
-        changed = true;
-    }
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Property");
+        if w.choice(
+            ui,
+            "Property",
+            &mut property,
+            &[
+                ("porosity".to_string(), "porosity"),
+                ("amplitude".to_string(), "amplitude"),
+                ("joint_dip".to_string(), "joint_dip"),
+            ],
+            120.0,
+        ) {
+            scene.property = property;
+            changed = true;
+        }
+    });
     ui.separator();
     changed |= w.slider(
         ui,
@@ -120,8 +126,16 @@ pub fn editor(
             changed |= w.add(ui, &format!("Sort {label}"), &r) && r.changed();
         }
     });
-    // Tiles composite the precise footprints: faithful mode draws the seed's points.
-    ui.add_enabled_ui(fidelity == Fidelity::Precise, |ui| {
+    // Tiles composite the precise footprints: faithful mode draws the original points.
+    let precise = fidelity == Fidelity::Precise;
+    if !precise {
+        w.text(
+            ui,
+            "Draw needs precise",
+            "Points or tiles: precise mode only (faithful draws the original points)",
+        );
+    }
+    ui.add_enabled_ui(precise, |ui| {
         ui.horizontal_wrapped(|ui| {
             ui.label("Draw");
             for (d, label) in [(DrawChoice::Points, "points"), (DrawChoice::Tiles, "tiles")] {
@@ -142,15 +156,26 @@ pub fn editor(
         scene.mode = if volume { Mode::Volume } else { Mode::Surface };
         changed = true;
     }
-    ui.add_enabled_ui(volume, |ui| {
-        changed |= w.drag_value(
+    if !volume {
+        w.text(
             ui,
-            "Threshold",
-            &mut scene.volume.threshold,
-            -1e9..=1e9,
-            0.0005,
+            "Threshold needs volume mode",
+            "Threshold and range: in volume mode only",
         );
-        changed |= w.drag_value(ui, "Range", &mut scene.volume.range, 0.0..=1e9, 0.0005);
+    }
+    ui.add_enabled_ui(volume, |ui| {
+        ui.horizontal_wrapped(|ui| {
+            ui.label("Threshold");
+            changed |= w.drag_value(
+                ui,
+                "Threshold",
+                &mut scene.volume.threshold,
+                -1e9..=1e9,
+                0.0005,
+            );
+            ui.label("± range");
+            changed |= w.drag_value(ui, "Range", &mut scene.volume.range, 0.0..=1e9, 0.0005);
+        });
     });
     changed
 }

@@ -225,9 +225,7 @@ mod tests {
 
     #[test]
     fn autzen_is_in_feet() {
-        let Some(path) = crate::input::shared_data("points/autzen_trim.laz") else {
-            return;
-        };
+        let path = crate::input::data_file("points/autzen_trim.laz");
         assert_eq!(las_units(&path).horizontal.as_deref(), Some("ft"));
     }
 }

@@ -46,6 +46,9 @@ pub struct Widgets {
     pub focus: Option<String>,
     /// A pending `set`.
     pub set: Option<SetRequest>,
+    /// The scrolled panels of the last frame: name, content and shown height (points),
+    /// and whether their scroll bar floats (hidden until hovered).
+    pub scrolls: Vec<(String, f32, f32, bool)>,
 }
 
 impl Widgets {
@@ -53,6 +56,22 @@ impl Widgets {
     pub fn begin_frame(&mut self) {
         self.seen.clear();
         self.texts.clear();
+        self.scrolls.clear();
+    }
+
+    /// Note a panel's scroll area after it was drawn (for `check layout`).
+    pub fn note_scroll<R>(
+        &mut self,
+        ui: &Ui,
+        name: &str,
+        out: &egui::scroll_area::ScrollAreaOutput<R>,
+    ) {
+        self.scrolls.push((
+            name.to_string(),
+            out.content_size.y,
+            out.inner_rect.height(),
+            ui.style().spacing.scroll.floating,
+        ));
     }
 
     /// The text a [`Widgets::text`] label showed last frame (a script's `print`).

@@ -417,7 +417,7 @@ impl VolumeSource {
             VolumeSource::Synthetic(spec) => synthetic::amplitude(spec, limits),
             VolumeSource::Store(p) => Err(VolumeError::Unsupported {
                 path: base.join(p),
-                message: "a store is streamed brick by brick by 3D opacity, never loaded whole (use it as every attribute's volume of an opacity3d scene)".into(),
+                message: "a store is never loaded whole: only 3D opacity's attribute volumes stream one, brick by brick (give the same store as each attribute's volume of an opacity3d scene)".into(),
             }),
         }
     }
@@ -468,6 +468,27 @@ pub fn inspect(path: &Path) -> Result<String, VolumeError> {
             nifti_file::inspect(path)?
         ));
     }
+    // The headers and the trace grid first, as `convert` checks them (milliseconds, the
+    // traces unread): a file whose headers do not fit it fails here, and a file too large
+    // to read whole is described from them alone.
+    let len = std::fs::metadata(path).map_or(0, |m| m.len());
+    match segy::SegyStream::open(path) {
+        Ok(stream) if len > INSPECT_WHOLE_MAX => {
+            let facts: String = stream
+                .describe()
+                .iter()
+                .map(|(k, v)| format!("{k}: {v}\n"))
+                .collect();
+            let [i, j, k] = stream.dims();
+            return Ok(format!(
+                "{}\n{facts}dimensions (i, j, k): {i} x {j} x {k}\nstatistics: not computed for a file over {} (they read every sample; `arbvis convert` computes them into a store, which `arbvis inspect STORE` shows)\n",
+                path.display(),
+                crate::budget::format_bytes(INSPECT_WHOLE_MAX)
+            ));
+        }
+        Err(e) if len > INSPECT_WHOLE_MAX => return Err(e),
+        _ => {}
+    }
     let bytes = read_file(path, u64::MAX)?;
     match segy::parse(path, &bytes, &segy::ReadOptions::default()) {
         Ok(s) => Ok(format!(
@@ -484,6 +505,9 @@ pub fn inspect(path: &Path) -> Result<String, VolumeError> {
         },
     }
 }
+
+/// Largest SEG-Y file `inspect` reads whole (for its statistics).
+pub const INSPECT_WHOLE_MAX: u64 = 1 << 30;
 
 /// Dimensions and value statistics, one item per line.
 pub fn describe(v: &Volume) -> String {

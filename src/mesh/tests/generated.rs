@@ -108,10 +108,12 @@ fn mesh_sources_from_toml() {
     assert_eq!(s.mesh.load(Path::new(".")).unwrap().tets.len(), 24_576);
     let s: S = toml::from_str("mesh = { file = \"tets/post.vtk\" }").unwrap();
     assert_eq!(s.mesh.path(), Some(Path::new("tets/post.vtk")));
-    if let Some(data) = super::shared("tets") {
-        let m = s.mesh.load(data.parent().unwrap()).unwrap();
-        assert_eq!(m.tets.len(), 8750);
-    }
+    let data = crate::input::data_file("tets/post.vtk");
+    let m = s
+        .mesh
+        .load(data.parent().unwrap().parent().unwrap())
+        .unwrap();
+    assert_eq!(m.tets.len(), 8750);
     for bad in [
         "mesh = { grid = { points = [5, 4, 3], field = \"cubic\" } }",
         "mesh = { grid = { point = [5, 4, 3] } }",

@@ -1,15 +1,14 @@
-//! The real files in ../shared/data/tets: counts from its README, values read by hand
+//! The real files in data/tets: counts from its README, values read by hand
 //! from the files (python struct / the ASCII text), and properties every mesh must have.
 
 use std::collections::HashMap;
 
-use super::shared;
+use crate::input::data_file;
 use crate::mesh::quality::{signed_volume, Quality};
 use crate::mesh::{inspect, read, Mesh};
 
-fn load(name: &str) -> Option<Mesh> {
-    let p = shared(&format!("tets/{name}"))?;
-    Some(read(&p).unwrap_or_else(|e| panic!("{e}")))
+fn load(name: &str) -> Mesh {
+    read(&data_file(&format!("tets/{name}"))).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Every tetrahedron positive and every point index valid.
@@ -42,7 +41,7 @@ pub fn face_counts(tets: &[[u32; 4]]) -> HashMap<[u32; 3], u32> {
 
 #[test]
 fn post_vtk_binary_legacy() {
-    let Some(m) = load("post.vtk") else { return };
+    let m = load("post.vtk");
     well_formed(&m);
     assert_eq!((m.points.len(), m.tets.len()), (2288, 8750));
     assert_eq!((m.info.version.as_str(), m.info.flipped), ("3.0", 0));
@@ -62,9 +61,7 @@ fn post_vtk_binary_legacy() {
 
 #[test]
 fn tetra_mesh_vtk_ascii_half_of_its_tetrahedra_are_flipped() {
-    let Some(m) = load("tetraMesh.vtk") else {
-        return;
-    };
+    let m = load("tetraMesh.vtk");
     well_formed(&m);
     assert_eq!(
         (m.points.len(), m.tets.len(), m.info.flipped),
@@ -73,7 +70,7 @@ fn tetra_mesh_vtk_ascii_half_of_its_tetrahedra_are_flipped() {
     assert_eq!(m.points[0], [9.78032, -1.80307, 0.98754]);
     // The cells as written (lines 63 to 222: "4 54 32 26 7", ...): each tetrahedron is
     // the file's cell or the file's cell with its last two vertices swapped, 80 of them.
-    let text = std::fs::read_to_string(shared("tets/tetraMesh.vtk").unwrap()).unwrap();
+    let text = std::fs::read_to_string(data_file("tets/tetraMesh.vtk")).unwrap();
     let file: Vec<[u32; 4]> = text
         .lines()
         .skip(62)
@@ -100,9 +97,7 @@ fn tetra_mesh_vtk_ascii_half_of_its_tetrahedra_are_flipped() {
 
 #[test]
 fn tetrahedron_vtu_fills_its_cube() {
-    let Some(m) = load("Tetrahedron.vtu") else {
-        return;
-    };
+    let m = load("Tetrahedron.vtu");
     well_formed(&m);
     assert_eq!((m.points.len(), m.tets.len()), (35, 96));
     assert_eq!(m.bounds(), Some(([0.0; 3], [2.0; 3])));
@@ -146,9 +141,7 @@ fn can_hexes(bytes: &[u8]) -> Vec<[i64; 8]> {
 
 #[test]
 fn can_vtu_hexahedra_split_conformingly() {
-    let Some(path) = shared("tets/can.vtu") else {
-        return;
-    };
+    let path = data_file("tets/can.vtu");
     let m = read(&path).unwrap();
     well_formed(&m);
     assert_eq!(
@@ -194,13 +187,11 @@ fn can_vtu_hexahedra_split_conformingly() {
 
 #[test]
 fn the_three_bracket_files_give_one_mesh() {
-    let (Some(a), Some(b), Some(c)) = (
+    let (a, b, c) = (
         load("bracket-2.2.msh"),
         load("bracket-4.1.msh"),
         load("bracket-4.1-binary.msh"),
-    ) else {
-        return;
-    };
+    );
     for m in [&a, &b, &c] {
         well_formed(m);
         assert_eq!((m.points.len(), m.tets.len()), (8715, 40710));
@@ -234,9 +225,7 @@ fn the_three_bracket_files_give_one_mesh() {
 
 #[test]
 fn inspect_reports_what_was_read() {
-    let Some(p) = shared("tets/can.vtu") else {
-        return;
-    };
+    let p = data_file("tets/can.vtu");
     let s = inspect(&p).unwrap();
     for want in [
         "format: VTK XML UnstructuredGrid 1.0 (appended raw, UInt64 headers, little-endian)",

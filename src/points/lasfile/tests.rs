@@ -408,9 +408,7 @@ fn every_truncation_fails_cleanly() {
 
 #[test]
 fn autzen_laz() {
-    let Some(path) = crate::points::shared_data("points/autzen_trim.laz") else {
-        return;
-    };
+    let path = crate::input::data_file("points/autzen_trim.laz");
     let t = std::time::Instant::now();
     let c = read(&path).unwrap();
     eprintln!(
@@ -653,7 +651,7 @@ fn extreme_scales_and_offsets() {
 }
 
 /// The hostile clouds the integration tests share (equal points and the like).
-#[path = "../../../tests/common/hostile_files.rs"]
+#[path = "../../../tests/it/common/hostile_files.rs"]
 mod hostile_files;
 use hostile_files::equal_points_laz as equal_points;
 

@@ -300,6 +300,14 @@ impl CellprojScene {
                 ));
             }
         }
+        if let Some([lo, hi]) = self.scalars.range {
+            if !(lo.is_finite() && hi.is_finite() && lo <= hi) {
+                return Err(FieldError::new(
+                    "scalars.range",
+                    format!("[{lo}, {hi}]: must be finite, the low end first"),
+                ));
+            }
+        }
         if let Some(v) = &self.volume {
             v.validate().map_err(|e| e.within("volume"))?;
         }

@@ -11,7 +11,7 @@
 //!
 //! Shapes: the sphere of radius 0.35 N at the volume's centre; a torus generated as
 //! a closed triangle mesh (1,152 triangles, tilted, so its surface cuts blocks at every
-//! angle); and `cow.obj` (5,804 triangles) when `../shared/data/surfaces/` is present. The
+//! angle); and `cow.obj` (5,804 triangles) from the project's `data/surfaces/`. The
 //! texture sweep adds an *open* mesh, the upper half of a finer torus's tube (4,608
 //! triangles, open along the whole ring), whose unbalanced rows the fast winding number
 //! decides: its "built in" time is the open-mesh clip's cost at each grid size.
@@ -147,7 +147,7 @@ pub fn shapes() -> Vec<(String, ShapeSpec, PathBuf)> {
             PathBuf::from("."),
         ),
     ];
-    let cow = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data/surfaces/cow.obj");
+    let cow = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/surfaces/cow.obj");
     if cow.is_file() {
         out.push((
             "cow.obj".to_string(),

@@ -409,7 +409,7 @@ fn an_open_mesh_is_decided_by_the_winding_number() {
     assert_eq!(wrong, 0);
 }
 
-use crate::input::shared_data as shared;
+use crate::input::data_file;
 
 /// Place `mesh` to fill about 80 % of `[-half, half]`.
 fn fit(mesh: &TriangleMesh, half: [f64; 3]) -> MeshShape {
@@ -426,9 +426,7 @@ fn fit(mesh: &TriangleMesh, half: [f64; 3]) -> MeshShape {
 
 #[test]
 fn cow_signs_match_the_winding_number() {
-    let Some(path) = shared("surfaces/cow.obj") else {
-        return;
-    };
+    let path = data_file("surfaces/cow.obj");
     let cow = crate::surface::read(&path).unwrap();
     let dims = [40, 26, 18];
     let grid = ClipGrid::new(dims, half(dims)).unwrap();
@@ -461,9 +459,7 @@ fn cow_signs_match_the_winding_number() {
 
 #[test]
 fn the_real_stl_is_closed_and_signed() {
-    let Some(path) = shared("surfaces/42400-IDGH.stl") else {
-        return;
-    };
+    let path = data_file("surfaces/42400-IDGH.stl");
     let part = crate::surface::read(&path).unwrap();
     let dims = [32, 32, 32];
     let grid = ClipGrid::new(dims, half(dims)).unwrap();

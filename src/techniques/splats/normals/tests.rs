@@ -306,9 +306,7 @@ fn orientation_faces_the_eye() {
 #[test]
 fn bunny_normals_follow_its_surface() {
     // The Stanford bunny's vertices, against the area-weighted normals of its faces.
-    let Some(path) = crate::points::shared_data("points/bunny.ply") else {
-        return;
-    };
+    let path = crate::input::data_file("points/bunny.ply");
     let ply = crate::points::ply::read(&path).unwrap();
     let cloud = crate::points::plycloud::cloud(&path, &ply).unwrap();
     assert_eq!(cloud.len(), 35_947);

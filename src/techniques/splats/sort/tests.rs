@@ -318,9 +318,7 @@ fn time_methods_reports_every_row() {
 #[test]
 fn lidar_tile_orders_agree() {
     // 110,000 lidar returns quantized to centimetres: plenty of exact ties.
-    let Some(path) = crate::points::shared_data("points/autzen_trim.laz") else {
-        return;
-    };
+    let path = crate::input::data_file("points/autzen_trim.laz");
     let cloud = crate::points::lasfile::read(&path).unwrap().cloud;
     assert_eq!(cloud.len(), 110_000);
     let positions = &cloud.positions;

@@ -1,0 +1,147 @@
+//! `arbvis inspect STORE`: what a store holds, read through the same checks as opening it
+//! (its metadata and every array), finished or not: the format, the dimensions with the
+//! survey's own coordinates, each attribute's type, chunks, codecs and statistics, the
+//! levels, an interrupted conversion's progress, and the size on disk.
+
+use std::fmt::Write;
+use std::path::Path;
+
+use super::meta::StoreMeta;
+use super::StoreError;
+
+/// Most files counted for the size on disk (a store of 10^6 chunks is counted whole).
+const MAX_FILES_COUNTED: u64 = 10_000_000;
+
+/// The description `inspect` prints for the store at `store`.
+pub fn describe(store: &Path) -> Result<String, StoreError> {
+    let meta = super::check::read_meta(store)?;
+    let (arrays, _) = super::check::open_arrays(store, &meta)?;
+    let mut s = String::new();
+    let state = if meta.complete {
+        "complete".to_string()
+    } else {
+        progress(store, &meta)
+    };
+    let _ = writeln!(s, "{}", store.display());
+    let _ = writeln!(
+        s,
+        "format: arbvis store version {} (zarr v3), {state}",
+        meta.version
+    );
+    let src = &meta.source;
+    let _ = writeln!(s, "source: {} {} ({} bytes)", src.kind, src.path, src.bytes);
+    for (k, v) in &src.facts {
+        let _ = writeln!(s, "  {k}: {v}");
+    }
+    let _ = writeln!(s, "dimensions:");
+    for line in axes(&meta) {
+        let _ = writeln!(s, "  {line}");
+    }
+    let _ = writeln!(
+        s,
+        "levels: {} of {}³ bricks (filter: {})",
+        meta.levels, meta.brick, meta.filter
+    );
+    for level in 0..meta.levels {
+        let d = meta.level_dims(level);
+        let c = meta.brick_counts(level);
+        let _ = writeln!(
+            s,
+            "  level {level}: {} x {} x {} voxels, {} x {} x {} bricks",
+            d[0], d[1], d[2], c[0], c[1], c[2]
+        );
+    }
+    let _ = writeln!(s, "attributes:");
+    for (a, attr) in meta.attributes.iter().enumerate() {
+        let array = &arrays[a][0];
+        let stats = match (attr.min, attr.max, attr.mean) {
+            (Some(lo), Some(hi), Some(mean)) => format!("min {lo} max {hi} mean {mean:.6}"),
+            _ => "statistics not yet written".into(),
+        };
+        let _ = writeln!(
+            s,
+            "  {}: {}, chunks {:?}, codecs {}, fill {}; {stats}, {} non-finite samples",
+            attr.name,
+            array.data_type.name(),
+            array.chunks,
+            array.codec_names(),
+            array.fill_value,
+            attr.non_finite
+        );
+    }
+    let (bytes, files) = disk_use(store);
+    let _ = writeln!(
+        s,
+        "size on disk: {:.1} MB in {files} files",
+        bytes as f64 / 1e6
+    );
+    Ok(s)
+}
+
+/// The axes with their names, sizes and the survey's own coordinates where it gave them.
+fn axes(meta: &StoreMeta) -> Vec<String> {
+    let [ni, nj, nk] = meta.dims;
+    let src = &meta.source;
+    let numbers = |first_step: Option<[i64; 2]>, n: usize| {
+        first_step.map_or(String::new(), |[first, step]| {
+            let last = first.saturating_add(step.saturating_mul(n as i64 - 1));
+            format!(", numbers {first}..{last} (step {step})")
+        })
+    };
+    let time = src.interval_us.map_or(String::new(), |us| {
+        let dt = us as f64 / 1000.0;
+        format!(", time 0..{} ms (every {dt} ms)", dt * (ni as f64 - 1.0))
+    });
+    vec![
+        format!("sample: {ni}{time}"),
+        format!("crossline: {nj}{}", numbers(src.crosslines, nj)),
+        format!("inline: {nk}{}", numbers(src.inlines, nk)),
+        format!(
+            "spacing (sample, crossline, inline): {} {} {}",
+            meta.spacing[0], meta.spacing[1], meta.spacing[2]
+        ),
+    ]
+}
+
+/// An interrupted conversion's progress, from its log.
+fn progress(store: &Path, meta: &StoreMeta) -> String {
+    let log = store.join(super::progress::PROGRESS_LOG);
+    let total: u64 = (0..meta.levels)
+        .map(|l| {
+            let c = meta.brick_counts(l);
+            (c[1] * c[2]) as u64
+        })
+        .sum();
+    match super::progress::logged_columns(&log, meta) {
+        Ok(done) => format!(
+            "INCOMPLETE: an interrupted conversion, {done} of {total} columns written (run the same `arbvis convert` again to resume it)"
+        ),
+        Err(e) => format!("INCOMPLETE: no readable progress log ({e})"),
+    }
+}
+
+/// Bytes and files under `folder` (links not followed).
+fn disk_use(folder: &Path) -> (u64, u64) {
+    let (mut bytes, mut files) = (0u64, 0u64);
+    let mut stack = vec![folder.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for entry in entries.flatten() {
+            let Ok(m) = std::fs::symlink_metadata(entry.path()) else {
+                continue;
+            };
+            if m.is_dir() {
+                stack.push(entry.path());
+            } else {
+                bytes += m.len();
+                files += 1;
+                if files >= MAX_FILES_COUNTED {
+                    return (bytes, files);
+                }
+            }
+        }
+    }
+    (bytes, files)
+}

@@ -1,0 +1,234 @@
+//! What makes a conversion safe to kill and to repeat: the lock that keeps a second writer
+//! out, the progress log that lets the same command resume, and the checks that make a
+//! damaged log an error naming its line instead of a panic.
+//!
+//! The log's first line is the job (input, its length and time, options); every finished
+//! column appends one line. It is created whole (a temporary renamed into place) before
+//! anything else of the store, so a conversion killed at any moment leaves either nothing
+//! but the lock (a fresh start) or a log to resume from.
+
+use std::collections::HashMap;
+use std::fs::File;
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::meta::StoreMeta;
+use super::StoreError;
+
+/// The progress log's name inside the store.
+pub const PROGRESS_LOG: &str = "arbvis-progress.log";
+
+/// The lock file's name inside the store.
+pub const LOCK_FILE: &str = "arbvis-convert.lock";
+
+/// The job, as the progress log's first line (a resumed run must match it).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub(crate) struct Job {
+    pub input: String,
+    pub bytes: u64,
+    pub modified: u64,
+    pub brick: usize,
+    pub attributes: Vec<String>,
+    pub zstd: i32,
+    pub raw: Option<String>,
+}
+
+/// One finished column: `u` = `[level, j brick, k brick]`; per attribute, the ranges of
+/// its bricks along i and `[sum, finite count, non-finite count]`.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub(crate) struct Unit {
+    pub u: [usize; 3],
+    pub ranges: Vec<Vec<[f32; 2]>>,
+    pub sums: Vec<[f64; 3]>,
+}
+
+impl Unit {
+    /// Why this record cannot belong to a conversion of `meta`, if it cannot.
+    fn check(&self, meta: &StoreMeta) -> Result<(), String> {
+        let [level, j, k] = self.u;
+        if level >= meta.levels {
+            return Err(format!("level {level}, but the store has {}", meta.levels));
+        }
+        let counts = meta.brick_counts(level);
+        if j >= counts[1] || k >= counts[2] {
+            return Err(format!(
+                "column {j}, {k} of level {level}, which has {} x {} columns",
+                counts[1], counts[2]
+            ));
+        }
+        let attrs = meta.attributes.len();
+        if self.ranges.len() != attrs || self.sums.len() != attrs {
+            return Err(format!(
+                "{} ranges and {} sums for {attrs} attributes",
+                self.ranges.len(),
+                self.sums.len()
+            ));
+        }
+        if let Some(r) = self.ranges.iter().find(|r| r.len() != counts[0]) {
+            return Err(format!(
+                "{} brick ranges in a column of {} bricks",
+                r.len(),
+                counts[0]
+            ));
+        }
+        let bricks_voxels = (meta.brick as f64).powi(3) * counts[0] as f64;
+        for s in &self.sums {
+            let counted = s[1] >= 0.0 && s[2] >= 0.0 && s[1] + s[2] <= bricks_voxels;
+            if !s.iter().all(|v| v.is_finite()) || !counted {
+                return Err(format!("statistics {s:?} cannot be a column's"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The bytes a progress log of `meta` can hold: a first line, then at most one line per
+/// column of every level (two numbers of at most ~20 characters a brick per attribute,
+/// and sums).
+fn log_bound(meta: &StoreMeta) -> u64 {
+    let columns: u64 = (0..meta.levels)
+        .map(|l| {
+            let c = meta.brick_counts(l);
+            (c[1] * c[2]) as u64
+        })
+        .sum();
+    let line = 1024 + 48 * meta.attributes.len() as u64 * (meta.brick_counts(0)[0] as u64 + 4);
+    4096u64.saturating_add(columns.saturating_add(1).saturating_mul(line))
+}
+
+/// The columns a log lists, without checking them (for `inspect`).
+pub(crate) fn logged_columns(path: &Path, meta: &StoreMeta) -> Result<usize, StoreError> {
+    let text =
+        crate::input::read_regular(path, log_bound(meta)).map_err(|e| StoreError::io(path, e))?;
+    Ok(text
+        .split(|&b| b == b'\n')
+        .skip(1)
+        .filter(|l| !l.is_empty())
+        .count())
+}
+
+/// The columns a log lists as done, each checked against `meta`. A last line torn by
+/// an interruption is dropped (its column is done again); any other bad line is an
+/// error naming it.
+pub(crate) fn read_log(
+    path: &Path,
+    job: &Job,
+    meta: &StoreMeta,
+) -> Result<HashMap<[usize; 3], Unit>, StoreError> {
+    let text =
+        crate::input::read_regular(path, log_bound(meta)).map_err(|e| StoreError::io(path, e))?;
+    let text = String::from_utf8_lossy(&text);
+    let mut lines = text.split_terminator('\n');
+    let first = lines.next().unwrap_or_default();
+    let was: Job = serde_json::from_str(first).map_err(|e| {
+        StoreError::invalid(path, format!("line 1 is not the job's description: {e}"))
+    })?;
+    if &was != job {
+        return Err(StoreError::invalid(
+            path,
+            format!(
+                "the interrupted conversion here was of {} ({} bytes, brick {}, attributes {}, zstd {}); this one is of {} ({} bytes, brick {}, attributes {}, zstd {}): run the same command to resume, or name a new store",
+                was.input, was.bytes, was.brick, was.attributes.join(","), was.zstd,
+                job.input, job.bytes, job.brick, job.attributes.join(","), job.zstd
+            ),
+        ));
+    }
+    let all: Vec<&str> = lines.collect();
+    let torn_ok = !text.ends_with('\n');
+    let mut done = HashMap::new();
+    for (n, line) in all.iter().enumerate() {
+        let last = n + 1 == all.len();
+        let unit = serde_json::from_str::<Unit>(line)
+            .map_err(|e| e.to_string())
+            .and_then(|u| u.check(meta).map(|_| u));
+        match unit {
+            Ok(u) => {
+                done.insert(u.u, u);
+            }
+            // A line torn by the interruption: its column is done again.
+            Err(_) if last && torn_ok => {}
+            Err(e) => {
+                return Err(StoreError::invalid(
+                    path,
+                    format!(
+                        "line {}: {e} (the log is damaged: remove the store and convert again)",
+                        n + 2
+                    ),
+                ))
+            }
+        }
+    }
+    Ok(done)
+}
+
+/// Create the log with the job's line, whole or not at all.
+pub(crate) fn start_log(path: &Path, job: &Job) -> Result<(), StoreError> {
+    let line = serde_json::to_string(job).map_err(|e| StoreError::io(path, e))?;
+    crate::png_io::write_atomic(path, format!("{line}\n").as_bytes())
+        .map_err(|e| StoreError::io(path, e))
+}
+
+/// The exclusive right to write a store, held until dropped (then the lock file goes).
+pub(crate) struct StoreLock {
+    file: File,
+    path: PathBuf,
+}
+
+impl StoreLock {
+    /// Take the store's lock, or say which process holds it.
+    pub(crate) fn acquire(store: &Path) -> Result<StoreLock, StoreError> {
+        let path = store.join(LOCK_FILE);
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .map_err(|e| StoreError::io(&path, e))?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                let mut holder = String::new();
+                let _ = (&file).take(64).read_to_string(&mut holder);
+                let holder = holder.trim();
+                return Err(StoreError::invalid(
+                    store,
+                    format!(
+                        "another conversion ({}) is writing this store; wait for it, or stop it and run this command again to resume",
+                        if holder.is_empty() { "a process".to_string() } else { format!("pid {holder}") }
+                    ),
+                ));
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(StoreError::io(&path, e)),
+        }
+        file.set_len(0)
+            .and_then(|_| write!(file, "{}", std::process::id()))
+            .and_then(|_| file.sync_data())
+            .map_err(|e| StoreError::io(&path, e))?;
+        Ok(StoreLock { file, path })
+    }
+}
+
+impl Drop for StoreLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+        let _ = self.file.unlock();
+    }
+}
+
+/// A store folder that holds nothing of a conversion's but its lock and temporaries
+/// (a conversion killed before its log existed): safe to start afresh in.
+pub(crate) fn holds_nothing(store: &Path) -> Result<bool, StoreError> {
+    let entries = std::fs::read_dir(store).map_err(|e| StoreError::io(store, e))?;
+    for entry in entries {
+        let entry = entry.map_err(|e| StoreError::io(store, e))?;
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        if name != LOCK_FILE && !name.contains(crate::png_io::TMP_MARK) {
+            return Ok(false);
+        }
+    }
+    Ok(true)
+}

@@ -1,0 +1,607 @@
+//! Reading zarr v3 arrays as the bounded input every other file is: metadata and chunks
+//! are opened through [`crate::input`]'s regular-file check (a FIFO, a device or a link to
+//! `/dev/zero` is refused with its true cause, never waited on), every number in a
+//! `zarr.json` is checked before it sizes anything, a chunk file longer than its codecs
+//! can produce is refused before it is read, and a chunk is decoded into a buffer of its
+//! known size, each codec stopping at the first byte past what it may produce (a zstd
+//! frame declaring a terabyte, or inflating without end, fails in microseconds).
+//!
+//! Supported: data types bool, (u)int8-64, float16/32/64; the `regular` chunk grid; the
+//! `default` and `v2` chunk key encodings; codecs `bytes` (either byte order), `zstd`,
+//! `gzip`, `crc32c` and an identity `transpose`. Others are refused by name. Writing
+//! stays with the `zarrs` crate.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+
+use serde_json::{Map, Value};
+
+use super::StoreError;
+
+/// Largest `zarr.json` read (arbvis writes a few KiB; MDIO's statistics and histograms
+/// stay far below this).
+pub const MAX_METADATA_BYTES: u64 = 16 << 20;
+
+/// Largest chunk, decoded (a 512³ brick of float32 is 512 MiB).
+pub const MAX_CHUNK_BYTES: u64 = 1 << 30;
+
+/// A `zarr.json` read and parsed: bounded, regular files only, JSON errors with their
+/// line and column.
+pub fn read_json(file: &Path) -> Result<Value, StoreError> {
+    let text = crate::input::read_regular(file, MAX_METADATA_BYTES)
+        .and_then(crate::input::utf8)
+        .map_err(|e| StoreError::io(file, e))?;
+    serde_json::from_str(&text).map_err(|e| {
+        StoreError::invalid(
+            file,
+            format!("line {}, column {}: {e}", e.line(), e.column()),
+        )
+    })
+}
+
+/// The element types arbvis reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum DataType {
+    Bool,
+    Int8,
+    Int16,
+    Int32,
+    Int64,
+    UInt8,
+    UInt16,
+    UInt32,
+    UInt64,
+    Float16,
+    Float32,
+    Float64,
+}
+
+impl DataType {
+    /// The zarr v3 name's type, if arbvis reads it.
+    pub fn parse(name: &str) -> Option<DataType> {
+        use DataType::*;
+        Some(match name {
+            "bool" => Bool,
+            "int8" => Int8,
+            "int16" => Int16,
+            "int32" => Int32,
+            "int64" => Int64,
+            "uint8" => UInt8,
+            "uint16" => UInt16,
+            "uint32" => UInt32,
+            "uint64" => UInt64,
+            "float16" => Float16,
+            "float32" => Float32,
+            "float64" => Float64,
+            _ => return None,
+        })
+    }
+
+    /// The zarr v3 name.
+    pub fn name(self) -> &'static str {
+        use DataType::*;
+        match self {
+            Bool => "bool",
+            Int8 => "int8",
+            Int16 => "int16",
+            Int32 => "int32",
+            Int64 => "int64",
+            UInt8 => "uint8",
+            UInt16 => "uint16",
+            UInt32 => "uint32",
+            UInt64 => "uint64",
+            Float16 => "float16",
+            Float32 => "float32",
+            Float64 => "float64",
+        }
+    }
+
+    /// Bytes per element.
+    pub fn size(self) -> usize {
+        use DataType::*;
+        match self {
+            Bool | Int8 | UInt8 => 1,
+            Int16 | UInt16 | Float16 => 2,
+            Int32 | UInt32 | Float32 => 4,
+            Int64 | UInt64 | Float64 => 8,
+        }
+    }
+
+    /// Element `bytes` (exactly [`DataType::size`] of them) as f64.
+    fn value(self, bytes: &[u8], big_endian: bool) -> f64 {
+        use DataType::*;
+        let mut b = [0u8; 8];
+        let n = self.size();
+        b[..n].copy_from_slice(&bytes[..n]);
+        if big_endian {
+            b[..n].reverse();
+        }
+        match self {
+            Bool => (b[0] != 0) as u8 as f64,
+            Int8 => b[0] as i8 as f64,
+            UInt8 => b[0] as f64,
+            Int16 => i16::from_le_bytes([b[0], b[1]]) as f64,
+            UInt16 => u16::from_le_bytes([b[0], b[1]]) as f64,
+            Float16 => half::f16::from_le_bytes([b[0], b[1]]).to_f64(),
+            Int32 => i32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            UInt32 => u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Float32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+            Int64 => i64::from_le_bytes(b) as f64,
+            UInt64 => u64::from_le_bytes(b) as f64,
+            Float64 => f64::from_le_bytes(b),
+        }
+    }
+}
+
+/// A bytes-to-bytes codec, as it encoded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Codec {
+    Zstd,
+    Gzip,
+    Crc32c,
+}
+
+impl Codec {
+    /// The zarr name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Codec::Zstd => "zstd",
+            Codec::Gzip => "gzip",
+            Codec::Crc32c => "crc32c",
+        }
+    }
+
+    /// The most bytes this codec can make of `n` bytes (generous: zstd's and deflate's
+    /// worst cases are under n/256 and n/1000 plus a header).
+    fn bound(self, n: u64) -> u64 {
+        match self {
+            Codec::Zstd | Codec::Gzip => n.saturating_add(n / 64).saturating_add(1024),
+            Codec::Crc32c => n.saturating_add(4),
+        }
+    }
+
+    /// Undo this codec on `data`, which must decode to at most `limit` bytes.
+    fn decode(self, data: Vec<u8>, limit: u64) -> Result<Vec<u8>, String> {
+        match self {
+            Codec::Zstd => {
+                if let Ok(Some(declared)) = zstd::zstd_safe::get_frame_content_size(&data) {
+                    if declared > limit {
+                        return Err(format!(
+                            "its zstd frame declares {declared} bytes, more than the {limit} it may hold"
+                        ));
+                    }
+                }
+                let mut decoder = zstd::stream::read::Decoder::with_buffer(data.as_slice())
+                    .map_err(|e| format!("zstd: {e}"))?;
+                // The window a frame may ask for: no more than the chunk needs (2^10 at least).
+                let log = (64 - limit.max(1024).leading_zeros()).min(31);
+                decoder
+                    .window_log_max(log)
+                    .map_err(|e| format!("zstd: {e}"))?;
+                bounded_read(decoder, limit, "zstd").map_err(|e| {
+                    if e.contains("too much memory") {
+                        format!("its zstd frame asks for a window larger than a chunk of {limit} bytes needs")
+                    } else {
+                        e
+                    }
+                })
+            }
+            Codec::Gzip => bounded_read(
+                flate2::read::MultiGzDecoder::new(data.as_slice()),
+                limit,
+                "gzip",
+            ),
+            Codec::Crc32c => {
+                if data.len() < 4 {
+                    return Err("crc32c: shorter than its 4-byte checksum".into());
+                }
+                let (body, sum) = data.split_at(data.len() - 4);
+                let want = u32::from_le_bytes([sum[0], sum[1], sum[2], sum[3]]);
+                let got = crc32c::crc32c(body);
+                if got != want {
+                    return Err(format!(
+                        "crc32c checksum {got:#010x}, the chunk says {want:#010x}: the chunk is damaged"
+                    ));
+                }
+                Ok(body.to_vec())
+            }
+        }
+    }
+}
+
+/// Read all of `reader` into a buffer, failing at the first byte past `limit`.
+fn bounded_read(reader: impl Read, limit: u64, codec: &str) -> Result<Vec<u8>, String> {
+    let mut out = Vec::new();
+    let cap = usize::try_from(limit.min(MAX_CHUNK_BYTES)).unwrap_or(0);
+    out.try_reserve(cap)
+        .map_err(|_| format!("cannot allocate {limit} bytes to decode it"))?;
+    reader
+        .take(limit.saturating_add(1))
+        .read_to_end(&mut out)
+        .map_err(|e| format!("{codec}: {e}"))?;
+    if out.len() as u64 > limit {
+        return Err(format!(
+            "{codec} inflates it past the {limit} bytes a chunk of this array holds"
+        ));
+    }
+    Ok(out)
+}
+
+/// How chunk keys are spelled.
+#[derive(Debug, Clone, PartialEq, Eq)]
+enum ChunkKeys {
+    /// `c/0/1/2` (or with another separator).
+    Default(char),
+    /// `0.1.2` (zarr v2's, in a v3 array).
+    V2(char),
+}
+
+/// One array's `zarr.json`, checked.
+#[derive(Debug, Clone)]
+pub struct ArrayMeta {
+    /// The array's folder.
+    pub folder: PathBuf,
+    /// Its shape, slowest axis first.
+    pub shape: Vec<u64>,
+    /// Its chunk shape.
+    pub chunks: Vec<u64>,
+    /// The element type.
+    pub data_type: DataType,
+    /// The fill value (absent chunks hold it), as f64.
+    pub fill_value: f64,
+    /// `bytes` codec's byte order.
+    pub big_endian: bool,
+    /// Bytes-to-bytes codecs, in the order they encoded.
+    pub codecs: Vec<Codec>,
+    /// `dimension_names`, where given.
+    pub dimension_names: Option<Vec<Option<String>>>,
+    /// `attributes`.
+    pub attributes: Map<String, Value>,
+    keys: ChunkKeys,
+}
+
+/// `value` as `field` of `file`, or an error naming both.
+fn field<'a>(doc: &'a Value, name: &str, file: &Path) -> Result<&'a Value, StoreError> {
+    doc.get(name)
+        .ok_or_else(|| StoreError::invalid(file, format!("no `{name}`: not a zarr v3 array")))
+}
+
+/// A list of sizes (`shape`, `chunk_shape`), each checked.
+fn sizes(v: &Value, name: &str, file: &Path, min: u64) -> Result<Vec<u64>, StoreError> {
+    let list = v
+        .as_array()
+        .ok_or_else(|| StoreError::invalid(file, format!("`{name}`: expected a list of sizes")))?;
+    if list.len() > 32 {
+        return Err(StoreError::invalid(
+            file,
+            format!("`{name}`: {} axes, more than 32", list.len()),
+        ));
+    }
+    list.iter()
+        .enumerate()
+        .map(|(i, x)| {
+            x.as_u64()
+                .filter(|&n| n >= min && n <= 1 << 40)
+                .ok_or_else(|| {
+                    StoreError::invalid(
+                        file,
+                        format!("`{name}[{i}]` is {x}: expected a whole number {min}..=2^40"),
+                    )
+                })
+        })
+        .collect()
+}
+
+/// A fill value as f64: numbers, `"NaN"`, `"Infinity"`, `"-Infinity"`, hex bit
+/// patterns (`"0x7fc00000"`), booleans.
+fn fill(v: &Value, t: DataType, file: &Path) -> Result<f64, StoreError> {
+    let bad = || StoreError::invalid(file, format!("`fill_value` {v}: not a {} value", t.name()));
+    match v {
+        Value::Bool(b) => Ok(*b as u8 as f64),
+        Value::Number(n) => n.as_f64().ok_or_else(bad),
+        Value::String(s) => match s.as_str() {
+            "NaN" => Ok(f64::NAN),
+            "Infinity" => Ok(f64::INFINITY),
+            "-Infinity" => Ok(f64::NEG_INFINITY),
+            hex if hex.starts_with("0x") => {
+                let bits = u64::from_str_radix(&hex[2..], 16).map_err(|_| bad())?;
+                Ok(match t {
+                    DataType::Float16 => half::f16::from_bits(bits as u16).to_f64(),
+                    DataType::Float32 => f32::from_bits(bits as u32) as f64,
+                    DataType::Float64 => f64::from_bits(bits),
+                    _ => return Err(bad()),
+                })
+            }
+            _ => Err(bad()),
+        },
+        Value::Null => Ok(0.0),
+        _ => Err(bad()),
+    }
+}
+
+/// The array at `folder` (its `zarr.json`), every field checked.
+pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
+    let file = folder.join("zarr.json");
+    let doc = read_json(&file)?;
+    let invalid = |m: String| StoreError::invalid(&file, m);
+    if doc.get("zarr_format").and_then(Value::as_u64) != Some(3) {
+        return Err(invalid(format!(
+            "`zarr_format` is {}: arbvis reads zarr v3",
+            doc.get("zarr_format").unwrap_or(&Value::Null)
+        )));
+    }
+    if doc.get("node_type").and_then(Value::as_str) != Some("array") {
+        return Err(invalid("`node_type` is not \"array\"".into()));
+    }
+    let shape = sizes(field(&doc, "shape", &file)?, "shape", &file, 0)?;
+    let type_name = field(&doc, "data_type", &file)?;
+    let data_type = type_name
+        .as_str()
+        .and_then(DataType::parse)
+        .ok_or_else(|| {
+            invalid(format!(
+                "`data_type` {type_name}: arbvis reads bool, (u)int8-64 and float16-64"
+            ))
+        })?;
+    let grid = field(&doc, "chunk_grid", &file)?;
+    if grid.get("name").and_then(Value::as_str) != Some("regular") {
+        return Err(invalid(format!(
+            "`chunk_grid` {grid}: arbvis reads the \"regular\" grid"
+        )));
+    }
+    let chunk_shape = grid
+        .pointer("/configuration/chunk_shape")
+        .ok_or_else(|| invalid("`chunk_grid.configuration.chunk_shape` is missing".into()))?;
+    let chunks = sizes(
+        chunk_shape,
+        "chunk_grid.configuration.chunk_shape",
+        &file,
+        1,
+    )?;
+    if chunks.len() != shape.len() {
+        return Err(invalid(format!(
+            "chunk shape {chunks:?} has {} axes, the shape {shape:?} {}",
+            chunks.len(),
+            shape.len()
+        )));
+    }
+    let elements = chunks
+        .iter()
+        .try_fold(1u64, |a, &c| a.checked_mul(c))
+        .and_then(|n| n.checked_mul(data_type.size() as u64))
+        .filter(|&bytes| bytes <= MAX_CHUNK_BYTES);
+    if elements.is_none() {
+        return Err(invalid(format!(
+            "chunks of {chunks:?} {} elements: more than the {} MiB arbvis reads in one chunk",
+            data_type.name(),
+            MAX_CHUNK_BYTES >> 20
+        )));
+    }
+    let keys = chunk_keys(doc.get("chunk_key_encoding"), &file)?;
+    let fill_value = fill(field(&doc, "fill_value", &file)?, data_type, &file)?;
+    if doc
+        .get("storage_transformers")
+        .and_then(Value::as_array)
+        .is_some_and(|t| !t.is_empty())
+    {
+        return Err(invalid("storage transformers: arbvis reads none".into()));
+    }
+    let (big_endian, codecs) = codecs(field(&doc, "codecs", &file)?, shape.len(), &file)?;
+    let dimension_names = match doc.get("dimension_names") {
+        None | Some(Value::Null) => None,
+        Some(Value::Array(names)) if names.len() == shape.len() => Some(
+            names
+                .iter()
+                .map(|n| n.as_str().map(str::to_string))
+                .collect(),
+        ),
+        Some(other) => {
+            return Err(invalid(format!(
+                "`dimension_names` {other}: expected {} names",
+                shape.len()
+            )))
+        }
+    };
+    let attributes = match doc.get("attributes") {
+        Some(Value::Object(m)) => m.clone(),
+        _ => Map::new(),
+    };
+    Ok(ArrayMeta {
+        folder: folder.to_path_buf(),
+        shape,
+        chunks,
+        data_type,
+        fill_value,
+        big_endian,
+        codecs,
+        dimension_names,
+        attributes,
+        keys,
+    })
+}
+
+fn chunk_keys(v: Option<&Value>, file: &Path) -> Result<ChunkKeys, StoreError> {
+    let Some(v) = v else {
+        return Ok(ChunkKeys::Default('/'));
+    };
+    let separator = match v.pointer("/configuration/separator") {
+        None => None,
+        Some(Value::String(s)) if s == "/" || s == "." => s.chars().next(),
+        Some(other) => {
+            return Err(StoreError::invalid(
+                file,
+                format!("`chunk_key_encoding` separator {other}: expected \"/\" or \".\""),
+            ))
+        }
+    };
+    match v.get("name").and_then(Value::as_str) {
+        Some("default") => Ok(ChunkKeys::Default(separator.unwrap_or('/'))),
+        Some("v2") => Ok(ChunkKeys::V2(separator.unwrap_or('.'))),
+        _ => Err(StoreError::invalid(
+            file,
+            format!("`chunk_key_encoding` {v}: arbvis reads \"default\" and \"v2\""),
+        )),
+    }
+}
+
+/// The `bytes` codec's byte order and the bytes-to-bytes codecs, checked.
+fn codecs(v: &Value, axes: usize, file: &Path) -> Result<(bool, Vec<Codec>), StoreError> {
+    let list = v
+        .as_array()
+        .ok_or_else(|| StoreError::invalid(file, "`codecs`: expected a list"))?;
+    let mut big_endian = None;
+    let mut after = Vec::new();
+    for (i, c) in list.iter().enumerate() {
+        let name = c.get("name").and_then(Value::as_str).unwrap_or("");
+        let config = c.get("configuration");
+        let refuse =
+            |why: &str| StoreError::invalid(file, format!("`codecs[{i}]` {name:?}: {why}"));
+        match (name, big_endian.is_some()) {
+            ("transpose", false) => {
+                let identity: Vec<Value> = (0..axes).map(Value::from).collect();
+                let order = config.and_then(|c| c.get("order"));
+                if order.and_then(Value::as_array) != Some(&identity) {
+                    return Err(refuse("arbvis reads only the identity order"));
+                }
+            }
+            ("bytes", false) => {
+                let endian = config.and_then(|c| c.get("endian")).and_then(Value::as_str);
+                big_endian = Some(match endian {
+                    Some("big") => true,
+                    Some("little") | None => false,
+                    Some(other) => return Err(refuse(&format!("endian {other:?}"))),
+                });
+            }
+            ("zstd", true) => after.push(Codec::Zstd),
+            ("gzip", true) => after.push(Codec::Gzip),
+            ("crc32c", true) => after.push(Codec::Crc32c),
+            ("sharding_indexed", _) => {
+                return Err(refuse(
+                    "sharded arrays are not read; rewrite the store without sharding",
+                ))
+            }
+            _ => {
+                return Err(refuse(
+                    "not a codec arbvis reads (bytes, zstd, gzip, crc32c, identity transpose); \
+                     rewrite the store with those, e.g. zarr-python's default zstd",
+                ))
+            }
+        }
+    }
+    let big_endian =
+        big_endian.ok_or_else(|| StoreError::invalid(file, "`codecs` has no `bytes` codec"))?;
+    Ok((big_endian, after))
+}
+
+impl ArrayMeta {
+    /// Elements in one chunk.
+    pub fn chunk_elements(&self) -> usize {
+        self.chunks.iter().product::<u64>() as usize
+    }
+
+    /// Chunks per axis.
+    pub fn chunk_counts(&self) -> Vec<u64> {
+        self.shape
+            .iter()
+            .zip(&self.chunks)
+            .map(|(s, c)| s.div_ceil(*c))
+            .collect()
+    }
+
+    /// The file of chunk `index` (slowest axis first).
+    pub fn chunk_file(&self, index: &[u64]) -> PathBuf {
+        let parts: Vec<String> = index.iter().map(u64::to_string).collect();
+        match self.keys {
+            ChunkKeys::Default(sep) => {
+                let mut key = String::from("c");
+                for p in &parts {
+                    key.push(sep);
+                    key.push_str(p);
+                }
+                self.folder.join(key)
+            }
+            ChunkKeys::V2(sep) => self.folder.join(parts.join(&sep.to_string())),
+        }
+    }
+
+    /// The most bytes a chunk file may hold: the decoded size grown by each codec's bound.
+    pub fn max_encoded_bytes(&self) -> u64 {
+        let decoded = (self.chunk_elements() * self.data_type.size()) as u64;
+        self.codecs.iter().fold(decoded, |n, c| c.bound(n))
+    }
+
+    /// Chunk `index` decoded to f32 values (the last axis fastest), or `None` where its
+    /// file is absent (zarr's "all fill value"). Errors say what is wrong, without the
+    /// file's name (the caller names it).
+    pub fn read_chunk(&self, index: &[u64]) -> Result<Option<Vec<f32>>, String> {
+        Ok(self
+            .read_chunk_bytes(index)?
+            .map(|data| self.values(&data).map(|v| v as f32).collect()))
+    }
+
+    /// [`ArrayMeta::read_chunk`] in f64 (coordinates that need it).
+    pub fn read_chunk_f64(&self, index: &[u64]) -> Result<Option<Vec<f64>>, String> {
+        Ok(self
+            .read_chunk_bytes(index)?
+            .map(|data| self.values(&data).collect()))
+    }
+
+    /// Decoded bytes as values.
+    fn values<'a>(&self, data: &'a [u8]) -> impl Iterator<Item = f64> + 'a {
+        let (t, big) = (self.data_type, self.big_endian);
+        data.chunks_exact(t.size()).map(move |b| t.value(b, big))
+    }
+
+    /// Chunk `index`'s decoded bytes, exactly one chunk's worth, or `None` where absent.
+    fn read_chunk_bytes(&self, index: &[u64]) -> Result<Option<Vec<u8>>, String> {
+        let file = self.chunk_file(index);
+        let meta = match std::fs::metadata(&file) {
+            Ok(m) => m,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(e.to_string()),
+        };
+        let max = self.max_encoded_bytes();
+        if meta.is_file() && meta.len() > max {
+            return Err(format!(
+                "the file holds {} bytes; its codecs ({}) can make at most {max} of a chunk",
+                meta.len(),
+                self.codec_names()
+            ));
+        }
+        let mut data = crate::input::read_regular(&file, max).map_err(|e| e.to_string())?;
+        let decoded = self.chunk_elements() * self.data_type.size();
+        let mut limits = vec![decoded as u64];
+        for c in &self.codecs {
+            let last = *limits.last().unwrap_or(&0);
+            limits.push(c.bound(last));
+        }
+        for (k, codec) in self.codecs.iter().enumerate().rev() {
+            data = codec
+                .decode(data, limits[k])
+                .map_err(|e| format!("cannot be decoded: {e}"))?;
+        }
+        if data.len() != decoded {
+            return Err(format!(
+                "decodes to {} bytes, not the {decoded} of a {:?} chunk of {}",
+                data.len(),
+                self.chunks,
+                self.data_type.name()
+            ));
+        }
+        Ok(Some(data))
+    }
+
+    /// The codecs, in words.
+    pub fn codec_names(&self) -> String {
+        let mut names = vec![if self.big_endian {
+            "bytes (big-endian)"
+        } else {
+            "bytes"
+        }];
+        names.extend(self.codecs.iter().map(|c| c.name()));
+        names.join(" + ")
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,164 @@
+//! Shared test harness: contexts, pixel probes with bit-depth tolerances, golden images.
+#![allow(dead_code)]
+
+pub mod hostile_files;
+pub mod splats;
+#[cfg(feature = "viewer")]
+pub mod viewer;
+
+use std::path::{Path, PathBuf};
+
+use arbvis::gl::{Backend, Headless};
+use arbvis::image::Image;
+use arbvis::png_io::{read_png, write_png};
+use arbvis::scene::{Scene, TechniqueScene};
+use arbvis::techniques::opacity3d::Opacity3dScene;
+
+/// One step of an 8-bit channel.
+pub const LEVEL: f32 = 1.0 / 255.0;
+
+/// A context on `backend`; fails the test with the backend's own error when unavailable
+/// (CI installs Mesa's EGL and libosmesa6, so a missing backend is a real failure).
+pub fn headless(backend: Backend) -> Headless {
+    Headless::new(backend).unwrap_or_else(|e| panic!("no {} context: {e}", backend.name()))
+}
+
+/// Assert that `actual` is within `tolerance` of `expected` in every channel.
+pub fn assert_close(actual: [f32; 4], expected: [f32; 4], tolerance: f32, what: &str) {
+    let worst = actual
+        .iter()
+        .zip(&expected)
+        .map(|(a, e)| (a - e).abs())
+        .fold(0f32, f32::max);
+    assert!(
+        worst <= tolerance,
+        "{what}: got {actual:?}, expected {expected:?} (largest difference {worst}, {:.2} levels; tolerance {tolerance})",
+        worst / LEVEL
+    );
+}
+
+/// Assert the 8-bit pixel at (x, y) equals `expected` exactly.
+pub fn assert_pixel_u8(image: &Image, x: u32, y: u32, expected: [u8; 4], what: &str) {
+    let got = image.pixel_u8(x, y);
+    assert_eq!(got, expected, "{what}: pixel ({x}, {y})");
+}
+
+fn snapshot_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots")
+}
+
+/// Compare `image` with the golden `tests/snapshots/NAME.png`: the largest channel
+/// difference must be at most `tolerance`. On failure `NAME.new.png` and `NAME.diff.png`
+/// are written beside it; `UPDATE_SNAPSHOTS=1` accepts the new image instead.
+pub fn assert_snapshot(name: &str, image: &Image, tolerance: f32) {
+    let golden = snapshot_dir().join(format!("{name}.png"));
+    let new = snapshot_dir().join(format!("{name}.new.png"));
+    let diff = snapshot_dir().join(format!("{name}.diff.png"));
+    if let Some(parent) = golden.parent() {
+        std::fs::create_dir_all(parent).unwrap();
+    }
+    let image8 = Image {
+        format: arbvis::gl::TargetFormat::Rgba8,
+        ..image.clone()
+    };
+    if std::env::var_os("UPDATE_SNAPSHOTS").is_some_and(|v| v == "1") {
+        write_png(&golden, &image8, &[]).unwrap();
+        let _ = std::fs::remove_file(&new);
+        let _ = std::fs::remove_file(&diff);
+        return;
+    }
+    let (expected, _) = match read_png(&golden) {
+        Ok(g) => g,
+        Err(e) => {
+            write_png(&new, &image8, &[]).unwrap();
+            panic!(
+                "golden {} unreadable ({e}); wrote {}; accept with UPDATE_SNAPSHOTS=1",
+                golden.display(),
+                new.display()
+            );
+        }
+    };
+    // Compare what the PNG can hold: 8-bit levels.
+    let actual = arbvis::image::Image {
+        data: image8
+            .to_rgba8()
+            .iter()
+            .map(|&b| b as f32 / 255.0)
+            .collect(),
+        ..image8
+    };
+    let Some(d) = actual.compare(&expected, tolerance) else {
+        write_png(&new, &actual, &[]).unwrap();
+        panic!(
+            "{name}: size {}x{} differs from golden {}x{}; wrote {}",
+            actual.width,
+            actual.height,
+            expected.width,
+            expected.height,
+            new.display()
+        );
+    };
+    if d.max_abs > tolerance as f64 + 1e-6 {
+        write_png(&new, &actual, &[]).unwrap();
+        let diff_image = actual.diff_image(&expected, tolerance, 16.0).unwrap();
+        write_png(&diff, &diff_image, &[]).unwrap();
+        panic!(
+            "{name}: max abs {:.4} ({:.1} levels) at {:?} over tolerance {tolerance}; {} pixels over; RMSE {:.5}, PSNR {:.1} dB; wrote {} and {}",
+            d.max_abs,
+            d.max_abs * 255.0,
+            d.worst,
+            d.pixels_over,
+            d.rmse,
+            d.psnr,
+            new.display(),
+            diff.display()
+        );
+    }
+    let _ = std::fs::remove_file(&new);
+    let _ = std::fs::remove_file(&diff);
+}
+
+/// A file under the project's `data/` (real files no one here wrote, which travel with
+/// the clone; `data/README.md` gives their sources and licences).
+pub fn data_file(relative: &str) -> std::path::PathBuf {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data")
+        .join(relative);
+    assert!(path.is_file(), "{} is missing from data/", path.display());
+    path
+}
+
+/// A fresh, empty folder for one test's files (emptied at the start of each run).
+pub fn temp_dir(name: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("arbvis-test-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The 3D-opacity parameters of `scene` (a test's own scene: anything else is a bug).
+pub fn opacity3d(scene: &Scene) -> &Opacity3dScene {
+    match &scene.technique {
+        TechniqueScene::Opacity3d(p) => p,
+        _ => panic!("not an opacity3d scene"),
+    }
+}
+
+/// [`opacity3d`], to change.
+pub fn opacity3d_mut(scene: &mut Scene) -> &mut Opacity3dScene {
+    match &mut scene.technique {
+        TechniqueScene::Opacity3d(p) => p,
+        _ => panic!("not an opacity3d scene"),
+    }
+}
+
+/// The cell-projection tests' rotated camera: it sees all three axes of the seed's grid
+/// (no face is edge-on) with a margin.
+pub fn seed_grid_camera(projection: arbvis::camera::Projection) -> arbvis::camera::Camera {
+    arbvis::camera::Camera {
+        projection,
+        rotation: [0.2391, 0.3696, 0.0990, 0.8924],
+        zoom: 0.9,
+        ..arbvis::camera::Camera::default()
+    }
+}

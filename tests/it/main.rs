@@ -1,0 +1,28 @@
+//! The integration tests, one binary (`cargo test --test it`; one module per former test
+//! file, e.g. `cargo test --test it hostile::`). One binary links the crate once, where
+//! twenty took most of the test build's time. `tests/fuzz.rs` stays its own binary: it
+//! installs a capping global allocator, a silent panic hook and a process-wide memory
+//! budget, which must not reach the other tests.
+
+mod common;
+
+mod cellproj;
+mod cellproj_volume;
+mod cli;
+mod clip;
+mod data;
+mod docs;
+mod hostile;
+mod layers;
+mod opacity3d;
+mod opacity3d_precise;
+mod pictures;
+mod programs;
+mod quad;
+mod splats;
+mod splats_tiles;
+mod store;
+mod store_hostile;
+mod v3o2_verbatim;
+mod viewer;
+mod viewer_screen;
