@@ -13,19 +13,11 @@ done
 for demo in splats-section splats-section-precise; do
   "$arbvis" render --demo "$demo" --size 1200x675 -o "$out/$demo.png"
 done
-# Real data (from ../shared/data, which a user's clone may not have).
-if [ -d ../shared/data ]; then
-  for s in f3 icbm152 post autzen bunny; do
-    "$arbvis" render "scenes/data/$s.toml" -o "$out/data-$s.png"
-  done
-fi
-# Issue 16: volume rendering of the real tetrahedral meshes (cell projection's volume mode).
-if [ -d ../shared/data ]; then
-  for s in bracket-volume post-volume; do
-    "$arbvis" render "scenes/data/$s.toml" -o "$out/data-$s.png"
-  done
-  "$arbvis" render scenes/data/bracket-volume.toml --fidelity faithful -o "$out/data-bracket-volume-faithful.png"
-fi
+# Real data (data/, which travels with the clone).
+for s in f3 icbm152 post autzen bunny bracket-volume post-volume; do
+  "$arbvis" render "scenes/data/$s.toml" -o "$out/data-$s.png"
+done
+"$arbvis" render scenes/data/bracket-volume.toml --fidelity faithful -o "$out/data-bracket-volume-faithful.png"
 "$arbvis" render scenes/bench/cellproj-seed-volume.toml -o "$out/cellproj-seed-volume.png"
 # NASA's CFD meshes (`python3 benches/meshes.py nasa` downloads them into target/meshes).
 if [ -f target/meshes/bluntfin.vtk ] && [ -f target/meshes/oxygen-post.vtk ]; then
