@@ -755,7 +755,7 @@ fn log_case(bytes: &[u8]) {
     let from = store_template().join("part.zarr");
     let to = store_template().join("resumed.zarr");
     let _ = std::fs::remove_dir_all(&to);
-    copy_tree(&from, &to);
+    common::copy_tree(&from, &to);
     std::fs::write(to.join(arbvis::store::progress::PROGRESS_LOG), bytes).unwrap();
     let o = ConvertOptions {
         brick: 4,
@@ -772,19 +772,6 @@ fn log_case(bytes: &[u8]) {
                 s.chunk(a, 0, [i, 0, 0])
                     .expect("a resumed conversion wrote every chunk");
             }
-        }
-    }
-}
-
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let entry = entry.unwrap();
-        let target = to.join(entry.file_name());
-        if entry.file_type().unwrap().is_dir() {
-            copy_tree(&entry.path(), &target);
-        } else {
-            std::fs::copy(entry.path(), target).unwrap();
         }
     }
 }

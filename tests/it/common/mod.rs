@@ -162,3 +162,17 @@ pub fn seed_grid_camera(projection: arbvis::camera::Projection) -> arbvis::camer
         ..arbvis::camera::Camera::default()
     }
 }
+
+/// Copy the folder `from` to `to`, recursively (files and folders only).
+pub fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let target = to.join(entry.file_name());
+        if entry.file_type().unwrap().is_dir() {
+            copy_tree(&entry.path(), &target);
+        } else {
+            std::fs::copy(entry.path(), target).unwrap();
+        }
+    }
+}
