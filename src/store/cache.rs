@@ -34,14 +34,15 @@ use super::lod::BrickId;
 use super::reader::Store;
 use crate::gl::{Extent, Filter, GlResult, Gpu, TexelData, TexelFormat, Texture};
 use crate::volume::index_data::SlotGrid;
-use crate::volume::quantize::quantize_value;
+use crate::volume::quantize::{quantize_level, NoData};
 
 /// How a brick's attributes become texels: per texture channel (R, G, B), the store's
 /// attribute and its quantization range (v3o2: G primary, B secondary, R tertiary).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Packing {
-    /// Per channel R, G, B: `(attribute index in the store, low, high)`, or none (0).
-    pub channels: [Option<(usize, f64, f64)>; 3],
+    /// Per channel R, G, B: `(attribute index in the store, low, high, what NaN becomes)`,
+    /// or none (0).
+    pub channels: [Option<(usize, f64, f64, NoData)>; 3],
 }
 
 impl Packing {
@@ -416,14 +417,14 @@ pub fn pack_brick(store: &Store, packing: &Packing, id: BrickId) -> Result<Vec<u
     let mut texels = vec![0u8; Packing::brick_bytes(side)];
     let c = id.c.map(|x| x as usize);
     for (ch, p) in packing.channels.iter().enumerate() {
-        let Some((attr, low, high)) = *p else {
+        let Some((attr, low, high, no_data)) = *p else {
             continue;
         };
         let values = store
             .brick(attr, id.level as usize, c)
             .map_err(|e| e.to_string())?;
         for (t, &v) in texels.chunks_exact_mut(3).zip(&values) {
-            t[ch] = quantize_value(v, low, high);
+            t[ch] = quantize_level(v, low, high, no_data);
         }
     }
     Ok(texels)

@@ -14,6 +14,10 @@ const MAX_FILES_COUNTED: u64 = 10_000_000;
 
 /// The description `inspect` prints for the store at `store`.
 pub fn describe(store: &Path) -> Result<String, StoreError> {
+    let root = super::zarr::read_json(&store.join("zarr.json"))?;
+    if root["attributes"].get("arbvis").is_none() && super::mdio::is_mdio(&root) {
+        return describe_mdio(store);
+    }
     let meta = super::check::read_meta(store)?;
     let (arrays, _) = super::check::open_arrays(store, &meta)?;
     let mut s = String::new();
@@ -68,6 +72,76 @@ pub fn describe(store: &Path) -> Result<String, StoreError> {
             array.fill_value,
             attr.non_finite
         );
+    }
+    let (bytes, files) = disk_use(store);
+    let _ = writeln!(
+        s,
+        "size on disk: {:.1} MB in {files} files",
+        bytes as f64 / 1e6
+    );
+    Ok(s)
+}
+
+/// An MDIO dataset: what arbvis draws of it, then every variable of the group.
+fn describe_mdio(store: &Path) -> Result<String, StoreError> {
+    let opened = super::Store::open(store)?;
+    let meta = &opened.meta;
+    let mut s = String::new();
+    let _ = writeln!(s, "{}", store.display());
+    let _ = writeln!(
+        s,
+        "format: {} (zarr v3), read in place: one level, no per-brick ranges",
+        meta.source.kind
+    );
+    for (k, v) in &meta.source.facts {
+        let _ = writeln!(s, "  {k}: {v}");
+    }
+    let _ = writeln!(s, "dimensions:");
+    for line in axes(meta) {
+        let _ = writeln!(s, "  {line}");
+    }
+    let a = &meta.attributes[0];
+    if let (Some(lo), Some(hi)) = (a.min, a.max) {
+        let _ = writeln!(
+            s,
+            "statistics (statsV1, non-zero samples): min {lo} max {hi}"
+        );
+    }
+    let _ = writeln!(s, "variables:");
+    let mut entries: Vec<_> = std::fs::read_dir(store)
+        .map_err(|e| StoreError::io(store, e))?
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.join("zarr.json").is_file())
+        .collect();
+    entries.sort();
+    for folder in entries {
+        let name = folder
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
+        match super::zarr::open_array(&folder) {
+            Ok(v) => {
+                let dims = v
+                    .dimension_names
+                    .iter()
+                    .flatten()
+                    .map(|d| d.clone().unwrap_or_default())
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                let _ = writeln!(
+                    s,
+                    "  {name}: {} ({dims}) shape {:?}, chunks {:?}, codecs {}",
+                    v.data_type.name(),
+                    v.shape,
+                    v.chunks,
+                    v.codec_names()
+                );
+            }
+            Err(e) => {
+                let _ = writeln!(s, "  {name}: not read by arbvis ({e})");
+            }
+        }
     }
     let (bytes, files) = disk_use(store);
     let _ = writeln!(

@@ -31,6 +31,7 @@
 //! - [`convert`]: `arbvis convert` (streamed, parallel, resumable; memory bound);
 //!   [`progress`]: its lock and progress log.
 //! - [`describe`]: `arbvis inspect STORE`.
+//! - [`mdio`]: MDIO v1 datasets (written by mdio-python) opened in place as one level.
 //! - [`reader`]: chunks, bricks with their one-voxel border, and level-0 windows read back.
 //! - [`lod`]: which bricks a view needs (screen-space error), in visibility order (no GL).
 //! - [`cache`]: the GPU brick cache (fixed texture budget, LRU, a loader thread).
@@ -41,6 +42,7 @@ pub mod convert;
 pub mod describe;
 pub mod input;
 pub mod lod;
+pub mod mdio;
 pub mod meta;
 pub mod progress;
 pub mod reader;

@@ -39,6 +39,8 @@ pub struct Store {
     cache: Mutex<ChunkCache>,
     /// Being written by a conversion: every chunk it logged must be present.
     incomplete: bool,
+    /// An MDIO dataset's level 0, read in place (then there are no arbvis arrays).
+    mdio: Option<super::mdio::Mdio>,
 }
 
 /// Decoded chunks kept for neighbouring bricks' borders, least recently used first out.
@@ -88,6 +90,16 @@ impl Store {
             };
             return Err(StoreError::invalid(path, why));
         }
+        let root_file = path.join("zarr.json");
+        if std::fs::symlink_metadata(&root_file).is_ok() {
+            let root = super::zarr::read_json(&root_file)?;
+            if root["attributes"].get("arbvis").is_none() && super::mdio::is_mdio(&root) {
+                let (meta, mdio) = super::mdio::open(path, &root)?;
+                let mut store = Store::with_arrays(path, meta, (Vec::new(), Vec::new()), false);
+                store.mdio = Some(mdio);
+                return Ok(store);
+            }
+        }
         let meta = super::check::read_meta(path)?;
         if !meta.complete {
             return Err(StoreError::invalid(
@@ -104,8 +116,17 @@ impl Store {
     }
 
     fn with_meta(path: &Path, meta: StoreMeta, incomplete: bool) -> Result<Store, StoreError> {
-        let (arrays, range_arrays) = super::check::open_arrays(path, &meta)?;
-        Ok(Store {
+        let arrays = super::check::open_arrays(path, &meta)?;
+        Ok(Store::with_arrays(path, meta, arrays, incomplete))
+    }
+
+    fn with_arrays(
+        path: &Path,
+        meta: StoreMeta,
+        (arrays, range_arrays): (super::check::ArraysByLevel, super::check::ArraysByLevel),
+        incomplete: bool,
+    ) -> Store {
+        Store {
             path: path.to_path_buf(),
             meta,
             arrays,
@@ -117,7 +138,19 @@ impl Store {
                 capacity: CHUNK_CACHE,
             }),
             incomplete,
-        })
+            mdio: None,
+        }
+    }
+
+    /// Whether `attr` may read NaN ("no data": non-finite samples, dead traces, absent
+    /// chunks of an MDIO variable whose fill is NaN).
+    pub fn may_hold_nan(&self, attr: usize) -> bool {
+        self.meta.attributes[attr].non_finite > 0 || self.mdio.as_ref().is_some_and(|m| m.nan_fill)
+    }
+
+    /// True when this is an MDIO dataset read in place (one level, no brick ranges).
+    pub fn is_mdio(&self) -> bool {
+        self.mdio.is_some()
     }
 
     /// The zarr path of attribute `attr`'s level `level` (`/amplitude/0`).
@@ -132,6 +165,9 @@ impl Store {
 
     /// The file of chunk `c` (`[i, j, k]` brick indices) of `attr` at `level`.
     pub fn chunk_file(&self, attr: usize, level: usize, c: [usize; 3]) -> PathBuf {
+        if let Some(m) = &self.mdio {
+            return m.chunk_file(self.meta.brick, c);
+        }
         self.arrays[attr][level].chunk_file(&[c[2] as u64, c[1] as u64, c[0] as u64])
     }
 
@@ -159,6 +195,19 @@ impl Store {
             return Err(fail(format!(
                 "outside the level's {counts:?} bricks (sample, crossline, inline)"
             )));
+        }
+        if let Some(m) = &self.mdio {
+            if attr != 0 || level != 0 {
+                return Err(fail(
+                    "an MDIO dataset has one attribute and one level".into(),
+                ));
+            }
+            let values = Arc::new(m.brick(self.meta.dims, self.meta.brick, c).map_err(fail)?);
+            self.cache
+                .lock()
+                .expect("chunk cache")
+                .put(key, values.clone());
+            return Ok(values);
         }
         let array = &self.arrays[attr][level];
         let values = match array.read_chunk(&index).map_err(fail)? {
@@ -211,6 +260,16 @@ impl Store {
             .get(&(attr, level))
         {
             return Ok(t.clone());
+        }
+        if self.mdio.is_some() {
+            // No per-brick ranges: every brick may hold the whole range.
+            let a = &self.meta.attributes[attr];
+            let range = [
+                a.min.map_or(f32::MIN, |v| v as f32),
+                a.max.map_or(f32::MAX, |v| v as f32),
+            ];
+            let n = self.meta.brick_counts(level).iter().product::<usize>();
+            return Ok(Arc::new(vec![range; n]));
         }
         let array = &self.range_arrays[attr][level];
         let file = array.chunk_file(&[0, 0, 0, 0]);

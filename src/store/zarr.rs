@@ -7,8 +7,9 @@
 //! frame declaring a terabyte, or inflating without end, fails in microseconds).
 //!
 //! Supported: data types bool, (u)int8-64, float16/32/64; the `regular` chunk grid; the
-//! `default` and `v2` chunk key encodings; codecs `bytes` (either byte order), `zstd`,
-//! `gzip`, `crc32c` and an identity `transpose`. Others are refused by name. Writing
+//! `default` and `v2` chunk key encodings; codecs `bytes` (either byte order), `blosc`
+//! (MDIO's: decoded by the `zarrs` crate after its header is checked here), `zstd`, `gzip`,
+//! `crc32c` and an identity `transpose`. Others are refused by name. Writing
 //! stays with the `zarrs` crate.
 
 use std::io::Read;
@@ -134,35 +135,42 @@ impl DataType {
 }
 
 /// A bytes-to-bytes codec, as it encoded.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Codec {
     Zstd,
     Gzip,
     Crc32c,
+    /// Blosc 1 (MDIO's codec), decoded by the `zarrs` crate's codec after its header is
+    /// checked here; the configuration as the array states it.
+    Blosc(Value),
 }
 
 impl Codec {
     /// The zarr name.
-    pub fn name(self) -> &'static str {
+    pub fn name(&self) -> &'static str {
         match self {
             Codec::Zstd => "zstd",
             Codec::Gzip => "gzip",
             Codec::Crc32c => "crc32c",
+            Codec::Blosc(_) => "blosc",
         }
     }
 
     /// The most bytes this codec can make of `n` bytes (generous: zstd's and deflate's
     /// worst cases are under n/256 and n/1000 plus a header).
-    fn bound(self, n: u64) -> u64 {
+    fn bound(&self, n: u64) -> u64 {
         match self {
-            Codec::Zstd | Codec::Gzip => n.saturating_add(n / 64).saturating_add(1024),
+            Codec::Zstd | Codec::Gzip | Codec::Blosc(_) => {
+                n.saturating_add(n / 64).saturating_add(1024)
+            }
             Codec::Crc32c => n.saturating_add(4),
         }
     }
 
     /// Undo this codec on `data`, which must decode to at most `limit` bytes.
-    fn decode(self, data: Vec<u8>, limit: u64) -> Result<Vec<u8>, String> {
+    fn decode(&self, data: Vec<u8>, limit: u64) -> Result<Vec<u8>, String> {
         match self {
+            Codec::Blosc(config) => blosc_decode(config, data, limit),
             Codec::Zstd => {
                 if let Ok(Some(declared)) = zstd::zstd_safe::get_frame_content_size(&data) {
                     if declared > limit {
@@ -207,6 +215,50 @@ impl Codec {
             }
         }
     }
+}
+
+/// The `zarrs` blosc codec of an array's configuration.
+fn blosc_codec(config: &Value) -> Result<zarrs::array::codec::BloscCodec, String> {
+    let configuration: zarrs::metadata_ext::codec::blosc::BloscCodecConfiguration =
+        serde_json::from_value(config.clone())
+            .map_err(|e| format!("configuration {config}: {e}"))?;
+    zarrs::array::codec::BloscCodec::new_with_configuration(&configuration)
+        .map_err(|e| format!("configuration {config}: {e}"))
+}
+
+/// A blosc 1 buffer decoded, its 16-byte header checked first: what it declares to hold
+/// (at most `limit`), its block size (within that), and its compressed length (the
+/// buffer's own), so that the decoder never allocates more than the chunk may hold.
+fn blosc_decode(config: &Value, data: Vec<u8>, limit: u64) -> Result<Vec<u8>, String> {
+    use zarrs::array::BytesToBytesCodecTraits;
+    if data.len() < 16 {
+        return Err(format!(
+            "blosc: {} bytes, shorter than its 16-byte header",
+            data.len()
+        ));
+    }
+    let word =
+        |at: usize| u32::from_le_bytes([data[at], data[at + 1], data[at + 2], data[at + 3]]) as u64;
+    let (nbytes, blocksize, cbytes) = (word(4), word(8), word(12));
+    if nbytes > limit {
+        return Err(format!(
+            "its blosc header declares {nbytes} bytes, more than the {limit} it may hold"
+        ));
+    }
+    if blocksize == 0 || blocksize > nbytes.max(1) || cbytes != data.len() as u64 {
+        return Err(format!(
+            "its blosc header (block size {blocksize}, {cbytes} compressed bytes) does not fit its {nbytes} bytes in a buffer of {}",
+            data.len()
+        ));
+    }
+    let decoded = blosc_codec(config)?
+        .decode(
+            std::borrow::Cow::Borrowed(&data),
+            &zarrs::array::BytesRepresentation::BoundedSize(limit),
+            &zarrs::array::CodecOptions::default(),
+        )
+        .map_err(|e| format!("blosc: {e}"))?;
+    Ok(decoded.into_owned())
 }
 
 /// Read all of `reader` into a buffer, failing at the first byte past `limit`.
@@ -339,8 +391,9 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
         .as_str()
         .and_then(DataType::parse)
         .ok_or_else(|| {
+            let shown = crate::input::shorten(&type_name.to_string(), 60);
             invalid(format!(
-                "`data_type` {type_name}: arbvis reads bool, (u)int8-64 and float16-64"
+                "`data_type` {shown}: arbvis reads bool, (u)int8-64 and float16-64"
             ))
         })?;
     let grid = field(&doc, "chunk_grid", &file)?;
@@ -475,6 +528,18 @@ fn codecs(v: &Value, axes: usize, file: &Path) -> Result<(bool, Vec<Codec>), Sto
             ("zstd", true) => after.push(Codec::Zstd),
             ("gzip", true) => after.push(Codec::Gzip),
             ("crc32c", true) => after.push(Codec::Crc32c),
+            ("blosc", true) => {
+                let config = config.cloned().unwrap_or(Value::Null);
+                blosc_codec(&config).map_err(|e| refuse(&e))?;
+                after.push(Codec::Blosc(config));
+            }
+            ("numcodecs.zfpy" | "zfp" | "zfpy", _) => {
+                return Err(refuse(
+                    "lossy ZFP is not read by this build of arbvis; rewrite the variable with a \
+                     lossless codec (e.g. in xarray: ds.to_zarr(new, encoding={VAR: {\"compressors\": \
+                     zarr.codecs.BloscCodec()}}))",
+                ))
+            }
             ("sharding_indexed", _) => {
                 return Err(refuse(
                     "sharded arrays are not read; rewrite the store without sharding",
@@ -482,8 +547,8 @@ fn codecs(v: &Value, axes: usize, file: &Path) -> Result<(bool, Vec<Codec>), Sto
             }
             _ => {
                 return Err(refuse(
-                    "not a codec arbvis reads (bytes, zstd, gzip, crc32c, identity transpose); \
-                     rewrite the store with those, e.g. zarr-python's default zstd",
+                    "not a codec arbvis reads (bytes, blosc, zstd, gzip, crc32c, identity \
+                     transpose); rewrite the store with those, e.g. zarr-python's default zstd",
                 ))
             }
         }
@@ -598,7 +663,7 @@ impl ArrayMeta {
         } else {
             "bytes"
         }];
-        names.extend(self.codecs.iter().map(|c| c.name()));
+        names.extend(self.codecs.iter().map(Codec::name));
         names.join(" + ")
     }
 }

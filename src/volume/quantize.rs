@@ -44,6 +44,64 @@ pub fn quantize_value(v: f32, low: f64, high: f64) -> u8 {
     (t * 255.0).round().clamp(0.0, 255.0) as u8
 }
 
+/// What NaN ("no data": dead traces, non-finite samples) becomes when quantized.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoData {
+    /// The attribute holds no NaN: level 0 as [`quantize_value`] gives it.
+    Absent,
+    /// NaN takes this level, one the colour table makes transparent (the one nearest the
+    /// table's middle), so no data draws nothing and fades at its edges as data does.
+    Level(u8),
+    /// No level is transparent: level 0 is kept for NaN, finite values take 1..=255, and
+    /// the renderer clears the table's entry 0.
+    Reserved,
+}
+
+impl NoData {
+    /// The choice for an attribute that may hold NaN (`may_hold_nan`) and whose colour
+    /// table has opacity `alpha` per level (256 entries).
+    pub fn choose(may_hold_nan: bool, alpha: &[u8]) -> NoData {
+        if !may_hold_nan {
+            return NoData::Absent;
+        }
+        (0..alpha.len())
+            .filter(|&l| alpha[l] == 0)
+            .min_by_key(|&l| (l as i64 - 128).abs())
+            .map_or(NoData::Reserved, |l| NoData::Level(l as u8))
+    }
+}
+
+/// `v` as a level, NaN as `no_data` says ([`NoData`]).
+pub fn quantize_level(v: f32, low: f64, high: f64, no_data: NoData) -> u8 {
+    match no_data {
+        NoData::Absent => quantize_value(v, low, high),
+        NoData::Level(l) if v.is_nan() => l,
+        NoData::Level(_) => quantize_value(v, low, high),
+        NoData::Reserved if v.is_nan() => 0,
+        NoData::Reserved if high <= low => 1,
+        NoData::Reserved => {
+            let t = (v as f64 - low) / (high - low);
+            1 + (t * 254.0).round().clamp(0.0, 254.0) as u8
+        }
+    }
+}
+
+#[cfg(test)]
+#[test]
+fn no_data_takes_a_transparent_level_or_a_reserved_one() {
+    let mut alpha = vec![255u8; 256];
+    assert_eq!(NoData::choose(false, &alpha), NoData::Absent);
+    assert_eq!(NoData::choose(true, &alpha), NoData::Reserved);
+    alpha[100..=110].fill(0);
+    alpha[200] = 0;
+    assert_eq!(NoData::choose(true, &alpha), NoData::Level(110));
+    assert_eq!(quantize_level(f32::NAN, 0.0, 1.0, NoData::Level(110)), 110);
+    assert_eq!(quantize_level(1.0, 0.0, 1.0, NoData::Level(110)), 255);
+    assert_eq!(quantize_level(f32::NAN, 0.0, 1.0, NoData::Reserved), 0);
+    assert_eq!(quantize_level(0.0, 0.0, 1.0, NoData::Reserved), 1);
+    assert_eq!(quantize_level(1.0, 0.0, 1.0, NoData::Reserved), 255);
+}
+
 /// The range `how` selects for `volume`; `(0, 0)` when no sample is finite.
 pub fn range(volume: &Volume, how: Quantization) -> Result<(f64, f64), String> {
     match how {

@@ -14,6 +14,7 @@ mod data;
 mod docs;
 mod hostile;
 mod layers;
+mod mdio;
 mod opacity3d;
 mod opacity3d_precise;
 mod pictures;

@@ -3,7 +3,9 @@
 use std::path::Path;
 use std::sync::Arc;
 
-use zarrs::array::codec::{Crc32cCodec, GzipCodec, ZstdCodec};
+use zarrs::array::codec::{
+    BloscCodec, BloscCompressor, BloscShuffleMode, Crc32cCodec, GzipCodec, ZstdCodec,
+};
 use zarrs::array::{data_type, ArrayBuilder};
 use zarrs::filesystem::FilesystemStore;
 
@@ -75,6 +77,22 @@ fn reads_what_zarrs_writes_with_each_codec() {
                 Arc::new(Crc32cCodec::new()),
             ],
         ),
+        (
+            "blosc",
+            vec![blosc(BloscCompressor::Zstd, BloscShuffleMode::Shuffle)],
+        ),
+        (
+            "blosc-lz4",
+            vec![blosc(BloscCompressor::LZ4, BloscShuffleMode::BitShuffle)],
+        ),
+        (
+            "blosc-blosclz",
+            vec![blosc(BloscCompressor::BloscLZ, BloscShuffleMode::NoShuffle)],
+        ),
+        (
+            "blosc-zlib",
+            vec![blosc(BloscCompressor::Zlib, BloscShuffleMode::Shuffle)],
+        ),
     ];
     for (name, codecs) in cases {
         let dir = temp(&format!("codec-{name}"));
@@ -93,6 +111,39 @@ fn reads_what_zarrs_writes_with_each_codec() {
         );
         std::fs::remove_dir_all(&dir).unwrap();
     }
+}
+
+/// A blosc codec as MDIO and numcodecs write it (level 5, 4-byte elements).
+fn blosc(
+    c: BloscCompressor,
+    shuffle: BloscShuffleMode,
+) -> Arc<dyn zarrs::array::BytesToBytesCodecTraits> {
+    Arc::new(BloscCodec::new(c, 5.try_into().unwrap(), None, shuffle, Some(4)).unwrap())
+}
+
+#[test]
+fn a_blosc_header_declaring_more_than_the_chunk_is_refused_before_decoding() {
+    let dir = temp("blosc-header");
+    write_array(
+        &dir,
+        vec![blosc(BloscCompressor::Zstd, BloscShuffleMode::Shuffle)],
+    );
+    let a = open_array(&dir.join("a")).unwrap();
+    let file = a.chunk_file(&[0, 0, 0]);
+    let mut bytes = std::fs::read(&file).unwrap();
+    bytes[4..8].copy_from_slice(&u32::MAX.to_le_bytes());
+    std::fs::write(&file, &bytes).unwrap();
+    let e = a.read_chunk(&[0, 0, 0]).unwrap_err();
+    assert!(
+        e.contains("its blosc header declares 4294967295 bytes"),
+        "{e}"
+    );
+    bytes[4..8].copy_from_slice(&256u32.to_le_bytes());
+    bytes[12..16].copy_from_slice(&7u32.to_le_bytes());
+    std::fs::write(&file, &bytes).unwrap();
+    let e = a.read_chunk(&[0, 0, 0]).unwrap_err();
+    assert!(e.contains("does not fit"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// Write `bytes` as chunk 0/0/0 of a fresh zstd array and read it.
@@ -224,18 +275,42 @@ fn metadata_numbers_are_checked_before_they_size_anything() {
     let e = open_error("dtype", &array_json("[10]", "[4]", "complex64", bytes));
     assert!(e.contains("`data_type` \"complex64\""), "{e}");
     let e = open_error(
-        "blosc",
+        "bz2",
         &array_json(
             "[10]",
             "[4]",
             "float32",
-            r#"[{"name": "bytes"}, {"name": "blosc", "configuration": {"cname": "zstd"}}]"#,
+            r#"[{"name": "bytes"}, {"name": "numcodecs.bz2", "configuration": {"level": 1}}]"#,
         ),
     );
     assert!(
-        e.contains("`codecs[1]` \"blosc\": not a codec arbvis reads"),
+        e.contains("`codecs[1]` \"numcodecs.bz2\": not a codec arbvis reads"),
         "{e}"
     );
+    let e = open_error(
+        "zfp",
+        &array_json(
+            "[10]",
+            "[4]",
+            "float32",
+            r#"[{"name": "bytes"}, {"name": "numcodecs.zfpy", "configuration": {"mode": 4}}]"#,
+        ),
+    );
+    assert!(
+        e.contains("lossy ZFP is not read") && e.contains("lossless codec"),
+        "{e}"
+    );
+    // A blosc configuration the codec cannot take is refused at open, naming it.
+    let e = open_error(
+        "blosc-config",
+        &array_json(
+            "[10]",
+            "[4]",
+            "float32",
+            r#"[{"name": "bytes"}, {"name": "blosc", "configuration": {"cname": "nope"}}]"#,
+        ),
+    );
+    assert!(e.contains("`codecs[1]` \"blosc\""), "{e}");
     let e = open_error(
         "shard",
         &array_json(

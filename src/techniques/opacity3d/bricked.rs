@@ -62,7 +62,7 @@ use crate::store::lod::{self, BrickId, Pyramid, View};
 use crate::store::Store;
 use crate::techniques::{Frame, Params, Renderer};
 use crate::vocab::{Fidelity, FieldError};
-use crate::volume::quantize::{quantize_value, Quantization};
+use crate::volume::quantize::{quantize_level, NoData, Quantization};
 use crate::volume::VolumeSource;
 
 /// `[technique.opacity3d.store]`: how a store is streamed.
@@ -229,6 +229,9 @@ pub struct BrickedRenderer {
     /// Per level, per brick (i fastest), per attribute: the levels its samples can read.
     levels: Vec<Vec<[(u8, u8); 3]>>,
     table_alpha: [Option<Vec<u8>>; 3],
+    /// What NaN ("no data": dead traces) became in each attribute's levels; where level 0
+    /// is reserved for it, the table's entry 0 is cleared, so no data is transparent.
+    no_data: [NoData; 3],
     mesh: Option<Mesh>,
     streaming: bool,
     last: (usize, usize, usize),
@@ -269,10 +272,26 @@ impl BrickedRenderer {
         let meta = &store.meta;
         let mut channels = [None; 3];
         let mut attrs = [None; 3];
+        let mut no_data_of = [NoData::Absent; 3];
+        let scene_attrs = params.attributes();
         for (a, at) in attributes.iter().enumerate() {
             if let Some((index, low, high)) = *at {
-                channels[CHANNEL[a]] = Some((index, low, high));
-                attrs[a] = Some((index, low, high, meta.attributes[index].non_finite > 0));
+                // NaN takes a level the table makes transparent (see `NoData`).
+                let alpha: Vec<u8> = match scene_attrs[a] {
+                    Some(attr) => attr
+                        .table
+                        .build(base)
+                        .map_err(GlError::Data)?
+                        .entries
+                        .iter()
+                        .map(|e| e[3])
+                        .collect(),
+                    None => Vec::new(),
+                };
+                let no_data = NoData::choose(store.may_hold_nan(index), &alpha);
+                channels[CHANNEL[a]] = Some((index, low, high, no_data));
+                attrs[a] = Some((index, low, high, no_data));
+                no_data_of[a] = no_data;
             }
         }
         let budget = match gpu_memory {
@@ -307,13 +326,14 @@ impl BrickedRenderer {
             let n = counts.iter().product::<usize>();
             let mut per = vec![[(0u8, 0u8); 3]; n];
             for (a, at) in attrs.iter().enumerate() {
-                let Some((index, low, high, nan)) = *at else {
+                let Some((index, low, high, no_data)) = *at else {
                     continue;
                 };
                 let ranges = store
                     .ranges(index, level)
                     .map_err(|e| GlError::Data(e.to_string()))?;
-                let q = |v: f32| quantize_value(v, low, high);
+                let q = |v: f32| quantize_level(v, low, high, no_data);
+                let nan = no_data != NoData::Absent;
                 for k in 0..counts[2] {
                     for j in 0..counts[1] {
                         for i in 0..counts[0] {
@@ -390,6 +410,7 @@ impl BrickedRenderer {
             neutral: None,
             levels,
             table_alpha: [None, None, None],
+            no_data: no_data_of,
             mesh: None,
             streaming: false,
             last: (0, 0, 0),
@@ -405,7 +426,10 @@ impl BrickedRenderer {
         for (a, attr) in self.params.attributes().into_iter().enumerate() {
             match attr {
                 Some(attr) => {
-                    let t = attr.table.build(&self.base).map_err(GlError::Data)?;
+                    let mut t = attr.table.build(&self.base).map_err(GlError::Data)?;
+                    if self.no_data[a] == NoData::Reserved {
+                        t.entries[0] = [0; 4];
+                    }
                     self.table_alpha[a] = Some(t.entries.iter().map(|e| e[3]).collect());
                     self.tables[a] = Some(table_texture(
                         gpu,

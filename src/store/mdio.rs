@@ -1,0 +1,391 @@
+//! MDIO v1 stores (TGS's open zarr format for seismic, written by `multidimio`) opened as
+//! a store of one level: the dataset's default variable (`amplitude`, dimensions
+//! `inline, crossline, time` or `depth`) is level 0, read through [`super::zarr`] (blosc
+//! and every other codec it reads, any chunk shape) and cut into the renderer's bricks;
+//! dead traces (`trace_mask` false) read as NaN, so they draw as no data; the axes take
+//! the dataset's own inline, crossline and time (or depth) coordinates; the statistics
+//! come from the variable's `statsV1`. MDIO keeps no coarser levels and no per-brick
+//! ranges: every brick may show something, and the renderer draws level 0.
+
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+
+use serde_json::Value;
+
+use super::meta::{AttributeMeta, SourceMeta, StoreMeta};
+use super::zarr::{self, ArrayMeta};
+use super::StoreError;
+
+/// Brick side the renderer cuts an MDIO variable into.
+pub const BRICK: usize = 64;
+
+/// Decoded MDIO chunks kept (a 128³ float32 chunk is 8 MiB).
+const CHUNK_CACHE: usize = 8;
+
+/// Decoded chunks by index, with their last use.
+type DecodedChunks = HashMap<Vec<u64>, (Arc<Vec<f32>>, u64)>;
+
+/// An open MDIO dataset's level 0.
+pub struct Mdio {
+    /// The variable drawn.
+    pub data: ArrayMeta,
+    /// Its fill value (absent chunks) is NaN: samples may be "no data" though no trace is dead.
+    pub nan_fill: bool,
+    /// Live traces, inline-major (`k * crosslines + j`), where the dataset has a mask.
+    pub live: Option<Vec<bool>>,
+    cache: Mutex<(DecodedChunks, u64)>,
+}
+
+/// Whether the root attributes are an MDIO dataset's.
+pub fn is_mdio(root: &Value) -> bool {
+    let a = &root["attributes"];
+    a.get("apiVersion").is_some() && a.get("attributes").is_some_and(Value::is_object)
+}
+
+/// The whole of a one- or two-dimensional array (a coordinate, the trace mask), held to
+/// the memory budget; absent chunks are the fill value.
+fn read_whole(array: &ArrayMeta) -> Result<Vec<f64>, StoreError> {
+    let file = array.folder.join("zarr.json");
+    let (rows, cols) = match array.shape[..] {
+        [n] => (1, n),
+        [r, c] => (r, c),
+        _ => {
+            return Err(StoreError::invalid(
+                &file,
+                format!("shape {:?}: expected one or two axes", array.shape),
+            ))
+        }
+    };
+    let n = rows
+        .checked_mul(cols)
+        .filter(|&n| n <= 1 << 40)
+        .ok_or_else(|| {
+            StoreError::invalid(&file, format!("shape {:?}: too many values", array.shape))
+        })?;
+    let mut out = crate::budget::vec_for::<f64>(n as usize, "an MDIO coordinate or mask")
+        .map_err(|e| StoreError::Budget(e.to_string()))?;
+    out.resize(n as usize, array.fill_value);
+    let (cr, cc) = match array.chunks[..] {
+        [c] => (1, c),
+        [r, c] => (r, c),
+        _ => unreachable!("chunks have the shape's axes"),
+    };
+    for a in 0..rows.div_ceil(cr) {
+        for b in 0..cols.div_ceil(cc) {
+            let index: Vec<u64> = if array.shape.len() == 1 {
+                vec![b]
+            } else {
+                vec![a, b]
+            };
+            let values = array
+                .read_chunk_f64(&index)
+                .map_err(|e| StoreError::invalid(&array.chunk_file(&index), e))?;
+            let Some(values) = values else { continue };
+            for y in 0..cr.min(rows - a * cr) {
+                for x in 0..cc.min(cols - b * cc) {
+                    out[((a * cr + y) * cols + b * cc + x) as usize] =
+                        values[(y * cc + x) as usize];
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// `first, step` of a coordinate that is a whole-number progression.
+fn first_step(values: &[f64]) -> Option<[i64; 2]> {
+    let first = *values.first()?;
+    let step = values.get(1).map_or(1.0, |v| v - first);
+    (first.fract() == 0.0 && step.fract() == 0.0).then_some([first as i64, step as i64])
+}
+
+/// The variable's `statsV1` (a JSON object, or a string holding one).
+fn stats(array: &ArrayMeta) -> Option<Value> {
+    match array.attributes.get("statsV1")? {
+        Value::String(s) => serde_json::from_str(s).ok(),
+        v @ Value::Object(_) => Some(v.clone()),
+        _ => None,
+    }
+}
+
+/// Open the MDIO dataset at `store` (whose root `zarr.json` is `root`).
+pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError> {
+    let file = store.join("zarr.json");
+    let a = &root["attributes"];
+    let api = a["apiVersion"].as_str().unwrap_or("?").to_string();
+    let variable = a["attributes"]["defaultVariableName"]
+        .as_str()
+        .unwrap_or("amplitude")
+        .to_string();
+    if variable.contains(['/', '\\']) || variable.starts_with('.') {
+        return Err(StoreError::invalid(
+            &file,
+            format!("defaultVariableName {variable:?}: not a variable's name"),
+        ));
+    }
+    let data = zarr::open_array(&store.join(&variable))?;
+    let vfile = store.join(&variable).join("zarr.json");
+    let names: Vec<String> = data
+        .dimension_names
+        .clone()
+        .unwrap_or_default()
+        .into_iter()
+        .map(Option::unwrap_or_default)
+        .collect();
+    let domain = names.last().cloned().unwrap_or_default();
+    if data.shape.len() != 3 || !(domain == "time" || domain == "depth") {
+        return Err(StoreError::invalid(
+            &vfile,
+            format!(
+                "{variable} has dimensions {names:?}: arbvis draws post-stack 3D variables (inline, crossline, time or depth); a pre-stack or 2D dataset is not drawn"
+            ),
+        ));
+    }
+    let [nk, nj, ni] = [data.shape[0], data.shape[1], data.shape[2]].map(|n| n as usize);
+    for (n, name) in [(ni, &names[2]), (nj, &names[1]), (nk, &names[0])] {
+        if n == 0 || n > super::check::MAX_SIDE {
+            return Err(StoreError::invalid(
+                &vfile,
+                format!("{name}: {n} values: must be 1..={}", super::check::MAX_SIDE),
+            ));
+        }
+    }
+    let coordinate = |name: &str| -> Result<Option<Vec<f64>>, StoreError> {
+        let folder = store.join(name);
+        if !folder.join("zarr.json").exists() {
+            return Ok(None);
+        }
+        let array = zarr::open_array(&folder)?;
+        if array.shape.len() != 1 {
+            return Err(StoreError::invalid(
+                &folder.join("zarr.json"),
+                format!("{name}: shape {:?}, expected one axis", array.shape),
+            ));
+        }
+        Ok(Some(read_whole(&array)?))
+    };
+    let inlines = coordinate(&names[0])?;
+    let crosslines = coordinate(&names[1])?;
+    let samples = coordinate(&domain)?;
+    for (values, n, name) in [
+        (&inlines, nk, &names[0]),
+        (&crosslines, nj, &names[1]),
+        (&samples, ni, &domain),
+    ] {
+        if let Some(v) = values {
+            if v.len() != n {
+                return Err(StoreError::invalid(
+                    &store.join(name).join("zarr.json"),
+                    format!("{name} has {} values, {variable} {n} along it", v.len()),
+                ));
+            }
+        }
+    }
+    let live = match store.join("trace_mask").join("zarr.json").exists() {
+        false => None,
+        true => Some(trace_mask(store, nk, nj)?),
+    };
+    let dead = live
+        .as_ref()
+        .map_or(0, |l| l.iter().filter(|&&x| !x).count());
+    let s = stats(&data);
+    let number = |key: &str| {
+        s.as_ref()
+            .and_then(|s| s[key].as_f64())
+            .filter(|v| v.is_finite())
+    };
+    // statsV1 counts the non-zero samples of the live traces (mdio-python leaves zeros
+    // out), so its sum over the live samples is their mean.
+    let live_samples = ((nk * nj - dead) * ni) as u64;
+    let non_finite = (dead * ni) as u64;
+    let mut facts = BTreeMap::new();
+    facts.insert("MDIO apiVersion".to_string(), api.clone());
+    if let Some(n) = a["name"].as_str() {
+        facts.insert("template".into(), n.to_string());
+    }
+    for key in ["surveyType", "gatherType"] {
+        if let Some(v) = a["attributes"][key].as_str() {
+            facts.insert(key.into(), v.to_string());
+        }
+    }
+    facts.insert(
+        "variable".into(),
+        format!(
+            "{variable} ({}, dimensions {})",
+            data.data_type.name(),
+            names.join(", ")
+        ),
+    );
+    facts.insert("chunks".into(), format!("{:?}", data.chunks));
+    facts.insert("codecs".into(), data.codec_names());
+    if let Some(l) = &live {
+        facts.insert(
+            "live traces".into(),
+            format!("{} of {}", l.len() - dead, l.len()),
+        );
+    }
+    // Map coordinates, where the dataset has them.
+    for name in ["cdp_x", "cdp_y"] {
+        let folder = store.join(name);
+        if folder.join("zarr.json").exists() {
+            let values = read_whole(&zarr::open_array(&folder)?)?;
+            let (lo, hi) = values
+                .iter()
+                .filter(|v| v.is_finite())
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            if lo <= hi {
+                facts.insert(name.into(), format!("{lo} .. {hi}"));
+            }
+        }
+    }
+    let interval_us = match (&samples, domain.as_str()) {
+        (Some(t), "time") if t.len() > 1 => Some(((t[1] - t[0]) * 1000.0).round().max(0.0) as u32),
+        _ => None,
+    };
+    if let Some(d) = &samples {
+        if domain == "depth" {
+            facts.insert("depth".into(), format!("{} .. {} m", d[0], d[d.len() - 1]));
+        }
+    }
+    let meta = StoreMeta {
+        format: format!("MDIO v{}", api.split('.').next().unwrap_or("1")),
+        version: 1,
+        dims: [ni, nj, nk],
+        spacing: [1.0; 3],
+        brick: BRICK,
+        levels: 1,
+        filter: "none: MDIO keeps one resolution".into(),
+        attributes: vec![AttributeMeta {
+            name: "amplitude".into(),
+            dtype: "float32".into(),
+            min: number("min"),
+            max: number("max"),
+            mean: match number("sum") {
+                Some(sum) if live_samples > 0 => Some(sum / live_samples as f64),
+                _ => None,
+            },
+            non_finite,
+        }],
+        source: SourceMeta {
+            path: store.display().to_string(),
+            kind: format!("MDIO v{api}"),
+            bytes: 0,
+            facts,
+            inlines: inlines.as_deref().and_then(first_step),
+            crosslines: crosslines.as_deref().and_then(first_step),
+            interval_us,
+        },
+        compression: data.codec_names(),
+        complete: true,
+    };
+    let bricks = super::brick_counts(meta.dims, BRICK)
+        .iter()
+        .try_fold(1u64, |n, &c| n.checked_mul(c as u64))
+        .filter(|&n| n <= super::check::MAX_BRICKS_PER_LEVEL);
+    if bricks.is_none() {
+        return Err(StoreError::invalid(
+            &vfile,
+            format!("{:?} samples: more bricks than arbvis draws", meta.dims),
+        ));
+    }
+    Ok((
+        meta,
+        Mdio {
+            nan_fill: data.fill_value.is_nan(),
+            data,
+            live,
+            cache: Mutex::new((HashMap::new(), 0)),
+        },
+    ))
+}
+
+/// The trace mask over (inline, crossline).
+fn trace_mask(store: &Path, nk: usize, nj: usize) -> Result<Vec<bool>, StoreError> {
+    let mask = zarr::open_array(&store.join("trace_mask"))?;
+    if mask.shape != [nk as u64, nj as u64] {
+        return Err(StoreError::invalid(
+            &mask.folder.join("zarr.json"),
+            format!(
+                "trace_mask has shape {:?}, the survey [{nk}, {nj}] traces",
+                mask.shape
+            ),
+        ));
+    }
+    Ok(read_whole(&mask)?.into_iter().map(|v| v != 0.0).collect())
+}
+
+impl Mdio {
+    /// One decoded chunk of the variable (cached), or its fill where absent.
+    fn chunk(&self, index: &[u64]) -> Result<Arc<Vec<f32>>, String> {
+        let mut guard = self.cache.lock().expect("MDIO chunk cache");
+        let (cache, tick) = &mut *guard;
+        *tick += 1;
+        if let Some((v, t)) = cache.get_mut(index) {
+            *t = *tick;
+            return Ok(v.clone());
+        }
+        let values = match self.data.read_chunk(index)? {
+            Some(v) => v,
+            None => vec![self.data.fill_value as f32; self.data.chunk_elements()],
+        };
+        let values = Arc::new(values);
+        if cache.len() >= CHUNK_CACHE {
+            if let Some(oldest) = cache
+                .iter()
+                .min_by_key(|(_, (_, t))| *t)
+                .map(|(k, _)| k.clone())
+            {
+                cache.remove(&oldest);
+            }
+        }
+        cache.insert(index.to_vec(), (values.clone(), *tick));
+        Ok(values)
+    }
+
+    /// Brick `c` (`[i, j, k]` in bricks of `b`): `b³` values, i fastest, from the chunks
+    /// it overlaps; dead traces NaN; beyond the survey 0.
+    pub fn brick(&self, dims: [usize; 3], b: usize, c: [usize; 3]) -> Result<Vec<f32>, String> {
+        let [ci, cj, ck] = [
+            self.data.chunks[2],
+            self.data.chunks[1],
+            self.data.chunks[0],
+        ]
+        .map(|n| n as usize);
+        let lo = c.map(|x| x * b);
+        let hi: [usize; 3] = std::array::from_fn(|a| ((c[a] + 1) * b).min(dims[a]));
+        let mut out = vec![0f32; b * b * b];
+        for k in lo[2]..hi[2] {
+            for j in lo[1]..hi[1] {
+                let dead = self.live.as_ref().is_some_and(|l| !l[k * dims[1] + j]);
+                let row = b * ((j - lo[1]) + b * (k - lo[2]));
+                let mut i = lo[0];
+                while i < hi[0] {
+                    let index = [(k / ck) as u64, (j / cj) as u64, (i / ci) as u64];
+                    let run = (ci - i % ci).min(hi[0] - i);
+                    if dead {
+                        out[row + i - lo[0]..][..run].fill(f32::NAN);
+                    } else {
+                        let chunk = self.chunk(&index)?;
+                        let at = (i % ci) + ci * ((j % cj) + cj * (k % ck));
+                        out[row + i - lo[0]..][..run].copy_from_slice(&chunk[at..at + run]);
+                    }
+                    i += run;
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The chunk file holding brick `c`'s first voxel.
+    pub fn chunk_file(&self, b: usize, c: [usize; 3]) -> std::path::PathBuf {
+        let ch = &self.data.chunks;
+        self.data.chunk_file(&[
+            (c[2] * b) as u64 / ch[0],
+            (c[1] * b) as u64 / ch[1],
+            (c[0] * b) as u64 / ch[2],
+        ])
+    }
+}

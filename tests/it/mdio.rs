@@ -1,0 +1,220 @@
+//! MDIO stores written by mdio-python (`multidimio` from PyPI, installed by `.ci/run`),
+//! opened by arbvis: every sample equal to the same SEG-Y read by arbvis's own reader,
+//! the dataset's inline, crossline and time coordinates on the axes, and dead traces
+//! (`trace_mask` false) read as no data and drawn transparent. Skipped (SKIPPED on stderr)
+//! without `python3 -c "import mdio"`; `ARBVIS_NO_SKIP=1` makes a skip a failure.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::common::{data_file, headless, temp_dir};
+use arbvis::gl::Backend;
+use arbvis::render::render_on;
+use arbvis::scene::Scene;
+use arbvis::store::Store;
+use arbvis::volume::segy;
+
+/// mdio-python's SEG-Y ingestion of the F3 crop's header layout (rev 1: inline at byte 189,
+/// crossline at 193, CDP x/y at 181/185), as its documentation shows it.
+const INGEST: &str = r#"
+import sys
+from mdio import segy_to_mdio
+from mdio.builder.template_registry import get_template
+from segy.standards import get_segy_standard
+from segy.schema import HeaderField
+
+def main():
+    spec = get_segy_standard(1.0).customize(trace_header_fields=[
+        HeaderField(name="inline", byte=189, format="int32"),
+        HeaderField(name="crossline", byte=193, format="int32"),
+        HeaderField(name="cdp_x", byte=181, format="int32"),
+        HeaderField(name="cdp_y", byte=185, format="int32"),
+    ])
+    segy_to_mdio(segy_spec=spec, mdio_template=get_template("PostStack3DTime"),
+                 input_path=sys.argv[1], output_path=sys.argv[2], overwrite=True)
+
+if __name__ == "__main__":
+    main()
+"#;
+
+fn has_mdio() -> bool {
+    let ok = Command::new("python3")
+        .args(["-c", "import mdio"])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok {
+        let reason = "python3 with multidimio is missing (pip install multidimio)";
+        if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
+            panic!("ARBVIS_NO_SKIP=1 but {reason}");
+        }
+        eprintln!("SKIPPED: {reason}");
+    }
+    ok
+}
+
+/// `sgy` ingested by mdio-python into `DIR/NAME.mdio`.
+fn ingest(dir: &Path, sgy: &Path, name: &str) -> PathBuf {
+    let script = dir.join("ingest.py");
+    std::fs::write(&script, INGEST).unwrap();
+    let out = dir.join(format!("{name}.mdio"));
+    let run = Command::new("python3")
+        .arg(&script)
+        .arg(sgy)
+        .arg(&out)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "mdio-python: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    out
+}
+
+/// The F3 crop without the traces of crosslines 0..9 of inlines 5..11 (a hole inside the
+/// grid, which mdio-python keeps and marks dead).
+fn with_hole(dir: &Path) -> PathBuf {
+    let bytes = std::fs::read(data_file("seismic/f3.sgy")).unwrap();
+    // 3600 bytes of headers, then traces of 240 + 75 x 2 bytes, 18 crosslines an inline.
+    let trace = 240 + 75 * 2;
+    let mut out = bytes[..3600].to_vec();
+    for t in 0..23 * 18 {
+        let (k, j) = (t / 18, t % 18);
+        if !(HOLE_K.contains(&k) && HOLE_J.contains(&j)) {
+            out.extend_from_slice(&bytes[3600 + t * trace..][..trace]);
+        }
+    }
+    let path = dir.join("holes.sgy");
+    std::fs::write(&path, out).unwrap();
+    path
+}
+
+const HOLE_K: std::ops::Range<usize> = 5..11;
+const HOLE_J: std::ops::Range<usize> = 0..9;
+
+/// Level 0 of attribute 0, i fastest.
+fn level0(store: &Store) -> Vec<f32> {
+    store.region(0, 0, [0; 3], store.meta.dims).unwrap()
+}
+
+#[test]
+fn an_mdio_store_from_mdio_python_reads_as_the_segy_does() {
+    if !has_mdio() {
+        return;
+    }
+    let dir = temp_dir("mdio-f3");
+    let sgy = data_file("seismic/f3.sgy");
+    let mdio = ingest(&dir, &sgy, "f3");
+    let store = Store::open(&mdio).unwrap();
+    let cube = segy::read(&sgy, &Default::default()).unwrap().volume;
+    assert_eq!(store.meta.dims, cube.dims);
+    // Every sample exactly: MDIO holds the int16 samples as float32, as arbvis reads them.
+    assert_eq!(level0(&store), cube.values);
+    // The axes carry the dataset's own coordinates.
+    let src = &store.meta.source;
+    assert_eq!(src.inlines, Some([111, 1]));
+    assert_eq!(src.crosslines, Some([875, 1]));
+    assert_eq!(src.interval_us, Some(4000));
+    assert!(
+        src.facts["cdp_x"].starts_with("620181.9"),
+        "{:?}",
+        src.facts
+    );
+    assert!(store.is_mdio() && store.meta.levels == 1);
+    // inspect describes it, the blosc codec and the trace headers it does not draw.
+    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args(["inspect", mdio.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    for want in [
+        "format: MDIO v1.",
+        "template: PostStack3DTime",
+        "live traces: 414 of 414",
+        "crossline: 18, numbers 875..892",
+        "amplitude: float32 (inline, crossline, time) shape [23, 18, 75]",
+        "codecs bytes + blosc",
+        "headers: not read by arbvis",
+    ] {
+        assert!(text.contains(want), "{want}\n{text}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The F3 store scene (scenes/store/f3.toml) on `store`, 160 px.
+fn scene_on(dir: &Path, store: &Path) -> Scene {
+    let text =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/store/f3.toml"))
+            .unwrap()
+            .replace("../../f3.zarr", store.to_str().unwrap());
+    let mut scene = Scene::parse(&text, "f3-mdio.toml").unwrap();
+    scene.base = dir.to_path_buf();
+    scene.size = [160, 160];
+    scene
+}
+
+#[test]
+fn dead_traces_read_as_no_data_and_draw_transparent() {
+    if !has_mdio() {
+        return;
+    }
+    let dir = temp_dir("mdio-holes");
+    let full = ingest(&dir, &data_file("seismic/f3.sgy"), "full");
+    let holes = ingest(&dir, &with_hole(&dir), "holes");
+    let (a, b) = (Store::open(&full).unwrap(), Store::open(&holes).unwrap());
+    // mdio-python keeps the whole grid and marks the missing traces dead.
+    assert_eq!(a.meta.dims, b.meta.dims);
+    assert!(b.meta.source.facts["live traces"].starts_with("360 of 414"));
+    let (va, vb) = (level0(&a), level0(&b));
+    let [ni, nj, _] = a.meta.dims;
+    for (n, (x, y)) in va.iter().zip(&vb).enumerate() {
+        let (k, j) = (n / (ni * nj), n / ni % nj);
+        if HOLE_K.contains(&k) && HOLE_J.contains(&j) {
+            assert!(y.is_nan(), "dead trace {k}, {j}: {y}");
+        } else {
+            assert_eq!(x, y, "live sample {n}");
+        }
+    }
+    // Seen along the time axis (each pixel's ray runs down one trace), with a table whose
+    // ends are opaque: the pixels over the hole go dark, about its share of the traces
+    // (54 of 414), and nothing new lights up. Dead traces drawn as any value the table
+    // shows (the lowest amplitude, or zero with a table that shows zero) would keep them lit.
+    let h = headless(Backend::Egl);
+    for fidelity in [
+        arbvis::vocab::Fidelity::Faithful,
+        arbvis::vocab::Fidelity::Precise,
+    ] {
+        let render = |store: &Path| {
+            let mut scene = scene_on(&dir, store);
+            scene.fidelity = fidelity;
+            scene.camera.rotation = [
+                0.0,
+                std::f64::consts::FRAC_1_SQRT_2,
+                0.0,
+                std::f64::consts::FRAC_1_SQRT_2,
+            ];
+            let bg = scene.background;
+            let image = render_on(&h, &scene).unwrap().image;
+            image
+                .data
+                .chunks_exact(4)
+                .map(|p| (0..3).any(|c| (p[c] - bg[c]).abs() > 2.0 / 255.0))
+                .collect::<Vec<bool>>()
+        };
+        let (la, lb) = (render(&full), render(&holes));
+        let lit = la.iter().filter(|&&x| x).count();
+        let darkened = la.iter().zip(&lb).filter(|(a, b)| **a && !**b).count();
+        let lightened = la.iter().zip(&lb).filter(|(a, b)| !**a && **b).count();
+        // 54/414 = 13 % of the traces; the hole's edge pixels blend with live traces.
+        assert!(
+            darkened * 100 >= lit * 8,
+            "{fidelity:?}: {darkened} of {lit} lit pixels went dark"
+        );
+        assert!(
+            lightened * 100 <= lit,
+            "{fidelity:?}: {lightened} pixels lit up"
+        );
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
