@@ -629,20 +629,20 @@ fn targets() -> Vec<Target> {
             text: true,
             sections: false,
             corpus: vec![
-                template_file("amplitude/0/zarr.json"),
-                template_file("envelope/range/1/zarr.json"),
+                template_file("amplitude/zarr.json"),
+                template_file("level_1/envelope_range/zarr.json"),
             ],
-            run: |b| store_case("amplitude/0/zarr.json", b),
+            run: |b| store_case("amplitude/zarr.json", b),
         },
         Target {
             name: "store-chunk",
             text: false,
             sections: false,
             corpus: vec![
-                template_file("amplitude/0/c/0/0/0"),
-                template_file("envelope/0/c/1/0/1"),
+                template_file("amplitude/c/0/0/0"),
+                template_file("envelope/c/1/0/1"),
             ],
-            run: |b| store_case("amplitude/0/c/0/0/0", b),
+            run: |b| store_case("amplitude/c/0/0/0", b),
         },
         Target {
             name: "store-log",

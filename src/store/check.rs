@@ -8,7 +8,7 @@ use std::path::Path;
 
 use serde::Deserialize;
 
-use super::meta::{StoreMeta, FORMAT, VERSION};
+use super::meta::{StoreMeta, FORMAT, VERSIONS};
 use super::zarr::{self, ArrayMeta, DataType};
 use super::StoreError;
 
@@ -83,9 +83,9 @@ pub fn read_meta(store: &Path) -> Result<StoreMeta, StoreError> {
 /// Every number of `meta` bounded and consistent (`file` names it in errors).
 pub fn check_meta(file: &Path, meta: &StoreMeta) -> Result<(), StoreError> {
     let bad = |m: String| Err(StoreError::invalid(file, m));
-    if meta.format != FORMAT || meta.version != VERSION {
+    if meta.format != FORMAT || !VERSIONS.contains(&meta.version) {
         return bad(format!(
-            "format {:?} version {}: arbvis reads {FORMAT:?} version {VERSION}",
+            "format {:?} version {}: arbvis reads {FORMAT:?} versions {VERSIONS:?}",
             meta.format, meta.version
         ));
     }
@@ -212,12 +212,12 @@ pub fn open_arrays(
     let b = meta.brick as u64;
     let mut data = Vec::with_capacity(meta.attributes.len());
     let mut ranges = Vec::with_capacity(meta.attributes.len());
-    for attribute in &meta.attributes {
+    for (a, attribute) in meta.attributes.iter().enumerate() {
         let (mut d, mut r) = (Vec::new(), Vec::new());
         for level in 0..meta.levels {
             let n = meta.level_dims(level);
             let shape = [n[2] as u64, n[1] as u64, n[0] as u64];
-            let name = format!("{}/{level}", attribute.name);
+            let name = meta.array_path(a, level)[1..].to_string();
             d.push(checked_array(
                 store,
                 &name,
@@ -227,7 +227,7 @@ pub fn open_arrays(
             )?);
             let c = meta.brick_counts(level);
             let shape = [c[2] as u64, c[1] as u64, c[0] as u64, 2];
-            let name = format!("{}/range/{level}", attribute.name);
+            let name = meta.range_path(a, level)[1..].to_string();
             r.push(checked_array(store, &name, &shape, &shape, "float32")?);
         }
         data.push(d);

@@ -38,12 +38,11 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use rustfft::FftPlanner;
-use zarrs::array::codec::ZstdCodec;
-use zarrs::array::{data_type, Array, ArrayBuilder, CodecOptions};
+use zarrs::array::{Array, CodecOptions};
 use zarrs::filesystem::FilesystemStore;
-use zarrs::group::GroupBuilder;
 
 use super::input::Input;
+use super::layout;
 use super::meta::{AttributeMeta, StoreMeta, FORMAT, VERSION};
 use super::progress::{holds_nothing, read_log, start_log, Job, StoreLock, Unit};
 use super::reader::Store;
@@ -137,6 +136,7 @@ fn job_of(input: &Path, o: &ConvertOptions, attributes: &[Attribute]) -> Result<
         attributes: attributes.iter().map(|a| a.name().to_string()).collect(),
         zstd: o.zstd,
         raw: o.raw.as_ref().map(|r| format!("{r:?}")),
+        layout: VERSION,
     })
 }
 
@@ -229,7 +229,8 @@ pub fn convert(
     };
     let storage = Arc::new(FilesystemStore::new(store).map_err(|e| StoreError::io(store, e))?);
     // Every zarr.json, written whole (again on a resume: a kill may have cut one).
-    create_arrays(&storage, store, &meta, o)?;
+    let has_cdp = src.has_coordinates();
+    let writers = layout::write_layout(&storage, store, &meta, o.zstd, has_cdp, None)?;
     let log = Log {
         file: Mutex::new(
             OpenOptions::new()
@@ -239,11 +240,10 @@ pub fn convert(
         ),
     };
     let resumed = done.len();
-    let arrays = open_arrays(&storage, store, &meta)?;
     let ctx = Ctx {
         store,
         meta: &meta,
-        arrays: &arrays,
+        writers: &writers,
         attributes: &attributes,
         log: &log,
         log_path: &log_path,
@@ -293,7 +293,7 @@ pub fn convert(
             .collect::<Result<_, _>>()?;
         done.extend(new.into_iter().map(|u| (u.u, u)));
     }
-    let meta = finish_store(&storage, store, meta.clone(), &done)?;
+    let meta = finish_store(&storage, store, meta.clone(), &done, o.zstd, has_cdp)?;
     std::fs::remove_file(&log_path).map_err(|e| StoreError::io(&log_path, e))?;
     Ok(ConvertReport {
         written: ctx.written.load(Ordering::Relaxed),
@@ -304,105 +304,10 @@ pub fn convert(
     })
 }
 
-fn create_arrays(
-    storage: &Arc<FilesystemStore>,
-    store: &Path,
-    meta: &StoreMeta,
-    o: &ConvertOptions,
-) -> Result<(), StoreError> {
-    let mut group = GroupBuilder::new()
-        .build(storage.clone(), "/")
-        .map_err(|e| StoreError::io(store, e))?;
-    group.attributes_mut().insert(
-        "arbvis".into(),
-        serde_json::to_value(meta).map_err(|e| StoreError::io(store, e))?,
-    );
-    write_json(store, "/", group.metadata())?;
-    let b = meta.brick as u64;
-    for (a, am) in meta.attributes.iter().enumerate() {
-        let g = GroupBuilder::new()
-            .build(storage.clone(), &format!("/{}", am.name))
-            .map_err(|e| StoreError::io(store, e))?;
-        write_json(store, g.path().as_str(), g.metadata())?;
-        let g = GroupBuilder::new()
-            .build(storage.clone(), &format!("/{}/range", am.name))
-            .map_err(|e| StoreError::io(store, e))?;
-        write_json(store, g.path().as_str(), g.metadata())?;
-        for level in 0..meta.levels {
-            let d = meta.level_dims(level);
-            let shape = vec![d[2] as u64, d[1] as u64, d[0] as u64];
-            let mut builder = if am.dtype == "float16" {
-                ArrayBuilder::new(shape, vec![b; 3], data_type::float16(), half::f16::ZERO)
-            } else {
-                ArrayBuilder::new(shape, vec![b; 3], data_type::float32(), 0.0f32)
-            };
-            if o.zstd > 0 {
-                builder.bytes_to_bytes_codecs(vec![Arc::new(ZstdCodec::new(o.zstd, false))]);
-            }
-            builder.dimension_names(Some(["inline", "crossline", "sample"]));
-            let p = Store::array_path(meta, a, level);
-            let array = builder
-                .build(storage.clone(), &p)
-                .map_err(|e| StoreError::io(store, e))?;
-            write_json(store, &p, array.metadata())?;
-            let c = meta.brick_counts(level);
-            let rshape = vec![c[2] as u64, c[1] as u64, c[0] as u64, 2];
-            let mut rb = ArrayBuilder::new(rshape.clone(), rshape, data_type::float32(), f32::NAN);
-            rb.dimension_names(Some([
-                "inline_brick",
-                "crossline_brick",
-                "sample_brick",
-                "min_max",
-            ]));
-            let rp = Store::range_path(meta, a, level);
-            let r = rb
-                .build(storage.clone(), &rp)
-                .map_err(|e| StoreError::io(store, e))?;
-            write_json(store, &rp, r.metadata())?;
-        }
-    }
-    Ok(())
-}
-
-/// Write the `zarr.json` of the node at zarr path `node` whole: a temporary renamed into
-/// place, so that a kill leaves the old file or the new one, never a cut one.
-fn write_json(
-    store: &Path,
-    node: &str,
-    metadata: &impl serde::Serialize,
-) -> Result<(), StoreError> {
-    let folder = store.join(node.trim_start_matches('/'));
-    std::fs::create_dir_all(&folder).map_err(|e| StoreError::io(&folder, e))?;
-    let file = folder.join("zarr.json");
-    let json = serde_json::to_vec_pretty(metadata).map_err(|e| StoreError::io(&file, e))?;
-    crate::png_io::write_atomic(&file, &json).map_err(|e| StoreError::io(&file, e))
-}
-
-type Arrays = Vec<Vec<Array<FilesystemStore>>>;
-
-fn open_arrays(
-    storage: &Arc<FilesystemStore>,
-    store: &Path,
-    meta: &StoreMeta,
-) -> Result<Arrays, StoreError> {
-    (0..meta.attributes.len())
-        .map(|a| {
-            (0..meta.levels)
-                .map(|l| {
-                    let p = Store::array_path(meta, a, l);
-                    Array::open(storage.clone(), &p).map_err(|e| {
-                        StoreError::invalid(&store.join(&p[1..]), format!("cannot open: {e}"))
-                    })
-                })
-                .collect()
-        })
-        .collect()
-}
-
 struct Ctx<'a> {
     store: &'a Path,
     meta: &'a StoreMeta,
-    arrays: &'a Arrays,
+    writers: &'a layout::Writers,
     attributes: &'a [Attribute],
     log: &'a Log,
     log_path: &'a Path,
@@ -411,15 +316,17 @@ struct Ctx<'a> {
     bytes: AtomicU64,
 }
 
-/// Range and sums of a brick's finite values.
-fn brick_stats(values: impl Iterator<Item = f32>) -> ([f32; 2], [f64; 3]) {
+/// Range, sums (sum, finite count, non-finite count) and sum of squares of a brick's
+/// values.
+fn brick_stats(values: impl Iterator<Item = f32>) -> ([f32; 2], [f64; 3], f64) {
     let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    let (mut sum, mut n, mut bad) = (0.0f64, 0.0f64, 0.0f64);
+    let (mut sum, mut n, mut bad, mut squares) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     for v in values {
         if v.is_finite() {
             lo = lo.min(v);
             hi = hi.max(v);
             sum += v as f64;
+            squares += v as f64 * v as f64;
             n += 1.0;
         } else {
             bad += 1.0;
@@ -428,7 +335,7 @@ fn brick_stats(values: impl Iterator<Item = f32>) -> ([f32; 2], [f64; 3]) {
     if lo > hi {
         (lo, hi) = (f32::NAN, f32::NAN);
     }
-    ([lo, hi], [sum, n, bad])
+    ([lo, hi], [sum, n, bad], squares)
 }
 
 impl Ctx<'_> {
@@ -439,7 +346,7 @@ impl Ctx<'_> {
         c: [usize; 3],
         values: &[f32],
     ) -> Result<(), StoreError> {
-        let array = &self.arrays[attr][level];
+        let array = &self.writers.data[attr][level];
         let index = [c[2] as u64, c[1] as u64, c[0] as u64];
         let options = CodecOptions::default().with_store_empty_chunks(true);
         let result = if self.meta.attributes[attr].dtype == "float16" {
@@ -460,6 +367,47 @@ impl Ctx<'_> {
             chunk: index,
             message: format!("cannot be written: {e}"),
         })
+    }
+
+    /// A column's traces: the trace mask (every trace of a converted survey is live) and,
+    /// where the survey gives them, the CDP coordinates, as `B x B` chunks over
+    /// (inline, crossline).
+    fn store_traces(
+        &self,
+        u: [usize; 3],
+        nj: usize,
+        nk: usize,
+        coordinates: &[[f64; 2]],
+    ) -> Result<(), StoreError> {
+        let b = self.meta.brick;
+        let index = [u[2] as u64, u[1] as u64];
+        let options = CodecOptions::default().with_store_empty_chunks(true);
+        let fail = |what: &str, e: String| StoreError::Io {
+            path: self.store.join(what),
+            message: format!("chunk {index:?} cannot be written: {e}"),
+        };
+        let mut live = vec![false; b * b];
+        for y in 0..nk {
+            live[y * b..y * b + nj].fill(true);
+        }
+        self.writers
+            .mask
+            .store_chunk_opt(&index, live.as_slice(), &options)
+            .map_err(|e| fail("trace_mask", e.to_string()))?;
+        if let Some(cdp) = &self.writers.cdp {
+            for (c, (array, name)) in cdp.iter().zip(["cdp_x", "cdp_y"]).enumerate() {
+                let mut values = vec![f64::NAN; b * b];
+                for y in 0..nk {
+                    for x in 0..nj {
+                        values[y * b + x] = coordinates[y * nj + x][c];
+                    }
+                }
+                array
+                    .store_chunk_opt(&index, values.as_slice(), &options)
+                    .map_err(|e| fail(name, e.to_string()))?;
+            }
+        }
+        Ok(())
     }
 
     /// Values as the store will hold them (float16 attributes rounded), so that ranges
@@ -501,7 +449,14 @@ impl Ctx<'_> {
         let (j1, k1) = ((j0 + b).min(nj), (k0 + b).min(nk));
         let traces = (j1 - j0) * (k1 - k0);
         let mut column = vec![0f32; ni * traces];
-        src.read_column(j0..j1, k0..k1, &mut column)?;
+        let mut coordinates = vec![[f64::NAN; 2]; traces];
+        let wanted = self
+            .writers
+            .cdp
+            .is_some()
+            .then_some(coordinates.as_mut_slice());
+        src.read_column(j0..j1, k0..k1, &mut column, wanted)?;
+        self.store_traces(u, j1 - j0, k1 - k0, &coordinates)?;
         self.bytes
             .fetch_add(traces as u64 * src.bytes_per_trace(), Ordering::Relaxed);
         let mut planes: Vec<Vec<f32>> = vec![column];
@@ -526,6 +481,7 @@ impl Ctx<'_> {
         let bricks_i = ni.div_ceil(b);
         let mut ranges = vec![Vec::with_capacity(bricks_i); planes.len()];
         let mut sums = vec![[0.0f64; 3]; planes.len()];
+        let mut squares = vec![0.0f64; planes.len()];
         let mut chunk = vec![0f32; b * b * b];
         let (nj_c, nk_c) = (j1 - j0, k1 - k0);
         for (a, plane) in planes.iter().enumerate() {
@@ -542,15 +498,21 @@ impl Ctx<'_> {
                     let chunk = &chunk;
                     (0..nj_c).flat_map(move |y| chunk[b * (y + b * z)..][..i1 - i0].iter().copied())
                 });
-                let (range, s) = brick_stats(inside);
+                let (range, s, sq) = brick_stats(inside);
                 ranges[a].push(range);
                 for q in 0..3 {
                     sums[a][q] += s[q];
                 }
+                squares[a] += sq;
                 self.store_chunk(a, 0, [bi, u[1], u[2]], &chunk)?;
             }
         }
-        Ok(Unit { u, ranges, sums })
+        Ok(Unit {
+            u,
+            ranges,
+            sums,
+            squares,
+        })
     }
 
     /// One column of level `u[0]`, filtered from the level below.
@@ -562,6 +524,7 @@ impl Ctx<'_> {
         let bricks_i = n[0].div_ceil(b);
         let mut ranges = vec![Vec::with_capacity(bricks_i); self.attributes.len()];
         let mut sums = vec![[0.0f64; 3]; self.attributes.len()];
+        let mut squares = vec![0.0f64; self.attributes.len()];
         let mut chunk = vec![0f32; b * b * b];
         for (a, &attribute) in self.attributes.iter().enumerate() {
             for bi in 0..bricks_i {
@@ -596,15 +559,21 @@ impl Ctx<'_> {
                 }
                 self.round_to_stored(a, &mut chunk);
                 self.round_to_stored(a, &mut inside);
-                let (range, s) = brick_stats(inside.into_iter());
+                let (range, s, sq) = brick_stats(inside.into_iter());
                 ranges[a].push(range);
                 for q in 0..3 {
                     sums[a][q] += s[q];
                 }
+                squares[a] += sq;
                 self.store_chunk(a, level, c, &chunk)?;
             }
         }
-        Ok(Unit { u, ranges, sums })
+        Ok(Unit {
+            u,
+            ranges,
+            sums,
+            squares,
+        })
     }
 }
 
@@ -687,8 +656,11 @@ fn finish_store(
     store: &Path,
     mut meta: StoreMeta,
     done: &HashMap<[usize; 3], Unit>,
+    zstd: i32,
+    has_cdp: bool,
 ) -> Result<StoreMeta, StoreError> {
     let mut totals: BTreeMap<usize, [f64; 3]> = BTreeMap::new();
+    let mut squares: BTreeMap<usize, f64> = BTreeMap::new();
     let mut extremes: BTreeMap<usize, [f64; 2]> = BTreeMap::new();
     for a in 0..meta.attributes.len() {
         for level in 0..meta.levels {
@@ -719,6 +691,8 @@ fn finish_store(
                         for (total, sum) in t.iter_mut().zip(unit.sums[a]) {
                             *total += sum;
                         }
+                        *squares.entry(a).or_insert(0.0) +=
+                            unit.squares.get(a).copied().unwrap_or(0.0);
                     }
                 }
             }
@@ -742,14 +716,18 @@ fn finish_store(
         am.non_finite = t[2] as u64;
     }
     meta.complete = true;
-    let mut group = GroupBuilder::new()
-        .build(storage.clone(), "/")
-        .map_err(|e| StoreError::io(store, e))?;
-    group.attributes_mut().insert(
-        "arbvis".into(),
-        serde_json::to_value(&meta).map_err(|e| StoreError::io(store, e))?,
-    );
-    write_json(store, "/", group.metadata())?;
+    let stats: Vec<layout::Stats> = (0..meta.attributes.len())
+        .map(|a| {
+            let t = totals.get(&a).copied().unwrap_or([0.0; 3]);
+            layout::Stats {
+                count: t[1],
+                sum: t[0],
+                sum_squares: squares.get(&a).copied().unwrap_or(0.0),
+            }
+        })
+        .collect();
+    // Every zarr.json again, now with the statistics, the root (complete) last.
+    layout::write_layout(storage, store, &meta, zstd, has_cdp, Some(&stats))?;
     Ok(meta)
 }
 

@@ -27,9 +27,14 @@ pub fn describe(store: &Path) -> Result<String, StoreError> {
         progress(store, &meta)
     };
     let _ = writeln!(s, "{}", store.display());
+    let layout = if meta.version >= 2 {
+        "zarr v3, the MDIO v1 layout"
+    } else {
+        "zarr v3, the layout before MDIO"
+    };
     let _ = writeln!(
         s,
-        "format: arbvis store version {} (zarr v3), {state}",
+        "format: arbvis store version {} ({layout}), {state}",
         meta.version
     );
     let src = &meta.source;

@@ -153,6 +153,11 @@ impl Input {
         Ok(Input::Segy(s, m))
     }
 
+    /// Whether the input gives map coordinates per trace (SEG-Y's CDP x and y).
+    pub fn has_coordinates(&self) -> bool {
+        matches!(self, Input::Segy(..))
+    }
+
     /// Voxels along i, j, k.
     pub fn dims(&self) -> [usize; 3] {
         match self {
@@ -189,15 +194,17 @@ impl Input {
         }
     }
 
-    /// Every sample of crosslines `j` and inlines `k`, sample fastest, into `out`.
+    /// Every sample of crosslines `j` and inlines `k`, sample fastest, into `out`; for
+    /// SEG-Y also each trace's CDP x and y into `coordinates` (crossline fastest).
     pub fn read_column(
         &self,
         j: Range<usize>,
         k: Range<usize>,
         out: &mut [f32],
+        coordinates: Option<&mut [[f64; 2]]>,
     ) -> Result<(), StoreError> {
         match self {
-            Input::Segy(s, _) => Ok(s.read_column(j, k, out)?),
+            Input::Segy(s, _) => Ok(s.read_column_with_coordinates(j, k, out, coordinates)?),
             Input::Flat(f) => f.read_column(j, k, out),
             Input::Memory(v, _) => {
                 let ni = v.dims[0];

@@ -8,8 +8,13 @@ use crate::volume::attributes::Attribute;
 
 /// Format name in [`StoreMeta::format`].
 pub const FORMAT: &str = "arbvis bricked multi-resolution survey";
-/// Version of the layout.
-pub const VERSION: u32 = 1;
+/// Version of the layout `arbvis convert` writes: 2, the MDIO v1 layout (level 0 as the
+/// group's own variables, coarser levels in `level_N` groups). Version 1 (every level
+/// under `ATTRIBUTE/LEVEL`) is still read.
+pub const VERSION: u32 = 2;
+
+/// The layout versions arbvis reads.
+pub const VERSIONS: [u32; 2] = [1, 2];
 
 /// The group attribute `arbvis`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -85,6 +90,38 @@ pub struct SourceMeta {
 }
 
 impl StoreMeta {
+    /// The zarr path of attribute `attr`'s level `level` (`/amplitude`, `/level_1/amplitude`;
+    /// version 1: `/amplitude/0`).
+    pub fn array_path(&self, attr: usize, level: usize) -> String {
+        let name = &self.attributes[attr].name;
+        match (self.version, level) {
+            (1, _) => format!("/{name}/{level}"),
+            (_, 0) => format!("/{name}"),
+            (_, l) => format!("/level_{l}/{name}"),
+        }
+    }
+
+    /// The zarr path of the per-brick ranges of `attr` at `level` (`/amplitude_range`,
+    /// `/level_1/amplitude_range`; version 1: `/amplitude/range/0`).
+    pub fn range_path(&self, attr: usize, level: usize) -> String {
+        let name = &self.attributes[attr].name;
+        match (self.version, level) {
+            (1, _) => format!("/{name}/range/{level}"),
+            (_, 0) => format!("/{name}_range"),
+            (_, l) => format!("/level_{l}/{name}_range"),
+        }
+    }
+
+    /// The name of the sample axis: `time` where the survey gave a sample interval
+    /// (SEG-Y), else `sample`.
+    pub fn domain(&self) -> &'static str {
+        if self.source.interval_us.is_some() {
+            "time"
+        } else {
+            "sample"
+        }
+    }
+
     /// The attribute named `name`, and its position.
     pub fn attribute(&self, name: &str) -> Option<(usize, &AttributeMeta)> {
         self.attributes

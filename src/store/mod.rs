@@ -3,20 +3,22 @@
 //! what streams it to the GPU.
 //!
 //! # The store
-//! A zarr v3 group (`STORE/zarr.json`) whose attribute `arbvis` ([`StoreMeta`]) holds the
-//! survey's dimensions, spacing, brick side, level count, filter, each attribute's value
-//! statistics and the source's header facts. One array per attribute and level:
-//! `STORE/<attribute>/<level>` (`amplitude/0` is the survey itself), shape
+//! A zarr v3 group (`STORE/zarr.json`) laid out as an MDIO v1 post-stack dataset
+//! ([`layout`]), whose attribute `arbvis` ([`StoreMeta`]) holds the survey's dimensions,
+//! spacing, brick side, level count, filter, each attribute's value statistics and the
+//! source's header facts. Level 0 is the group's variables (`STORE/amplitude`, ...),
+//! level `L` the group `STORE/level_L`: one array per attribute and level, shape
 //! `[inlines, crosslines, samples]` (zarr's C order: the sample axis fastest, as in
-//! [`crate::volume::Volume`]), dimension names `inline, crossline, sample`, chunks of
-//! `B³` voxels (the bricks; `B` = 64 by default), zstd-compressed. Level `L` is
-//! `ceil(n / 2^L)` voxels per axis; levels go on until one brick holds the volume.
-//! Amplitude is float32 (exactly the source's values); the derived attributes (envelope,
-//! phase, frequency) are float16 (11 significant bits, a relative error of 2^-11, far below
-//! the 1/255 the colour tables resolve) to halve their disk and read cost.
-//! `STORE/<attribute>/range/<level>` holds per brick the min and max of its finite
-//! samples (`[bricks_k, bricks_j, bricks_i, 2]`, float32; NaN where none is finite), so a
-//! brick that the tables make transparent is skipped without reading it.
+//! [`crate::volume::Volume`]), dimension names `inline, crossline, time` (or `sample`;
+//! suffixed `_L` in level `L`), chunks of `B³` voxels (the bricks; `B` = 64 by default),
+//! zstd-compressed. Level `L` is `ceil(n / 2^L)` voxels per axis; levels go on until one
+//! brick holds the volume. Amplitude is float32 (exactly the source's values); the derived
+//! attributes (envelope, phase, frequency) are float16 (11 significant bits, a relative
+//! error of 2^-11, far below the 1/255 the colour tables resolve) to halve their disk and
+//! read cost. `NAME_range` holds per brick the min and max of its finite samples
+//! (`[bricks_k, bricks_j, bricks_i, 2]`, float32; NaN where none is finite), so a brick
+//! that the tables make transparent is skipped without reading it. Stores of version 1
+//! (`STORE/<attribute>/<level>`, `STORE/<attribute>/range/<level>`) are still read.
 //!
 //! The filter from one level to the next is a box (the mean of the 2x2x2 voxels, fewer at
 //! a far edge of odd size), for every attribute but phase, whose mean wraps wrongly at
@@ -32,6 +34,7 @@
 //!   [`progress`]: its lock and progress log.
 //! - [`describe`]: `arbvis inspect STORE`.
 //! - [`mdio`]: MDIO v1 datasets (written by mdio-python) opened in place as one level.
+//! - [`layout`]: the MDIO v1 layout `convert` writes (metadata, coordinates, statistics).
 //! - [`reader`]: chunks, bricks with their one-voxel border, and level-0 windows read back.
 //! - [`lod`]: which bricks a view needs (screen-space error), in visibility order (no GL).
 //! - [`cache`]: the GPU brick cache (fixed texture budget, LRU, a loader thread).
@@ -41,6 +44,7 @@ pub mod check;
 pub mod convert;
 pub mod describe;
 pub mod input;
+pub mod layout;
 pub mod lod;
 pub mod mdio;
 pub mod meta;

@@ -33,6 +33,13 @@ pub(crate) struct Job {
     pub attributes: Vec<String>,
     pub zstd: i32,
     pub raw: Option<String>,
+    /// The store layout's version (a log written before version 2 has none).
+    #[serde(default = "layout_one")]
+    pub layout: u32,
+}
+
+fn layout_one() -> u32 {
+    1
 }
 
 /// One finished column: `u` = `[level, j brick, k brick]`; per attribute, the ranges of
@@ -42,6 +49,9 @@ pub(crate) struct Unit {
     pub u: [usize; 3],
     pub ranges: Vec<Vec<[f32; 2]>>,
     pub sums: Vec<[f64; 3]>,
+    /// Per attribute, the sum of squares of the finite values (MDIO's statsV1).
+    #[serde(default)]
+    pub squares: Vec<f64>,
 }
 
 impl Unit {
@@ -59,11 +69,12 @@ impl Unit {
             ));
         }
         let attrs = meta.attributes.len();
-        if self.ranges.len() != attrs || self.sums.len() != attrs {
+        if self.ranges.len() != attrs || self.sums.len() != attrs || self.squares.len() != attrs {
             return Err(format!(
-                "{} ranges and {} sums for {attrs} attributes",
+                "{} ranges, {} sums and {} squares for {attrs} attributes",
                 self.ranges.len(),
-                self.sums.len()
+                self.sums.len(),
+                self.squares.len()
             ));
         }
         if let Some(r) = self.ranges.iter().find(|r| r.len() != counts[0]) {
@@ -74,10 +85,10 @@ impl Unit {
             ));
         }
         let bricks_voxels = (meta.brick as f64).powi(3) * counts[0] as f64;
-        for s in &self.sums {
+        for (s, q) in self.sums.iter().zip(&self.squares) {
             let counted = s[1] >= 0.0 && s[2] >= 0.0 && s[1] + s[2] <= bricks_voxels;
-            if !s.iter().all(|v| v.is_finite()) || !counted {
-                return Err(format!("statistics {s:?} cannot be a column's"));
+            if !(s.iter().all(|v| v.is_finite()) && counted && q.is_finite() && *q >= 0.0) {
+                return Err(format!("statistics {s:?} and {q} cannot be a column's"));
             }
         }
         Ok(())

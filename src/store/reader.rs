@@ -153,14 +153,14 @@ impl Store {
         self.mdio.is_some()
     }
 
-    /// The zarr path of attribute `attr`'s level `level` (`/amplitude/0`).
+    /// The zarr path of attribute `attr`'s level `level` ([`StoreMeta::array_path`]).
     pub fn array_path(meta: &StoreMeta, attr: usize, level: usize) -> String {
-        format!("/{}/{level}", meta.attributes[attr].name)
+        meta.array_path(attr, level)
     }
 
     /// The zarr path of the per-brick ranges of `attr` at `level`.
     pub fn range_path(meta: &StoreMeta, attr: usize, level: usize) -> String {
-        format!("/{}/range/{level}", meta.attributes[attr].name)
+        meta.range_path(attr, level)
     }
 
     /// The file of chunk `c` (`[i, j, k]` brick indices) of `attr` at `level`.

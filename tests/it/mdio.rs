@@ -218,3 +218,63 @@ fn dead_traces_read_as_no_data_and_draw_transparent() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// arbvis's own store opened by mdio-python and xarray: the same amplitude, coordinates
+/// and map coordinates as mdio-python's ingestion of the same SEG-Y, every level a
+/// dataset of the data tree.
+#[test]
+fn an_arbvis_store_opens_in_mdio_python_and_xarray() {
+    if !has_mdio() {
+        return;
+    }
+    let dir = temp_dir("mdio-arbvis");
+    let sgy = data_file("seismic/f3.sgy");
+    let theirs = ingest(&dir, &sgy, "theirs");
+    let ours = dir.join("ours.zarr");
+    let o = arbvis::store::convert::ConvertOptions {
+        brick: 16,
+        progress: false,
+        ..Default::default()
+    };
+    arbvis::store::convert::convert(&sgy, &ours, &o).unwrap();
+    let script = r#"
+import sys, numpy as np, xarray as xr, mdio
+ours, theirs = mdio.open_mdio(sys.argv[1]), mdio.open_mdio(sys.argv[2])
+for name in ["amplitude", "inline", "crossline", "time", "cdp_x", "cdp_y", "trace_mask"]:
+    a, b = ours[name].values, theirs[name].values
+    print(name, a.shape == b.shape and bool(np.array_equal(a, b)))
+print("envelope", ours["envelope"].dims, ours["envelope"].dtype)
+print("stats", ours["amplitude"].attrs["statsV1"][:9])
+tree = xr.open_datatree(sys.argv[1], engine="zarr", consolidated=False)
+print("levels", sorted(k for k in tree.children))
+print("level_1", tree["level_1"]["amplitude"].dims, tree["level_1"]["amplitude"].shape)
+"#;
+    let out = Command::new("python3")
+        .args(["-c", script])
+        .arg(&ours)
+        .arg(&theirs)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for want in [
+        "amplitude True",
+        "inline True",
+        "crossline True",
+        "time True",
+        "cdp_x True",
+        "cdp_y True",
+        "trace_mask True",
+        "envelope ('inline', 'crossline', 'time') float32",
+        "stats {\"count\"",
+        "levels ['level_1', 'level_2', 'level_3']",
+        "level_1 ('inline_1', 'crossline_1', 'time_1') (12, 9, 38)",
+    ] {
+        assert!(text.contains(want), "{want}\n{text}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

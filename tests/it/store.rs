@@ -214,7 +214,7 @@ fn an_interrupted_conversion_resumes_to_the_same_store() {
     let e = Store::open(&path).err().unwrap().to_string();
     assert!(e.contains("resume"), "{e}");
     // A chunk torn by the interruption (a column not in the log): garbage on disk.
-    let torn = path.join("amplitude/0/c/2/2/3");
+    let torn = path.join("amplitude/c/2/2/3");
     std::fs::create_dir_all(torn.parent().unwrap()).unwrap();
     std::fs::write(&torn, b"torn write").unwrap();
     // Other options are refused, naming both.
@@ -603,9 +603,9 @@ fn streaming_refines_to_the_full_picture_and_survives_a_corrupt_chunk() {
     // Corrupt one chunk and delete another: offscreen names the chunk; streaming keeps
     // drawing and says which bricks failed.
     let store = dir.join("s.zarr");
-    let chunk = store.join("amplitude/0/c/1/1/2");
+    let chunk = store.join("amplitude/c/1/1/2");
     std::fs::write(&chunk, b"not zstd").unwrap();
-    std::fs::remove_file(store.join("envelope/0/c/2/2/4")).unwrap();
+    std::fs::remove_file(store.join("envelope/c/2/2/4")).unwrap();
     let level0 = "[technique.opacity3d.store]\nlevel = 0\n";
     let scene0 = store_scene(&dir, "{ store = \"s.zarr\" }", level0, 64);
     let e = match render_on(&h, &scene0) {
@@ -613,13 +613,13 @@ fn streaming_refines_to_the_full_picture_and_survives_a_corrupt_chunk() {
         Ok(_) => panic!("a corrupt chunk rendered"),
     };
     assert!(
-        e.contains("amplitude/0/c/1/1/2") && e.contains("cannot be decoded"),
+        e.contains("amplitude/c/1/1/2") && e.contains("cannot be decoded"),
         "{e}"
     );
     let s = Store::open(&store).unwrap();
     let e = s.chunk(1, 0, [4, 2, 2]).unwrap_err().to_string();
     assert!(
-        e.contains("envelope/0/c/2/2/4") && e.contains("missing"),
+        e.contains("envelope/c/2/2/4") && e.contains("missing"),
         "{e}"
     );
     let mut renderer = build(gpu, &scene0, kind).unwrap();
@@ -666,13 +666,13 @@ fn zarr_python_reads_the_store() {
 import zarr
 root = zarr.open_group("survey.zarr", mode="r")
 meta = root.attrs["arbvis"]
-amplitude = root["amplitude/0"]
+amplitude = root["amplitude"]
 section = amplitude[5, :, :]
-coarse = root["amplitude/1"][:]
-ranges = root["amplitude/range/0"][:]
+coarse = root["level_1/amplitude"][:]
+ranges = root["amplitude_range"][:]
 print(meta["dims"], amplitude.shape, amplitude.chunks, str(amplitude.dtype))
 print(repr(float(section[3, 17])), repr(float(amplitude[10, 12, 20])))
-print(coarse.shape, ranges.shape, str(root["phase/0"].dtype))
+print(coarse.shape, ranges.shape, str(root["phase"].dtype))
 "#;
     let out = std::process::Command::new("python3")
         .args(["-c", script])
@@ -698,5 +698,54 @@ print(coarse.shape, ranges.shape, str(root["phase/0"].dtype))
     let expect = [v.values[v.index(17, 3, 5)], v.values[v.index(20, 12, 10)]];
     assert_eq!(read, expect.map(f64::from), "{text}");
     assert_eq!(lines[2], "(6, 7, 11) (2, 2, 3, 2) float16", "{text}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A store of the layout before MDIO (version 1: every level under `ATTRIBUTE/LEVEL`, the
+/// ranges under `ATTRIBUTE/range/LEVEL`) still opens and reads the same values: made here
+/// by moving a version 2 store's arrays to those paths.
+#[test]
+fn a_store_of_the_layout_before_mdio_still_reads() {
+    let dir = temp_dir("store-v1");
+    let sgy = write_segy(&dir, &survey([21, 13, 11]));
+    let s = dir.join("s.zarr");
+    convert(&sgy, &s, &options(8)).unwrap();
+    let want = all_values(&Store::open(&s).unwrap());
+    let meta = Store::open(&s).unwrap().meta;
+    let group = r#"{"zarr_format": 3, "node_type": "group", "attributes": {}}"#;
+    for a in &meta.attributes {
+        let name = &a.name;
+        let tmp = dir.join(format!("{name}-0"));
+        std::fs::rename(s.join(name), &tmp).unwrap();
+        std::fs::create_dir_all(s.join(name).join("range")).unwrap();
+        std::fs::write(s.join(name).join("zarr.json"), group).unwrap();
+        std::fs::write(s.join(name).join("range/zarr.json"), group).unwrap();
+        std::fs::rename(&tmp, s.join(name).join("0")).unwrap();
+        std::fs::rename(
+            s.join(format!("{name}_range")),
+            s.join(name).join("range/0"),
+        )
+        .unwrap();
+        for level in 1..meta.levels {
+            std::fs::rename(
+                s.join(format!("level_{level}/{name}")),
+                s.join(name).join(level.to_string()),
+            )
+            .unwrap();
+            std::fs::rename(
+                s.join(format!("level_{level}/{name}_range")),
+                s.join(name).join(format!("range/{level}")),
+            )
+            .unwrap();
+        }
+    }
+    let root = s.join("zarr.json");
+    let text = std::fs::read_to_string(&root).unwrap();
+    let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    v["attributes"]["arbvis"]["version"] = serde_json::json!(1);
+    std::fs::write(&root, v.to_string()).unwrap();
+    let old = Store::open(&s).unwrap();
+    assert_eq!(old.meta.version, 1);
+    assert_eq!(all_values(&old), want);
     std::fs::remove_dir_all(&dir).unwrap();
 }

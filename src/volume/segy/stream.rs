@@ -278,6 +278,18 @@ impl SegyStream {
         k: Range<usize>,
         out: &mut [f32],
     ) -> Result<(), VolumeError> {
+        self.read_column_with_coordinates(j, k, out, None)
+    }
+
+    /// [`SegyStream::read_column`], and each trace's CDP x and y (bytes 181-188, scaled by
+    /// the coordinate scalar of bytes 71-72) into `coordinates` (crossline fastest).
+    pub fn read_column_with_coordinates(
+        &self,
+        j: Range<usize>,
+        k: Range<usize>,
+        out: &mut [f32],
+        mut coordinates: Option<&mut [[f64; 2]]>,
+    ) -> Result<(), VolumeError> {
         let ns = self.layout.samples;
         let tl = self.layout.trace_len;
         let (big, format) = (self.layout.big, self.layout.format);
@@ -321,6 +333,22 @@ impl SegyStream {
                                 self.crosslines[cell]
                             ),
                         ));
+                    }
+                    if let Some(c) = coordinates.as_deref_mut() {
+                        let s = i16::from_be_bytes(if big {
+                            [trace[70], trace[71]]
+                        } else {
+                            [trace[71], trace[70]]
+                        }) as f64;
+                        let scale = match s {
+                            s if s < 0.0 => 1.0 / -s,
+                            s if s > 0.0 => s,
+                            _ => 1.0,
+                        };
+                        c[at / ns + q] = [
+                            i32_at(trace, 180, big) as f64 * scale,
+                            i32_at(trace, 184, big) as f64 * scale,
+                        ];
                     }
                     let dst = &mut out[at + q * ns..][..ns];
                     for (s, v) in dst.iter_mut().enumerate() {

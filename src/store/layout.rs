@@ -1,0 +1,387 @@
+//! The layout `arbvis convert` writes (version 2): an MDIO v1 post-stack dataset that also
+//! carries arbvis's pyramid, so that xarray, mdio-python and Dask open the survey and
+//! arbvis streams it.
+//!
+//! - The root group is MDIO's: attributes `apiVersion`, `name` (`PostStack3DTime` for a
+//!   SEG-Y survey), `attributes` (`surveyType`, `gatherType`, `defaultVariableName`), and
+//!   arbvis's own `arbvis` ([`StoreMeta`]).
+//! - Level 0 is the group's variables on dimensions `inline, crossline, time` (`sample`
+//!   for a survey without a sample interval): `amplitude` and the derived attributes,
+//!   each with MDIO's `statsV1`; the coordinates `inline`, `crossline`, `time` (ms);
+//!   `trace_mask` (every trace of a converted survey is live); `cdp_x`, `cdp_y` where
+//!   the SEG-Y gives them (bytes 181-188, scaled by bytes 71-72); per-brick ranges
+//!   `NAME_range` on dimensions `inline_brick, crossline_brick, time_brick, min_max`.
+//! - Level `L` is the group `level_L`, a dataset of its own: the same variables and
+//!   ranges, halved per axis, on dimensions of its own (`inline_L`, `crossline_L`,
+//!   `time_L`: a data tree aligns a group's dimensions with its parent's of the same
+//!   name), with coordinates that are the means of the cells' level-0 coordinates
+//!   (`xarray.open_datatree` opens every level).
+//! - SEG-Y trace headers (a structured type) are not written: zarrs writes no structured
+//!   types.
+//!
+//! Every `zarr.json` is written whole (a temporary renamed into place), and all of them
+//! again when the conversion resumes and when it finishes (with the statistics), the root
+//! last, so that the root's `complete` flag never precedes the rest.
+
+use std::path::Path;
+use std::sync::Arc;
+
+use serde_json::{json, Map, Value};
+use zarrs::array::{data_type, Array, ArrayBuilder, ArraySubset, DataType};
+use zarrs::filesystem::FilesystemStore;
+use zarrs::group::GroupBuilder;
+
+use super::meta::StoreMeta;
+use super::StoreError;
+
+/// The MDIO version whose layout this follows (as multidimio 1.1.3 writes it).
+pub const MDIO_API_VERSION: &str = "1.1.3";
+
+/// One attribute's statistics over level 0, as MDIO's `statsV1`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Stats {
+    /// Finite samples.
+    pub count: f64,
+    /// Their sum.
+    pub sum: f64,
+    /// Their sum of squares.
+    pub sum_squares: f64,
+}
+
+fn storage_error(path: &Path, e: impl std::fmt::Display) -> StoreError {
+    StoreError::io(path, e)
+}
+
+/// Write the `zarr.json` of the node at zarr path `node` whole: a temporary renamed into
+/// place, so that a kill leaves the old file or the new one, never a cut one.
+pub fn write_json(
+    store: &Path,
+    node: &str,
+    metadata: &impl serde::Serialize,
+) -> Result<(), StoreError> {
+    let folder = store.join(node.trim_start_matches('/'));
+    std::fs::create_dir_all(&folder).map_err(|e| StoreError::io(&folder, e))?;
+    let file = folder.join("zarr.json");
+    let json = serde_json::to_vec_pretty(metadata).map_err(|e| StoreError::io(&file, e))?;
+    crate::png_io::write_atomic(&file, &json).map_err(|e| StoreError::io(&file, e))
+}
+
+/// A group at `node` with `attributes`.
+fn group(
+    storage: &Arc<FilesystemStore>,
+    store: &Path,
+    node: &str,
+    attributes: Map<String, Value>,
+) -> Result<(), StoreError> {
+    let mut g = GroupBuilder::new()
+        .build(storage.clone(), node)
+        .map_err(|e| storage_error(store, e))?;
+    *g.attributes_mut() = attributes;
+    write_json(store, node, g.metadata())
+}
+
+/// An array's metadata written; the array, to write chunks into.
+#[allow(clippy::too_many_arguments)]
+fn array(
+    storage: &Arc<FilesystemStore>,
+    store: &Path,
+    node: &str,
+    shape: Vec<u64>,
+    chunks: Vec<u64>,
+    dtype: DataType,
+    fill: impl Into<zarrs::array::builder::ArrayBuilderFillValue>,
+    dims: &[&str],
+    zstd: i32,
+    attributes: Map<String, Value>,
+) -> Result<Array<FilesystemStore>, StoreError> {
+    let mut b = ArrayBuilder::new(shape, chunks, dtype, fill);
+    if zstd > 0 {
+        b.bytes_to_bytes_codecs(vec![Arc::new(zarrs::array::codec::ZstdCodec::new(
+            zstd, false,
+        ))]);
+    }
+    b.dimension_names(Some(dims.to_vec()));
+    b.attributes(attributes);
+    let a = b
+        .build(storage.clone(), node)
+        .map_err(|e| storage_error(store, e))?;
+    write_json(store, node, a.metadata())?;
+    Ok(a)
+}
+
+/// The level-0 coordinate values along each axis: inline and crossline numbers (the
+/// survey's, else indices), and time in ms (else sample indices).
+pub fn coordinates(meta: &StoreMeta) -> [Vec<f64>; 3] {
+    let [ni, nj, nk] = meta.dims;
+    let numbers = |n: usize, first_step: Option<[i64; 2]>| -> Vec<f64> {
+        let [first, step] = first_step.unwrap_or([0, 1]);
+        (0..n).map(|x| (first + step * x as i64) as f64).collect()
+    };
+    let dt = meta.source.interval_us.map_or(1.0, |us| us as f64 / 1000.0);
+    [
+        (0..ni).map(|i| i as f64 * dt).collect(),
+        numbers(nj, meta.source.crosslines),
+        numbers(nk, meta.source.inlines),
+    ]
+}
+
+/// `values` (a level-0 axis) at level `level`: the mean over each cell of `2^level`.
+fn coarsen(values: &[f64], level: usize) -> Vec<f64> {
+    values
+        .chunks(1 << level)
+        .map(|c| c.iter().sum::<f64>() / c.len() as f64)
+        .collect()
+}
+
+/// The `statsV1` attribute of an attribute, as MDIO writes it (a JSON text).
+fn stats_v1(meta: &StoreMeta, attr: usize, s: &Stats) -> Value {
+    let a = &meta.attributes[attr];
+    let v = json!({
+        "count": s.count as u64,
+        "sum": s.sum,
+        "sumSquares": s.sum_squares,
+        "min": a.min.unwrap_or(0.0),
+        "max": a.max.unwrap_or(0.0),
+        "histogram": {"counts": [], "binCenters": []},
+    });
+    Value::String(v.to_string())
+}
+
+/// The root group's attributes: MDIO's and `arbvis`.
+fn root_attributes(meta: &StoreMeta) -> Result<Map<String, Value>, serde_json::Error> {
+    let mut m = Map::new();
+    m.insert("apiVersion".into(), json!(MDIO_API_VERSION));
+    let name = if meta.domain() == "time" {
+        "PostStack3DTime"
+    } else {
+        "PostStack3D"
+    };
+    m.insert("name".into(), json!(name));
+    m.insert(
+        "attributes".into(),
+        json!({"surveyType": "3D", "gatherType": "stacked", "defaultVariableName": "amplitude"}),
+    );
+    m.insert("arbvis".into(), serde_json::to_value(meta)?);
+    Ok(m)
+}
+
+/// What a conversion writes chunks into: per attribute and level the data array, and
+/// (level 0, chunked by columns) the trace mask and map coordinates.
+pub struct Writers {
+    /// Data arrays by attribute, then level.
+    pub data: Vec<Vec<Array<FilesystemStore>>>,
+    /// `trace_mask`, chunks of `B x B` traces.
+    pub mask: Array<FilesystemStore>,
+    /// `cdp_x` and `cdp_y`, chunks of `B x B` traces, where the survey gives them.
+    pub cdp: Option<[Array<FilesystemStore>; 2]>,
+}
+
+/// Every node's metadata (and the coordinate arrays' values), for `meta` and, once the
+/// conversion ends, the statistics; returns the arrays to write chunks into.
+pub fn write_layout(
+    storage: &Arc<FilesystemStore>,
+    store: &Path,
+    meta: &StoreMeta,
+    zstd: i32,
+    has_cdp: bool,
+    stats: Option<&[Stats]>,
+) -> Result<Writers, StoreError> {
+    let b = meta.brick as u64;
+    let domain = meta.domain();
+    let dims = ["inline", "crossline", domain];
+    let coords = coordinates(meta);
+    // By attribute, then level.
+    let mut data: Vec<Vec<Array<FilesystemStore>>> =
+        meta.attributes.iter().map(|_| Vec::new()).collect();
+    let variable_attributes = |attr: usize| -> Map<String, Value> {
+        let mut m = Map::new();
+        if has_cdp {
+            m.insert("coordinates".into(), json!("cdp_x cdp_y"));
+        }
+        if let Some(s) = stats {
+            m.insert("statsV1".into(), stats_v1(meta, attr, &s[attr]));
+        }
+        m
+    };
+    for level in 0..meta.levels {
+        let prefix = if level == 0 {
+            String::new()
+        } else {
+            format!("/level_{level}")
+        };
+        if level > 0 {
+            let mut attributes = Map::new();
+            attributes.insert(
+                "description".into(),
+                json!(format!(
+                    "arbvis level {level}: every axis halved {level} times from the root's"
+                )),
+            );
+            group(storage, store, &prefix, attributes)?;
+        }
+        // A level's dimensions are its own (`inline_1`, ...): xarray's data tree aligns a
+        // group's dimensions with its parent's of the same name.
+        let suffix = if level == 0 {
+            String::new()
+        } else {
+            format!("_{level}")
+        };
+        let names: Vec<String> = dims.iter().map(|d| format!("{d}{suffix}")).collect();
+        let level_dims: Vec<&str> = names.iter().map(String::as_str).collect();
+        let bricks: Vec<String> = dims
+            .iter()
+            .map(|d| format!("{d}_brick{suffix}"))
+            .chain(["min_max".to_string()])
+            .collect();
+        let brick_dims: Vec<&str> = bricks.iter().map(String::as_str).collect();
+        // Coordinates: integers where they are whole, else float64.
+        for (axis, name) in [
+            (2usize, level_dims[0]),
+            (1, level_dims[1]),
+            (0, level_dims[2]),
+        ] {
+            let values = coarsen(&coords[axis], level);
+            let node = format!("{prefix}/{name}");
+            let n = values.len() as u64;
+            let whole = values.iter().all(|v| v.fract() == 0.0 && v.abs() < 2e9);
+            let a = if whole {
+                let a = array(
+                    storage,
+                    store,
+                    &node,
+                    vec![n],
+                    vec![n],
+                    data_type::int32(),
+                    0i32,
+                    &[name],
+                    zstd,
+                    Map::new(),
+                )?;
+                let v: Vec<i32> = values.iter().map(|&x| x as i32).collect();
+                a.store_array_subset(&ArraySubset::new_with_shape(vec![n]), v.as_slice())
+                    .map_err(|e| storage_error(store, e))?;
+                a
+            } else {
+                let a = array(
+                    storage,
+                    store,
+                    &node,
+                    vec![n],
+                    vec![n],
+                    data_type::float64(),
+                    f64::NAN,
+                    &[name],
+                    zstd,
+                    Map::new(),
+                )?;
+                a.store_array_subset(&ArraySubset::new_with_shape(vec![n]), values.as_slice())
+                    .map_err(|e| storage_error(store, e))?;
+                a
+            };
+            drop(a);
+        }
+        for (attr, am) in meta.attributes.iter().enumerate() {
+            let d = meta.level_dims(level);
+            let shape = vec![d[2] as u64, d[1] as u64, d[0] as u64];
+            let attributes = if level == 0 {
+                variable_attributes(attr)
+            } else {
+                Map::new()
+            };
+            let node = format!("{prefix}/{}", am.name);
+            let a = if am.dtype == "float16" {
+                array(
+                    storage,
+                    store,
+                    &node,
+                    shape,
+                    vec![b; 3],
+                    data_type::float16(),
+                    half::f16::NAN,
+                    &level_dims,
+                    zstd,
+                    attributes,
+                )?
+            } else {
+                array(
+                    storage,
+                    store,
+                    &node,
+                    shape,
+                    vec![b; 3],
+                    data_type::float32(),
+                    f32::NAN,
+                    &level_dims,
+                    zstd,
+                    attributes,
+                )?
+            };
+            data[attr].push(a);
+            let c = meta.brick_counts(level);
+            let rshape = vec![c[2] as u64, c[1] as u64, c[0] as u64, 2];
+            array(
+                storage,
+                store,
+                &format!("{prefix}/{}_range", am.name),
+                rshape.clone(),
+                rshape,
+                data_type::float32(),
+                f32::NAN,
+                &brick_dims,
+                0,
+                Map::new(),
+            )?;
+        }
+    }
+    let [_, nj, nk] = meta.dims;
+    let traces = vec![nk as u64, nj as u64];
+    let mask = array(
+        storage,
+        store,
+        "/trace_mask",
+        traces.clone(),
+        vec![b, b],
+        data_type::bool(),
+        zarrs::array::FillValue::from(false),
+        &dims[..2],
+        zstd,
+        Map::new(),
+    )?;
+    let cdp = if has_cdp {
+        let x = array(
+            storage,
+            store,
+            "/cdp_x",
+            traces.clone(),
+            vec![b, b],
+            data_type::float64(),
+            f64::NAN,
+            &dims[..2],
+            zstd,
+            Map::new(),
+        )?;
+        let y = array(
+            storage,
+            store,
+            "/cdp_y",
+            traces,
+            vec![b, b],
+            data_type::float64(),
+            f64::NAN,
+            &dims[..2],
+            zstd,
+            Map::new(),
+        )?;
+        Some([x, y])
+    } else {
+        None
+    };
+    // The root last: its `complete` flag only once every other node is written.
+    group(
+        storage,
+        store,
+        "/",
+        root_attributes(meta).map_err(|e| storage_error(store, e))?,
+    )?;
+    Ok(Writers { data, mask, cdp })
+}
