@@ -190,15 +190,19 @@ enum Command {
         #[arg(long, default_value = "study")]
         out: PathBuf,
     },
-    /// Convert a survey (SEG-Y, NIfTI-1, raw) into a bricked multi-resolution zarr v3
-    /// store that `{ store = "STORE" }` scenes stream (src/store/). Streams the input
-    /// (one column of traces per worker), computes the derived attributes, builds the
-    /// levels; run it again after an interruption to resume.
+    /// Convert a survey (SEG-Y, NIfTI-1, raw, an MDIO dataset) into a bricked
+    /// multi-resolution zarr v3 store, laid out as an MDIO v1 dataset, that
+    /// `{ store = "STORE" }` scenes stream (src/store/). Streams the input (one column of
+    /// traces per worker), computes the derived attributes, builds the levels; run it
+    /// again after an interruption to resume. Given an MDIO dataset and no STORE, adds the
+    /// levels, ranges and derived attributes to the dataset itself, beside its own arrays.
     Convert {
-        /// The survey: SEG-Y, NIfTI-1 (.nii, .nii.gz), or raw with --raw-dims.
+        /// The survey: SEG-Y, NIfTI-1 (.nii, .nii.gz), raw with --raw-dims, or an MDIO
+        /// dataset (a folder).
         input: PathBuf,
         /// The store's folder (created; an interrupted conversion there is resumed).
-        store: PathBuf,
+        /// Without it, an MDIO dataset given as the input gains the levels in place.
+        store: Option<PathBuf>,
         /// Brick (chunk) side in voxels.
         #[arg(long, default_value_t = 64)]
         brick: usize,
@@ -290,7 +294,12 @@ fn dry_run(command: &Command) -> Result<()> {
     }
     match command {
         Command::Inspect { file, .. } => exists(file)?,
-        Command::Convert { input, .. } => exists(input)?,
+        Command::Convert { input, store, .. } => {
+            exists(input)?;
+            if store.is_none() && !input.is_dir() {
+                bail!("name the store to write (arbvis convert SURVEY STORE); only an MDIO dataset converts in place");
+            }
+        }
         Command::Study { from, scenes, .. } => {
             for path in from {
                 exists(path)?;
@@ -657,6 +666,13 @@ fn run(cli: Cli) -> Result<()> {
                 zstd,
                 raw,
                 ..Default::default()
+            };
+            let store = match store {
+                Some(s) => s,
+                None if input.is_dir() => input.clone(),
+                None => bail!(
+                    "name the store to write (arbvis convert SURVEY STORE); only an MDIO dataset converts in place"
+                ),
             };
             let report = arbvis::store::convert::convert(&input, &store, &options)
                 .with_context(|| format!("converting {}", input.display()))?;

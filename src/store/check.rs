@@ -218,13 +218,29 @@ pub fn open_arrays(
             let n = meta.level_dims(level);
             let shape = [n[2] as u64, n[1] as u64, n[0] as u64];
             let name = meta.array_path(a, level)[1..].to_string();
-            d.push(checked_array(
-                store,
-                &name,
-                &shape,
-                &[b; 3],
-                &attribute.dtype,
-            )?);
+            match (&meta.source_variable, a, level) {
+                // An MDIO dataset's own variable, any chunk shape and type.
+                (Some(variable), 0, 0) => {
+                    let array = zarr::open_array(&store.join(variable))?;
+                    if array.shape != shape {
+                        return Err(StoreError::invalid(
+                            &store.join(variable).join("zarr.json"),
+                            format!(
+                                "{variable}: shape is {:?}, but the store's metadata makes it {shape:?}",
+                                array.shape
+                            ),
+                        ));
+                    }
+                    d.push(array);
+                }
+                _ => d.push(checked_array(
+                    store,
+                    &name,
+                    &shape,
+                    &[b; 3],
+                    &attribute.dtype,
+                )?),
+            }
             let c = meta.brick_counts(level);
             let shape = [c[2] as u64, c[1] as u64, c[0] as u64, 2];
             let name = meta.range_path(a, level)[1..].to_string();

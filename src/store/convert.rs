@@ -120,8 +120,15 @@ struct Log {
     file: Mutex<File>,
 }
 
-fn job_of(input: &Path, o: &ConvertOptions, attributes: &[Attribute]) -> Result<Job, StoreError> {
-    let m = std::fs::metadata(input).map_err(|e| StoreError::io(input, e))?;
+/// The job: the input (its length and time taken from `identity`, the file that stands
+/// for it: an MDIO dataset's variable's `zarr.json`) and the options.
+fn job_of(
+    input: &Path,
+    identity: &Path,
+    o: &ConvertOptions,
+    attributes: &[Attribute],
+) -> Result<Job, StoreError> {
+    let m = std::fs::metadata(identity).map_err(|e| StoreError::io(identity, e))?;
     let modified = m
         .modified()
         .ok()
@@ -163,7 +170,17 @@ pub fn convert(
     let dims = src.dims();
     let b = o.brick;
     let levels = super::level_count(dims, b);
-    let job = job_of(input, o, &attributes)?;
+    // An MDIO dataset converted into itself: levels and ranges beside its own arrays.
+    let in_place = matches!(src, Input::Mdio(..))
+        && std::fs::canonicalize(input).ok() == std::fs::canonicalize(store).ok();
+    let (identity, source_variable) = match &src {
+        Input::Mdio(m, meta) => (
+            m.data.folder.join("zarr.json"),
+            meta.source_variable.clone().filter(|_| in_place),
+        ),
+        _ => (input.to_path_buf(), None),
+    };
+    let job = job_of(input, &identity, o, &attributes)?;
     let workers = rayon::current_num_threads().max(1);
     let bound = memory_bound(dims[0], b, attributes.len(), workers);
     crate::budget::check(
@@ -177,6 +194,7 @@ pub fn convert(
     )
     .map_err(|e| StoreError::Budget(e.to_string()))?;
     check_work(input, &src, dims, b, attributes.len())?;
+    let in_place_level0 = usize::from(in_place);
     let log_path = store.join(PROGRESS_LOG);
     let meta = StoreMeta {
         format: FORMAT.into(),
@@ -204,6 +222,7 @@ pub fn convert(
             "none".into()
         },
         complete: false,
+        source_variable,
     };
     if store.exists() && !store.is_dir() {
         return Err(StoreError::invalid(
@@ -212,11 +231,17 @@ pub fn convert(
         ));
     }
     std::fs::create_dir_all(store).map_err(|e| StoreError::io(store, e))?;
+    check_disk(store, &meta, in_place_level0, o.progress)?;
     // One writer at a time; the lock goes when this function returns.
     let _lock = StoreLock::acquire(store)?;
+    let beside = if in_place {
+        Some(mdio_root_attributes(store)?)
+    } else {
+        None
+    };
     let mut done: HashMap<[usize; 3], Unit> = if log_path.exists() {
         read_log(&log_path, &job, &meta)?
-    } else if holds_nothing(store)? {
+    } else if in_place || holds_nothing(store)? {
         // A new store, or one killed before its log existed: the log first, whole, so
         // that from here on any interruption can be resumed.
         start_log(&log_path, &job)?;
@@ -230,7 +255,14 @@ pub fn convert(
     let storage = Arc::new(FilesystemStore::new(store).map_err(|e| StoreError::io(store, e))?);
     // Every zarr.json, written whole (again on a resume: a kill may have cut one).
     let has_cdp = src.has_coordinates();
-    let writers = layout::write_layout(&storage, store, &meta, o.zstd, has_cdp, None)?;
+    let writers = layout::write_layout(
+        &storage,
+        store,
+        &meta,
+        (o.zstd, has_cdp),
+        None,
+        beside.as_ref(),
+    )?;
     let log = Log {
         file: Mutex::new(
             OpenOptions::new()
@@ -293,7 +325,14 @@ pub fn convert(
             .collect::<Result<_, _>>()?;
         done.extend(new.into_iter().map(|u| (u.u, u)));
     }
-    let meta = finish_store(&storage, store, meta.clone(), &done, o.zstd, has_cdp)?;
+    let meta = finish_store(
+        &storage,
+        store,
+        meta.clone(),
+        &done,
+        (o.zstd, has_cdp),
+        beside.as_ref(),
+    )?;
     std::fs::remove_file(&log_path).map_err(|e| StoreError::io(&log_path, e))?;
     Ok(ConvertReport {
         written: ctx.written.load(Ordering::Relaxed),
@@ -346,7 +385,10 @@ impl Ctx<'_> {
         c: [usize; 3],
         values: &[f32],
     ) -> Result<(), StoreError> {
-        let array = &self.writers.data[attr][level];
+        // An MDIO dataset's own variable is left as it is.
+        let Some(array) = &self.writers.data[attr][level] else {
+            return Ok(());
+        };
         let index = [c[2] as u64, c[1] as u64, c[0] as u64];
         let options = CodecOptions::default().with_store_empty_chunks(true);
         let result = if self.meta.attributes[attr].dtype == "float16" {
@@ -369,7 +411,7 @@ impl Ctx<'_> {
         })
     }
 
-    /// A column's traces: the trace mask (every trace of a converted survey is live) and,
+    /// A column's traces: the trace mask (live unless every sample is NaN) and,
     /// where the survey gives them, the CDP coordinates, as `B x B` chunks over
     /// (inline, crossline).
     fn store_traces(
@@ -377,6 +419,7 @@ impl Ctx<'_> {
         u: [usize; 3],
         nj: usize,
         nk: usize,
+        column: &[f32],
         coordinates: &[[f64; 2]],
     ) -> Result<(), StoreError> {
         let b = self.meta.brick;
@@ -386,14 +429,19 @@ impl Ctx<'_> {
             path: self.store.join(what),
             message: format!("chunk {index:?} cannot be written: {e}"),
         };
+        // A trace is live unless every sample is NaN (an MDIO input's dead traces).
+        let ni = self.meta.dims[0];
         let mut live = vec![false; b * b];
         for y in 0..nk {
-            live[y * b..y * b + nj].fill(true);
+            for x in 0..nj {
+                let trace = &column[(y * nj + x) * ni..][..ni];
+                live[y * b + x] = trace.iter().any(|v| !v.is_nan());
+            }
         }
-        self.writers
-            .mask
-            .store_chunk_opt(&index, live.as_slice(), &options)
-            .map_err(|e| fail("trace_mask", e.to_string()))?;
+        if let Some(mask) = &self.writers.mask {
+            mask.store_chunk_opt(&index, live.as_slice(), &options)
+                .map_err(|e| fail("trace_mask", e.to_string()))?;
+        }
         if let Some(cdp) = &self.writers.cdp {
             for (c, (array, name)) in cdp.iter().zip(["cdp_x", "cdp_y"]).enumerate() {
                 let mut values = vec![f64::NAN; b * b];
@@ -456,7 +504,7 @@ impl Ctx<'_> {
             .is_some()
             .then_some(coordinates.as_mut_slice());
         src.read_column(j0..j1, k0..k1, &mut column, wanted)?;
-        self.store_traces(u, j1 - j0, k1 - k0, &coordinates)?;
+        self.store_traces(u, j1 - j0, k1 - k0, &column, &coordinates)?;
         self.bytes
             .fetch_add(traces as u64 * src.bytes_per_trace(), Ordering::Relaxed);
         let mut planes: Vec<Vec<f32>> = vec![column];
@@ -603,6 +651,71 @@ pub fn filter(attribute: Attribute, get: impl Fn(usize, usize, usize) -> Option<
     }
 }
 
+/// Bytes the store's chunks can take before compression: every brick of every attribute
+/// and level, less the first `skip` attributes' level 0 (an MDIO dataset's own).
+pub fn store_bytes(meta: &StoreMeta, skip: usize) -> u64 {
+    let brick = (meta.brick as u64).pow(3);
+    let mut total = 0u64;
+    for (a, am) in meta.attributes.iter().enumerate() {
+        let each = if am.dtype == "float16" { 2 } else { 4 };
+        for level in 0..meta.levels {
+            if level == 0 && a < skip {
+                continue;
+            }
+            let bricks = meta.brick_counts(level).iter().product::<usize>() as u64;
+            total = total.saturating_add(bricks.saturating_mul(brick * each + 8));
+        }
+    }
+    total
+}
+
+/// Say what the conversion will write, and refuse when the store's disk has less room.
+fn check_disk(store: &Path, meta: &StoreMeta, skip: usize, say: bool) -> Result<(), StoreError> {
+    let need = store_bytes(meta, skip);
+    let free = nix::sys::statvfs::statvfs(store)
+        .ok()
+        .map(|s| s.blocks_available().saturating_mul(s.fragment_size()));
+    let size = crate::budget::format_bytes;
+    if say {
+        crate::progress::line(&format!(
+            "{}: writes up to {} (before compression){}",
+            store.display(),
+            size(need),
+            free.map_or(String::new(), |f| format!("; {} free on its disk", size(f)))
+        ));
+    }
+    match free {
+        Some(f) if f < need => Err(StoreError::invalid(
+            store,
+            format!(
+                "the conversion writes up to {} (before compression) and its disk has {} free: free some space or name a store on another disk",
+                size(need),
+                size(f)
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// An MDIO dataset's root attributes, without an `arbvis` one an earlier run added; an
+/// error if a finished conversion already added its levels.
+fn mdio_root_attributes(
+    store: &Path,
+) -> Result<serde_json::Map<String, serde_json::Value>, StoreError> {
+    let file = store.join("zarr.json");
+    let root = super::zarr::read_json(&file)?;
+    let mut attributes = root["attributes"].as_object().cloned().unwrap_or_default();
+    if let Some(a) = attributes.remove("arbvis") {
+        if a["complete"].as_bool() == Some(true) {
+            return Err(StoreError::invalid(
+                store,
+                "its levels and ranges were added already: the dataset opens as a store as it is",
+            ));
+        }
+    }
+    Ok(attributes)
+}
+
 /// Most chunk files a conversion may write for an input of `bytes` (at least 65,536): a
 /// thin volume in cubic bricks is mostly padding, and `1 x 1 x 2^21` samples in 64³ bricks
 /// would be 32,768 chunks per attribute and level for 2 MB.
@@ -656,8 +769,8 @@ fn finish_store(
     store: &Path,
     mut meta: StoreMeta,
     done: &HashMap<[usize; 3], Unit>,
-    zstd: i32,
-    has_cdp: bool,
+    codecs: (i32, bool),
+    beside: Option<&serde_json::Map<String, serde_json::Value>>,
 ) -> Result<StoreMeta, StoreError> {
     let mut totals: BTreeMap<usize, [f64; 3]> = BTreeMap::new();
     let mut squares: BTreeMap<usize, f64> = BTreeMap::new();
@@ -727,7 +840,7 @@ fn finish_store(
         })
         .collect();
     // Every zarr.json again, now with the statistics, the root (complete) last.
-    layout::write_layout(storage, store, &meta, zstd, has_cdp, Some(&stats))?;
+    layout::write_layout(storage, store, &meta, codecs, Some(&stats), beside)?;
     Ok(meta)
 }
 

@@ -112,6 +112,11 @@ fn describe_mdio(store: &Path) -> Result<String, StoreError> {
             "statistics (statsV1, non-zero samples): min {lo} max {hi}"
         );
     }
+    let _ = writeln!(
+        s,
+        "levels: none (MDIO keeps one resolution); `arbvis convert {}` adds levels, per-brick ranges and derived attributes beside its arrays, which makes turning faster",
+        store.display()
+    );
     let _ = writeln!(s, "variables:");
     let mut entries: Vec<_> = std::fs::read_dir(store)
         .map_err(|e| StoreError::io(store, e))?

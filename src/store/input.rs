@@ -25,6 +25,8 @@ pub enum Input {
     Flat(Flat),
     /// A volume held whole (gzip NIfTI).
     Memory(Volume, SourceMeta),
+    /// An MDIO dataset's default variable, read from its chunks.
+    Mdio(Box<super::mdio::Mdio>, Box<super::meta::StoreMeta>),
 }
 
 /// A file of samples in i, j, k order from a byte offset.
@@ -57,6 +59,17 @@ impl Input {
     /// Open `path`: raw when `raw` describes it, NIfTI by extension (`.nii`, `.nii.gz`),
     /// else SEG-Y.
     pub fn open(path: &Path, raw: Option<&RawSpec>) -> Result<Input, StoreError> {
+        if path.is_dir() && raw.is_none() {
+            let root = super::zarr::read_json(&path.join("zarr.json"))?;
+            if !super::mdio::is_mdio(&root) {
+                return Err(StoreError::invalid(
+                    path,
+                    "a folder that is not an MDIO dataset: convert reads SEG-Y, NIfTI, raw files and MDIO datasets",
+                ));
+            }
+            let (meta, mdio) = super::mdio::open(path, &root)?;
+            return Ok(Input::Mdio(Box::new(mdio), Box::new(meta)));
+        }
         let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
         if let Some(spec) = raw {
             spec.validate()
@@ -164,6 +177,7 @@ impl Input {
             Input::Segy(s, _) => s.dims(),
             Input::Flat(f) => f.dims,
             Input::Memory(v, _) => v.dims,
+            Input::Mdio(_, m) => m.dims,
         }
     }
 
@@ -173,6 +187,7 @@ impl Input {
             Input::Segy(..) => [1.0; 3],
             Input::Flat(f) => f.spacing,
             Input::Memory(v, _) => v.spacing,
+            Input::Mdio(_, m) => m.spacing,
         }
     }
 
@@ -182,6 +197,7 @@ impl Input {
             Input::Segy(_, m) => m.clone(),
             Input::Flat(f) => f.meta.clone(),
             Input::Memory(_, m) => m.clone(),
+            Input::Mdio(_, m) => m.source.clone(),
         }
     }
 
@@ -191,6 +207,7 @@ impl Input {
             Input::Segy(s, _) => s.trace_bytes() as u64,
             Input::Flat(f) => (f.dims[0] * f.sample.bytes()) as u64,
             Input::Memory(v, _) => (v.dims[0] * 4) as u64,
+            Input::Mdio(_, m) => (m.dims[0] * 4) as u64,
         }
     }
 
@@ -205,6 +222,9 @@ impl Input {
     ) -> Result<(), StoreError> {
         match self {
             Input::Segy(s, _) => Ok(s.read_column_with_coordinates(j, k, out, coordinates)?),
+            Input::Mdio(m, meta) => m
+                .column(meta.dims, j, k, out)
+                .map_err(|e| StoreError::invalid(&m.data.folder, e)),
             Input::Flat(f) => f.read_column(j, k, out),
             Input::Memory(v, _) => {
                 let ni = v.dims[0];

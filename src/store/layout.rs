@@ -8,7 +8,7 @@
 //! - Level 0 is the group's variables on dimensions `inline, crossline, time` (`sample`
 //!   for a survey without a sample interval): `amplitude` and the derived attributes,
 //!   each with MDIO's `statsV1`; the coordinates `inline`, `crossline`, `time` (ms);
-//!   `trace_mask` (every trace of a converted survey is live); `cdp_x`, `cdp_y` where
+//!   `trace_mask` (a trace is live unless every sample is NaN); `cdp_x`, `cdp_y` where
 //!   the SEG-Y gives them (bytes 181-188, scaled by bytes 71-72); per-brick ranges
 //!   `NAME_range` on dimensions `inline_brick, crossline_brick, time_brick, min_max`.
 //! - Level `L` is the group `level_L`, a dataset of its own: the same variables and
@@ -168,30 +168,33 @@ fn root_attributes(meta: &StoreMeta) -> Result<Map<String, Value>, serde_json::E
 /// What a conversion writes chunks into: per attribute and level the data array, and
 /// (level 0, chunked by columns) the trace mask and map coordinates.
 pub struct Writers {
-    /// Data arrays by attribute, then level.
-    pub data: Vec<Vec<Array<FilesystemStore>>>,
-    /// `trace_mask`, chunks of `B x B` traces.
-    pub mask: Array<FilesystemStore>,
+    /// Data arrays by attribute, then level (none where an MDIO dataset's own variable is
+    /// level 0 of the attribute).
+    pub data: Vec<Vec<Option<Array<FilesystemStore>>>>,
+    /// `trace_mask`, chunks of `B x B` traces (none beside an MDIO dataset's own).
+    pub mask: Option<Array<FilesystemStore>>,
     /// `cdp_x` and `cdp_y`, chunks of `B x B` traces, where the survey gives them.
     pub cdp: Option<[Array<FilesystemStore>; 2]>,
 }
 
 /// Every node's metadata (and the coordinate arrays' values), for `meta` and, once the
-/// conversion ends, the statistics; returns the arrays to write chunks into.
+/// conversion ends, the statistics; returns the arrays to write chunks into. `beside`: the
+/// root attributes of an MDIO dataset converted in place, whose own variable, coordinates
+/// and mask are level 0 and are left as they are (its root gains the `arbvis` attribute).
 pub fn write_layout(
     storage: &Arc<FilesystemStore>,
     store: &Path,
     meta: &StoreMeta,
-    zstd: i32,
-    has_cdp: bool,
+    (zstd, has_cdp): (i32, bool),
     stats: Option<&[Stats]>,
+    beside: Option<&Map<String, Value>>,
 ) -> Result<Writers, StoreError> {
     let b = meta.brick as u64;
     let domain = meta.domain();
     let dims = ["inline", "crossline", domain];
     let coords = coordinates(meta);
     // By attribute, then level.
-    let mut data: Vec<Vec<Array<FilesystemStore>>> =
+    let mut data: Vec<Vec<Option<Array<FilesystemStore>>>> =
         meta.attributes.iter().map(|_| Vec::new()).collect();
     let variable_attributes = |attr: usize| -> Map<String, Value> {
         let mut m = Map::new();
@@ -234,12 +237,18 @@ pub fn write_layout(
             .chain(["min_max".to_string()])
             .collect();
         let brick_dims: Vec<&str> = bricks.iter().map(String::as_str).collect();
-        // Coordinates: integers where they are whole, else float64.
-        for (axis, name) in [
-            (2usize, level_dims[0]),
-            (1, level_dims[1]),
-            (0, level_dims[2]),
-        ] {
+        // Coordinates: integers where they are whole, else float64 (an MDIO dataset's own
+        // at its level 0).
+        let coordinate_axes = if level == 0 && beside.is_some() {
+            Vec::new()
+        } else {
+            vec![
+                (2usize, level_dims[0]),
+                (1, level_dims[1]),
+                (0, level_dims[2]),
+            ]
+        };
+        for (axis, name) in coordinate_axes {
             let values = coarsen(&coords[axis], level);
             let node = format!("{prefix}/{name}");
             let n = values.len() as u64;
@@ -289,8 +298,11 @@ pub fn write_layout(
                 Map::new()
             };
             let node = format!("{prefix}/{}", am.name);
-            let a = if am.dtype == "float16" {
-                array(
+            let own = level == 0 && attr == 0 && beside.is_some();
+            let a = if own {
+                None
+            } else if am.dtype == "float16" {
+                Some(array(
                     storage,
                     store,
                     &node,
@@ -301,9 +313,9 @@ pub fn write_layout(
                     &level_dims,
                     zstd,
                     attributes,
-                )?
+                )?)
             } else {
-                array(
+                Some(array(
                     storage,
                     store,
                     &node,
@@ -314,7 +326,7 @@ pub fn write_layout(
                     &level_dims,
                     zstd,
                     attributes,
-                )?
+                )?)
             };
             data[attr].push(a);
             let c = meta.brick_counts(level);
@@ -335,18 +347,21 @@ pub fn write_layout(
     }
     let [_, nj, nk] = meta.dims;
     let traces = vec![nk as u64, nj as u64];
-    let mask = array(
-        storage,
-        store,
-        "/trace_mask",
-        traces.clone(),
-        vec![b, b],
-        data_type::bool(),
-        zarrs::array::FillValue::from(false),
-        &dims[..2],
-        zstd,
-        Map::new(),
-    )?;
+    let mask = match beside {
+        Some(_) => None,
+        None => Some(array(
+            storage,
+            store,
+            "/trace_mask",
+            traces.clone(),
+            vec![b, b],
+            data_type::bool(),
+            zarrs::array::FillValue::from(false),
+            &dims[..2],
+            zstd,
+            Map::new(),
+        )?),
+    };
     let cdp = if has_cdp {
         let x = array(
             storage,
@@ -377,11 +392,14 @@ pub fn write_layout(
         None
     };
     // The root last: its `complete` flag only once every other node is written.
-    group(
-        storage,
-        store,
-        "/",
-        root_attributes(meta).map_err(|e| storage_error(store, e))?,
-    )?;
+    let mut root = root_attributes(meta).map_err(|e| storage_error(store, e))?;
+    if let Some(own) = beside {
+        let arbvis = root.remove("arbvis");
+        root = own.clone();
+        if let Some(a) = arbvis {
+            root.insert("arbvis".into(), a);
+        }
+    }
+    group(storage, store, "/", root)?;
     Ok(Writers { data, mask, cdp })
 }

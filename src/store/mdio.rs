@@ -27,6 +27,7 @@ const CHUNK_CACHE: usize = 8;
 type DecodedChunks = HashMap<Vec<u64>, (Arc<Vec<f32>>, u64)>;
 
 /// An open MDIO dataset's level 0.
+#[derive(Debug)]
 pub struct Mdio {
     /// The variable drawn.
     pub data: ArrayMeta,
@@ -280,6 +281,7 @@ pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError>
         },
         compression: data.codec_names(),
         complete: true,
+        source_variable: Some(variable.clone()),
     };
     let bricks = super::brick_counts(meta.dims, BRICK)
         .iter()
@@ -345,22 +347,26 @@ impl Mdio {
         Ok(values)
     }
 
-    /// Brick `c` (`[i, j, k]` in bricks of `b`): `b³` values, i fastest, from the chunks
-    /// it overlaps; dead traces NaN; beyond the survey 0.
-    pub fn brick(&self, dims: [usize; 3], b: usize, c: [usize; 3]) -> Result<Vec<f32>, String> {
+    /// Samples over the box `lo..hi` (i, j, k) into `out`, whose rows are `sx` and planes
+    /// `sx * sy` long; dead traces NaN.
+    fn read_box(
+        &self,
+        dims: [usize; 3],
+        lo: [usize; 3],
+        hi: [usize; 3],
+        out: &mut [f32],
+        [sx, sy]: [usize; 2],
+    ) -> Result<(), String> {
         let [ci, cj, ck] = [
             self.data.chunks[2],
             self.data.chunks[1],
             self.data.chunks[0],
         ]
         .map(|n| n as usize);
-        let lo = c.map(|x| x * b);
-        let hi: [usize; 3] = std::array::from_fn(|a| ((c[a] + 1) * b).min(dims[a]));
-        let mut out = vec![0f32; b * b * b];
         for k in lo[2]..hi[2] {
             for j in lo[1]..hi[1] {
                 let dead = self.live.as_ref().is_some_and(|l| !l[k * dims[1] + j]);
-                let row = b * ((j - lo[1]) + b * (k - lo[2]));
+                let row = sx * ((j - lo[1]) + sy * (k - lo[2]));
                 let mut i = lo[0];
                 while i < hi[0] {
                     let index = [(k / ck) as u64, (j / cj) as u64, (i / ci) as u64];
@@ -376,7 +382,36 @@ impl Mdio {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Brick `c` (`[i, j, k]` in bricks of `b`): `b³` values, i fastest, from the chunks
+    /// it overlaps; dead traces NaN; beyond the survey 0.
+    pub fn brick(&self, dims: [usize; 3], b: usize, c: [usize; 3]) -> Result<Vec<f32>, String> {
+        let lo = c.map(|x| x * b);
+        let hi: [usize; 3] = std::array::from_fn(|a| ((c[a] + 1) * b).min(dims[a]));
+        let mut out = vec![0f32; b * b * b];
+        self.read_box(dims, lo, hi, &mut out, [b, b])?;
         Ok(out)
+    }
+
+    /// Every sample of crosslines `j` and inlines `k` (a column of traces), sample fastest,
+    /// into `out`.
+    pub fn column(
+        &self,
+        dims: [usize; 3],
+        j: std::ops::Range<usize>,
+        k: std::ops::Range<usize>,
+        out: &mut [f32],
+    ) -> Result<(), String> {
+        let sy = j.len();
+        self.read_box(
+            dims,
+            [0, j.start, k.start],
+            [dims[0], j.end, k.end],
+            out,
+            [dims[0], sy],
+        )
     }
 
     /// The chunk file holding brick `c`'s first voxel.

@@ -41,6 +41,10 @@ pub struct StoreMeta {
     pub compression: String,
     /// True once every chunk and range of every level is written.
     pub complete: bool,
+    /// Where the levels were added beside an MDIO dataset's own arrays: the dataset's
+    /// variable that is level 0 of amplitude, read in place.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub source_variable: Option<String>,
 }
 
 /// One stored attribute.

@@ -117,7 +117,17 @@ impl Store {
 
     fn with_meta(path: &Path, meta: StoreMeta, incomplete: bool) -> Result<Store, StoreError> {
         let arrays = super::check::open_arrays(path, &meta)?;
-        Ok(Store::with_arrays(path, meta, arrays, incomplete))
+        let mdio = match &meta.source_variable {
+            // Levels added beside an MDIO dataset: its own variable is level 0.
+            Some(_) => {
+                let root = super::zarr::read_json(&path.join("zarr.json"))?;
+                Some(super::mdio::open(path, &root)?.1)
+            }
+            None => None,
+        };
+        let mut store = Store::with_arrays(path, meta, arrays, incomplete);
+        store.mdio = mdio;
+        Ok(store)
     }
 
     fn with_arrays(
@@ -148,9 +158,10 @@ impl Store {
         self.meta.attributes[attr].non_finite > 0 || self.mdio.as_ref().is_some_and(|m| m.nan_fill)
     }
 
-    /// True when this is an MDIO dataset read in place (one level, no brick ranges).
+    /// True when this is an MDIO dataset read in place without levels (one level, no
+    /// brick ranges: `arbvis convert` on it adds them).
     pub fn is_mdio(&self) -> bool {
-        self.mdio.is_some()
+        self.mdio.is_some() && self.arrays.is_empty()
     }
 
     /// The zarr path of attribute `attr`'s level `level` ([`StoreMeta::array_path`]).
@@ -165,7 +176,7 @@ impl Store {
 
     /// The file of chunk `c` (`[i, j, k]` brick indices) of `attr` at `level`.
     pub fn chunk_file(&self, attr: usize, level: usize, c: [usize; 3]) -> PathBuf {
-        if let Some(m) = &self.mdio {
+        if let Some(m) = self.mdio.as_ref().filter(|_| attr == 0 && level == 0) {
             return m.chunk_file(self.meta.brick, c);
         }
         self.arrays[attr][level].chunk_file(&[c[2] as u64, c[1] as u64, c[0] as u64])
@@ -197,17 +208,19 @@ impl Store {
             )));
         }
         if let Some(m) = &self.mdio {
-            if attr != 0 || level != 0 {
+            if attr == 0 && level == 0 {
+                let values = Arc::new(m.brick(self.meta.dims, self.meta.brick, c).map_err(fail)?);
+                self.cache
+                    .lock()
+                    .expect("chunk cache")
+                    .put(key, values.clone());
+                return Ok(values);
+            }
+            if self.arrays.is_empty() {
                 return Err(fail(
-                    "an MDIO dataset has one attribute and one level".into(),
+                    "an MDIO dataset read in place has one attribute and one level".into(),
                 ));
             }
-            let values = Arc::new(m.brick(self.meta.dims, self.meta.brick, c).map_err(fail)?);
-            self.cache
-                .lock()
-                .expect("chunk cache")
-                .put(key, values.clone());
-            return Ok(values);
         }
         let array = &self.arrays[attr][level];
         let values = match array.read_chunk(&index).map_err(fail)? {
@@ -261,7 +274,7 @@ impl Store {
         {
             return Ok(t.clone());
         }
-        if self.mdio.is_some() {
+        if self.mdio.is_some() && self.arrays.is_empty() {
             // No per-brick ranges: every brick may hold the whole range.
             let a = &self.meta.attributes[attr];
             let range = [

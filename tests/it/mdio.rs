@@ -216,6 +216,24 @@ fn dead_traces_read_as_no_data_and_draw_transparent() {
             "{fidelity:?}: {lightened} pixels lit up"
         );
     }
+    // Converted into a store of its own, the dataset keeps its dead traces dead.
+    let copy = dir.join("copy.zarr");
+    let o = arbvis::store::convert::ConvertOptions {
+        progress: false,
+        ..Default::default()
+    };
+    arbvis::store::convert::convert(&holes, &copy, &o).unwrap();
+    let mask = arbvis::store::zarr::open_array(&copy.join("trace_mask")).unwrap();
+    let live = mask.read_chunk(&[0, 0]).unwrap().unwrap();
+    let dead = (0..23 * 18)
+        .filter(|t| live[(t / 18) * 64 + t % 18] == 0.0)
+        .count();
+    assert_eq!(dead, HOLE_K.len() * HOLE_J.len());
+    let nan = level0(&Store::open(&copy).unwrap())
+        .iter()
+        .filter(|v| v.is_nan())
+        .count();
+    assert_eq!(nan, dead * 75);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -276,5 +294,128 @@ print("level_1", tree["level_1"]["amplitude"].dims, tree["level_1"]["amplitude"]
     ] {
         assert!(text.contains(want), "{want}\n{text}");
     }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Every file of `dir` but its root `zarr.json`, with its bytes.
+fn files_but_root(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            if p.is_dir() {
+                stack.push(p);
+            } else if p != dir.join("zarr.json") {
+                out.push((p.clone(), std::fs::read(&p).unwrap()));
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// `arbvis convert DATASET` adds levels, ranges and the derived attributes beside an MDIO
+/// dataset's own arrays, which it leaves byte for byte; resumable; and the dataset still
+/// opens in mdio-python with the same amplitude.
+#[test]
+fn convert_adds_levels_to_an_mdio_dataset_in_place() {
+    if !has_mdio() {
+        return;
+    }
+    let dir = temp_dir("mdio-in-place");
+    let original = ingest(&dir, &with_hole(&dir), "holes");
+    let before = files_but_root(&original);
+    let whole = Store::open(&original).unwrap();
+    let want = level0(&whole);
+    drop(whole);
+    // Stopped after one column, then resumed, by the command a user runs.
+    let o = arbvis::store::convert::ConvertOptions {
+        brick: 16,
+        progress: false,
+        stop_after: Some(1),
+        ..Default::default()
+    };
+    assert!(arbvis::store::convert::convert(&original, &original, &o).is_err());
+    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args(["convert", original.to_str().unwrap(), "--brick", "16"])
+        .env("CI", "true")
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // MDIO's own files are as they were.
+    let after = files_but_root(&original);
+    for (path, bytes) in &before {
+        let now = after.iter().find(|(p, _)| p == path).map(|(_, b)| b);
+        assert_eq!(now, Some(bytes), "{} changed", path.display());
+    }
+    let store = Store::open(&original).unwrap();
+    assert!(
+        !store.is_mdio() && store.meta.levels == 4,
+        "{:?}",
+        store.meta.levels
+    );
+    assert_eq!(store.meta.source_variable.as_deref(), Some("amplitude"));
+    let got = level0(&store);
+    assert!(got
+        .iter()
+        .zip(&want)
+        .all(|(a, b)| a == b || (a.is_nan() && b.is_nan())));
+    // The coarser levels hold the box filter of level 0 (a spot check of one voxel).
+    let coarse = store.region(0, 1, [3, 5, 8], [1, 1, 1]).unwrap()[0];
+    let [ni, nj, _] = store.meta.dims;
+    let cell: Vec<f32> = (0..8)
+        .map(|n| {
+            let (i, j, k) = (6 + (n & 1), 10 + ((n >> 1) & 1), 16 + (n >> 2));
+            want[i + ni * (j + nj * k)]
+        })
+        .filter(|v| v.is_finite())
+        .collect();
+    let mean = cell.iter().map(|&v| v as f64).sum::<f64>() / cell.len() as f64;
+    assert!(
+        (coarse as f64 - mean).abs() <= 1e-3 * mean.abs().max(1.0),
+        "{coarse} {mean}"
+    );
+    // mdio-python still reads its variable, and xarray every level.
+    let script = r#"
+import sys, numpy as np, xarray as xr, mdio
+ds = mdio.open_mdio(sys.argv[1])
+print("vars", sorted(ds.data_vars))
+tree = xr.open_datatree(sys.argv[1], engine="zarr", consolidated=False)
+print("levels", sorted(tree.children))
+"#;
+    let out = Command::new("python3")
+        .args(["-c", script])
+        .arg(&original)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("'amplitude', 'amplitude_range', 'envelope'"),
+        "{text}"
+    );
+    assert!(
+        text.contains("levels ['level_1', 'level_2', 'level_3']"),
+        "{text}"
+    );
+    // A second run says there is nothing to do.
+    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args(["convert", original.to_str().unwrap(), "--brick", "16"])
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && e.contains("were added already"),
+        "{e}"
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
