@@ -206,8 +206,11 @@ enum Command {
         /// Brick (chunk) side in voxels.
         #[arg(long, default_value_t = 64)]
         brick: usize,
-        /// Derived attributes (per-trace Hilbert transform), comma-separated, or "none".
-        #[arg(long, value_delimiter = ',', default_values_t = ["envelope".to_string(), "phase".to_string(), "frequency".to_string()])]
+        /// Derived attributes (per-trace Hilbert transform), comma-separated, or "none":
+        /// envelope, phase, cosine-phase, frequency. The default, envelope, makes a store
+        /// about 1.8 times the survey (amplitude alone: 0.96); each of phase and frequency
+        /// adds about 0.45.
+        #[arg(long, value_delimiter = ',', default_values_t = ["envelope".to_string()])]
         attributes: Vec<String>,
         /// zstd level of the chunks (0: uncompressed).
         #[arg(long, default_value_t = 1)]

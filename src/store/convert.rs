@@ -74,7 +74,10 @@ impl Default for ConvertOptions {
     fn default() -> Self {
         ConvertOptions {
             brick: 64,
-            derived: vec![Attribute::Envelope, Attribute::Phase, Attribute::Frequency],
+            // Amplitude and envelope: what v3o2's displays start from, at 1.8 times the
+            // survey's disk and twice amplitude's conversion time; phase and frequency
+            // (each another 0.45-0.5 times the disk) on request.
+            derived: vec![Attribute::Envelope],
             zstd: 1,
             raw: None,
             progress: true,
@@ -356,25 +359,52 @@ struct Ctx<'a> {
 }
 
 /// Range, sums (sum, finite count, non-finite count) and sum of squares of a brick's
-/// values.
-fn brick_stats(values: impl Iterator<Item = f32>) -> ([f32; 2], [f64; 3], f64) {
-    let (mut lo, mut hi) = (f32::INFINITY, f32::NEG_INFINITY);
-    let (mut sum, mut n, mut bad, mut squares) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
-    for v in values {
-        if v.is_finite() {
-            lo = lo.min(v);
-            hi = hi.max(v);
-            sum += v as f64;
-            squares += v as f64 * v as f64;
-            n += 1.0;
-        } else {
-            bad += 1.0;
+/// values, gathered a run of values at a time.
+#[derive(Default)]
+struct BrickStats {
+    lo: f32,
+    hi: f32,
+    sum: f64,
+    n: f64,
+    bad: f64,
+    squares: f64,
+}
+
+impl BrickStats {
+    fn new() -> BrickStats {
+        BrickStats {
+            lo: f32::INFINITY,
+            hi: f32::NEG_INFINITY,
+            ..Default::default()
         }
     }
-    if lo > hi {
-        (lo, hi) = (f32::NAN, f32::NAN);
+
+    fn add(&mut self, values: &[f32]) {
+        let (mut sum, mut squares, mut n) = (0.0f64, 0.0f64, 0usize);
+        for &v in values {
+            if v.is_finite() {
+                self.lo = self.lo.min(v);
+                self.hi = self.hi.max(v);
+                sum += v as f64;
+                squares += v as f64 * v as f64;
+                n += 1;
+            }
+        }
+        self.sum += sum;
+        self.squares += squares;
+        self.n += n as f64;
+        self.bad += (values.len() - n) as f64;
     }
-    ([lo, hi], [sum, n, bad], squares)
+
+    /// `[min, max]` (NaN where no value is finite), `[sum, finite, non-finite]`, squares.
+    fn finish(self) -> ([f32; 2], [f64; 3], f64) {
+        let range = if self.lo > self.hi {
+            [f32::NAN; 2]
+        } else {
+            [self.lo, self.hi]
+        };
+        (range, [self.sum, self.n, self.bad], self.squares)
+    }
 }
 
 impl Ctx<'_> {
@@ -535,18 +565,16 @@ impl Ctx<'_> {
         for (a, plane) in planes.iter().enumerate() {
             for bi in 0..bricks_i {
                 let (i0, i1) = (bi * b, ((bi + 1) * b).min(ni));
-                chunk.iter_mut().for_each(|v| *v = 0.0);
+                chunk.fill(0.0);
+                let mut stats = BrickStats::new();
                 for z in 0..nk_c {
                     for y in 0..nj_c {
                         let src = &plane[(z * nj_c + y) * ni..][i0..i1];
                         chunk[b * (y + b * z)..][..i1 - i0].copy_from_slice(src);
+                        stats.add(src);
                     }
                 }
-                let inside = (0..nk_c).flat_map(|z| {
-                    let chunk = &chunk;
-                    (0..nj_c).flat_map(move |y| chunk[b * (y + b * z)..][..i1 - i0].iter().copied())
-                });
-                let (range, s, sq) = brick_stats(inside);
+                let (range, s, sq) = stats.finish();
                 ranges[a].push(range);
                 for q in 0..3 {
                     sums[a][q] += s[q];
@@ -585,29 +613,53 @@ impl Ctx<'_> {
                 chunk.iter_mut().for_each(|v| *v = 0.0);
                 let mut inside =
                     Vec::with_capacity((hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]));
+                // Per axis and output voxel: whether the cell's second voxel below exists
+                // (a far face of odd size has only the first).
+                let second: [Vec<bool>; 3] = std::array::from_fn(|q| {
+                    (0..hi[q] - lo[q])
+                        .map(|t| 2 * (lo[q] + t) + 1 < m[q])
+                        .collect()
+                });
+                let (sx, sxy) = (size[0], size[0] * size[1]);
                 for z in 0..hi[2] - lo[2] {
+                    let dzs = if second[2][z] { 2 } else { 1 };
                     for y in 0..hi[1] - lo[1] {
-                        for x in 0..hi[0] - lo[0] {
-                            let v = filter(attribute, |dx, dy, dz| {
-                                let g = [
-                                    2 * (lo[0] + x) + dx,
-                                    2 * (lo[1] + y) + dy,
-                                    2 * (lo[2] + z) + dz,
-                                ];
-                                if g[0] >= m[0] || g[1] >= m[1] || g[2] >= m[2] {
-                                    return None;
+                        let dys = if second[1][y] { 2 } else { 1 };
+                        let row = &mut chunk[b * (y + b * z)..][..hi[0] - lo[0]];
+                        for (x, out) in row.iter_mut().enumerate() {
+                            let base = 2 * x + sx * 2 * y + sxy * 2 * z;
+                            let v = if attribute == Attribute::Phase {
+                                below_vals[base]
+                            } else {
+                                let dxs = if second[0][x] { 2 } else { 1 };
+                                let (mut sum, mut n) = (0.0f64, 0u32);
+                                for dz in 0..dzs {
+                                    for dy in 0..dys {
+                                        for dx in 0..dxs {
+                                            let v = below_vals[base + dx + sx * dy + sxy * dz];
+                                            if v.is_finite() {
+                                                sum += v as f64;
+                                                n += 1;
+                                            }
+                                        }
+                                    }
                                 }
-                                let (px, py, pz) = (2 * x + dx, 2 * y + dy, 2 * z + dz);
-                                Some(below_vals[px + size[0] * (py + size[1] * pz)])
-                            });
-                            chunk[x + b * (y + b * z)] = v;
+                                if n == 0 {
+                                    f32::NAN
+                                } else {
+                                    (sum / n as f64) as f32
+                                }
+                            };
+                            *out = v;
                             inside.push(v);
                         }
                     }
                 }
                 self.round_to_stored(a, &mut chunk);
                 self.round_to_stored(a, &mut inside);
-                let (range, s, sq) = brick_stats(inside.into_iter());
+                let mut stats = BrickStats::new();
+                stats.add(&inside);
+                let (range, s, sq) = stats.finish();
                 ranges[a].push(range);
                 for q in 0..3 {
                     sums[a][q] += s[q];
@@ -622,32 +674,6 @@ impl Ctx<'_> {
             sums,
             squares,
         })
-    }
-}
-
-/// The level filter over one 2x2x2 cell (`get(dx, dy, dz)`: None beyond the level below):
-/// the mean of the finite voxels present (NaN when none is), or for phase the first voxel.
-pub fn filter(attribute: Attribute, get: impl Fn(usize, usize, usize) -> Option<f32>) -> f32 {
-    if attribute == Attribute::Phase {
-        return get(0, 0, 0).unwrap_or(f32::NAN);
-    }
-    let (mut sum, mut n) = (0.0f64, 0u32);
-    for dz in 0..2 {
-        for dy in 0..2 {
-            for dx in 0..2 {
-                if let Some(v) = get(dx, dy, dz) {
-                    if v.is_finite() {
-                        sum += v as f64;
-                        n += 1;
-                    }
-                }
-            }
-        }
-    }
-    if n == 0 {
-        f32::NAN
-    } else {
-        (sum / n as f64) as f32
     }
 }
 
@@ -737,7 +763,8 @@ pub fn chunk_count(dims: [usize; 3], brick: usize, attributes: usize) -> u64 {
         .saturating_mul(attributes as u64)
 }
 
-/// Refuse work that grows faster than the input: more chunk files than [`max_chunks`].
+/// Refuse work that grows faster than the input: more chunk files than [`max_chunks`],
+/// or chunks (before compression) of more than 64 bytes per byte of the survey.
 fn check_work(
     input: &Path,
     src: &Input,
@@ -750,7 +777,9 @@ fn check_work(
         .saturating_mul((dims[1] * dims[2]) as u64);
     let chunks = chunk_count(dims, brick, attributes);
     let most = max_chunks(bytes);
-    if chunks > most {
+    // And at most 64 bytes of chunks (before compression) per byte of survey, at least 1 GiB.
+    let padded = chunks.saturating_mul((brick as u64).pow(3) * 4);
+    if chunks > most || padded > bytes.saturating_mul(64).max(1 << 30) {
         return Err(StoreError::invalid(
             input,
             format!(

@@ -315,24 +315,33 @@ impl Store {
             .map_err(|e| StoreError::Budget(e.to_string()))?;
         out.resize(count, 0.0);
         let clamp = |v: i64, a: usize| v.clamp(0, n[a] as i64 - 1) as usize;
-        // Source voxel per output index, per axis.
-        let src: [Vec<usize>; 3] =
-            std::array::from_fn(|a| (0..size[a]).map(|t| clamp(lo[a] + t as i64, a)).collect());
-        let mut current: Option<([usize; 3], Arc<Vec<f32>>)> = None;
-        for (z, &k) in src[2].iter().enumerate() {
-            for (y, &j) in src[1].iter().enumerate() {
-                let row = size[0] * (y + size[1] * z);
-                for (x, &i) in src[0].iter().enumerate() {
-                    let c = [i / b, j / b, k / b];
-                    let chunk = match &current {
-                        Some((key, chunk)) if *key == c => chunk.clone(),
-                        _ => {
-                            let chunk = self.chunk(attr, level, c)?;
-                            current = Some((c, chunk.clone()));
-                            chunk
-                        }
-                    };
-                    out[row + x] = chunk[(i % b) + b * ((j % b) + b * (k % b))];
+        // Per axis and output index: the chunk and the voxel within it (the source voxel
+        // clamped to the level's faces).
+        let src: [Vec<(usize, usize)>; 3] = std::array::from_fn(|a| {
+            (0..size[a])
+                .map(|t| {
+                    let v = clamp(lo[a] + t as i64, a);
+                    (v / b, v % b)
+                })
+                .collect()
+        });
+        // The chunks a row of the box crosses, fetched when the row's (j, k) chunk changes.
+        let first = src[0].first().map_or(0, |c| c.0);
+        let last = src[0].last().map_or(0, |c| c.0);
+        let mut key = (usize::MAX, usize::MAX);
+        let mut row_chunks: Vec<Arc<Vec<f32>>> = Vec::new();
+        for (z, &(ck, vk)) in src[2].iter().enumerate() {
+            for (y, &(cj, vj)) in src[1].iter().enumerate() {
+                if key != (cj, ck) {
+                    key = (cj, ck);
+                    row_chunks = (first..=last)
+                        .map(|ci| self.chunk(attr, level, [ci, cj, ck]))
+                        .collect::<Result<_, _>>()?;
+                }
+                let row = &mut out[size[0] * (y + size[1] * z)..][..size[0]];
+                let plane = b * (vj + b * vk);
+                for (o, &(ci, vi)) in row.iter_mut().zip(&src[0]) {
+                    *o = row_chunks[ci - first][vi + plane];
                 }
             }
         }

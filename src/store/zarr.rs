@@ -599,9 +599,21 @@ impl ArrayMeta {
     /// file is absent (zarr's "all fill value"). Errors say what is wrong, without the
     /// file's name (the caller names it).
     pub fn read_chunk(&self, index: &[u64]) -> Result<Option<Vec<f32>>, String> {
-        Ok(self
-            .read_chunk_bytes(index)?
-            .map(|data| self.values(&data).map(|v| v as f32).collect()))
+        let Some(data) = self.read_chunk_bytes(index)? else {
+            return Ok(None);
+        };
+        // The store's own types directly; any other through f64.
+        Ok(Some(match (self.data_type, self.big_endian) {
+            (DataType::Float32, false) => data
+                .chunks_exact(4)
+                .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                .collect(),
+            (DataType::Float16, false) => data
+                .chunks_exact(2)
+                .map(|b| half::f16::from_le_bytes([b[0], b[1]]).to_f32())
+                .collect(),
+            _ => self.values(&data).map(|v| v as f32).collect(),
+        }))
     }
 
     /// [`ArrayMeta::read_chunk`] in f64 (coordinates that need it).

@@ -55,9 +55,11 @@ pub(crate) fn write_segy(dir: &Path, v: &Volume) -> PathBuf {
     path
 }
 
+/// Conversion options with every derived attribute (the default is envelope alone).
 pub(crate) fn options(brick: usize) -> ConvertOptions {
     ConvertOptions {
         brick,
+        derived: vec![Attribute::Envelope, Attribute::Phase, Attribute::Frequency],
         progress: false,
         ..Default::default()
     }

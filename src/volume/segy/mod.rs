@@ -147,6 +147,41 @@ impl SampleFormat {
         }
     }
 
+    /// Decode a trace's samples (`out.len()` of them) from `b`: [`SampleFormat::decode`]
+    /// for each, with the common formats in loops of their own (a conversion decodes
+    /// every sample of a survey).
+    pub fn decode_trace(self, b: &[u8], big: bool, out: &mut [f32]) {
+        let w = self.bytes();
+        let b = &b[..out.len() * w];
+        match (self, big) {
+            (SampleFormat::IeeeFloat, true) => {
+                for (o, s) in out.iter_mut().zip(b.chunks_exact(4)) {
+                    *o = f32::from_be_bytes([s[0], s[1], s[2], s[3]]);
+                }
+            }
+            (SampleFormat::IeeeFloat, false) => {
+                for (o, s) in out.iter_mut().zip(b.chunks_exact(4)) {
+                    *o = f32::from_le_bytes([s[0], s[1], s[2], s[3]]);
+                }
+            }
+            (SampleFormat::IbmFloat, true) => {
+                for (o, s) in out.iter_mut().zip(b.chunks_exact(4)) {
+                    *o = ibm_to_f32(u32::from_be_bytes([s[0], s[1], s[2], s[3]]));
+                }
+            }
+            (SampleFormat::Int16, true) => {
+                for (o, s) in out.iter_mut().zip(b.chunks_exact(2)) {
+                    *o = i16::from_be_bytes([s[0], s[1]]) as f32;
+                }
+            }
+            _ => {
+                for (o, s) in out.iter_mut().zip(b.chunks_exact(w)) {
+                    *o = self.decode(s, big);
+                }
+            }
+        }
+    }
+
     /// Encode one sample (for writing test files); integers round and saturate.
     pub fn encode(self, v: f32, big: bool) -> Vec<u8> {
         let order4 = |x: u32| {

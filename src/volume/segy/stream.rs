@@ -293,7 +293,6 @@ impl SegyStream {
         let ns = self.layout.samples;
         let tl = self.layout.trace_len;
         let (big, format) = (self.layout.big, self.layout.format);
-        let width = format.bytes();
         let mut buf: Vec<u8> = Vec::new();
         let mut at = 0;
         for kk in k.clone() {
@@ -351,9 +350,7 @@ impl SegyStream {
                         ];
                     }
                     let dst = &mut out[at + q * ns..][..ns];
-                    for (s, v) in dst.iter_mut().enumerate() {
-                        *v = format.decode(&trace[TRACE_HEADER + s * width..], big);
-                    }
+                    format.decode_trace(&trace[TRACE_HEADER..], big, dst);
                 }
                 at += n * ns;
                 jj += n;
