@@ -35,15 +35,29 @@ struct GroupAttributes {
     arbvis: Option<StoreMeta>,
 }
 
+/// Why a folder without `zarr.json` is not read: a zarr v2 store (an MDIO v0 dataset among
+/// them) says so, with the way forward.
+pub fn not_v3(store: &Path) -> String {
+    let v2 = [".zgroup", ".zarray", ".zmetadata"]
+        .iter()
+        .any(|f| std::fs::symlink_metadata(store.join(f)).is_ok());
+    let mdio_v0 = store.join("data").join(".zgroup").exists()
+        || store.join("metadata").join(".zgroup").exists();
+    if mdio_v0 {
+        "an MDIO v0 dataset (zarr v2): arbvis reads MDIO v1 (zarr v3); ingest the survey's SEG-Y with multidimio 1.x, or convert it with `arbvis convert SURVEY STORE`".into()
+    } else if v2 {
+        "a zarr v2 store: arbvis reads zarr v3; rewrite it as v3 (e.g. zarr-python 3: zarr.open_group(..., zarr_format=3) and copy the arrays)".into()
+    } else {
+        "no zarr.json: not a zarr store (make one with `arbvis convert SURVEY STORE`)".into()
+    }
+}
+
 /// The `arbvis` attribute of the group at `store`, parsed (a type error names its field,
 /// line and column) and checked ([`check_meta`]).
 pub fn read_meta(store: &Path) -> Result<StoreMeta, StoreError> {
     let file = store.join("zarr.json");
     if std::fs::symlink_metadata(&file).is_err() {
-        return Err(StoreError::invalid(
-            store,
-            "no zarr.json: not a zarr store (make one with `arbvis convert SURVEY STORE`)",
-        ));
+        return Err(StoreError::invalid(store, not_v3(store)));
     }
     let text = crate::input::read_regular(&file, zarr::MAX_METADATA_BYTES)
         .and_then(crate::input::utf8)

@@ -185,7 +185,11 @@ pub fn convert(
     };
     let job = job_of(input, &identity, o, &attributes)?;
     let workers = rayon::current_num_threads().max(1);
-    let bound = memory_bound(dims[0], b, attributes.len(), workers);
+    let bound = memory_bound(dims[0], b, attributes.len(), workers)
+        + match &src {
+            Input::Mdio(m, _) => m.cache_bytes(),
+            _ => 0,
+        };
     crate::budget::check(
         format!(
             "converting {} ({} samples per trace, {b}³ bricks, {} attributes, {workers} workers)",
@@ -288,10 +292,16 @@ pub fn convert(
     };
     // Level 0 from the input.
     let counts = meta.brick_counts(0);
-    let units: Vec<[usize; 3]> = (0..counts[2])
+    let mut units: Vec<[usize; 3]> = (0..counts[2])
         .flat_map(|k| (0..counts[1]).map(move |j| [0, j, k]))
         .filter(|u| !done.contains_key(u))
         .collect();
+    // An MDIO input's chunks span several columns: convert those columns one after the
+    // other (in tiles), so each chunk is decoded about once.
+    if let Input::Mdio(m, _) = &src {
+        let t = m.tile(b);
+        units.sort_by_key(|u| (u[2] / t, u[1] / t, u[2] % t, u[1] % t));
+    }
     let bar = progress_bar(
         o.progress,
         (units.len() * b * b) as u64 * src.bytes_per_trace(),

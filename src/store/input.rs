@@ -60,6 +60,9 @@ impl Input {
     /// else SEG-Y.
     pub fn open(path: &Path, raw: Option<&RawSpec>) -> Result<Input, StoreError> {
         if path.is_dir() && raw.is_none() {
+            if !path.join("zarr.json").exists() {
+                return Err(StoreError::invalid(path, super::check::not_v3(path)));
+            }
             let root = super::zarr::read_json(&path.join("zarr.json"))?;
             if !super::mdio::is_mdio(&root) {
                 return Err(StoreError::invalid(

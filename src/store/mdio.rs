@@ -20,8 +20,8 @@ use super::StoreError;
 /// Brick side the renderer cuts an MDIO variable into.
 pub const BRICK: usize = 64;
 
-/// Decoded MDIO chunks kept (a 128³ float32 chunk is 8 MiB).
-const CHUNK_CACHE: usize = 8;
+/// Most bytes of decoded MDIO chunks kept (a 128³ float32 chunk is 8 MiB).
+const CHUNK_CACHE_BYTES: u64 = 1 << 30;
 
 /// Decoded chunks by index, with their last use.
 type DecodedChunks = HashMap<Vec<u64>, (Arc<Vec<f32>>, u64)>;
@@ -36,6 +36,10 @@ pub struct Mdio {
     /// Live traces, inline-major (`k * crosslines + j`), where the dataset has a mask.
     pub live: Option<Vec<bool>>,
     cache: Mutex<(DecodedChunks, u64)>,
+    /// Chunks the cache keeps: enough for four columns of chunks along the traces (two
+    /// workers, each with the neighbouring column that shares its chunks), at least 8,
+    /// within [`CHUNK_CACHE_BYTES`].
+    capacity: usize,
 }
 
 /// Whether the root attributes are an MDIO dataset's.
@@ -293,6 +297,9 @@ pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError>
             format!("{:?} samples: more bricks than arbvis draws", meta.dims),
         ));
     }
+    let along = data.shape[2].div_ceil(data.chunks[2]) as usize;
+    let chunk_bytes = (data.chunk_elements() * 4).max(1) as u64;
+    let capacity = (4 * along).clamp(8, (CHUNK_CACHE_BYTES / chunk_bytes).max(8) as usize);
     Ok((
         meta,
         Mdio {
@@ -300,6 +307,7 @@ pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError>
             data,
             live,
             cache: Mutex::new((HashMap::new(), 0)),
+            capacity,
         },
     ))
 }
@@ -334,7 +342,7 @@ impl Mdio {
             None => vec![self.data.fill_value as f32; self.data.chunk_elements()],
         };
         let values = Arc::new(values);
-        if cache.len() >= CHUNK_CACHE {
+        if cache.len() >= self.capacity {
             if let Some(oldest) = cache
                 .iter()
                 .min_by_key(|(_, (_, t))| *t)
@@ -412,6 +420,19 @@ impl Mdio {
             out,
             [dims[0], sy],
         )
+    }
+
+    /// Bytes the chunk cache may hold at most.
+    pub fn cache_bytes(&self) -> u64 {
+        (self.capacity * self.data.chunk_elements() * 4) as u64
+    }
+
+    /// How many bricks of side `b` a chunk spans across the traces (at least 1): columns
+    /// of bricks converted in tiles of this side share their chunks.
+    pub fn tile(&self, b: usize) -> usize {
+        (self.data.chunks[0].max(self.data.chunks[1]) as usize)
+            .div_ceil(b)
+            .max(1)
     }
 
     /// The chunk file holding brick `c`'s first voxel.

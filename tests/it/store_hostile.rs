@@ -473,3 +473,28 @@ fn the_default_budget_holds_to_the_process_address_space_limit() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn zarr_v2_stores_and_mdio_v0_datasets_are_refused_with_the_way_forward() {
+    let dir = temp_dir("sh-v2");
+    let v0 = dir.join("survey_v0.mdio");
+    std::fs::create_dir_all(v0.join("data")).unwrap();
+    std::fs::write(v0.join(".zgroup"), r#"{"zarr_format": 2}"#).unwrap();
+    std::fs::write(v0.join("data/.zgroup"), r#"{"zarr_format": 2}"#).unwrap();
+    let e = open_error(&v0);
+    assert!(
+        e.contains("an MDIO v0 dataset (zarr v2)") && e.contains("multidimio 1.x"),
+        "{e}"
+    );
+    let v2 = dir.join("plain.zarr");
+    std::fs::create_dir_all(&v2).unwrap();
+    std::fs::write(v2.join(".zgroup"), r#"{"zarr_format": 2}"#).unwrap();
+    let e = open_error(&v2);
+    assert!(e.contains("a zarr v2 store: arbvis reads zarr v3"), "{e}");
+    // convert says the same of them as inputs.
+    let e = convert(&v0, &dir.join("out.zarr"), &options(8))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("an MDIO v0 dataset"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
