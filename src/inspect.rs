@@ -150,12 +150,14 @@ pub fn inspect(path: &Path) -> Result<String, InspectError> {
         error,
     };
     if path.is_dir() {
-        if std::fs::symlink_metadata(path.join("zarr.json")).is_ok() {
+        if std::fs::symlink_metadata(path.join("zarr.json")).is_ok()
+            || crate::store::mdio::is_mdio_v0(path)
+        {
             return Ok(crate::store::describe::describe(path)?);
         }
         return Err(InspectError::Unknown {
             path: path.display().to_string(),
-            what: "a folder without zarr.json (not a store)".into(),
+            what: "a folder without zarr.json or an MDIO v0 .zattrs (not a store)".into(),
         });
     }
     let (file, _) = crate::input::open_regular(path).map_err(io)?;

@@ -44,7 +44,7 @@ pub fn not_v3(store: &Path) -> String {
     let mdio_v0 = store.join("data").join(".zgroup").exists()
         || store.join("metadata").join(".zgroup").exists();
     if mdio_v0 {
-        "an MDIO v0 dataset (zarr v2): arbvis reads MDIO v1 (zarr v3); ingest the survey's SEG-Y with multidimio 1.x, or convert it with `arbvis convert SURVEY STORE`".into()
+        "an MDIO v0 dataset (zarr v2) without its variable data/chunked_012: not a dataset arbvis reads".into()
     } else if v2 {
         "a zarr v2 store: arbvis reads zarr v3; rewrite it as v3 (e.g. zarr-python 3: zarr.open_group(..., zarr_format=3) and copy the arrays)".into()
     } else {

@@ -176,9 +176,15 @@ pub fn convert(
     // An MDIO dataset converted into itself: levels and ranges beside its own arrays.
     let in_place = matches!(src, Input::Mdio(..))
         && std::fs::canonicalize(input).ok() == std::fs::canonicalize(store).ok();
+    if in_place && matches!(&src, Input::Mdio(_, m) if m.source_variable.is_none()) {
+        return Err(StoreError::invalid(
+            input,
+            "an MDIO v0 dataset (zarr v2) cannot gain zarr v3 levels in place: convert it into a store of its own (arbvis convert DATASET STORE)",
+        ));
+    }
     let (identity, source_variable) = match &src {
         Input::Mdio(m, meta) => (
-            m.data.folder.join("zarr.json"),
+            m.data.metadata_file(),
             meta.source_variable.clone().filter(|_| in_place),
         ),
         _ => (input.to_path_buf(), None),

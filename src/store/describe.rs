@@ -14,6 +14,9 @@ const MAX_FILES_COUNTED: u64 = 10_000_000;
 
 /// The description `inspect` prints for the store at `store`.
 pub fn describe(store: &Path) -> Result<String, StoreError> {
+    if !store.join("zarr.json").exists() && super::mdio::is_mdio_v0(store) {
+        return describe_mdio(store);
+    }
     let root = super::zarr::read_json(&store.join("zarr.json"))?;
     if root["attributes"].get("arbvis").is_none() && super::mdio::is_mdio(&root) {
         return describe_mdio(store);
@@ -93,10 +96,12 @@ fn describe_mdio(store: &Path) -> Result<String, StoreError> {
     let meta = &opened.meta;
     let mut s = String::new();
     let _ = writeln!(s, "{}", store.display());
+    let v0 = super::mdio::is_mdio_v0(store) && !store.join("zarr.json").exists();
     let _ = writeln!(
         s,
-        "format: {} (zarr v3), read in place: one level, no per-brick ranges",
-        meta.source.kind
+        "format: {} (zarr {}), read in place: one level, no per-brick ranges",
+        meta.source.kind,
+        if v0 { "v2" } else { "v3" }
     );
     for (k, v) in &meta.source.facts {
         let _ = writeln!(s, "  {k}: {v}");
@@ -109,27 +114,34 @@ fn describe_mdio(store: &Path) -> Result<String, StoreError> {
     if let (Some(lo), Some(hi)) = (a.min, a.max) {
         let _ = writeln!(
             s,
-            "statistics (statsV1, non-zero samples): min {lo} max {hi}"
+            "statistics ({}): min {lo} max {hi}",
+            if v0 {
+                "the dataset's"
+            } else {
+                "statsV1, non-zero samples"
+            }
         );
     }
-    let _ = writeln!(
-        s,
-        "levels: none (MDIO keeps one resolution); `arbvis convert {}` adds levels, per-brick ranges and derived attributes beside its arrays, which makes turning faster",
-        store.display()
-    );
+    if v0 {
+        let _ = writeln!(
+            s,
+            "levels: none (MDIO keeps one resolution); `arbvis convert {} STORE` writes a store with levels, per-brick ranges and derived attributes (MDIO v0 is not converted in place)",
+            store.display()
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "levels: none (MDIO keeps one resolution); `arbvis convert {}` adds levels, per-brick ranges and derived attributes beside its arrays, which makes turning faster",
+            store.display()
+        );
+    }
     let _ = writeln!(s, "variables:");
-    let mut entries: Vec<_> = std::fs::read_dir(store)
-        .map_err(|e| StoreError::io(store, e))?
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.join("zarr.json").is_file())
-        .collect();
-    entries.sort();
-    for folder in entries {
+    for folder in variables(store, v0)? {
         let name = folder
-            .file_name()
-            .map(|n| n.to_string_lossy().to_string())
-            .unwrap_or_default();
+            .strip_prefix(store)
+            .unwrap_or(&folder)
+            .to_string_lossy()
+            .to_string();
         match super::zarr::open_array(&folder) {
             Ok(v) => {
                 let dims = v
@@ -141,8 +153,13 @@ fn describe_mdio(store: &Path) -> Result<String, StoreError> {
                     .join(", ");
                 let _ = writeln!(
                     s,
-                    "  {name}: {} ({dims}) shape {:?}, chunks {:?}, codecs {}",
+                    "  {name}: {}{} shape {:?}, chunks {:?}, codecs {}",
                     v.data_type.name(),
+                    if dims.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" ({dims})")
+                    },
                     v.shape,
                     v.chunks,
                     v.codec_names()
@@ -160,6 +177,29 @@ fn describe_mdio(store: &Path) -> Result<String, StoreError> {
         bytes as f64 / 1e6
     );
     Ok(s)
+}
+
+/// The folders of an MDIO dataset's variables, sorted: the group's children with a
+/// `zarr.json` (v1), or those under `data/` and `metadata/` with a `.zarray` (v0).
+fn variables(store: &Path, v0: bool) -> Result<Vec<std::path::PathBuf>, StoreError> {
+    let (parents, marker) = if v0 {
+        (vec![store.join("data"), store.join("metadata")], ".zarray")
+    } else {
+        (vec![store.to_path_buf()], "zarr.json")
+    };
+    let mut entries = Vec::new();
+    for parent in parents {
+        let Ok(list) = std::fs::read_dir(&parent) else {
+            continue;
+        };
+        entries.extend(
+            list.flatten()
+                .map(|e| e.path())
+                .filter(|p| p.join(marker).is_file()),
+        );
+    }
+    entries.sort();
+    Ok(entries)
 }
 
 /// The axes with their names, sizes and the survey's own coordinates where it gave them.

@@ -61,6 +61,10 @@ impl Input {
     pub fn open(path: &Path, raw: Option<&RawSpec>) -> Result<Input, StoreError> {
         if path.is_dir() && raw.is_none() {
             if !path.join("zarr.json").exists() {
+                if super::mdio::is_mdio_v0(path) {
+                    let (meta, mdio) = super::mdio::open_v0(path)?;
+                    return Ok(Input::Mdio(Box::new(mdio), Box::new(meta)));
+                }
                 return Err(StoreError::invalid(path, super::check::not_v3(path)));
             }
             let root = super::zarr::read_json(&path.join("zarr.json"))?;

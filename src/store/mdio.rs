@@ -51,7 +51,7 @@ pub fn is_mdio(root: &Value) -> bool {
 /// The whole of a one- or two-dimensional array (a coordinate, the trace mask), held to
 /// the memory budget; absent chunks are the fill value.
 fn read_whole(array: &ArrayMeta) -> Result<Vec<f64>, StoreError> {
-    let file = array.folder.join("zarr.json");
+    let file = array.metadata_file();
     let (rows, cols) = match array.shape[..] {
         [n] => (1, n),
         [r, c] => (r, c),
@@ -114,8 +114,44 @@ fn stats(array: &ArrayMeta) -> Option<Value> {
     }
 }
 
-/// Open the MDIO dataset at `store` (whose root `zarr.json` is `root`).
+/// What an MDIO dataset of either version says of its survey, before it is checked and
+/// described alike.
+struct Parts {
+    api: String,
+    /// The variable drawn and its path in the dataset.
+    data: ArrayMeta,
+    variable: String,
+    /// Dimension names, slowest first; the last is the sample axis.
+    names: Vec<String>,
+    /// Coordinates along inline, crossline and samples, where given.
+    coordinates: [Option<Vec<f64>>; 3],
+    live: Option<Vec<bool>>,
+    min: Option<f64>,
+    max: Option<f64>,
+    /// The sum of the live samples (v1's statsV1), or their mean (v0's attributes).
+    sum: Option<f64>,
+    mean: Option<f64>,
+    facts: BTreeMap<String, String>,
+    /// Levels may be added in place (v1; a v0 dataset is zarr v2).
+    in_place: bool,
+}
+
+/// Whether `store` is an MDIO v0 dataset (zarr v2: `data/chunked_012`).
+pub fn is_mdio_v0(store: &Path) -> bool {
+    store.join("data/chunked_012/.zarray").is_file() && store.join(".zattrs").is_file()
+}
+
+/// Open the MDIO dataset at `store`: v1 (whose root `zarr.json` is `root`), or v0.
 pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError> {
+    assemble(store, parts_v1(store, root)?)
+}
+
+/// Open an MDIO v0 dataset (zarr v2) at `store`.
+pub fn open_v0(store: &Path) -> Result<(StoreMeta, Mdio), StoreError> {
+    assemble(store, parts_v0(store)?)
+}
+
+fn parts_v1(store: &Path, root: &Value) -> Result<Parts, StoreError> {
     let file = store.join("zarr.json");
     let a = &root["attributes"];
     let api = a["apiVersion"].as_str().unwrap_or("?").to_string();
@@ -130,7 +166,6 @@ pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError>
         ));
     }
     let data = zarr::open_array(&store.join(&variable))?;
-    let vfile = store.join(&variable).join("zarr.json");
     let names: Vec<String> = data
         .dimension_names
         .clone()
@@ -138,8 +173,147 @@ pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError>
         .into_iter()
         .map(Option::unwrap_or_default)
         .collect();
-    let domain = names.last().cloned().unwrap_or_default();
-    if data.shape.len() != 3 || !(domain == "time" || domain == "depth") {
+    let coordinate = |name: &str| -> Result<Option<Vec<f64>>, StoreError> {
+        let folder = store.join(name);
+        if name.is_empty() || !folder.join("zarr.json").exists() {
+            return Ok(None);
+        }
+        Ok(Some(read_whole(&zarr::open_array(&folder)?)?))
+    };
+    let name = |i: usize| names.get(i).cloned().unwrap_or_default();
+    let coordinates = [
+        coordinate(&name(0))?,
+        coordinate(&name(1))?,
+        coordinate(&name(2))?,
+    ];
+    let (nk, nj) = (
+        data.shape.first().copied().unwrap_or(0) as usize,
+        data.shape.get(1).copied().unwrap_or(0) as usize,
+    );
+    let live = match store.join("trace_mask").join("zarr.json").exists() {
+        false => None,
+        true => Some(trace_mask(
+            &zarr::open_array(&store.join("trace_mask"))?,
+            nk,
+            nj,
+        )?),
+    };
+    let s = stats(&data);
+    let number = |key: &str| {
+        s.as_ref()
+            .and_then(|s| s[key].as_f64())
+            .filter(|v| v.is_finite())
+    };
+    let mut facts = BTreeMap::new();
+    facts.insert("MDIO apiVersion".to_string(), api.clone());
+    if let Some(n) = a["name"].as_str() {
+        facts.insert("template".into(), n.to_string());
+    }
+    for key in ["surveyType", "gatherType"] {
+        if let Some(v) = a["attributes"][key].as_str() {
+            facts.insert(key.into(), v.to_string());
+        }
+    }
+    // Map coordinates, where the dataset has them.
+    for cdp in ["cdp_x", "cdp_y"] {
+        let folder = store.join(cdp);
+        if folder.join("zarr.json").exists() {
+            let values = read_whole(&zarr::open_array(&folder)?)?;
+            let (lo, hi) = values
+                .iter()
+                .filter(|v| v.is_finite())
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                    (a.min(v), b.max(v))
+                });
+            if lo <= hi {
+                facts.insert(cdp.into(), format!("{lo} .. {hi}"));
+            }
+        }
+    }
+    Ok(Parts {
+        api,
+        data,
+        variable,
+        names,
+        coordinates,
+        live,
+        min: number("min"),
+        max: number("max"),
+        sum: number("sum"),
+        mean: None,
+        facts,
+        in_place: true,
+    })
+}
+
+fn parts_v0(store: &Path) -> Result<Parts, StoreError> {
+    let attrs = zarr::read_json(&store.join(".zattrs"))?;
+    let api = attrs["api_version"].as_str().unwrap_or("0").to_string();
+    let data = zarr::open_array(&store.join("data/chunked_012"))?;
+    let dimensions = attrs["dimension"].as_array().cloned().unwrap_or_default();
+    let names: Vec<String> = dimensions
+        .iter()
+        .map(|d| d["name"].as_str().unwrap_or_default().to_string())
+        .collect();
+    let coordinate = |i: usize| -> Option<Vec<f64>> {
+        dimensions.get(i)?["coords"]
+            .as_array()
+            .map(|c| c.iter().filter_map(Value::as_f64).collect())
+    };
+    let coordinates = [coordinate(0), coordinate(1), coordinate(2)];
+    let (nk, nj) = (
+        data.shape.first().copied().unwrap_or(0) as usize,
+        data.shape.get(1).copied().unwrap_or(0) as usize,
+    );
+    let mask = store.join("metadata/live_mask");
+    let live = match mask.join(".zarray").exists() {
+        false => None,
+        true => Some(trace_mask(&zarr::open_array(&mask)?, nk, nj)?),
+    };
+    let number = |key: &str| attrs[key].as_f64().filter(|v| v.is_finite());
+    let mut facts = BTreeMap::new();
+    facts.insert("MDIO api_version".to_string(), api.clone());
+    if let Some(n) = attrs["trace_count"].as_u64() {
+        facts.insert("trace count".into(), n.to_string());
+    }
+    Ok(Parts {
+        api,
+        data,
+        variable: "data/chunked_012".into(),
+        names,
+        coordinates,
+        live,
+        min: number("min"),
+        max: number("max"),
+        sum: None,
+        mean: number("mean"),
+        facts,
+        in_place: false,
+    })
+}
+
+/// One dataset's parts checked and described as a store of one level.
+fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError> {
+    let Parts {
+        api,
+        data,
+        variable,
+        names,
+        coordinates,
+        live,
+        min,
+        max,
+        sum,
+        mean,
+        mut facts,
+        in_place,
+    } = parts;
+    let vfile = data.metadata_file();
+    let domain = names.get(2).cloned().unwrap_or_default();
+    let post_stack = data.shape.len() == 3
+        && names.len() == 3
+        && matches!(domain.as_str(), "time" | "depth" | "sample");
+    if !post_stack {
         return Err(StoreError::invalid(
             &vfile,
             format!(
@@ -156,64 +330,30 @@ pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError>
             ));
         }
     }
-    let coordinate = |name: &str| -> Result<Option<Vec<f64>>, StoreError> {
-        let folder = store.join(name);
-        if !folder.join("zarr.json").exists() {
-            return Ok(None);
-        }
-        let array = zarr::open_array(&folder)?;
-        if array.shape.len() != 1 {
-            return Err(StoreError::invalid(
-                &folder.join("zarr.json"),
-                format!("{name}: shape {:?}, expected one axis", array.shape),
-            ));
-        }
-        Ok(Some(read_whole(&array)?))
-    };
-    let inlines = coordinate(&names[0])?;
-    let crosslines = coordinate(&names[1])?;
-    let samples = coordinate(&domain)?;
     for (values, n, name) in [
-        (&inlines, nk, &names[0]),
-        (&crosslines, nj, &names[1]),
-        (&samples, ni, &domain),
+        (&coordinates[0], nk, &names[0]),
+        (&coordinates[1], nj, &names[1]),
+        (&coordinates[2], ni, &domain),
     ] {
         if let Some(v) = values {
             if v.len() != n {
                 return Err(StoreError::invalid(
-                    &store.join(name).join("zarr.json"),
+                    &store.join(name),
                     format!("{name} has {} values, {variable} {n} along it", v.len()),
                 ));
             }
         }
     }
-    let live = match store.join("trace_mask").join("zarr.json").exists() {
-        false => None,
-        true => Some(trace_mask(store, nk, nj)?),
-    };
     let dead = live
         .as_ref()
         .map_or(0, |l| l.iter().filter(|&&x| !x).count());
-    let s = stats(&data);
-    let number = |key: &str| {
-        s.as_ref()
-            .and_then(|s| s[key].as_f64())
-            .filter(|v| v.is_finite())
-    };
-    // statsV1 counts the non-zero samples of the live traces (mdio-python leaves zeros
-    // out), so its sum over the live samples is their mean.
+    // v1's statsV1 counts the non-zero samples of the live traces (mdio-python leaves
+    // zeros out), so its sum over the live samples is their mean.
     let live_samples = ((nk * nj - dead) * ni) as u64;
-    let non_finite = (dead * ni) as u64;
-    let mut facts = BTreeMap::new();
-    facts.insert("MDIO apiVersion".to_string(), api.clone());
-    if let Some(n) = a["name"].as_str() {
-        facts.insert("template".into(), n.to_string());
-    }
-    for key in ["surveyType", "gatherType"] {
-        if let Some(v) = a["attributes"][key].as_str() {
-            facts.insert(key.into(), v.to_string());
-        }
-    }
+    let mean = mean.or(match sum {
+        Some(sum) if live_samples > 0 => Some(sum / live_samples as f64),
+        _ => None,
+    });
     facts.insert(
         "variable".into(),
         format!(
@@ -230,27 +370,14 @@ pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError>
             format!("{} of {}", l.len() - dead, l.len()),
         );
     }
-    // Map coordinates, where the dataset has them.
-    for name in ["cdp_x", "cdp_y"] {
-        let folder = store.join(name);
-        if folder.join("zarr.json").exists() {
-            let values = read_whole(&zarr::open_array(&folder)?)?;
-            let (lo, hi) = values
-                .iter()
-                .filter(|v| v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
-            if lo <= hi {
-                facts.insert(name.into(), format!("{lo} .. {hi}"));
-            }
+    let samples = &coordinates[2];
+    let interval_us = match (samples, domain.as_str()) {
+        (Some(t), "time" | "sample") if t.len() > 1 => {
+            Some(((t[1] - t[0]) * 1000.0).round().max(0.0) as u32)
         }
-    }
-    let interval_us = match (&samples, domain.as_str()) {
-        (Some(t), "time") if t.len() > 1 => Some(((t[1] - t[0]) * 1000.0).round().max(0.0) as u32),
         _ => None,
     };
-    if let Some(d) = &samples {
+    if let Some(d) = samples {
         if domain == "depth" {
             facts.insert("depth".into(), format!("{} .. {} m", d[0], d[d.len() - 1]));
         }
@@ -266,26 +393,23 @@ pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError>
         attributes: vec![AttributeMeta {
             name: "amplitude".into(),
             dtype: "float32".into(),
-            min: number("min"),
-            max: number("max"),
-            mean: match number("sum") {
-                Some(sum) if live_samples > 0 => Some(sum / live_samples as f64),
-                _ => None,
-            },
-            non_finite,
+            min,
+            max,
+            mean,
+            non_finite: (dead * ni) as u64,
         }],
         source: SourceMeta {
             path: store.display().to_string(),
             kind: format!("MDIO v{api}"),
             bytes: 0,
             facts,
-            inlines: inlines.as_deref().and_then(first_step),
-            crosslines: crosslines.as_deref().and_then(first_step),
+            inlines: coordinates[0].as_deref().and_then(first_step),
+            crosslines: coordinates[1].as_deref().and_then(first_step),
             interval_us,
         },
         compression: data.codec_names(),
         complete: true,
-        source_variable: Some(variable.clone()),
+        source_variable: in_place.then(|| variable.clone()),
     };
     let bricks = super::brick_counts(meta.dims, BRICK)
         .iter()
@@ -313,18 +437,17 @@ pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError>
 }
 
 /// The trace mask over (inline, crossline).
-fn trace_mask(store: &Path, nk: usize, nj: usize) -> Result<Vec<bool>, StoreError> {
-    let mask = zarr::open_array(&store.join("trace_mask"))?;
+fn trace_mask(mask: &ArrayMeta, nk: usize, nj: usize) -> Result<Vec<bool>, StoreError> {
     if mask.shape != [nk as u64, nj as u64] {
         return Err(StoreError::invalid(
-            &mask.folder.join("zarr.json"),
+            &mask.folder,
             format!(
-                "trace_mask has shape {:?}, the survey [{nk}, {nj}] traces",
+                "the trace mask has shape {:?}, the survey [{nk}, {nj}] traces",
                 mask.shape
             ),
         ));
     }
-    Ok(read_whole(&mask)?.into_iter().map(|v| v != 0.0).collect())
+    Ok(read_whole(mask)?.into_iter().map(|v| v != 0.0).collect())
 }
 
 impl Mdio {

@@ -100,6 +100,12 @@ impl Store {
                 return Ok(store);
             }
         }
+        if !root_file.exists() && super::mdio::is_mdio_v0(path) {
+            let (meta, mdio) = super::mdio::open_v0(path)?;
+            let mut store = Store::with_arrays(path, meta, (Vec::new(), Vec::new()), false);
+            store.mdio = Some(mdio);
+            return Ok(store);
+        }
         let meta = super::check::read_meta(path)?;
         if !meta.complete {
             return Err(StoreError::invalid(

@@ -9,7 +9,8 @@
 //! Supported: data types bool, (u)int8-64, float16/32/64; the `regular` chunk grid; the
 //! `default` and `v2` chunk key encodings; codecs `bytes` (either byte order), `blosc`
 //! (MDIO's: decoded by the `zarrs` crate after its header is checked here), `zstd`, `gzip`,
-//! `crc32c` and an identity `transpose`. Others are refused by name. Writing
+//! `crc32c` and an identity `transpose`. Others are refused by name. zarr v2 arrays
+//! (`.zarray`, as MDIO v0 datasets hold them) are read too ([`v2`]). Writing
 //! stays with the `zarrs` crate.
 
 use std::io::Read;
@@ -310,6 +311,8 @@ pub struct ArrayMeta {
     /// `attributes`.
     pub attributes: Map<String, Value>,
     keys: ChunkKeys,
+    /// Read from a zarr v2 `.zarray` (an MDIO v0 dataset's) rather than a `zarr.json`.
+    v2: bool,
 }
 
 /// `value` as `field` of `file`, or an error naming both.
@@ -374,6 +377,9 @@ fn fill(v: &Value, t: DataType, file: &Path) -> Result<f64, StoreError> {
 /// The array at `folder` (its `zarr.json`), every field checked.
 pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
     let file = folder.join("zarr.json");
+    if !file.exists() && folder.join(".zarray").exists() {
+        return v2::open_array(folder);
+    }
     let doc = read_json(&file)?;
     let invalid = |m: String| StoreError::invalid(&file, m);
     if doc.get("zarr_format").and_then(Value::as_u64) != Some(3) {
@@ -470,6 +476,7 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
         dimension_names,
         attributes,
         keys,
+        v2: false,
     })
 }
 
@@ -562,6 +569,12 @@ impl ArrayMeta {
     /// Elements in one chunk.
     pub fn chunk_elements(&self) -> usize {
         self.chunks.iter().product::<u64>() as usize
+    }
+
+    /// The file this array's metadata was read from: `zarr.json`, or v2's `.zarray`.
+    pub fn metadata_file(&self) -> PathBuf {
+        self.folder
+            .join(if self.v2 { ".zarray" } else { "zarr.json" })
     }
 
     /// Chunks per axis.
@@ -682,3 +695,4 @@ impl ArrayMeta {
 
 #[cfg(test)]
 mod tests;
+mod v2;

@@ -475,7 +475,7 @@ fn the_default_budget_holds_to_the_process_address_space_limit() {
 }
 
 #[test]
-fn zarr_v2_stores_and_mdio_v0_datasets_are_refused_with_the_way_forward() {
+fn zarr_v2_stores_and_mdio_v0_datasets_without_their_variable_are_refused() {
     let dir = temp_dir("sh-v2");
     let v0 = dir.join("survey_v0.mdio");
     std::fs::create_dir_all(v0.join("data")).unwrap();
@@ -483,7 +483,7 @@ fn zarr_v2_stores_and_mdio_v0_datasets_are_refused_with_the_way_forward() {
     std::fs::write(v0.join("data/.zgroup"), r#"{"zarr_format": 2}"#).unwrap();
     let e = open_error(&v0);
     assert!(
-        e.contains("an MDIO v0 dataset (zarr v2)") && e.contains("multidimio 1.x"),
+        e.contains("an MDIO v0 dataset (zarr v2) without its variable data/chunked_012"),
         "{e}"
     );
     let v2 = dir.join("plain.zarr");
@@ -496,5 +496,46 @@ fn zarr_v2_stores_and_mdio_v0_datasets_are_refused_with_the_way_forward() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("an MDIO v0 dataset"), "{e}");
+    // A v0 variable's .zarray: each field checked, the file named.
+    let array = v0.join("data/chunked_012");
+    std::fs::create_dir_all(&array).unwrap();
+    std::fs::write(
+        v0.join(".zattrs"),
+        r#"{"api_version": "0.8.5", "dimension": []}"#,
+    )
+    .unwrap();
+    let zarray = |dtype: &str, extra: &str| {
+        format!(
+            r#"{{"zarr_format": 2, "shape": [4, 5, 6], "chunks": [4, 5, 6], "dtype": {dtype},
+            "order": "C", "filters": null, "compressor": null, "fill_value": 0{extra}}}"#
+        )
+    };
+    for (text, want) in [
+        (zarray(r#""""#, ""), "`dtype` \"\": arbvis reads bool"),
+        (zarray(r#"">c8""#, ""), "`dtype` \">c8\""),
+        (zarray(r#"[["a", "<i4"]]"#, ""), "`dtype` a structured type"),
+        (
+            zarray(r#""<f4""#, r#", "dimension_separator": "-""#),
+            "`dimension_separator` \"-\"",
+        ),
+        (
+            zarray(r#""<f4""#, "").replace(r#""order": "C""#, r#""order": "F""#),
+            "`order` is not \"C\"",
+        ),
+        (
+            zarray(r#""<f4""#, "")
+                .replace(r#""compressor": null"#, r#""compressor": {"id": "lzma"}"#),
+            "\"lzma\" is not a compressor arbvis reads",
+        ),
+        (
+            zarray(r#""<f4""#, "").replace("[4, 5, 6], \"dtype", "[4000, 5000, 6000], \"dtype"),
+            "MiB arbvis reads in one chunk",
+        ),
+        (zarray(r#""<f4""#, ""), "has dimensions []"),
+    ] {
+        std::fs::write(array.join(".zarray"), &text).unwrap();
+        let e = open_error(&v0);
+        assert!(e.contains(want) && e.contains("chunked_012"), "{want}: {e}");
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
