@@ -212,10 +212,16 @@ fn axes(meta: &StoreMeta) -> Vec<String> {
             format!(", numbers {first}..{last} (step {step})")
         })
     };
-    let time = src.interval_us.map_or(String::new(), |us| {
-        let dt = us as f64 / 1000.0;
-        format!(", time 0..{} ms (every {dt} ms)", dt * (ni as f64 - 1.0))
-    });
+    let s = src.sample_axis();
+    let time = if s.unit.is_empty() {
+        String::new()
+    } else {
+        let last = s.first + s.step * (ni as f64 - 1.0);
+        format!(
+            ", {} {}..{last} {} (every {} {})",
+            s.domain, s.first, s.unit, s.step, s.unit
+        )
+    };
     vec![
         format!("sample: {ni}{time}"),
         format!("crossline: {nj}{}", numbers(src.crosslines, nj)),

@@ -52,6 +52,7 @@ fn meta(path: &Path, kind: &str, bytes: u64, facts: Vec<(String, String)>) -> So
         inlines: None,
         crosslines: None,
         interval_us: None,
+        samples: None,
     }
 }
 
@@ -173,9 +174,14 @@ impl Input {
         Ok(Input::Segy(s, m))
     }
 
-    /// Whether the input gives map coordinates per trace (SEG-Y's CDP x and y).
+    /// Whether the input gives map coordinates per trace (SEG-Y's CDP x and y, an MDIO
+    /// dataset's `cdp_x` and `cdp_y`).
     pub fn has_coordinates(&self) -> bool {
-        matches!(self, Input::Segy(..))
+        match self {
+            Input::Segy(..) => true,
+            Input::Mdio(m, _) => m.cdp.is_some(),
+            _ => false,
+        }
     }
 
     /// Voxels along i, j, k.
@@ -229,9 +235,19 @@ impl Input {
     ) -> Result<(), StoreError> {
         match self {
             Input::Segy(s, _) => Ok(s.read_column_with_coordinates(j, k, out, coordinates)?),
-            Input::Mdio(m, meta) => m
-                .column(meta.dims, j, k, out)
-                .map_err(|e| StoreError::invalid(&m.data.folder, e)),
+            Input::Mdio(m, meta) => {
+                if let (Some(cdp), Some(c)) = (&m.cdp, coordinates) {
+                    let nj = meta.dims[1];
+                    let traces = k
+                        .clone()
+                        .flat_map(|kk| j.clone().map(move |jj| kk * nj + jj));
+                    for (t, at) in traces.zip(c.iter_mut()) {
+                        *at = [cdp[0][t], cdp[1][t]];
+                    }
+                }
+                m.column(meta.dims, j, k, out)
+                    .map_err(|e| StoreError::invalid(&m.data.folder, e))
+            }
             Input::Flat(f) => f.read_column(j, k, out),
             Input::Memory(v, _) => {
                 let ni = v.dims[0];

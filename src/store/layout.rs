@@ -110,16 +110,16 @@ fn array(
 }
 
 /// The level-0 coordinate values along each axis: inline and crossline numbers (the
-/// survey's, else indices), and time in ms (else sample indices).
+/// survey's, else indices), and the sample axis's (time in ms, depth in m, else indices).
 pub fn coordinates(meta: &StoreMeta) -> [Vec<f64>; 3] {
     let [ni, nj, nk] = meta.dims;
     let numbers = |n: usize, first_step: Option<[i64; 2]>| -> Vec<f64> {
         let [first, step] = first_step.unwrap_or([0, 1]);
         (0..n).map(|x| (first + step * x as i64) as f64).collect()
     };
-    let dt = meta.source.interval_us.map_or(1.0, |us| us as f64 / 1000.0);
+    let s = meta.source.sample_axis();
     [
-        (0..ni).map(|i| i as f64 * dt).collect(),
+        (0..ni).map(|i| s.first + i as f64 * s.step).collect(),
         numbers(nj, meta.source.crosslines),
         numbers(nk, meta.source.inlines),
     ]
@@ -151,10 +151,10 @@ fn stats_v1(meta: &StoreMeta, attr: usize, s: &Stats) -> Value {
 fn root_attributes(meta: &StoreMeta) -> Result<Map<String, Value>, serde_json::Error> {
     let mut m = Map::new();
     m.insert("apiVersion".into(), json!(MDIO_API_VERSION));
-    let name = if meta.domain() == "time" {
-        "PostStack3DTime"
-    } else {
-        "PostStack3D"
+    let name = match meta.domain().as_str() {
+        "time" => "PostStack3DTime",
+        "depth" => "PostStack3DDepth",
+        _ => "PostStack3D",
     };
     m.insert("name".into(), json!(name));
     m.insert(
@@ -191,7 +191,7 @@ pub fn write_layout(
 ) -> Result<Writers, StoreError> {
     let b = meta.brick as u64;
     let domain = meta.domain();
-    let dims = ["inline", "crossline", domain];
+    let dims = ["inline", "crossline", domain.as_str()];
     let coords = coordinates(meta);
     // By attribute, then level.
     let mut data: Vec<Vec<Option<Array<FilesystemStore>>>> =
@@ -362,7 +362,8 @@ pub fn write_layout(
             Map::new(),
         )?),
     };
-    let cdp = if has_cdp {
+    // In place, the dataset's own trace mask and map coordinates stay as they are.
+    let cdp = if has_cdp && beside.is_none() {
         let x = array(
             storage,
             store,

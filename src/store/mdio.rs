@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 
 use serde_json::Value;
 
-use super::meta::{AttributeMeta, SourceMeta, StoreMeta};
+use super::meta::{AttributeMeta, SampleAxis, SourceMeta, StoreMeta};
 use super::zarr::{self, ArrayMeta};
 use super::StoreError;
 
@@ -35,6 +35,8 @@ pub struct Mdio {
     pub nan_fill: bool,
     /// Live traces, inline-major (`k * crosslines + j`), where the dataset has a mask.
     pub live: Option<Vec<bool>>,
+    /// `cdp_x`, `cdp_y` per trace, inline-major, where the dataset has them.
+    pub cdp: Option<[Vec<f64>; 2]>,
     cache: Mutex<(DecodedChunks, u64)>,
     /// Chunks the cache keeps: enough for four columns of chunks along the traces (two
     /// workers, each with the neighbouring column that shares its chunks), at least 8,
@@ -134,6 +136,38 @@ struct Parts {
     facts: BTreeMap<String, String>,
     /// Levels may be added in place (v1; a v0 dataset is zarr v2).
     in_place: bool,
+    /// `cdp_x`, `cdp_y` over (inline, crossline), where given.
+    cdp: Option<[Vec<f64>; 2]>,
+}
+
+/// The map coordinates `cdp_x` and `cdp_y` of the dataset or store at `store` (zarr v3
+/// arrays of shape `[nk, nj]` at its root), inline-major; `None` where it has none.
+pub fn map_coordinates(
+    store: &Path,
+    nk: usize,
+    nj: usize,
+) -> Result<Option<[Vec<f64>; 2]>, StoreError> {
+    let read = |name: &str| -> Result<Option<Vec<f64>>, StoreError> {
+        let folder = store.join(name);
+        if !folder.join("zarr.json").exists() {
+            return Ok(None);
+        }
+        let array = zarr::open_array(&folder)?;
+        if array.shape != [nk as u64, nj as u64] {
+            return Err(StoreError::invalid(
+                &array.metadata_file(),
+                format!(
+                    "{name} has shape {:?}, the survey [{nk}, {nj}] traces",
+                    array.shape
+                ),
+            ));
+        }
+        read_whole(&array).map(Some)
+    };
+    Ok(match (read("cdp_x")?, read("cdp_y")?) {
+        (Some(x), Some(y)) => Some([x, y]),
+        _ => None,
+    })
 }
 
 /// Whether `store` is an MDIO v0 dataset (zarr v2: `data/chunked_012`).
@@ -215,19 +249,16 @@ fn parts_v1(store: &Path, root: &Value) -> Result<Parts, StoreError> {
         }
     }
     // Map coordinates, where the dataset has them.
-    for cdp in ["cdp_x", "cdp_y"] {
-        let folder = store.join(cdp);
-        if folder.join("zarr.json").exists() {
-            let values = read_whole(&zarr::open_array(&folder)?)?;
-            let (lo, hi) = values
-                .iter()
-                .filter(|v| v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                });
-            if lo <= hi {
-                facts.insert(cdp.into(), format!("{lo} .. {hi}"));
-            }
+    let cdp = map_coordinates(store, nk, nj)?;
+    for (values, name) in cdp.iter().flatten().zip(["cdp_x", "cdp_y"]) {
+        let (lo, hi) = values
+            .iter()
+            .filter(|v| v.is_finite())
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+                (a.min(v), b.max(v))
+            });
+        if lo <= hi {
+            facts.insert(name.into(), format!("{lo} .. {hi}"));
         }
     }
     Ok(Parts {
@@ -243,6 +274,7 @@ fn parts_v1(store: &Path, root: &Value) -> Result<Parts, StoreError> {
         mean: None,
         facts,
         in_place: true,
+        cdp,
     })
 }
 
@@ -289,6 +321,7 @@ fn parts_v0(store: &Path) -> Result<Parts, StoreError> {
         mean: number("mean"),
         facts,
         in_place: false,
+        cdp: None,
     })
 }
 
@@ -307,6 +340,7 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
         mean,
         mut facts,
         in_place,
+        cdp,
     } = parts;
     let vfile = data.metadata_file();
     let domain = names.get(2).cloned().unwrap_or_default();
@@ -382,6 +416,21 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
             facts.insert("depth".into(), format!("{} .. {} m", d[0], d[d.len() - 1]));
         }
     }
+    // The sample axis as the dataset numbers it: its first value and domain.
+    let sample_axis = samples
+        .as_deref()
+        .filter(|d| !d.is_empty())
+        .map(|d| SampleAxis {
+            domain: domain.clone(),
+            unit: match domain.as_str() {
+                "time" => "ms",
+                "depth" => "m",
+                _ => "",
+            }
+            .into(),
+            first: d[0],
+            step: if d.len() > 1 { d[1] - d[0] } else { 1.0 },
+        });
     let meta = StoreMeta {
         format: format!("MDIO v{}", api.split('.').next().unwrap_or("1")),
         version: 1,
@@ -406,6 +455,7 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
             inlines: coordinates[0].as_deref().and_then(first_step),
             crosslines: coordinates[1].as_deref().and_then(first_step),
             interval_us,
+            samples: sample_axis,
         },
         compression: data.codec_names(),
         complete: true,
@@ -430,6 +480,7 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
             nan_fill: data.fill_value.is_nan(),
             data,
             live,
+            cdp,
             cache: Mutex::new((HashMap::new(), 0)),
             capacity,
         },

@@ -91,6 +91,58 @@ pub struct SourceMeta {
     /// Sample interval in microseconds (SEG-Y).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interval_us: Option<u32>,
+    /// The sample axis as the source numbers it, where it says more than `interval_us`
+    /// (an MDIO dataset's time or depth coordinate: its first value, a depth domain).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples: Option<SampleAxis>,
+}
+
+/// The sample axis's domain and numbers: sample `i` is at `first + i * step` `unit`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SampleAxis {
+    /// `time`, `depth` or `sample` (MDIO's dimension name).
+    pub domain: String,
+    /// `ms`, `m`, or empty for plain sample numbers.
+    pub unit: String,
+    /// The first sample's coordinate.
+    pub first: f64,
+    /// The spacing of samples.
+    pub step: f64,
+}
+
+impl SampleAxis {
+    /// `time (ms)`, `depth (m)` or `sample`.
+    pub fn label(&self) -> String {
+        if self.unit.is_empty() {
+            self.domain.clone()
+        } else {
+            format!("{} ({})", self.domain, self.unit)
+        }
+    }
+}
+
+impl SourceMeta {
+    /// The sample axis: as given, else time in ms from the sample interval (SEG-Y starts
+    /// at 0), else plain sample numbers.
+    pub fn sample_axis(&self) -> SampleAxis {
+        if let Some(s) = &self.samples {
+            return s.clone();
+        }
+        match self.interval_us {
+            Some(us) => SampleAxis {
+                domain: "time".into(),
+                unit: "ms".into(),
+                first: 0.0,
+                step: us as f64 / 1000.0,
+            },
+            None => SampleAxis {
+                domain: "sample".into(),
+                unit: String::new(),
+                first: 0.0,
+                step: 1.0,
+            },
+        }
+    }
 }
 
 impl StoreMeta {
@@ -116,14 +168,10 @@ impl StoreMeta {
         }
     }
 
-    /// The name of the sample axis: `time` where the survey gave a sample interval
-    /// (SEG-Y), else `sample`.
-    pub fn domain(&self) -> &'static str {
-        if self.source.interval_us.is_some() {
-            "time"
-        } else {
-            "sample"
-        }
+    /// The name of the sample axis: `time` or `depth` where the source says (SEG-Y's
+    /// sample interval, an MDIO dataset's dimension), else `sample`.
+    pub fn domain(&self) -> String {
+        self.source.sample_axis().domain
     }
 
     /// The attribute named `name`, and its position.

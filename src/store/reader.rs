@@ -164,6 +164,19 @@ impl Store {
         self.meta.attributes[attr].non_finite > 0 || self.mdio.as_ref().is_some_and(|m| m.nan_fill)
     }
 
+    /// Each trace's map coordinates (`cdp_x`, `cdp_y`, inline-major over the whole survey),
+    /// where the store or dataset has them: read whole, so a caller keeps them.
+    pub fn map_coordinates(&self) -> Result<Option<[Vec<f64>; 2]>, StoreError> {
+        if let Some(m) = &self.mdio {
+            return Ok(m.cdp.clone());
+        }
+        let [_, nj, nk] = self.meta.dims;
+        if self.meta.version < 2 {
+            return Ok(None);
+        }
+        super::mdio::map_coordinates(&self.path, nk, nj)
+    }
+
     /// True when this is an MDIO dataset read in place without levels (one level, no
     /// brick ranges: `arbvis convert` on it adds them).
     pub fn is_mdio(&self) -> bool {

@@ -14,7 +14,7 @@
 use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
 
 use super::axes::{self, section_axes, section_voxels, Axis};
-use super::store_sections::{SectionKey, StoreSections};
+use super::store_sections::{MapPositions, SectionKey, StoreSections};
 use super::summary::{cloud_units, data_box, CloudSummary, DataBox, MeshSummary};
 use crate::colortable::{ColorTable, TableSpec};
 use crate::gl::{GlError, Gpu, ProgramKind};
@@ -73,6 +73,29 @@ pub struct SectionGrid {
     pub half: glam::DVec3,
     /// Attributes present (0 primary, 1 secondary, 2 tertiary).
     pub present: Vec<usize>,
+    /// Each trace's map position, where the store has one.
+    pub positions: Option<std::sync::Arc<MapPositions>>,
+}
+
+impl SectionGrid {
+    /// What the pointer at `(across, down)` (fractions of the picture, 0..1) over the
+    /// section at `index` along `axis` points at: the voxel's numbers on the three axes,
+    /// inline first, and the trace's map position where the data has one.
+    pub fn point(&self, axis: usize, index: usize, across: f32, down: f32) -> String {
+        let (u, w) = super::axes::section_axes(axis);
+        let at = |f: f32, n: usize| ((f.max(0.0) * n as f32) as usize).min(n.saturating_sub(1));
+        let mut v = [0usize; 3];
+        v[axis] = index.min(self.dims[axis].saturating_sub(1));
+        v[u] = at(across, self.dims[u]);
+        v[w] = at(down, self.dims[w]);
+        let mut text = [2, 1, 0]
+            .map(|a| format!("{} {}", self.axes[a].name, self.axes[a].label(v[a])))
+            .join(", ");
+        if let Some([x, y]) = self.positions.as_ref().and_then(|p| p.at(v[1], v[2])) {
+            text.push_str(&format!("\nmap x {x:.1}, y {y:.1}"));
+        }
+        text
+    }
 }
 
 /// Build the scene's renderer with programs of `kind`, keeping its prepared data.
@@ -262,6 +285,7 @@ impl ViewData {
                 dims: v.prepared.dims,
                 half: v.prepared.half,
                 present: (0..3).filter(|&a| v.prepared.tables[a].is_some()).collect(),
+                positions: None,
             });
         }
         let s = self.store.as_ref()?;
@@ -270,6 +294,7 @@ impl ViewData {
             dims: s.dims,
             half: s.half,
             present: (0..3).filter(|&a| s.attributes[a].is_some()).collect(),
+            positions: s.positions.clone(),
         })
     }
 

@@ -403,7 +403,7 @@ fn sections(ui: &mut egui::Ui, scene: &Scene, data: &mut ViewData, state: &mut P
     let Some(grid) = data.section_grid() else {
         return;
     };
-    let axes = grid.axes;
+    let axes = &grid.axes;
     let dims = grid.dims;
     let half = grid.half;
     let present: Vec<(usize, &str)> = grid.present.iter().map(|&a| (a, lut3d::ROLES[a])).collect();
@@ -440,7 +440,15 @@ fn sections(ui: &mut egui::Ui, scene: &Scene, data: &mut ViewData, state: &mut P
             if let Some(t) = data.section(&ctx, scene, a, *index, state.sections.attribute) {
                 let size = Vec2::new(ex * s, ey * s);
                 let r = col.add(egui::Image::new((t.id(), size)));
-                r.on_hover_text(format!("{} across, {} down", axes[u].name, axes[wv].name));
+                // Under the pointer: the voxel's numbers and the trace's map position.
+                let text = match r.hover_pos() {
+                    Some(p) => {
+                        let f = (p - r.rect.min) / r.rect.size();
+                        grid.point(a, *index, f.x, f.y)
+                    }
+                    None => format!("{} across, {} down", axes[u].name, axes[wv].name),
+                };
+                r.on_hover_text(text);
             }
         }
     });

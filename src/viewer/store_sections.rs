@@ -11,6 +11,7 @@
 
 use std::path::Path;
 use std::sync::mpsc::{channel, Receiver, Sender};
+use std::sync::Arc;
 
 use glam::DVec3;
 
@@ -19,6 +20,26 @@ use crate::store::Store;
 use crate::techniques::opacity3d::bricked::StoreScene;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::volume::quantize::quantize_value;
+
+/// Map positions (`cdp_x`, `cdp_y`) of a survey's traces, and where the shown window
+/// starts in it.
+pub struct MapPositions {
+    /// x, then y, per trace, inline-major over the whole survey.
+    pub xy: [Vec<f64>; 2],
+    /// Crosslines in the whole survey.
+    pub crosslines: usize,
+    /// The window's first crossline and inline (voxel indices in the survey).
+    pub origin: [usize; 2],
+}
+
+impl MapPositions {
+    /// The position of the trace at crossline `j`, inline `k` of the window, if known.
+    pub fn at(&self, j: usize, k: usize) -> Option<[f64; 2]> {
+        let t = (self.origin[1] + k) * self.crosslines + self.origin[0] + j;
+        let p = [*self.xy[0].get(t)?, *self.xy[1].get(t)?];
+        p.iter().all(|v| v.is_finite()).then_some(p)
+    }
+}
 
 /// A request: (axis, index, attribute).
 pub type SectionKey = (usize, usize, usize);
@@ -33,6 +54,8 @@ pub struct StoreSections {
     pub axes: [Axis; 3],
     /// Per scene attribute: the store's attribute index and the quantization range.
     pub attributes: [Option<(usize, f64, f64)>; 3],
+    /// Each trace's map position, where the store has one.
+    pub positions: Option<Arc<MapPositions>>,
     window: [[usize; 3]; 2],
     requests: Sender<Request>,
     replies: Receiver<Reply>,
@@ -55,6 +78,21 @@ impl StoreSections {
         let window = pyramid.window;
         let dims: [usize; 3] = std::array::from_fn(|a| window[1][a].saturating_sub(window[0][a]));
         let axes = store_axes(meta, window);
+        // Map positions for the pointer's read-out: a missing or unreadable pair costs the
+        // read-out only, never the view.
+        let positions = match store.map_coordinates() {
+            Ok(xy) => xy.map(|xy| {
+                Arc::new(MapPositions {
+                    xy,
+                    crosslines: meta.dims[1],
+                    origin: [window[0][1], window[0][2]],
+                })
+            }),
+            Err(e) => {
+                eprintln!("map coordinates not shown: {e}");
+                None
+            }
+        };
         let (req_tx, req_rx) = channel();
         let (rep_tx, rep_rx) = channel();
         let reader = store.clone();
@@ -67,6 +105,7 @@ impl StoreSections {
             half: pyramid.half(),
             axes,
             attributes,
+            positions,
             window,
             requests: req_tx,
             replies: rep_rx,
@@ -146,35 +185,34 @@ fn read_sections(store: &Store, requests: Receiver<Request>, replies: Sender<Rep
     }
 }
 
-/// The axes of a store's window: SEG-Y time in ms, crossline and inline numbers from the
-/// source's first and step; plain indices otherwise.
+/// The axes of a store's window: the sample axis as the store numbers it (SEG-Y time in
+/// ms, an MDIO dataset's time or depth), crossline and inline numbers from the source's
+/// first and step; plain indices where it gave none.
 pub fn store_axes(meta: &crate::store::meta::StoreMeta, window: [[usize; 3]; 2]) -> [Axis; 3] {
     let len = |a: usize| window[1][a].saturating_sub(window[0][a]);
-    let numbered = |name: &str, a: usize, first_step: Option<[i64; 2]>, unit: f64| {
-        let (start, step) = match first_step {
-            Some([first, step]) => (first as f64, step as f64),
-            None => (0.0, unit),
-        };
-        Axis {
-            name: name.to_string(),
-            len: len(a),
-            numbers: Numbers::Linear {
-                start: start + window[0][a] as f64 * step,
-                step,
-            },
-        }
+    let numbered = |name: &str, a: usize, start: f64, step: f64| Axis {
+        name: name.to_string(),
+        len: len(a),
+        numbers: Numbers::Linear {
+            start: start + window[0][a] as f64 * step,
+            step,
+        },
     };
     let s = &meta.source;
-    match s.interval_us {
-        Some(us) => [
-            numbered("time (ms)", 0, None, us as f64 / 1000.0),
-            numbered("crossline", 1, s.crosslines, 1.0),
-            numbered("inline", 2, s.inlines, 1.0),
-        ],
-        None => [
-            numbered("i", 0, None, 1.0),
-            numbered("j", 1, None, 1.0),
-            numbered("k", 2, None, 1.0),
-        ],
-    }
+    let samples = s.sample_axis();
+    let line = |name: &str, plain: &str, a: usize, first_step: Option<[i64; 2]>| match first_step {
+        Some([first, step]) => numbered(name, a, first as f64, step as f64),
+        None => numbered(plain, a, 0.0, 1.0),
+    };
+    let plain = samples.unit.is_empty() && s.inlines.is_none() && s.crosslines.is_none();
+    let (i, j, k) = if plain {
+        ("i".to_string(), "j", "k")
+    } else {
+        (samples.label(), "crossline", "inline")
+    };
+    [
+        numbered(&i, 0, samples.first, samples.step),
+        line("crossline", j, 1, s.crosslines),
+        line("inline", k, 2, s.inlines),
+    ]
 }

@@ -15,6 +15,7 @@ mod docs;
 mod hostile;
 mod layers;
 mod mdio;
+mod mdio_positions;
 mod mdio_v0;
 mod opacity3d;
 mod opacity3d_precise;

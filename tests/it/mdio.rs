@@ -30,14 +30,15 @@ def main():
         HeaderField(name="cdp_x", byte=181, format="int32"),
         HeaderField(name="cdp_y", byte=185, format="int32"),
     ])
-    segy_to_mdio(segy_spec=spec, mdio_template=get_template("PostStack3DTime"),
+    template = sys.argv[3] if len(sys.argv) > 3 else "PostStack3DTime"
+    segy_to_mdio(segy_spec=spec, mdio_template=get_template(template),
                  input_path=sys.argv[1], output_path=sys.argv[2], overwrite=True)
 
 if __name__ == "__main__":
     main()
 "#;
 
-fn has_mdio() -> bool {
+pub(crate) fn has_mdio() -> bool {
     let ok = Command::new("python3")
         .args(["-c", "import mdio"])
         .output()
@@ -54,6 +55,11 @@ fn has_mdio() -> bool {
 
 /// `sgy` ingested by mdio-python into `DIR/NAME.mdio`.
 fn ingest(dir: &Path, sgy: &Path, name: &str) -> PathBuf {
+    ingest_as(dir, sgy, name, "PostStack3DTime")
+}
+
+/// `sgy` ingested by mdio-python into `DIR/NAME.mdio` with its template `template`.
+pub(crate) fn ingest_as(dir: &Path, sgy: &Path, name: &str, template: &str) -> PathBuf {
     let script = dir.join("ingest.py");
     std::fs::write(&script, INGEST).unwrap();
     let out = dir.join(format!("{name}.mdio"));
@@ -61,6 +67,7 @@ fn ingest(dir: &Path, sgy: &Path, name: &str) -> PathBuf {
         .arg(&script)
         .arg(sgy)
         .arg(&out)
+        .arg(template)
         .current_dir(dir)
         .output()
         .unwrap();
