@@ -15,10 +15,14 @@
 // (G, s0): s(p) = G.p + s0), 4096 per row; texture1: RGBA32UI neighbours across the
 // four faces (0xFFFFFFFF: boundary); texture2: transfer function, count x 2 RGBA32F
 // (row 0 colour and opacity value, row 1 the scalar positions); texture3: isovalues,
-// count x 2 (row 0 colours, row 1 values); texture4..11: entry layers (tet, t).
+// count x 2 (row 0 colours, row 1 values); texture4..11: entry layers (tet, t);
+// texture12: what earlier batches of entry layers accumulated (C, 1 - T), where
+// program_local[6].w is 1 (a ray entering more than 8 times is walked 8 entries a pass;
+// the walk then goes on from there and writes the sum so far, unblended).
 // program_local[0..3]: inverse ModelViewProj rows; [4]: viewport (width, height,
 // corner x, corner y); [5]: (control points, isovalues, termination transmittance,
-// eye tetrahedron or -1); [6]: (entry layers, 1 / unit distance, most steps, 0).
+// eye tetrahedron or -1); [6]: (entry layers, 1 / unit distance, most steps, 1 when
+// texture12 holds the earlier batches' sum).
 uniform sampler2D texture0;
 uniform usampler2D texture1;
 uniform sampler2D texture3;
@@ -30,6 +34,7 @@ uniform sampler2D texture8;
 uniform sampler2D texture9;
 uniform sampler2D texture10;
 uniform sampler2D texture11;
+uniform sampler2D texture12;
 uniform vec4 program_local[7];
 out vec4 color;
 
@@ -121,8 +126,13 @@ void main() {
     ray_d = e / ray_end;
     points = int(program_local[5].x + 0.5);
     inv_unit = program_local[6].y;
+    if (program_local[6].w > 0.5) {
+        acc = texelFetch(texture12, ivec2(pixel), 0);
+        // Ended already: opaque (an isosurface) or below the termination.
+        done = acc.a >= 1.0 || 1.0 - acc.a < program_local[5].z;
+    }
     int eye = int(program_local[5].w);
-    if (eye >= 0) walk(eye, -1.0);
+    if (eye >= 0 && !done) walk(eye, -1.0);
     int layers = int(program_local[6].x + 0.5);
     for (int k = 0; k < layers && !done; k++) {
         vec2 entry = layer(k, ivec2(pixel));

@@ -82,6 +82,32 @@ impl<'a> DrawCall<'a> {
     }
 }
 
+/// Draw `call` onto `surface` and count the samples that passed every test (an
+/// occlusion query: `SAMPLES_PASSED`); waits for the GL to finish the draw.
+pub fn draw_counted(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<u64> {
+    /// The query, deleted on every path out.
+    struct Query<'g>(&'g glow::Context, glow::Query);
+    impl Drop for Query<'_> {
+        fn drop(&mut self) {
+            // SAFETY: the query was created on this context and is not in use.
+            unsafe { self.0.delete_query(self.1) };
+        }
+    }
+    let gl = gpu.glow();
+    // SAFETY: plain object creation.
+    let query = Query(gl, unsafe { gl.create_query() }.map_err(GlError::Invalid)?);
+    // SAFETY: one query of this target active at a time (begun and ended here).
+    unsafe { gl.begin_query(glow::SAMPLES_PASSED, query.1) };
+    let drawn = draw(gpu, surface, call);
+    // SAFETY: as above.
+    unsafe { gl.end_query(glow::SAMPLES_PASSED) };
+    drawn?;
+    // SAFETY: the query has ended; QUERY_RESULT waits for it.
+    let samples = unsafe { gl.get_query_parameter_u32(query.1, glow::QUERY_RESULT) };
+    crate::gl_debug_check!(gpu)?;
+    Ok(samples as u64)
+}
+
 /// Execute `call` on `surface`; the state the draw set is restored afterwards.
 pub fn draw(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<()> {
     let (first, count) = call.range.unwrap_or((0, call.mesh.draw_count()));

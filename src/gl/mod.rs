@@ -19,7 +19,7 @@ mod texture;
 #[cfg(feature = "viewer")]
 pub mod window;
 
-pub use draw::{draw, Blend, DrawCall, Primitive};
+pub use draw::{draw, draw_counted, Blend, DrawCall, Primitive};
 pub use error::{error_name, CompileError, GlError, GlResult};
 pub use gpu::{renderer_is_software, ArbLimits, Caps, Gpu, Resource};
 pub use headless::{Backend, Headless, OSMESA_LIBRARIES};

@@ -7,6 +7,7 @@
 mod common;
 
 mod cellproj;
+mod cellproj_entries;
 mod cellproj_volume;
 mod cli;
 mod clip;

@@ -181,13 +181,36 @@ pub fn mpvonc_order(
     (order, stats)
 }
 
-/// Whether the mesh's boundary is locally convex: at every boundary edge, the other
-/// boundary faces' far vertices lie on the inner side of each face's plane (within 1e-9
-/// of the box). For one closed boundary this means a ray enters the mesh once (several
-/// separate convex bodies pass this test too; the renderer's entry layers say how many
-/// entries it follows).
+/// Whether every tetrahedron reaches every other across shared faces (one body).
+pub fn one_body(neighbours: &[[u32; 4]]) -> bool {
+    if neighbours.is_empty() {
+        return true;
+    }
+    let mut seen = vec![false; neighbours.len()];
+    let mut stack = vec![0u32];
+    seen[0] = true;
+    let mut reached = 1;
+    while let Some(t) = stack.pop() {
+        for &m in &neighbours[t as usize] {
+            if m != BOUNDARY && !seen[m as usize] {
+                seen[m as usize] = true;
+                reached += 1;
+                stack.push(m);
+            }
+        }
+    }
+    reached == neighbours.len()
+}
+
+/// Whether the mesh is one convex body, so that a ray enters it once: one body
+/// ([`one_body`]; separate convex plates pass the next test each), and its boundary
+/// locally convex: at every boundary edge, the other boundary faces' far vertices lie on
+/// the inner side of each face's plane (within 1e-9 of the box).
 pub fn boundary_is_convex(prepared: &Prepared, neighbours: &[[u32; 4]]) -> bool {
     use std::collections::HashMap;
+    if !one_body(neighbours) {
+        return false;
+    }
     let mut faces = Vec::new();
     for (t, row) in neighbours.iter().enumerate() {
         for (k, &m) in row.iter().enumerate() {

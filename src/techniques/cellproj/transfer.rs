@@ -59,8 +59,8 @@ pub struct VolumeSpec {
     /// How that table is built.
     #[serde(default)]
     pub build: Build,
-    /// Precise mode: entries into the mesh followed along a ray (0: 1 for a convex
-    /// boundary, 4 otherwise).
+    /// Precise mode: the most entries into the mesh followed along a ray (0: every one
+    /// the view has; a cap trades what lies behind it for time).
     #[serde(default)]
     pub entries: u32,
     /// Precise mode's method.
@@ -110,8 +110,8 @@ fn default_table() -> [u32; 2] {
     [128, 64]
 }
 
-/// Most entry layers (texture units 4..11 of the walk).
-pub const MAX_ENTRIES: u32 = 8;
+/// The largest `entries` cap a scene may set.
+pub const MAX_ENTRIES: u32 = 1024;
 
 fn default_unit() -> f64 {
     1.0
@@ -197,7 +197,7 @@ impl VolumeSpec {
         if self.entries > MAX_ENTRIES {
             return Err(FieldError::new(
                 "entries",
-                format!("{}: at most {MAX_ENTRIES} (0 chooses)", self.entries),
+                format!("{}: at most {MAX_ENTRIES} (0: every entry)", self.entries),
             ));
         }
         let t = self.termination;

@@ -19,9 +19,12 @@
 //! the entry (single bright pixels, the faithful pictures' speckle).
 //!
 //! **Precise** (GLSL, float target): the mesh in textures (face planes, scalar, face
-//! neighbours); `entries` passes peel the boundary faces through which rays enter the
-//! mesh (`volume_peel.frag`, one RGBA32F target each); one full-screen pass walks every
-//! pixel's ray through the tetrahedra (`volume_walk.frag`) and integrates it exactly.
+//! neighbours); passes peel the boundary faces through which rays enter the mesh
+//! (`volume_peel.frag`, one RGBA32F target each), until a pass finds none (an occlusion
+//! query counts its samples) or the scene's `entries` cap; a full-screen pass walks every
+//! pixel's ray through the tetrahedra (`volume_walk.frag`) and integrates it exactly,
+//! eight entries at a time: a ray entering more often goes on in the next pass from the
+//! sum so far (two more RGBA32F targets, ping-pong), so no entry is ever dropped.
 
 use std::time::Instant;
 
@@ -149,9 +152,18 @@ struct Precise {
     tf: Texture,
     isos: Texture,
     iso_count: usize,
+    /// Up to [`BATCH`] entry layers.
     layers: Vec<Target>,
-    entries: usize,
+    /// The sums of earlier batches (ping-pong), made when a view needs them.
+    sums: Vec<Target>,
+    /// The most entries followed (the scene's `entries`; `None`: every one).
+    cap: Option<usize>,
+    /// Entry layers the last frame peeled.
+    peeled: usize,
 }
+
+/// Entry layers one walk pass reads (texture units 4..11 of `volume_walk.frag`).
+const BATCH: usize = 8;
 
 /// The volume of a cell-projection scene.
 pub struct VolumeRenderer {
@@ -217,13 +229,13 @@ fn table_map(spec: &VolumeSpec, longest: f64) -> [[f64; 4]; 2] {
     ]
 }
 
-/// Entry layers the precise walk peels: the scene's, else one for a convex boundary and
-/// four otherwise.
-fn entry_layers(spec: &VolumeSpec, convex: bool) -> usize {
+/// The most entry layers the precise walk peels: the scene's cap, one for a convex
+/// boundary (a ray enters it once), else every entry the view has (`None`).
+fn entry_cap(spec: &VolumeSpec, convex: bool) -> Option<usize> {
     match spec.entries {
-        0 if convex => 1,
-        0 => 4,
-        e => e as usize,
+        0 if convex => Some(1),
+        0 => None,
+        e => Some(e as usize),
     }
 }
 
@@ -453,7 +465,7 @@ impl VolumeRenderer {
         .flat_map(|&(x, y)| [x, y, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])
         .collect();
         let quad = Mesh::new(gpu, "cellproj volume full-screen quad", &[4, 4], &quad)?;
-        let entries = entry_layers(&self.spec, self.convex);
+        let cap = entry_cap(&self.spec, self.convex);
         Ok(Precise {
             peel,
             walk,
@@ -465,7 +477,9 @@ impl VolumeRenderer {
             isos,
             iso_count,
             layers: Vec::new(),
-            entries,
+            sums: Vec::new(),
+            cap,
+            peeled: 0,
         })
     }
 
@@ -480,11 +494,7 @@ impl VolumeRenderer {
         }
         self.transfer = transfer;
         if let Some(p) = &mut self.precise {
-            let entries = entry_layers(spec, self.convex);
-            if entries != p.entries {
-                p.entries = entries;
-                p.layers.clear();
-            }
+            p.cap = entry_cap(spec, self.convex);
         }
         // The spec the textures were made for moves aside with them (see `refresh`).
         if !self.stale {
@@ -546,9 +556,10 @@ impl VolumeRenderer {
         &self.neighbours
     }
 
-    /// Entry layers the precise walk follows.
+    /// Entry layers the precise walk peeled for the last frame (the most entries of any
+    /// ray, within the scene's cap).
     pub fn entries(&self) -> usize {
-        self.precise.as_ref().map_or(0, |p| p.entries)
+        self.precise.as_ref().map_or(0, |p| p.peeled)
     }
 
     /// Draw onto `surface` (the isosurfaces' depth already there in `mode = "both"`).
@@ -664,12 +675,12 @@ impl VolumeRenderer {
     ) -> GlResult<()> {
         let (w, h) = (frame.width, frame.height);
         let p = self.precise.as_mut().expect("precise");
-        if p.layers
-            .first()
-            .is_none_or(|l| l.width() != w || l.height() != h)
-        {
+        let pool = p.cap.map_or(BATCH, |c| c.min(BATCH));
+        let sized = |t: &[Target]| t.first().is_some_and(|l| l.width() == w && l.height() == h);
+        if !sized(&p.layers) || p.layers.len() != pool {
             p.layers.clear();
-            for _ in 0..p.entries {
+            p.sums.clear();
+            for _ in 0..pool {
                 p.layers
                     .push(Target::with_depth(gpu, w, h, TargetFormat::Rgba32f)?);
             }
@@ -683,24 +694,6 @@ impl VolumeRenderer {
             p.walk.set_local(gpu, i, *row)?;
         }
         p.peel.set_local(gpu, 4, [w as f64, h as f64, 0.0, 0.0])?;
-        for k in 0..p.layers.len() {
-            p.layers[k].clear(gpu, [-1.0, -1.0, 0.0, 0.0])?;
-            p.peel
-                .set_local(gpu, 5, [(k > 0) as u8 as f64, 0.0, 0.0, 0.0])?;
-            let (before, rest) = p.layers.split_at(k);
-            let textures: Vec<(u32, &Texture)> =
-                before.last().map(|l| (3, l.color())).into_iter().collect();
-            gl::draw(
-                gpu,
-                Surface::Target(&rest[0]),
-                &DrawCall {
-                    textures: &textures,
-                    depth_test: true,
-                    cull_back: true,
-                    ..DrawCall::new(&p.peel, &p.boundary)
-                },
-            )?;
-        }
         let corner = match surface {
             Surface::Target(_) => [0.0, 0.0],
             Surface::Window([x, y, _, _]) => [x as f64, y as f64],
@@ -712,42 +705,109 @@ impl VolumeRenderer {
             Projection::Orthographic => -1.0,
         };
         let s = &self.spec;
-        p.walk
-            .set_local(gpu, 4, [w as f64, h as f64, corner[0], corner[1]])?;
-        p.walk.set_local(
-            gpu,
-            5,
-            [
-                self.transfer.s.len() as f64,
-                p.iso_count as f64,
-                s.termination,
-                eye_tet,
-            ],
-        )?;
-        p.walk.set_local(
-            gpu,
-            6,
-            [
-                p.layers.len() as f64,
-                1.0 / self.transfer.unit,
-                self.tets as f64 + 16.0,
-                0.0,
-            ],
-        )?;
-        let mut textures: Vec<(u32, &Texture)> =
-            vec![(0, &p.tets), (1, &p.neighbours), (2, &p.tf), (3, &p.isos)];
-        for (k, l) in p.layers.iter().enumerate() {
-            textures.push((4 + k as u32, l.color()));
+        let locals = [
+            self.transfer.s.len() as f64,
+            p.iso_count as f64,
+            s.termination,
+        ];
+        let inv_unit = 1.0 / self.transfer.unit;
+        // Every boundary face at most once per ray: no more layers than that.
+        let most = p
+            .cap
+            .unwrap_or(usize::MAX)
+            .min(p.boundary.draw_count() / 3 + 1);
+        p.peeled = 0;
+        let mut batch = 0;
+        loop {
+            // Peel up to BATCH entry layers; layer 0 of a later batch reads the previous
+            // batch's last (the pool's last), which it overwrites only at its own end.
+            let mut n = 0;
+            while n < p.layers.len() && p.peeled < most {
+                let k = n;
+                p.layers[k].clear(gpu, [-1.0, -1.0, 0.0, 0.0])?;
+                let after = p.peeled > 0;
+                p.peel
+                    .set_local(gpu, 5, [after as u8 as f64, 0.0, 0.0, 0.0])?;
+                let previous = if k > 0 { k - 1 } else { p.layers.len() - 1 };
+                let textures: Vec<(u32, &Texture)> = if after {
+                    vec![(3, p.layers[previous].color())]
+                } else {
+                    Vec::new()
+                };
+                let call = DrawCall {
+                    textures: &textures,
+                    depth_test: true,
+                    cull_back: true,
+                    ..DrawCall::new(&p.peel, &p.boundary)
+                };
+                // Without a cap the layers go on until one is empty; with one (a convex
+                // boundary's single layer), no count is needed.
+                let target = Surface::Target(&p.layers[k]);
+                if p.cap.is_none() {
+                    if gl::draw_counted(gpu, target, &call)? == 0 {
+                        break;
+                    }
+                } else {
+                    gl::draw(gpu, target, &call)?;
+                }
+                n += 1;
+                p.peeled += 1;
+            }
+            // The last batch: fewer than a full pool, or at the cap.
+            let last = n < p.layers.len() || p.peeled >= most;
+            if !last && p.sums.is_empty() {
+                for _ in 0..2 {
+                    p.sums.push(Target::new(gpu, w, h, TargetFormat::Rgba32f)?);
+                }
+            }
+            let (sum_in, sum_out) = (batch % 2, (batch + 1) % 2);
+            let eye = if batch == 0 { eye_tet } else { -1.0 };
+            // The surface's corner for the last pass; the sums are targets of their own.
+            let at = if last { corner } else { [0.0, 0.0] };
+            p.walk
+                .set_local(gpu, 4, [w as f64, h as f64, at[0], at[1]])?;
+            p.walk
+                .set_local(gpu, 5, [locals[0], locals[1], locals[2], eye])?;
+            p.walk.set_local(
+                gpu,
+                6,
+                [
+                    n as f64,
+                    inv_unit,
+                    self.tets as f64 + 16.0,
+                    (batch > 0) as u8 as f64,
+                ],
+            )?;
+            let mut textures: Vec<(u32, &Texture)> =
+                vec![(0, &p.tets), (1, &p.neighbours), (2, &p.tf), (3, &p.isos)];
+            for (k, l) in p.layers[..n].iter().enumerate() {
+                textures.push((4 + k as u32, l.color()));
+            }
+            if batch > 0 {
+                textures.push((12, p.sums[sum_in].color()));
+            }
+            if last {
+                return gl::draw(
+                    gpu,
+                    surface,
+                    &DrawCall {
+                        textures: &textures,
+                        blend: Blend::PremultipliedOver,
+                        ..DrawCall::new(&p.walk, &p.quad)
+                    },
+                );
+            }
+            p.sums[sum_out].clear(gpu, [0.0; 4])?;
+            gl::draw(
+                gpu,
+                Surface::Target(&p.sums[sum_out]),
+                &DrawCall {
+                    textures: &textures,
+                    ..DrawCall::new(&p.walk, &p.quad)
+                },
+            )?;
+            batch += 1;
         }
-        gl::draw(
-            gpu,
-            surface,
-            &DrawCall {
-                textures: &textures,
-                blend: Blend::PremultipliedOver,
-                ..DrawCall::new(&p.walk, &p.quad)
-            },
-        )
     }
 }
 
