@@ -50,11 +50,41 @@ def offscreen_window(renderer, scene):
         cam.ParallelProjectionOff()
         cam.SetViewAngle(c["view_angle"])
     cam.SetClippingRange(max(distance - 2.0, 1e-3), distance + 2.0)
-    window = vtk.vtkRenderWindow()
-    window.SetOffScreenRendering(1)
-    window.SetSize(*scene["size"])
+    window = plain_window(scene["size"])
     window.AddRenderer(renderer)
     return window
+
+
+def plain_window(size):
+    """An offscreen window of `size` as a careful user sets one up for a benchmark:
+    multisampling off (VTK's EGL window multisamples 8x by default; arbvis renders
+    without), so both draw one sample per pixel."""
+    import vtk
+
+    window = vtk.vtkRenderWindow()
+    window.SetMultiSamples(0)
+    window.SetOffScreenRendering(1)
+    window.SetSize(*size)
+    return window
+
+
+def window_config(window):
+    """The peer's window as the output states it beside every ratio."""
+    import vtk
+
+    w, h = window.GetSize()
+    return (f"VTK {vtk.vtkVersion.GetVTKVersion()} {window.GetClassName()}, {w}x{h}, "
+            f"multisamples {window.GetMultiSamples()}, offscreen {window.GetOffScreenRendering()}")
+
+
+def mapper_config(mapper, names):
+    """`Name=value` of each getter in `names` that `mapper` has (GetName)."""
+    out = []
+    for n in names:
+        getter = getattr(mapper, "Get" + n, None)
+        if getter is not None:
+            out.append(f"{n}={getter()}")
+    return f"{mapper.GetClassName()}(" + ", ".join(out) + ")"
 
 
 def timed_frame(window):

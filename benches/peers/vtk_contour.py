@@ -30,7 +30,7 @@ import vtk  # noqa: E402
 from vtk.util import numpy_support  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from peer_common import kuhn_tets  # noqa: E402
+from peer_common import kuhn_tets, plain_window, window_config  # noqa: E402
 
 
 def grid_mesh(n):
@@ -71,9 +71,7 @@ def measure(n, edits, size):
     ren = vtk.vtkRenderer()
     ren.AddActor(actor)
     ren.SetBackground(0, 0, 0)
-    win = vtk.vtkRenderWindow()
-    win.SetOffScreenRendering(1)
-    win.SetSize(*size)
+    win = plain_window(size)
     win.AddRenderer(ren)
     ren.ResetCamera()
     win.Render()
@@ -99,6 +97,7 @@ def measure(n, edits, size):
         "frame_ms": statistics.median(frames),
         "triangles": contour.GetOutput().GetNumberOfCells(),
         "renderer": win.ReportCapabilities().split("OpenGL renderer string:")[-1].split("\n")[0].strip(),
+        "config": window_config(win),
     }
 
 
@@ -117,7 +116,7 @@ def main():
         print(
             f"VTK {vtk.vtkVersion.GetVTKVersion()} grid {n}: {r['tets']:>9} tets, "
             f"{r['triangles']:>8} triangles, edit->frame {r['edit_to_frame_ms']:8.2f} ms, "
-            f"frame {r['frame_ms']:7.2f} ms ({r['renderer']})",
+            f"frame {r['frame_ms']:7.2f} ms ({r['renderer']}; {r['config']})",
             flush=True,
         )
     if a.json:

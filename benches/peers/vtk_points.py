@@ -29,12 +29,23 @@ import json
 import os
 import statistics
 import subprocess
+import sys
 import time
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 import numpy as np  # noqa: E402
 import vtk  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from peer_common import plain_window, window_config  # noqa: E402
+
+
+MODES = {
+    "opaque": "VTK's default: splats drawn opaque with the depth test, nothing blended",
+    "unsorted": "translucent: blended in the points' order (no sort)",
+    "peeled": "translucent, depth-peeled: blended in depth order (arbvis's work)",
+}
 
 
 def write_cloud(path, n, seed):
@@ -98,7 +109,7 @@ def arbvis_frames(binary, scene, frames, turn):
 
 
 class VtkScene:
-    def __init__(self, ply, size, pixels):
+    def __init__(self, ply, size, pixels, mode):
         reader = vtk.vtkPLYReader()
         reader.SetFileName(ply)
         reader.Update()
@@ -112,10 +123,23 @@ class VtkScene:
         self.ren = vtk.vtkRenderer()
         self.ren.AddActor(actor)
         self.ren.SetBackground(0, 0, 0)
-        self.win = vtk.vtkRenderWindow()
-        self.win.SetOffScreenRendering(1)
-        self.win.SetSize(*size)
+        self.win = plain_window(size)
         self.win.AddRenderer(self.ren)
+        if mode != "opaque":
+            # The actor translucent (opacity 0.999: VTK blends only translucent actors;
+            # the Gaussian's alpha scaled by 0.999), so the splats are blended as arbvis's.
+            actor.GetProperty().SetOpacity(0.999)
+        if mode == "peeled":
+            # Equal work: blended in depth order, as arbvis's are (the mapper itself sorts
+            # nothing). Peels until nothing is left (no cap, occlusion ratio 0).
+            self.win.SetAlphaBitPlanes(1)
+            self.ren.SetUseDepthPeeling(1)
+            self.ren.SetMaximumNumberOfPeels(0)
+            self.ren.SetOcclusionRatio(0.0)
+        self.mode = mode
+        self.config = (f"{window_config(self.win)}; vtkPointGaussianMapper, {MODES[mode]}, "
+                       f"opacity {actor.GetProperty().GetOpacity()}, depth peeling "
+                       f"{self.ren.GetUseDepthPeeling()}")
         cam = self.ren.GetActiveCamera()
         cam.ParallelProjectionOn()
         b = reader.GetOutput().GetBounds()
@@ -164,6 +188,8 @@ def main():
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--turn", type=float, default=0.0,
                    help="degrees the camera turns before every frame (both systems)")
+    p.add_argument("--vtk-modes", default="opaque,unsorted,peeled",
+                   help="how VTK draws: " + "; ".join(f"{k}: {v}" for k, v in MODES.items()))
     p.add_argument("--dir", default="/tmp/arbvis-vtk-points")
     p.add_argument("--json", default=None)
     p.add_argument("--png", default=None, help="write VTK's frame here (to compare coverage "
@@ -178,31 +204,37 @@ def main():
     for draw in ("points", "tiles"):
         scenes[draw] = os.path.join(a.dir, f"splats-{draw}.toml")
         arbvis_scene(scenes[draw], ply, size, a.pixels, draw)
-    v = VtkScene(ply, size, a.pixels)
+    peers = [VtkScene(ply, size, a.pixels, m) for m in a.vtk_modes.split(",") if m]
+    for v in peers:
+        print(f"VTK {v.mode}: {v.config}", flush=True)
     if a.png:
-        v.save_png(a.png)
+        peers[0].save_png(a.png)
     arb = {draw: [] for draw in scenes}
-    vtk_ms = []
+    vtk_ms = {v.mode: [] for v in peers}
     renderer = ""
     for r in range(a.rounds):
         for draw, scene in scenes.items():
             ms, renderer = arbvis_frames(a.arbvis, scene, a.frames, a.turn)
             arb[draw] += ms
-        vtk_ms += v.frames(a.frames, a.turn)
+        for v in peers:
+            vtk_ms[v.mode] += v.frames(a.frames, a.turn)
         print(f"round {r + 1} of {a.rounds} done", flush=True)
-    mv = statistics.median(vtk_ms)
-    print(f"{v.n} points at {size[0]}x{size[1]}, {a.pixels}-pixel splats, {renderer}; "
+    print(f"{peers[0].n if peers else '?'} points at {size[0]}x{size[1]}, {a.pixels}-pixel splats, {renderer}; "
           f"VTK {vtk.vtkVersion.GetVTKVersion()}; camera turning {a.turn} degrees per frame")
     for draw, ms in arb.items():
         m = statistics.median(ms)
-        print(f"arbvis splats, draw = {draw:<6} (Gaussian): median {m:8.1f} ms/frame, "
-              f"{mv / m:5.1f}x faster than VTK")
-    print(f"VTK point Gaussian mapper:                median {mv:8.1f} ms/frame")
+        against = ", ".join(f"{statistics.median(t) / m:.1f}x VTK {k}" for k, t in vtk_ms.items())
+        print(f"arbvis splats, draw = {draw:<6} (Gaussian, in depth order): median {m:8.1f} "
+              f"ms/frame; {against}")
+    for v in peers:
+        print(f"VTK {v.mode:<8} median {statistics.median(vtk_ms[v.mode]):8.1f} ms/frame: "
+              f"{v.config}")
     if a.json:
         with open(a.json, "w") as f:
             json.dump({"points": v.n, "size": size, "pixels": a.pixels, "turn": a.turn,
                        "renderer": renderer, "arbvis_ms": arb["points"],
-                       "arbvis_tiles_ms": arb["tiles"], "vtk_ms": vtk_ms}, f, indent=1)
+                       "arbvis_tiles_ms": arb["tiles"], "vtk_ms": vtk_ms,
+                       "vtk_config": {v.mode: v.config for v in peers}}, f, indent=1)
 
 
 if __name__ == "__main__":

@@ -44,7 +44,8 @@ import vtk  # noqa: E402
 from vtk.util import numpy_support  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from peer_common import load_export, offscreen_window, rgb_error, timed_frame, window_rgb  # noqa: E402
+from peer_common import (load_export, mapper_config, offscreen_window, rgb_error,  # noqa: E402
+                         timed_frame, window_config, window_rgb)
 
 MAPPERS = {
     "projected-tetrahedra": "vtkProjectedTetrahedraMapper",
@@ -100,12 +101,21 @@ class VtkPeer:
         prop.SetInterpolationTypeToLinear()
         self.mapper = getattr(vtk, MAPPERS[mapper_name])()
         self.mapper.SetInputData(ug)
+        if hasattr(self.mapper, "SetAutoAdjustImageSampleDistances"):
+            # Every pixel cast (no lower-resolution image when a frame runs long), as
+            # arbvis draws every pixel: the ray caster's and the z-sweep's quality at its
+            # fastest fixed setting.
+            self.mapper.SetAutoAdjustImageSampleDistances(0)
+            self.mapper.SetImageSampleDistance(1.0)
         volume = vtk.vtkVolume()
         volume.SetMapper(self.mapper)
         volume.SetProperty(prop)
         renderer = vtk.vtkRenderer()
         renderer.AddVolume(volume)
         self.window = offscreen_window(renderer, scene)
+        self.config = (window_config(self.window) + "; " + mapper_config(self.mapper, [
+            "AutoAdjustImageSampleDistances", "ImageSampleDistance", "MaxPixelListSize",
+            "UseFloatingPointFrameBuffer"]))
 
     def frame(self):
         return timed_frame(self.window)
@@ -152,7 +162,8 @@ def main():
         save_ppm(os.path.join(args.export, f"vtk-{m}.ppm"), image)
         peers[m] = {"peer": peer, "first_ms": first, "max_abs": err[0], "rmse": err[1],
                     "frames_ms": []}
-        print(f"VTK {m}: first {first:.0f} ms, RMSE {err[1]:.5f}, max {err[0]:.3f}", flush=True)
+        print(f"VTK {m}: first {first:.0f} ms, RMSE {err[1]:.5f}, max {err[0]:.3f}; "
+              f"{peer.config}", flush=True)
     for r in range(args.rounds):
         report = arbvis_bench(args, score=False)
         for m in report["settings"]:
@@ -183,7 +194,8 @@ def main():
         out = {"arbvis": scored, "arbvis_frames": arb,
                "vtk": [{"mapper": m, "first_ms": v["first_ms"], "frames_ms": v["frames_ms"],
                         "rmse": v["rmse"], "max_abs": v["max_abs"]} for m, v in peers.items()],
-               "vtk_version": vtk.vtkVersion.GetVTKVersion()}
+               "vtk_version": vtk.vtkVersion.GetVTKVersion(),
+               "vtk_config": {m: v["peer"].config for m, v in peers.items()}}
         with open(args.json, "w") as f:
             json.dump(out, f, indent=1)
 

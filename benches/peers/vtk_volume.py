@@ -44,7 +44,8 @@ import vtk  # noqa: E402
 from vtk.util import numpy_support  # noqa: E402
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from peer_common import load_export, offscreen_window, rgb_error, timed_frame, window_rgb  # noqa: E402
+from peer_common import (load_export, mapper_config, offscreen_window, rgb_error,  # noqa: E402
+                         timed_frame, window_config, window_rgb)
 
 
 def arbvis_bench(args, extra, score):
@@ -189,6 +190,9 @@ def main():
     distances = [float(x) for x in args.sample_distances.split(",") if x]
     for t in [x for x in args.types.split(",") if x]:
         peer = VtkPeer(scene, t)
+        print(f"VTK {t}: {window_config(peer.window)}; " + mapper_config(peer.mapper, [
+            "AutoAdjustSampleDistances", "UseJittering", "LockSampleDistanceToInputSpacing",
+            "ImageSampleDistance"]), flush=True)
         for sd in distances:
             peer.set_sample_distance(sd)
             first = peer.frame()
@@ -234,7 +238,9 @@ def main():
                "vtk": [{"type": t, "sample_distance": sd, "first_ms": v["first_ms"],
                         "frames_ms": v["frames_ms"], "rmse": v["rmse"],
                         "max_abs": v["max_abs"]} for (t, sd), v in peers.items()],
-               "vtk_version": vtk.vtkVersion.GetVTKVersion()}
+               "vtk_version": vtk.vtkVersion.GetVTKVersion(),
+               "vtk_config": window_config(next(iter(peers.values()))["peer"].window)
+               if peers else None}
         with open(args.json, "w") as f:
             json.dump(out, f, indent=1)
 

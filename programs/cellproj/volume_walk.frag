@@ -16,13 +16,17 @@
 // four faces (0xFFFFFFFF: boundary); texture2: transfer function, count x 2 RGBA32F
 // (row 0 colour and opacity value, row 1 the scalar positions); texture3: isovalues,
 // count x 2 (row 0 colours, row 1 values); texture4..11: entry layers (tet, t);
+// texture13: RG32UI per tetrahedron (first, count) into texture14, R32UI: the boundary
+// tetrahedra a ray leaving it through the boundary may re-enter at once (see reenter);
 // texture12: what earlier batches of entry layers accumulated (C, 1 - T), where
 // program_local[6].w is 1 (a ray entering more than 8 times is walked 8 entries a pass;
 // the walk then goes on from there and writes the sum so far, unblended).
 // program_local[0..3]: inverse ModelViewProj rows; [4]: viewport (width, height,
 // corner x, corner y); [5]: (control points, isovalues, termination transmittance,
 // eye tetrahedron or -1); [6]: (entry layers, 1 / unit distance, most steps, 1 when
-// texture12 holds the earlier batches' sum).
+// texture12 holds the earlier batches' sum); [7].x: 1 to look for re-entries (one pass
+// only: across passes `reached` is not kept, and a re-entry walked in one pass would be
+// walked again from its entry layer in the next).
 uniform sampler2D texture0;
 uniform usampler2D texture1;
 uniform sampler2D texture3;
@@ -35,7 +39,9 @@ uniform sampler2D texture9;
 uniform sampler2D texture10;
 uniform sampler2D texture11;
 uniform sampler2D texture12;
-uniform vec4 program_local[7];
+uniform usampler2D texture13;
+uniform usampler2D texture14;
+uniform vec4 program_local[8];
 out vec4 color;
 
 const int ROW = 4096;
@@ -48,6 +54,45 @@ ivec2 at(int k) {
 vec3 ray_o;
 vec3 ray_d;
 float ray_end;
+// The farthest point along the ray a walk has reached: an entry layer before it was
+// walked already (a re-entry the walk found itself).
+float reached = -1e30;
+
+// The ray's interval [t_in, t_out] in tetrahedron `tet` (t_in > t_out: it misses).
+vec2 interval(int tet) {
+    float t_in = -1e30;
+    float t_out = 1e30;
+    for (int k = 0; k < 4; k++) {
+        vec4 plane = texelFetch(texture0, at(tet * 5 + k), 0);
+        float dn = dot(plane.xyz, ray_d);
+        float num = plane.w - dot(plane.xyz, ray_o);
+        if (dn > 1e-7) t_out = min(t_out, num / dn);
+        else if (dn < -1e-7) t_in = max(t_in, num / dn);
+        else if (num < 0.0) return vec2(1.0, 0.0);
+    }
+    return vec2(t_in, t_out);
+}
+
+// A ray leaving `tet` through the boundary at `t`: the candidate it enters next within
+// a ten-thousandth of its length (the nearest entry, a segment longer than a millionth),
+// or -1. Where the ray grazes the boundary past an edge, the entry layers can miss that
+// re-entry (rasterization gives its face no sample there) and the rest of the ray
+// would be lost.
+int reenter(int tet, float t, out float t_in) {
+    uvec2 range = texelFetch(texture13, at(tet), 0).xy;
+    int best = -1;
+    float best_t = t + 1e-4 * ray_end;
+    for (uint i = 0u; i < range.y; i++) {
+        int c = int(texelFetch(texture14, at(int(range.x + i)), 0).r);
+        vec2 iv = interval(c);
+        if (iv.x >= t - 1e-6 * ray_end && iv.x <= best_t && iv.y - iv.x > 1e-6 * ray_end) {
+            best = c;
+            best_t = iv.x;
+        }
+    }
+    t_in = max(best_t, t);
+    return best;
+}
 
 // The segment [a, b] of the ray in a tetrahedron whose scalar is G.p + s0.
 void segment(vec4 scalar, float a, float b) {
@@ -95,10 +140,17 @@ void walk(int tet, float t) {
         float a = max(t, 0.0);
         float b = min(t_exit, ray_end);
         if (b > a) segment(texelFetch(texture0, at(base + 4), 0), a, b);
+        reached = max(reached, t_exit);
         if (t_exit >= ray_end) break;
         uint next = texelFetch(texture1, at(tet), 0)[face];
-        tet = next == 0xFFFFFFFFu ? -1 : int(next);
         t = t_exit;
+        if (next == 0xFFFFFFFFu && program_local[7].x > 0.5) {
+            float t_in;
+            tet = reenter(tet, t_exit, t_in);
+            t = t_in;
+        } else {
+            tet = next == 0xFFFFFFFFu ? -1 : int(next);
+        }
     }
 }
 
@@ -137,6 +189,8 @@ void main() {
     for (int k = 0; k < layers && !done; k++) {
         vec2 entry = layer(k, ivec2(pixel));
         if (entry.x < 0.0) break;
+        // Walked already from an earlier entry that re-entered by itself.
+        if (entry.y < reached - 1e-5 * ray_end) continue;
         walk(int(entry.x + 0.5), entry.y);
     }
     if (acc.a <= 0.0) discard;

@@ -149,6 +149,9 @@ struct Precise {
     quad: Mesh,
     tets: Texture,
     neighbours: Texture,
+    /// Per tetrahedron (first, count) into `reentry` ([`reentry_candidates`]).
+    reentry_offsets: Texture,
+    reentry: Texture,
     tf: Texture,
     isos: Texture,
     iso_count: usize,
@@ -237,6 +240,53 @@ fn entry_cap(spec: &VolumeSpec, convex: bool) -> Option<usize> {
         0 => None,
         e => Some(e as usize),
     }
+}
+
+/// Most re-entry candidates kept per tetrahedron (the walk tests each).
+const MAX_REENTRY: usize = 64;
+
+/// Where a ray that leaves the mesh may enter it again at once: for each tetrahedron
+/// with a boundary face, the other tetrahedra with a boundary face that share a vertex
+/// with one of its boundary faces (at most [`MAX_REENTRY`], nearest first by index
+/// distance kept as found). A ray grazing the boundary past an edge leaves through one
+/// and re-enters through another within a hair, and the rasterized entry layers can
+/// miss that re-entry (the entry face covers a sliver of the pixel); the walk tests these
+/// instead. Returns (first, count) per tetrahedron and the list.
+fn reentry_candidates(prepared: &Prepared, neighbours: &[[u32; 4]]) -> (Vec<u32>, Vec<u32>) {
+    let n = neighbours.len();
+    // Boundary tetrahedra around each vertex of a boundary face.
+    let mut around: std::collections::HashMap<u32, Vec<u32>> = Default::default();
+    let boundary_vertices = |t: usize| {
+        let row = neighbours[t];
+        let mut v: Vec<u32> = (0..4)
+            .filter(|&k| row[k] == BOUNDARY)
+            .flat_map(|k| FACES[k].0.map(|i| prepared.tets[t][i]))
+            .collect();
+        v.sort_unstable();
+        v.dedup();
+        v
+    };
+    for t in 0..n {
+        for v in boundary_vertices(t) {
+            around.entry(v).or_default().push(t as u32);
+        }
+    }
+    let mut offsets = vec![0u32; 2 * n];
+    let mut list = Vec::new();
+    for t in 0..n {
+        let mut found: Vec<u32> = boundary_vertices(t)
+            .iter()
+            .flat_map(|v| around[v].iter().copied())
+            .filter(|&c| c as usize != t)
+            .collect();
+        found.sort_unstable();
+        found.dedup();
+        found.truncate(MAX_REENTRY);
+        offsets[2 * t] = list.len() as u32;
+        offsets[2 * t + 1] = found.len() as u32;
+        list.extend(found);
+    }
+    (offsets, list)
 }
 
 /// The four faces of every tetrahedron, as the faithful and projected paths draw them.
@@ -429,6 +479,21 @@ impl VolumeRenderer {
             TexelData::U32(&nb),
             n,
         )?;
+        let (offsets, list) = reentry_candidates(prepared, &self.neighbours);
+        let reentry_offsets = rows_texture(
+            gpu,
+            "cellproj volume re-entry candidates (first, count) per tetrahedron",
+            TexelFormat::Rg32ui,
+            TexelData::U32(&offsets),
+            n,
+        )?;
+        let reentry = rows_texture(
+            gpu,
+            "cellproj volume re-entry candidates",
+            TexelFormat::R32ui,
+            TexelData::U32(&list),
+            list.len(),
+        )?;
         let tf = tf_texture(gpu, &self.transfer)?;
         let iso_count = isovalues.len();
         let mut list = super::prepare::iso_list(isovalues);
@@ -473,6 +538,8 @@ impl VolumeRenderer {
             quad,
             tets,
             neighbours,
+            reentry_offsets,
+            reentry,
             tf,
             isos,
             iso_count,
@@ -778,8 +845,17 @@ impl VolumeRenderer {
                     (batch > 0) as u8 as f64,
                 ],
             )?;
-            let mut textures: Vec<(u32, &Texture)> =
-                vec![(0, &p.tets), (1, &p.neighbours), (2, &p.tf), (3, &p.isos)];
+            let one_pass = last && batch == 0;
+            p.walk
+                .set_local(gpu, 7, [one_pass as u8 as f64, 0.0, 0.0, 0.0])?;
+            let mut textures: Vec<(u32, &Texture)> = vec![
+                (0, &p.tets),
+                (1, &p.neighbours),
+                (2, &p.tf),
+                (3, &p.isos),
+                (13, &p.reentry_offsets),
+                (14, &p.reentry),
+            ];
             for (k, l) in p.layers[..n].iter().enumerate() {
                 textures.push((4 + k as u32, l.color()));
             }
