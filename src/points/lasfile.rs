@@ -186,7 +186,7 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
 /// decoder) where it could return an error; the checks above cannot foresee what an
 /// arithmetic-coded stream decodes to, so this is the last guard: the decoder that
 /// panicked is dropped with the error, never reused.
-fn guarded<T>(f: impl FnOnce() -> las::Result<T>) -> Result<T, String> {
+pub(super) fn guarded<T>(f: impl FnOnce() -> las::Result<T>) -> Result<T, String> {
     match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
         Ok(result) => result.map_err(|e| e.to_string()),
         Err(panic) => {

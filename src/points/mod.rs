@@ -37,6 +37,7 @@
 //! [`progress::MIN_POINTS`] points or more when stderr is a terminal.
 
 mod cloud;
+pub mod copc;
 pub mod dat;
 pub mod lasfile;
 pub mod ply;
@@ -44,6 +45,7 @@ pub mod plycloud;
 pub mod progress;
 pub mod section;
 
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -257,6 +259,22 @@ impl FileKind {
 /// file's coordinates, the origin and scale chosen, and every attribute with its min,
 /// max, median and NaN count. `.dat` files are read with the default columns.
 pub fn inspect(path: &Path) -> Result<String, PointsError> {
+    // A COPC file is described from its header and hierarchy, without decoding a point.
+    let mut head = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|f| f.take(512).read_to_end(&mut head))
+        .map_err(|e| PointsError::io(path, e))?;
+    if copc::is_copc(&head) {
+        let c = copc::Copc::open(path)?;
+        return Ok(format!(
+            "{}\nformat: COPC (LAZ 1.4, point format {}, {}-byte records), {} points\n{}",
+            path.display(),
+            c.format.0,
+            c.format.1,
+            c.points,
+            c.describe()
+        ));
+    }
     let bytes = read_file(path)?;
     let (format, cloud) = match FileKind::detect(path, &bytes) {
         FileKind::Las => {

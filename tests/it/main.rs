@@ -11,6 +11,7 @@ mod cellproj_entries;
 mod cellproj_volume;
 mod cli;
 mod clip;
+mod copc;
 mod data;
 mod docs;
 mod hostile;
