@@ -34,6 +34,22 @@ const EVLR_HEADER: u64 = 60;
 /// Deepest octree level read (keys are i32: 2^30 nodes a side is far past any survey).
 const MAX_LEVEL: i32 = 30;
 
+/// A COPC cloud in a scene: the file, and the most points drawn (whole levels from the
+/// root; the root's level always).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CopcSpec {
+    /// The `.copc.laz` file.
+    pub path: PathBuf,
+    /// The point budget (default 1,000,000, Potree's).
+    #[serde(default = "default_budget")]
+    pub points: u64,
+}
+
+fn default_budget() -> u64 {
+    1_000_000
+}
+
 /// One octree node: its key, where its chunk lies and how many points it holds.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Node {
@@ -214,6 +230,32 @@ impl Copc {
             nodes,
             reader: Mutex::new(reader),
         })
+    }
+
+    /// The file.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// The nodes of the whole levels from the root down whose points fit in `budget`
+    /// (the root's level always), and their levels' count.
+    pub fn cut(&self, budget: u64) -> (Vec<Node>, usize) {
+        let mut total = 0u64;
+        let mut levels = Vec::new();
+        for (level, _, points) in self.levels() {
+            if !levels.is_empty() && total + points > budget {
+                break;
+            }
+            total += points;
+            levels.push(level);
+        }
+        let nodes = self
+            .nodes
+            .iter()
+            .filter(|n| levels.contains(&n.key[0]))
+            .copied()
+            .collect();
+        (nodes, levels.len())
     }
 
     /// (level, nodes, points) of every level holding points, from the root down.

@@ -145,6 +145,12 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
         progress.inc(n);
     }
     drop(progress);
+    let cloud = cloud_of(cols, &extras, has_rgb).map_err(decode_error)?;
+    Ok(LasCloud { cloud, info })
+}
+
+/// The cloud of the gathered columns: the LAS attributes, then every extra-bytes one.
+fn cloud_of(cols: Columns, extras: &[Extra], has_rgb: bool) -> Result<PointCloud, String> {
     let mut attributes = vec![
         ("intensity".to_string(), Values::Int(cols.intensity)),
         (
@@ -171,14 +177,41 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
         };
         attributes.push((label, values));
     }
-    let cloud = PointCloud::from_parts(CloudParts {
+    PointCloud::from_parts(CloudParts {
         positions: cols.positions,
         attributes,
         rgb: has_rgb.then_some(cols.rgb),
         normals: None,
     })
-    .map_err(decode_error)?;
-    Ok(LasCloud { cloud, info })
+}
+
+/// The points of a COPC file's `nodes`, as one cloud (the LAS attributes and RGB; COPC's
+/// extra bytes are not read yet), held to the memory budget before a node is decoded.
+pub(super) fn copc_cloud(
+    copc: &super::copc::Copc,
+    nodes: &[super::copc::Node],
+) -> Result<PointCloud, PointsError> {
+    let count: u64 = nodes.iter().map(|n| n.points).sum();
+    let has_rgb = matches!(copc.format.0, 7 | 8);
+    let over = |e: OverBudget| PointsError::format(copc.path(), 247, e.to_string());
+    crate::budget::check(
+        format!("{count} points of {}", copc.path().display()),
+        super::footprint(count, 4, has_rgb, false),
+    )
+    .map_err(over)?;
+    let mut cols = Columns::new(count, 0, has_rgb).map_err(over)?;
+    for node in nodes {
+        let pd = copc.read_node(node)?;
+        cols.append(&pd, &[], copc.format.1 as usize)
+            .map_err(|_| PointsError::Decode {
+                path: copc.path().to_path_buf(),
+                message: format!("node {:?}: more points than its entry declares", node.key),
+            })?;
+    }
+    cloud_of(cols, &[], has_rgb).map_err(|message| PointsError::Decode {
+        path: copc.path().to_path_buf(),
+        message,
+    })
 }
 
 /// Run a `las`/`laz` call, turning a panic into an error message. `laz` asserts on

@@ -181,7 +181,8 @@ pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, PointsError> {
 
 /// Where a cloud comes from, as written in a scene:
 /// `{ dat = { path = "s.dat", columns = { porosity = 7 } } }`, `{ las = "x.laz" }`,
-/// `{ ply = "bunny.ply" }`, `{ section = { points = 570000, seed = 1 } }`.
+/// `{ ply = "bunny.ply" }`, `{ section = { points = 570000, seed = 1 } }`,
+/// `{ copc = { path = "scan.copc.laz", points = 1000000 } }`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase", deny_unknown_fields)]
 pub enum PointSource {
@@ -191,6 +192,8 @@ pub enum PointSource {
     Las(PathBuf),
     /// A PLY file's vertices.
     Ply(PathBuf),
+    /// A COPC file's octree, whole levels from the root within a point budget.
+    Copc(copc::CopcSpec),
     /// The generated geological section.
     Section(section::SectionSpec),
 }
@@ -203,6 +206,11 @@ impl PointSource {
             PointSource::Dat(spec) => dat::read(&base.join(&spec.path), &spec.columns),
             PointSource::Las(p) => Ok(lasfile::read(&base.join(p))?.cloud),
             PointSource::Ply(p) => Ok(plycloud::read(&base.join(p))?.cloud),
+            PointSource::Copc(spec) => {
+                let c = copc::Copc::open(&base.join(&spec.path))?;
+                let (nodes, _) = c.cut(spec.points);
+                lasfile::copc_cloud(&c, &nodes)
+            }
             PointSource::Section(spec) => section::generate(spec),
         }
     }
@@ -211,6 +219,7 @@ impl PointSource {
     pub fn path(&self) -> Option<&Path> {
         match self {
             PointSource::Dat(spec) => Some(&spec.path),
+            PointSource::Copc(spec) => Some(&spec.path),
             PointSource::Las(p) | PointSource::Ply(p) => Some(p),
             PointSource::Section(_) => None,
         }
@@ -220,6 +229,7 @@ impl PointSource {
     pub fn path_mut(&mut self) -> Option<&mut PathBuf> {
         match self {
             PointSource::Dat(spec) => Some(&mut spec.path),
+            PointSource::Copc(spec) => Some(&mut spec.path),
             PointSource::Las(p) | PointSource::Ply(p) => Some(p),
             PointSource::Section(_) => None,
         }

@@ -58,6 +58,7 @@ pub fn cloud_units(source: &PointSource, base: &Path) -> Units {
             vertical: Some("m".into()),
         },
         PointSource::Las(p) => las_units(&base.join(p)),
+        PointSource::Copc(spec) => las_units(&base.join(&spec.path)),
         PointSource::Dat(_) | PointSource::Ply(_) => Units::default(),
     }
 }

@@ -197,3 +197,63 @@ fn damaged_copc_files_are_refused_naming_the_byte_or_the_node() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A scene's `{ copc = { path, points } }`: whole levels from the root within the budget
+/// (the root's level even past it), all of them equal to the file read whole as LAZ; and
+/// drawn as splats.
+#[test]
+fn a_copc_cloud_in_a_scene_takes_whole_levels_within_its_budget() {
+    use arbvis::points::copc::CopcSpec;
+    use arbvis::points::PointSource;
+    let base = data_file("points/simple.copc.laz")
+        .parent()
+        .unwrap()
+        .to_path_buf();
+    let load = |points| {
+        PointSource::Copc(CopcSpec {
+            path: "simple_with_page.copc.laz".into(),
+            points,
+        })
+        .load(&base)
+        .unwrap()
+    };
+    // Levels hold 24, 66, 197 and 778 points.
+    assert_eq!(load(10).len(), 24);
+    assert_eq!(load(100).len(), 90);
+    assert_eq!(load(286).len(), 90);
+    assert_eq!(load(287).len(), 287);
+    let all = load(1_000_000);
+    let whole = arbvis::points::lasfile::read(&base.join("simple_with_page.copc.laz"))
+        .unwrap()
+        .cloud;
+    assert_eq!(all.len(), whole.len());
+    // The same points (in the octree's order, not the file's): sorted positions equal.
+    let sorted = |c: &arbvis::points::PointCloud| {
+        let mut p: Vec<[u64; 3]> = (0..c.len())
+            .map(|i| c.original(i).unwrap().map(f64::to_bits))
+            .collect();
+        p.sort_unstable();
+        p
+    };
+    assert_eq!(sorted(&all), sorted(&whole));
+    // Drawn: the autzen scene's settings on the COPC cloud at 96 x 72.
+    let text = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/data/autzen.toml"),
+    )
+    .unwrap()
+    .replace(
+        r#"cloud = { las = "../../data/points/autzen_trim.laz" }"#,
+        r#"cloud = { copc = { path = "../../data/points/simple.copc.laz", points = 100 } }"#,
+    );
+    let mut scene = arbvis::scene::Scene::parse(&text, "copc.toml").unwrap();
+    scene.base = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/data");
+    scene.size = [96, 72];
+    let h = crate::common::headless(arbvis::gl::Backend::Egl);
+    let image = arbvis::render::render_on(&h, &scene).unwrap().image;
+    let lit = image
+        .data
+        .chunks(4)
+        .filter(|p| p[0] + p[1] + p[2] > 0.05)
+        .count();
+    assert!(lit > 20, "{lit} pixels lit");
+}
