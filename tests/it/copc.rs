@@ -14,18 +14,10 @@ use arbvis::points::copc::Copc;
 const FILES: [&str; 2] = ["points/simple.copc.laz", "points/simple_with_page.copc.laz"];
 
 fn has_laspy() -> bool {
-    let ok = Command::new("python3")
-        .args(["-c", "import laspy, lazrs"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        let reason = "python3 with laspy and lazrs is missing (pip install laspy lazrs)";
-        if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
-            panic!("ARBVIS_NO_SKIP=1 but {reason}");
-        }
-        eprintln!("SKIPPED: {reason}");
-    }
-    ok
+    crate::common::python_has(
+        "import laspy, lazrs",
+        "python3 with laspy and lazrs is missing (pip install laspy lazrs)",
+    )
 }
 
 /// Every point of `level`, one line each (raw X Y Z, intensity, returns, classification,

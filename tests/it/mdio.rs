@@ -39,18 +39,10 @@ if __name__ == "__main__":
 "#;
 
 pub(crate) fn has_mdio() -> bool {
-    let ok = Command::new("python3")
-        .args(["-c", "import mdio"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        let reason = "python3 with multidimio is missing (pip install multidimio)";
-        if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
-            panic!("ARBVIS_NO_SKIP=1 but {reason}");
-        }
-        eprintln!("SKIPPED: {reason}");
-    }
-    ok
+    crate::common::python_has(
+        "import mdio",
+        "python3 with multidimio is missing (pip install multidimio)",
+    )
 }
 
 /// `sgy` ingested by mdio-python into `DIR/NAME.mdio`.

@@ -50,21 +50,10 @@ zarr.consolidate_metadata(out)
 "#;
 
 fn has_zarr() -> bool {
-    let ok = Command::new("python3")
-        .args([
-            "-c",
-            "import zarr, numcodecs; assert int(zarr.__version__[0]) >= 3",
-        ])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !ok {
-        let reason = "python3 with zarr 3 and numcodecs is missing (pip install zarr)";
-        if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
-            panic!("ARBVIS_NO_SKIP=1 but {reason}");
-        }
-        eprintln!("SKIPPED: {reason}");
-    }
-    ok
+    crate::common::python_has(
+        "import zarr, numcodecs; assert int(zarr.__version__[0]) >= 3",
+        "python3 with zarr 3 and numcodecs is missing (pip install zarr)",
+    )
 }
 
 /// Traces dead in the test's dataset: inline 7, crosslines 3..12 (inside the grid).

@@ -647,16 +647,10 @@ fn streaming_refines_to_the_full_picture_and_survives_a_corrupt_chunk() {
 /// installs zarr from PyPI and sets ARBVIS_NO_SKIP=1, which makes a skip a failure.
 #[test]
 fn zarr_python_reads_the_store() {
-    let has_zarr = std::process::Command::new("python3")
-        .args(["-c", "import zarr"])
-        .output()
-        .is_ok_and(|o| o.status.success());
-    if !has_zarr {
-        let reason = "python3 with zarr is missing (pip install zarr)";
-        if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
-            panic!("ARBVIS_NO_SKIP=1 but {reason}");
-        }
-        eprintln!("SKIPPED: {reason}");
+    if !crate::common::python_has(
+        "import zarr",
+        "python3 with zarr is missing (pip install zarr)",
+    ) {
         return;
     }
     let dir = temp_dir("store-zarr-python");

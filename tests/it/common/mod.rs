@@ -176,3 +176,20 @@ pub fn copy_tree(from: &Path, to: &Path) {
         }
     }
 }
+
+/// Whether `python3 -c CHECK` succeeds (the Python tool a test compares with is there).
+/// If not: "SKIPPED: `missing`" on stderr, or a panic under `ARBVIS_NO_SKIP=1` (set by
+/// `.ci/run`, which installs the tools).
+pub fn python_has(check: &str, missing: &str) -> bool {
+    let ok = std::process::Command::new("python3")
+        .args(["-c", check])
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !ok {
+        if std::env::var_os("ARBVIS_NO_SKIP").is_some_and(|v| v == "1") {
+            panic!("ARBVIS_NO_SKIP=1 but {missing}");
+        }
+        eprintln!("SKIPPED: {missing}");
+    }
+    ok
+}
