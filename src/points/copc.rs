@@ -3,25 +3,29 @@
 //! pages of (level, x, y, z) keys with the chunk's offset, byte size and point count. The
 //! first VLR (`copc`, record 1) gives the octree's centre, half-size and root spacing.
 //!
-//! Read through the `las` crate's `CopcReader` (the crate arbvis already reads LAS/LAZ
-//! with; it pages the hierarchy into one table and decodes a node's chunk with `laz`'s
-//! layered decompressor), so only what no crate does is here: the checks. `las` trusts
-//! the file (it reads every EVLR whole at the size its header declares, and a node's
-//! points at the count its entry declares), so before it is called the LAS 1.4 header,
-//! every VLR and EVLR header is checked against the file's length and the memory budget,
-//! and after it every hierarchy entry: key inside the octree, chunk inside the point
-//! data, at most 1,000,000 points plus one per compressed byte (as for LAZ files), the
-//! counts summing to the header's. A node's points are decoded only on request, under
-//! `catch_unwind` (`laz` panics on some corrupt streams), the error naming the node.
+//! The header and VLRs through the `las` crate and a node's chunk through `laz`'s layered
+//! decompressor (the crates arbvis already reads LAS/LAZ with); the hierarchy is walked
+//! here, because `las` 0.11's `CopcReader` follows child pages by key without a visited
+//! set: a page that points to itself (a 4-byte change) makes it collect entries until
+//! memory runs out. Before `las` is called the LAS 1.4 header and every VLR and EVLR
+//! header are checked against the file's length and the memory budget, and the laszip
+//! items against the record length. The hierarchy: every page inside the hierarchy EVLR,
+//! a whole number of 32-byte entries, read once (a second reference, a cycle among them,
+//! is refused); every key inside the octree and unique; every chunk inside the point data
+//! with at most 1,000,000 points plus one per compressed byte (as for LAZ files); the
+//! counts summing to the header's. The octree's centre, half-size and spacing must be
+//! finite and the sizes positive. Errors name the byte (an entry's own). A node's points
+//! are decoded only on request from its chunk alone, under `catch_unwind` (`laz` panics on
+//! some corrupt streams), the error naming the node.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
-use las::copc::{CopcInfoVlr, Entry, VoxelKey};
-use las::{CopcReader, PointData};
+use las::{Header, PointData, PointDataBuilder};
+use laz::record::{LayeredPointRecordDecompressor, RecordDecompressor};
 
 use super::lasfile::guarded;
 use super::PointsError;
@@ -67,14 +71,32 @@ pub struct Node {
 pub struct Copc {
     path: PathBuf,
     /// The octree's centre, half-size and root spacing (file units).
-    pub info: CopcInfoVlr,
+    pub info: OctreeInfo,
     /// Point format (6, 7 or 8) and record length.
     pub format: (u8, u16),
     /// The header's point count.
     pub points: u64,
     /// Nodes holding points, by level then key.
     pub nodes: Vec<Node>,
-    reader: Mutex<CopcReader<'static, BufReader<File>>>,
+    header: Header,
+    items: Vec<laz::LazItem>,
+    file: Mutex<BufReader<File>>,
+}
+
+/// The COPC info VLR's octree: centre, half-size (centre to a face of the root node) and
+/// the spacing of the root's points (halved at each level).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OctreeInfo {
+    /// Centre x.
+    pub center_x: f64,
+    /// Centre y.
+    pub center_y: f64,
+    /// Centre z.
+    pub center_z: f64,
+    /// Half the root node's side.
+    pub halfsize: f64,
+    /// Spacing of the root's points.
+    pub spacing: f64,
 }
 
 /// Whether `head` (a file's first bytes) is a COPC file's: LAS 1.4 whose first VLR is
@@ -133,6 +155,23 @@ impl Copc {
                 ),
             ));
         }
+        let f64_at_head = |at: usize| f64::from_le_bytes(head[at..at + 8].try_into().expect("8"));
+        for (axis, at) in [("x", 131), ("y", 139), ("z", 147)] {
+            let (scale, offset) = (f64_at_head(at), f64_at_head(at + 24));
+            if !(scale.is_finite() && scale != 0.0 && offset.is_finite()) {
+                return Err(bad(at as u64, format!("{axis} scale {scale}, offset {offset}: expected a finite, non-zero scale and a finite offset")));
+            }
+            let (max, min) = (
+                f64_at_head(179 + (at - 131) * 2),
+                f64_at_head(187 + (at - 131) * 2),
+            );
+            if !(min.is_finite() && max.is_finite() && min <= max) {
+                return Err(bad(
+                    (179 + (at - 131) * 2) as u64,
+                    format!("{axis} bounds {min}..{max}: expected finite, min <= max"),
+                ));
+            }
+        }
         if header_size < HEADER as u64 || point_offset < header_size || point_offset > len {
             return Err(bad(
                 94,
@@ -170,6 +209,7 @@ impl Copc {
             return Err(bad(235, format!("the first EVLR at {evlr_start}: must lie between the point data ({point_offset}) and the end ({len})")));
         }
         let mut at = evlr_start;
+        let mut hierarchy = None;
         for k in 0..evlr_count {
             let mut h = [0u8; EVLR_HEADER as usize];
             if at.checked_add(EVLR_HEADER).is_none_or(|e| e > len) {
@@ -183,6 +223,9 @@ impl Copc {
             file.read_exact(&mut h)
                 .map_err(|e| PointsError::io(path, e))?;
             let size = u64_at(&h, 20);
+            if &h[2..6] == b"copc" && h[6..18].iter().all(|&b| b == 0) && u16_at(&h, 18) == 1000 {
+                hierarchy.get_or_insert((at + EVLR_HEADER, at + EVLR_HEADER + size.min(len)));
+            }
             at = at
                 .checked_add(EVLR_HEADER)
                 .and_then(|a| a.checked_add(size))
@@ -194,22 +237,68 @@ impl Copc {
             (at - evlr_start).saturating_mul(3),
         )
         .map_err(|e| bad(evlr_start, e.to_string()))?;
-        drop(file);
-        let reader = guarded(|| CopcReader::from_path(path))
-            .map_err(|e| bad(evlr_start, format!("the COPC header or hierarchy: {e}")))?;
-        let info = reader
-            .header()
-            .copc_info_vlr()
-            .ok_or_else(|| bad(HEADER as u64, "no COPC info VLR".into()))?;
+        // The info VLR's octree and root page.
+        let mut info = [0u8; 160];
+        file.seek(SeekFrom::Start(header_size + VLR_HEADER))
+            .and_then(|_| file.read_exact(&mut info))
+            .map_err(|e| PointsError::io(path, e))?;
+        let f64_at = |at: usize| f64::from_le_bytes(info[at..at + 8].try_into().expect("8"));
+        let octree = OctreeInfo {
+            center_x: f64_at(0),
+            center_y: f64_at(8),
+            center_z: f64_at(16),
+            halfsize: f64_at(24),
+            spacing: f64_at(32),
+        };
+        let info_at = header_size + VLR_HEADER;
+        let finite = [octree.center_x, octree.center_y, octree.center_z]
+            .iter()
+            .all(|v| v.is_finite());
+        let sizes = [octree.halfsize, octree.spacing]
+            .iter()
+            .all(|v| v.is_finite() && *v > 0.0);
+        if !finite || !sizes {
+            return Err(bad(
+                info_at,
+                format!("COPC info: centre ({}, {}, {}), half-size {}, spacing {}: expected a finite centre and positive sizes", octree.center_x, octree.center_y, octree.center_z, octree.halfsize, octree.spacing),
+            ));
+        }
+        // The header's bounds inside the root node's cube (a scale step of slack).
+        let centre = [octree.center_x, octree.center_y, octree.center_z];
+        for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+            let (max, min) = (f64_at_head(179 + 16 * a), f64_at_head(187 + 16 * a));
+            let slack = f64_at_head(131 + 8 * a).abs() + 1e-9 * octree.halfsize;
+            if min < centre[a] - octree.halfsize - slack
+                || max > centre[a] + octree.halfsize + slack
+            {
+                return Err(bad(
+                    info_at,
+                    format!("the points' {axis} bounds {min}..{max} are outside the octree's cube ({} +- {})", centre[a], octree.halfsize),
+                ));
+            }
+        }
+        let root = (u64_at(&info, 40), u64_at(&info, 48));
+        let hierarchy = hierarchy.ok_or_else(|| {
+            bad(
+                evlr_start,
+                "no hierarchy EVLR (user `copc`, record 1000)".into(),
+            )
+        })?;
+        let mut data = vec![0u8; (hierarchy.1 - hierarchy.0) as usize];
+        file.seek(SeekFrom::Start(hierarchy.0))
+            .and_then(|_| file.read_exact(&mut data))
+            .map_err(|e| PointsError::io(path, e))?;
+        let nodes_found = walk_hierarchy(
+            &data,
+            hierarchy.0,
+            (root, info_at + 40),
+            point_offset,
+            evlr_start,
+        )
+        .map_err(|(at, m)| bad(at, m))?;
         let mut nodes = Vec::new();
         let mut total = 0u64;
-        for e in reader.hierarchy_entries() {
-            let node = check_entry(&e, point_offset, evlr_start).map_err(|m| {
-                bad(
-                    evlr_start,
-                    format!("hierarchy entry {:?}: {m}", key(&e.key)),
-                )
-            })?;
+        for node in nodes_found {
             if node.points > 0 {
                 total += node.points;
                 nodes.push(node);
@@ -221,14 +310,72 @@ impl Copc {
                 format!("the header declares {points} points, the hierarchy's nodes hold {total}"),
             ));
         }
+        file.seek(SeekFrom::Start(0))
+            .map_err(|e| PointsError::io(path, e))?;
+        let header = guarded(|| Header::new(BufReader::new(&mut file)))
+            .map_err(|e| bad(0, format!("the LAS header: {e}")))?;
+        let laz = guarded(|| header.laz_vlr())
+            .map_err(|e| bad(header_size, format!("the laszip VLR: {e}")))?;
+        // COPC's points are compressed in layers (compressor 3), with the items of their
+        // format: Point14, then RGB14 (7) or RGBNIR14 (8), then any extra bytes.
+        let compressor = header
+            .vlrs()
+            .iter()
+            .find(|v| v.user_id == laz::LazVlr::USER_ID && v.record_id == laz::LazVlr::RECORD_ID)
+            .and_then(|v| v.data.get(..2))
+            .map(|b| u16::from_le_bytes([b[0], b[1]]));
+        if compressor != Some(3) {
+            return Err(bad(
+                header_size,
+                format!(
+                    "the laszip VLR's compressor {compressor:?}: COPC is compressed in layers (3)"
+                ),
+            ));
+        }
+        let types: Vec<laz::LazItemType> = laz.items().iter().map(|i| i.item_type()).collect();
+        use laz::LazItemType::{Byte14, Point14, RGB14, RGBNIR14};
+        let colour = match format & 0x3f {
+            6 => None,
+            7 => Some(RGB14),
+            _ => Some(RGBNIR14),
+        };
+        let expected = types.first() == Some(&Point14)
+            && types
+                .get(1)
+                .copied()
+                .filter(|t| *t == RGB14 || *t == RGBNIR14)
+                == colour
+            && types[1 + usize::from(colour.is_some())..]
+                .iter()
+                .all(|t| matches!(t, Byte14(_)));
+        if !expected {
+            return Err(bad(
+                104,
+                format!(
+                    "point format {}: the laszip items are {types:?}",
+                    format & 0x3f
+                ),
+            ));
+        }
+        if laz.items_size() != record as u64 {
+            return Err(bad(
+                105,
+                format!(
+                    "the LAZ items hold {} bytes, the point records {record}",
+                    laz.items_size()
+                ),
+            ));
+        }
         nodes.sort();
         Ok(Copc {
             path: path.to_path_buf(),
-            info,
+            info: octree,
             format: (format & 0x3f, record),
             points,
             nodes,
-            reader: Mutex::new(reader),
+            header,
+            items: laz.items().clone(),
+            file: Mutex::new(BufReader::new(file)),
         })
     }
 
@@ -278,25 +425,32 @@ impl Copc {
             node.points.saturating_mul(record).saturating_mul(2),
         )
         .map_err(|e| PointsError::format(&self.path, node.offset, e.to_string()))?;
-        let entry = Entry {
-            key: VoxelKey {
-                l: node.key[0],
-                x: node.key[1],
-                y: node.key[2],
-                z: node.key[3],
-            },
-            offset: node.offset,
-            byte_size: node.bytes as i32,
-            point_count: node.points as i32,
-        };
-        let mut reader = self.reader.lock().expect("COPC reader");
-        guarded(|| reader.read_entry(&entry)).map_err(|e| PointsError::Decode {
+        let what = |e: String| PointsError::Decode {
             path: self.path.clone(),
             message: format!(
                 "node {:?} ({} points, {} bytes at byte {}): {e}",
                 node.key, node.points, node.bytes, node.offset
             ),
+        };
+        let mut chunk = vec![0u8; node.bytes as usize];
+        {
+            let mut file = self.file.lock().expect("COPC file");
+            file.seek(SeekFrom::Start(node.offset))
+                .and_then(|_| file.read_exact(&mut chunk))
+                .map_err(|e| what(e.to_string()))?;
+        }
+        let mut out = vec![0u8; (node.points * record) as usize];
+        guarded(|| {
+            let mut d = LayeredPointRecordDecompressor::new(std::io::Cursor::new(&chunk));
+            d.set_fields_from(&self.items)?;
+            d.decompress_many(&mut out)?;
+            Ok(())
         })
+        .map_err(what)?;
+        PointDataBuilder::new()
+            .for_header(&self.header)
+            .build_from_bytes(out)
+            .map_err(|e| what(e.to_string()))
     }
 
     /// What `inspect` says of the octree.
@@ -337,46 +491,105 @@ impl Copc {
     }
 }
 
-fn key(k: &VoxelKey) -> [i32; 4] {
-    [k.l, k.x, k.y, k.z]
-}
-
-/// A hierarchy entry checked: key inside the octree, chunk inside the point data, a
-/// point count the chunk can hold.
-fn check_entry(e: &Entry, point_offset: u64, evlr_start: u64) -> Result<Node, String> {
-    let k = key(&e.key);
-    let side = if (0..=MAX_LEVEL).contains(&k[0]) {
-        1i64 << k[0]
-    } else {
-        return Err(format!("level {}: expected 0..={MAX_LEVEL}", k[0]));
-    };
-    if k[1..].iter().any(|&c| c < 0 || c as i64 >= side) {
-        return Err(format!("x, y, z must lie in 0..{side} at level {}", k[0]));
-    }
-    if e.point_count < 0 || e.byte_size < 0 {
-        return Err(format!(
-            "{} points in {} bytes: expected counts of 0 or more",
-            e.point_count, e.byte_size
-        ));
-    }
-    let (points, bytes) = (e.point_count as u64, e.byte_size as u64);
-    if points > 0 {
-        if e.offset < point_offset || e.offset.saturating_add(bytes) > evlr_start || bytes == 0 {
-            return Err(format!(
-                "its chunk ({bytes} bytes at {}) must lie in the point data ({point_offset}..{evlr_start})",
-                e.offset
+/// The hierarchy's nodes: pages from `root` (file offset, bytes; given at byte `root_at`)
+/// inside `data` (the hierarchy EVLR's bytes, starting at file offset `base`), each read
+/// once; every entry checked. An error is (its byte, what was expected).
+fn walk_hierarchy(
+    data: &[u8],
+    base: u64,
+    (root, root_at): ((u64, u64), u64),
+    point_offset: u64,
+    evlr_start: u64,
+) -> Result<Vec<Node>, (u64, String)> {
+    let end = base + data.len() as u64;
+    let mut pages = vec![(root, root_at)];
+    let mut seen_pages = HashSet::new();
+    let mut keys: HashMap<[i32; 4], u64> = HashMap::new();
+    let mut nodes = Vec::new();
+    while let Some(((offset, size), named_at)) = pages.pop() {
+        if offset < base || offset.saturating_add(size) > end || size == 0 || size % 32 != 0 {
+            return Err((
+                named_at,
+                format!("a hierarchy page of {size} bytes at {offset}: expected a whole number of 32-byte entries inside the hierarchy EVLR ({base}..{end})"),
             ));
         }
-        if points > 1_000_000 + bytes {
-            return Err(format!(
-                "{points} points in {bytes} compressed bytes: more than 1,000,000 plus one a byte"
+        if !seen_pages.insert(offset) {
+            return Err((
+                named_at,
+                format!(
+                    "the hierarchy page at {offset} is referenced twice (a cycle among the pages)"
+                ),
+            ));
+        }
+        for k in 0..size / 32 {
+            let at = offset + 32 * k;
+            let e = &data[(at - base) as usize..][..32];
+            let i32_at = |o: usize| i32::from_le_bytes(e[o..o + 4].try_into().expect("4"));
+            let key = [i32_at(0), i32_at(4), i32_at(8), i32_at(12)];
+            let target = u64_at(e, 16);
+            let (bytes, points) = (i32_at(24), i32_at(28));
+            let fail = |m: String| (at, format!("hierarchy entry {key:?}: {m}"));
+            let side = if (0..=MAX_LEVEL).contains(&key[0]) {
+                1i64 << key[0]
+            } else {
+                return Err(fail(format!("level {}: expected 0..={MAX_LEVEL}", key[0])));
+            };
+            if key[1..].iter().any(|&c| c < 0 || c as i64 >= side) {
+                return Err(fail(format!(
+                    "x, y, z must lie in 0..{side} at level {}",
+                    key[0]
+                )));
+            }
+            if let Some(first) = keys.insert(key, at) {
+                return Err(fail(format!(
+                    "the key is listed twice (first at byte {first})"
+                )));
+            }
+            if points == -1 {
+                if bytes <= 0 {
+                    return Err(fail(format!("a child page of {bytes} bytes")));
+                }
+                // The page's entry for this key comes again inside it.
+                keys.remove(&key);
+                pages.push(((target, bytes as u64), at));
+                continue;
+            }
+            if points < 0 || bytes < 0 {
+                return Err(fail(format!(
+                    "{points} points in {bytes} bytes: expected counts of 0 or more (-1: a child page)"
+                )));
+            }
+            let (points, bytes) = (points as u64, bytes as u64);
+            if points > 0 {
+                if target < point_offset || target.saturating_add(bytes) > evlr_start || bytes == 0
+                {
+                    return Err(fail(format!(
+                        "its chunk ({bytes} bytes at {target}) must lie in the point data ({point_offset}..{evlr_start})"
+                    )));
+                }
+                if points > 1_000_000 + bytes {
+                    return Err(fail(format!(
+                        "{points} points in {bytes} compressed bytes: more than 1,000,000 plus one a byte"
+                    )));
+                }
+            }
+            nodes.push(Node {
+                key,
+                offset: target,
+                bytes,
+                points,
+            });
+        }
+    }
+    // Every node below the root under a node of the hierarchy (its parent's key listed).
+    for (key, at) in &keys {
+        let parent = [key[0] - 1, key[1] / 2, key[2] / 2, key[3] / 2];
+        if key[0] > 0 && !keys.contains_key(&parent) {
+            return Err((
+                *at,
+                format!("hierarchy entry {key:?}: its parent {parent:?} is not in the hierarchy"),
             ));
         }
     }
-    Ok(Node {
-        key: k,
-        offset: e.offset,
-        bytes,
-        points,
-    })
+    Ok(nodes)
 }

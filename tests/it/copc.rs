@@ -1,8 +1,9 @@
 //! COPC files (issue 28, item 1): laspy's own test files (`data/points/simple.copc.laz` and
 //! `simple_with_page.copc.laz`, the second with its hierarchy in two pages) read node by
 //! node and compared with laspy's `CopcReader` level by level, every point and attribute
-//! equal; `inspect` on them; a damaged hierarchy or header refused naming the byte, a
-//! damaged chunk an error naming the node, never a panic. The laspy comparison is skipped
+//! equal; `inspect` on them; a damaged hierarchy (a cycle among its pages, a key twice,
+//! a chunk outside the points) or header refused naming the byte, a damaged chunk an error
+//! naming the node, never a panic. The laspy comparison is skipped
 //! (SKIPPED on stderr) without `python3 -c "import laspy, lazrs"`; `ARBVIS_NO_SKIP=1`
 //! makes a skip a failure.
 
@@ -163,6 +164,31 @@ fn damaged_copc_files_are_refused_naming_the_byte_or_the_node() {
         e.contains("hierarchy entry") && e.contains("point data"),
         "{e}"
     );
+    // The root page's first entry made a pointer to the root page itself: a cycle (las
+    // 0.11's own reader collects entries until memory runs out on this).
+    let size = u64::from_le_bytes(bytes[vlr + 48..vlr + 56].try_into().unwrap());
+    let mut b = bytes.clone();
+    b[root + 16..root + 24].copy_from_slice(&(root as u64).to_le_bytes());
+    b[root + 24..root + 28].copy_from_slice(&(size as i32).to_le_bytes());
+    b[root + 28..root + 32].copy_from_slice(&(-1i32).to_le_bytes());
+    let p = write("cycle.copc.laz", &b);
+    let e = Copc::open(&p).err().expect("refused").to_string();
+    assert!(e.contains("referenced twice"), "{e}");
+    // A key listed twice, named at the second entry's byte.
+    let mut b = bytes.clone();
+    b.copy_within(root..root + 16, root + 32);
+    let p = write("twice.copc.laz", &b);
+    let e = Copc::open(&p).err().expect("refused").to_string();
+    assert!(
+        e.contains(&format!("at byte {}", root + 32)) && e.contains("listed twice"),
+        "{e}"
+    );
+    // An octree spacing that is not a number.
+    let mut b = bytes.clone();
+    b[vlr + 32..vlr + 40].copy_from_slice(&f64::NAN.to_le_bytes());
+    let p = write("spacing.copc.laz", &b);
+    let e = Copc::open(&p).err().expect("refused").to_string();
+    assert!(e.contains("positive sizes"), "{e}");
     // Not LAS 1.4.
     let mut b = bytes.clone();
     b[25] = 2;
