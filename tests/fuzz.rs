@@ -652,6 +652,16 @@ fn targets() -> Vec<Target> {
             run: log_case,
         },
         Target {
+            name: "points-copc",
+            text: false,
+            sections: false,
+            corpus: ["simple.copc.laz", "simple_with_page.copc.laz"]
+                .iter()
+                .map(|n| std::fs::read(common::data_file(&format!("points/{n}"))).unwrap())
+                .collect(),
+            run: copc_case,
+        },
+        Target {
             name: "table",
             text: true,
             sections: false,
@@ -725,6 +735,23 @@ fn template_log() -> Vec<u8> {
 
 /// Write `bytes` as `name` of the complete store, open it and read every range and chunk,
 /// then put the file back.
+/// A COPC file of `bytes` opened (header, VLRs, hierarchy) and every node read.
+fn copc_case(bytes: &[u8]) {
+    let path = std::env::temp_dir().join(format!(
+        "arbvis-fuzz-copc-{}-{:?}.copc.laz",
+        std::process::id(),
+        std::thread::current().id()
+    ));
+    std::fs::write(&path, bytes).unwrap();
+    if let Ok(c) = arbvis::points::copc::Copc::open(&path) {
+        for node in &c.nodes {
+            let _ = c.read_node(node);
+        }
+        let _ = c.describe();
+    }
+    let _ = std::fs::remove_file(&path);
+}
+
 fn store_case(name: &str, bytes: &[u8]) {
     let store = store_template().join("complete.zarr");
     let file = store.join(name);

@@ -439,6 +439,40 @@ impl Copc {
                 .and_then(|_| file.read_exact(&mut chunk))
                 .map_err(|e| what(e.to_string()))?;
         }
+        // A layered chunk: the first point raw, a u32 point count, a u32 size per layer,
+        // the layers. `laz` allocates each layer at its declared size: the sizes must fit
+        // in the chunk first.
+        let layers: usize = self
+            .items
+            .iter()
+            .map(|i| match i.item_type() {
+                laz::LazItemType::Point14 => 9,
+                laz::LazItemType::RGB14 => 1,
+                laz::LazItemType::RGBNIR14 => 2,
+                laz::LazItemType::Byte14(n) => n as usize,
+                _ => 0,
+            })
+            .sum();
+        let sizes_at = record as usize + 4;
+        let sizes_end = sizes_at + 4 * layers;
+        if chunk.len() < sizes_end {
+            return Err(what(format!(
+                "a layered chunk needs {sizes_end} bytes before its layers"
+            )));
+        }
+        let count = u32_at(&chunk, record as usize) as u64;
+        if count != node.points {
+            return Err(what(format!("the chunk holds {count} points")));
+        }
+        let sum: u64 = (0..layers)
+            .map(|l| u32_at(&chunk, sizes_at + 4 * l) as u64)
+            .sum();
+        if sum > (chunk.len() - sizes_end) as u64 {
+            return Err(what(format!(
+                "its layers declare {sum} bytes, {} follow",
+                chunk.len() - sizes_end
+            )));
+        }
         let mut out = vec![0u8; (node.points * record) as usize];
         guarded(|| {
             let mut d = LayeredPointRecordDecompressor::new(std::io::Cursor::new(&chunk));
