@@ -6,7 +6,7 @@ use std::io::Read;
 use std::path::Path;
 
 /// What `inspect` reads, for the message about a file it does not.
-pub const READS: &str = "volumes: SEG-Y (.sgy, .segy), NIfTI-1 (.nii, .nii.gz); tetrahedral meshes: VTK legacy (.vtk), VTK XML (.vtu), gmsh (.msh); point clouds: LAS/LAZ (.las, .laz), PLY (.ply), ReconMS text (.dat); surfaces: OBJ (.obj), STL (.stl); survey stores (a folder, from `arbvis convert`)";
+pub const READS: &str = "volumes: SEG-Y (.sgy, .segy), NIfTI-1 (.nii, .nii.gz); tetrahedral meshes: VTK legacy (.vtk), VTK XML (.vtu), gmsh (.msh); point clouds: LAS/LAZ (.las, .laz; COPC .copc.laz described from its octree), PLY (.ply), ReconMS text (.dat); surfaces: OBJ (.obj), STL (.stl); survey stores (a folder, from `arbvis convert`)";
 
 /// The kinds of file `inspect` knows.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

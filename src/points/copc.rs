@@ -27,7 +27,7 @@ use std::sync::Mutex;
 use las::{Header, PointData, PointDataBuilder};
 use laz::record::{LayeredPointRecordDecompressor, RecordDecompressor};
 
-use super::lasfile::guarded;
+use super::guarded;
 use super::PointsError;
 
 /// LAS 1.4's header size.

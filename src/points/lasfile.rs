@@ -47,6 +47,7 @@ use extra::{decode_extra, extra_bytes, extra_type_size, Extra};
 pub use header::LasInfo;
 use header::RECORD_LENGTH;
 
+use super::guarded;
 use super::progress::Progress;
 use super::{read_file, CloudParts, PointCloud, PointsError, Values};
 use crate::budget::{vec_for, OverBudget};
@@ -212,28 +213,6 @@ pub(super) fn copc_cloud(
         path: copc.path().to_path_buf(),
         message,
     })
-}
-
-/// Run a `las`/`laz` call, turning a panic into an error message. `laz` asserts on
-/// some corrupt compressed streams (e.g. `assert!(sym < (1 << 16))` in its arithmetic
-/// decoder) where it could return an error; the checks above cannot foresee what an
-/// arithmetic-coded stream decodes to, so this is the last guard: the decoder that
-/// panicked is dropped with the error, never reused.
-pub(super) fn guarded<T>(f: impl FnOnce() -> las::Result<T>) -> Result<T, String> {
-    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
-        Ok(result) => result.map_err(|e| e.to_string()),
-        Err(panic) => {
-            let what = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            Err(format!(
-                "the decoder failed on corrupt data ({})",
-                crate::input::shorten(&what, 80)
-            ))
-        }
-    }
 }
 
 /// Columns gathered batch by batch.
