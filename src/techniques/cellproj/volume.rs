@@ -741,6 +741,7 @@ impl VolumeRenderer {
         prepared: &Prepared,
     ) -> GlResult<()> {
         let (w, h) = (frame.width, frame.height);
+        let convex = self.convex;
         let p = self.precise.as_mut().expect("precise");
         let pool = p.cap.map_or(BATCH, |c| c.min(BATCH));
         let sized = |t: &[Target]| t.first().is_some_and(|l| l.width() == w && l.height() == h);
@@ -845,9 +846,11 @@ impl VolumeRenderer {
                     (batch > 0) as u8 as f64,
                 ],
             )?;
-            let one_pass = last && batch == 0;
+            // Re-entries exist only where the boundary is not one convex body, and are
+            // looked for only in a single pass (see volume_walk.frag).
+            let search = last && batch == 0 && !convex;
             p.walk
-                .set_local(gpu, 7, [one_pass as u8 as f64, 0.0, 0.0, 0.0])?;
+                .set_local(gpu, 7, [search as u8 as f64, 0.0, 0.0, 0.0])?;
             let mut textures: Vec<(u32, &Texture)> = vec![
                 (0, &p.tets),
                 (1, &p.neighbours),
