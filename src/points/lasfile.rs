@@ -37,6 +37,7 @@ use std::io::Cursor;
 use std::path::Path;
 
 use las::{PointData, PointDataBuilder, Reader};
+use rayon::prelude::*;
 
 mod check;
 mod extra;
@@ -201,18 +202,45 @@ pub(super) fn copc_cloud(
     )
     .map_err(over)?;
     let mut cols = Columns::new(count, 0, has_rgb).map_err(over)?;
-    for node in nodes {
-        let pd = copc.read_node(node)?;
-        cols.append(&pd, &[], copc.format.1 as usize)
-            .map_err(|_| PointsError::Decode {
-                path: copc.path().to_path_buf(),
-                message: format!("node {:?}: more points than its entry declares", node.key),
-            })?;
+    // Decoded in parallel a batch at a time (a batch's records held at once: at most
+    // BATCH_BYTES beyond a node), appended in the nodes' order.
+    let mut batches: Vec<&[super::copc::Node]> = Vec::new();
+    let (mut start, mut bytes) = (0, 0u64);
+    for (k, n) in nodes.iter().enumerate() {
+        bytes += n.points * copc.format.1 as u64;
+        if bytes > BATCH_BYTES {
+            batches.push(&nodes[start..=k]);
+            (start, bytes) = (k + 1, 0);
+        }
+    }
+    batches.push(&nodes[start..]);
+    for batch in batches {
+        let decoded: Vec<PointData> = batch
+            .par_iter()
+            .map(|node| copc.read_node(node))
+            .collect::<Result<_, _>>()?;
+        for (node, pd) in batch.iter().zip(&decoded) {
+            append_node(&mut cols, copc, node, pd)?;
+        }
     }
     cloud_of(cols, &[], has_rgb).map_err(|message| PointsError::Decode {
         path: copc.path().to_path_buf(),
         message,
     })
+}
+
+/// Append one decoded node to the columns.
+fn append_node(
+    cols: &mut Columns,
+    copc: &super::copc::Copc,
+    node: &super::copc::Node,
+    pd: &PointData,
+) -> Result<(), PointsError> {
+    cols.append(pd, &[], copc.format.1 as usize)
+        .map_err(|_| PointsError::Decode {
+            path: copc.path().to_path_buf(),
+            message: format!("node {:?}: more points than its entry declares", node.key),
+        })
 }
 
 /// Columns gathered batch by batch.
