@@ -110,6 +110,12 @@ pub fn is_copc(head: &[u8]) -> bool {
         && u16::from_le_bytes([head[HEADER + 18], head[HEADER + 19]]) == 1
 }
 
+/// Fill `buf` from byte `at` of `file`.
+fn read_at(file: &mut (impl Read + Seek), at: u64, buf: &mut [u8]) -> std::io::Result<()> {
+    file.seek(SeekFrom::Start(at))?;
+    file.read_exact(buf)
+}
+
 fn u16_at(b: &[u8], at: usize) -> u16 {
     u16::from_le_bytes([b[at], b[at + 1]])
 }
@@ -188,10 +194,7 @@ impl Copc {
                     format!("VLR {k} of {vlr_count} runs past the point data at {point_offset}"),
                 ));
             }
-            file.seek(SeekFrom::Start(at))
-                .map_err(|e| PointsError::io(path, e))?;
-            file.read_exact(&mut h)
-                .map_err(|e| PointsError::io(path, e))?;
+            read_at(&mut file, at, &mut h).map_err(|e| PointsError::io(path, e))?;
             let size = u16_at(&h, 20) as u64;
             if k == 0 && !(&h[2..6] == b"copc" && u16_at(&h, 18) == 1 && size == 160) {
                 return Err(bad(at, "the first VLR is not COPC's info (user `copc`, record 1, 160 bytes): not a COPC file".into()));
@@ -218,10 +221,7 @@ impl Copc {
                     format!("EVLR {k} of {evlr_count} runs past the end of the file ({len} bytes)"),
                 ));
             }
-            file.seek(SeekFrom::Start(at))
-                .map_err(|e| PointsError::io(path, e))?;
-            file.read_exact(&mut h)
-                .map_err(|e| PointsError::io(path, e))?;
+            read_at(&mut file, at, &mut h).map_err(|e| PointsError::io(path, e))?;
             let size = u64_at(&h, 20);
             if &h[2..6] == b"copc" && h[6..18].iter().all(|&b| b == 0) && u16_at(&h, 18) == 1000 {
                 hierarchy.get_or_insert((at + EVLR_HEADER, at + EVLR_HEADER + size.min(len)));
@@ -239,8 +239,7 @@ impl Copc {
         .map_err(|e| bad(evlr_start, e.to_string()))?;
         // The info VLR's octree and root page.
         let mut info = [0u8; 160];
-        file.seek(SeekFrom::Start(header_size + VLR_HEADER))
-            .and_then(|_| file.read_exact(&mut info))
+        read_at(&mut file, header_size + VLR_HEADER, &mut info)
             .map_err(|e| PointsError::io(path, e))?;
         let f64_at = |at: usize| f64::from_le_bytes(info[at..at + 8].try_into().expect("8"));
         let octree = OctreeInfo {
@@ -285,9 +284,7 @@ impl Copc {
             )
         })?;
         let mut data = vec![0u8; (hierarchy.1 - hierarchy.0) as usize];
-        file.seek(SeekFrom::Start(hierarchy.0))
-            .and_then(|_| file.read_exact(&mut data))
-            .map_err(|e| PointsError::io(path, e))?;
+        read_at(&mut file, hierarchy.0, &mut data).map_err(|e| PointsError::io(path, e))?;
         let nodes_found = walk_hierarchy(
             &data,
             hierarchy.0,
@@ -435,9 +432,7 @@ impl Copc {
         let mut chunk = vec![0u8; node.bytes as usize];
         {
             let mut file = self.file.lock().expect("COPC file");
-            file.seek(SeekFrom::Start(node.offset))
-                .and_then(|_| file.read_exact(&mut chunk))
-                .map_err(|e| what(e.to_string()))?;
+            read_at(&mut *file, node.offset, &mut chunk).map_err(|e| what(e.to_string()))?;
         }
         // A layered chunk: the first point raw, a u32 point count, a u32 size per layer,
         // the layers. `laz` allocates each layer at its declared size: the sizes must fit

@@ -364,31 +364,21 @@ pub fn write_layout(
     };
     // In place, the dataset's own trace mask and map coordinates stay as they are.
     let cdp = if has_cdp && beside.is_none() {
-        let x = array(
-            storage,
-            store,
-            "/cdp_x",
-            traces.clone(),
-            vec![b, b],
-            data_type::float64(),
-            f64::NAN,
-            &dims[..2],
-            zstd,
-            Map::new(),
-        )?;
-        let y = array(
-            storage,
-            store,
-            "/cdp_y",
-            traces,
-            vec![b, b],
-            data_type::float64(),
-            f64::NAN,
-            &dims[..2],
-            zstd,
-            Map::new(),
-        )?;
-        Some([x, y])
+        let coordinate = |name: &str| {
+            array(
+                storage,
+                store,
+                name,
+                traces.clone(),
+                vec![b, b],
+                data_type::float64(),
+                f64::NAN,
+                &dims[..2],
+                zstd,
+                Map::new(),
+            )
+        };
+        Some([coordinate("/cdp_x")?, coordinate("/cdp_y")?])
     } else {
         None
     };

@@ -321,6 +321,43 @@ fn field<'a>(doc: &'a Value, name: &str, file: &Path) -> Result<&'a Value, Store
         .ok_or_else(|| StoreError::invalid(file, format!("no `{name}`: not a zarr v3 array")))
 }
 
+/// A chunk shape (each side at least 1) with one side per axis of `shape`, whose chunks of
+/// `data_type` hold at most [`MAX_CHUNK_BYTES`].
+fn chunk_sizes(
+    v: &Value,
+    name: &str,
+    (shape, data_type): (&[u64], DataType),
+    file: &Path,
+) -> Result<Vec<u64>, StoreError> {
+    let chunks = sizes(v, name, file, 1)?;
+    if chunks.len() != shape.len() {
+        return Err(StoreError::invalid(
+            file,
+            format!(
+                "`{name}` {chunks:?} has {} axes, the shape {shape:?} {}",
+                chunks.len(),
+                shape.len()
+            ),
+        ));
+    }
+    let bytes = chunks
+        .iter()
+        .try_fold(1u64, |a, &c| a.checked_mul(c))
+        .and_then(|n| n.checked_mul(data_type.size() as u64))
+        .filter(|&b| b <= MAX_CHUNK_BYTES);
+    if bytes.is_none() {
+        return Err(StoreError::invalid(
+            file,
+            format!(
+                "chunks of {chunks:?} {} elements: more than the {} MiB arbvis reads in one chunk",
+                data_type.name(),
+                MAX_CHUNK_BYTES >> 20
+            ),
+        ));
+    }
+    Ok(chunks)
+}
+
 /// A list of sizes (`shape`, `chunk_shape`), each checked.
 fn sizes(v: &Value, name: &str, file: &Path, min: u64) -> Result<Vec<u64>, StoreError> {
     let list = v
@@ -411,31 +448,12 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
     let chunk_shape = grid
         .pointer("/configuration/chunk_shape")
         .ok_or_else(|| invalid("`chunk_grid.configuration.chunk_shape` is missing".into()))?;
-    let chunks = sizes(
+    let chunks = chunk_sizes(
         chunk_shape,
         "chunk_grid.configuration.chunk_shape",
+        (&shape, data_type),
         &file,
-        1,
     )?;
-    if chunks.len() != shape.len() {
-        return Err(invalid(format!(
-            "chunk shape {chunks:?} has {} axes, the shape {shape:?} {}",
-            chunks.len(),
-            shape.len()
-        )));
-    }
-    let elements = chunks
-        .iter()
-        .try_fold(1u64, |a, &c| a.checked_mul(c))
-        .and_then(|n| n.checked_mul(data_type.size() as u64))
-        .filter(|&bytes| bytes <= MAX_CHUNK_BYTES);
-    if elements.is_none() {
-        return Err(invalid(format!(
-            "chunks of {chunks:?} {} elements: more than the {} MiB arbvis reads in one chunk",
-            data_type.name(),
-            MAX_CHUNK_BYTES >> 20
-        )));
-    }
     let keys = chunk_keys(doc.get("chunk_key_encoding"), &file)?;
     let fill_value = fill(field(&doc, "fill_value", &file)?, data_type, &file)?;
     if doc

@@ -5,7 +5,7 @@
 //! entries (the old default) the same views are far off.
 
 use crate::cellproj_volume::{
-    draw_counting_entries, prepared_of, reference_image, scene, slotted, spec,
+    draw_counting_entries, prepared_of, reference_image, scene, slotted, slotted_volume, spec,
 };
 use crate::common::headless;
 use arbvis::camera::{Camera, Projection};
@@ -138,15 +138,7 @@ fn every_entry_is_followed_on_a_stack_of_plates() {
 fn rays_grazing_the_boundary_keep_their_path() {
     let h = headless(Backend::Egl);
     let prepared = slotted();
-    let volume = VolumeSpec {
-        points: vec![
-            [0.0, 1.0, 0.0, 0.0, 0.6],
-            [0.5, 0.0, 1.0, 0.0, 0.6],
-            [1.0, 0.0, 0.0, 1.0, 0.6],
-        ],
-        unit_distance: 0.05,
-        ..spec(Sort::Mpvonc)
-    };
+    let volume = slotted_volume(Sort::Mpvonc);
     let p = scene(Mode::Volume, volume, Vec::new());
     for rotation in [
         [0.45, -0.3, 0.1, 0.83],

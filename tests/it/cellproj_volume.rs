@@ -334,6 +334,20 @@ fn faithful_is_within_its_table_and_target_quantization_and_arb_equals_glsl() {
     assert!(err.contains("orthographic"), "{err}");
 }
 
+/// The slotted mesh's transfer function, whose colour tells the order: red, green, blue
+/// along the scalar, equally dense.
+pub(crate) fn slotted_volume(sort: Sort) -> VolumeSpec {
+    VolumeSpec {
+        points: vec![
+            [0.0, 1.0, 0.0, 0.0, 0.6],
+            [0.5, 0.0, 1.0, 0.0, 0.6],
+            [1.0, 0.0, 0.0, 1.0, 0.6],
+        ],
+        unit_distance: 0.05,
+        ..spec(sort)
+    }
+}
+
 /// A non-convex mesh of very unequal tetrahedra: the 7³ grid with a slot cut through it
 /// and its points stretched (x -> x³, z -> z²), so long thin tetrahedra lie beside short
 /// ones and centroids misorder them.
@@ -373,15 +387,7 @@ fn on_a_non_convex_mesh_mpvonc_and_precise_are_right_where_centroids_are_not() {
         rotation: [0.45, -0.3, 0.1, 0.83],
         ..Camera::default()
     };
-    let volume = |sort| VolumeSpec {
-        points: vec![
-            [0.0, 1.0, 0.0, 0.0, 0.6],
-            [0.5, 0.0, 1.0, 0.0, 0.6],
-            [1.0, 0.0, 0.0, 1.0, 0.6],
-        ],
-        unit_distance: 0.05,
-        ..spec(sort)
-    };
+    let volume = slotted_volume;
     let mut rmse = Vec::new();
     for sort in [Sort::Centroid, Sort::Mpvonc] {
         let p = scene(Mode::Volume, volume(sort), Vec::new());

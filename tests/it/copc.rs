@@ -101,21 +101,13 @@ fn copc_nodes_read_as_laspy_reads_them() {
         if !has_laspy() {
             continue;
         }
-        let out = Command::new("python3")
-            .args(["-c", LASPY_LEVEL])
-            .arg(&path)
-            .arg("4")
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        let out = crate::common::stdout_of(
+            Command::new("python3")
+                .args(["-c", LASPY_LEVEL])
+                .arg(&path)
+                .arg("4"),
         );
-        let theirs: Vec<String> = String::from_utf8_lossy(&out.stdout)
-            .lines()
-            .map(str::to_string)
-            .collect();
+        let theirs: Vec<String> = out.lines().map(str::to_string).collect();
         assert_eq!(theirs.len(), ours.len(), "{name}");
         for (a, b) in ours.iter().zip(&theirs) {
             assert_eq!(a, b, "{name}");
@@ -125,19 +117,15 @@ fn copc_nodes_read_as_laspy_reads_them() {
 
 #[test]
 fn inspect_describes_the_octree_without_decoding() {
-    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args(["inspect", data_file(FILES[1]).to_str().unwrap()])
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    for want in [
-        "format: COPC (LAZ 1.4, point format 7, 36-byte records), 1065 points",
-        "65 nodes with points, 1065 points",
-        "gps time, red, green, blue",
-        "level 3: 48 nodes, 778 points, spacing 4.5271",
-    ] {
-        assert!(text.contains(want), "{want}\n{text}");
-    }
+    crate::common::assert_says(
+        &crate::common::inspect(&data_file(FILES[1])),
+        &[
+            "format: COPC (LAZ 1.4, point format 7, 36-byte records), 1065 points",
+            "65 nodes with points, 1065 points",
+            "gps time, red, green, blue",
+            "level 3: 48 nodes, 778 points, spacing 4.5271",
+        ],
+    );
 }
 
 #[test]

@@ -13,7 +13,7 @@ use arbvis::render::render_on;
 use arbvis::scene::{Scene, TechniqueScene};
 use arbvis::volume::raw::RawSpec;
 use arbvis::volume::{nifti_file, raw, segy, Endian, SampleType, VolumeError};
-use common::{data_file, headless, temp_dir, LEVEL};
+use common::{data_file, headless, inspect, temp_dir, LEVEL};
 
 #[test]
 fn f3_grids_from_its_trace_headers() {
@@ -370,19 +370,4 @@ fn point_cloud_scenes_render() {
         // 16-bit fields once came out black).
         assert!(lit > 160 * 120 / 10, "{file}: {lit} pixels drawn");
     }
-}
-
-/// `arbvis inspect FILE`'s standard output, the command having succeeded.
-fn inspect(path: &std::path::Path) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args(["inspect", path.to_str().unwrap()])
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}: {}",
-        path.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8_lossy(&out.stdout).into_owned()
 }

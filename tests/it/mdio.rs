@@ -55,18 +55,13 @@ pub(crate) fn ingest_as(dir: &Path, sgy: &Path, name: &str, template: &str) -> P
     let script = dir.join("ingest.py");
     std::fs::write(&script, INGEST).unwrap();
     let out = dir.join(format!("{name}.mdio"));
-    let run = Command::new("python3")
-        .arg(&script)
-        .arg(sgy)
-        .arg(&out)
-        .arg(template)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "mdio-python: {}",
-        String::from_utf8_lossy(&run.stderr)
+    crate::common::stdout_of(
+        Command::new("python3")
+            .arg(&script)
+            .arg(sgy)
+            .arg(&out)
+            .arg(template)
+            .current_dir(dir),
     );
     out
 }
@@ -122,22 +117,18 @@ fn an_mdio_store_from_mdio_python_reads_as_the_segy_does() {
     );
     assert!(store.is_mdio() && store.meta.levels == 1);
     // inspect describes it, the blosc codec and the trace headers it does not draw.
-    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args(["inspect", mdio.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    for want in [
-        "format: MDIO v1.",
-        "template: PostStack3DTime",
-        "live traces: 414 of 414",
-        "crossline: 18, numbers 875..892",
-        "amplitude: float32 (inline, crossline, time) shape [23, 18, 75]",
-        "codecs bytes + blosc",
-        "headers: not read by arbvis",
-    ] {
-        assert!(text.contains(want), "{want}\n{text}");
-    }
+    crate::common::assert_says(
+        &crate::common::inspect(&mdio),
+        &[
+            "format: MDIO v1.",
+            "template: PostStack3DTime",
+            "live traces: 414 of 414",
+            "crossline: 18, numbers 875..892",
+            "amplitude: float32 (inline, crossline, time) shape [23, 18, 75]",
+            "codecs bytes + blosc",
+            "headers: not read by arbvis",
+        ],
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

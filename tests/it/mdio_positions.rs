@@ -29,14 +29,9 @@ fn a_depth_dataset_keeps_its_depths_and_map_positions_into_a_store() {
     };
     assert_eq!(dataset.meta.source.sample_axis(), depth);
     assert_eq!(dataset.meta.source.interval_us, None);
-    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args(["inspect", mdio.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        text.contains("sample: 75, depth 0..296 m (every 4 m)"),
-        "{text}"
+    crate::common::assert_says(
+        &crate::common::inspect(&mdio),
+        &["sample: 75, depth 0..296 m (every 4 m)"],
     );
     // The dataset's positions are the SEG-Y's (arbvis's own reader, through a store
     // converted from the SEG-Y): the same numbers to the bit.

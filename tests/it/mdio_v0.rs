@@ -76,18 +76,13 @@ fn write_v0(dir: &Path) -> (PathBuf, arbvis::volume::Volume) {
     std::fs::write(dir.join("live.raw"), live).unwrap();
     std::fs::write(dir.join("write_v0.py"), WRITE_V0).unwrap();
     let out = dir.join("f3_v0.mdio");
-    let run = Command::new("python3")
-        .arg(dir.join("write_v0.py"))
-        .arg(dir.join("a.raw"))
-        .arg(&out)
-        .args([nk, nj, ni].map(|n| n.to_string()))
-        .arg(dir.join("live.raw"))
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "zarr-python: {}",
-        String::from_utf8_lossy(&run.stderr)
+    crate::common::stdout_of(
+        Command::new("python3")
+            .arg(dir.join("write_v0.py"))
+            .arg(dir.join("a.raw"))
+            .arg(&out)
+            .args([nk, nj, ni].map(|n| n.to_string()))
+            .arg(dir.join("live.raw")),
     );
     (out, cube)
 }
@@ -124,20 +119,16 @@ fn an_mdio_v0_dataset_reads_as_the_segy_does_with_dead_traces_as_no_data() {
         src.facts
     );
     // inspect names the format and the way to levels.
-    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args(["inspect", v0.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let text = String::from_utf8_lossy(&out.stdout);
-    for want in [
-        "format: MDIO v0.8.5 (zarr v2)",
-        "inline: 23, numbers 200..244 (step 2)",
-        "data/chunked_012: float32 shape [23, 18, 75], chunks [16, 16, 32], codecs bytes + blosc",
-        "metadata/live_mask: bool",
-        "(MDIO v0 is not converted in place)",
-    ] {
-        assert!(text.contains(want), "{want}\n{text}");
-    }
+    crate::common::assert_says(
+        &crate::common::inspect(&v0),
+        &[
+            "format: MDIO v0.8.5 (zarr v2)",
+            "inline: 23, numbers 200..244 (step 2)",
+            "data/chunked_012: float32 shape [23, 18, 75], chunks [16, 16, 32], codecs bytes + blosc",
+            "metadata/live_mask: bool",
+            "(MDIO v0 is not converted in place)",
+        ],
+    );
     drop(store);
     // Converted into a store of its own: the same samples, the dead traces dead; in place
     // it is refused (arbvis writes zarr v3 beside MDIO v1 arrays only).

@@ -19,15 +19,10 @@ use arbvis::scene::{Fidelity, Scene};
 use common::{headless, temp_dir, LEVEL};
 
 fn render_png(args: &[&str], png: &Path) {
-    let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-        .args(["render", "-o", png.to_str().unwrap()])
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    crate::common::stdout_of(
+        Command::new(env!("CARGO_BIN_EXE_arbvis"))
+            .args(["render", "-o", png.to_str().unwrap()])
+            .args(args),
     );
 }
 

@@ -386,18 +386,7 @@ fn raw_dims_are_given_as_the_guide_writes_them() {
 #[test]
 fn inspect_describes_a_store_and_an_interrupted_one() {
     let (dir, s) = store("sh-inspect");
-    let inspect = |p: &Path| {
-        let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-            .args(["inspect", p.to_str().unwrap()])
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8_lossy(&out.stdout).to_string()
-    };
+    let inspect = crate::common::inspect;
     let text = inspect(&s);
     for want in [
         "format: arbvis store version 2 (zarr v3, the MDIO v1 layout), complete",

@@ -6,7 +6,7 @@ use std::path::Path;
 
 use serde_json::{json, Value};
 
-use super::{fill, read_json, sizes, ArrayMeta, ChunkKeys, Codec, DataType, MAX_CHUNK_BYTES};
+use super::{chunk_sizes, fill, read_json, sizes, ArrayMeta, ChunkKeys, Codec, DataType};
 use crate::store::StoreError;
 
 /// A numpy type string (`<f4`, `>i2`, `|b1`) as a data type and its byte order.
@@ -48,19 +48,6 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
         return Err(invalid("`zarr_format` is not 2".into()));
     }
     let shape = sizes(doc.get("shape").unwrap_or(&Value::Null), "shape", &file, 0)?;
-    let chunks = sizes(
-        doc.get("chunks").unwrap_or(&Value::Null),
-        "chunks",
-        &file,
-        1,
-    )?;
-    if chunks.len() != shape.len() {
-        return Err(invalid(format!(
-            "chunks {chunks:?} have {} axes, the shape {shape:?} {}",
-            chunks.len(),
-            shape.len()
-        )));
-    }
     let type_name = doc.get("dtype").and_then(Value::as_str).unwrap_or("");
     let (data_type, big_endian) = numpy_type(type_name).ok_or_else(|| {
         let what = match doc.get("dtype") {
@@ -71,17 +58,12 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
             "`dtype` {what}: arbvis reads bool, (u)int8-64 and float16-64"
         ))
     })?;
-    let bytes = chunks
-        .iter()
-        .try_fold(1u64, |a, &c| a.checked_mul(c))
-        .and_then(|n| n.checked_mul(data_type.size() as u64))
-        .filter(|&b| b <= MAX_CHUNK_BYTES);
-    if bytes.is_none() {
-        return Err(invalid(format!(
-            "chunks of {chunks:?} {type_name}: more than the {} MiB arbvis reads in one chunk",
-            MAX_CHUNK_BYTES >> 20
-        )));
-    }
+    let chunks = chunk_sizes(
+        doc.get("chunks").unwrap_or(&Value::Null),
+        "chunks",
+        (&shape, data_type),
+        &file,
+    )?;
     if doc.get("order").and_then(Value::as_str) != Some("C") {
         return Err(invalid(
             "`order` is not \"C\": arbvis reads row-major chunks".into(),

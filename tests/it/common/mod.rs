@@ -193,3 +193,31 @@ pub fn python_has(check: &str, missing: &str) -> bool {
     }
     ok
 }
+
+/// Run `command` to success (its standard error in the failure) and return its standard
+/// output.
+pub fn stdout_of(command: &mut std::process::Command) -> String {
+    let out = command.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{command:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+/// `arbvis inspect PATH`'s standard output, the command having succeeded.
+pub fn inspect(path: &Path) -> String {
+    stdout_of(
+        std::process::Command::new(env!("CARGO_BIN_EXE_arbvis"))
+            .arg("inspect")
+            .arg(path),
+    )
+}
+
+/// `text` holds every line of `wants` (each named with the whole text on failure).
+pub fn assert_says(text: &str, wants: &[&str]) {
+    for want in wants {
+        assert!(text.contains(want), "{want}\n{text}");
+    }
+}
