@@ -191,17 +191,21 @@ enum Command {
         out: PathBuf,
     },
     /// Convert a survey (SEG-Y, NIfTI-1, raw, an MDIO dataset) into a bricked
-    /// multi-resolution zarr v3 store, laid out as an MDIO v1 dataset, that
-    /// `{ store = "STORE" }` scenes stream (src/store/). Streams the input (one column of
+    /// multi-resolution zarr v3 store, or a point cloud (LAS, LAZ, PLY, seed .dat) into a
+    /// COPC file (when STORE ends in `.copc.laz`: an octree of LAZ chunks, built out of
+    /// core, that `{ copc = ... }` scenes draw). A store is laid out as an MDIO v1
+    /// dataset, that `{ store = "STORE" }` scenes stream (src/store/). Streams the input (one column of
     /// traces per worker), computes the derived attributes, builds the levels; run it
     /// again after an interruption to resume. Given an MDIO dataset and no STORE, adds the
     /// levels, ranges and derived attributes to the dataset itself, beside its own arrays.
     Convert {
         /// The survey: SEG-Y, NIfTI-1 (.nii, .nii.gz), raw with --raw-dims, or an MDIO
-        /// dataset (a folder).
+        /// dataset (a folder); or a point cloud (LAS, LAZ, PLY, seed .dat) for COPC.
         input: PathBuf,
         /// The store's folder (created; an interrupted conversion there is resumed).
         /// Without it, an MDIO dataset given as the input gains the levels in place.
+        /// A name ending in `.copc.laz` writes the cloud as COPC (started over if
+        /// interrupted).
         store: Option<PathBuf>,
         /// Brick (chunk) side in voxels.
         #[arg(long, default_value_t = 64)]
@@ -227,6 +231,13 @@ enum Command {
         /// Bytes to skip at the start of a raw input.
         #[arg(long, default_value_t = 0)]
         raw_offset: u64,
+        /// COPC: most points in a leaf node.
+        #[arg(long, default_value_t = 100_000)]
+        node_points: usize,
+        /// COPC: most points built in memory at once (default: what the memory budget
+        /// allows, a quarter of it); larger clouds go through spill files beside the output.
+        #[arg(long)]
+        memory_points: Option<u64>,
     },
     /// Open the desktop viewer (winit + glutin + egui).
     #[cfg(feature = "viewer")]
@@ -281,6 +292,11 @@ impl Command {
             _ => None,
         }
     }
+}
+
+/// Whether a conversion's output names a COPC file (`*.copc.laz`).
+fn is_copc_name(path: &Path) -> bool {
+    path.to_string_lossy().to_lowercase().ends_with(".copc.laz")
 }
 
 /// `--dry-run`: the command's scene loaded and the files it reads found, nothing run.
@@ -637,7 +653,40 @@ fn run(cli: Cli) -> Result<()> {
             raw_type,
             raw_endian,
             raw_offset,
+            node_points,
+            memory_points,
         } => {
+            if let Some(out) = store.as_ref().filter(|s| is_copc_name(s)) {
+                let report = arbvis::points::copc_write::write_copc(
+                    &input,
+                    out,
+                    &arbvis::points::copc_write::CopcWriteOptions {
+                        node_points,
+                        memory_points,
+                        ..Default::default()
+                    },
+                )
+                .with_context(|| format!("converting {}", input.display()))?;
+                println!(
+                    "{}: {} points, point format {} ({} bytes a record), {} nodes, levels 0-{}, {}{}",
+                    out.display(),
+                    report.points,
+                    report.format.0,
+                    report.format.1,
+                    report.nodes,
+                    report.depth,
+                    arbvis::budget::format_bytes(report.bytes),
+                    if report.spilled {
+                        format!(
+                            " (built through spill files, at most {} points in memory at once)",
+                            report.memory_points
+                        )
+                    } else {
+                        String::new()
+                    }
+                );
+                return Ok(());
+            }
             let mut derived = Vec::new();
             for name in attributes.iter().filter(|a| a.as_str() != "none") {
                 match arbvis::volume::attributes::by_name(name) {

@@ -255,6 +255,63 @@ pub fn write_new(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     result
 }
 
+/// A temporary file or folder beside `path` (`.NAME.arbvis-tmp.PID` and a suffix) for a
+/// large write done piece by piece: removed when dropped unless committed, on
+/// SIGINT/SIGTERM by [`remove_temporaries_on_signals`]'s handler, and, if its process
+/// died harder, by the next temporary or write for the same name.
+pub struct Temporary {
+    path: PathBuf,
+    committed: bool,
+}
+
+impl Temporary {
+    /// Name a temporary beside `path`; nothing is created.
+    pub fn beside(path: &Path, suffix: &str) -> std::io::Result<Temporary> {
+        let (dir, file_name) = dir_and_name(path)?;
+        remove_stale(&dir, &file_name);
+        let tmp = dir.join(format!(
+            ".{file_name}{TMP_MARK}{}{suffix}",
+            std::process::id()
+        ));
+        remove_path(&tmp);
+        lock_temporaries().push(tmp.clone());
+        Ok(Temporary {
+            path: tmp,
+            committed: false,
+        })
+    }
+
+    /// Its path.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Rename it to `to` (replacing a file there).
+    pub fn commit(mut self, to: &Path) -> std::io::Result<()> {
+        std::fs::rename(&self.path, to)?;
+        self.committed = true;
+        Ok(())
+    }
+}
+
+impl Drop for Temporary {
+    fn drop(&mut self) {
+        if !self.committed {
+            remove_path(&self.path);
+        }
+        lock_temporaries().retain(|t| t != &self.path);
+    }
+}
+
+/// Remove a file, or a folder and what it holds.
+fn remove_path(path: &Path) {
+    if path.is_dir() {
+        let _ = std::fs::remove_dir_all(path);
+    } else {
+        let _ = std::fs::remove_file(path);
+    }
+}
+
 fn lock_temporaries() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
     TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
 }
@@ -262,7 +319,7 @@ fn lock_temporaries() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
 /// Remove the temporaries of writes in progress (called on SIGINT/SIGTERM).
 pub fn remove_temporaries() {
     for t in lock_temporaries().drain(..) {
-        let _ = std::fs::remove_file(t);
+        remove_path(&t);
     }
 }
 
@@ -291,7 +348,7 @@ fn remove_stale(dir: &Path, file_name: &str) {
             continue;
         };
         if pid != std::process::id() && !process_alive(pid) {
-            let _ = std::fs::remove_file(entry.path());
+            remove_path(&entry.path());
         }
     }
 }

@@ -42,6 +42,7 @@ use rayon::prelude::*;
 mod check;
 mod extra;
 mod header;
+pub(crate) mod stream;
 
 use check::{check, laz_bound};
 use extra::{decode_extra, extra_bytes, extra_type_size, Extra};
@@ -187,21 +188,30 @@ fn cloud_of(cols: Columns, extras: &[Extra], has_rgb: bool) -> Result<PointCloud
     })
 }
 
-/// The points of a COPC file's `nodes`, as one cloud (the LAS attributes and RGB; COPC's
-/// extra bytes are not read yet), held to the memory budget before a node is decoded.
+/// The points of a COPC file's `nodes`, as one cloud (the LAS attributes, RGB and every
+/// extra-bytes attribute its VLRs describe), held to the memory budget before a node is
+/// decoded.
 pub(super) fn copc_cloud(
     copc: &super::copc::Copc,
     nodes: &[super::copc::Node],
 ) -> Result<PointCloud, PointsError> {
     let count: u64 = nodes.iter().map(|n| n.points).sum();
     let has_rgb = matches!(copc.format.0, 7 | 8);
+    let extras = {
+        let path = copc.path();
+        let (mut file, len) =
+            crate::input::open_regular(path).map_err(|e| PointsError::io(path, e))?;
+        let (head, checked, _) = stream::read_head(path, &mut file, len)?;
+        let base = RECORD_LENGTH[copc.format.0 as usize] as usize;
+        extra_bytes(path, &head, &checked.vlrs, base, copc.format.1 as usize)?
+    };
     let over = |e: OverBudget| PointsError::format(copc.path(), 247, e.to_string());
     crate::budget::check(
         format!("{count} points of {}", copc.path().display()),
-        super::footprint(count, 4, has_rgb, false),
+        super::footprint(count, 4 + extras.len(), has_rgb, false),
     )
     .map_err(over)?;
-    let mut cols = Columns::new(count, 0, has_rgb).map_err(over)?;
+    let mut cols = Columns::new(count, extras.len(), has_rgb).map_err(over)?;
     // Decoded in parallel a batch at a time (a batch's records held at once: at most
     // BATCH_BYTES beyond a node), appended in the nodes' order.
     let mut batches: Vec<&[super::copc::Node]> = Vec::new();
@@ -220,10 +230,10 @@ pub(super) fn copc_cloud(
             .map(|node| copc.read_node(node))
             .collect::<Result<_, _>>()?;
         for (node, pd) in batch.iter().zip(&decoded) {
-            append_node(&mut cols, copc, node, pd)?;
+            append_node(&mut cols, copc, node, pd, &extras)?;
         }
     }
-    cloud_of(cols, &[], has_rgb).map_err(|message| PointsError::Decode {
+    cloud_of(cols, &extras, has_rgb).map_err(|message| PointsError::Decode {
         path: copc.path().to_path_buf(),
         message,
     })
@@ -235,8 +245,9 @@ fn append_node(
     copc: &super::copc::Copc,
     node: &super::copc::Node,
     pd: &PointData,
+    extras: &[Extra],
 ) -> Result<(), PointsError> {
-    cols.append(pd, &[], copc.format.1 as usize)
+    cols.append(pd, extras, copc.format.1 as usize)
         .map_err(|_| PointsError::Decode {
             path: copc.path().to_path_buf(),
             message: format!("node {:?}: more points than its entry declares", node.key),

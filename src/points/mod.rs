@@ -38,6 +38,7 @@
 
 mod cloud;
 pub mod copc;
+pub mod copc_write;
 pub mod dat;
 pub mod lasfile;
 pub mod ply;

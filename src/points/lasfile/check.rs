@@ -81,9 +81,73 @@ pub(super) struct Checked {
 
 /// Check the header, VLRs and sizes before the `las` crate reads anything.
 pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
-    let len = b.len();
+    check_up_to(name, b, MAX_POINTS)
+}
+
+/// [`check`] with a limit of `max_points` points.
+pub(super) fn check_up_to(name: &Path, b: &[u8], max_points: u64) -> Result<Checked, PointsError> {
+    let (checked, offset_to_points) = check_head(name, b, b.len())?;
+    let Checked {
+        info,
+        mut vlrs,
+        count_at,
+    } = checked;
     let fail = |at: usize, m: String| PointsError::format(name, at as u64, m);
-    if len < 227 {
+    if info.points > max_points {
+        return Err(fail(
+            count_at,
+            format!(
+                "the header declares {} points, more than the {max_points} this reader loads",
+                info.points
+            ),
+        ));
+    }
+    evlrs(name, b, info.version, offset_to_points, &mut vlrs)?;
+    if info.compressed {
+        check_laz(name, b, &info, offset_to_points, &vlrs)?;
+    } else {
+        check_count(name, &info, offset_to_points, b.len())?;
+    }
+    Ok(Checked {
+        info,
+        vlrs,
+        count_at,
+    })
+}
+
+/// An uncompressed file of `len` bytes must hold the records its header declares.
+pub(super) fn check_count(
+    name: &Path,
+    info: &LasInfo,
+    offset_to_points: usize,
+    len: usize,
+) -> Result<(), PointsError> {
+    let (points, record_length) = (info.points, info.record_length);
+    let need = points.checked_mul(record_length as u64);
+    let have = (len - offset_to_points) as u64;
+    if need.is_none_or(|n| n > have) {
+        return Err(PointsError::format(
+            name,
+            offset_to_points as u64,
+            format!(
+                "the header declares {points} points of {record_length} bytes, but the {have} bytes after the point offset hold only {}",
+                have / record_length as u64
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Check the header and the VLRs of a file of `len` bytes whose first bytes are `b`
+/// (the whole file, or at least up to the point data); returns them and the offset of
+/// the point data.
+pub(super) fn check_head(
+    name: &Path,
+    b: &[u8],
+    len: usize,
+) -> Result<(Checked, usize), PointsError> {
+    let fail = |at: usize, m: String| PointsError::format(name, at as u64, m);
+    if b.len() < 227 {
         return Err(fail(
             len,
             format!("the file ends inside the LAS header (227 bytes needed, {len} present)"),
@@ -129,6 +193,15 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
             96,
             format!(
                 "offset to point data {offset_to_points} lies outside {header_size}..{len} (after the header, inside the file)"
+            ),
+        ));
+    }
+    if offset_to_points > b.len() {
+        return Err(fail(
+            96,
+            format!(
+                "offset to point data {offset_to_points}: the header and VLRs may take at most {} bytes here",
+                b.len()
             ),
         ));
     }
@@ -190,14 +263,6 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
             ),
         ));
     }
-    if points > MAX_POINTS {
-        return Err(fail(
-            count_at,
-            format!(
-                "the header declares {points} points, more than the {MAX_POINTS} this reader loads"
-            ),
-        ));
-    }
     // VLRs: each inside the file, before the point data.
     let mut vlrs = Vec::new();
     let mut at = header_size;
@@ -226,7 +291,6 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
         });
         at = data.end;
     }
-    evlrs(name, b, version, offset_to_points, &mut vlrs)?;
     let info = LasInfo {
         version,
         point_format,
@@ -238,26 +302,14 @@ pub(super) fn check(name: &Path, b: &[u8]) -> Result<Checked, PointsError> {
         header_bounds: bounds,
         extra_bytes: Vec::new(),
     };
-    if compressed {
-        check_laz(name, b, &info, offset_to_points, &vlrs)?;
-    } else {
-        let need = points.checked_mul(record_length as u64);
-        let have = (len - offset_to_points) as u64;
-        if need.is_none_or(|n| n > have) {
-            return Err(fail(
-                offset_to_points,
-                format!(
-                    "the header declares {points} points of {record_length} bytes, but the {have} bytes after the point offset hold only {}",
-                    have / record_length as u64
-                ),
-            ));
-        }
-    }
-    Ok(Checked {
-        info,
-        vlrs,
-        count_at,
-    })
+    Ok((
+        Checked {
+            info,
+            vlrs,
+            count_at,
+        },
+        offset_to_points,
+    ))
 }
 
 /// Every EVLR (LAS 1.4): each inside the file, one after another from the header's

@@ -1,0 +1,187 @@
+//! `arbvis convert CLOUD X.copc.laz`: a COPC file (copc.io 1.0) from a LAS/LAZ, PLY or
+//! seed `.dat` cloud, for clouds larger than memory.
+//!
+//! The octree (`octree.rs`): a root cube around the points, `grid`³ cells per node, each
+//! point in the first node from the root whose cell is free, leaves of at most
+//! `node_points` points; clouds of more than `memory_points` points are distributed
+//! through spill files beside the output, in streamed passes over the input. Records are
+//! point format 6, 7 or 8 with the input's extra bytes (`records.rs`); a LAS input keeps
+//! its scales and offsets, so coordinates are copied exactly.
+//!
+//! The file: the LAS 1.4 header, the `copc` info VLR first, the `laszip encoded` VLR
+//! (layered chunks of variable size), the input's extra-bytes and coordinate-system VLRs;
+//! then one LAZ chunk per node, compressed in parallel (rayon) by `laz`'s layered
+//! compressor, the chunk table, and the hierarchy EVLR (`copc`, 1000) as one page of
+//! every node's key, offset, size and count. Written to a temporary beside the output
+//! and renamed when complete; an interrupted run leaves nothing named like the output
+//! (its temporary and spill folder are removed on error, on Ctrl-C, or by the next run),
+//! and a run starts over (cleanly restartable, not resumable).
+//!
+//! The header's bounds are trusted for the cube, and checked: when a point lies outside
+//! them the octree is built again around the points' own bounds.
+
+mod file;
+mod octree;
+pub(crate) mod records;
+mod source;
+
+use std::path::Path;
+
+use crate::points::PointsError;
+pub use octree::Key;
+use octree::{Cube, Limits};
+
+/// How the octree is built.
+#[derive(Debug, Clone)]
+pub struct CopcWriteOptions {
+    /// Most points a leaf holds (PDAL's and Untwine's order of magnitude).
+    pub node_points: usize,
+    /// Most points built in memory at once; `None`: what the memory budget allows.
+    pub memory_points: Option<u64>,
+    /// Cells per node side (a level's spacing is its side over this).
+    pub grid: u32,
+}
+
+impl Default for CopcWriteOptions {
+    fn default() -> Self {
+        CopcWriteOptions {
+            node_points: 100_000,
+            memory_points: None,
+            grid: 128,
+        }
+    }
+}
+
+/// What a conversion wrote.
+#[derive(Debug, Clone)]
+pub struct CopcWriteReport {
+    /// Points written.
+    pub points: u64,
+    /// Point format (6, 7 or 8) and record length.
+    pub format: (u8, usize),
+    /// Nodes and the deepest level.
+    pub nodes: usize,
+    pub depth: i32,
+    /// Bytes of the file.
+    pub bytes: u64,
+    /// Whether points went through spill files.
+    pub spilled: bool,
+    /// Points built in memory at once, at most.
+    pub memory_points: u64,
+}
+
+/// Write `input` as a COPC file at `output`.
+pub fn write_copc(
+    input: &Path,
+    output: &Path,
+    options: &CopcWriteOptions,
+) -> Result<CopcWriteReport, PointsError> {
+    let mut source = source::Source::open(input)?;
+    if source.count == 0 {
+        return Err(PointsError::unsupported(input, "the cloud has no points"));
+    }
+    // What a point costs while a subtree is built in memory: its record, its place in
+    // the cube, its index, its copy into a node and its share of the compressed chunk.
+    let each = 2 * source.record as u64 + 24 + 8 + 8;
+    let memory_points = options
+        .memory_points
+        .unwrap_or_else(|| (crate::budget::current().bytes / 4 / each).clamp(1 << 16, 1 << 25));
+    crate::budget::check(
+        format!(
+            "building {memory_points} points of {} in memory",
+            input.display()
+        ),
+        memory_points.saturating_mul(each) + (64 << 20) * 2,
+    )
+    .map_err(|e| PointsError::unsupported(input, e.to_string()))?;
+    let limits = Limits {
+        node_points: options.node_points.max(1),
+        memory_points: memory_points.max(options.node_points as u64),
+        record: source.record,
+    };
+    let grid = options.grid.clamp(2, 1 << 12);
+    let spilled = source.count > limits.memory_points;
+    let mut bounds = source.bounds;
+    for attempt in 0..2 {
+        let cube = cube_around(&bounds, &source, grid);
+        let mut out = file::CopcFile::create(output, &source, &cube)?;
+        let bar = crate::progress::Bar::new(
+            source.count,
+            &format!("writing {}", output.display()),
+            crate::progress::Unit::Points,
+        );
+        let mut seen = [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]];
+        let spill = out.spill_dir().to_path_buf();
+        let count = source.count;
+        {
+            let src = &mut source;
+            let mut next = |buf: &mut Vec<u8>| -> Result<u64, PointsError> {
+                let at = buf.len();
+                let n = src.next(buf)?;
+                for r in buf[at..].chunks_exact(src.record) {
+                    let q = records::xyz(r);
+                    for a in 0..3 {
+                        let v = q[a] as f64 * src.scale[a] + src.offset[a];
+                        seen[0][a] = seen[0][a].min(v);
+                        seen[1][a] = seen[1][a].max(v);
+                    }
+                }
+                Ok(n)
+            };
+            let tree = octree::Tree {
+                cube: &cube,
+                limits: &limits,
+                spill: &spill,
+            };
+            octree::build(
+                &tree,
+                [0, 0, 0, 0],
+                count,
+                &mut next,
+                &mut |key, records| out.add(key, records),
+                &|n| bar.inc(n),
+            )?;
+        }
+        drop(bar);
+        let inside =
+            (0..3).all(|a| seen[0][a] >= cube.min[a] && seen[1][a] <= cube.min[a] + cube.side);
+        if !inside && attempt == 0 {
+            crate::progress::line(&format!(
+                "{}: points lie outside the header's bounds; building the octree again around the points' own",
+                input.display()
+            ));
+            bounds = seen;
+            source.rewind()?;
+            continue;
+        }
+        let written = out.finish(&source, &cube)?;
+        return Ok(CopcWriteReport {
+            points: written.points,
+            format: (source.format, source.record),
+            nodes: written.nodes,
+            depth: written.depth,
+            bytes: written.bytes,
+            spilled,
+            memory_points: limits.memory_points,
+        });
+    }
+    unreachable!("the second attempt uses the points' own bounds")
+}
+
+/// The root cube: centred on `bounds`, its side the largest extent, padded by two steps
+/// of the coordinates' scale so that points on the bounds are inside.
+fn cube_around(bounds: &[[f64; 3]; 2], source: &source::Source, grid: u32) -> Cube {
+    let pad = 2.0 * source.scale.iter().fold(0f64, |m, s| m.max(s.abs()));
+    let side = (0..3)
+        .map(|a| bounds[1][a] - bounds[0][a])
+        .fold(0f64, f64::max)
+        + 2.0 * pad;
+    let centre: [f64; 3] = std::array::from_fn(|a| 0.5 * (bounds[0][a] + bounds[1][a]));
+    Cube {
+        min: centre.map(|c| c - 0.5 * side),
+        side,
+        scale: source.scale,
+        offset: source.offset,
+        grid,
+    }
+}
