@@ -81,6 +81,8 @@ pub struct Settings<'a> {
     pub base: &'a Path,
     /// The camera's projection when the renderer is built.
     pub projection: Projection,
+    /// The first view (camera and image size): what a COPC cloud's nodes are chosen for.
+    pub view: crate::points::copc_lod::View,
 }
 
 /// Build the renderer for `technique`, with programs of `kind`; nothing else is created.
@@ -95,6 +97,7 @@ pub fn build(
         programs,
         base,
         projection,
+        view,
     } = *settings;
     Ok(match technique {
         TechniqueScene::Quad(params) => Box::new(quad::QuadRenderer::new(gpu, kind, params)?),
@@ -124,7 +127,12 @@ pub fn build(
             projection,
         )?),
         TechniqueScene::Splats(params) => Box::new(splats::SplatsRenderer::new(
-            gpu, kind, fidelity, params, base,
+            gpu,
+            kind,
+            fidelity,
+            params,
+            base,
+            Some(view),
         )?),
         TechniqueScene::Cellproj(params) => Box::new(cellproj::CellprojRenderer::new(
             gpu, kind, fidelity, params, base,

@@ -234,8 +234,9 @@ enum Command {
         /// COPC: most points in a leaf node.
         #[arg(long, default_value_t = 100_000)]
         node_points: usize,
-        /// COPC: most points built in memory at once (default: what the memory budget
-        /// allows, a quarter of it); larger clouds go through spill files beside the output.
+        /// COPC: most points built in memory at once (default: a quarter of the memory
+        /// budget, at most 8 Mi points); larger clouds go through spill files beside the
+        /// output.
         #[arg(long)]
         memory_points: Option<u64>,
     },
@@ -473,6 +474,10 @@ struct SceneArgs {
     /// budget (a scene's `[technique.opacity3d.store] gpu_memory`).
     #[arg(long, value_name = "SIZE", value_parser = gpu_memory)]
     gpu_memory: Option<String>,
+    /// The most points drawn of a COPC cloud (a scene's `copc = { points = N }`; Potree's
+    /// default is 1000000): the nodes largest on screen first.
+    #[arg(long, value_name = "POINTS")]
+    point_budget: Option<u64>,
 }
 
 fn gpu_memory(s: &str) -> Result<String, String> {
@@ -505,6 +510,15 @@ impl SceneArgs {
         if let Some(g) = &self.gpu_memory {
             if let arbvis::scene::TechniqueScene::Opacity3d(p) = &mut scene.technique {
                 p.store.get_or_insert_with(Default::default).gpu_memory = g.clone();
+            }
+        }
+        if let Some(points) = self.point_budget {
+            match &mut scene.technique {
+                arbvis::scene::TechniqueScene::Splats(p) => match &mut p.cloud {
+                    arbvis::points::PointSource::Copc(spec) => spec.points = points,
+                    _ => bail!("--point-budget: the scene's cloud is not a COPC file"),
+                },
+                _ => bail!("--point-budget: the scene draws no point cloud"),
             }
         }
         if let Some(bytes) = scene

@@ -221,6 +221,21 @@ impl PointCloud {
         })
     }
 
+    /// Rescale the positions around `bounds` instead of the points' own (a COPC cut is
+    /// framed by its file's bounds, so that every cut lies at the same place); the
+    /// points' bounds stay as they are.
+    pub fn reframe(&mut self, bounds: &[[f64; 3]; 2]) {
+        let (origin, scale) = origin_and_scale(bounds);
+        let (old_origin, old_scale) = (self.origin, self.scale);
+        self.positions.par_iter_mut().for_each(|p| {
+            *p = std::array::from_fn(|a| {
+                local(old_origin[a] + old_scale * p[a] as f64, origin[a], scale)
+            })
+        });
+        self.origin = origin;
+        self.scale = scale;
+    }
+
     /// Number of points.
     pub fn len(&self) -> usize {
         self.positions.len()
@@ -318,7 +333,7 @@ impl PointCloud {
 /// The centre of `bounds` and half of its largest extent (1 when that is 0), computed
 /// from halves so that finite coordinates anywhere in f64's range (±1.7e308) give a
 /// finite origin and scale: `0.5 * (lo + hi)` and `hi - lo` would overflow there.
-fn origin_and_scale(bounds: &[[f64; 3]; 2]) -> ([f64; 3], f64) {
+pub(crate) fn origin_and_scale(bounds: &[[f64; 3]; 2]) -> ([f64; 3], f64) {
     let [lo, hi] = bounds;
     let origin = std::array::from_fn(|a| 0.5 * lo[a] + 0.5 * hi[a]);
     let half = (0..3)

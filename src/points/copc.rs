@@ -48,6 +48,14 @@ pub struct CopcSpec {
     /// The point budget (default 1,000,000, Potree's).
     #[serde(default = "default_budget")]
     pub points: u64,
+    /// Nodes whose bounding sphere projects under this radius in pixels are not drawn
+    /// (Potree's `minimumNodePixelSize`, 150); 0 draws every node the budget allows.
+    #[serde(default = "default_min_node_pixels")]
+    pub min_node_pixels: f64,
+}
+
+fn default_min_node_pixels() -> f64 {
+    150.0
 }
 
 fn default_budget() -> u64 {
@@ -76,6 +84,8 @@ pub struct Copc {
     pub format: (u8, u16),
     /// The header's point count.
     pub points: u64,
+    /// The header's bounds (min, max), inside the octree's cube.
+    pub bounds: [[f64; 3]; 2],
     /// Nodes holding points, by level then key.
     pub nodes: Vec<Node>,
     header: Header,
@@ -364,7 +374,12 @@ impl Copc {
             ));
         }
         nodes.sort();
+        let bounds = [
+            [f64_at_head(187), f64_at_head(203), f64_at_head(219)],
+            [f64_at_head(179), f64_at_head(195), f64_at_head(211)],
+        ];
         Ok(Copc {
+            bounds,
             path: path.to_path_buf(),
             info: octree,
             format: (format & 0x3f, record),

@@ -194,6 +194,7 @@ fn cloud_of(cols: Columns, extras: &[Extra], has_rgb: bool) -> Result<PointCloud
 pub(super) fn copc_cloud(
     copc: &super::copc::Copc,
     nodes: &[super::copc::Node],
+    stride: u64,
 ) -> Result<PointCloud, PointsError> {
     let count: u64 = nodes.iter().map(|n| n.points).sum();
     let has_rgb = matches!(copc.format.0, 7 | 8);
@@ -232,6 +233,9 @@ pub(super) fn copc_cloud(
         for (node, pd) in batch.iter().zip(&decoded) {
             append_node(&mut cols, copc, node, pd, &extras)?;
         }
+    }
+    if stride > 1 {
+        cols.thin(stride as usize);
     }
     cloud_of(cols, &extras, has_rgb).map_err(|message| PointsError::Decode {
         path: copc.path().to_path_buf(),
@@ -284,6 +288,23 @@ impl Columns {
                 .map(|_| vec_for(n, "the extra-bytes attributes"))
                 .collect::<Result<_, _>>()?,
         })
+    }
+
+    /// Keep every `stride`th point.
+    fn thin(&mut self, stride: usize) {
+        fn every<T: Copy>(v: &mut Vec<T>, stride: usize) {
+            let kept: Vec<T> = v.iter().step_by(stride).copied().collect();
+            *v = kept;
+        }
+        every(&mut self.positions, stride);
+        every(&mut self.intensity, stride);
+        every(&mut self.classification, stride);
+        every(&mut self.return_number, stride);
+        every(&mut self.number_of_returns, stride);
+        every(&mut self.rgb, stride);
+        for e in &mut self.extras {
+            every(e, stride);
+        }
     }
 
     /// Append a batch; fails (without allocating) when the points would pass the

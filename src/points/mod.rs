@@ -38,6 +38,7 @@
 
 mod cloud;
 pub mod copc;
+pub mod copc_lod;
 pub mod copc_write;
 pub mod dat;
 pub mod lasfile;
@@ -201,19 +202,53 @@ pub enum PointSource {
 
 impl PointSource {
     /// Load or generate the cloud; relative paths are taken from `base` (the scene's
-    /// folder).
+    /// folder). A COPC cloud: whole levels from the root within its budget.
     pub fn load(&self, base: &Path) -> Result<PointCloud, PointsError> {
-        match self {
-            PointSource::Dat(spec) => dat::read(&base.join(&spec.path), &spec.columns),
-            PointSource::Las(p) => Ok(lasfile::read(&base.join(p))?.cloud),
-            PointSource::Ply(p) => Ok(plycloud::read(&base.join(p))?.cloud),
+        Ok(self.load_for(base, None)?.0)
+    }
+
+    /// [`PointSource::load`], a COPC cloud's nodes chosen for `view` (Potree's policy,
+    /// [`copc_lod`]) when there is one; with what a COPC cut holds.
+    pub fn load_for(
+        &self,
+        base: &Path,
+        view: Option<&copc_lod::View>,
+    ) -> Result<(PointCloud, Option<copc_lod::Loaded>), PointsError> {
+        let cloud = match self {
+            PointSource::Dat(spec) => dat::read(&base.join(&spec.path), &spec.columns)?,
+            PointSource::Las(p) => lasfile::read(&base.join(p))?.cloud,
+            PointSource::Ply(p) => plycloud::read(&base.join(p))?.cloud,
             PointSource::Copc(spec) => {
                 let c = copc::Copc::open(&base.join(&spec.path))?;
-                let (nodes, _) = c.cut(spec.points);
-                lasfile::copc_cloud(&c, &nodes)
+                let cut = match view {
+                    Some(v) => copc_lod::select(&c, v, spec.points, spec.min_node_pixels),
+                    None => {
+                        let (nodes, _) = c.cut(spec.points);
+                        let points = nodes.iter().map(|n| n.points).sum();
+                        copc_lod::Cut::whole(nodes, points, spec.points)
+                    }
+                };
+                let mut cloud = lasfile::copc_cloud(&c, &cut.nodes, cut.root_stride)?;
+                cloud.reframe(&c.bounds);
+                let deepest = c.info.spacing / f64::from(1u32 << cut.deepest.clamp(0, 30));
+                let spacings = copc_lod::spacings(
+                    &c,
+                    &cut,
+                    (0..cloud.len()).filter_map(|i| cloud.original(i)),
+                );
+                let loaded = copc_lod::Loaded {
+                    spacing: deepest * (cut.root_stride as f64).sqrt() / cloud.scale,
+                    size_scales: spacings
+                        .iter()
+                        .map(|s| (*s as f64 / deepest) as f32)
+                        .collect(),
+                    describe: cut.describe(&c),
+                };
+                return Ok((cloud, Some(loaded)));
             }
-            PointSource::Section(spec) => section::generate(spec),
-        }
+            PointSource::Section(spec) => section::generate(spec)?,
+        };
+        Ok((cloud, None))
     }
 
     /// The file it names, if any.

@@ -192,6 +192,7 @@ fn seed_dat_and_ply_attributes_become_extra_bytes() {
     let back = PointSource::Copc(arbvis::points::copc::CopcSpec {
         path: out.clone(),
         points: 1 << 40,
+        min_node_pixels: 150.0,
     })
     .load(Path::new("."))
     .unwrap();
@@ -233,6 +234,7 @@ fn seed_dat_and_ply_attributes_become_extra_bytes() {
     let back = PointSource::Copc(arbvis::points::copc::CopcSpec {
         path: bunny.clone(),
         points: 1 << 40,
+        min_node_pixels: 150.0,
     })
     .load(Path::new("."))
     .unwrap();

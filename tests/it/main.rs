@@ -12,6 +12,7 @@ mod cellproj_volume;
 mod cli;
 mod clip;
 mod copc;
+mod copc_lod;
 mod copc_write;
 mod data;
 mod docs;

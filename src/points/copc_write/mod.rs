@@ -36,7 +36,8 @@ use octree::{Cube, Limits};
 pub struct CopcWriteOptions {
     /// Most points a leaf holds (PDAL's and Untwine's order of magnitude).
     pub node_points: usize,
-    /// Most points built in memory at once; `None`: what the memory budget allows.
+    /// Most points built in memory at once; `None`: a quarter of the memory budget, at
+    /// most 8 Mi points.
     pub memory_points: Option<u64>,
     /// Cells per node side (a level's spacing is its side over this).
     pub grid: u32,
@@ -83,9 +84,11 @@ pub fn write_copc(
     // What a point costs while a subtree is built in memory: its record, its place in
     // the cube, its index, its copy into a node and its share of the compressed chunk.
     let each = 2 * source.record as u64 + 24 + 8 + 8;
+    // At most 8 Mi points at once (about 1 GB with format 7): the whole conversion stays
+    // under 2 GB of memory for any size of cloud.
     let memory_points = options
         .memory_points
-        .unwrap_or_else(|| (crate::budget::current().bytes / 4 / each).clamp(1 << 16, 1 << 25));
+        .unwrap_or_else(|| (crate::budget::current().bytes / 4 / each).clamp(1 << 16, 1 << 23));
     crate::budget::check(
         format!(
             "building {memory_points} points of {} in memory",
@@ -179,6 +182,7 @@ fn cube_around(bounds: &[[f64; 3]; 2], source: &source::Source, grid: u32) -> Cu
     let centre: [f64; 3] = std::array::from_fn(|a| 0.5 * (bounds[0][a] + bounds[1][a]));
     Cube {
         min: centre.map(|c| c - 0.5 * side),
+        extent: std::array::from_fn(|a| (bounds[1][a] - bounds[0][a]).min(side)),
         side,
         scale: source.scale,
         offset: source.offset,

@@ -10,8 +10,9 @@
 //! streamed pass: the points taken by its first `d` levels stay in memory (a sample:
 //! at most the cells of those levels), the others are appended to one spill file per
 //! node of level `d` below it; each spill file is then built the same way, in memory
-//! when it fits (`d` chosen so that a surface-like cloud's files hold about half of
-//! `memory_points`, at most 4 levels), else distributed again. The spill files' buffers
+//! when it fits (`d` chosen so that the files hold about half of `memory_points` if the
+//! points spread over the nodes the cloud's extent reaches, at most 4^d: a surface; at
+//! most 4 levels), else distributed again. The spill files' buffers
 //! hold at most [`SPILL_BUFFERS`] bytes together.
 
 use std::collections::{HashMap, HashSet};
@@ -40,6 +41,8 @@ pub(super) struct Cube {
     pub(super) offset: [f64; 3],
     /// Cells per node side.
     pub(super) grid: u32,
+    /// The points' extent along each axis (at most the side).
+    pub(super) extent: [f64; 3],
 }
 
 impl Cube {
@@ -99,10 +102,25 @@ pub(super) fn build(
         placed(n as u64);
         return Ok(());
     }
-    // Levels kept in memory: a surface-like cloud (4^d nodes at depth d) leaves about
-    // half of memory_points in each spill file.
+    // Levels kept in memory: enough that each spill file holds about half of
+    // memory_points, if the points spread over the nodes of depth d that the cloud's
+    // extent reaches and at most 4^d of them (a surface), at most 4 levels.
+    let nodes_at = |d: i32| -> f64 {
+        let side = cube.side / f64::from(1u32 << root[0]);
+        let reach: f64 = (0..3)
+            .map(|a| {
+                (cube.extent[a].min(side) * f64::from(1u32 << d) / side)
+                    .ceil()
+                    .max(1.0)
+            })
+            .product();
+        reach.min(4f64.powi(d))
+    };
     let mut d = 1;
-    while d < 4 && root[0] + d < MAX_LEVEL - 1 && count >> (2 * d) > limits.memory_points / 2 {
+    while d < 4
+        && root[0] + d < MAX_LEVEL - 1
+        && count as f64 / nodes_at(d) > (limits.memory_points / 2) as f64
+    {
         d += 1;
     }
     let mut taken: Vec<HashSet<u64>> = vec![HashSet::new(); d as usize];

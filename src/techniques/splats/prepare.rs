@@ -49,10 +49,30 @@ pub struct Prepared {
 /// Load the scene's cloud (relative paths from `base`) and prepare it; returns the
 /// cloud too (a renderer keeps it to re-prepare after edits without reloading).
 pub fn prepare(scene: &SplatsScene, base: &Path) -> Result<(PointCloud, Prepared), String> {
-    let cloud = scene.cloud.load(base).map_err(|e| e.to_string())?;
+    let (cloud, prepared, _) = prepare_for(scene, base, None)?;
+    Ok((cloud, prepared))
+}
+
+/// [`prepare`], a COPC cloud's nodes chosen for `view`; with what a COPC cut holds.
+pub fn prepare_for(
+    scene: &SplatsScene,
+    base: &Path,
+    view: Option<&crate::points::copc_lod::View>,
+) -> Result<
+    (
+        PointCloud,
+        Prepared,
+        Option<crate::points::copc_lod::Loaded>,
+    ),
+    String,
+> {
+    let (cloud, note) = scene
+        .cloud
+        .load_for(base, view)
+        .map_err(|e| e.to_string())?;
     let normals = normals_for(&cloud, scene);
     let prepared = from_cloud(&cloud, scene, normals)?;
-    Ok((cloud, prepared))
+    Ok((cloud, prepared, note))
 }
 
 /// Normals of a scene's cloud (k nearest neighbours, PCA, per layer) and the count of
@@ -326,6 +346,20 @@ pub fn rgba_of(
     };
     let a = if prepared.visible[i] { a } else { 0.0 };
     [c[0], c[1], c[2], a]
+}
+
+/// The point size that closes a COPC cut's gaps in `view`: splats twice the deepest
+/// level's spacing across (`spacing`, frame units), as the seed sizes them (`pointSize /
+/// distance * factor`: a length at eye distance d covers `length * P[1][1] * h / 2 / d`
+/// pixels, so the distance cancels in perspective), or the scene's own when larger.
+pub fn point_size_for_spacing(
+    scene: &SplatsScene,
+    view: &crate::points::copc_lod::View,
+    spacing: f64,
+) -> f64 {
+    let covering =
+        2.0 * spacing * view.projection_y * 0.5 * view.size[1] as f64 / scene.factor.max(1e-9);
+    scene.point_size.max(covering)
 }
 
 #[cfg(test)]

@@ -22,7 +22,8 @@ use std::time::{Duration, Instant};
 
 use super::oit::{z_row, OitPass};
 use super::prepare::{
-    from_cloud, normals_for, prepare, Prepared, COLOR_A, COLOR_B, PHONG, VERTEX_COMPONENTS,
+    from_cloud, normals_for, point_size_for_spacing, prepare_for, Prepared, COLOR_A, COLOR_B,
+    PHONG, VERTEX_COMPONENTS,
 };
 use super::reference::{eye_position, view_direction, SplatParams};
 use super::scene::{ColourMode, DrawChoice, Kernel, Mode, SortChoice, SplatsScene};
@@ -36,6 +37,7 @@ use crate::camera::Projection;
 use crate::gl::{
     self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind, Surface,
 };
+use crate::points::copc_lod::View as CloudView;
 use crate::points::PointCloud;
 use crate::programs::{self, ProgramPair};
 
@@ -87,6 +89,11 @@ pub struct SplatsRenderer {
     pub last_sort: Duration,
     /// Time of the last placing, binning and upload of tile lists.
     pub last_bin: Duration,
+    /// The view a COPC cloud's nodes were chosen for, and what its cut holds.
+    view: Option<CloudView>,
+    cut: Option<String>,
+    /// A COPC cut's points' sizes over the scene's (tiles only; empty: all 1).
+    size_scales: Vec<f32>,
 }
 
 /// The tile pass and the frame its uploads were made for.
@@ -131,12 +138,39 @@ impl SplatsRenderer {
         fidelity: Fidelity,
         params: &SplatsScene,
         base: &Path,
+        view: Option<CloudView>,
     ) -> GlResult<SplatsRenderer> {
         params
             .validate()
             .map_err(|e| GlError::Data(e.to_string()))?;
-        let (cloud, prepared) = prepare(params, base).map_err(GlError::Data)?;
-        SplatsRenderer::from_prepared(gpu, kind, fidelity, params, base, cloud, prepared)
+        let (cloud, prepared, loaded) =
+            prepare_for(params, base, view.as_ref()).map_err(GlError::Data)?;
+        // A COPC cut's splats cover its deepest level's spacing.
+        let mut sized = params.clone();
+        if let (Some(l), Some(v)) = (&loaded, &view) {
+            sized.point_size = point_size_for_spacing(params, v, l.spacing);
+        }
+        let mut r =
+            SplatsRenderer::from_prepared(gpu, kind, fidelity, &sized, base, cloud, prepared)?;
+        r.view = view;
+        if let Some(l) = loaded {
+            r.cut = Some(format!(
+                "{}; splats of point size {:.1} (the scene's {:.1}){}",
+                l.describe,
+                sized.point_size,
+                params.point_size,
+                if r.params.draw == DrawChoice::Tiles {
+                    ", larger where coarser levels stand in for missing ones"
+                } else {
+                    ""
+                }
+            ));
+            if let Some(t) = &mut r.tiles {
+                t.points.size_scales = l.size_scales.clone();
+            }
+            r.size_scales = l.size_scales;
+        }
+        Ok(r)
     }
 
     /// Upload a cloud prepared elsewhere.
@@ -179,9 +213,45 @@ impl SplatsRenderer {
             tiles: None,
             last_sort: Duration::ZERO,
             last_bin: Duration::ZERO,
+            view: None,
+            cut: None,
+            size_scales: Vec::new(),
         };
         r.install(gpu)?;
         Ok(r)
+    }
+
+    /// The frame's line: points drawn, sort or tiles.
+    fn frame_status(&self) -> String {
+        let drawn = self.prepared.visible.iter().filter(|v| **v).count();
+        if self.params.sort == SortChoice::Oit {
+            return format!(
+                "{drawn} of {} points drawn; weighted blended OIT (no sort)",
+                self.prepared.len()
+            );
+        }
+        let points = format!("{drawn} of {} points drawn", self.prepared.len());
+        let sort = format!(
+            "last sort ({:?}): {:.1} ms",
+            self.params.sort,
+            self.last_sort.as_secs_f64() * 1e3
+        );
+        match &self.tiles {
+            None => format!("{points}; {sort}"),
+            Some(TileState { entries: Ok(n), .. }) => format!(
+                "{points} as tiles of {} px: {n} list entries, placed, binned and ordered \
+                 per tile: last lists {:.1} ms",
+                self.params.tile,
+                self.last_bin.as_secs_f64() * 1e3
+            ),
+            Some(TileState {
+                entries: Err(TooManyEntries(n)),
+                ..
+            }) => format!(
+                "{points}; tiles would need {n} list entries (more than \
+                 {DEFAULT_MAX_ENTRIES}): drawn as points; {sort}"
+            ),
+        }
     }
 
     /// Set up the ordering of the current `prepared` and `params`, and the constants.
@@ -207,7 +277,10 @@ impl SplatsRenderer {
                     Some(t) => t.pass,
                     None => TilePass::new(gpu)?,
                 },
-                points: spatial_order(&self.prepared.positions, &self.prepared.visible),
+                points: SpatialPoints {
+                    size_scales: self.size_scales.clone(),
+                    ..spatial_order(&self.prepared.positions, &self.prepared.visible)
+                },
                 binner: Binner::default(),
                 lists_for: None,
                 colours_for: None,
@@ -424,7 +497,14 @@ impl Renderer for SplatsRenderer {
             .map_err(|e| GlError::Data(e.to_string()))?;
         let p = &self.params;
         if new.cloud != p.cloud {
-            *self = SplatsRenderer::new(gpu, self.kind, self.fidelity, new, &self.base.clone())?;
+            *self = SplatsRenderer::new(
+                gpu,
+                self.kind,
+                self.fidelity,
+                new,
+                &self.base.clone(),
+                self.view,
+            )?;
             return Ok(());
         }
         let lit = |s: &SplatsScene| (s.lighting && s.mode == Mode::Surface, s.normals_k);
@@ -459,34 +539,10 @@ impl Renderer for SplatsRenderer {
     }
 
     fn status(&self) -> Option<String> {
-        let drawn = self.prepared.visible.iter().filter(|v| **v).count();
-        if self.params.sort == SortChoice::Oit {
-            return Some(format!(
-                "{drawn} of {} points drawn; weighted blended OIT (no sort)",
-                self.prepared.len()
-            ));
-        }
-        let points = format!("{drawn} of {} points drawn", self.prepared.len());
-        let sort = format!(
-            "last sort ({:?}): {:.1} ms",
-            self.params.sort,
-            self.last_sort.as_secs_f64() * 1e3
-        );
-        Some(match &self.tiles {
-            None => format!("{points}; {sort}"),
-            Some(TileState { entries: Ok(n), .. }) => format!(
-                "{points} as tiles of {} px: {n} list entries, placed, binned and ordered \
-                 per tile: last lists {:.1} ms",
-                self.params.tile,
-                self.last_bin.as_secs_f64() * 1e3
-            ),
-            Some(TileState {
-                entries: Err(TooManyEntries(n)),
-                ..
-            }) => format!(
-                "{points}; tiles would need {n} list entries (more than \
-                 {DEFAULT_MAX_ENTRIES}): drawn as points; {sort}"
-            ),
+        let line = self.frame_status();
+        Some(match &self.cut {
+            Some(cut) => format!("{cut}\n{line}"),
+            None => line,
         })
     }
 }

@@ -151,6 +151,9 @@ pub struct SpatialPoints {
     pub positions: Vec<[f32; 3]>,
     /// Each one's index in the cloud.
     pub index: Vec<u32>,
+    /// Each point's size over the scene's, by index in the cloud (empty: all 1; a COPC
+    /// cut's coarser points stand in for their missing children).
+    pub size_scales: Vec<f32>,
 }
 
 /// The points with `visible` set, in Morton order (10 bits per axis over their bounds).
@@ -185,6 +188,7 @@ pub fn spatial_order(positions: &[[f32; 3]], visible: &[bool]) -> SpatialPoints 
     SpatialPoints {
         positions: keyed.iter().map(|&(_, i)| positions[i as usize]).collect(),
         index: keyed.into_iter().map(|(_, i)| i).collect(),
+        size_scales: Vec::new(),
     }
 }
 
@@ -293,7 +297,7 @@ pub fn place_splats(
                 let s = match eye {
                     Some(e) => point_size / q.distance(e) * factor,
                     None => point_size * factor,
-                };
+                } * points.size_scales.get(i as usize).copied().unwrap_or(1.0);
                 // The reference's rule: a NaN size draws nothing, others are clamped.
                 let s = if s.is_nan() { s } else { s.max(lo).min(hi) };
                 let drawn = s > 0.0;

@@ -1,0 +1,301 @@
+//! Which COPC nodes a view draws: Potree's policy. Nodes are ranked by the radius their
+//! bounding sphere projects to on screen, in pixels; from the root down the largest is
+//! taken while the point budget lasts, its children queued; nodes outside the view
+//! frustum and nodes whose sphere projects under `min_node_pixels` (Potree's 150) are
+//! not queued. The root is always taken: when it alone is over the budget, a stride of
+//! its points is drawn (the loader thins it), so no picture has more points than the
+//! budget. No GL: the view is the camera's matrix in the cloud's frame.
+//!
+//! The frame is fixed by the file, not by the cut: positions are rescaled around the
+//! header's bounds (`PointCloud`'s rule: origin at their centre, scale half the largest
+//! extent), so every budget and every cut places the cloud at the same place.
+
+use std::collections::{BinaryHeap, HashMap};
+
+use glam::{DMat4, DVec3, DVec4};
+
+use super::copc::{Copc, Node};
+
+/// A view: the camera's view-projection over the cloud's frame ([-1, 1]³ around the
+/// header's bounds), its projection's y scale (`P[1][1]`), and the image size.
+#[derive(Debug, Clone, Copy)]
+pub struct View {
+    /// Clip from frame coordinates.
+    pub view_projection: DMat4,
+    /// The projection matrix's `[1][1]`: pixels per unit at clip w = 1, over half the
+    /// height.
+    pub projection_y: f64,
+    /// Image width and height in pixels.
+    pub size: [u32; 2],
+}
+
+impl View {
+    /// The view of `camera` on an image of `size` pixels.
+    pub fn of(camera: &crate::camera::Camera, size: [u32; 2]) -> View {
+        let aspect = size[0].max(1) as f64 / size[1].max(1) as f64;
+        View {
+            view_projection: camera.view_projection(aspect),
+            projection_y: camera.projection_matrix(aspect).y_axis.y,
+            size,
+        }
+    }
+}
+
+/// What a COPC cloud's load says: its cut in a line, and the spacing of the deepest level
+/// drawn in the cloud's frame (what a splat must cover for the picture to have no gaps).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Loaded {
+    /// The cut, as [`Cut::describe`] says it.
+    pub describe: String,
+    /// The deepest level's spacing, in frame units ([-1, 1] over the largest extent).
+    pub spacing: f64,
+    /// Each point's spacing over the deepest level's ([`spacings`]): 1, 2, 4, ...
+    pub size_scales: Vec<f32>,
+}
+
+/// The nodes a view draws and what was left.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cut {
+    /// Nodes taken, largest on screen first.
+    pub nodes: Vec<Node>,
+    /// Points of those nodes.
+    pub points: u64,
+    /// The root's stride when it alone is over the budget (1: every point).
+    pub root_stride: u64,
+    /// Deepest level taken.
+    pub deepest: i32,
+    /// Nodes not queued: outside the view, and under `min_node_pixels`.
+    pub culled: usize,
+    pub too_small: usize,
+    /// Nodes queued but left for the budget.
+    pub over_budget: usize,
+}
+
+impl Cut {
+    /// A cut of whole levels (`Copc::cut`), with the root's stride for `budget`.
+    pub fn whole(nodes: Vec<Node>, points: u64, budget: u64) -> Cut {
+        Cut {
+            deepest: nodes.iter().map(|n| n.key[0]).max().unwrap_or(0),
+            root_stride: if points > budget && budget > 0 {
+                points.div_ceil(budget)
+            } else {
+                1
+            },
+            nodes,
+            points,
+            culled: 0,
+            too_small: 0,
+            over_budget: 0,
+        }
+    }
+
+    /// A line for `--stats` and the viewer.
+    pub fn describe(&self, copc: &Copc) -> String {
+        let bytes: u64 = self.nodes.iter().map(|n| n.bytes).sum();
+        let levels = self
+            .nodes
+            .iter()
+            .map(|n| n.key[0])
+            .collect::<std::collections::BTreeSet<_>>();
+        format!(
+            "COPC: {} of {} nodes, levels {:?}, {} points{} ({} compressed), {} nodes outside the view, {} under the pixel size, {} left for the budget",
+            self.nodes.len(),
+            copc.nodes.len(),
+            levels,
+            self.points / self.root_stride.max(1),
+            if self.root_stride > 1 {
+                format!(" (every {}th of the root's)", self.root_stride)
+            } else {
+                String::new()
+            },
+            crate::budget::format_bytes(bytes),
+            self.culled,
+            self.too_small,
+            self.over_budget
+        )
+    }
+}
+
+/// A queued node and its projected radius.
+struct Ranked {
+    pixels: f64,
+    index: usize,
+}
+
+impl PartialEq for Ranked {
+    fn eq(&self, other: &Self) -> bool {
+        self.pixels == other.pixels && self.index == other.index
+    }
+}
+impl Eq for Ranked {}
+impl PartialOrd for Ranked {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+impl Ord for Ranked {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.pixels
+            .total_cmp(&other.pixels)
+            .then(other.index.cmp(&self.index))
+    }
+}
+
+/// Each point's spacing (file units) in a cloud loaded from `cut` (its nodes' points in
+/// order, `positions` in file coordinates): the spacing of the deepest level drawn in its
+/// part of the octree, the child octant it lies in (its own level's where that child is
+/// not drawn). A level's points stand in for its missing children: a splat sized from
+/// this covers what they would have.
+pub fn spacings(copc: &Copc, cut: &Cut, positions: impl Iterator<Item = [f64; 3]>) -> Vec<f32> {
+    let info = copc.info;
+    // The deepest level drawn under each drawn node.
+    let mut deepest: HashMap<[i32; 4], i32> = HashMap::new();
+    for n in &cut.nodes {
+        let mut k = n.key;
+        loop {
+            let e = deepest.entry(k).or_insert(n.key[0]);
+            *e = (*e).max(n.key[0]);
+            if k[0] == 0 {
+                break;
+            }
+            k = [k[0] - 1, k[1] >> 1, k[2] >> 1, k[3] >> 1];
+        }
+    }
+    let lo = [info.center_x, info.center_y, info.center_z].map(|c| c - info.halfsize);
+    let mut out = Vec::new();
+    let mut positions = positions;
+    for n in &cut.nodes {
+        let level = n.key[0].clamp(0, 30);
+        let side = 2.0 * info.halfsize / f64::from(1u32 << level);
+        let count = if cut.root_stride > 1 {
+            n.points.div_ceil(cut.root_stride)
+        } else {
+            n.points
+        };
+        for p in positions.by_ref().take(count as usize) {
+            let child: [i32; 4] = [
+                level + 1,
+                2 * n.key[1] + i32::from(p[0] >= lo[0] + side * (n.key[1] as f64 + 0.5)),
+                2 * n.key[2] + i32::from(p[1] >= lo[1] + side * (n.key[2] as f64 + 0.5)),
+                2 * n.key[3] + i32::from(p[2] >= lo[2] + side * (n.key[3] as f64 + 0.5)),
+            ];
+            let d = deepest.get(&child).copied().unwrap_or(level).clamp(0, 30);
+            out.push((info.spacing / f64::from(1u32 << d)) as f32);
+        }
+    }
+    out
+}
+
+/// The frame's origin and scale for `copc` (its header's bounds).
+pub fn frame(copc: &Copc) -> ([f64; 3], f64) {
+    super::cloud::origin_and_scale(&copc.bounds)
+}
+
+/// The nodes `view` draws within `budget` points.
+pub fn select(copc: &Copc, view: &View, budget: u64, min_node_pixels: f64) -> Cut {
+    let (origin, scale) = frame(copc);
+    let info = copc.info;
+    let planes = frustum(&view.view_projection);
+    // Each node's children: the nodes whose nearest present ancestor it is.
+    let index: HashMap<[i32; 4], usize> = copc
+        .nodes
+        .iter()
+        .enumerate()
+        .map(|(i, n)| (n.key, i))
+        .collect();
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); copc.nodes.len()];
+    let mut roots = Vec::new();
+    for (i, n) in copc.nodes.iter().enumerate() {
+        let mut k = n.key;
+        let parent = loop {
+            if k[0] == 0 {
+                break None;
+            }
+            k = [k[0] - 1, k[1] >> 1, k[2] >> 1, k[3] >> 1];
+            if let Some(&p) = index.get(&k) {
+                break Some(p);
+            }
+        };
+        match parent {
+            Some(p) => children[p].push(i),
+            None => roots.push(i),
+        }
+    }
+    let half_height = 0.5 * view.size[1] as f64;
+    let rank = |i: usize| -> Option<f64> {
+        let n = &copc.nodes[i];
+        let side = 2.0 * info.halfsize / f64::from(1u32 << n.key[0].clamp(0, 31));
+        let lo = [info.center_x, info.center_y, info.center_z].map(|c| c - info.halfsize);
+        let c = DVec3::new(
+            (lo[0] + side * (n.key[1] as f64 + 0.5) - origin[0]) / scale,
+            (lo[1] + side * (n.key[2] as f64 + 0.5) - origin[1]) / scale,
+            (lo[2] + side * (n.key[3] as f64 + 0.5) - origin[2]) / scale,
+        );
+        let r = 0.5 * 3f64.sqrt() * side / scale;
+        if planes.iter().any(|p| p.dot(c.extend(1.0)) < -r) {
+            return None;
+        }
+        let w = view.view_projection.row(3).dot(c.extend(1.0));
+        // A sphere around the eye (or behind it) is as large as it gets.
+        Some(if w <= r {
+            f64::INFINITY
+        } else {
+            r * view.projection_y * half_height / w
+        })
+    };
+    let mut cut = Cut {
+        nodes: Vec::new(),
+        points: 0,
+        root_stride: 1,
+        deepest: 0,
+        culled: 0,
+        too_small: 0,
+        over_budget: 0,
+    };
+    let mut queue = BinaryHeap::new();
+    for &i in &roots {
+        // The roots are queued whatever their size (a picture always has them).
+        queue.push(Ranked {
+            pixels: rank(i).unwrap_or(0.0),
+            index: i,
+        });
+    }
+    while let Some(Ranked { index, .. }) = queue.pop() {
+        let n = copc.nodes[index];
+        if !cut.nodes.is_empty() && cut.points + n.points > budget {
+            cut.over_budget += 1 + queue.len();
+            break;
+        }
+        cut.points += n.points;
+        cut.deepest = cut.deepest.max(n.key[0]);
+        cut.nodes.push(n);
+        for &c in &children[index] {
+            match rank(c) {
+                None => cut.culled += 1,
+                Some(p) if p < min_node_pixels => cut.too_small += 1,
+                Some(p) => queue.push(Ranked {
+                    pixels: p,
+                    index: c,
+                }),
+            }
+        }
+    }
+    if cut.points > budget && budget > 0 {
+        cut.root_stride = cut.points.div_ceil(budget);
+    }
+    cut
+}
+
+/// The six planes of the view frustum (Gribb and Hartmann): a point is inside when every
+/// plane's dot product with it is at least 0; each plane scaled to a unit normal.
+fn frustum(m: &DMat4) -> [DVec4; 6] {
+    let (r0, r1, r2, r3) = (m.row(0), m.row(1), m.row(2), m.row(3));
+    [r3 + r0, r3 - r0, r3 + r1, r3 - r1, r3 + r2, r3 - r2].map(|p| {
+        let n = p.truncate().length();
+        if n > 0.0 {
+            p / n
+        } else {
+            p
+        }
+    })
+}

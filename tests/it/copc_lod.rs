@@ -1,0 +1,213 @@
+//! Which COPC nodes a view draws (issue 28, item 3): Potree's policy on laspy's
+//! `simple_with_page.copc.laz` (65 nodes over four levels). Never more points than the
+//! budget (a stride of the root's when the root alone is over it); every node taken has
+//! its parent taken; nodes under the pixel size are left; a node called outside the view
+//! has all eight corners outside one plane of the clip volume (checked here by projecting
+//! them, not by the selector's spheres); a zoomed-in, rotated perspective view culls and
+//! draws the nodes in front deeper; `render` draws the cut and `--stats` says so.
+
+use std::process::Command;
+
+use arbvis::camera::{Camera, Projection};
+use arbvis::points::copc::Copc;
+use arbvis::points::copc_lod::{frame, select, Cut, View};
+use glam::DVec4;
+
+use crate::common::{data_file, stdout_of, temp_dir};
+
+fn copc() -> Copc {
+    Copc::open(&data_file("points/simple_with_page.copc.laz")).unwrap()
+}
+
+fn camera(projection: Projection, zoom: f64, rotation: [f64; 4]) -> Camera {
+    let q = glam::DQuat::from_array(rotation).normalize();
+    Camera {
+        projection,
+        rotation: q.to_array(),
+        zoom,
+        ..Default::default()
+    }
+}
+
+/// The eight corners of a node's cube in the cloud's frame, in clip coordinates.
+fn corners(c: &Copc, view: &View, key: [i32; 4]) -> Vec<DVec4> {
+    let (origin, scale) = frame(c);
+    let i = c.info;
+    let side = 2.0 * i.halfsize / f64::from(1 << key[0]);
+    let lo = [
+        i.center_x - i.halfsize + side * key[1] as f64,
+        i.center_y - i.halfsize + side * key[2] as f64,
+        i.center_z - i.halfsize + side * key[3] as f64,
+    ];
+    (0..8)
+        .map(|k| {
+            let p: [f64; 3] =
+                std::array::from_fn(|a| (lo[a] + side * ((k >> a) & 1) as f64 - origin[a]) / scale);
+            view.view_projection * DVec4::new(p[0], p[1], p[2], 1.0)
+        })
+        .collect()
+}
+
+/// Whether every corner lies outside the same clip plane.
+fn outside(corners: &[DVec4]) -> bool {
+    let planes: [fn(&DVec4) -> bool; 6] = [
+        |p| p.x < -p.w,
+        |p| p.x > p.w,
+        |p| p.y < -p.w,
+        |p| p.y > p.w,
+        |p| p.z < -p.w,
+        |p| p.z > p.w,
+    ];
+    planes.iter().any(|f| corners.iter().all(f))
+}
+
+/// The cut's invariants: within the budget, parents before children.
+fn check(c: &Copc, cut: &Cut, budget: u64) {
+    assert!(cut.points / cut.root_stride <= budget.max(1), "{cut:?}");
+    if cut.root_stride > 1 {
+        assert_eq!(cut.nodes.len(), 1);
+    }
+    let keys: Vec<[i32; 4]> = cut.nodes.iter().map(|n| n.key).collect();
+    for k in &keys[1..] {
+        let parent = [k[0] - 1, k[1] >> 1, k[2] >> 1, k[3] >> 1];
+        assert!(keys.contains(&parent), "{k:?} without its parent");
+    }
+    assert_eq!(keys[0], [0, 0, 0, 0]);
+    let _ = c;
+}
+
+#[test]
+fn budgets_are_never_passed_and_parents_come_first() {
+    let c = copc();
+    let rotated = [0.3, -0.5, 0.1, 0.8];
+    for projection in [Projection::Orthographic, Projection::Perspective] {
+        let view = View::of(&camera(projection, 1.3, rotated), [1600, 900]);
+        for budget in [1, 10, 23, 24, 25, 90, 100, 287, 500, 1065, 10_000] {
+            let cut = select(&c, &view, budget, 0.0);
+            check(&c, &cut, budget);
+            if budget >= 1065 {
+                assert_eq!(cut.nodes.len(), 65, "{projection:?}: every node fits");
+            }
+        }
+        // The root's 24 points over a budget of 10: every third.
+        assert_eq!(select(&c, &view, 10, 0.0).root_stride, 3);
+    }
+}
+
+#[test]
+fn the_pixel_size_decides_the_depth() {
+    let c = copc();
+    let cam = camera(Projection::Orthographic, 1.0, [0.0, 0.0, 0.0, 1.0]);
+    // A thumbnail: every child's sphere projects under 150 px; only the root.
+    let small = select(&c, &View::of(&cam, [64, 48]), 1_000_000, 150.0);
+    assert_eq!(small.nodes.len(), 1);
+    assert_eq!(small.too_small, 4);
+    // 1600 x 900: the root's sphere is about 780 px in radius, halving each level:
+    // levels 0-2 are over 150 px, level 3 (about 97 px) is not.
+    let large = select(&c, &View::of(&cam, [1600, 900]), 1_000_000, 150.0);
+    assert_eq!(large.deepest, 2, "{large:?}");
+    assert_eq!(large.nodes.len(), 1 + 4 + 12);
+    assert_eq!(large.too_small, 48);
+    // Without a pixel size, the budget alone.
+    assert_eq!(
+        select(&c, &View::of(&cam, [64, 48]), 1_000_000, 0.0)
+            .nodes
+            .len(),
+        65
+    );
+}
+
+#[test]
+fn a_zoomed_rotated_perspective_culls_what_it_cannot_see() {
+    let c = copc();
+    let cam = camera(Projection::Perspective, 4.0, [0.2, 0.6, -0.1, 0.75]);
+    let view = View::of(&cam, [800, 600]);
+    let cut = select(&c, &view, 1_000_000, 0.0);
+    check(&c, &cut, 1_000_000);
+    assert!(cut.culled > 0, "{cut:?}");
+    let taken: Vec<[i32; 4]> = cut.nodes.iter().map(|n| n.key).collect();
+    let mut outside_count = 0;
+    for n in &c.nodes {
+        let out = outside(&corners(&c, &view, n.key));
+        outside_count += usize::from(out);
+        // A node entirely outside one plane is never drawn; one whose parent is drawn
+        // and that is not outside is drawn (no pixel size, budget to spare). The
+        // selector's sphere test is looser than the cube, so only these two hold.
+        if out {
+            assert!(!taken.contains(&n.key), "{:?} is outside but drawn", n.key);
+        }
+    }
+    assert!(
+        outside_count >= cut.culled,
+        "{outside_count} {}",
+        cut.culled
+    );
+    // Seen whole, nothing is culled.
+    let whole = View::of(
+        &camera(Projection::Perspective, 0.8, [0.2, 0.6, -0.1, 0.75]),
+        [800, 600],
+    );
+    assert_eq!(select(&c, &whole, 1_000_000, 0.0).culled, 0);
+}
+
+#[test]
+fn render_draws_the_cut_and_stats_say_what_it_holds() {
+    let dir = temp_dir("copc-lod-render");
+    let scene = dir.join("copc.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "size = [320, 180]\n[camera]\nrotation = [0.2, 0.6, -0.1, 0.75]\nprojection = \"perspective\"\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\" }} }}\ncolour = \"rgb\"\n",
+            data_file("points/simple_with_page.copc.laz").display()
+        ),
+    )
+    .unwrap();
+    let out = dir.join("copc.png");
+    let said = stdout_of(
+        Command::new(env!("CARGO_BIN_EXE_arbvis"))
+            .arg("render")
+            .arg(&scene)
+            .arg("-o")
+            .arg(&out)
+            .args(["--stats", "--point-budget", "100"]),
+    );
+    assert!(said.contains("COPC: "), "{said}");
+    assert!(said.contains("of 65 nodes"), "{said}");
+    let drawn: u64 = said
+        .split(" points drawn")
+        .next()
+        .and_then(|s| s.rsplit('\n').next())
+        .and_then(|s| s.split(" of ").next())
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or_else(|| panic!("{said}"));
+    assert!((24..=100).contains(&drawn), "{said}");
+    assert!(out.is_file());
+}
+
+/// Splat sizes follow the spacing: a point of a drawn node counts the spacing of the
+/// deepest level drawn in its child octant, over the deepest level's: 1, 2 or 4 here
+/// (levels 0-2 drawn), 1 for the level-2 nodes' own points (their children are not).
+#[test]
+fn coarse_points_stand_in_for_their_missing_children() {
+    use arbvis::points::copc::CopcSpec;
+    use arbvis::points::PointSource;
+    let cam = camera(Projection::Orthographic, 1.0, [0.0, 0.0, 0.0, 1.0]);
+    let view = View::of(&cam, [1600, 900]);
+    let (cloud, loaded) = PointSource::Copc(CopcSpec {
+        path: data_file("points/simple_with_page.copc.laz"),
+        points: 1_000_000,
+        min_node_pixels: 150.0,
+    })
+    .load_for(std::path::Path::new("."), Some(&view))
+    .unwrap();
+    let loaded = loaded.unwrap();
+    assert_eq!(cloud.len(), 24 + 66 + 197);
+    let scales = &loaded.size_scales;
+    assert_eq!(scales.len(), cloud.len());
+    assert!(scales.iter().all(|s| [1.0, 2.0, 4.0].contains(s)), "{scales:?}");
+    // Nodes come largest first: the last 197 points are the level-2 nodes'.
+    assert!(scales[24 + 66..].iter().all(|s| *s == 1.0));
+    // The root's points: some stand in for a level drawn only to 1 or 2 below.
+    assert!(scales[..24].iter().any(|s| *s < 4.0), "{:?}", &scales[..24]);
+    assert!(loaded.describe.contains("17 of 65 nodes"), "{}", loaded.describe);
+}
