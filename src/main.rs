@@ -171,6 +171,9 @@ enum Command {
         /// functions to add to the grids.
         #[arg(long, value_delimiter = ',')]
         scenes: Vec<PathBuf>,
+        /// Splats-lod: point budgets.
+        #[arg(long, value_delimiter = ',', default_values_t = [250_000u64, 500_000, 1_000_000, 2_000_000, 4_000_000, 8_000_000])]
+        budgets: Vec<u64>,
         /// Clipping: clip grid sides of the texture sweep.
         #[arg(long, value_delimiter = ',', default_values_t = [256, 512])]
         clip_sizes: Vec<usize>,
@@ -394,6 +397,9 @@ enum StudyTechnique {
     /// Splats: every sort method at each cloud size, and frame times per sort choice
     /// while the camera turns.
     Splats,
+    /// Splats of a COPC cloud (`--scenes SCENE`): each of `--budgets`' pictures against
+    /// every point's, and the frame time turning.
+    SplatsLod,
 }
 
 /// The sizes a bench or study sweeps.
@@ -813,6 +819,45 @@ fn run(cli: Cli) -> Result<()> {
                 options.frame_points
             );
             arbvis::techniques::splats::study::plot(&frames, &png, &title)?;
+            println!("wrote {}", png.display());
+        }
+        Command::Study {
+            sweep,
+            technique: StudyTechnique::SplatsLod,
+            scenes,
+            budgets,
+            out,
+            ..
+        } => {
+            let [path] = scenes.as_slice() else {
+                bail!("--technique splats-lod: name one COPC scene with --scenes SCENE");
+            };
+            let scene = Scene::load(path)?;
+            let headless = Headless::new(sweep.backend)?;
+            let rows = arbvis::techniques::splats::study::lod::lod(
+                &headless,
+                &scene,
+                &budgets,
+                sweep.frames,
+                arbvis::progress::line,
+            )?;
+            write_study(
+                &out,
+                [(
+                    "splats-lod.csv",
+                    arbvis::techniques::splats::study::lod::to_csv(&rows),
+                )],
+            )?;
+            let png = out.join("splats-lod.png");
+            let title = format!(
+                "splats-lod: {} at {}x{}, budgets {}-{} points",
+                path.display(),
+                scene.size[0],
+                scene.size[1],
+                budgets.iter().min().unwrap_or(&0),
+                budgets.iter().max().unwrap_or(&0)
+            );
+            arbvis::techniques::splats::study::lod::plot(&rows, &png, &title)?;
             println!("wrote {}", png.display());
         }
         Command::Study {

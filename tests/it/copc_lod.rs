@@ -204,10 +204,53 @@ fn coarse_points_stand_in_for_their_missing_children() {
     assert_eq!(cloud.len(), 24 + 66 + 197);
     let scales = &loaded.size_scales;
     assert_eq!(scales.len(), cloud.len());
-    assert!(scales.iter().all(|s| [1.0, 2.0, 4.0].contains(s)), "{scales:?}");
+    assert!(
+        scales.iter().all(|s| [1.0, 2.0, 4.0].contains(s)),
+        "{scales:?}"
+    );
     // Nodes come largest first: the last 197 points are the level-2 nodes'.
     assert!(scales[24 + 66..].iter().all(|s| *s == 1.0));
     // The root's points: some stand in for a level drawn only to 1 or 2 below.
     assert!(scales[..24].iter().any(|s| *s < 4.0), "{:?}", &scales[..24]);
-    assert!(loaded.describe.contains("17 of 65 nodes"), "{}", loaded.describe);
+    assert!(
+        loaded.describe.contains("17 of 65 nodes"),
+        "{}",
+        loaded.describe
+    );
+}
+
+/// The splats-lod study on the small file: every budget's points within it, the whole
+/// cloud's picture its own reference (RMSE 0), a coarser cut further from it than the
+/// finest but one.
+#[test]
+fn the_lod_study_measures_each_budget_against_every_point() {
+    let dir = temp_dir("copc-lod-study");
+    let scene_path = dir.join("copc.toml");
+    std::fs::write(
+        &scene_path,
+        format!(
+            "size = [160, 90]\nfidelity = \"precise\"\n[camera]\nrotation = [0.2, 0.6, -0.1, 0.75]\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\" }} }}\ncolour = \"rgb\"\ndraw = \"tiles\"\n",
+            data_file("points/simple_with_page.copc.laz").display()
+        ),
+    )
+    .unwrap();
+    let scene = arbvis::scene::Scene::load(&scene_path).unwrap();
+    let h = crate::common::headless(arbvis::gl::Backend::Egl);
+    let rows = arbvis::techniques::splats::study::lod::lod(&h, &scene, &[24, 300, 1065], 1, |_| {})
+        .unwrap();
+    assert_eq!(rows.len(), 3);
+    for r in &rows {
+        assert!(
+            r.points <= r.budget && r.ms.is_finite() && r.ms > 0.0,
+            "{r:?}"
+        );
+    }
+    assert_eq!(rows[2].points, 1065);
+    assert_eq!(rows[2].rmse, 0.0);
+    assert!(rows[0].rmse > 0.0, "{rows:?}");
+    let csv = arbvis::techniques::splats::study::lod::to_csv(&rows);
+    assert!(
+        csv.starts_with("budget,points,nodes,deepest_level,ms_turning,rmse\n24,24,1,0,"),
+        "{csv}"
+    );
 }

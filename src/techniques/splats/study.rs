@@ -8,7 +8,10 @@
 //! order's share is the tile lists' time, and each drawing's RMSE against the f64
 //! reference of the same splats in exact order ([`plot`]: RMSE against time). For clouds
 //! up to 2 M points also the f64 references' time and weighted blended OIT's error against
-//! exact order, and the normals' estimation time.
+//! exact order, and the normals' estimation time. `lod.rs`: the point budget's trade on a
+//! COPC scene (`--technique splats-lod`).
+
+pub mod lod;
 
 use crate::study::median;
 use crate::techniques::Params;
