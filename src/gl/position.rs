@@ -1,7 +1,9 @@
 //! Turning a driver's compile message into a line and column of the program text.
 //!
-//! Drivers differ: Mesa's ARB assembler says `line 3, char 1: error: ...`, Mesa's GLSL
-//! compiler `0:3(5): error: ...`, NVIDIA's `0(3) : error C0000: ...`. The ARB
+//! Drivers differ: Mesa's ARB assembler says `line 3, char 1: error: ...`, NVIDIA's
+//! `line 3, column 1:  error: ...`, Mesa's GLSL compiler `0:3(5): error: ...`, NVIDIA's
+//! `0(3) : error C0000: ...` (no column: where the message quotes a name found on that
+//! line, the name's column is taken, [`with_quoted_column`]). The ARB
 //! `GL_PROGRAM_ERROR_POSITION_ARB` is a byte offset by the spec, but Mesa's is not, so the
 //! message wins when it names a position and the byte offset is the fallback.
 
@@ -53,15 +55,32 @@ fn leading_number(s: &str) -> Option<(u32, &str)> {
     Some((s[..end].parse().ok()?, &s[end..]))
 }
 
-/// `line 3, char 1: ...` (Mesa ARB assembler).
+/// `line 3, char 1: ...` (Mesa ARB assembler), `line 3, column 1: ...` (NVIDIA's).
 fn arb_style(message: &str) -> Option<Position> {
     let rest = &message[message.find("line ")? + 5..];
     let (line, rest) = leading_number(rest)?;
     let column = rest
         .strip_prefix(", char ")
+        .or_else(|| rest.strip_prefix(", column "))
         .and_then(leading_number)
         .map(|(c, _)| c);
     Some(Position { line, column })
+}
+
+/// `pos` with a column where it has none and `message` quotes a name (`"name"` or
+/// `'name'`) that appears on its line of `text`: the name's first column there.
+pub fn with_quoted_column(pos: Position, message: &str, text: &str) -> Position {
+    if pos.column.is_some() {
+        return pos;
+    }
+    let line = source_line(text, pos.line);
+    let column = ['"', '\'']
+        .iter()
+        .flat_map(|&q| message.split(q).skip(1).step_by(2))
+        .filter(|name| !name.is_empty() && !name.contains(char::is_whitespace))
+        .find_map(|name| line.find(name))
+        .map(|at| line[..at].chars().count() as u32 + 1);
+    Position { column, ..pos }
 }
 
 /// `0:3(5): error: ...` (Mesa GLSL).
@@ -144,6 +163,44 @@ mod tests {
                 column: None
             }
         );
+    }
+
+    #[test]
+    fn parses_nvidia_arb_message() {
+        assert_eq!(
+            from_message("line 4, column 1:  error: invalid statement"),
+            Some(Position {
+                line: 4,
+                column: Some(1)
+            })
+        );
+    }
+
+    #[test]
+    fn a_quoted_name_on_the_line_gives_the_column() {
+        let text = "void main() {\n    frag_color = v * undeclared_gain;\n}\n";
+        let pos =
+            from_message("0(2) : error C1503: undefined variable \"undeclared_gain\"").unwrap();
+        assert_eq!(pos.column, None);
+        let with = with_quoted_column(
+            pos,
+            "0(2) : error C1503: undefined variable \"undeclared_gain\"",
+            text,
+        );
+        assert_eq!(
+            with,
+            Position {
+                line: 2,
+                column: Some(22)
+            }
+        );
+        // A quoted name not on the line, or a column already known: unchanged.
+        assert_eq!(with_quoted_column(pos, "error: \"elsewhere\"", text), pos);
+        let known = Position {
+            line: 2,
+            column: Some(3),
+        };
+        assert_eq!(with_quoted_column(known, "\"v\"", text), known);
     }
 
     #[test]

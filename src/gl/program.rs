@@ -297,6 +297,7 @@ fn compile_arb(gpu: &Gpu, target: u32, text: &ProgramText) -> GlResult<u32> {
 }
 
 fn compile_error(text: &ProgramText, pos: position::Position, message: String) -> GlError {
+    let pos = position::with_quoted_column(pos, &message, &text.text);
     GlError::Compile(CompileError {
         program: text.name.to_string(),
         line: pos.line,
