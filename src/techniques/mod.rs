@@ -74,6 +74,18 @@ pub trait Renderer {
     fn pending(&self) -> bool {
         false
     }
+    /// The user is still at `camera` on an image of `size` (the viewer, once the camera
+    /// stops): a renderer whose data depend on the view (a COPC cloud's nodes) loads what
+    /// that view needs; true when it did (the picture must be drawn again).
+    fn settle(
+        &mut self,
+        gpu: &Gpu,
+        camera: &crate::camera::Camera,
+        size: [u32; 2],
+    ) -> GlResult<bool> {
+        let _ = (gpu, camera, size);
+        Ok(false)
+    }
     /// A line for the viewer about the last frame's CPU work (e.g. the sort time).
     fn status(&self) -> Option<String> {
         None

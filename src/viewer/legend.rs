@@ -407,7 +407,16 @@ pub fn class_name(code: i32) -> String {
         5 => "high vegetation",
         6 => "building",
         7 => "low point (noise)",
+        8 => "model key point",
         9 => "water",
+        10 => "rail",
+        11 => "road surface",
+        13 => "wire guard",
+        14 => "wire conductor",
+        15 => "transmission tower",
+        16 => "wire connector",
+        17 => "bridge deck",
+        18 => "high noise",
         _ => return format!("class {code}"),
     };
     format!("{code} {name}")
@@ -531,6 +540,7 @@ pub fn legends(
                     let entries = s
                         .classes
                         .iter()
+                        .filter(|c| !sp.hide_classes.contains(c))
                         .map(|&c| (rgb(class_colour(c)), class_name(c)))
                         .collect();
                     out.push(key("classes", entries, s.more[2]));

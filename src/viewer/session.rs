@@ -301,6 +301,15 @@ impl Running {
         if streaming && !interacting {
             self.volume.refine();
         }
+        // Still: a COPC cloud loads the nodes this view needs (synchronously: a loader
+        // thread is not there yet).
+        if !interacting
+            && self
+                .renderer
+                .settle(gpu, &self.scene.camera, self.scene.size)?
+        {
+            self.volume.refine();
+        }
         let pending = self.volume.update(
             gpu,
             self.renderer.as_mut(),

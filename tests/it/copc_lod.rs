@@ -254,3 +254,36 @@ fn the_lod_study_measures_each_budget_against_every_point() {
         "{csv}"
     );
 }
+
+/// The viewer's hook once the camera stops: a COPC renderer loads the nodes of the new
+/// view (and says so), and nothing when the view is the one it has.
+#[test]
+fn a_still_camera_loads_the_nodes_of_its_view() {
+    let dir = temp_dir("copc-lod-settle");
+    let scene_path = dir.join("copc.toml");
+    std::fs::write(
+        &scene_path,
+        format!(
+            "size = [800, 450]\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\" }} }}\ncolour = \"rgb\"\n",
+            data_file("points/simple_with_page.copc.laz").display()
+        ),
+    )
+    .unwrap();
+    let scene = arbvis::scene::Scene::load(&scene_path).unwrap();
+    let h = crate::common::headless(arbvis::gl::Backend::Egl);
+    let gpu = h.gpu();
+    let kind = scene.programs.resolve(gpu);
+    let mut r = arbvis::catalog::build(gpu, &scene.technique, &scene.settings(), kind).unwrap();
+    let before = r.status().unwrap();
+    assert!(!r.settle(gpu, &scene.camera, scene.size).unwrap());
+    let closer = camera(Projection::Perspective, 5.0, [0.2, 0.6, -0.1, 0.75]);
+    assert!(r.settle(gpu, &closer, scene.size).unwrap());
+    let after = r.status().unwrap();
+    assert_ne!(
+        before.lines().next(),
+        after.lines().next(),
+        "{before}\n{after}"
+    );
+    assert!(after.contains("outside the view"), "{after}");
+    assert!(!r.settle(gpu, &closer, scene.size).unwrap());
+}

@@ -166,12 +166,14 @@ pub fn from_cloud(
             }
         })
         .collect();
+    let classes = cloud.ints("classification");
     let visible: Vec<bool> = (0..n)
         .map(|i| {
             let hidden_layer = layers.is_some_and(|l| scene.hide_layers.contains(&l[i]));
+            let hidden_class = classes.is_some_and(|c| scene.hide_classes.contains(&c[i]));
             let undefined =
                 scene.hide_undefined && facies.is_some_and(|f| f[i] == UNDEFINED_FACIES);
-            !(hidden_layer || undefined)
+            !(hidden_layer || hidden_class || undefined)
         })
         .collect();
     let (normals, normal_fallbacks) = match normals {
@@ -189,9 +191,10 @@ pub fn from_cloud(
     })
 }
 
-/// LAS classification colours (ASPRS classes; others grey).
+/// LAS classification colours (ASPRS classes of LAS 1.4 table 17; others grey).
 pub fn class_colour(class: i32) -> [u8; 3] {
     match class {
+        1 => [200, 200, 200],
         2 => [166, 118, 29],
         3 => [161, 217, 155],
         4 => [65, 171, 93],
@@ -199,6 +202,11 @@ pub fn class_colour(class: i32) -> [u8; 3] {
         6 => [222, 45, 38],
         7 => [255, 0, 255],
         9 => [49, 130, 189],
+        10 => [120, 80, 140],
+        11 => [90, 90, 90],
+        13..=16 => [255, 200, 0],
+        17 => [140, 110, 180],
+        18 => [255, 120, 160],
         _ => [160, 160, 160],
     }
 }
@@ -380,6 +388,8 @@ mod tests {
         })
         .unwrap();
         let mut s = scene();
+        // A classification filter on a cloud without classes hides nothing.
+        s.hide_classes = vec![0, 1, 2];
         s.hide_layers = vec![0, 3];
         s.hide_undefined = true;
         s.faults_white = true;
@@ -438,5 +448,29 @@ mod tests {
         assert_eq!(toward, away, "a normal facing away is flipped");
         let grazing = lit(c, DVec3::X, DVec3::Z);
         assert!(grazing[0] < toward[0]);
+    }
+
+    /// `hide_classes` hides the points of those LAS classes and no others.
+    #[test]
+    fn hidden_classes_are_not_drawn() {
+        use crate::points::{CloudParts, Values};
+        let classes: Vec<i32> = (0..50).map(|i| [1, 2, 5, 7, 2][i % 5]).collect();
+        let cloud = PointCloud::from_parts(CloudParts {
+            positions: (0..50)
+                .map(|i| [i as f64, (i * 7 % 11) as f64, 0.5])
+                .collect(),
+            attributes: vec![("classification".into(), Values::Int(classes.clone()))],
+            rgb: None,
+            normals: None,
+        })
+        .unwrap();
+        let mut s = scene();
+        s.colour = ColourMode::Classification;
+        s.hide_classes = vec![2, 7];
+        let p = from_cloud(&cloud, &s, None).unwrap();
+        for (i, c) in classes.iter().enumerate() {
+            assert_eq!(p.visible[i], ![2, 7].contains(c), "point {i}, class {c}");
+        }
+        assert_eq!(p.colours[2], byte_colour(class_colour(5)));
     }
 }

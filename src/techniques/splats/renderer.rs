@@ -33,7 +33,7 @@ use super::tiles::{
     place_splats, point_colours, spatial_order, Binner, SpatialPoints, TooManyEntries,
     DEFAULT_MAX_ENTRIES,
 };
-use crate::camera::Projection;
+use crate::camera::{Camera, Projection};
 use crate::gl::{
     self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind, Surface,
 };
@@ -92,6 +92,8 @@ pub struct SplatsRenderer {
     /// The view a COPC cloud's nodes were chosen for, and what its cut holds.
     view: Option<CloudView>,
     cut: Option<String>,
+    /// The scene's point size (a COPC cut's splats may be drawn larger).
+    scene_point_size: f64,
     /// A COPC cut's points' sizes over the scene's (tiles only; empty: all 1).
     size_scales: Vec<f32>,
 }
@@ -153,6 +155,7 @@ impl SplatsRenderer {
         let mut r =
             SplatsRenderer::from_prepared(gpu, kind, fidelity, &sized, base, cloud, prepared)?;
         r.view = view;
+        r.scene_point_size = params.point_size;
         if let Some(l) = loaded {
             r.cut = Some(format!(
                 "{}; splats of point size {:.1} (the scene's {:.1}){}",
@@ -215,6 +218,7 @@ impl SplatsRenderer {
             last_bin: Duration::ZERO,
             view: None,
             cut: None,
+            scene_point_size: params.point_size,
             size_scales: Vec::new(),
         };
         r.install(gpu)?;
@@ -515,6 +519,7 @@ impl Renderer for SplatsRenderer {
             || new.property != p.property
             || new.faults_white != p.faults_white
             || new.hide_layers != p.hide_layers
+            || new.hide_classes != p.hide_classes
             || new.hide_undefined != p.hide_undefined
             || lit(new) != lit(p)
             || new.sort != p.sort
@@ -536,6 +541,29 @@ impl Renderer for SplatsRenderer {
 
     fn program_kind(&self) -> ProgramKind {
         self.program.kind()
+    }
+
+    fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> GlResult<bool> {
+        let view = CloudView::of(camera, size);
+        let same = self.view.is_some_and(|v| {
+            v.size == view.size && v.view_projection.abs_diff_eq(view.view_projection, 1e-12)
+        });
+        if self.cut.is_none() || same {
+            return Ok(false);
+        }
+        let params = SplatsScene {
+            point_size: self.scene_point_size,
+            ..self.params.clone()
+        };
+        *self = SplatsRenderer::new(
+            gpu,
+            self.kind,
+            self.fidelity,
+            &params,
+            &self.base.clone(),
+            Some(view),
+        )?;
+        Ok(true)
     }
 
     fn status(&self) -> Option<String> {

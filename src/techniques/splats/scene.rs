@@ -123,6 +123,9 @@ pub struct SplatsScene {
     /// Layer ids not drawn.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub hide_layers: Vec<i32>,
+    /// LAS classes (ASPRS codes: 2 ground, 5 high vegetation, 7 noise, ...) not drawn.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub hide_classes: Vec<i32>,
     /// Points of undefined facies (-999) not drawn.
     #[serde(default)]
     pub hide_undefined: bool,
