@@ -301,8 +301,8 @@ impl Running {
         if streaming && !interacting {
             self.volume.refine();
         }
-        // Still: a COPC cloud loads the nodes this view needs (synchronously: a loader
-        // thread is not there yet).
+        // Still: a COPC cloud loads the nodes this view needs on a thread, drawing the
+        // cut it has until they arrive.
         if !interacting
             && self
                 .renderer

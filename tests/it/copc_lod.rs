@@ -256,7 +256,8 @@ fn the_lod_study_measures_each_budget_against_every_point() {
 }
 
 /// The viewer's hook once the camera stops: a COPC renderer loads the nodes of the new
-/// view (and says so), and nothing when the view is the one it has.
+/// view on a thread, keeps drawing the old cut until they arrive (pending), then says
+/// so; nothing when the view is the one it has.
 #[test]
 fn a_still_camera_loads_the_nodes_of_its_view() {
     let dir = temp_dir("copc-lod-settle");
@@ -277,7 +278,16 @@ fn a_still_camera_loads_the_nodes_of_its_view() {
     let before = r.status().unwrap();
     assert!(!r.settle(gpu, &scene.camera, scene.size).unwrap());
     let closer = camera(Projection::Perspective, 5.0, [0.2, 0.6, -0.1, 0.75]);
-    assert!(r.settle(gpu, &closer, scene.size).unwrap());
+    // The cut is loaded on a thread: the drawn one stays (pending) until it arrives.
+    assert!(!r.settle(gpu, &closer, scene.size).unwrap());
+    assert!(r.pending());
+    assert_eq!(r.status().unwrap(), before);
+    let start = std::time::Instant::now();
+    while !r.settle(gpu, &closer, scene.size).unwrap() {
+        assert!(start.elapsed().as_secs() < 30, "the cut never arrived");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(!r.pending());
     let after = r.status().unwrap();
     assert_ne!(
         before.lines().next(),

@@ -94,6 +94,8 @@ pub struct SplatsRenderer {
     cut: Option<String>,
     /// The scene's point size (a COPC cut's splats may be drawn larger).
     scene_point_size: f64,
+    /// The cut of the view the camera stopped at, being loaded.
+    loading: Option<Loading>,
     /// A COPC cut's points' sizes over the scene's (tiles only; empty: all 1).
     size_scales: Vec<f32>,
 }
@@ -131,6 +133,19 @@ fn view_bits(view: View) -> [u64; 4] {
     }
 }
 
+/// What [`prepare_for`] makes: the cloud, its preparation and a COPC cut's account.
+type Prepared3 = (
+    PointCloud,
+    Prepared,
+    Option<crate::points::copc_lod::Loaded>,
+);
+
+/// A COPC cut being loaded on a thread for a view.
+struct Loading {
+    view: CloudView,
+    result: std::sync::mpsc::Receiver<Result<Prepared3, String>>,
+}
+
 impl SplatsRenderer {
     /// Load and prepare the scene's cloud (relative paths from `base`), then upload;
     /// programs of `kind`.
@@ -145,8 +160,20 @@ impl SplatsRenderer {
         params
             .validate()
             .map_err(|e| GlError::Data(e.to_string()))?;
-        let (cloud, prepared, loaded) =
-            prepare_for(params, base, view.as_ref()).map_err(GlError::Data)?;
+        let loaded = prepare_for(params, base, view.as_ref()).map_err(GlError::Data)?;
+        SplatsRenderer::upload(gpu, kind, fidelity, params, base, view, loaded)
+    }
+
+    /// Upload what [`prepare_for`] made for `view`.
+    fn upload(
+        gpu: &Gpu,
+        kind: ProgramKind,
+        fidelity: Fidelity,
+        params: &SplatsScene,
+        base: &Path,
+        view: Option<CloudView>,
+        (cloud, prepared, loaded): Prepared3,
+    ) -> GlResult<SplatsRenderer> {
         // A COPC cut's splats cover its deepest level's spacing.
         let mut sized = params.clone();
         if let (Some(l), Some(v)) = (&loaded, &view) {
@@ -219,6 +246,7 @@ impl SplatsRenderer {
             view: None,
             cut: None,
             scene_point_size: params.point_size,
+            loading: None,
             size_scales: Vec::new(),
         };
         r.install(gpu)?;
@@ -544,26 +572,57 @@ impl Renderer for SplatsRenderer {
     }
 
     fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> GlResult<bool> {
-        let view = CloudView::of(camera, size);
-        let same = self.view.is_some_and(|v| {
-            v.size == view.size && v.view_projection.abs_diff_eq(view.view_projection, 1e-12)
-        });
-        if self.cut.is_none() || same {
+        if self.cut.is_none() {
             return Ok(false);
         }
+        let view = CloudView::of(camera, size);
+        let same = |v: &CloudView| {
+            v.size == view.size && v.view_projection.abs_diff_eq(view.view_projection, 1e-12)
+        };
         let params = SplatsScene {
             point_size: self.scene_point_size,
             ..self.params.clone()
         };
-        *self = SplatsRenderer::new(
-            gpu,
-            self.kind,
-            self.fidelity,
-            &params,
-            &self.base.clone(),
-            Some(view),
-        )?;
-        Ok(true)
+        // A cut that has arrived replaces the drawn one.
+        if let Some(loading) = &self.loading {
+            match loading.result.try_recv() {
+                Ok(result) => {
+                    let view = loading.view;
+                    self.loading = None;
+                    let loaded = result.map_err(GlError::Data)?;
+                    let base = self.base.clone();
+                    *self = SplatsRenderer::upload(
+                        gpu,
+                        self.kind,
+                        self.fidelity,
+                        &params,
+                        &base,
+                        Some(view),
+                        loaded,
+                    )?;
+                    return Ok(true);
+                }
+                Err(std::sync::mpsc::TryRecvError::Empty) if same(&loading.view) => {
+                    return Ok(false)
+                }
+                Err(_) => self.loading = None,
+            }
+        }
+        if self.view.as_ref().is_some_and(same) {
+            return Ok(false);
+        }
+        // Load the new view's cut on a thread; the drawn one stays until it arrives.
+        let (send, result) = std::sync::mpsc::channel();
+        let base = self.base.clone();
+        std::thread::spawn(move || {
+            let _ = send.send(prepare_for(&params, &base, Some(&view)));
+        });
+        self.loading = Some(Loading { view, result });
+        Ok(false)
+    }
+
+    fn pending(&self) -> bool {
+        self.loading.is_some()
     }
 
     fn status(&self) -> Option<String> {
