@@ -110,22 +110,25 @@ pub fn build(
         TechniqueScene::Opacity3d(params) => params,
         TechniqueScene::Splats(params) => {
             // Prepared here (as `SplatsRenderer::new` would) to keep the cloud's key.
+            // A COPC cloud's nodes are chosen for the first view, and again whenever
+            // the camera stops (`Renderer::settle`).
             params.validate().map_err(|e| data_error(e.to_string()))?;
-            let (cloud, prepared) =
-                crate::techniques::splats::prepare::prepare(params, &scene.base)
+            let view = crate::points::copc_lod::View::of(&scene.camera, scene.size);
+            let loaded =
+                crate::techniques::splats::prepare::prepare_for(params, &scene.base, Some(&view))
                     .map_err(data_error)?;
             data.cloud = Some(CloudSummary::of(
-                &cloud,
+                &loaded.0,
                 &cloud_units(&params.cloud, &scene.base),
             ));
-            return Ok(Box::new(SplatsRenderer::from_prepared(
+            return Ok(Box::new(SplatsRenderer::upload(
                 gpu,
                 kind,
                 scene.fidelity,
                 params,
                 &scene.base,
-                cloud,
-                prepared,
+                Some(view),
+                loaded,
             )?));
         }
         TechniqueScene::Cellproj(params) => {

@@ -92,8 +92,10 @@ pub struct SplatsRenderer {
     /// The view a COPC cloud's nodes were chosen for, and what its cut holds.
     view: Option<CloudView>,
     cut: Option<String>,
-    /// The scene's point size (a COPC cut's splats may be drawn larger).
+    /// The scene's point size (a COPC cut's splats may be drawn larger), and the cut's
+    /// deepest spacing that sizes them.
     scene_point_size: f64,
+    spacing: Option<f64>,
     /// The cut of the view the camera stopped at, being loaded.
     loading: Option<Loading>,
     /// A COPC cut's points' sizes over the scene's (tiles only; empty: all 1).
@@ -164,8 +166,9 @@ impl SplatsRenderer {
         SplatsRenderer::upload(gpu, kind, fidelity, params, base, view, loaded)
     }
 
-    /// Upload what [`prepare_for`] made for `view`.
-    fn upload(
+    /// Upload what [`prepare_for`] made for `view` (the viewer prepares it itself to keep
+    /// the cloud's summary).
+    pub fn upload(
         gpu: &Gpu,
         kind: ProgramKind,
         fidelity: Fidelity,
@@ -183,6 +186,7 @@ impl SplatsRenderer {
             SplatsRenderer::from_prepared(gpu, kind, fidelity, &sized, base, cloud, prepared)?;
         r.view = view;
         r.scene_point_size = params.point_size;
+        r.spacing = loaded.as_ref().map(|l| l.spacing);
         if let Some(l) = loaded {
             r.cut = Some(format!(
                 "{}; splats of point size {:.1} (the scene's {:.1}){}",
@@ -246,6 +250,7 @@ impl SplatsRenderer {
             view: None,
             cut: None,
             scene_point_size: params.point_size,
+            spacing: None,
             loading: None,
             size_scales: Vec::new(),
         };
@@ -523,10 +528,20 @@ impl Renderer for SplatsRenderer {
     }
 
     fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
-        let new = params.get::<SplatsScene>()?;
-        new.validate().map_err(|e| GlError::Data(e.to_string()))?;
-        new.draw_allowed(self.fidelity, crate::gl::ProgramChoice::Auto)
+        let asked = params.get::<SplatsScene>()?;
+        asked.validate().map_err(|e| GlError::Data(e.to_string()))?;
+        asked
+            .draw_allowed(self.fidelity, crate::gl::ProgramChoice::Auto)
             .map_err(|e| GlError::Data(e.to_string()))?;
+        // A COPC cut keeps its splats sized from its spacing over the scene's size.
+        let mut sized = asked.clone();
+        if let (Some(v), Some(spacing)) = (&self.view, self.spacing) {
+            if asked.cloud == self.params.cloud {
+                self.scene_point_size = asked.point_size;
+                sized.point_size = point_size_for_spacing(asked, v, spacing);
+            }
+        }
+        let new = &sized;
         let p = &self.params;
         if new.cloud != p.cloud {
             *self = SplatsRenderer::new(
