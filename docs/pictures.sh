@@ -26,3 +26,8 @@ if [ -f target/meshes/bluntfin.vtk ] && [ -f target/meshes/oxygen-post.vtk ]; th
     -o "$out/nasa-bluntfin-volume-faithful.png"
   "$arbvis" render scenes/meshes/oxygen-post-volume.toml -o "$out/nasa-oxygen-post-volume.png"
 fi
+# The outcrop cloud of the COPC bench (benches/points/copc.sh DIR writes DIR/outcrop.toml
+# over 200 million points): OUTCROP=DIR bash docs/pictures.sh.
+if [ -n "${OUTCROP:-}" ] && [ -f "$OUTCROP/outcrop.toml" ]; then
+  "$arbvis" render "$OUTCROP/outcrop.toml" --size 1200x675 -o "$out/outcrop-copc.png"
+fi

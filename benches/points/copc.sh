@@ -37,6 +37,6 @@ for draw in tiles points; do
   sed "s|^sort = .*|sort = \"radix\"\ndraw = \"$draw\"|; s|^fidelity = .*|fidelity = \"precise\"|" \
     "$root/scenes/bench/splats-section-study.toml" >"$dir/section-$draw.toml"
   echo "## turning, $draw: the outcrop's 1 M points, then the section's 570,000"
-  "$bin" bench "$dir/outcrop-$draw.toml" --turn 1 --frames 5 --rounds 3 | grep -iE "ms|frame"
-  "$bin" bench "$dir/section-$draw.toml" --turn 1 --frames 5 --rounds 3 | grep -iE "ms|frame"
+  "$bin" bench "$dir/outcrop-$draw.toml" --turn 1 --frames 5 --rounds 3 | grep -iE "ms|frame|splats"
+  "$bin" bench "$dir/section-$draw.toml" --turn 1 --frames 5 --rounds 3 | grep -iE "ms|frame|splats"
 done
