@@ -104,6 +104,12 @@ pub const SPLATS_OIT_COMPOSITE_FRAG: ProgramText = program!("splats/oit_composit
 /// Splats composited per pixel from tile lists (GLSL only: ARB fragment programs have
 /// no loops), over the common transform.
 pub const SPLATS_TILES_FRAG: ProgramText = program!("splats/tiles.frag");
+/// Eye-dome lighting: the depth pass (vertex and fragment) and the shading pass.
+pub const SPLATS_EDL_DEPTH_VERT: ProgramText = program!("splats/edl_depth.vert");
+/// See [`SPLATS_EDL_DEPTH_VERT`].
+pub const SPLATS_EDL_DEPTH_FRAG: ProgramText = program!("splats/edl_depth.frag");
+/// See [`SPLATS_EDL_DEPTH_VERT`].
+pub const SPLATS_EDL_FRAG: ProgramText = program!("splats/edl.frag");
 
 /// A vertex + fragment pair of one kind.
 #[derive(Debug, Clone)]
@@ -201,6 +207,9 @@ pub fn all_texts() -> Vec<ProgramText> {
         SPLATS_OIT_COMPOSITE_ARBFP,
         SPLATS_OIT_COMPOSITE_FRAG,
         SPLATS_TILES_FRAG,
+        SPLATS_EDL_DEPTH_VERT,
+        SPLATS_EDL_DEPTH_FRAG,
+        SPLATS_EDL_FRAG,
         CLIP_SINGLE_ARBFP,
         CLIP_MULTIRES_SLOT_CENTRE_ARBFP,
         CLIP_MULTIRES_OFFSET_ARBFP,

@@ -30,6 +30,8 @@ pub enum Blend {
     /// Product of transmittances: `ZERO, ONE_MINUS_SRC_ALPHA` on every channel (weighted
     /// blended transparency's revealage).
     Reveal,
+    /// Product of colours: `ZERO, SRC_COLOR` (a shade laid over a picture).
+    Multiply,
 }
 
 /// What the vertices make.
@@ -171,6 +173,11 @@ pub fn draw(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<()
                 gl.enable(glow::BLEND);
                 gl.blend_equation(glow::FUNC_ADD);
                 gl.blend_func(glow::ZERO, glow::ONE_MINUS_SRC_ALPHA);
+            }
+            Blend::Multiply => {
+                gl.enable(glow::BLEND);
+                gl.blend_equation(glow::FUNC_ADD);
+                gl.blend_func(glow::ZERO, glow::SRC_COLOR);
             }
         }
         let points = call.primitive == Primitive::Points;

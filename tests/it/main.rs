@@ -27,6 +27,7 @@ mod pictures;
 mod programs;
 mod quad;
 mod splats;
+mod splats_edl;
 mod splats_tiles;
 mod store;
 mod store_hostile;

@@ -35,6 +35,7 @@
 //! (Gaussian) at the splat centre and largest on the rim, the reverse of the splats it
 //! describes; [`reference`](mod@reference)'s doc gives the details and the precise versions.
 
+pub mod edl;
 pub mod normals;
 pub mod oit;
 pub mod prepare;

@@ -20,6 +20,7 @@
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
+use super::edl::{EdlPass, EdlView};
 use super::oit::{z_row, OitPass};
 use super::prepare::{
     from_cloud, normals_for, point_size_for_spacing, prepare_for, Prepared, COLOR_A, COLOR_B,
@@ -98,6 +99,8 @@ pub struct SplatsRenderer {
     spacing: Option<f64>,
     /// The cut of the view the camera stopped at, being loaded.
     loading: Option<Loading>,
+    /// Eye-dome lighting's depth target and programs, made at the first frame's size.
+    edl: Option<EdlPass>,
     /// A COPC cut's points' sizes over the scene's (tiles only; empty: all 1).
     size_scales: Vec<f32>,
 }
@@ -252,10 +255,73 @@ impl SplatsRenderer {
             scene_point_size: params.point_size,
             spacing: None,
             loading: None,
+            edl: None,
             size_scales: Vec::new(),
         };
         r.install(gpu)?;
         Ok(r)
+    }
+
+    /// The splats of one frame (tiles, points or OIT), without eye-dome lighting.
+    fn draw_splats(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+        if self.tiles.is_some() && self.prepare_tiles(gpu, frame)? {
+            if let Some(state) = &self.tiles {
+                let gaussian = if self.params.kernel == Kernel::Gaussian {
+                    1.0
+                } else {
+                    0.0
+                };
+                return state
+                    .pass
+                    .draw(gpu, surface, [gaussian, self.params.gauss_width]);
+            }
+        }
+        // Points (also a tiles frame past the bound on list entries).
+        let camera = &frame.camera;
+        let view = View::of_camera(camera);
+        self.order(gpu, view)?;
+        self.program
+            .set_transform(gpu, camera.view_projection(frame.aspect()))?;
+        let inverse = camera.view().inverse();
+        let eye = inverse.transform_point3(glam::DVec3::ZERO);
+        let dir = inverse.transform_vector3(glam::DVec3::NEG_Z).normalize();
+        let perspective = if camera.projection == Projection::Perspective {
+            1.0
+        } else {
+            0.0
+        };
+        self.program
+            .set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, perspective])?;
+        self.program
+            .set_vertex_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
+        self.program
+            .set_vertex_local(gpu, 8, z_row(camera).to_array())?;
+        // The viewport in window coordinates (the precise programs' splat positions):
+        // OIT draws into its own targets, whose corner is the origin.
+        let viewport = match surface {
+            Surface::Window(v) if self.params.sort != SortChoice::Oit => v.map(f64::from),
+            _ => [0.0, 0.0, frame.width as f64, frame.height as f64],
+        };
+        self.program.set_vertex_local(gpu, 9, viewport)?;
+        if self.params.sort == SortChoice::Oit {
+            let (w, h) = (frame.width, frame.height);
+            if !self.oit.as_ref().is_some_and(|o| o.fits(w, h)) {
+                self.oit = None;
+                self.oit = Some(OitPass::new(gpu, self.kind, w, h)?);
+            }
+            if let Some(oit) = &self.oit {
+                return oit.draw(gpu, &self.program, &self.mesh, surface);
+            }
+        }
+        gl::draw(
+            gpu,
+            surface,
+            &DrawCall {
+                blend: Blend::Over,
+                primitive: Primitive::Points,
+                ..DrawCall::new(&self.program, &self.mesh)
+            },
+        )
     }
 
     /// The frame's line: points drawn, sort or tiles.
@@ -467,66 +533,29 @@ impl SplatsRenderer {
 
 impl Renderer for SplatsRenderer {
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
-        if self.tiles.is_some() && self.prepare_tiles(gpu, frame)? {
-            if let Some(state) = &self.tiles {
-                let gaussian = if self.params.kernel == Kernel::Gaussian {
-                    1.0
-                } else {
-                    0.0
-                };
-                return state
-                    .pass
-                    .draw(gpu, surface, [gaussian, self.params.gauss_width]);
-            }
-        }
-        // Points (also a tiles frame past the bound on list entries).
-        let camera = &frame.camera;
-        let view = View::of_camera(camera);
-        self.order(gpu, view)?;
-        self.program
-            .set_transform(gpu, camera.view_projection(frame.aspect()))?;
-        let inverse = camera.view().inverse();
-        let eye = inverse.transform_point3(glam::DVec3::ZERO);
-        let dir = inverse.transform_vector3(glam::DVec3::NEG_Z).normalize();
-        let perspective = if camera.projection == Projection::Perspective {
-            1.0
-        } else {
-            0.0
-        };
-        self.program
-            .set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, perspective])?;
-        self.program
-            .set_vertex_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
-        self.program
-            .set_vertex_local(gpu, 8, z_row(camera).to_array())?;
-        // The viewport in window coordinates (the precise programs' splat positions):
-        // OIT draws into its own targets, whose corner is the origin.
-        let viewport = match surface {
-            Surface::Window(v) if self.params.sort != SortChoice::Oit => v.map(f64::from),
-            _ => [0.0, 0.0, frame.width as f64, frame.height as f64],
-        };
-        self.program.set_vertex_local(gpu, 9, viewport)?;
-        if self.params.sort == SortChoice::Oit {
+        self.draw_splats(gpu, surface, frame)?;
+        if self.params.edl > 0.0 {
             let (w, h) = (frame.width, frame.height);
-            if !self.oit.as_ref().is_some_and(|o| o.fits(w, h)) {
-                self.oit = None;
-                self.oit = Some(OitPass::new(gpu, self.kind, w, h)?);
+            if !self.edl.as_ref().is_some_and(|e| e.fits(w, h)) {
+                self.edl = None;
+                self.edl = Some(EdlPass::new(gpu, w, h)?);
             }
-            if let Some(oit) = &self.oit {
-                return oit.draw(gpu, &self.program, &self.mesh, surface);
+            let camera = &frame.camera;
+            let eye = camera.view().inverse().transform_point3(glam::DVec3::ZERO);
+            let perspective = f64::from(u8::from(camera.projection == Projection::Perspective));
+            let view = EdlView {
+                transform: camera.view_projection(frame.aspect()),
+                eye: eye.extend(perspective),
+                z_row: z_row(camera),
+                size: [self.params.point_size, self.params.factor],
+                size_range: self.splat_params().size_range,
+            };
+            if let Some(edl) = &self.edl {
+                edl.draw(gpu, &self.mesh, &view, self.params.edl, surface)?;
             }
         }
-        gl::draw(
-            gpu,
-            surface,
-            &DrawCall {
-                blend: Blend::Over,
-                primitive: Primitive::Points,
-                ..DrawCall::new(&self.program, &self.mesh)
-            },
-        )
+        Ok(())
     }
-
     fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
         let asked = params.get::<SplatsScene>()?;
         asked.validate().map_err(|e| GlError::Data(e.to_string()))?;

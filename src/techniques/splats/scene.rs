@@ -123,6 +123,10 @@ pub struct SplatsScene {
     /// Layer ids not drawn.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub hide_layers: Vec<i32>,
+    /// Eye-dome lighting's strength (precise, GLSL; 0: off; CloudCompare's and Potree's
+    /// shading for clouds without normals, about 1).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub edl: f64,
     /// LAS classes (ASPRS codes: 2 ground, 5 high vegetation, 7 noise, ...) not drawn.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub hide_classes: Vec<i32>,
@@ -237,6 +241,13 @@ impl SplatsScene {
         fidelity: Fidelity,
         programs: ProgramChoice,
     ) -> Result<(), FieldError> {
+        if self.edl > 0.0 && (fidelity == Fidelity::Faithful || programs == ProgramChoice::Arb) {
+            return Err(FieldError::new(
+                "edl",
+                "eye-dome lighting is a precise shading in GLSL: use fidelity = \"precise\" \
+                 and programs = \"glsl\" or \"auto\", or edl = 0",
+            ));
+        }
         if self.draw != DrawChoice::Tiles {
             return Ok(());
         }
@@ -271,6 +282,12 @@ impl SplatsScene {
         };
         positive("point_size", self.point_size, MAX_POINT_SIZE)?;
         positive("factor", self.factor, 1e6)?;
+        if !(self.edl.is_finite() && (0.0..=100.0).contains(&self.edl)) {
+            return Err(FieldError::new(
+                "edl",
+                format!("{}: must be 0 (off) to 100", self.edl),
+            ));
+        }
         if !(self.gauss_width.is_finite() && self.gauss_width >= 0.0) {
             return Err(FieldError::new(
                 "gauss_width",
@@ -307,4 +324,8 @@ impl SplatsScene {
         }
         Ok(())
     }
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
