@@ -79,7 +79,7 @@ fn eye_dome_lighting_darkens_what_lies_behind_an_edge_only() {
         // The darkened pixels: a band a few pixels wide beside the edge, on the far
         // plane; everything else (flat planes, background) exactly as without it.
         assert!(
-            darker >= 80 && darker <= 80 * 6,
+            (80..=80 * 6).contains(&darker),
             "{draw}: {darker} darker, {same} same"
         );
         assert_eq!(darker_near, 0, "{draw}");
