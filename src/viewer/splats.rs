@@ -1,6 +1,6 @@
 //! The splat editor: layers shown or hidden, colour mode, faults and undefined facies,
 //! point size and factor, kernel and its width, lighting (per-layer normals), sort
-//! method, points or tiles (precise only) and the tile size, and volume mode's transfer
+//! method, points or tiles (precise only), the tile size and eye-dome lighting, and volume mode's transfer
 //! function. The frame, sort and tile-list times show in the panel's status line.
 
 use super::widgets::Widgets;
@@ -144,6 +144,14 @@ pub fn editor(
             }
         });
         changed |= w.slider(ui, "Tile size", &mut scene.tile, 1..=16, "tile (px)", false);
+        changed |= w.slider(
+            ui,
+            "Eye-dome lighting",
+            &mut scene.edl,
+            0.0..=5.0,
+            "eye-dome",
+            false,
+        );
     });
     ui.separator();
     let mut volume = scene.mode == Mode::Volume;
