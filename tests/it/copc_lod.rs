@@ -19,6 +19,21 @@ fn copc() -> Copc {
     Copc::open(&data_file("points/simple_with_page.copc.laz")).unwrap()
 }
 
+/// A scene file over `simple_with_page.copc.laz`: `head` (size, fidelity, camera lines)
+/// then `[technique.splats]` with its cloud and `keys`.
+fn copc_scene_file(name: &str, head: &str, keys: &str) -> std::path::PathBuf {
+    let path = temp_dir(name).join("copc.toml");
+    std::fs::write(
+        &path,
+        format!(
+            "{head}[technique.splats]\ncloud = {{ copc = {{ path = \"{}\" }} }}\ncolour = \"rgb\"\n{keys}",
+            data_file("points/simple_with_page.copc.laz").display()
+        ),
+    )
+    .unwrap();
+    path
+}
+
 fn camera(projection: Projection, zoom: f64, rotation: [f64; 4]) -> Camera {
     let q = glam::DQuat::from_array(rotation).normalize();
     Camera {
@@ -152,16 +167,12 @@ fn a_zoomed_rotated_perspective_culls_what_it_cannot_see() {
 
 #[test]
 fn render_draws_the_cut_and_stats_say_what_it_holds() {
-    let dir = temp_dir("copc-lod-render");
-    let scene = dir.join("copc.toml");
-    std::fs::write(
-        &scene,
-        format!(
-            "size = [320, 180]\n[camera]\nrotation = [0.2, 0.6, -0.1, 0.75]\nprojection = \"perspective\"\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\" }} }}\ncolour = \"rgb\"\n",
-            data_file("points/simple_with_page.copc.laz").display()
-        ),
-    )
-    .unwrap();
+    let scene = copc_scene_file(
+        "copc-lod-render",
+        "size = [320, 180]\n[camera]\nrotation = [0.2, 0.6, -0.1, 0.75]\nprojection = \"perspective\"\n",
+        "",
+    );
+    let dir = scene.parent().unwrap().to_path_buf();
     let out = dir.join("copc.png");
     let said = stdout_of(
         Command::new(env!("CARGO_BIN_EXE_arbvis"))
@@ -224,16 +235,11 @@ fn coarse_points_stand_in_for_their_missing_children() {
 /// finest but one.
 #[test]
 fn the_lod_study_measures_each_budget_against_every_point() {
-    let dir = temp_dir("copc-lod-study");
-    let scene_path = dir.join("copc.toml");
-    std::fs::write(
-        &scene_path,
-        format!(
-            "size = [160, 90]\nfidelity = \"precise\"\n[camera]\nrotation = [0.2, 0.6, -0.1, 0.75]\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\" }} }}\ncolour = \"rgb\"\ndraw = \"tiles\"\n",
-            data_file("points/simple_with_page.copc.laz").display()
-        ),
-    )
-    .unwrap();
+    let scene_path = copc_scene_file(
+        "copc-lod-study",
+        "size = [160, 90]\nfidelity = \"precise\"\n[camera]\nrotation = [0.2, 0.6, -0.1, 0.75]\n",
+        "draw = \"tiles\"\n",
+    );
     let scene = arbvis::scene::Scene::load(&scene_path).unwrap();
     let h = crate::common::headless(arbvis::gl::Backend::Egl);
     let rows = arbvis::techniques::splats::study::lod::lod(&h, &scene, &[24, 300, 1065], 1, |_| {})
@@ -260,16 +266,7 @@ fn the_lod_study_measures_each_budget_against_every_point() {
 /// so; nothing when the view is the one it has.
 #[test]
 fn a_still_camera_loads_the_nodes_of_its_view() {
-    let dir = temp_dir("copc-lod-settle");
-    let scene_path = dir.join("copc.toml");
-    std::fs::write(
-        &scene_path,
-        format!(
-            "size = [800, 450]\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\" }} }}\ncolour = \"rgb\"\n",
-            data_file("points/simple_with_page.copc.laz").display()
-        ),
-    )
-    .unwrap();
+    let scene_path = copc_scene_file("copc-lod-settle", "size = [800, 450]\n", "");
     let scene = arbvis::scene::Scene::load(&scene_path).unwrap();
     let h = crate::common::headless(arbvis::gl::Backend::Egl);
     let gpu = h.gpu();
