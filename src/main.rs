@@ -141,6 +141,11 @@ enum Command {
     /// RMSE against the f64 reference in exact order (splats-frames.csv, splats.png: RMSE
     /// against ms). About 2 minutes.
     ///
+    /// --technique splats-lod: a COPC scene (--scenes SCENE): for each of --budgets, the
+    /// nodes the budget allows for the scene's view, drawn and scored by RGB RMSE against
+    /// the picture of every point, and timed with the camera turning 1° a frame
+    /// (splats-lod.csv, splats-lod.png: RMSE against ms). About 35 s on a 20 M-point cloud.
+    ///
     /// --from RUN.json...: instead of sweeping, the trade against VTK from runs of the
     /// peer script made on this machine (pip install vtk numpy; cargo build --release
     /// --no-default-features; then e.g. `python3 benches/peers/vtk_volume.py
@@ -234,13 +239,14 @@ enum Command {
         /// Bytes to skip at the start of a raw input.
         #[arg(long, default_value_t = 0)]
         raw_offset: u64,
-        /// COPC: most points in a leaf node.
-        #[arg(long, default_value_t = 100_000)]
-        node_points: usize,
+        /// COPC: a node whose subtree holds more points is sampled at its level's spacing
+        /// (one point per cell of 128³) and the rest pushed down to its children.
+        #[arg(long, default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1..))]
+        node_points: u64,
         /// COPC: most points built in memory at once (default: a quarter of the memory
         /// budget, at most 8 Mi points); larger clouds go through spill files beside the
         /// output.
-        #[arg(long)]
+        #[arg(long, value_parser = clap::value_parser!(u64).range(10_000..))]
         memory_points: Option<u64>,
     },
     /// Open the desktop viewer (winit + glutin + egui).
@@ -681,7 +687,7 @@ fn run(cli: Cli) -> Result<()> {
                     &input,
                     out,
                     &arbvis::points::copc_write::CopcWriteOptions {
-                        node_points,
+                        node_points: node_points as usize,
                         memory_points,
                         ..Default::default()
                     },

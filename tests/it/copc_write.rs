@@ -4,7 +4,8 @@
 //! attribute equal to the input's; built in memory and through spill files; every point
 //! inside its node's cube (what a reader's spatial query relies on); seed `.dat` and PLY
 //! attributes as extra bytes; one point, equal points, coordinates near ±1e9, wrong
-//! header bounds; bad input refused with nothing left behind.
+//! header bounds; bad input (short, empty, a zero scale, a LAS 1.4 legacy count that
+//! disagrees) refused naming the byte, with nothing left behind.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -376,7 +377,7 @@ fn edge_clouds_one_point_equal_points_far_coordinates_wrong_bounds() {
         let stderr = String::from_utf8_lossy(&run.stderr);
         assert!(run.status.success(), "{name}: {stderr}");
         assert_eq!(
-            stderr.contains("outside the header's bounds"),
+            stderr.contains("not the header's"),
             name == "wrong-bounds",
             "{name}: {stderr}"
         );
@@ -411,9 +412,20 @@ fn bad_clouds_are_refused_leaving_nothing_behind() {
     std::fs::write(&input, &bytes[..bytes.len() - 100]).unwrap();
     let empty = dir.join("empty.las");
     write_las(&empty, &[], 0.01, [0.0; 3], [[0.0; 3], [0.0; 3]]);
+    // Scales of 0 and below (an octree's cube would be inverted or empty).
+    let flat = dir.join("flat.las");
+    write_las(&flat, &[[1, 2, 3]; 10], 0.0, [0.0; 3], [[0.0; 3], [1.0; 3]]);
+    // LAS 1.4 whose legacy 32-bit count disagrees with its 64-bit count (laspy's COPC
+    // file, 1,065 points, the legacy field set to 41): taking either would lose points.
+    let mut b = std::fs::read(data_file("points/simple.copc.laz")).unwrap();
+    b[107..111].copy_from_slice(&41u32.to_le_bytes());
+    let legacy = dir.join("legacy.las");
+    std::fs::write(&legacy, &b).unwrap();
     for (file, says) in [
         (&input, "the header declares 100 points of 28 bytes, but the 2700 bytes after the point offset hold only 96"),
         (&empty, "no points"),
+        (&flat, "at byte 131: x scale 0: a COPC file needs a positive scale"),
+        (&legacy, "at byte 107: the legacy point count 41 disagrees with LAS 1.4's 64-bit count 1065 at byte 247"),
     ] {
         let out = dir.join("out.copc.laz");
         let run = Command::new(env!("CARGO_BIN_EXE_arbvis"))

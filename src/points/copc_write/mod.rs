@@ -34,7 +34,9 @@ use octree::{Cube, Limits};
 /// How the octree is built.
 #[derive(Debug, Clone)]
 pub struct CopcWriteOptions {
-    /// Most points a leaf holds (PDAL's and Untwine's order of magnitude).
+    /// A node whose subtree holds more points than this keeps one point per cell of its
+    /// level's grid and pushes the rest down (so a node may hold more: one per occupied
+    /// cell); PDAL's and Untwine's order of magnitude.
     pub node_points: usize,
     /// Most points built in memory at once; `None`: a quarter of the memory budget, at
     /// most 8 Mi points.
@@ -104,34 +106,46 @@ pub fn write_copc(
     };
     let grid = options.grid.clamp(2, 1 << 12);
     let spilled = source.count > limits.memory_points;
+    let valid = |b: &[[f64; 3]; 2]| {
+        (0..3).all(|a| b[0][a].is_finite() && b[1][a].is_finite() && b[0][a] <= b[1][a])
+    };
     let mut bounds = source.bounds;
+    if !valid(&bounds) {
+        bounds = scan_bounds(&mut source)?;
+    }
     for attempt in 0..2 {
-        let cube = cube_around(&bounds, &source, grid);
+        let cube =
+            cube_around(&bounds, &source, grid).map_err(|m| PointsError::format(input, 179, m))?;
         let mut out = file::CopcFile::create(output, &source, &cube)?;
         let bar = crate::progress::Bar::new(
             source.count,
             &format!("writing {}", output.display()),
             crate::progress::Unit::Points,
         );
-        let mut seen = [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]];
         let spill = out.spill_dir().to_path_buf();
         let count = source.count;
-        {
+        // A point outside the cube (the header's bounds were wrong) stops the pass: the
+        // octree is built again around the points' own bounds.
+        let mut outside = false;
+        let built = {
             let src = &mut source;
             let mut next = |buf: &mut Vec<u8>| -> Result<u64, PointsError> {
                 let at = buf.len();
                 let n = src.next(buf)?;
                 for r in buf[at..].chunks_exact(src.record) {
-                    let q = records::xyz(r);
-                    for a in 0..3 {
-                        let v = q[a] as f64 * src.scale[a] + src.offset[a];
-                        seen[0][a] = seen[0][a].min(v);
-                        seen[1][a] = seen[1][a].max(v);
+                    let u = cube.unit(r);
+                    if u.iter().any(|c| !(0.0..=1.0).contains(c)) {
+                        outside = true;
+                        return Err(PointsError::unsupported(
+                            input,
+                            "a point outside the header's bounds",
+                        ));
                     }
                 }
                 Ok(n)
             };
             let tree = octree::Tree {
+                input,
                 cube: &cube,
                 limits: &limits,
                 spill: &spill,
@@ -143,19 +157,30 @@ pub fn write_copc(
                 &mut next,
                 &mut |key, records| out.add(key, records),
                 &|n| bar.inc(n),
-            )?;
-        }
+            )
+        };
         drop(bar);
-        let inside =
-            (0..3).all(|a| seen[0][a] >= cube.min[a] && seen[1][a] <= cube.min[a] + cube.side);
-        if !inside && attempt == 0 {
-            crate::progress::line(&format!(
-                "{}: points lie outside the header's bounds; building the octree again around the points' own",
-                input.display()
-            ));
-            bounds = seen;
-            source.rewind()?;
-            continue;
+        match built {
+            // A point outside the header's bounds, or a failure where the header's bounds
+            // are not the points' (a degenerate axis misleads the spill depth): again
+            // around the points' own bounds.
+            Err(e) if attempt == 0 => {
+                drop(out);
+                let own = scan_bounds(&mut source)?;
+                let pad = 2.0 * source.scale.iter().fold(0f64, |m, s| m.max(s.abs()));
+                let differ = (0..2).any(|k| (0..3).any(|a| (own[k][a] - bounds[k][a]).abs() > pad));
+                if !(outside || differ) {
+                    return Err(e);
+                }
+                crate::progress::line(&format!(
+                    "{}: the points' bounds are not the header's; building the octree again around the points' own",
+                    input.display()
+                ));
+                bounds = own;
+                continue;
+            }
+            Err(e) => return Err(e),
+            Ok(()) => {}
         }
         let written = out.finish(&source, &cube)?;
         return Ok(CopcWriteReport {
@@ -171,21 +196,49 @@ pub fn write_copc(
     unreachable!("the second attempt uses the points' own bounds")
 }
 
+/// The points' own bounds, from a pass over them (the source rewound before and after).
+fn scan_bounds(source: &mut source::Source) -> Result<[[f64; 3]; 2], PointsError> {
+    source.rewind()?;
+    let mut seen = [[f64::INFINITY; 3], [f64::NEG_INFINITY; 3]];
+    let mut buf = Vec::new();
+    loop {
+        buf.clear();
+        if source.next(&mut buf)? == 0 {
+            break;
+        }
+        for r in buf.chunks_exact(source.record) {
+            for (a, q) in records::xyz(r).into_iter().enumerate() {
+                let v = q as f64 * source.scale[a] + source.offset[a];
+                seen[0][a] = seen[0][a].min(v);
+                seen[1][a] = seen[1][a].max(v);
+            }
+        }
+    }
+    source.rewind()?;
+    Ok(seen)
+}
+
 /// The root cube: centred on `bounds`, its side the largest extent, padded by two steps
 /// of the coordinates' scale so that points on the bounds are inside.
-fn cube_around(bounds: &[[f64; 3]; 2], source: &source::Source, grid: u32) -> Cube {
+fn cube_around(bounds: &[[f64; 3]; 2], source: &source::Source, grid: u32) -> Result<Cube, String> {
     let pad = 2.0 * source.scale.iter().fold(0f64, |m, s| m.max(s.abs()));
     let side = (0..3)
         .map(|a| bounds[1][a] - bounds[0][a])
         .fold(0f64, f64::max)
         + 2.0 * pad;
-    let centre: [f64; 3] = std::array::from_fn(|a| 0.5 * (bounds[0][a] + bounds[1][a]));
-    Cube {
+    let centre: [f64; 3] = std::array::from_fn(|a| 0.5 * bounds[0][a] + 0.5 * bounds[1][a]);
+    if !(side.is_finite() && side > 0.0 && centre.iter().all(|c| c.is_finite())) {
+        return Err(format!(
+            "bounds {:?}..{:?}: too far apart (or not finite) for an octree's cube",
+            bounds[0], bounds[1]
+        ));
+    }
+    Ok(Cube {
         min: centre.map(|c| c - 0.5 * side),
         extent: std::array::from_fn(|a| (bounds[1][a] - bounds[0][a]).min(side)),
         side,
         scale: source.scale,
         offset: source.offset,
         grid,
-    }
+    })
 }

@@ -71,8 +71,9 @@ pub(super) struct Limits {
     pub(super) record: usize,
 }
 
-/// A build: the cube, its limits and the folder for spill files.
+/// A build: the input (for errors), the cube, its limits and the folder for spill files.
 pub(super) struct Tree<'a> {
+    pub(super) input: &'a Path,
     pub(super) cube: &'a Cube,
     pub(super) limits: &'a Limits,
     pub(super) spill: &'a Path,
@@ -174,9 +175,9 @@ pub(super) fn build(
         // what a point costs in an in-memory build.
         if upper_points > 2 * limits.memory_points {
             return Err(PointsError::unsupported(
-                spill,
+                tree.input,
                 format!(
-                    "the top {d} levels under node {root:?} sample more than {} points: a cloud this dense in 3D needs a larger memory budget (--memory-budget)",
+                    "the top {d} levels under node {root:?} sample more than {} points: give more points in memory at once (--memory-points) or a larger memory budget (--memory-budget)",
                     2 * limits.memory_points
                 ),
             ));
@@ -184,6 +185,9 @@ pub(super) fn build(
     }
     drop(taken);
     placed(upper_points);
+    // In key order: the same input makes the same file.
+    let mut upper: Vec<(Key, Vec<u8>)> = upper.into_iter().collect();
+    upper.sort_by_key(|(key, _)| *key);
     for (key, records) in upper {
         emit(key, records)?;
     }

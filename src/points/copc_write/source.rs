@@ -67,7 +67,20 @@ impl Source {
         let from = info.point_format;
         let format = output_format(from);
         let extra = info.record_length as usize - BASE[from as usize];
-        let vlrs = records
+        for a in 0..3 {
+            if info.scale[a].is_nan() || info.scale[a] <= 0.0 {
+                return Err(PointsError::format(
+                    path,
+                    131 + 8 * a as u64,
+                    format!(
+                        "{} scale {}: a COPC file needs a positive scale",
+                        ["x", "y", "z"][a],
+                        info.scale[a]
+                    ),
+                ));
+            }
+        }
+        let mut vlrs: Vec<CopiedVlr> = records
             .vlrs
             .iter()
             .filter(|v| kept(v))
@@ -78,6 +91,46 @@ impl Source {
                 data: v.data.clone(),
             })
             .collect();
+        // The Extra Bytes descriptors must describe the records' extra bytes exactly
+        // (readers refuse a file where they do not): more is refused, what they leave
+        // undescribed gets "undocumented" descriptors (data type 0).
+        let is_extra = |v: &CopiedVlr| v.user_id == "LASF_Spec" && v.record_id == 4;
+        let described = vlrs
+            .iter()
+            .filter(|v| is_extra(v))
+            .try_fold(0usize, |sum, v| described_bytes(&v.data).map(|n| sum + n))
+            .map_err(|m| PointsError::unsupported(path, m))?;
+        if described > extra {
+            return Err(PointsError::unsupported(
+                path,
+                format!(
+                    "the Extra Bytes descriptors describe {described} bytes, the records hold {extra} after point format {from}'s {}",
+                    BASE[from as usize]
+                ),
+            ));
+        }
+        if described < extra {
+            let mut data = Vec::new();
+            let mut left = extra - described;
+            while left > 0 {
+                let n = left.min(255);
+                let mut d = [0u8; 192];
+                d[3] = n as u8; // data type 0: `options` is the byte count
+                let name = format!("undocumented_{}", extra - left);
+                d[4..4 + name.len()].copy_from_slice(name.as_bytes());
+                data.extend_from_slice(&d);
+                left -= n;
+            }
+            match vlrs.iter_mut().find(|v| is_extra(v)) {
+                Some(v) => v.data.extend_from_slice(&data),
+                None => vlrs.push(CopiedVlr {
+                    user_id: "LASF_Spec".into(),
+                    record_id: 4,
+                    description: [0; 32],
+                    data,
+                }),
+            }
+        }
         Ok(Source {
             format,
             record: BASE[format as usize] + extra,
@@ -247,4 +300,35 @@ fn extra_name(name: &str) -> String {
     } else {
         name.to_string()
     }
+}
+
+/// Bytes of the record the Extra Bytes descriptors in `data` (192 bytes each) describe.
+fn described_bytes(data: &[u8]) -> Result<usize, String> {
+    if !data.len().is_multiple_of(192) {
+        return Err(format!(
+            "the Extra Bytes record holds {} bytes, not a multiple of its 192-byte descriptors",
+            data.len()
+        ));
+    }
+    let size = |t: u8| -> Option<usize> {
+        Some(match t {
+            1 | 2 => 1,
+            3 | 4 => 2,
+            5 | 6 | 9 => 4,
+            7 | 8 | 10 => 8,
+            _ => return None,
+        })
+    };
+    data.chunks_exact(192)
+        .enumerate()
+        .map(|(k, d)| match d[2] {
+            0 => Ok(d[3] as usize),
+            t @ 1..=10 => Ok(size(t).unwrap_or(0)),
+            t @ 11..=20 => Ok(2 * size(t - 10).unwrap_or(0)),
+            t @ 21..=30 => Ok(3 * size(t - 20).unwrap_or(0)),
+            t => Err(format!(
+                "extra bytes descriptor {k}: data type {t} is not LAS 1.4's"
+            )),
+        })
+        .sum()
 }

@@ -228,9 +228,21 @@ pub(super) fn check_head(
             ),
         ));
     }
+    // LAS 1.4 counts in 64 bits at byte 247; the legacy 32-bit count at 107 is 0 or, for
+    // formats 0-5 that fit, the same number. One that disagrees is refused rather than
+    // trusted (taking it would drop points silently).
     let legacy_count = u32_at(b, 107) as u64;
-    let (points, count_at) = if legacy_count == 0 && version.1 >= 4 {
-        (u64_at(b, 247), 247)
+    let (points, count_at) = if version.1 >= 4 {
+        let count = u64_at(b, 247);
+        if legacy_count != 0 && legacy_count != count {
+            return Err(fail(
+                107,
+                format!(
+                    "the legacy point count {legacy_count} disagrees with LAS 1.4's 64-bit count {count} at byte 247"
+                ),
+            ));
+        }
+        (count, 247)
     } else {
         (legacy_count, 107)
     };

@@ -248,9 +248,18 @@ fn hostile_headers_are_refused_before_reading() {
         e.contains("declares 1099511627776 points, more than the 100000000"),
         "{e}"
     );
-    // A count the data cannot hold.
+    // A legacy count that disagrees with the 64-bit one: refused, not trusted.
     let mut b = good.clone();
     set(&mut b, 107, &1_000_000u32.to_le_bytes());
+    let e = error(&b);
+    assert!(
+        e.contains("t.las: at byte 107: the legacy point count 1000000 disagrees with LAS 1.4's 64-bit count 4 at byte 247"),
+        "{e}"
+    );
+    // A count the data cannot hold (both fields).
+    let mut b = good.clone();
+    set(&mut b, 107, &1_000_000u32.to_le_bytes());
+    set(&mut b, 247, &1_000_000u64.to_le_bytes());
     let e = error(&b);
     assert!(
         e.contains(&format!(
