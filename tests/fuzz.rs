@@ -1181,7 +1181,8 @@ fn issue_17_cloud_and_surface_reproducers() -> Result<(), String> {
     refused(
         "extra bytes LAZ",
         r,
-        &["x.laz: at byte 107: the header declares 250000 points with 120 extra-bytes attributes"],
+        // LAS 1.4: the 64-bit count at byte 247 is the one in force.
+        &["x.laz: at byte 247: the header declares 250000 points with 120 extra-bytes attributes"],
     )?;
     // Time: equal points past 1,000,000 + 1 a compressed byte.
     // Amplification: point-14 items (layered chunks) under a VLR whose compressor field

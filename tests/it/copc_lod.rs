@@ -294,3 +294,52 @@ fn a_still_camera_loads_the_nodes_of_its_view() {
     assert!(after.contains("outside the view"), "{after}");
     assert!(!r.settle(gpu, &closer, scene.size).unwrap());
 }
+
+/// A damaged node met when the camera stops: the drawn cut stays and the status line says
+/// which node could not be read.
+#[test]
+fn a_damaged_node_keeps_the_drawn_cut_and_says_so() {
+    let dir = temp_dir("copc-lod-damaged");
+    let good = data_file("points/simple_with_page.copc.laz");
+    let copc = Copc::open(&good).unwrap();
+    let mut b = std::fs::read(&good).unwrap();
+    for n in copc.nodes.iter().filter(|n| n.key[0] == 3) {
+        for k in 0..n.bytes as usize {
+            let at = n.offset as usize + k;
+            b[at] = b[at].wrapping_mul(31).wrapping_add(7);
+        }
+    }
+    let damaged = dir.join("damaged.copc.laz");
+    std::fs::write(&damaged, &b).unwrap();
+    let text = format!(
+        "size = [800, 450]\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\" }} }}\ncolour = \"rgb\"\n",
+        damaged.display()
+    );
+    let scene = arbvis::scene::Scene::parse(&text, "damaged.toml").unwrap();
+    let h = crate::common::headless(arbvis::gl::Backend::Egl);
+    let gpu = h.gpu();
+    let kind = scene.programs.resolve(gpu);
+    // The first view reaches level 2 only (level 3 is under 150 px): it draws.
+    let mut r = arbvis::catalog::build(gpu, &scene.technique, &scene.settings(), kind).unwrap();
+    let closer = camera(Projection::Perspective, 5.0, [0.2, 0.6, -0.1, 0.75]);
+    assert!(!r.settle(gpu, &closer, scene.size).unwrap());
+    let start = std::time::Instant::now();
+    while !r.settle(gpu, &closer, scene.size).unwrap() {
+        assert!(start.elapsed().as_secs() < 30, "no answer from the loader");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let status = r.status().unwrap();
+    assert!(
+        status.contains("not refined: ") && status.contains("node [3,"),
+        "{status}"
+    );
+    // And it still draws.
+    let target = arbvis::gl::Target::new(gpu, 80, 45, arbvis::gl::TargetFormat::Rgba8).unwrap();
+    let frame = arbvis::techniques::Frame {
+        camera: closer,
+        width: 80,
+        height: 45,
+    };
+    r.draw(gpu, arbvis::gl::Surface::Target(&target), &frame)
+        .unwrap();
+}

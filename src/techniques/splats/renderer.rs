@@ -633,7 +633,22 @@ impl Renderer for SplatsRenderer {
                 Ok(result) => {
                     let view = loading.view;
                     self.loading = None;
-                    let loaded = result.map_err(GlError::Data)?;
+                    // A node that cannot be read (a damaged file): the drawn cut stays,
+                    // and the status line says why the view was not refined.
+                    let loaded = match result {
+                        Ok(loaded) => loaded,
+                        Err(e) => {
+                            let kept = self.cut.take().unwrap_or_default();
+                            let kept = kept
+                                .split("\nnot refined: ")
+                                .next()
+                                .unwrap_or("")
+                                .to_string();
+                            self.cut = Some(format!("{kept}\nnot refined: {e}"));
+                            self.view = Some(view);
+                            return Ok(true);
+                        }
+                    };
                     let base = self.base.clone();
                     *self = SplatsRenderer::upload(
                         gpu,
