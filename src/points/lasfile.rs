@@ -195,7 +195,12 @@ pub(super) fn copc_cloud(
     copc: &super::copc::Copc,
     nodes: &[super::copc::Node],
     stride: u64,
-) -> Result<PointCloud, PointsError> {
+) -> Result<(PointCloud, usize), PointsError> {
+    use super::copc_cache::{self, FileId};
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Arc;
+    let file = FileId::of(copc.path());
+    let cached = AtomicUsize::new(0);
     let count: u64 = nodes.iter().map(|n| n.points).sum();
     let has_rgb = matches!(copc.format.0, 7 | 8);
     let extras = {
@@ -226,10 +231,19 @@ pub(super) fn copc_cloud(
     }
     batches.push(&nodes[start..]);
     for batch in batches {
-        let decoded: Vec<PointData> = batch
+        // Nodes decoded for an earlier cut come from the cache.
+        let decoded: Vec<Arc<PointData>> = batch
             .par_iter()
-            .map(|node| copc.read_node(node))
-            .collect::<Result<_, _>>()?;
+            .map(|node| {
+                if let Some(d) = copc_cache::get(&file, node.key) {
+                    cached.fetch_add(1, Ordering::Relaxed);
+                    return Ok(d);
+                }
+                let d = Arc::new(copc.read_node(node)?);
+                copc_cache::put(&file, node.key, d.clone());
+                Ok(d)
+            })
+            .collect::<Result<_, PointsError>>()?;
         for (node, pd) in batch.iter().zip(&decoded) {
             append_node(&mut cols, copc, node, pd, &extras)?;
         }
@@ -237,10 +251,11 @@ pub(super) fn copc_cloud(
     if stride > 1 {
         cols.thin(stride as usize);
     }
-    cloud_of(cols, &extras, has_rgb).map_err(|message| PointsError::Decode {
+    let cloud = cloud_of(cols, &extras, has_rgb).map_err(|message| PointsError::Decode {
         path: copc.path().to_path_buf(),
         message,
-    })
+    })?;
+    Ok((cloud, cached.into_inner()))
 }
 
 /// Append one decoded node to the columns.

@@ -38,6 +38,7 @@
 
 mod cloud;
 pub mod copc;
+pub mod copc_cache;
 pub mod copc_lod;
 pub mod copc_write;
 pub mod dat;
@@ -228,7 +229,7 @@ impl PointSource {
                         copc_lod::Cut::whole(nodes, points, spec.points)
                     }
                 };
-                let mut cloud = lasfile::copc_cloud(&c, &cut.nodes, cut.root_stride)?;
+                let (mut cloud, cached) = lasfile::copc_cloud(&c, &cut.nodes, cut.root_stride)?;
                 cloud.reframe(&c.bounds);
                 let deepest = c.info.spacing / f64::from(1u32 << cut.deepest.clamp(0, 30));
                 let spacings = copc_lod::spacings(
@@ -242,7 +243,11 @@ impl PointSource {
                         .iter()
                         .map(|s| (*s as f64 / deepest) as f32)
                         .collect(),
-                    describe: cut.describe(&c),
+                    describe: format!(
+                        "{}; {cached} of its {} nodes from memory",
+                        cut.describe(&c),
+                        cut.nodes.len()
+                    ),
                 };
                 return Ok((cloud, Some(loaded)));
             }

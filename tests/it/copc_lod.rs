@@ -343,3 +343,30 @@ fn a_damaged_node_keeps_the_drawn_cut_and_says_so() {
     r.draw(gpu, arbvis::gl::Surface::Target(&target), &frame)
         .unwrap();
 }
+
+/// Decoded nodes are kept between cuts: a second load of the same view reads no node
+/// again, and its points are the same.
+#[test]
+fn a_second_cut_takes_its_nodes_from_memory() {
+    use arbvis::points::copc::CopcSpec;
+    use arbvis::points::PointSource;
+    let view = View::of(
+        &camera(Projection::Orthographic, 1.0, [0.1, 0.2, 0.0, 0.97]),
+        [640, 360],
+    );
+    let source = PointSource::Copc(CopcSpec {
+        path: data_file("points/simple_with_page.copc.laz"),
+        points: 1_000_000,
+        min_node_pixels: 0.0,
+    });
+    let (first, _) = source
+        .load_for(std::path::Path::new("."), Some(&view))
+        .unwrap();
+    let (second, loaded) = source
+        .load_for(std::path::Path::new("."), Some(&view))
+        .unwrap();
+    let said = loaded.unwrap().describe;
+    assert!(said.contains("65 of its 65 nodes from memory"), "{said}");
+    assert_eq!(first, second);
+    assert!(arbvis::points::copc_cache::held() > 0);
+}
