@@ -1,6 +1,7 @@
 //! The shared vocabulary at the bottom of the house: words every layer uses and none
 //! owns. A scene value that cannot be used ([`FieldError`]), the two fidelity modes
-//! ([`Fidelity`]) and the precision of a colour target ([`TargetFormat`]). Nothing here
+//! ([`Fidelity`]), the precision of a colour target ([`TargetFormat`]) and an item ranked
+//! by a priority in a heap ([`Ranked`]). Nothing here
 //! imports anything of arbvis (ARCHITECTURE.md, "Layers").
 
 /// Colour-target precision; faithful mode draws into RGBA8 as the original did.
@@ -129,5 +130,49 @@ impl FieldError {
 impl std::fmt::Display for FieldError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}: {}", self.key, self.message)
+    }
+}
+
+/// An item ranked by an `f64` priority: a `BinaryHeap` pops the largest priority first
+/// (`total_cmp`, so NaN has a place), ties the smaller item first. What the survey
+/// store's bricks and a COPC file's nodes are chosen by.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ranked<T> {
+    /// The priority (screen-space error, projected size).
+    pub priority: f64,
+    /// What it ranks.
+    pub item: T,
+}
+
+impl<T: Ord> Eq for Ranked<T> {}
+
+impl<T: Ord> PartialOrd for Ranked<T> {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl<T: Ord> Ord for Ranked<T> {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.priority
+            .total_cmp(&other.priority)
+            .then(other.item.cmp(&self.item))
+    }
+}
+
+#[cfg(test)]
+mod ranked_tests {
+    use super::Ranked;
+
+    /// Largest priority first, ties by the smaller item, NaN (total order) above every
+    /// number.
+    #[test]
+    fn a_heap_pops_the_largest_priority_and_ties_by_the_smaller_item() {
+        let mut heap = std::collections::BinaryHeap::new();
+        for (priority, item) in [(1.0, 7), (3.5, 2), (3.5, 1), (-2.0, 0), (f64::NAN, 9)] {
+            heap.push(Ranked { priority, item });
+        }
+        let order: Vec<u32> = std::iter::from_fn(|| heap.pop().map(|r| r.item)).collect();
+        assert_eq!(order, [9, 1, 2, 7, 0]);
     }
 }

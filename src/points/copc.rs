@@ -54,8 +54,12 @@ pub struct CopcSpec {
     pub min_node_pixels: f64,
 }
 
+/// Potree's `minimumNodePixelSize`: nodes whose bounding sphere projects under this
+/// radius in pixels are not drawn.
+pub const DEFAULT_MIN_NODE_PIXELS: f64 = 150.0;
+
 fn default_min_node_pixels() -> f64 {
-    150.0
+    DEFAULT_MIN_NODE_PIXELS
 }
 
 fn default_budget() -> u64 {

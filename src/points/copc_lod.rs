@@ -116,30 +116,8 @@ impl Cut {
     }
 }
 
-/// A queued node and its projected radius.
-struct Ranked {
-    pixels: f64,
-    index: usize,
-}
-
-impl PartialEq for Ranked {
-    fn eq(&self, other: &Self) -> bool {
-        self.pixels == other.pixels && self.index == other.index
-    }
-}
-impl Eq for Ranked {}
-impl PartialOrd for Ranked {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-impl Ord for Ranked {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.pixels
-            .total_cmp(&other.pixels)
-            .then(other.index.cmp(&self.index))
-    }
-}
+/// A queued node (its index) and its projected radius.
+type Ranked = crate::vocab::Ranked<usize>;
 
 /// Each point's spacing (file units) in a cloud loaded from `cut` (its nodes' points in
 /// order, `positions` in file coordinates): the spacing of the deepest level drawn in its
@@ -256,11 +234,11 @@ pub fn select(copc: &Copc, view: &View, budget: u64, min_node_pixels: f64) -> Cu
     for &i in &roots {
         // The roots are queued whatever their size (a picture always has them).
         queue.push(Ranked {
-            pixels: rank(i).unwrap_or(0.0),
-            index: i,
+            priority: rank(i).unwrap_or(0.0),
+            item: i,
         });
     }
-    while let Some(Ranked { index, .. }) = queue.pop() {
+    while let Some(Ranked { item: index, .. }) = queue.pop() {
         let n = copc.nodes[index];
         if !cut.nodes.is_empty() && cut.points + n.points > budget {
             cut.over_budget += 1 + queue.len();
@@ -274,8 +252,8 @@ pub fn select(copc: &Copc, view: &View, budget: u64, min_node_pixels: f64) -> Cu
                 None => cut.culled += 1,
                 Some(p) if p < min_node_pixels => cut.too_small += 1,
                 Some(p) => queue.push(Ranked {
-                    pixels: p,
-                    index: c,
+                    priority: p,
+                    item: c,
                 }),
             }
         }

@@ -202,6 +202,15 @@ pub enum PointSource {
 }
 
 impl PointSource {
+    /// A COPC file drawn within `points` (Potree's pixel size: nodes under 150 px left).
+    pub fn copc(path: impl Into<PathBuf>, points: u64) -> PointSource {
+        PointSource::Copc(copc::CopcSpec {
+            path: path.into(),
+            points,
+            min_node_pixels: copc::DEFAULT_MIN_NODE_PIXELS,
+        })
+    }
+
     /// Load or generate the cloud; relative paths are taken from `base` (the scene's
     /// folder). A COPC cloud: whole levels from the root within its budget.
     pub fn load(&self, base: &Path) -> Result<PointCloud, PointsError> {

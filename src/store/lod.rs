@@ -256,19 +256,7 @@ pub struct Selection {
     pub missing: usize,
 }
 
-#[derive(PartialEq)]
-struct Node(f64, BrickId);
-impl Eq for Node {}
-impl PartialOrd for Node {
-    fn partial_cmp(&self, o: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(o))
-    }
-}
-impl Ord for Node {
-    fn cmp(&self, o: &Self) -> std::cmp::Ordering {
-        self.0.total_cmp(&o.0).then(o.1.cmp(&self.1))
-    }
-}
+type Node = crate::vocab::Ranked<BrickId>;
 
 /// The wanted cut for `view` at `pixels` per voxel, at most `max_bricks` bricks; `visible`
 /// says whether a brick can show anything (ranges against the tables).
@@ -287,10 +275,17 @@ pub fn wanted(
     let mut heap = BinaryHeap::new();
     let mut leaves: Vec<BrickId> = Vec::new();
     for r in pyr.roots().into_iter().filter(|&r| keep(r)) {
-        heap.push(Node(error(r), r));
+        heap.push(Node {
+            priority: error(r),
+            item: r,
+        });
     }
     let mut count = heap.len();
-    while let Some(Node(e, id)) = heap.pop() {
+    while let Some(Node {
+        priority: e,
+        item: id,
+    }) = heap.pop()
+    {
         if id.level == 0 || e <= pixels {
             leaves.push(id);
             continue;
@@ -302,7 +297,10 @@ pub fn wanted(
         }
         count = count - 1 + kids.len();
         for k in kids {
-            heap.push(Node(error(k), k));
+            heap.push(Node {
+                priority: error(k),
+                item: k,
+            });
         }
     }
     // Most urgent first: coarse levels (they stand in for everything below), then by error.

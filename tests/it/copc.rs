@@ -22,17 +22,17 @@ fn has_laspy() -> bool {
 }
 
 /// Every point of `level`, one line each (raw X Y Z, intensity, returns, classification,
-/// scan angle in degrees, user data, point source, GPS time, RGB), sorted.
+/// user data, point source, scan angle in degrees, GPS time, RGB), sorted.
 const LASPY_LEVEL: &str = r#"
 import sys, laspy
 with laspy.CopcReader.open(sys.argv[1]) as r:
     for level in range(int(sys.argv[2])):
         p = r.query(level=level)
         rows = sorted(
-            f"{level} {x} {y} {z} {i} {rn} {nr} {c} {sa:.3f} {ud} {ps} {t!r} {red} {g} {b}"
-            for x, y, z, i, rn, nr, c, sa, ud, ps, t, red, g, b in zip(
+            f"{level} {x} {y} {z} {i} {rn} {nr} {c} {ud} {ps} {sa:.3f} {t!r} {red} {g} {b}"
+            for x, y, z, i, rn, nr, c, ud, ps, sa, t, red, g, b in zip(
                 p.X, p.Y, p.Z, p.intensity, p.return_number, p.number_of_returns,
-                p.classification, p.scan_angle * 0.006, p.user_data, p.point_source_id,
+                p.classification, p.user_data, p.point_source_id, p.scan_angle * 0.006,
                 p.gps_time.tolist(), p.red, p.green, p.blue))
         print("\n".join(rows))
 "#;
@@ -45,27 +45,18 @@ fn arbvis_lines(copc: &Copc) -> Vec<String> {
         let mut rows = Vec::new();
         for node in copc.nodes.iter().filter(|n| n.key[0] == level) {
             let p = copc.read_node(node).unwrap();
-            let t: Vec<f64> = p.gps_time().unwrap().collect();
-            let rgb: Vec<(u16, u16, u16)> = p.rgb().unwrap().collect();
-            let cols: Vec<Vec<String>> = vec![
-                p.x_raw().map(|v| v.to_string()).collect(),
-                p.y_raw().map(|v| v.to_string()).collect(),
-                p.z_raw().map(|v| v.to_string()).collect(),
-                p.intensity().map(|v| v.to_string()).collect(),
-                p.return_number().map(|v| v.to_string()).collect(),
-                p.number_of_returns().map(|v| v.to_string()).collect(),
-                p.classification().map(|v| v.to_string()).collect(),
-                p.scan_angle_degrees().map(|v| format!("{v:.3}")).collect(),
-                p.user_data().map(|v| v.to_string()).collect(),
-                p.point_source_id().map(|v| v.to_string()).collect(),
-                t.iter().map(|v| python_float(*v)).collect(),
-            ];
+            let mut cols = crate::common::las_columns(&p);
+            cols.push(p.scan_angle_degrees().map(|v| format!("{v:.3}")).collect());
+            cols.push(p.gps_time().unwrap().map(python_float).collect());
+            cols.push(
+                p.rgb()
+                    .unwrap()
+                    .map(|(r, g, b)| format!("{r} {g} {b}"))
+                    .collect(),
+            );
             assert_eq!(p.len() as u64, node.points, "node {:?}", node.key);
-            for k in 0..p.len() {
-                let (r, g, b) = rgb[k];
-                let fields: Vec<&str> = cols.iter().map(|c| c[k].as_str()).collect();
-                rows.push(format!("{level} {} {r} {g} {b}", fields.join(" ")));
-            }
+            let lines = crate::common::rows_of(&cols, p.len());
+            rows.extend(lines.into_iter().map(|l| format!("{level} {l}")));
         }
         rows.sort();
         out.extend(rows);
@@ -209,20 +200,15 @@ fn damaged_copc_files_are_refused_naming_the_byte_or_the_node() {
 /// drawn as splats.
 #[test]
 fn a_copc_cloud_in_a_scene_takes_whole_levels_within_its_budget() {
-    use arbvis::points::copc::CopcSpec;
     use arbvis::points::PointSource;
     let base = data_file("points/simple.copc.laz")
         .parent()
         .unwrap()
         .to_path_buf();
     let load = |points| {
-        PointSource::Copc(CopcSpec {
-            path: "simple_with_page.copc.laz".into(),
-            points,
-            min_node_pixels: 150.0,
-        })
-        .load(&base)
-        .unwrap()
+        PointSource::copc("simple_with_page.copc.laz", points)
+            .load(&base)
+            .unwrap()
     };
     // Levels hold 24, 66, 197 and 778 points; a budget under the root's takes every
     // third of the root's 24 points (never more than the budget).

@@ -200,17 +200,13 @@ fn render_draws_the_cut_and_stats_say_what_it_holds() {
 /// (levels 0-2 drawn), 1 for the level-2 nodes' own points (their children are not).
 #[test]
 fn coarse_points_stand_in_for_their_missing_children() {
-    use arbvis::points::copc::CopcSpec;
     use arbvis::points::PointSource;
     let cam = camera(Projection::Orthographic, 1.0, [0.0, 0.0, 0.0, 1.0]);
     let view = View::of(&cam, [1600, 900]);
-    let (cloud, loaded) = PointSource::Copc(CopcSpec {
-        path: data_file("points/simple_with_page.copc.laz"),
-        points: 1_000_000,
-        min_node_pixels: 150.0,
-    })
-    .load_for(std::path::Path::new("."), Some(&view))
-    .unwrap();
+    let (cloud, loaded) =
+        PointSource::copc(data_file("points/simple_with_page.copc.laz"), 1_000_000)
+            .load_for(std::path::Path::new("."), Some(&view))
+            .unwrap();
     let loaded = loaded.unwrap();
     assert_eq!(cloud.len(), 24 + 66 + 197);
     let scales = &loaded.size_scales;

@@ -26,33 +26,16 @@ fn convert(input: &Path, output: &Path, extra: &[&str]) -> String {
 /// Every point of a LAS/LAZ/COPC file as one sorted line of raw fields (X Y Z,
 /// intensity, returns, classification, user data, source, GPS time bits, RGB).
 fn las_rows(pd: &las::PointData) -> Vec<String> {
-    let cols: Vec<Vec<String>> = vec![
-        pd.x_raw().map(|v| v.to_string()).collect(),
-        pd.y_raw().map(|v| v.to_string()).collect(),
-        pd.z_raw().map(|v| v.to_string()).collect(),
-        pd.intensity().map(|v| v.to_string()).collect(),
-        pd.return_number().map(|v| v.to_string()).collect(),
-        pd.number_of_returns().map(|v| v.to_string()).collect(),
-        pd.classification().map(|v| v.to_string()).collect(),
-        pd.user_data().map(|v| v.to_string()).collect(),
-        pd.point_source_id().map(|v| v.to_string()).collect(),
-        match pd.gps_time() {
-            Some(t) => t.map(|v| format!("{:x}", v.to_bits())).collect(),
-            None => vec!["0".into(); pd.len()],
-        },
-        match pd.rgb() {
-            Some(c) => c.map(|(r, g, b)| format!("{r},{g},{b}")).collect(),
-            None => vec!["-".into(); pd.len()],
-        },
-    ];
-    let mut rows: Vec<String> = (0..pd.len())
-        .map(|k| {
-            cols.iter()
-                .map(|c| c[k].as_str())
-                .collect::<Vec<_>>()
-                .join(" ")
-        })
-        .collect();
+    let mut cols = crate::common::las_columns(pd);
+    cols.push(match pd.gps_time() {
+        Some(t) => t.map(|v| format!("{:x}", v.to_bits())).collect(),
+        None => vec!["0".into(); pd.len()],
+    });
+    cols.push(match pd.rgb() {
+        Some(c) => c.map(|(r, g, b)| format!("{r},{g},{b}")).collect(),
+        None => vec!["-".into(); pd.len()],
+    });
+    let mut rows = crate::common::rows_of(&cols, pd.len());
     rows.sort();
     rows
 }
@@ -190,13 +173,9 @@ fn seed_dat_and_ply_attributes_become_extra_bytes() {
     let read = dat::read(&path, &Default::default()).unwrap();
     let out = dir.join("s.copc.laz");
     convert(&path, &out, &["--node-points", "500"]);
-    let back = PointSource::Copc(arbvis::points::copc::CopcSpec {
-        path: out.clone(),
-        points: 1 << 40,
-        min_node_pixels: 150.0,
-    })
-    .load(Path::new("."))
-    .unwrap();
+    let back = PointSource::copc(out.clone(), 1 << 40)
+        .load(Path::new("."))
+        .unwrap();
     assert_eq!(back.len(), read.len());
     // Points come back in node order: match them by position (the .dat's are distinct).
     let key = |p: [f64; 3]| p.map(|v| (v * 1e3).round() as i64);
@@ -232,13 +211,9 @@ fn seed_dat_and_ply_attributes_become_extra_bytes() {
     // named `intensity_extra`, as laspy requires.
     let bunny = dir.join("bunny.copc.laz");
     convert(&data_file("points/bunny.ply"), &bunny, &[]);
-    let back = PointSource::Copc(arbvis::points::copc::CopcSpec {
-        path: bunny.clone(),
-        points: 1 << 40,
-        min_node_pixels: 150.0,
-    })
-    .load(Path::new("."))
-    .unwrap();
+    let back = PointSource::copc(bunny.clone(), 1 << 40)
+        .load(Path::new("."))
+        .unwrap();
     assert!(back.floats("confidence").is_some() && back.floats("intensity_extra").is_some());
     if has_laspy() {
         let said = stdout_of(Command::new("python3").args([

@@ -221,3 +221,35 @@ pub fn assert_says(text: &str, wants: &[&str]) {
         assert!(text.contains(want), "{want}\n{text}");
     }
 }
+
+/// The raw fields every point of a LAS record has, a column each, as text: X Y Z,
+/// intensity, return number, number of returns, classification, user data, point source.
+pub fn las_columns(pd: &las::PointData) -> Vec<Vec<String>> {
+    fn text<T: ToString>(it: impl Iterator<Item = T>) -> Vec<String> {
+        it.map(|v| v.to_string()).collect()
+    }
+    vec![
+        text(pd.x_raw()),
+        text(pd.y_raw()),
+        text(pd.z_raw()),
+        text(pd.intensity()),
+        text(pd.return_number()),
+        text(pd.number_of_returns()),
+        text(pd.classification()),
+        text(pd.user_data()),
+        text(pd.point_source_id()),
+    ]
+}
+
+/// One line per point: each column's text, space-separated.
+pub fn rows_of(columns: &[Vec<String>], points: usize) -> Vec<String> {
+    (0..points)
+        .map(|k| {
+            columns
+                .iter()
+                .map(|c| c[k].as_str())
+                .collect::<Vec<_>>()
+                .join(" ")
+        })
+        .collect()
+}
