@@ -224,9 +224,11 @@ enum Command {
         /// adds about 0.45.
         #[arg(long, value_delimiter = ',', default_values_t = ["envelope".to_string()])]
         attributes: Vec<String>,
-        /// zstd level of the chunks (0: uncompressed).
-        #[arg(long, default_value_t = 1)]
-        zstd: i32,
+        /// Chunk compression: lz4 (blosc LZ4 over shuffled bytes, as MDIO's blosc), zstd,
+        /// zstd:LEVEL (1-22) or none. On float surveys lz4 makes the smallest store and the
+        /// fastest conversion.
+        #[arg(long, default_value = "lz4")]
+        compression: arbvis::store::compression::Compression,
         /// A raw input's dimensions I,J,K (i fastest), e.g. 512,400,300.
         #[arg(long, value_name = "I,J,K", value_parser = parse_dims)]
         raw_dims: Option<[usize; 3]>,
@@ -674,7 +676,7 @@ fn run(cli: Cli) -> Result<()> {
             store,
             brick,
             attributes,
-            zstd,
+            compression,
             raw_dims,
             raw_type,
             raw_endian,
@@ -741,7 +743,7 @@ fn run(cli: Cli) -> Result<()> {
             let options = arbvis::store::convert::ConvertOptions {
                 brick,
                 derived,
-                zstd,
+                compression,
                 raw,
                 ..Default::default()
             };

@@ -31,6 +31,7 @@ use zarrs::array::{data_type, Array, ArrayBuilder, ArraySubset, DataType};
 use zarrs::filesystem::FilesystemStore;
 use zarrs::group::GroupBuilder;
 
+use super::compression::Compression;
 use super::meta::StoreMeta;
 use super::StoreError;
 
@@ -91,15 +92,12 @@ fn array(
     dtype: DataType,
     fill: impl Into<zarrs::array::builder::ArrayBuilderFillValue>,
     dims: &[&str],
-    zstd: i32,
+    compression: Compression,
     attributes: Map<String, Value>,
 ) -> Result<Array<FilesystemStore>, StoreError> {
+    let typesize = dtype.fixed_size();
     let mut b = ArrayBuilder::new(shape, chunks, dtype, fill);
-    if zstd > 0 {
-        b.bytes_to_bytes_codecs(vec![Arc::new(zarrs::array::codec::ZstdCodec::new(
-            zstd, false,
-        ))]);
-    }
+    b.bytes_to_bytes_codecs(compression.codecs(typesize));
     b.dimension_names(Some(dims.to_vec()));
     b.attributes(attributes);
     let a = b
@@ -185,7 +183,7 @@ pub fn write_layout(
     storage: &Arc<FilesystemStore>,
     store: &Path,
     meta: &StoreMeta,
-    (zstd, has_cdp): (i32, bool),
+    (compression, has_cdp): (Compression, bool),
     stats: Option<&[Stats]>,
     beside: Option<&Map<String, Value>>,
 ) -> Result<Writers, StoreError> {
@@ -263,7 +261,7 @@ pub fn write_layout(
                     data_type::int32(),
                     0i32,
                     &[name],
-                    zstd,
+                    compression,
                     Map::new(),
                 )?;
                 let v: Vec<i32> = values.iter().map(|&x| x as i32).collect();
@@ -280,7 +278,7 @@ pub fn write_layout(
                     data_type::float64(),
                     f64::NAN,
                     &[name],
-                    zstd,
+                    compression,
                     Map::new(),
                 )?;
                 a.store_array_subset(&ArraySubset::new_with_shape(vec![n]), values.as_slice())
@@ -311,7 +309,7 @@ pub fn write_layout(
                     data_type::float16(),
                     half::f16::NAN,
                     &level_dims,
-                    zstd,
+                    compression,
                     attributes,
                 )?)
             } else {
@@ -324,7 +322,7 @@ pub fn write_layout(
                     data_type::float32(),
                     f32::NAN,
                     &level_dims,
-                    zstd,
+                    compression,
                     attributes,
                 )?)
             };
@@ -340,7 +338,7 @@ pub fn write_layout(
                 data_type::float32(),
                 f32::NAN,
                 &brick_dims,
-                0,
+                Compression::None,
                 Map::new(),
             )?;
         }
@@ -358,7 +356,7 @@ pub fn write_layout(
             data_type::bool(),
             zarrs::array::FillValue::from(false),
             &dims[..2],
-            zstd,
+            compression,
             Map::new(),
         )?),
     };
@@ -374,7 +372,7 @@ pub fn write_layout(
                 data_type::float64(),
                 f64::NAN,
                 &dims[..2],
-                zstd,
+                compression,
                 Map::new(),
             )
         };

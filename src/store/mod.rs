@@ -41,6 +41,7 @@
 
 pub mod cache;
 pub mod check;
+pub mod compression;
 pub mod convert;
 pub mod describe;
 pub mod input;

@@ -31,7 +31,9 @@ pub(crate) struct Job {
     pub modified: u64,
     pub brick: usize,
     pub attributes: Vec<String>,
-    pub zstd: i32,
+    /// The chunks' compression (`Compression`'s name; a log from before it has none).
+    #[serde(default)]
+    pub compression: String,
     pub raw: Option<String>,
     /// The store layout's version (a log written before version 2 has none).
     #[serde(default = "layout_one")]
@@ -140,9 +142,9 @@ pub(crate) fn read_log(
         return Err(StoreError::invalid(
             path,
             format!(
-                "the interrupted conversion here was of {} ({} bytes, brick {}, attributes {}, zstd {}); this one is of {} ({} bytes, brick {}, attributes {}, zstd {}): run the same command to resume, or name a new store",
-                was.input, was.bytes, was.brick, was.attributes.join(","), was.zstd,
-                job.input, job.bytes, job.brick, job.attributes.join(","), job.zstd
+                "the interrupted conversion here was of {} ({} bytes, brick {}, attributes {}, compression {}); this one is of {} ({} bytes, brick {}, attributes {}, compression {}): run the same command to resume, or name a new store",
+                was.input, was.bytes, was.brick, was.attributes.join(","), was.compression,
+                job.input, job.bytes, job.brick, job.attributes.join(","), job.compression
             ),
         ));
     }

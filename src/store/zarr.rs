@@ -701,12 +701,20 @@ impl ArrayMeta {
 
     /// The codecs, in words.
     pub fn codec_names(&self) -> String {
-        let mut names = vec![if self.big_endian {
+        let bytes = if self.big_endian {
             "bytes (big-endian)"
         } else {
             "bytes"
-        }];
-        names.extend(self.codecs.iter().map(Codec::name));
+        };
+        let mut names = vec![bytes.to_string()];
+        names.extend(self.codecs.iter().map(|c| match c {
+            // Blosc's compressor and shuffle, as its configuration names them.
+            Codec::Blosc(config) => {
+                let field = |k: &str| config.get(k).and_then(Value::as_str).unwrap_or("?");
+                format!("blosc ({}, {})", field("cname"), field("shuffle"))
+            }
+            other => other.name().to_string(),
+        }));
         names.join(" + ")
     }
 }

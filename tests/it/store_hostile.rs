@@ -395,7 +395,7 @@ fn inspect_describes_a_store_and_an_interrupted_one() {
         "inline: 11, numbers 100..110 (step 1)",
         "levels: 3 of 8³ bricks",
         "level 0: 21 x 13 x 11 voxels, 3 x 2 x 2 bricks",
-        "amplitude: float32, chunks [8, 8, 8], codecs bytes + zstd",
+        "amplitude: float32, chunks [8, 8, 8], codecs bytes + blosc (lz4, shuffle)",
         "envelope: float32",
         "size on disk:",
     ] {
