@@ -220,7 +220,7 @@ enum Command {
         brick: usize,
         /// Derived attributes (per-trace Hilbert transform), comma-separated, or "none":
         /// envelope, phase, cosine-phase, frequency. The default, envelope, makes a store
-        /// about 1.8 times the survey (amplitude alone: 0.96); each of phase and frequency
+        /// about 1.8 times the survey (amplitude alone: 0.92); each of phase and frequency
         /// adds about 0.45.
         #[arg(long, value_delimiter = ',', default_values_t = ["envelope".to_string()])]
         attributes: Vec<String>,

@@ -9,7 +9,7 @@
 #
 # SURVEY_GB defaults to the largest survey (up to 20 GB) that leaves 15 GB of the disk
 # free with its store beside it (the store of amplitude + envelope is about 1.9 times the
-# survey, amplitude alone about 0.96 times, zstd included). When the disk cannot hold the
+# survey, amplitude alone about 0.92 times, lz4 included). When the disk cannot hold the
 # survey with an amplitude + envelope store, only amplitude is converted (and drawn). PROFILE=debug uses the dev profile (arbvis at opt-level 1,
 # dependencies at 2) instead of a release build. Output: DIR/run.log; the picture goes to
 # docs/pictures/store-survey.png.
