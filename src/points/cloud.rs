@@ -161,6 +161,16 @@ impl PointCloud {
     /// extent) and compute every attribute's statistics. Errors name the first
     /// non-finite position or a column of the wrong length.
     pub fn from_parts(parts: CloudParts) -> Result<PointCloud, String> {
+        PointCloud::from_parts_framed(parts, None)
+    }
+
+    /// [`PointCloud::from_parts`], framed by `frame` (smallest and largest corner) rather
+    /// than the points' own bounds where given: every cut of a COPC file framed by the
+    /// file's bounds gives a point the same f32 position.
+    pub fn from_parts_framed(
+        parts: CloudParts,
+        frame: Option<&[[f64; 3]; 2]>,
+    ) -> Result<PointCloud, String> {
         let n = parts.positions.len();
         let check = |what: &str, len: usize| {
             if len == n {
@@ -189,7 +199,7 @@ impl PointCloud {
             ));
         }
         let bounds = bounds(&parts.positions);
-        let (origin, scale) = origin_and_scale(&bounds);
+        let (origin, scale) = origin_and_scale(frame.unwrap_or(&bounds));
         let positions = parts
             .positions
             .par_iter()
@@ -219,21 +229,6 @@ impl PointCloud {
             rgb: parts.rgb,
             normals: parts.normals,
         })
-    }
-
-    /// Rescale the positions around `bounds` instead of the points' own (a COPC cut is
-    /// framed by its file's bounds, so that every cut lies at the same place); the
-    /// points' bounds stay as they are.
-    pub fn reframe(&mut self, bounds: &[[f64; 3]; 2]) {
-        let (origin, scale) = origin_and_scale(bounds);
-        let (old_origin, old_scale) = (self.origin, self.scale);
-        self.positions.par_iter_mut().for_each(|p| {
-            *p = std::array::from_fn(|a| {
-                local(old_origin[a] + old_scale * p[a] as f64, origin[a], scale)
-            })
-        });
-        self.origin = origin;
-        self.scale = scale;
     }
 
     /// Number of points.

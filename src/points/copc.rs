@@ -111,6 +111,8 @@ pub struct OctreeInfo {
     pub halfsize: f64,
     /// Spacing of the root's points.
     pub spacing: f64,
+    /// The earliest and latest GPS time of the points (as the info VLR says; unchecked).
+    pub gps_range: [f64; 2],
 }
 
 /// Whether `head` (a file's first bytes) is a COPC file's: LAS 1.4 whose first VLR is
@@ -262,6 +264,7 @@ impl Copc {
             center_z: f64_at(16),
             halfsize: f64_at(24),
             spacing: f64_at(32),
+            gps_range: [f64_at(56), f64_at(64)],
         };
         let info_at = header_size + VLR_HEADER;
         let finite = [octree.center_x, octree.center_y, octree.center_z]

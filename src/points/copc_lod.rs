@@ -51,6 +51,9 @@ pub struct Loaded {
     pub spacing: f64,
     /// Each point's spacing over the deepest level's ([`spacings`]): 1, 2, 4, ...
     pub size_scales: Vec<f32>,
+    /// The cut's nodes in the cloud's order: each key and its points in the cloud (the
+    /// cloud holds them one node after the other).
+    pub nodes: Vec<([i32; 4], usize)>,
 }
 
 /// The nodes a view draws and what was left.

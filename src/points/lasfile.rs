@@ -99,11 +99,13 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
         message: what,
     };
     let has_rgb = matches!(info.point_format, 2 | 3 | 5 | 7 | 8 | 10);
+    let has_gps = matches!(info.point_format, 1 | 3..=10);
     // Memory before reading: what the points become, what decoding holds besides (an f64
-    // per extra-bytes value, one batch of records) and the file itself.
+    // per extra-bytes value and GPS time, one batch of records) and the file itself.
     let batch = batch_points(record);
-    let extra_values = crate::budget::times(count, 8 * extras.len() as u64);
-    let estimate = super::footprint(count, 4 + extras.len(), has_rgb, false)
+    let f64_columns = extras.len() + usize::from(has_gps);
+    let extra_values = crate::budget::times(count, 8 * f64_columns as u64);
+    let estimate = super::footprint(count, 4 + f64_columns, has_rgb, false)
         .saturating_add(extra_values)
         .saturating_add(bytes.len() as u64)
         .saturating_add(batch * record as u64);
@@ -119,7 +121,7 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
         estimate,
     )
     .map_err(over)?;
-    let mut cols = Columns::new(count, extras.len(), has_rgb).map_err(over)?;
+    let mut cols = Columns::new(count, extras.len(), has_rgb, has_gps).map_err(over)?;
     let mut reader = guarded(|| Reader::new(Cursor::new(bytes)))
         .map_err(|e| decode_error(format!("the header: {e}")))?;
     let mut pd: PointData = PointDataBuilder::new().for_header(reader.header()).build();
@@ -148,12 +150,19 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
         progress.inc(n);
     }
     drop(progress);
-    let cloud = cloud_of(cols, &extras, has_rgb).map_err(decode_error)?;
+    let cloud = cloud_of(cols, &extras, has_rgb, (None, None)).map_err(decode_error)?;
     Ok(LasCloud { cloud, info })
 }
 
-/// The cloud of the gathered columns: the LAS attributes, then every extra-bytes one.
-fn cloud_of(cols: Columns, extras: &[Extra], has_rgb: bool) -> Result<PointCloud, String> {
+/// The cloud of the gathered columns: the LAS attributes, GPS time (where the format has
+/// it: seconds after `gps_reference`, else after the earliest point's), then every
+/// extra-bytes attribute.
+fn cloud_of(
+    cols: Columns,
+    extras: &[Extra],
+    has_rgb: bool,
+    (gps_reference, frame): (Option<f64>, Option<&[[f64; 3]; 2]>),
+) -> Result<PointCloud, String> {
     let mut attributes = vec![
         ("intensity".to_string(), Values::Int(cols.intensity)),
         (
@@ -166,6 +175,12 @@ fn cloud_of(cols: Columns, extras: &[Extra], has_rgb: bool) -> Result<PointCloud
             Values::Int(cols.number_of_returns),
         ),
     ];
+    if cols.has_gps {
+        attributes.push((
+            "gps_time".to_string(),
+            gps_after(&cols.gps_time, gps_reference),
+        ));
+    }
     for (e, values) in extras.iter().zip(cols.extras) {
         let integral =
             e.ty <= 6 && e.ty != 5 && e.scale == 1.0 && e.offset == 0.0 && e.no_data.is_none();
@@ -180,12 +195,13 @@ fn cloud_of(cols: Columns, extras: &[Extra], has_rgb: bool) -> Result<PointCloud
         };
         attributes.push((label, values));
     }
-    PointCloud::from_parts(CloudParts {
+    let parts = CloudParts {
         positions: cols.positions,
         attributes,
         rgb: has_rgb.then_some(cols.rgb),
         normals: None,
-    })
+    };
+    PointCloud::from_parts_framed(parts, frame)
 }
 
 /// The points of a COPC file's `nodes`, as one cloud (the LAS attributes, RGB and every
@@ -214,10 +230,11 @@ pub(super) fn copc_cloud(
     let over = |e: OverBudget| PointsError::format(copc.path(), 247, e.to_string());
     crate::budget::check(
         format!("{count} points of {}", copc.path().display()),
-        super::footprint(count, 4 + extras.len(), has_rgb, false),
+        super::footprint(count, 5 + extras.len(), has_rgb, false),
     )
     .map_err(over)?;
-    let mut cols = Columns::new(count, extras.len(), has_rgb).map_err(over)?;
+    // Formats 6-8 all carry GPS time.
+    let mut cols = Columns::new(count, extras.len(), has_rgb, true).map_err(over)?;
     // Decoded in parallel a batch at a time (a batch's records held at once: at most
     // BATCH_BYTES beyond a node), appended in the nodes' order.
     let mut batches: Vec<&[super::copc::Node]> = Vec::new();
@@ -251,7 +268,11 @@ pub(super) fn copc_cloud(
     if stride > 1 {
         cols.thin(stride as usize);
     }
-    let cloud = cloud_of(cols, &extras, has_rgb).map_err(|message| PointsError::Decode {
+    // GPS time after the file's earliest (its info VLR's) and positions framed by the
+    // file's bounds: the same for every cut.
+    let reference = Some(copc.info.gps_range[0]).filter(|t| t.is_finite());
+    let frame = (reference, Some(&copc.bounds));
+    let cloud = cloud_of(cols, &extras, has_rgb, frame).map_err(|message| PointsError::Decode {
         path: copc.path().to_path_buf(),
         message,
     })?;
@@ -273,6 +294,21 @@ fn append_node(
         })
 }
 
+/// GPS times as seconds after `reference` (where it is not after the earliest finite time,
+/// as a wrong header's could be; else after that earliest time), in f32:
+/// a survey's hours keep millisecond steps, where the absolute times (about 1e9 s of
+/// adjusted standard GPS time) would keep only steps of 64 s.
+fn gps_after(times: &[f64], reference: Option<f64>) -> Values {
+    let earliest = times
+        .iter()
+        .copied()
+        .filter(|t| t.is_finite())
+        .fold(f64::INFINITY, f64::min);
+    let earliest = if earliest.is_finite() { earliest } else { 0.0 };
+    let reference = reference.filter(|r| *r <= earliest).unwrap_or(earliest);
+    Values::Float(times.iter().map(|&t| (t - reference) as f32).collect())
+}
+
 /// Columns gathered batch by batch.
 struct Columns {
     positions: Vec<[f64; 3]>,
@@ -282,13 +318,15 @@ struct Columns {
     number_of_returns: Vec<i32>,
     rgb: Vec<[u16; 3]>,
     has_rgb: bool,
+    gps_time: Vec<f64>,
+    has_gps: bool,
     extras: Vec<Vec<f64>>,
 }
 
 impl Columns {
     /// Columns with room for `count` points, reserved at once (the caller checked the
     /// estimate against the budget), so that appending never grows them.
-    fn new(count: u64, extras: usize, has_rgb: bool) -> Result<Columns, OverBudget> {
+    fn new(count: u64, extras: usize, has_rgb: bool, has_gps: bool) -> Result<Columns, OverBudget> {
         let n = usize::try_from(count).unwrap_or(usize::MAX);
         let ints = || vec_for::<i32>(n, "the integer attributes");
         Ok(Columns {
@@ -299,6 +337,8 @@ impl Columns {
             number_of_returns: ints()?,
             rgb: vec_for(if has_rgb { n } else { 0 }, "the colours")?,
             has_rgb,
+            gps_time: vec_for(if has_gps { n } else { 0 }, "the GPS times")?,
+            has_gps,
             extras: (0..extras)
                 .map(|_| vec_for(n, "the extra-bytes attributes"))
                 .collect::<Result<_, _>>()?,
@@ -317,6 +357,7 @@ impl Columns {
         every(&mut self.return_number, stride);
         every(&mut self.number_of_returns, stride);
         every(&mut self.rgb, stride);
+        every(&mut self.gps_time, stride);
         for e in &mut self.extras {
             every(e, stride);
         }
@@ -337,6 +378,11 @@ impl Columns {
         self.return_number.extend(pd.return_number().map(i32::from));
         self.number_of_returns
             .extend(pd.number_of_returns().map(i32::from));
+        if self.has_gps {
+            if let Some(t) = pd.gps_time() {
+                self.gps_time.extend(t);
+            }
+        }
         if self.has_rgb {
             if let Some(rgb) = pd.rgb() {
                 self.rgb.extend(rgb.map(|(r, g, b)| [r, g, b]));

@@ -238,15 +238,26 @@ impl PointSource {
                         copc_lod::Cut::whole(nodes, points, spec.points)
                     }
                 };
-                let (mut cloud, cached) = lasfile::copc_cloud(&c, &cut.nodes, cut.root_stride)?;
-                cloud.reframe(&c.bounds);
+                // Framed by the file's bounds (every budget places the cloud alike).
+                let (cloud, cached) = lasfile::copc_cloud(&c, &cut.nodes, cut.root_stride)?;
                 let deepest = c.info.spacing / f64::from(1u32 << cut.deepest.clamp(0, 30));
                 let spacings = copc_lod::spacings(
                     &c,
                     &cut,
                     (0..cloud.len()).filter_map(|i| cloud.original(i)),
                 );
+                // The cloud holds the nodes in the cut's order; a root thinned to a
+                // stride is all of it.
+                let nodes = if cut.root_stride > 1 {
+                    cut.nodes.iter().map(|n| (n.key, cloud.len())).collect()
+                } else {
+                    cut.nodes
+                        .iter()
+                        .map(|n| (n.key, n.points as usize))
+                        .collect()
+                };
                 let loaded = copc_lod::Loaded {
+                    nodes,
                     spacing: deepest * (cut.root_stride as f64).sqrt() / cloud.scale,
                     size_scales: spacings
                         .iter()

@@ -553,6 +553,14 @@ pub fn legends(
                         s.range(&sp.property),
                     ));
                 }
+                ColourMode::Elevation => {
+                    out.push(gradient(
+                        "elevation",
+                        unit(COLOR_A),
+                        unit(COLOR_B),
+                        Some(s.elevation),
+                    ));
+                }
                 ColourMode::Intensity => {
                     let max = s.range("intensity").map_or(1.0, |r| r[1].max(1.0));
                     out.push(gradient(

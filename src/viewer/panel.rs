@@ -296,7 +296,7 @@ fn controls(
     let fidelity = scene.fidelity;
     if let TechniqueScene::Splats(sp) = &mut scene.technique {
         ui.separator();
-        if super::splats::editor(ui, sp, fidelity, w) {
+        if super::splats::editor(ui, sp, fidelity, data.cloud.as_ref(), w) {
             actions.push(UiAction::ParamsChanged);
         }
     }

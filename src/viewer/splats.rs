@@ -1,8 +1,11 @@
-//! The splat editor: layers shown or hidden, colour mode, faults and undefined facies,
+//! The splat editor: layers and classification codes shown or hidden, colour mode and
+//! property (the cloud's own attributes), faults and undefined facies,
 //! point size and factor, kernel and its width, lighting (per-layer normals), sort
 //! method, points or tiles (precise only), the tile size and eye-dome lighting, and volume mode's transfer
 //! function. The frame, sort and tile-list times show in the panel's status line.
 
+use super::legend::class_name;
+use super::summary::CloudSummary;
 use super::widgets::Widgets;
 use crate::techniques::splats::scene::{ColourMode, DrawChoice, Kernel, Mode, SortChoice};
 use crate::techniques::splats::SplatsScene;
@@ -11,27 +14,34 @@ use crate::vocab::Fidelity;
 /// Layer ids with a toggle (the seed's sections have layers 0..7).
 pub const LAYERS: i32 = 8;
 
-/// Draw the editor for a scene of `fidelity`; true when something changed.
+/// Properties offered when the cloud is not known (the seed's sections').
+const SEED_PROPERTIES: [&str; 3] = ["porosity", "amplitude", "joint_dip"];
+
+/// Draw the editor for a scene of `fidelity` (its cloud summarised by `cloud`, where
+/// loaded); true when something changed.
 pub fn editor(
     ui: &mut egui::Ui,
     scene: &mut SplatsScene,
     fidelity: Fidelity,
+    cloud: Option<&CloudSummary>,
     w: &mut Widgets,
 ) -> bool {
     let mut changed = false;
+    let classes = cloud.map_or(&[][..], |c| c.classes.as_slice());
+    if !classes.is_empty() {
+        ui.label("Classes shown");
+        ui.horizontal_wrapped(|ui| {
+            for &class in classes {
+                let (label, text) = (format!("Class {class}"), class_name(class));
+                changed |= shown_toggle(ui, w, &mut scene.hide_classes, class, &label, &text);
+            }
+        });
+    }
     ui.label("Layers shown");
     ui.horizontal_wrapped(|ui| {
         for layer in 0..LAYERS {
-            let mut shown = !scene.hide_layers.contains(&layer);
-            let label = format!("Layer {layer}");
-            if w.checkbox(ui, &label, &mut shown, &layer.to_string()) {
-                scene.hide_layers.retain(|&l| l != layer);
-                if !shown {
-                    scene.hide_layers.push(layer);
-                    scene.hide_layers.sort_unstable();
-                }
-                changed = true;
-            }
+            let (label, text) = (format!("Layer {layer}"), layer.to_string());
+            changed |= shown_toggle(ui, w, &mut scene.hide_layers, layer, &label, &text);
         }
     });
     changed |= w.checkbox(
@@ -59,24 +69,21 @@ pub fn editor(
                 (ColourMode::Rgb, "rgb"),
                 (ColourMode::Intensity, "intensity"),
                 (ColourMode::Classification, "classification"),
+                (ColourMode::Elevation, "elevation"),
             ],
             120.0,
         );
     });
     let mut property = scene.property.clone();
+    // The cloud's own attributes (a LAS file's intensity, GPS time, extra bytes, ...).
+    let names: Vec<String> = match cloud {
+        Some(c) if !c.ranges.is_empty() => c.ranges.iter().map(|(n, _)| n.clone()).collect(),
+        _ => SEED_PROPERTIES.iter().map(|n| n.to_string()).collect(),
+    };
+    let properties: Vec<(String, &str)> = names.iter().map(|n| (n.clone(), n.as_str())).collect();
     ui.horizontal_wrapped(|ui| {
         ui.label("Property");
-        if w.choice(
-            ui,
-            "Property",
-            &mut property,
-            &[
-                ("porosity".to_string(), "porosity"),
-                ("amplitude".to_string(), "amplitude"),
-                ("joint_dip".to_string(), "joint_dip"),
-            ],
-            120.0,
-        ) {
+        if w.choice(ui, "Property", &mut property, &properties, 120.0) {
             scene.property = property;
             changed = true;
         }
@@ -186,4 +193,26 @@ pub fn editor(
         });
     });
     changed
+}
+
+/// A checkbox (widget `label`, showing `text`) ticked while `id` is not in `hidden`
+/// (kept sorted); true when toggled.
+fn shown_toggle(
+    ui: &mut egui::Ui,
+    w: &mut Widgets,
+    hidden: &mut Vec<i32>,
+    id: i32,
+    label: &str,
+    text: &str,
+) -> bool {
+    let mut shown = !hidden.contains(&id);
+    if !w.checkbox(ui, label, &mut shown, text) {
+        return false;
+    }
+    hidden.retain(|&h| h != id);
+    if !shown {
+        hidden.push(id);
+        hidden.sort_unstable();
+    }
+    true
 }

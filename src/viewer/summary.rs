@@ -80,6 +80,8 @@ pub struct CloudSummary {
     pub faults: bool,
     /// Each attribute's name and finite range.
     pub ranges: Vec<(String, [f64; 2])>,
+    /// Lowest and highest z, in the file's units.
+    pub elevation: [f64; 2],
 }
 
 fn distinct(values: Option<&[i32]>) -> (Vec<i32>, usize) {
@@ -107,6 +109,7 @@ impl CloudSummary {
                 .iter()
                 .map(|a| (a.name.clone(), [a.stats.min, a.stats.max]))
                 .collect(),
+            elevation: [lo[2], hi[2]],
         }
     }
 

@@ -251,3 +251,53 @@ fn a_copc_cloud_in_a_scene_takes_whole_levels_within_its_budget() {
         .count();
     assert!(lit > 20, "{lit} pixels lit");
 }
+
+/// GPS time reaches the cloud as seconds after the file's earliest (the COPC info VLR's
+/// minimum; a plain LAS/LAZ read, the earliest point's), in f32: every cut of the COPC
+/// file and the whole-file read give each point the same value, equal to the node's raw
+/// f64 time less that reference, rounded once to f32.
+#[test]
+fn gps_time_is_an_attribute_after_the_files_earliest() {
+    use arbvis::points::PointSource;
+    for name in FILES {
+        let path = data_file(name);
+        let copc = Copc::open(&path).unwrap();
+        let reference = copc.info.gps_range[0];
+        let mut raw: Vec<f64> = Vec::new();
+        for node in &copc.nodes {
+            raw.extend(copc.read_node(node).unwrap().gps_time().unwrap());
+        }
+        let earliest = raw.iter().copied().fold(f64::INFINITY, f64::min);
+        assert!(
+            reference <= earliest,
+            "{name}: info {reference}, points {earliest}"
+        );
+        let expected = |reference: f64| -> Vec<u32> {
+            let mut v: Vec<u32> = raw
+                .iter()
+                .map(|&t| ((t - reference) as f32).to_bits())
+                .collect();
+            v.sort_unstable();
+            v
+        };
+        let values = |cloud: &arbvis::points::PointCloud| -> Vec<u32> {
+            let a = cloud.attribute("gps_time").expect("a gps_time attribute");
+            let arbvis::points::Values::Float(v) = &a.values else {
+                panic!("gps_time is not float")
+            };
+            let mut v: Vec<u32> = v.iter().map(|t| t.to_bits()).collect();
+            v.sort_unstable();
+            v
+        };
+        let base = path.parent().unwrap();
+        let file = path.file_name().unwrap().to_str().unwrap();
+        let all = PointSource::copc(file, 1_000_000).load(base).unwrap();
+        assert_eq!(values(&all), expected(reference), "{name}");
+        // A coarser cut: its points keep the values they have in the full one.
+        let cut = PointSource::copc(file, 100).load(base).unwrap();
+        let full = values(&all);
+        assert!(values(&cut).iter().all(|v| full.binary_search(v).is_ok()));
+        let whole = arbvis::points::lasfile::read(&path).unwrap().cloud;
+        assert_eq!(values(&whole), expected(earliest), "{name}");
+    }
+}

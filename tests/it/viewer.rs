@@ -409,6 +409,53 @@ click Save scene
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A lidar cloud's editor: a classification code hidden, colour by elevation, and the
+/// property list offering the file's own attributes (GPS time).
+#[test]
+fn the_splat_editor_hides_classes_and_offers_the_clouds_attributes() {
+    let dir = temp_dir("splat-classes-scene");
+    let scene = dir.join("lidar.toml");
+    let cloud =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("data/points/autzen_trim.laz");
+    std::fs::write(
+        &scene,
+        format!(
+            "fidelity = \"precise\"\n[camera]\nrotation = [0.2, 0.1, 0.0, 0.97]\nzoom = 1.8\n[technique.splats]\ncloud = {{ las = {:?} }}\ncolour = \"rgb\"\npoint_size = 6.0\n",
+            cloud.display().to_string()
+        ),
+    )
+    .unwrap();
+    let script = "\
+resize 900 640
+wait 2
+click Class 2
+set Colour elevation
+set Property gps_time
+set Box and labels false
+click Screenshot
+click Save scene
+";
+    let Some((out, _)) = run_script("splat-classes", scene.to_str().unwrap(), "200x150", script)
+    else {
+        return;
+    };
+    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let TechniqueScene::Splats(s) = &saved.technique else {
+        panic!("saved scene is not splats");
+    };
+    // autzen_trim holds classes 1 and 2; the second is hidden.
+    assert_eq!(s.hide_classes, vec![2]);
+    assert_eq!(
+        s.colour,
+        arbvis::techniques::splats::scene::ColourMode::Elevation
+    );
+    assert_eq!(s.property, "gps_time");
+    let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// What a script's `print Clip stats` steps wrote (`print LABEL: TEXT (script line N)`).
 fn clip_stats_lines(stdout: &str) -> Vec<&str> {
     stdout

@@ -134,6 +134,7 @@ pub fn from_cloud(
     let grey = [0.6f32; 3];
     // LAS stores colour in 16 bits, but many writers put 8-bit values there (autzen's
     // largest is 236): scale by 255 when nothing exceeds it, as PDAL and CloudCompare do.
+    let elevation_range = [cloud.bounds[0][2], cloud.bounds[1][2]];
     let rgb_scale = match &cloud.rgb {
         Some(rgb) if rgb.iter().flatten().all(|&v| v <= 255) => 255.0,
         _ => 65535.0,
@@ -158,6 +159,10 @@ pub fn from_cloud(
                 ColourMode::Classification => cloud
                     .ints("classification")
                     .map_or(grey, |c| byte_colour(class_colour(c[i]))),
+                ColourMode::Elevation => {
+                    let z = cloud.origin[2] + cloud.scale * cloud.positions[i][2] as f64;
+                    gradient_scale(z, elevation_range, Fidelity::Precise).map(|c| c as f32)
+                }
                 ColourMode::Property => grey,
             };
             match faults {
@@ -472,5 +477,43 @@ mod tests {
             assert_eq!(p.visible[i], ![2, 7].contains(c), "point {i}, class {c}");
         }
         assert_eq!(p.colours[2], byte_colour(class_colour(5)));
+    }
+
+    /// Elevation colours each point by its own z in the file's units through the
+    /// gradient, over the cloud's z range: the lowest at the gradient's start, the
+    /// highest at its end, one in between where its height puts it (within f32 rounding
+    /// of the positions: 1e-5 of the range).
+    #[test]
+    fn elevation_follows_each_points_height() {
+        use crate::points::CloudParts;
+        // Uneven heights far from the origin (a lidar tile's), x and y unrelated to z.
+        let z: Vec<f64> = (0..40)
+            .map(|i| 312.5 + ((i * 37) % 23) as f64 * 1.7)
+            .collect();
+        let cloud = PointCloud::from_parts(CloudParts {
+            positions: (0..40)
+                .map(|i| [635_000.0 + (i * 13 % 7) as f64, 848_000.0 + i as f64, z[i]])
+                .collect(),
+            attributes: vec![],
+            rgb: None,
+            normals: None,
+        })
+        .unwrap();
+        let mut s = scene();
+        s.colour = ColourMode::Elevation;
+        let p = from_cloud(&cloud, &s, None).unwrap();
+        let (lo, hi) = (312.5, 312.5 + 22.0 * 1.7);
+        for (i, &zi) in z.iter().enumerate() {
+            let want = gradient_scale(zi, [lo, hi], Fidelity::Precise);
+            let near = gradient_scale(zi + 1e-5 * (hi - lo), [lo, hi], Fidelity::Precise);
+            for c in 0..3 {
+                let tolerance = (near[c] - want[c]).abs().max(1e-6);
+                assert!(
+                    (p.colours[i][c] as f64 - want[c]).abs() <= tolerance,
+                    "point {i} (z {zi}) channel {c}: {:?} vs {want:?}",
+                    p.colours[i]
+                );
+            }
+        }
     }
 }

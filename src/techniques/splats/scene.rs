@@ -24,6 +24,8 @@ pub enum ColourMode {
     Intensity,
     /// LAS classification, one colour per class.
     Classification,
+    /// Height (z, the file's units) through the property gradient, over the cloud's z range.
+    Elevation,
 }
 
 /// How a splat's alpha falls off from its centre.
