@@ -88,6 +88,32 @@ impl Mesh {
         crate::gl_debug_check!(gpu)
     }
 
+    /// Overwrite the vertices from `first` on with `vertices` (within the buffer: it
+    /// keeps its size and the other vertices).
+    pub fn update_range(&mut self, gpu: &Gpu, first: usize, vertices: &[f32]) -> GlResult<()> {
+        let f = self.floats_per_vertex;
+        let count = vertices.len() / f;
+        if !vertices.len().is_multiple_of(f) || first + count > self.vertex_count {
+            return Err(GlError::Invalid(format!(
+                "mesh {}: {} floats at vertex {first} do not fit its {} vertices of {f} floats",
+                self.label,
+                vertices.len(),
+                self.vertex_count
+            )));
+        }
+        // SAFETY: f32 slice viewed as bytes, written inside the buffer (checked above);
+        // the buffer binding is restored to none.
+        unsafe {
+            let bytes =
+                std::slice::from_raw_parts(vertices.as_ptr().cast::<u8>(), vertices.len() * 4);
+            self.gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.vbo));
+            self.gl
+                .buffer_sub_data_u8_slice(glow::ARRAY_BUFFER, (first * f * 4) as i32, bytes);
+            self.gl.bind_buffer(glow::ARRAY_BUFFER, None);
+        }
+        crate::gl_debug_check!(gpu)
+    }
+
     fn upload(&mut self, vertices: &[f32]) -> GlResult<()> {
         if !vertices.len().is_multiple_of(self.floats_per_vertex) {
             return Err(GlError::Invalid(format!(

@@ -366,3 +366,75 @@ fn a_second_cut_takes_its_nodes_from_memory() {
     assert_eq!(first, second);
     assert!(arbvis::points::copc_cache::held() > 0);
 }
+
+/// The GPU node cache: when the camera stops and a new cut arrives, only the nodes the
+/// vertex buffer lacks are uploaded, and the picture is the one a renderer built afresh
+/// for that view draws, bit for bit. A budget of 100 points (room for 150 in the buffer),
+/// every node eligible, and six views zoomed in turn make nodes leave, come back and be
+/// evicted.
+#[test]
+fn a_refined_cut_uploads_only_what_the_buffer_lacks_and_draws_as_a_fresh_one() {
+    let text = format!(
+        "size = [160, 90]\nfidelity = \"precise\"\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\", points = 100, min_node_pixels = 0.0 }} }}\ncolour = \"rgb\"\n",
+        data_file("points/simple_with_page.copc.laz").display()
+    );
+    let scene = arbvis::scene::Scene::parse(&text, "cache.toml").unwrap();
+    let h = crate::common::headless(arbvis::gl::Backend::Egl);
+    let gpu = h.gpu();
+    let kind = scene.programs.resolve(gpu);
+    let draw = |r: &mut Box<dyn arbvis::techniques::Renderer>, camera: &Camera| {
+        let target =
+            arbvis::gl::Target::new(gpu, 160, 90, arbvis::gl::TargetFormat::Rgba32f).unwrap();
+        let frame = arbvis::techniques::Frame {
+            camera: *camera,
+            width: 160,
+            height: 90,
+        };
+        r.draw(gpu, arbvis::gl::Surface::Target(&target), &frame)
+            .unwrap();
+        target.read(gpu).unwrap()
+    };
+    let mut r = arbvis::catalog::build(gpu, &scene.technique, &scene.settings(), kind).unwrap();
+    let views = [
+        camera(Projection::Perspective, 5.0, [0.2, 0.6, -0.1, 0.75]),
+        camera(Projection::Perspective, 8.0, [-0.3, 0.1, 0.4, 0.85]),
+        camera(Projection::Orthographic, 6.0, [0.05, -0.2, 0.1, 0.97]),
+        camera(Projection::Perspective, 9.0, [0.7, -0.3, 0.2, 0.6]),
+        camera(Projection::Orthographic, 7.0, [-0.5, 0.5, 0.5, 0.5]),
+        camera(Projection::Perspective, 5.0, [0.2, 0.6, -0.1, 0.75]),
+    ];
+    let (mut kept, mut evicted) = (0, 0);
+    for (k, c) in views.iter().enumerate() {
+        let start = std::time::Instant::now();
+        while !r.settle(gpu, c, scene.size).unwrap() {
+            assert!(
+                start.elapsed().as_secs() < 30,
+                "view {k}: the cut never arrived"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+        let status = r.status().unwrap();
+        let line = status
+            .lines()
+            .find(|l| l.starts_with("node cache: "))
+            .unwrap_or_else(|| panic!("view {k}: no node cache line in\n{status}"));
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let (uploaded, nodes): (usize, usize) =
+            (words[2].parse().unwrap(), words[6].parse().unwrap());
+        assert!(uploaded <= nodes, "{line}");
+        kept += nodes - uploaded;
+        evicted += words[9].parse::<usize>().unwrap();
+        // The same view built afresh draws the same picture.
+        let mut settings = scene.settings();
+        settings.view = View::of(c, scene.size);
+        let mut fresh = arbvis::catalog::build(gpu, &scene.technique, &settings, kind).unwrap();
+        let (a, b) = (draw(&mut r, c), draw(&mut fresh, c));
+        assert_eq!(a.data, b.data, "view {k}: {line}");
+        assert!(
+            a.data.chunks(4).any(|p| p[3] > 0.0),
+            "view {k} drew nothing"
+        );
+    }
+    // Nodes were kept from cut to cut, and some evicted for others.
+    assert!(kept > 0 && evicted > 0, "kept {kept}, evicted {evicted}");
+}

@@ -41,6 +41,7 @@ pub mod oit;
 pub mod prepare;
 pub mod reference;
 pub mod renderer;
+pub mod resident;
 pub mod scene;
 pub mod sort;
 pub mod study;

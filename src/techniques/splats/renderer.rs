@@ -24,9 +24,10 @@ use super::edl::{EdlPass, EdlView};
 use super::oit::{z_row, OitPass};
 use super::prepare::{
     from_cloud, normals_for, point_size_for_spacing, prepare_for, Prepared, COLOR_A, COLOR_B,
-    PHONG, VERTEX_COMPONENTS,
+    FLOATS_PER_VERTEX, PHONG, VERTEX_COMPONENTS,
 };
 use super::reference::{eye_position, view_direction, SplatParams};
+use super::resident::{NodeKey, Resident};
 use super::scene::{ColourMode, DrawChoice, Kernel, Mode, SortChoice, SplatsScene};
 use super::sort::{seed_order, SeedPoint, SortCache, SortMethod, View};
 use super::tiled::TilePass;
@@ -103,6 +104,15 @@ pub struct SplatsRenderer {
     edl: Option<EdlPass>,
     /// A COPC cut's points' sizes over the scene's (tiles only; empty: all 1).
     size_scales: Vec<f32>,
+    /// A COPC cut's nodes (key, points) in the cloud's order (empty for other clouds).
+    nodes: Vec<(NodeKey, usize)>,
+    /// The GPU node cache placing those nodes in the vertex buffer (`None`: the buffer
+    /// holds the cloud's vertices in its order).
+    resident: Option<Resident>,
+    /// Each point's vertex in the cache's buffer (empty without the cache).
+    in_buffer: Vec<u32>,
+    /// The last placement: nodes uploaded, nodes in the cut, nodes evicted.
+    last_upload: Option<[usize; 3]>,
 }
 
 /// The tile pass and the frame its uploads were made for.
@@ -185,29 +195,67 @@ impl SplatsRenderer {
         if let (Some(l), Some(v)) = (&loaded, &view) {
             sized.point_size = point_size_for_spacing(params, v, l.spacing);
         }
-        let mut r =
-            SplatsRenderer::from_prepared(gpu, kind, fidelity, &sized, base, cloud, prepared)?;
+        let nodes = loaded.as_ref().map_or(Vec::new(), |l| l.nodes.clone());
+        let mut r = SplatsRenderer::with_nodes(
+            gpu,
+            kind,
+            fidelity,
+            &sized,
+            base,
+            (cloud, prepared, nodes),
+        )?;
         r.view = view;
         r.scene_point_size = params.point_size;
         r.spacing = loaded.as_ref().map(|l| l.spacing);
         if let Some(l) = loaded {
-            r.cut = Some(format!(
-                "{}; splats of point size {:.1} (the scene's {:.1}){}",
-                l.describe,
-                sized.point_size,
-                params.point_size,
-                if r.params.draw == DrawChoice::Tiles {
-                    ", larger where coarser levels stand in for missing ones"
-                } else {
-                    ""
-                }
-            ));
+            r.cut = Some(cut_text(&l, &sized, params.point_size));
             if let Some(t) = &mut r.tiles {
                 t.points.size_scales = l.size_scales.clone();
             }
             r.size_scales = l.size_scales;
         }
         Ok(r)
+    }
+
+    /// Draw a new cut of the same cloud for `view` (the viewer's refinement): programs,
+    /// targets and the vertex buffer are kept, and through the node cache only the nodes
+    /// the buffer lacks are uploaded.
+    fn replace_cut(
+        &mut self,
+        gpu: &Gpu,
+        params: &SplatsScene,
+        view: CloudView,
+        (cloud, prepared, loaded): Prepared3,
+    ) -> GlResult<()> {
+        let Some(l) = loaded else {
+            let base = self.base.clone();
+            *self = SplatsRenderer::upload(
+                gpu,
+                self.kind,
+                self.fidelity,
+                params,
+                &base,
+                Some(view),
+                (cloud, prepared, None),
+            )?;
+            return Ok(());
+        };
+        let sized = SplatsScene {
+            point_size: point_size_for_spacing(params, &view, l.spacing),
+            ..params.clone()
+        };
+        self.normals = (sized.lighting && sized.mode == Mode::Surface)
+            .then(|| (prepared.normals.clone(), prepared.normal_fallbacks));
+        self.cut = Some(cut_text(&l, &sized, params.point_size));
+        self.params = sized;
+        self.scene_point_size = params.point_size;
+        self.cloud = cloud;
+        self.prepared = prepared;
+        self.view = Some(view);
+        self.spacing = Some(l.spacing);
+        self.size_scales = l.size_scales;
+        self.nodes = l.nodes;
+        self.install(gpu)
     }
 
     /// Upload a cloud prepared elsewhere.
@@ -219,6 +267,20 @@ impl SplatsRenderer {
         base: &Path,
         cloud: PointCloud,
         prepared: Prepared,
+    ) -> GlResult<SplatsRenderer> {
+        let nodes = Vec::new();
+        SplatsRenderer::with_nodes(gpu, kind, fidelity, params, base, (cloud, prepared, nodes))
+    }
+
+    /// [`SplatsRenderer::from_prepared`], a COPC cut's `nodes` (in the cloud's order)
+    /// placed through the GPU node cache.
+    fn with_nodes(
+        gpu: &Gpu,
+        kind: ProgramKind,
+        fidelity: Fidelity,
+        params: &SplatsScene,
+        base: &Path,
+        (cloud, prepared, nodes): (PointCloud, Prepared, Vec<(NodeKey, usize)>),
     ) -> GlResult<SplatsRenderer> {
         params
             .draw_allowed(fidelity, crate::gl::ProgramChoice::Auto)
@@ -257,6 +319,10 @@ impl SplatsRenderer {
             loading: None,
             edl: None,
             size_scales: Vec::new(),
+            nodes,
+            resident: None,
+            in_buffer: Vec::new(),
+            last_upload: None,
         };
         r.install(gpu)?;
         Ok(r)
@@ -390,13 +456,78 @@ impl SplatsRenderer {
                 entries: Ok(0),
             }),
         };
-        self.mesh.clear_indices();
-        self.mesh.update(gpu, &self.prepared.vertices(None))?;
-        if matches!(self.params.sort, SortChoice::None | SortChoice::Oit) {
-            let visible: Vec<u32> = self.visible(0..self.prepared.len() as u32);
-            self.mesh.set_indices(gpu, &visible)?;
+        self.upload_vertices(gpu)?;
+        // Unordered sorts draw the visible points as they are; through the node cache
+        // every draw goes through indices (the buffer holds other nodes too).
+        let unordered = matches!(self.params.sort, SortChoice::None | SortChoice::Oit);
+        if unordered || self.resident.is_some() {
+            let visible = self.visible(0..self.prepared.len() as u32);
+            self.set_indices(gpu, visible)?;
         }
         self.send_constants(gpu)
+    }
+
+    /// The cloud's vertices into the buffer: through the node cache for a COPC cut
+    /// (only the nodes it lacks, or whose vertices changed), else whole.
+    fn upload_vertices(&mut self, gpu: &Gpu) -> GlResult<()> {
+        let vertices = self.prepared.vertices(None);
+        let f = FLOATS_PER_VERTEX;
+        let whole = self.nodes.iter().map(|n| n.1).sum::<usize>() == self.prepared.len();
+        // The seed's sort rewrites the buffer in order each time: no cache there.
+        if self.nodes.is_empty() || !whole || self.params.sort == SortChoice::Seed {
+            self.resident = None;
+            self.in_buffer.clear();
+            self.last_upload = None;
+            self.mesh.clear_indices();
+            return self.mesh.update(gpu, &vertices);
+        }
+        let mut slices = Vec::with_capacity(self.nodes.len());
+        let mut at = 0;
+        for &(key, n) in &self.nodes {
+            slices.push((key, &vertices[at * f..(at + n) * f]));
+            at += n;
+        }
+        // Room for one and a half point budgets: a turn's new nodes fit beside the drawn
+        // ones. Its CPU mirror is held to the memory budget; over it, no cache.
+        let fresh = self.resident.is_none();
+        if fresh {
+            let capacity = budget_of(&self.params).saturating_mul(3) / 2;
+            let capacity = capacity.max(self.prepared.len());
+            let bytes = (capacity * f * 4) as u64;
+            if crate::budget::check("the GPU node cache's copy of its vertices", bytes).is_err() {
+                self.nodes.clear();
+                return self.upload_vertices(gpu);
+            }
+            self.resident = Some(Resident::new(capacity, f));
+        }
+        let resident = self.resident.as_mut().expect("made above");
+        let placed = resident.place(&slices);
+        if fresh || placed.rebuilt {
+            self.mesh.clear_indices();
+            self.mesh.update(gpu, resident.vertices())?;
+        } else {
+            for &k in &placed.uploads {
+                self.mesh.update_range(gpu, placed.starts[k], slices[k].1)?;
+            }
+        }
+        self.in_buffer = self
+            .nodes
+            .iter()
+            .zip(&placed.starts)
+            .flat_map(|(&(_, n), &start)| (start..start + n).map(|v| v as u32))
+            .collect();
+        self.last_upload = Some([placed.uploads.len(), self.nodes.len(), placed.evicted]);
+        Ok(())
+    }
+
+    /// Draw the points `order` (the cloud's indices) from now on, through the node
+    /// cache's placement when there is one.
+    fn set_indices(&mut self, gpu: &Gpu, order: Vec<u32>) -> GlResult<()> {
+        if self.in_buffer.is_empty() {
+            return self.mesh.set_indices(gpu, &order);
+        }
+        let mapped: Vec<u32> = order.iter().map(|&i| self.in_buffer[i as usize]).collect();
+        self.mesh.set_indices(gpu, &mapped)
     }
 
     /// The prepared cloud.
@@ -429,7 +560,7 @@ impl SplatsRenderer {
         } else if let Some(cache) = &mut self.cache {
             let order: Vec<u32> = cache.order(&self.prepared.positions, view).to_vec();
             let order = self.visible(order);
-            self.mesh.set_indices(gpu, &order)?;
+            self.set_indices(gpu, order)?;
         }
         self.last_sort = t0.elapsed();
         self.ordered_for = Some(bits);
@@ -649,16 +780,7 @@ impl Renderer for SplatsRenderer {
                             return Ok(true);
                         }
                     };
-                    let base = self.base.clone();
-                    *self = SplatsRenderer::upload(
-                        gpu,
-                        self.kind,
-                        self.fidelity,
-                        &params,
-                        &base,
-                        Some(view),
-                        loaded,
-                    )?;
+                    self.replace_cut(gpu, &params, view, loaded)?;
                     return Ok(true);
                 }
                 Err(std::sync::mpsc::TryRecvError::Empty) if same(&loading.view) => {
@@ -685,7 +807,14 @@ impl Renderer for SplatsRenderer {
     }
 
     fn status(&self) -> Option<String> {
-        let line = self.frame_status();
+        let mut line = self.frame_status();
+        if let (Some([uploaded, nodes, evicted]), Some(r)) = (self.last_upload, &self.resident) {
+            line = format!(
+                "node cache: {uploaded} of the cut's {nodes} nodes uploaded, {evicted} evicted; {} nodes resident in room for {} points\n{line}",
+                r.len(),
+                r.capacity()
+            );
+        }
         Some(match &self.cut {
             Some(cut) => format!("{cut}\n{line}"),
             None => line,
@@ -715,4 +844,26 @@ pub fn program_pairs() -> Vec<ProgramPair> {
         &SPLATS_OIT_COMPOSITE_FRAG,
     ));
     pairs
+}
+
+/// A COPC cut's line: what it holds and how its splats are sized.
+fn cut_text(l: &crate::points::copc_lod::Loaded, sized: &SplatsScene, scene_size: f64) -> String {
+    format!(
+        "{}; splats of point size {:.1} (the scene's {scene_size:.1}){}",
+        l.describe,
+        sized.point_size,
+        if sized.draw == DrawChoice::Tiles {
+            ", larger where coarser levels stand in for missing ones"
+        } else {
+            ""
+        }
+    )
+}
+
+/// A COPC scene's point budget (0 for other clouds).
+fn budget_of(scene: &SplatsScene) -> usize {
+    match &scene.cloud {
+        crate::points::PointSource::Copc(spec) => usize::try_from(spec.points).unwrap_or(0),
+        _ => 0,
+    }
 }
