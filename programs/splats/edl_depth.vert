@@ -6,6 +6,7 @@
 // [6]: (point size, factor, 0, 0); [8]: the view-distance row; [10]: (smallest size,
 // largest size, 0, 0). GLSL only (with the tiles it serves).
 layout(location = 0) in vec3 aPos;
+layout(location = 4) in float aScale;
 uniform vec4 vertex_local[11];
 out float v_z;
 void main() {
@@ -15,7 +16,7 @@ void main() {
     bool perspective = vertex_local[4].w > 0.5;
     vec3 d = aPos - vertex_local[4].xyz;
     float dd = (perspective ? 1.0 : 0.0) * (dot(d, d) - 1.0) + 1.0;
-    float size = vertex_local[6].x * inversesqrt(dd) * vertex_local[6].y;
+    float size = vertex_local[6].x * inversesqrt(dd) * vertex_local[6].y * aScale;
     if (!isnan(size)) size = clamp(size, vertex_local[10].x, vertex_local[10].y);
     gl_PointSize = size;
     v_z = dot(vertex_local[8], p);

@@ -15,6 +15,9 @@ layout(location = 0) in vec3 aPos;
 layout(location = 1) in vec3 aColor;
 layout(location = 2) in float aValue;
 layout(location = 3) in vec3 aNormal;
+// A COPC point's size over the deepest drawn level's (1 for other clouds): coarse points
+// cover for the children not drawn.
+layout(location = 4) in float aScale;
 uniform vec4 vertex_local[11];
 out vec3 v_color;
 out float v_value;
@@ -34,7 +37,7 @@ void main() {
     // the ARB twin selects it (exact for distances over 0.71, the eye's units).
     vec3 d = aPos - cameraPos;
     float dd = (perspective ? 1.0 : 0.0) * (dot(d, d) - 1.0) + 1.0;
-    float size = pointSize * inversesqrt(dd) * factor;
+    float size = pointSize * inversesqrt(dd) * factor * aScale;
     // GL clamps gl_PointSize to its range; a NaN size stays NaN (nothing is drawn).
     if (!isnan(size)) size = clamp(size, vertex_local[10].x, vertex_local[10].y);
     gl_PointSize = size + vertex_local[10].z;

@@ -259,7 +259,8 @@ fn controls(
         state.fps, state.frame_ms
     ));
     if !state.volume_info.is_empty() {
-        ui.label(RichText::new(&state.volume_info).small());
+        // The renderer's own lines (a COPC cut, its node cache), recorded for scripts.
+        w.text(ui, "Renderer", &state.volume_info);
     }
     ui.separator();
 
@@ -394,7 +395,8 @@ fn controls(
         }
     });
     if !state.status.is_empty() {
-        ui.label(RichText::new(&state.status).small());
+        // Recorded for scripts (`print Status`).
+        w.text(ui, "Status", &state.status);
     }
 }
 

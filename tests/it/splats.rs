@@ -259,7 +259,11 @@ fn the_demo_builds_what_it_draws() {
         "{:?}",
         r.resources
     );
-    assert_eq!(r.resources[1].bytes, 20_000 * 10 * 4, "10 floats per point");
+    assert_eq!(
+        r.resources[1].bytes,
+        20_000 * 11 * 4,
+        "11 floats per point: position, colour, value, normal, size scale"
+    );
     let lit = r
         .image
         .data

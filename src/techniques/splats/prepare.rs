@@ -12,10 +12,12 @@ use crate::points::section::{facies_colour, PALETTE};
 use crate::points::{PointCloud, FACIES, FAULT, LAYER, UNDEFINED_FACIES};
 use crate::vocab::Fidelity;
 
-/// Floats per vertex: position 3, colour 3, property value 1, normal 3.
-pub const VERTEX_COMPONENTS: [usize; 4] = [3, 3, 1, 3];
+/// Floats per vertex: position 3, colour 3, property value 1, normal 3, size scale 1 (a
+/// COPC point's spacing over the deepest drawn level's; the precise programs multiply the
+/// splat size by it, the seed's ignore it).
+pub const VERTEX_COMPONENTS: [usize; 5] = [3, 3, 1, 3, 1];
 /// Sum of [`VERTEX_COMPONENTS`].
-pub const FLOATS_PER_VERTEX: usize = 10;
+pub const FLOATS_PER_VERTEX: usize = 11;
 
 /// The gradient scale's two end colours. The seed shows its gradient (Figure 3) but not
 /// the values of `colorA` and `colorB`; these are ours: deep blue to warm yellow.
@@ -227,14 +229,16 @@ impl Prepared {
         self.positions.is_empty()
     }
 
-    /// The vertex data of the points in `order` (all points when `None`).
-    pub fn vertices(&self, order: Option<&[u32]>) -> Vec<f32> {
+    /// The vertex data of the points in `order` (all points when `None`), each point's
+    /// size scaled by `scales` (1 where it has none).
+    pub fn vertices(&self, order: Option<&[u32]>, scales: &[f32]) -> Vec<f32> {
         let mut out = Vec::with_capacity(self.len() * FLOATS_PER_VERTEX);
         let mut push = |i: usize| {
             out.extend_from_slice(&self.positions[i]);
             out.extend_from_slice(&self.colours[i]);
             out.push(self.values[i]);
             out.extend_from_slice(&self.normals[i]);
+            out.push(scales.get(i).copied().unwrap_or(1.0));
         };
         match order {
             Some(o) => o.iter().for_each(|&i| push(i as usize)),
@@ -412,7 +416,7 @@ mod tests {
             }
         }
         assert!(p.range[0] >= 0.0 && p.range[1] > p.range[0]);
-        assert_eq!(p.vertices(None).len(), 2000 * FLOATS_PER_VERTEX);
+        assert_eq!(p.vertices(None, &[]).len(), 2000 * FLOATS_PER_VERTEX);
         assert!(matches!(s.cloud, PointSource::Section(_)));
     }
 

@@ -155,6 +155,9 @@ type Prepared3 = (
     Option<crate::points::copc_lod::Loaded>,
 );
 
+/// A COPC cut's nodes (key, points, in the cloud's order) and its points' size scales.
+type CutParts = (Vec<(NodeKey, usize)>, Vec<f32>);
+
 /// A COPC cut being loaded on a thread for a view.
 struct Loading {
     view: CloudView,
@@ -195,24 +198,16 @@ impl SplatsRenderer {
         if let (Some(l), Some(v)) = (&loaded, &view) {
             sized.point_size = point_size_for_spacing(params, v, l.spacing);
         }
-        let nodes = loaded.as_ref().map_or(Vec::new(), |l| l.nodes.clone());
-        let mut r = SplatsRenderer::with_nodes(
-            gpu,
-            kind,
-            fidelity,
-            &sized,
-            base,
-            (cloud, prepared, nodes),
-        )?;
+        let cut = loaded.as_ref().map_or((Vec::new(), Vec::new()), |l| {
+            (l.nodes.clone(), l.size_scales.clone())
+        });
+        let mut r =
+            SplatsRenderer::with_nodes(gpu, kind, fidelity, &sized, base, (cloud, prepared, cut))?;
         r.view = view;
         r.scene_point_size = params.point_size;
         r.spacing = loaded.as_ref().map(|l| l.spacing);
         if let Some(l) = loaded {
             r.cut = Some(cut_text(&l, &sized, params.point_size));
-            if let Some(t) = &mut r.tiles {
-                t.points.size_scales = l.size_scales.clone();
-            }
-            r.size_scales = l.size_scales;
         }
         Ok(r)
     }
@@ -268,19 +263,19 @@ impl SplatsRenderer {
         cloud: PointCloud,
         prepared: Prepared,
     ) -> GlResult<SplatsRenderer> {
-        let nodes = Vec::new();
-        SplatsRenderer::with_nodes(gpu, kind, fidelity, params, base, (cloud, prepared, nodes))
+        let cut = (Vec::new(), Vec::new());
+        SplatsRenderer::with_nodes(gpu, kind, fidelity, params, base, (cloud, prepared, cut))
     }
 
-    /// [`SplatsRenderer::from_prepared`], a COPC cut's `nodes` (in the cloud's order)
-    /// placed through the GPU node cache.
+    /// [`SplatsRenderer::from_prepared`] of a COPC cut: its `nodes` (in the cloud's
+    /// order) placed through the GPU node cache, its points sized by `size_scales`.
     fn with_nodes(
         gpu: &Gpu,
         kind: ProgramKind,
         fidelity: Fidelity,
         params: &SplatsScene,
         base: &Path,
-        (cloud, prepared, nodes): (PointCloud, Prepared, Vec<(NodeKey, usize)>),
+        (cloud, prepared, (nodes, size_scales)): (PointCloud, Prepared, CutParts),
     ) -> GlResult<SplatsRenderer> {
         params
             .draw_allowed(fidelity, crate::gl::ProgramChoice::Auto)
@@ -291,7 +286,7 @@ impl SplatsRenderer {
             gpu,
             "splats points",
             &VERTEX_COMPONENTS,
-            &prepared.vertices(None),
+            &prepared.vertices(None, &size_scales),
         )?;
         let normals = (params.lighting && params.mode == Mode::Surface)
             .then(|| (prepared.normals.clone(), prepared.normal_fallbacks));
@@ -318,7 +313,7 @@ impl SplatsRenderer {
             spacing: None,
             loading: None,
             edl: None,
-            size_scales: Vec::new(),
+            size_scales,
             nodes,
             resident: None,
             in_buffer: Vec::new(),
@@ -470,7 +465,7 @@ impl SplatsRenderer {
     /// The cloud's vertices into the buffer: through the node cache for a COPC cut
     /// (only the nodes it lacks, or whose vertices changed), else whole.
     fn upload_vertices(&mut self, gpu: &Gpu) -> GlResult<()> {
-        let vertices = self.prepared.vertices(None);
+        let vertices = self.prepared.vertices(None, &self.size_scales);
         let f = FLOATS_PER_VERTEX;
         let whole = self.nodes.iter().map(|n| n.1).sum::<usize>() == self.prepared.len();
         // The seed's sort rewrites the buffer in order each time: no cache there.
@@ -487,24 +482,26 @@ impl SplatsRenderer {
             slices.push((key, &vertices[at * f..(at + n) * f]));
             at += n;
         }
-        // Room for one and a half point budgets: a turn's new nodes fit beside the drawn
-        // ones. Its CPU mirror is held to the memory budget; over it, no cache.
+        // The arena starts as large as the first cut (an offline picture needs no more);
+        // the first refinement that does not fit lays it out again at twice its cut, so
+        // a turn's new nodes fit beside the drawn ones from then on.
         let fresh = self.resident.is_none();
-        if fresh {
-            let capacity = budget_of(&self.params).saturating_mul(3) / 2;
-            let capacity = capacity.max(self.prepared.len());
-            let bytes = (capacity * f * 4) as u64;
-            if crate::budget::check("the GPU node cache's copy of its vertices", bytes).is_err() {
-                self.nodes.clear();
-                return self.upload_vertices(gpu);
-            }
-            self.resident = Some(Resident::new(capacity, f));
-        }
-        let resident = self.resident.as_mut().expect("made above");
+        let resident = self
+            .resident
+            .get_or_insert_with(|| Resident::new(self.prepared.len(), f));
         let placed = resident.place(&slices);
         if fresh || placed.rebuilt {
+            // Laid out in the cut's order from the start: the cut's vertices, then room
+            // (none in a fresh arena, as large as its cut).
             self.mesh.clear_indices();
-            self.mesh.update(gpu, resident.vertices())?;
+            if resident.capacity() * f == vertices.len() {
+                self.mesh.update(gpu, &vertices)?;
+            } else {
+                let mut all = Vec::with_capacity(resident.capacity() * f);
+                all.extend_from_slice(&vertices);
+                all.resize(resident.capacity() * f, 0.0);
+                self.mesh.update(gpu, &all)?;
+            }
         } else {
             for &k in &placed.uploads {
                 self.mesh.update_range(gpu, placed.starts[k], slices[k].1)?;
@@ -555,7 +552,7 @@ impl SplatsRenderer {
             // buffer re-uploaded in that order (hidden points left out).
             let order = seed_order(&mut self.seed_points, view);
             let order = self.visible(order);
-            let vertices = self.prepared.vertices(Some(&order));
+            let vertices = self.prepared.vertices(Some(&order), &self.size_scales);
             self.mesh.update(gpu, &vertices)?;
         } else if let Some(cache) = &mut self.cache {
             let order: Vec<u32> = cache.order(&self.prepared.positions, view).to_vec();
@@ -858,12 +855,4 @@ fn cut_text(l: &crate::points::copc_lod::Loaded, sized: &SplatsScene, scene_size
             ""
         }
     )
-}
-
-/// A COPC scene's point budget (0 for other clouds).
-fn budget_of(scene: &SplatsScene) -> usize {
-    match &scene.cloud {
-        crate::points::PointSource::Copc(spec) => usize::try_from(spec.points).unwrap_or(0),
-        _ => 0,
-    }
 }

@@ -5,11 +5,12 @@
 //! placed node by node: a node already resident with the same vertices keeps its place
 //! (nothing uploaded), a new or changed one is written into free space, and when none is
 //! left the least recently drawn nodes outside the cut are evicted. A cut that still does
-//! not fit (fragmentation, or larger than the arena) is laid out afresh from the start,
-//! the arena growing to twice the cut when the cut is larger. No GL here: the renderer
-//! uploads what [`Placement`] lists. Each node's vertices are mirrored on the CPU, so a
-//! node whose vertices changed between cuts (colours normalised over the cut, normals
-//! estimated from its neighbours) is uploaded again rather than drawn stale.
+//! not fit (fragmentation, or larger than the arena) is laid out afresh from the start in
+//! an arena of twice the cut. No GL here: the renderer uploads what [`Placement`] lists.
+//! A node's vertices are known by a 64-bit hash of their bits, so a node whose vertices
+//! changed between cuts (colours normalised over the cut, normals estimated from its
+//! neighbours) is uploaded again rather than drawn stale, without a CPU copy of the
+//! buffer.
 
 use std::collections::HashMap;
 
@@ -25,8 +26,8 @@ pub struct Placement {
     pub uploads: Vec<usize>,
     /// Nodes evicted to make room.
     pub evicted: usize,
-    /// The arena was laid out afresh (every node uploaded; the buffer reallocated when
-    /// `capacity` changed).
+    /// The arena was laid out afresh: the cut's vertices one node after the other from
+    /// the start, in a buffer of [`Resident::capacity`] vertices (reallocated).
     pub rebuilt: bool,
 }
 
@@ -34,11 +35,13 @@ pub struct Placement {
 struct Slot {
     start: usize,
     len: usize,
+    /// The hash of its vertices' bits.
+    hash: u64,
     /// The placement that last drew it.
     used: u64,
 }
 
-/// The arena's bookkeeping and the CPU mirror of its vertices.
+/// The arena's bookkeeping.
 #[derive(Debug, Clone)]
 pub struct Resident {
     capacity: usize,
@@ -46,7 +49,6 @@ pub struct Resident {
     slots: HashMap<NodeKey, Slot>,
     /// Free ranges `(start, len)`, sorted by start, never adjacent.
     free: Vec<(usize, usize)>,
-    mirror: Vec<f32>,
     clock: u64,
 }
 
@@ -62,7 +64,6 @@ impl Resident {
             } else {
                 vec![]
             },
-            mirror: vec![0.0; capacity * floats_per_vertex],
             clock: 0,
         }
     }
@@ -82,14 +83,9 @@ impl Resident {
         self.slots.is_empty()
     }
 
-    /// The arena's vertices as the GPU holds them once the uploads are done.
-    pub fn vertices(&self) -> &[f32] {
-        &self.mirror
-    }
-
-    /// Place `cut` (each node's key and vertices, `floats_per_vertex` floats a vertex),
-    /// updating the mirror; the caller uploads [`Placement::uploads`] (or everything
-    /// when [`Placement::rebuilt`]).
+    /// Place `cut` (each node's key and vertices, `floats_per_vertex` floats a vertex);
+    /// the caller uploads [`Placement::uploads`] at their starts, or, when
+    /// [`Placement::rebuilt`], the cut's vertices in order into a new buffer.
     pub fn place(&mut self, cut: &[(NodeKey, &[f32])]) -> Placement {
         self.clock += 1;
         let f = self.floats_per_vertex;
@@ -97,20 +93,14 @@ impl Resident {
         if total > self.capacity {
             return self.rebuild(cut, 2 * total, 0);
         }
+        let hashes: Vec<u64> = cut.iter().map(|(_, v)| hash(v)).collect();
         let mut starts = vec![usize::MAX; cut.len()];
         let mut uploads = Vec::new();
         // Nodes resident with the same vertices stay; the others are freed and placed.
         for (k, (key, vertices)) in cut.iter().enumerate() {
             let len = vertices.len() / f;
             if let Some(slot) = self.slots.get_mut(key) {
-                // Bit for bit: a point without the property holds NaN, never == itself.
-                let held = &self.mirror[slot.start * f..(slot.start + len) * f];
-                let same = slot.len == len
-                    && held
-                        .iter()
-                        .zip(vertices.iter())
-                        .all(|(a, b)| a.to_bits() == b.to_bits());
-                if same {
+                if slot.len == len && slot.hash == hashes[k] {
                     slot.used = self.clock;
                     starts[k] = slot.start;
                     continue;
@@ -135,14 +125,14 @@ impl Resident {
                 evicted += 1;
             };
             let Some(start) = start else {
-                return self.rebuild(cut, self.capacity, evicted);
+                return self.rebuild(cut, self.capacity.max(2 * total), evicted);
             };
-            self.mirror[start * f..(start + len) * f].copy_from_slice(vertices);
             self.slots.insert(
                 *key,
                 Slot {
                     start,
                     len,
+                    hash: hashes[k],
                     used: self.clock,
                 },
             );
@@ -174,12 +164,12 @@ impl Resident {
         let mut at = 0;
         for (key, vertices) in cut {
             let len = vertices.len() / f;
-            self.mirror[at * f..(at + len) * f].copy_from_slice(vertices);
             self.slots.insert(
                 *key,
                 Slot {
                     start: at,
                     len,
+                    hash: hash(vertices),
                     used: clock,
                 },
             );
@@ -249,6 +239,23 @@ impl Resident {
     }
 }
 
+/// A 64-bit hash of the floats' bits (a multiply-xorshift over each pair of floats):
+/// bit for bit, so a NaN (a point without the property) matches itself.
+fn hash(values: &[f32]) -> u64 {
+    let mut h = 0x9e37_79b9_7f4a_7c15_u64 ^ values.len() as u64;
+    let mut pairs = values.chunks_exact(2);
+    for p in &mut pairs {
+        let w = u64::from(p[0].to_bits()) | (u64::from(p[1].to_bits()) << 32);
+        h = (h ^ w).wrapping_mul(0xff51_afd7_ed55_8ccd);
+        h ^= h >> 32;
+    }
+    for v in pairs.remainder() {
+        h = (h ^ u64::from(v.to_bits())).wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+        h ^= h >> 29;
+    }
+    h
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -265,39 +272,61 @@ mod tests {
         nodes.iter().map(|(k, v)| (*k, v.as_slice())).collect()
     }
 
-    /// After every placement the arena holds each cut node's vertices at its start, and
-    /// no two resident nodes overlap.
-    fn check(r: &Resident, nodes: &[(NodeKey, Vec<f32>)], p: &Placement) {
-        let f = r.floats_per_vertex;
-        for ((_, v), &s) in nodes.iter().zip(&p.starts) {
-            let held: Vec<u32> = r.vertices()[s * f..s * f + v.len()]
-                .iter()
-                .map(|x| x.to_bits())
-                .collect();
-            let want: Vec<u32> = v.iter().map(|x| x.to_bits()).collect();
-            assert_eq!(held, want);
+    /// The GPU buffer as the renderer keeps it: rebuilt with the cut in order, else the
+    /// uploads written at their starts.
+    struct Buffer(Vec<f32>);
+
+    impl Buffer {
+        fn new() -> Buffer {
+            Buffer(Vec::new())
         }
-        let mut ranges: Vec<(usize, usize)> = r.slots.values().map(|s| (s.start, s.len)).collect();
-        ranges.extend(r.free.iter().copied());
-        ranges.sort_unstable();
-        let mut at = 0;
-        for (s, l) in ranges.into_iter().filter(|r| r.1 > 0) {
-            assert!(s >= at, "overlap at {s}");
-            at = s + l;
+
+        /// Apply `p` as the renderer does, then check that every cut node's vertices lie
+        /// at its start and that no two resident nodes overlap.
+        fn apply(&mut self, r: &Resident, nodes: &[(NodeKey, Vec<f32>)], p: &Placement) {
+            let f = r.floats_per_vertex;
+            if p.rebuilt {
+                self.0 = vec![0.0; r.capacity() * f];
+                let all: Vec<f32> = nodes.iter().flat_map(|(_, v)| v.iter().copied()).collect();
+                self.0[..all.len()].copy_from_slice(&all);
+            } else {
+                for &k in &p.uploads {
+                    let (s, v) = (p.starts[k] * f, &nodes[k].1);
+                    self.0[s..s + v.len()].copy_from_slice(v);
+                }
+            }
+            for ((_, v), &s) in nodes.iter().zip(&p.starts) {
+                let held: Vec<u32> = self.0[s * f..s * f + v.len()]
+                    .iter()
+                    .map(|x| x.to_bits())
+                    .collect();
+                let want: Vec<u32> = v.iter().map(|x| x.to_bits()).collect();
+                assert_eq!(held, want, "{p:?}");
+            }
+            let mut ranges: Vec<(usize, usize)> =
+                r.slots.values().map(|s| (s.start, s.len)).collect();
+            ranges.extend(r.free.iter().copied());
+            ranges.sort_unstable();
+            let mut at = 0;
+            for (s, l) in ranges.into_iter().filter(|r| r.1 > 0) {
+                assert!(s >= at, "overlap at {s}");
+                at = s + l;
+            }
+            assert!(at <= r.capacity());
         }
-        assert!(at <= r.capacity());
     }
 
     #[test]
     fn resident_nodes_are_not_uploaded_again() {
-        let mut r = Resident::new(100, 1);
+        let (mut r, mut gpu) = (Resident::new(100, 1), Buffer::new());
         // A NaN (a point without the property) does not make a node look changed.
         let mut root = node([0, 0, 0, 0], 10, 0.0);
         root.1[3] = f32::NAN;
         let a = vec![root, node([1, 1, 0, 0], 7, 0.0)];
         let p = r.place(&cut(&a));
         assert_eq!(p.uploads, vec![0, 1]);
-        check(&r, &a, &p);
+        gpu.0 = vec![0.0; 100];
+        gpu.apply(&r, &a, &p);
         // The finer cut keeps both and adds two: only those are uploaded.
         let b = vec![
             a[0].clone(),
@@ -309,23 +338,24 @@ mod tests {
         assert_eq!(q.uploads, vec![1, 3]);
         assert_eq!((q.starts[0], q.starts[2]), (p.starts[0], p.starts[1]));
         assert!(!q.rebuilt);
-        check(&r, &b, &q);
+        gpu.apply(&r, &b, &q);
     }
 
     #[test]
     fn a_node_whose_vertices_changed_is_uploaded_again() {
-        let mut r = Resident::new(50, 1);
+        let (mut r, mut gpu) = (Resident::new(50, 1), Buffer(vec![0.0; 50]));
         let a = vec![node([0, 0, 0, 0], 10, 0.0), node([1, 1, 0, 0], 7, 0.0)];
-        r.place(&cut(&a));
+        let p = r.place(&cut(&a));
+        gpu.apply(&r, &a, &p);
         let b = vec![node([0, 0, 0, 0], 10, 0.5), a[1].clone()];
         let p = r.place(&cut(&b));
         assert_eq!(p.uploads, vec![0]);
-        check(&r, &b, &p);
+        gpu.apply(&r, &b, &p);
         // The same key with another count (a thinned root) too.
         let c = vec![node([0, 0, 0, 0], 4, 0.5), a[1].clone()];
         let p = r.place(&cut(&c));
         assert_eq!(p.uploads, vec![0]);
-        check(&r, &c, &p);
+        gpu.apply(&r, &c, &p);
     }
 
     #[test]
@@ -344,13 +374,15 @@ mod tests {
         // node outside the cut.
         let all = [n(2), n(3), n(5)];
         let p = r.place(&cut(&all));
-        assert_eq!((p.evicted, p.rebuilt), (1, false), "{p:?}");
-        check(&r, &all, &p);
+        assert_eq!(
+            (p.evicted, p.rebuilt, p.starts[2]),
+            (1, false, keep.starts[2])
+        );
     }
 
     #[test]
     fn a_cut_larger_than_the_arena_grows_it_and_fragmentation_lays_it_out_again() {
-        let mut r = Resident::new(20, 2);
+        let (mut r, mut gpu) = (Resident::new(20, 2), Buffer::new());
         let big: Vec<_> = (0..3).map(|x| node([2, x, 0, 0], 10, 0.0)).collect();
         let big: Vec<_> = big
             .into_iter()
@@ -364,23 +396,28 @@ mod tests {
         let p = r.place(&cut(&big));
         assert!(p.rebuilt);
         assert_eq!(r.capacity(), 60, "twice the cut's 30 vertices of 2 floats");
-        check(&r, &big, &p);
+        gpu.apply(&r, &big, &p);
         // Holes of 10 vertices between resident nodes; a node of 12 fits in none until
         // the others are evicted, and merged free space takes it.
-        let mut r = Resident::new(40, 1);
+        let (mut r, mut gpu) = (Resident::new(40, 1), Buffer(vec![0.0; 40]));
         let n = |x: i32, len| node([3, x, 0, 0], len, 0.0);
-        r.place(&cut(&[n(0, 10), n(1, 10), n(2, 10), n(3, 10)]));
-        let p = r.place(&cut(&[n(0, 10), n(2, 10), n(5, 12)]));
-        // 1 and 3 evicted leave 10 + 10 apart: no 12 fits, so the cut is laid out afresh.
+        let first = [n(0, 10), n(1, 10), n(2, 10), n(3, 10)];
+        let p = r.place(&cut(&first));
+        gpu.apply(&r, &first, &p);
+        let second = [n(0, 10), n(2, 10), n(5, 12)];
+        let p = r.place(&cut(&second));
+        // 1 and 3 evicted leave 10 + 10 apart: no 12 fits, so the cut is laid out afresh
+        // in an arena of twice the cut.
         assert!(p.rebuilt, "{p:?}");
-        assert_eq!((p.uploads.len(), p.evicted), (3, 2));
-        check(&r, &[n(0, 10), n(2, 10), n(5, 12)], &p);
+        assert_eq!((p.uploads.len(), p.evicted, r.capacity()), (3, 2, 64));
+        gpu.apply(&r, &second, &p);
     }
 
     #[test]
     fn random_cuts_always_hold_their_vertices() {
-        // A deterministic walk of cuts over 64 nodes of uneven sizes in an arena of 300.
-        let mut r = Resident::new(300, 3);
+        // A deterministic walk of cuts over 64 nodes of uneven sizes, in an arena of 100
+        // vertices at first (cuts of up to 232 make it grow).
+        let (mut r, mut gpu) = (Resident::new(100, 3), Buffer(vec![0.0; 300]));
         let mut seed = 12345u64;
         let mut next = || {
             seed = seed
@@ -388,6 +425,7 @@ mod tests {
                 .wrapping_add(1442695040888963407);
             (seed >> 33) as usize
         };
+        let (mut kept, mut rebuilt) = (0, 0);
         for round in 0..200 {
             let count = 1 + next() % 8;
             let mut nodes: Vec<(NodeKey, Vec<f32>)> = Vec::new();
@@ -403,13 +441,22 @@ mod tests {
                 nodes.push((key, v));
             }
             let p = r.place(&cut(&nodes));
-            for ((_, v), &s) in nodes.iter().zip(&p.starts) {
-                assert_eq!(
-                    &r.vertices()[s * 3..s * 3 + v.len()],
-                    v.as_slice(),
-                    "round {round}"
-                );
-            }
+            kept += nodes.len() - p.uploads.len();
+            rebuilt += usize::from(p.rebuilt);
+            gpu.apply(&r, &nodes, &p);
         }
+        assert!(kept > 0 && rebuilt > 0, "kept {kept}, rebuilt {rebuilt}");
+    }
+
+    #[test]
+    fn the_hash_sees_every_bit() {
+        let v: Vec<f32> = (0..9).map(|i| i as f32 * 0.37).collect();
+        for k in 0..v.len() {
+            let mut w = v.clone();
+            w[k] = f32::from_bits(w[k].to_bits() ^ 1);
+            assert_ne!(hash(&v), hash(&w), "float {k}");
+        }
+        assert_ne!(hash(&v[..8]), hash(&v));
+        assert_eq!(hash(&[f32::NAN]), hash(&[f32::NAN]));
     }
 }
