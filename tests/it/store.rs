@@ -224,10 +224,12 @@ fn an_interrupted_conversion_resumes_to_the_same_store() {
         .map(|rest| rest.split(']').next().unwrap().replace(',', "/"))
         .collect();
     assert_eq!(done.len(), 4, "{log}");
+    // Chunk keys run (inline column k, crossline column j, brick along the samples i):
+    // brick 1 of a column (j, k) not logged.
     let torn = (0..3)
-        .flat_map(|j| (0..3).map(move |k| format!("{j}/{k}")))
-        .find(|jk| !done.contains(jk))
-        .map(|jk| path.join(format!("amplitude/c/2/{jk}")))
+        .flat_map(|j| (0..3).map(move |k| (j, k)))
+        .find(|(j, k)| !done.contains(&format!("{j}/{k}")))
+        .map(|(j, k)| path.join(format!("amplitude/c/{k}/{j}/1")))
         .unwrap();
     std::fs::create_dir_all(torn.parent().unwrap()).unwrap();
     std::fs::write(&torn, b"torn write").unwrap();
