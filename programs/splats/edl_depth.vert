@@ -9,6 +9,8 @@ layout(location = 0) in vec3 aPos;
 layout(location = 4) in float aScale;
 uniform vec4 vertex_local[11];
 out float v_z;
+// 0 for a point whose centre lies outside the clip volume (dropped whole, as precise.vert).
+flat out float v_inside;
 void main() {
     vec4 p = vec4(aPos, 1.0);
     gl_Position = vec4(dot(vertex_local[0], p), dot(vertex_local[1], p),
@@ -20,4 +22,6 @@ void main() {
     if (!isnan(size)) size = clamp(size, vertex_local[10].x, vertex_local[10].y);
     gl_PointSize = size;
     v_z = dot(vertex_local[8], p);
+    vec4 clip = gl_Position;
+    v_inside = (clip.w > 0.0 && all(lessThanEqual(abs(clip.xyz), vec3(clip.w)))) ? 1.0 : 0.0;
 }

@@ -42,7 +42,11 @@ void main() {
     if (!isnan(size)) size = clamp(size, vertex_local[10].x, vertex_local[10].y);
     gl_PointSize = size + vertex_local[10].z;
     vec2 ndc = clip.xy * (1.0 / clip.w);
-    v_window = vec3((ndc + 1.0) * 0.5 * vertex_local[9].zw + vertex_local[9].xy, size);
+    // A point whose centre lies outside the clip volume is dropped whole, as the GL spec
+    // and the f64 reference drop it: some drivers (NVIDIA) draw wide points whose centre
+    // is off-screen. A size of 0 makes precise.frag discard every fragment.
+    float inside = (clip.w > 0.0 && all(lessThanEqual(abs(clip.xyz), vec3(clip.w)))) ? 1.0 : 0.0;
+    v_window = vec3((ndc + 1.0) * 0.5 * vertex_local[9].zw + vertex_local[9].xy, size * inside);
     v_color = aColor;
     v_value = aValue;
     v_z = dot(vertex_local[8], p);

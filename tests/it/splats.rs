@@ -44,7 +44,8 @@ fn gpu_matches_the_f64_reference() {
     ] {
         for projection in [Projection::Orthographic, Projection::Perspective] {
             let p = params(text);
-            let cam = camera(projection);
+            let cam = camera_for(projection, fidelity);
+            assert!(fidelity == Fidelity::Precise || all_centres_inside(&c, &cam));
             let gpu = rgb_only(&draw(&h, &c, &p, fidelity, cam));
             let cpu = rgb_only(&reference(&c, &p, fidelity, &cam));
             let d = gpu.compare(&cpu, 0.0).unwrap();
@@ -380,7 +381,7 @@ fn gpu_oit_matches_the_weighted_blended_reference() {
         for projection in [Projection::Orthographic, Projection::Perspective] {
             let text = format!("{text}\nsort = \"oit\"");
             let p = params(&text);
-            let cam = camera(projection);
+            let cam = camera_for(projection, fidelity);
             let expected = reference_of(&c, &p, fidelity, &cam, true);
             let exact = reference_of(&c, &p, fidelity, &cam, false);
             for &kind in kinds {

@@ -9,7 +9,8 @@
 //! 1. The vertex is transformed by the camera's `projection * view`; a point whose clip
 //!    position lies outside `-w ≤ x, y, z ≤ w` (or `w ≤ 0`: at or behind the eye) is
 //!    discarded whole, as the GL spec clips points by their vertex (some drivers keep
-//!    wide points whose centre is just off-screen; test scenes keep centres inside).
+//!    wide points whose centre is just off-screen, NVIDIA's among them: the precise
+//!    programs drop those themselves; the seed's, run as written, do not).
 //! 2. Its size in pixels ([`splat_size`]): `point_size / distance(p, eye) * factor` in
 //!    perspective, as the seed's vertex shader; `point_size * factor` in orthographic
 //!    (no distance there); clamped to `size_range` (GL's `POINT_SIZE_RANGE`, default
