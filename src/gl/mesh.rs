@@ -23,6 +23,15 @@ pub struct Mesh {
     label: String,
 }
 
+/// `values` viewed as their bytes (native order, as GL reads them).
+fn f32_bytes(values: &[f32]) -> &[u8] {
+    // SAFETY: any f32 is 4 initialised bytes; u8 has no alignment; the length covers
+    // exactly the slice.
+    unsafe {
+        std::slice::from_raw_parts(values.as_ptr().cast::<u8>(), std::mem::size_of_val(values))
+    }
+}
+
 impl Mesh {
     /// Create a mesh whose vertices have attributes of `components` floats each (in order,
     /// interleaved), filled with `vertices`.
@@ -82,10 +91,21 @@ impl Mesh {
         Ok(mesh)
     }
 
-    /// Replace the vertices (any count; the buffer is reallocated).
+    /// Replace the vertices (any count; the buffer is reallocated). A buffer that grows
+    /// is checked for the driver's out-of-memory error, as a new one is.
     pub fn update(&mut self, gpu: &Gpu, vertices: &[f32]) -> GlResult<()> {
+        let grows = vertices.len() / self.floats_per_vertex > self.vertex_count;
         self.upload(vertices)?;
-        crate::gl_debug_check!(gpu)
+        if grows {
+            let label = &self.label;
+            crate::gl_check_alloc!(
+                gpu,
+                || format!("the vertex buffer of {label}"),
+                std::mem::size_of_val(vertices) as u64
+            )
+        } else {
+            crate::gl_debug_check!(gpu)
+        }
     }
 
     /// Overwrite the vertices from `first` on with `vertices` (within the buffer: it
@@ -93,7 +113,9 @@ impl Mesh {
     pub fn update_range(&mut self, gpu: &Gpu, first: usize, vertices: &[f32]) -> GlResult<()> {
         let f = self.floats_per_vertex;
         let count = vertices.len() / f;
-        if !vertices.len().is_multiple_of(f) || first + count > self.vertex_count {
+        let offset = i32::try_from(first * f * 4);
+        if !vertices.len().is_multiple_of(f) || first + count > self.vertex_count || offset.is_err()
+        {
             return Err(GlError::Invalid(format!(
                 "mesh {}: {} floats at vertex {first} do not fit its {} vertices of {f} floats",
                 self.label,
@@ -101,14 +123,13 @@ impl Mesh {
                 self.vertex_count
             )));
         }
-        // SAFETY: f32 slice viewed as bytes, written inside the buffer (checked above);
-        // the buffer binding is restored to none.
+        // SAFETY: written inside the buffer (checked above); the buffer binding is
+        // restored to none.
         unsafe {
-            let bytes =
-                std::slice::from_raw_parts(vertices.as_ptr().cast::<u8>(), vertices.len() * 4);
+            let bytes = f32_bytes(vertices);
             self.gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.vbo));
             self.gl
-                .buffer_sub_data_u8_slice(glow::ARRAY_BUFFER, (first * f * 4) as i32, bytes);
+                .buffer_sub_data_u8_slice(glow::ARRAY_BUFFER, offset.unwrap_or(0), bytes);
             self.gl.bind_buffer(glow::ARRAY_BUFFER, None);
         }
         crate::gl_debug_check!(gpu)
@@ -123,10 +144,9 @@ impl Mesh {
                 self.floats_per_vertex
             )));
         }
-        // SAFETY: f32 slice viewed as bytes; the buffer binding is restored to none.
+        // SAFETY: the buffer binding is restored to none.
         unsafe {
-            let bytes =
-                std::slice::from_raw_parts(vertices.as_ptr().cast::<u8>(), vertices.len() * 4);
+            let bytes = f32_bytes(vertices);
             self.gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.vbo));
             self.gl
                 .buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes, glow::DYNAMIC_DRAW);

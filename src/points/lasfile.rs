@@ -294,8 +294,9 @@ fn append_node(
         })
 }
 
-/// GPS times as seconds after `reference` (where it is not after the earliest finite time,
-/// as a wrong header's could be; else after that earliest time), in f32:
+/// GPS times as seconds after `reference` (where it lies at most a day before the earliest
+/// finite time: a header's 0 or wrong value is not taken; else after that earliest time),
+/// in f32:
 /// a survey's hours keep millisecond steps, where the absolute times (about 1e9 s of
 /// adjusted standard GPS time) would keep only steps of 64 s.
 fn gps_after(times: &[f64], reference: Option<f64>) -> Values {
@@ -305,7 +306,9 @@ fn gps_after(times: &[f64], reference: Option<f64>) -> Values {
         .filter(|t| t.is_finite())
         .fold(f64::INFINITY, f64::min);
     let earliest = if earliest.is_finite() { earliest } else { 0.0 };
-    let reference = reference.filter(|r| *r <= earliest).unwrap_or(earliest);
+    let reference = reference
+        .filter(|r| *r <= earliest && earliest - *r <= 86_400.0)
+        .unwrap_or(earliest);
     Values::Float(times.iter().map(|&t| (t - reference) as f32).collect())
 }
 

@@ -246,10 +246,13 @@ impl PointSource {
                     &cut,
                     (0..cloud.len()).filter_map(|i| cloud.original(i)),
                 );
-                // The cloud holds the nodes in the cut's order; a root thinned to a
-                // stride is all of it.
+                // The cloud holds the nodes in the cut's order; a lone root thinned to a
+                // stride is all of it (several thinned nodes: no node cache).
                 let nodes = if cut.root_stride > 1 {
-                    cut.nodes.iter().map(|n| (n.key, cloud.len())).collect()
+                    match cut.nodes.as_slice() {
+                        [root] => vec![(root.key, cloud.len())],
+                        _ => Vec::new(),
+                    }
                 } else {
                     cut.nodes
                         .iter()

@@ -147,6 +147,7 @@ fn job_of(
         brick: o.brick,
         attributes: attributes.iter().map(|a| a.name().to_string()).collect(),
         compression: o.compression.to_string(),
+        legacy_zstd: None,
         raw: o.raw.as_ref().map(|r| format!("{r:?}")),
         layout: VERSION,
     })
@@ -154,18 +155,24 @@ fn job_of(
 
 /// Convert `input` into a new store at `store`, or resume an interrupted conversion there.
 ///
-/// Columns run on twice as many workers as the machine has cores: each chunk write waits
-/// for the disk (synced), and a second worker per core computes meanwhile (on 2 cores, 4
-/// workers convert a 2 GB survey about 15 % faster than 2).
+/// Columns run on two workers per rayon thread (one per core unless `RAYON_NUM_THREADS`
+/// says otherwise): each chunk write waits for the disk (synced), and a second worker per
+/// core computes meanwhile (on 2 cores, 4 workers convert a 2 GB survey about 15 %
+/// faster than 2). Where twice the workers' memory would pass the budget, one per thread.
 pub fn convert(
     input: &Path,
     store: &Path,
     o: &ConvertOptions,
 ) -> Result<ConvertReport, StoreError> {
-    let workers = 2 * rayon::current_num_threads().max(1);
-    match rayon::ThreadPoolBuilder::new().num_threads(workers).build() {
+    let threads = rayon::current_num_threads().max(1);
+    let on = |workers: usize| match rayon::ThreadPoolBuilder::new().num_threads(workers).build() {
         Ok(pool) => pool.install(|| convert_on_workers(input, store, o)),
         Err(_) => convert_on_workers(input, store, o),
+    };
+    // The budget is checked before anything is written: a refusal leaves nothing behind.
+    match on(2 * threads) {
+        Err(StoreError::Budget(_)) => on(threads),
+        done => done,
     }
 }
 

@@ -11,7 +11,7 @@
 //! `[inlines, crosslines, samples]` (zarr's C order: the sample axis fastest, as in
 //! [`crate::volume::Volume`]), dimension names `inline, crossline, time` (or `sample`;
 //! suffixed `_L` in level `L`), chunks of `B³` voxels (the bricks; `B` = 64 by default),
-//! zstd-compressed. Level `L` is `ceil(n / 2^L)` voxels per axis; levels go on until one
+//! compressed (blosc LZ4 over shuffled bytes by default; `--compression`). Level `L` is `ceil(n / 2^L)` voxels per axis; levels go on until one
 //! brick holds the volume. Amplitude is float32 (exactly the source's values); the derived
 //! attributes (envelope, phase, frequency) are float16 (11 significant bits, a relative
 //! error of 2^-11, far below the 1/255 the colour tables resolve) to halve their disk and

@@ -34,6 +34,9 @@ pub(crate) struct Job {
     /// The chunks' compression (`Compression`'s name; a log from before it has none).
     #[serde(default)]
     pub compression: String,
+    /// A log from before `compression`: its zstd level (0: none), read as `compression`.
+    #[serde(default, rename = "zstd", skip_serializing)]
+    pub legacy_zstd: Option<i32>,
     pub raw: Option<String>,
     /// The store layout's version (a log written before version 2 has none).
     #[serde(default = "layout_one")]
@@ -135,9 +138,19 @@ pub(crate) fn read_log(
     let text = String::from_utf8_lossy(&text);
     let mut lines = text.split_terminator('\n');
     let first = lines.next().unwrap_or_default();
-    let was: Job = serde_json::from_str(first).map_err(|e| {
+    let mut was: Job = serde_json::from_str(first).map_err(|e| {
         StoreError::invalid(path, format!("line 1 is not the job's description: {e}"))
     })?;
+    // A log written before `--compression` named its zstd level.
+    if let Some(level) = was.legacy_zstd.take() {
+        if was.compression.is_empty() {
+            was.compression = if level > 0 {
+                format!("zstd:{level}")
+            } else {
+                "none".into()
+            };
+        }
+    }
     if &was != job {
         return Err(StoreError::invalid(
             path,

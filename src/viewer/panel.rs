@@ -260,7 +260,7 @@ fn controls(
     ));
     if !state.volume_info.is_empty() {
         // The renderer's own lines (a COPC cut, its node cache), recorded for scripts.
-        w.text(ui, "Renderer", &state.volume_info);
+        w.status_text(ui, "Renderer", &state.volume_info);
     }
     ui.separator();
 
@@ -396,7 +396,7 @@ fn controls(
     });
     if !state.status.is_empty() {
         // Recorded for scripts (`print Status`).
-        w.text(ui, "Status", &state.status);
+        w.status_text(ui, "Status", &state.status);
     }
 }
 

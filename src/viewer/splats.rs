@@ -27,11 +27,15 @@ pub fn editor(
     w: &mut Widgets,
 ) -> bool {
     let mut changed = false;
-    let classes = cloud.map_or(&[][..], |c| c.classes.as_slice());
+    // The classes the cloud holds, and any the scene hides (a COPC cut may not hold them).
+    let mut classes: Vec<i32> = cloud.map_or(Vec::new(), |c| c.classes.clone());
+    classes.extend(scene.hide_classes.iter().copied());
+    classes.sort_unstable();
+    classes.dedup();
     if !classes.is_empty() {
         ui.label("Classes shown");
         ui.horizontal_wrapped(|ui| {
-            for &class in classes {
+            for class in classes {
                 let (label, text) = (format!("Class {class}"), class_name(class));
                 changed |= shown_toggle(ui, w, &mut scene.hide_classes, class, &label, &text);
             }
@@ -77,8 +81,8 @@ pub fn editor(
     let mut property = scene.property.clone();
     // The cloud's own attributes (a LAS file's intensity, GPS time, extra bytes, ...).
     let names: Vec<String> = match cloud {
-        Some(c) if !c.ranges.is_empty() => c.ranges.iter().map(|(n, _)| n.clone()).collect(),
-        _ => SEED_PROPERTIES.iter().map(|n| n.to_string()).collect(),
+        Some(c) => c.ranges.iter().map(|(n, _)| n.clone()).collect(),
+        None => SEED_PROPERTIES.iter().map(|n| n.to_string()).collect(),
     };
     let properties: Vec<(String, &str)> = names.iter().map(|n| (n.clone(), n.as_str())).collect();
     ui.horizontal_wrapped(|ui| {

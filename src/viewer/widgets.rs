@@ -86,6 +86,13 @@ impl Widgets {
         self.texts.insert(label.to_string(), text.to_string());
     }
 
+    /// A small text line whose text `print` can read as `label`, outside the layout check
+    /// (status lines that grow and shrink as the renderer reports).
+    pub fn status_text(&mut self, ui: &mut Ui, label: &str, text: &str) {
+        ui.label(egui::RichText::new(text).small());
+        self.texts.insert(label.to_string(), text.to_string());
+    }
+
     /// Where `label` was drawn last.
     pub fn get(&self, label: &str) -> Option<&Seen> {
         self.seen.get(label)

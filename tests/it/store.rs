@@ -198,6 +198,43 @@ fn raw_input_and_refusals() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// A conversion interrupted by a build from before `--compression` (its log names a zstd
+/// level) resumes with `--compression zstd:LEVEL`, and the default (lz4) is refused naming
+/// the level to give.
+#[test]
+fn a_log_from_before_compression_resumes_with_its_zstd_level() {
+    use arbvis::store::convert::Compression;
+    let dir = temp_dir("store-legacy-log");
+    let v = survey([30, 21, 18]);
+    let sgy = write_segy(&dir, &v);
+    let path = dir.join("old.zarr");
+    let zstd = ConvertOptions {
+        compression: Compression::Zstd(1),
+        ..options(8)
+    };
+    let stopped = ConvertOptions {
+        stop_after: Some(3),
+        ..zstd.clone()
+    };
+    assert!(convert(&sgy, &path, &stopped).is_err());
+    let log = path.join(arbvis::store::convert::PROGRESS_LOG);
+    let text = std::fs::read_to_string(&log).unwrap();
+    assert!(text.contains("\"compression\":\"zstd:1\""), "{text}");
+    std::fs::write(
+        &log,
+        text.replacen("\"compression\":\"zstd:1\"", "\"zstd\":1", 1),
+    )
+    .unwrap();
+    let e = convert(&sgy, &path, &options(8)).unwrap_err().to_string();
+    assert!(
+        e.contains("compression zstd:1") && e.contains("compression lz4"),
+        "{e}"
+    );
+    let report = convert(&sgy, &path, &zstd).unwrap();
+    assert_eq!(report.resumed, 3);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn an_interrupted_conversion_resumes_to_the_same_store() {
     let dir = temp_dir("store-resume");

@@ -14,7 +14,9 @@
 //! 2. Its size in pixels ([`splat_size`]): `point_size / distance(p, eye) * factor` in
 //!    perspective, as the seed's vertex shader; `point_size * factor` in orthographic
 //!    (no distance there); clamped to `size_range` (GL's `POINT_SIZE_RANGE`, default
-//!    `[1, 255]` as llvmpipe reports); a NaN size draws nothing.
+//!    `[1, 255]` as llvmpipe reports); a NaN size draws nothing. (A COPC cut's precise
+//!    splats are further scaled per point by their level's spacing, before the clamp; the
+//!    reference draws clouds without scales, and the tiles mirror the scaled rule.)
 //! 3. Point-sprite rasterization: fragments for the pixels whose centres lie in the
 //!    square of side `size` centred on the window position, half-open
 //!    (`x_w - size/2 ≤ x + 0.5 < x_w + size/2`, the same in y).

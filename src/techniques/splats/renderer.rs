@@ -102,7 +102,7 @@ pub struct SplatsRenderer {
     loading: Option<Loading>,
     /// Eye-dome lighting's depth target and programs, made at the first frame's size.
     edl: Option<EdlPass>,
-    /// A COPC cut's points' sizes over the scene's (tiles only; empty: all 1).
+    /// A COPC cut's points' sizes over the scene's (precise tiles and points; empty: all 1).
     size_scales: Vec<f32>,
     /// A COPC cut's nodes (key, points) in the cloud's order (empty for other clouds).
     nodes: Vec<(NodeKey, usize)>,
@@ -161,6 +161,8 @@ type CutParts = (Vec<(NodeKey, usize)>, Vec<f32>);
 /// A COPC cut being loaded on a thread for a view.
 struct Loading {
     view: CloudView,
+    /// The settings the cut is prepared with (an edit meanwhile prepares it again).
+    params: SplatsScene,
     result: std::sync::mpsc::Receiver<Result<Prepared3, String>>,
 }
 
@@ -207,7 +209,7 @@ impl SplatsRenderer {
         r.scene_point_size = params.point_size;
         r.spacing = loaded.as_ref().map(|l| l.spacing);
         if let Some(l) = loaded {
-            r.cut = Some(cut_text(&l, &sized, params.point_size));
+            r.cut = Some(cut_text(&l, &sized, params.point_size, fidelity));
         }
         Ok(r)
     }
@@ -218,10 +220,20 @@ impl SplatsRenderer {
     fn replace_cut(
         &mut self,
         gpu: &Gpu,
-        params: &SplatsScene,
+        (params, prepared_with): (&SplatsScene, Option<&SplatsScene>),
         view: CloudView,
         (cloud, prepared, loaded): Prepared3,
     ) -> GlResult<()> {
+        // Colours, visibility or lighting edited while the cut loaded: prepare it again
+        // with the scene as it is now.
+        let (cloud, prepared) = match prepared_with {
+            Some(then) if then != params => {
+                let normals = normals_for(&cloud, params);
+                let prepared = from_cloud(&cloud, params, normals).map_err(GlError::Data)?;
+                (cloud, prepared)
+            }
+            _ => (cloud, prepared),
+        };
         let Some(l) = loaded else {
             let base = self.base.clone();
             *self = SplatsRenderer::upload(
@@ -241,7 +253,7 @@ impl SplatsRenderer {
         };
         self.normals = (sized.lighting && sized.mode == Mode::Surface)
             .then(|| (prepared.normals.clone(), prepared.normal_fallbacks));
-        self.cut = Some(cut_text(&l, &sized, params.point_size));
+        self.cut = Some(cut_text(&l, &sized, params.point_size, self.fidelity));
         self.params = sized;
         self.scene_point_size = params.point_size;
         self.cloud = cloud;
@@ -468,8 +480,11 @@ impl SplatsRenderer {
         let vertices = self.prepared.vertices(None, &self.size_scales);
         let f = FLOATS_PER_VERTEX;
         let whole = self.nodes.iter().map(|n| n.1).sum::<usize>() == self.prepared.len();
-        // The seed's sort rewrites the buffer in order each time: no cache there.
-        if self.nodes.is_empty() || !whole || self.params.sort == SortChoice::Seed {
+        // The seed's sort rewrites the buffer in order each time: no cache there. Nor
+        // past what GL's signed 32-bit offsets address (an arena of twice a cut of more
+        // than about 24 M points).
+        let addressable = 2 * vertices.len() * 4 <= i32::MAX as usize;
+        if self.nodes.is_empty() || !whole || !addressable || self.params.sort == SortChoice::Seed {
             self.resident = None;
             self.in_buffer.clear();
             self.last_upload = None;
@@ -485,21 +500,26 @@ impl SplatsRenderer {
         // The arena starts as large as the first cut (an offline picture needs no more);
         // the first refinement that does not fit lays it out again at twice its cut, so
         // a turn's new nodes fit beside the drawn ones from then on.
+        // Taken out while uploading: a failed upload leaves the buffer unknown, and the
+        // next cut starts a fresh arena.
         let fresh = self.resident.is_none();
-        let resident = self
+        let mut resident = self
             .resident
-            .get_or_insert_with(|| Resident::new(self.prepared.len(), f));
+            .take()
+            .unwrap_or_else(|| Resident::new(self.prepared.len(), f));
         let placed = resident.place(&slices);
+        let capacity = resident.capacity();
+        self.in_buffer.clear();
         if fresh || placed.rebuilt {
             // Laid out in the cut's order from the start: the cut's vertices, then room
             // (none in a fresh arena, as large as its cut).
             self.mesh.clear_indices();
-            if resident.capacity() * f == vertices.len() {
+            if capacity * f == vertices.len() {
                 self.mesh.update(gpu, &vertices)?;
             } else {
-                let mut all = Vec::with_capacity(resident.capacity() * f);
+                let mut all = Vec::with_capacity(capacity * f);
                 all.extend_from_slice(&vertices);
-                all.resize(resident.capacity() * f, 0.0);
+                all.resize(capacity * f, 0.0);
                 self.mesh.update(gpu, &all)?;
             }
         } else {
@@ -514,6 +534,7 @@ impl SplatsRenderer {
             .flat_map(|(&(_, n), &start)| (start..start + n).map(|v| v as u32))
             .collect();
         self.last_upload = Some([placed.uploads.len(), self.nodes.len(), placed.evicted]);
+        self.resident = Some(resident);
         Ok(())
     }
 
@@ -760,6 +781,7 @@ impl Renderer for SplatsRenderer {
             match loading.result.try_recv() {
                 Ok(result) => {
                     let view = loading.view;
+                    let then = loading.params.clone();
                     self.loading = None;
                     // A node that cannot be read (a damaged file): the drawn cut stays,
                     // and the status line says why the view was not refined.
@@ -777,7 +799,7 @@ impl Renderer for SplatsRenderer {
                             return Ok(true);
                         }
                     };
-                    self.replace_cut(gpu, &params, view, loaded)?;
+                    self.replace_cut(gpu, (&params, Some(&then)), view, loaded)?;
                     return Ok(true);
                 }
                 Err(std::sync::mpsc::TryRecvError::Empty) if same(&loading.view) => {
@@ -792,10 +814,15 @@ impl Renderer for SplatsRenderer {
         // Load the new view's cut on a thread; the drawn one stays until it arrives.
         let (send, result) = std::sync::mpsc::channel();
         let base = self.base.clone();
+        let prepared_with = params.clone();
         std::thread::spawn(move || {
             let _ = send.send(prepare_for(&params, &base, Some(&view)));
         });
-        self.loading = Some(Loading { view, result });
+        self.loading = Some(Loading {
+            view,
+            params: prepared_with,
+            result,
+        });
         Ok(false)
     }
 
@@ -844,12 +871,19 @@ pub fn program_pairs() -> Vec<ProgramPair> {
 }
 
 /// A COPC cut's line: what it holds and how its splats are sized.
-fn cut_text(l: &crate::points::copc_lod::Loaded, sized: &SplatsScene, scene_size: f64) -> String {
+/// Precise programs (tiles and points) scale each point by its size scale; faithful
+/// ones draw one size.
+fn cut_text(
+    l: &crate::points::copc_lod::Loaded,
+    sized: &SplatsScene,
+    scene_size: f64,
+    fidelity: Fidelity,
+) -> String {
     format!(
         "{}; splats of point size {:.1} (the scene's {scene_size:.1}){}",
         l.describe,
         sized.point_size,
-        if sized.draw == DrawChoice::Tiles {
+        if fidelity == Fidelity::Precise {
             ", larger where coarser levels stand in for missing ones"
         } else {
             ""

@@ -6,7 +6,7 @@
 //! (nothing uploaded), a new or changed one is written into free space, and when none is
 //! left the least recently drawn nodes outside the cut are evicted. A cut that still does
 //! not fit (fragmentation, or larger than the arena) is laid out afresh from the start in
-//! an arena of twice the cut. No GL here: the renderer uploads what [`Placement`] lists.
+//! an arena of twice the cut (or as large as it was, when that is more). No GL here: the renderer uploads what [`Placement`] lists.
 //! A node's vertices are known by a 64-bit hash of their bits, so a node whose vertices
 //! changed between cuts (colours normalised over the cut, normals estimated from its
 //! neighbours) is uploaded again rather than drawn stale, without a CPU copy of the
