@@ -16,6 +16,9 @@ pub struct PointCloud {
     pub positions: Vec<[f32; 3]>,
     /// Smallest and largest coordinates, in the file's coordinates (zeros when empty).
     pub bounds: [[f64; 3]; 2],
+    /// The box the cloud is framed by (`origin` and `scale` come from it): a COPC file's
+    /// header bounds, the same for every cut; else `bounds`.
+    pub frame: [[f64; 3]; 2],
     /// Named attributes, in the order of the file.
     pub attributes: Vec<Attribute>,
     /// Colours, 16 bits per channel.
@@ -199,7 +202,8 @@ impl PointCloud {
             ));
         }
         let bounds = bounds(&parts.positions);
-        let (origin, scale) = origin_and_scale(frame.unwrap_or(&bounds));
+        let frame = *frame.unwrap_or(&bounds);
+        let (origin, scale) = origin_and_scale(&frame);
         let positions = parts
             .positions
             .par_iter()
@@ -225,6 +229,7 @@ impl PointCloud {
             scale,
             positions,
             bounds,
+            frame,
             attributes,
             rgb: parts.rgb,
             normals: parts.normals,

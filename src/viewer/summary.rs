@@ -109,7 +109,7 @@ impl CloudSummary {
                 .iter()
                 .map(|a| (a.name.clone(), [a.stats.min, a.stats.max]))
                 .collect(),
-            elevation: [lo[2], hi[2]],
+            elevation: [cloud.frame[0][2], cloud.frame[1][2]],
         }
     }
 

@@ -301,3 +301,37 @@ fn gps_time_is_an_attribute_after_the_files_earliest() {
         assert_eq!(values(&whole), expected(earliest), "{name}");
     }
 }
+
+/// Colour by elevation is over the file's z range: a point has the same colour in a
+/// coarse cut and in the whole cloud (and the lowest z of the header bounds sits at the
+/// gradient's start, not the cut's lowest point).
+#[test]
+fn elevation_colours_a_point_alike_in_every_cut() {
+    use arbvis::points::PointSource;
+    use arbvis::techniques::splats::prepare::from_cloud;
+    use arbvis::techniques::splats::scene::ColourMode;
+    use std::collections::HashMap;
+    let path = data_file("points/simple_with_page.copc.laz");
+    let base = path.parent().unwrap();
+    let file = path.file_name().unwrap().to_str().unwrap();
+    let mut scene: arbvis::techniques::splats::SplatsScene =
+        toml::from_str(&format!("cloud = {{ copc = {{ path = {file:?} }} }}")).unwrap();
+    scene.colour = ColourMode::Elevation;
+    let colours = |points: u64| -> HashMap<[u32; 3], [u32; 3]> {
+        let cloud = PointSource::copc(file, points).load(base).unwrap();
+        let p = from_cloud(&cloud, &scene, None).unwrap();
+        (0..cloud.len())
+            .map(|i| {
+                (
+                    cloud.positions[i].map(f32::to_bits),
+                    p.colours[i].map(f32::to_bits),
+                )
+            })
+            .collect()
+    };
+    let (coarse, all) = (colours(24), colours(1_000_000));
+    assert!(coarse.len() >= 20 && all.len() > coarse.len());
+    for (p, c) in &coarse {
+        assert_eq!(all.get(p), Some(c), "point {p:?}");
+    }
+}

@@ -310,6 +310,7 @@ fn pairs_the_key_cannot_order(camera: &Camera, sites: usize) -> (PointCloud, usi
         scale: 1.0,
         positions,
         bounds: [[-0.7; 3], [0.7; 3]],
+        frame: [[-0.7; 3], [0.7; 3]],
         attributes: Vec::new(),
         rgb: Some(rgb),
         normals: None,

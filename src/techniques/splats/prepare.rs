@@ -136,7 +136,8 @@ pub fn from_cloud(
     let grey = [0.6f32; 3];
     // LAS stores colour in 16 bits, but many writers put 8-bit values there (autzen's
     // largest is 236): scale by 255 when nothing exceeds it, as PDAL and CloudCompare do.
-    let elevation_range = [cloud.bounds[0][2], cloud.bounds[1][2]];
+    // Over the frame's z (a COPC file's, so that every cut colours a point alike).
+    let elevation_range = [cloud.frame[0][2], cloud.frame[1][2]];
     let rgb_scale = match &cloud.rgb {
         Some(rgb) if rgb.iter().flatten().all(|&v| v <= 255) => 255.0,
         _ => 65535.0,

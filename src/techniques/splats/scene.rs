@@ -24,7 +24,8 @@ pub enum ColourMode {
     Intensity,
     /// LAS classification, one colour per class.
     Classification,
-    /// Height (z, the file's units) through the property gradient, over the cloud's z range.
+    /// Height (z, the file's units) through the property gradient, over the z range of the
+    /// cloud's frame (a COPC file's header bounds: every cut alike; else its points').
     Elevation,
 }
 
