@@ -123,16 +123,29 @@ impl Mesh {
                 self.vertex_count
             )));
         }
-        // SAFETY: written inside the buffer (checked above); the buffer binding is
+        // Inside the buffer (checked above).
+        self.write(vertices, offset.ok());
+        crate::gl_debug_check!(gpu)
+    }
+
+    /// Write `vertices` into the vertex buffer: at byte `offset` of the buffer as it is,
+    /// or (`None`) as its whole new content.
+    fn write(&self, vertices: &[f32], offset: Option<i32>) {
+        // SAFETY: the caller keeps a sub-range inside the buffer; the buffer binding is
         // restored to none.
         unsafe {
             let bytes = f32_bytes(vertices);
             self.gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.vbo));
-            self.gl
-                .buffer_sub_data_u8_slice(glow::ARRAY_BUFFER, offset.unwrap_or(0), bytes);
+            match offset {
+                Some(at) => self
+                    .gl
+                    .buffer_sub_data_u8_slice(glow::ARRAY_BUFFER, at, bytes),
+                None => self
+                    .gl
+                    .buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes, glow::DYNAMIC_DRAW),
+            }
             self.gl.bind_buffer(glow::ARRAY_BUFFER, None);
         }
-        crate::gl_debug_check!(gpu)
     }
 
     fn upload(&mut self, vertices: &[f32]) -> GlResult<()> {
@@ -144,14 +157,7 @@ impl Mesh {
                 self.floats_per_vertex
             )));
         }
-        // SAFETY: the buffer binding is restored to none.
-        unsafe {
-            let bytes = f32_bytes(vertices);
-            self.gl.bind_buffer(glow::ARRAY_BUFFER, Some(self.vbo));
-            self.gl
-                .buffer_data_u8_slice(glow::ARRAY_BUFFER, bytes, glow::DYNAMIC_DRAW);
-            self.gl.bind_buffer(glow::ARRAY_BUFFER, None);
-        }
+        self.write(vertices, None);
         self.vertex_count = vertices.len() / self.floats_per_vertex;
         Ok(())
     }

@@ -465,11 +465,7 @@ fn precise_points_size_each_point_as_the_tiles_do() {
         // Measured 3e-8 (1.2e-7 at most); points drawn at their unscaled size put 38,208
         // channels more than 1e-3 off.
         assert!(p999 < 1e-4, "{programs}: 99.9 % within {p999:e}");
-        let lit = points
-            .data
-            .chunks(4)
-            .filter(|p| p[0] + p[1] + p[2] > 0.0)
-            .count();
+        let lit = crate::common::lit_pixels(&points, 0.0);
         assert!(lit > 1000, "{programs}: {lit} pixels drawn");
     }
 }

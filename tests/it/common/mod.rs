@@ -120,6 +120,16 @@ pub fn assert_snapshot(name: &str, image: &Image, tolerance: f32) {
 
 /// A file under the project's `data/` (real files no one here wrote, which travel with
 /// the clone; `data/README.md` gives their sources and licences).
+/// Pixels of `image` whose red + green + blue exceed `threshold` (what a picture drew
+/// over a black background).
+pub fn lit_pixels(image: &Image, threshold: f32) -> usize {
+    image
+        .data
+        .chunks(4)
+        .filter(|p| p[0] + p[1] + p[2] > threshold)
+        .count()
+}
+
 pub fn data_file(relative: &str) -> std::path::PathBuf {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("data")
