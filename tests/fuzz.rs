@@ -744,7 +744,7 @@ fn copc_case(bytes: &[u8]) {
     ));
     std::fs::write(&path, bytes).unwrap();
     if let Ok(c) = arbvis::points::copc::Copc::open(&path) {
-        for node in &c.nodes {
+        for node in c.all_nodes().unwrap_or_default().iter() {
             let _ = c.read_node(node);
         }
         let _ = c.describe();

@@ -9,16 +9,13 @@
 //! set: a page that points to itself (a 4-byte change) makes it collect entries until
 //! memory runs out. Before `las` is called the LAS 1.4 header and every VLR and EVLR
 //! header are checked against the file's length and the memory budget, and the laszip
-//! items against the record length. The hierarchy: every page inside the hierarchy EVLR,
-//! a whole number of 32-byte entries, read once (a second reference, a cycle among them,
-//! is refused); every key inside the octree and unique; every chunk inside the point data
-//! with at most 1,000,000 points plus one per compressed byte (as for LAZ files); the
-//! counts summing to the header's. The octree's centre, half-size and spacing must be
+//! items against the record length. The hierarchy is read a page at a time: the root's
+//! at opening, the others when a view reaches them (`copc_hierarchy`, with its checks). The octree's centre, half-size and spacing must be
 //! finite and the sizes positive. Errors name the byte (an entry's own). A node's points
 //! are decoded only on request from its chunk alone, under `catch_unwind` (`laz` panics on
 //! some corrupt streams), the error naming the node.
 
-use std::collections::{BTreeMap, HashMap, HashSet};
+use std::collections::BTreeMap;
 use std::fs::File;
 use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
@@ -27,6 +24,7 @@ use std::sync::Mutex;
 use las::{Header, PointData, PointDataBuilder};
 use laz::record::{LayeredPointRecordDecompressor, RecordDecompressor};
 
+use super::copc_hierarchy::Hierarchy;
 use super::guarded;
 use super::PointsError;
 
@@ -35,8 +33,6 @@ const HEADER: usize = 375;
 /// A VLR header; an EVLR header.
 const VLR_HEADER: u64 = 54;
 const EVLR_HEADER: u64 = 60;
-/// Deepest octree level read (keys are i32: 2^30 nodes a side is far past any survey).
-const MAX_LEVEL: i32 = 30;
 
 /// A COPC cloud in a scene: the file, and the most points drawn (whole levels from the
 /// root; the root's level always).
@@ -79,7 +75,7 @@ pub struct Node {
     pub points: u64,
 }
 
-/// An open COPC file: header, octree description and every node with points.
+/// An open COPC file: header, octree description and the hierarchy pages read so far.
 pub struct Copc {
     path: PathBuf,
     /// The octree's centre, half-size and root spacing (file units).
@@ -90,8 +86,8 @@ pub struct Copc {
     pub points: u64,
     /// The header's bounds (min, max), inside the octree's cube.
     pub bounds: [[f64; 3]; 2],
-    /// Nodes holding points, by level then key.
-    pub nodes: Vec<Node>,
+    /// The hierarchy pages read so far (the root's at opening, the others on demand).
+    hierarchy: Mutex<Hierarchy>,
     header: Header,
     items: Vec<laz::LazItem>,
     file: Mutex<BufReader<File>>,
@@ -300,30 +296,14 @@ impl Copc {
                 "no hierarchy EVLR (user `copc`, record 1000)".into(),
             )
         })?;
-        let mut data = vec![0u8; (hierarchy.1 - hierarchy.0) as usize];
-        read_at(&mut file, hierarchy.0, &mut data).map_err(|e| PointsError::io(path, e))?;
-        let nodes_found = walk_hierarchy(
-            &data,
-            hierarchy.0,
+        let hierarchy = Hierarchy::open(
+            hierarchy,
+            (point_offset, evlr_start),
+            points,
             (root, info_at + 40),
-            point_offset,
-            evlr_start,
+            &mut |at, buf| read_at(&mut file, at, buf),
         )
         .map_err(|(at, m)| bad(at, m))?;
-        let mut nodes = Vec::new();
-        let mut total = 0u64;
-        for node in nodes_found {
-            if node.points > 0 {
-                total += node.points;
-                nodes.push(node);
-            }
-        }
-        if total != points {
-            return Err(bad(
-                247,
-                format!("the header declares {points} points, the hierarchy's nodes hold {total}"),
-            ));
-        }
         file.seek(SeekFrom::Start(0))
             .map_err(|e| PointsError::io(path, e))?;
         let header = guarded(|| Header::new(BufReader::new(&mut file)))
@@ -380,7 +360,6 @@ impl Copc {
                 ),
             ));
         }
-        nodes.sort();
         let bounds = [
             [f64_at_head(187), f64_at_head(203), f64_at_head(219)],
             [f64_at_head(179), f64_at_head(195), f64_at_head(211)],
@@ -391,7 +370,7 @@ impl Copc {
             info: octree,
             format: (format & 0x3f, record),
             points,
-            nodes,
+            hierarchy: Mutex::new(hierarchy),
             header,
             items: laz.items().clone(),
             file: Mutex::new(BufReader::new(file)),
@@ -403,12 +382,52 @@ impl Copc {
         &self.path
     }
 
+    /// Nodes holding points in the hierarchy pages read so far, by level then key.
+    pub fn nodes_read(&self) -> Vec<Node> {
+        self.hierarchy().nodes()
+    }
+
+    /// Keys of the child pages of the hierarchy named and not read yet.
+    pub fn unread_pages(&self) -> Vec<[i32; 4]> {
+        self.hierarchy().unread()
+    }
+
+    /// Hierarchy pages read, and named but not read.
+    pub fn pages(&self) -> (usize, usize) {
+        self.hierarchy().pages()
+    }
+
+    /// Read the child pages of `keys` (keys that name no unread page are passed over).
+    pub fn read_pages(&self, keys: &[[i32; 4]]) -> Result<(), PointsError> {
+        let mut h = self.hierarchy();
+        let mut file = self.file.lock().unwrap_or_else(|e| e.into_inner());
+        for &key in keys {
+            h.read_key(key, &mut |at, buf| read_at(&mut *file, at, buf))
+                .map_err(|(at, m)| PointsError::format(&self.path, at, m))?;
+        }
+        Ok(())
+    }
+
+    /// Every node holding points, by level then key: the whole hierarchy, every page read
+    /// (and the counts checked against the header's).
+    pub fn all_nodes(&self) -> Result<Vec<Node>, PointsError> {
+        let mut h = self.hierarchy();
+        let mut file = self.file.lock().unwrap_or_else(|e| e.into_inner());
+        h.read_all(&mut |at, buf| read_at(&mut *file, at, buf))
+            .map_err(|(at, m)| PointsError::format(&self.path, at, m))?;
+        Ok(h.nodes())
+    }
+
+    fn hierarchy(&self) -> std::sync::MutexGuard<'_, Hierarchy> {
+        self.hierarchy.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
     /// The nodes of the whole levels from the root down whose points fit in `budget`
-    /// (the root's level always), and their levels' count.
-    pub fn cut(&self, budget: u64) -> (Vec<Node>, usize) {
+    /// (the root's level always), and their levels' count. Reads the whole hierarchy.
+    pub fn cut(&self, budget: u64) -> Result<(Vec<Node>, usize), PointsError> {
         let mut total = 0u64;
         let mut levels = Vec::new();
-        for (level, _, points) in self.levels() {
+        for (level, _, points) in self.levels()? {
             if !levels.is_empty() && total + points > budget {
                 break;
             }
@@ -416,23 +435,23 @@ impl Copc {
             levels.push(level);
         }
         let nodes = self
-            .nodes
-            .iter()
+            .all_nodes()?
+            .into_iter()
             .filter(|n| levels.contains(&n.key[0]))
-            .copied()
             .collect();
-        (nodes, levels.len())
+        Ok((nodes, levels.len()))
     }
 
-    /// (level, nodes, points) of every level holding points, from the root down.
-    pub fn levels(&self) -> Vec<(i32, usize, u64)> {
+    /// (level, nodes, points) of every level holding points, from the root down. Reads
+    /// the whole hierarchy.
+    pub fn levels(&self) -> Result<Vec<(i32, usize, u64)>, PointsError> {
         let mut by: BTreeMap<i32, (usize, u64)> = BTreeMap::new();
-        for n in &self.nodes {
+        for n in self.all_nodes()? {
             let e = by.entry(n.key[0]).or_default();
             e.0 += 1;
             e.1 += n.points;
         }
-        by.into_iter().map(|(l, (n, p))| (l, n, p)).collect()
+        Ok(by.into_iter().map(|(l, (n, p))| (l, n, p)).collect())
     }
 
     /// The points of `node`, decoded (its record bytes with the header's format and
@@ -504,18 +523,21 @@ impl Copc {
             .map_err(|e| what(e.to_string()))
     }
 
-    /// What `inspect` says of the octree.
-    pub fn describe(&self) -> String {
+    /// What `inspect` says of the octree (the whole hierarchy read).
+    pub fn describe(&self) -> Result<String, PointsError> {
         let i = &self.info;
+        let levels = self.levels()?;
+        let (pages, _) = self.pages();
         let mut out = format!(
-            "COPC octree: centre ({:.3}, {:.3}, {:.3}), half-size {:.3}, root spacing {:.4}; {} nodes with points, {} points\n",
+            "COPC octree: centre ({:.3}, {:.3}, {:.3}), half-size {:.3}, root spacing {:.4}; {} nodes with points, {} points, hierarchy in {pages} page{}\n",
             i.center_x,
             i.center_y,
             i.center_z,
             i.halfsize,
             i.spacing,
-            self.nodes.len(),
-            self.points
+            levels.iter().map(|l| l.1).sum::<usize>(),
+            self.points,
+            if pages == 1 { "" } else { "s" }
         );
         let (f, record) = self.format;
         let base = [30u16, 36, 38][(f - 6) as usize];
@@ -532,115 +554,12 @@ impl Copc {
                 String::new()
             }
         ));
-        for (level, nodes, points) in self.levels() {
+        for (level, nodes, points) in levels {
             out.push_str(&format!(
                 "  level {level}: {nodes} nodes, {points} points, spacing {:.4}\n",
                 i.spacing / f64::powi(2.0, level)
             ));
         }
-        out
+        Ok(out)
     }
-}
-
-/// The hierarchy's nodes: pages from `root` (file offset, bytes; given at byte `root_at`)
-/// inside `data` (the hierarchy EVLR's bytes, starting at file offset `base`), each read
-/// once; every entry checked. An error is (its byte, what was expected).
-fn walk_hierarchy(
-    data: &[u8],
-    base: u64,
-    (root, root_at): ((u64, u64), u64),
-    point_offset: u64,
-    evlr_start: u64,
-) -> Result<Vec<Node>, (u64, String)> {
-    let end = base + data.len() as u64;
-    let mut pages = vec![(root, root_at)];
-    let mut seen_pages = HashSet::new();
-    let mut keys: HashMap<[i32; 4], u64> = HashMap::new();
-    let mut nodes = Vec::new();
-    while let Some(((offset, size), named_at)) = pages.pop() {
-        if offset < base || offset.saturating_add(size) > end || size == 0 || size % 32 != 0 {
-            return Err((
-                named_at,
-                format!("a hierarchy page of {size} bytes at {offset}: expected a whole number of 32-byte entries inside the hierarchy EVLR ({base}..{end})"),
-            ));
-        }
-        if !seen_pages.insert(offset) {
-            return Err((
-                named_at,
-                format!(
-                    "the hierarchy page at {offset} is referenced twice (a cycle among the pages)"
-                ),
-            ));
-        }
-        for k in 0..size / 32 {
-            let at = offset + 32 * k;
-            let e = &data[(at - base) as usize..][..32];
-            let i32_at = |o: usize| i32::from_le_bytes(e[o..o + 4].try_into().expect("4"));
-            let key = [i32_at(0), i32_at(4), i32_at(8), i32_at(12)];
-            let target = u64_at(e, 16);
-            let (bytes, points) = (i32_at(24), i32_at(28));
-            let fail = |m: String| (at, format!("hierarchy entry {key:?}: {m}"));
-            let side = if (0..=MAX_LEVEL).contains(&key[0]) {
-                1i64 << key[0]
-            } else {
-                return Err(fail(format!("level {}: expected 0..={MAX_LEVEL}", key[0])));
-            };
-            if key[1..].iter().any(|&c| c < 0 || c as i64 >= side) {
-                return Err(fail(format!(
-                    "x, y, z must lie in 0..{side} at level {}",
-                    key[0]
-                )));
-            }
-            if let Some(first) = keys.insert(key, at) {
-                return Err(fail(format!(
-                    "the key is listed twice (first at byte {first})"
-                )));
-            }
-            if points == -1 {
-                if bytes <= 0 {
-                    return Err(fail(format!("a child page of {bytes} bytes")));
-                }
-                // The page's entry for this key comes again inside it.
-                keys.remove(&key);
-                pages.push(((target, bytes as u64), at));
-                continue;
-            }
-            if points < 0 || bytes < 0 {
-                return Err(fail(format!(
-                    "{points} points in {bytes} bytes: expected counts of 0 or more (-1: a child page)"
-                )));
-            }
-            let (points, bytes) = (points as u64, bytes as u64);
-            if points > 0 {
-                if target < point_offset || target.saturating_add(bytes) > evlr_start || bytes == 0
-                {
-                    return Err(fail(format!(
-                        "its chunk ({bytes} bytes at {target}) must lie in the point data ({point_offset}..{evlr_start})"
-                    )));
-                }
-                if points > 1_000_000 + bytes {
-                    return Err(fail(format!(
-                        "{points} points in {bytes} compressed bytes: more than 1,000,000 plus one a byte"
-                    )));
-                }
-            }
-            nodes.push(Node {
-                key,
-                offset: target,
-                bytes,
-                points,
-            });
-        }
-    }
-    // Every node below the root under a node of the hierarchy (its parent's key listed).
-    for (key, at) in &keys {
-        let parent = [key[0] - 1, key[1] / 2, key[2] / 2, key[3] / 2];
-        if key[0] > 0 && !keys.contains_key(&parent) {
-            return Err((
-                *at,
-                format!("hierarchy entry {key:?}: its parent {parent:?} is not in the hierarchy"),
-            ));
-        }
-    }
-    Ok(nodes)
 }

@@ -103,3 +103,25 @@ pub fn put(file: &FileId, key: [i32; 4], data: Arc<PointData>) {
 pub fn held() -> u64 {
     cache().bytes
 }
+
+/// The file at `path` opened, or the one opened before if it has not changed since: the
+/// hierarchy pages an earlier cut read stay read. The last few files are held.
+pub fn open(path: &Path) -> Result<Arc<super::copc::Copc>, super::PointsError> {
+    type Opened = Vec<(FileId, Arc<super::copc::Copc>)>;
+    static OPENED: OnceLock<Mutex<Opened>> = OnceLock::new();
+    const HELD: usize = 4;
+    let id = FileId::of(path);
+    let opened = OPENED.get_or_init(Default::default);
+    let held = |o: &Opened| o.iter().find(|(f, _)| *f == id).map(|(_, c)| c.clone());
+    if let Some(c) = held(&opened.lock().unwrap_or_else(|e| e.into_inner())) {
+        return Ok(c);
+    }
+    let c = Arc::new(super::copc::Copc::open(path)?);
+    let mut o = opened.lock().unwrap_or_else(|e| e.into_inner());
+    o.retain(|(f, _)| f.path != id.path);
+    if o.len() >= HELD {
+        o.remove(0);
+    }
+    o.push((id, c.clone()));
+    Ok(c)
+}

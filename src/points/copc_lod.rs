@@ -94,6 +94,8 @@ impl Cut {
 
     /// A line for `--stats` and the viewer.
     pub fn describe(&self, copc: &Copc) -> String {
+        let (read, unread) = copc.pages();
+        let known = copc.nodes_read().len();
         let bytes: u64 = self.nodes.iter().map(|n| n.bytes).sum();
         let levels = self
             .nodes
@@ -101,9 +103,16 @@ impl Cut {
             .map(|n| n.key[0])
             .collect::<std::collections::BTreeSet<_>>();
         format!(
-            "COPC: {} of {} nodes, levels {:?}, {} points{} ({} compressed), {} nodes outside the view, {} under the pixel size, {} left for the budget",
+            "COPC: {} of {}, levels {:?}, {} points{} ({} compressed), {} nodes outside the view, {} under the pixel size, {} left for the budget",
             self.nodes.len(),
-            copc.nodes.len(),
+            if unread == 0 {
+                format!("{known} nodes")
+            } else {
+                format!(
+                    "the {known} nodes of the {read} hierarchy page{} read ({unread} not read)",
+                    if read == 1 { "" } else { "s" }
+                )
+            },
             levels,
             self.points / self.root_stride.max(1),
             if self.root_stride > 1 {
@@ -172,22 +181,68 @@ pub fn frame(copc: &Copc) -> ([f64; 3], f64) {
     super::cloud::origin_and_scale(&copc.bounds)
 }
 
-/// The nodes `view` draws within `budget` points.
-pub fn select(copc: &Copc, view: &View, budget: u64, min_node_pixels: f64) -> Cut {
+/// The nodes `view` draws within `budget` points. The hierarchy's child pages are read
+/// as the view reaches them: a page is read when its key would be taken, and the choice
+/// is made again with its nodes (as many rounds as pages nest).
+pub fn select(
+    copc: &Copc,
+    view: &View,
+    budget: u64,
+    min_node_pixels: f64,
+) -> Result<Cut, super::PointsError> {
+    loop {
+        let nodes = copc.nodes_read();
+        let pages = copc.unread_pages();
+        let (cut, wanted) = select_known(copc, &nodes, &pages, view, budget, min_node_pixels);
+        if wanted.is_empty() {
+            return Ok(cut);
+        }
+        copc.read_pages(&wanted)?;
+    }
+}
+
+/// A tree entry: a node, or a child page not read (its key's points unknown).
+enum Known<'a> {
+    Node(&'a Node),
+    Page([i32; 4]),
+}
+
+impl Known<'_> {
+    fn key(&self) -> [i32; 4] {
+        match self {
+            Known::Node(n) => n.key,
+            Known::Page(k) => *k,
+        }
+    }
+}
+
+/// [`select`] over the nodes and unread pages known, and the unread pages it would take.
+fn select_known(
+    copc: &Copc,
+    nodes: &[Node],
+    pages: &[[i32; 4]],
+    view: &View,
+    budget: u64,
+    min_node_pixels: f64,
+) -> (Cut, Vec<[i32; 4]>) {
     let (origin, scale) = frame(copc);
     let info = copc.info;
     let planes = frustum(&view.view_projection);
-    // Each node's children: the nodes whose nearest present ancestor it is.
-    let index: HashMap<[i32; 4], usize> = copc
-        .nodes
+    let known: Vec<Known> = nodes
+        .iter()
+        .map(Known::Node)
+        .chain(pages.iter().map(|&k| Known::Page(k)))
+        .collect();
+    // Each entry's children: the entries whose nearest present ancestor it is.
+    let index: HashMap<[i32; 4], usize> = known
         .iter()
         .enumerate()
-        .map(|(i, n)| (n.key, i))
+        .map(|(i, n)| (n.key(), i))
         .collect();
-    let mut children: Vec<Vec<usize>> = vec![Vec::new(); copc.nodes.len()];
+    let mut children: Vec<Vec<usize>> = vec![Vec::new(); known.len()];
     let mut roots = Vec::new();
-    for (i, n) in copc.nodes.iter().enumerate() {
-        let mut k = n.key;
+    for (i, n) in known.iter().enumerate() {
+        let mut k = n.key();
         let parent = loop {
             if k[0] == 0 {
                 break None;
@@ -204,13 +259,13 @@ pub fn select(copc: &Copc, view: &View, budget: u64, min_node_pixels: f64) -> Cu
     }
     let half_height = 0.5 * view.size[1] as f64;
     let rank = |i: usize| -> Option<f64> {
-        let n = &copc.nodes[i];
-        let side = 2.0 * info.halfsize / f64::from(1u32 << n.key[0].clamp(0, 31));
+        let key = known[i].key();
+        let side = 2.0 * info.halfsize / f64::from(1u32 << key[0].clamp(0, 31));
         let lo = [info.center_x, info.center_y, info.center_z].map(|c| c - info.halfsize);
         let c = DVec3::new(
-            (lo[0] + side * (n.key[1] as f64 + 0.5) - origin[0]) / scale,
-            (lo[1] + side * (n.key[2] as f64 + 0.5) - origin[1]) / scale,
-            (lo[2] + side * (n.key[3] as f64 + 0.5) - origin[2]) / scale,
+            (lo[0] + side * (key[1] as f64 + 0.5) - origin[0]) / scale,
+            (lo[1] + side * (key[2] as f64 + 0.5) - origin[1]) / scale,
+            (lo[2] + side * (key[3] as f64 + 0.5) - origin[2]) / scale,
         );
         let r = 0.5 * 3f64.sqrt() * side / scale;
         if planes.iter().any(|p| p.dot(c.extend(1.0)) < -r) {
@@ -233,6 +288,7 @@ pub fn select(copc: &Copc, view: &View, budget: u64, min_node_pixels: f64) -> Cu
         too_small: 0,
         over_budget: 0,
     };
+    let mut wanted = Vec::new();
     let mut queue = BinaryHeap::new();
     for &i in &roots {
         // The roots are queued whatever their size (a picture always has them).
@@ -242,7 +298,14 @@ pub fn select(copc: &Copc, view: &View, budget: u64, min_node_pixels: f64) -> Cu
         });
     }
     while let Some(Ranked { item: index, .. }) = queue.pop() {
-        let n = copc.nodes[index];
+        let n = match known[index] {
+            Known::Node(n) => *n,
+            // Its points are not known until its page is read.
+            Known::Page(key) => {
+                wanted.push(key);
+                continue;
+            }
+        };
         if !cut.nodes.is_empty() && cut.points + n.points > budget {
             cut.over_budget += 1 + queue.len();
             break;
@@ -264,7 +327,7 @@ pub fn select(copc: &Copc, view: &View, budget: u64, min_node_pixels: f64) -> Cu
     if cut.points > budget && budget > 0 {
         cut.root_stride = cut.points.div_ceil(budget);
     }
-    cut
+    (cut, wanted)
 }
 
 /// The six planes of the view frustum (Gribb and Hartmann): a point is inside when every

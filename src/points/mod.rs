@@ -39,6 +39,7 @@
 mod cloud;
 pub mod copc;
 pub mod copc_cache;
+mod copc_hierarchy;
 pub mod copc_lod;
 pub mod copc_write;
 pub mod dat;
@@ -229,11 +230,11 @@ impl PointSource {
             PointSource::Las(p) => lasfile::read(&base.join(p))?.cloud,
             PointSource::Ply(p) => plycloud::read(&base.join(p))?.cloud,
             PointSource::Copc(spec) => {
-                let c = copc::Copc::open(&base.join(&spec.path))?;
+                let c = copc_cache::open(&base.join(&spec.path))?;
                 let cut = match view {
-                    Some(v) => copc_lod::select(&c, v, spec.points, spec.min_node_pixels),
+                    Some(v) => copc_lod::select(&c, v, spec.points, spec.min_node_pixels)?,
                     None => {
-                        let (nodes, _) = c.cut(spec.points);
+                        let (nodes, _) = c.cut(spec.points)?;
                         let points = nodes.iter().map(|n| n.points).sum();
                         copc_lod::Cut::whole(nodes, points, spec.points)
                     }
@@ -346,7 +347,7 @@ pub fn inspect(path: &Path) -> Result<String, PointsError> {
             c.format.0,
             c.format.1,
             c.points,
-            c.describe()
+            c.describe()?
         ));
     }
     let bytes = read_file(path)?;

@@ -40,10 +40,15 @@ with laspy.CopcReader.open(sys.argv[1]) as r:
 /// arbvis's lines for the same, node by node.
 fn arbvis_lines(copc: &Copc) -> Vec<String> {
     let mut out = Vec::new();
-    let levels = copc.levels().last().map_or(0, |l| l.0 + 1);
+    let levels = copc.levels().unwrap().last().map_or(0, |l| l.0 + 1);
     for level in 0..levels {
         let mut rows = Vec::new();
-        for node in copc.nodes.iter().filter(|n| n.key[0] == level) {
+        for node in copc
+            .all_nodes()
+            .unwrap()
+            .iter()
+            .filter(|n| n.key[0] == level)
+        {
             let p = copc.read_node(node).unwrap();
             let mut cols = crate::common::las_columns(&p);
             cols.push(p.scan_angle_degrees().map(|v| format!("{v:.3}")).collect());
@@ -81,8 +86,8 @@ fn copc_nodes_read_as_laspy_reads_them() {
         let copc = Copc::open(&path).unwrap();
         // The files' octree: 1,065 points in 65 nodes over four levels.
         assert_eq!(copc.points, 1065);
-        assert_eq!(copc.nodes.len(), 65);
-        let levels: Vec<(i32, usize, u64)> = copc.levels();
+        assert_eq!(copc.all_nodes().unwrap().len(), 65);
+        let levels: Vec<(i32, usize, u64)> = copc.levels().unwrap();
         assert_eq!(levels, [(0, 1, 24), (1, 4, 66), (2, 12, 197), (3, 48, 778)]);
         let ours = arbvis_lines(&copc);
         assert_eq!(ours.len(), 1065);
@@ -178,7 +183,7 @@ fn damaged_copc_files_are_refused_naming_the_byte_or_the_node() {
     // points, never a panic or an allocation past the node's count.
     let copc = Copc::open(&data_file(FILES[0])).unwrap();
     let mut b = bytes.clone();
-    for n in &copc.nodes {
+    for n in &copc.all_nodes().unwrap() {
         for k in 0..n.bytes as usize {
             let at = n.offset as usize + k;
             b[at] = b[at].wrapping_mul(31).wrapping_add(7);
@@ -186,7 +191,7 @@ fn damaged_copc_files_are_refused_naming_the_byte_or_the_node() {
     }
     let p = write("chunks.copc.laz", &b);
     let scrambled = Copc::open(&p).unwrap();
-    for n in &scrambled.nodes {
+    for n in &scrambled.all_nodes().unwrap() {
         match scrambled.read_node(n) {
             Ok(points) => assert_eq!(points.len() as u64, n.points),
             Err(e) => assert!(e.to_string().contains(&format!("node {:?}", n.key)), "{e}"),
@@ -260,7 +265,7 @@ fn gps_time_is_an_attribute_after_the_files_earliest() {
         let copc = Copc::open(&path).unwrap();
         let reference = copc.info.gps_range[0];
         let mut raw: Vec<f64> = Vec::new();
-        for node in &copc.nodes {
+        for node in &copc.all_nodes().unwrap() {
             raw.extend(copc.read_node(node).unwrap().gps_time().unwrap());
         }
         let earliest = raw.iter().copied().fold(f64::INFINITY, f64::min);

@@ -13,6 +13,7 @@ mod cli;
 mod clip;
 mod copc;
 mod copc_lod;
+mod copc_pages;
 mod copc_write;
 mod data;
 mod docs;

@@ -70,7 +70,7 @@ pub fn lod(
     let mut rows = Vec::new();
     for &budget in budgets {
         let s = with_budget(scene, budget)?;
-        let cut = select(&copc, &view, budget, 0.0);
+        let cut = select(&copc, &view, budget, 0.0)?;
         let image = crate::render::render_on(headless, &s)?.image;
         let rgb: Vec<f32> = full
             .data

@@ -1,0 +1,252 @@
+//! A COPC file's hierarchy, read a page at a time. The info VLR names the root page; an
+//! entry whose point count is -1 names a child page holding that key's entry and its
+//! subtree. [`Copc::open`](super::copc::Copc::open) reads the root page only; the level
+//! of detail reads a child page when the view reaches its key
+//! ([`super::copc_lod::select`]), and `inspect`, whole-level cuts and the writer's checks
+//! read them all. A 10-billion-point file's hierarchy (about 11 MB) is never read whole
+//! to draw a view.
+//!
+//! Every page lies inside the hierarchy EVLR, a whole number of 32-byte entries, and is
+//! read once (a second reference, a cycle among pages, is refused when it is met). Every
+//! key lies inside the octree, is listed once, and has its parent listed (in a page read
+//! or as a page not yet read); every chunk lies inside the point data with at most
+//! 1,000,000 points plus one per compressed byte (as for LAZ files). Once every page is
+//! read the counts must sum to the header's. An error is (its byte, what was expected).
+
+use std::collections::{BTreeMap, HashMap, HashSet};
+
+use super::copc::Node;
+
+/// Deepest octree level read (keys are i32: 2^30 nodes a side is far past any survey).
+const MAX_LEVEL: i32 = 30;
+
+/// A page not read yet: where it lies and the byte of the entry that names it.
+#[derive(Debug, Clone, Copy)]
+struct PageRef {
+    offset: u64,
+    size: u64,
+    named_at: u64,
+}
+
+/// The pages read so far and those named but not read.
+#[derive(Debug)]
+pub(super) struct Hierarchy {
+    /// The hierarchy EVLR's bytes: file offsets `start..end`.
+    evlr: (u64, u64),
+    /// The point data: file offsets `start..end` (every chunk lies inside).
+    point_data: (u64, u64),
+    /// The header's point count (the nodes' sum once every page is read).
+    points: u64,
+    /// Nodes holding points, in the pages read.
+    nodes: Vec<Node>,
+    /// Every key listed in the pages read and the byte of its entry.
+    keys: HashMap<[i32; 4], u64>,
+    /// Child pages named and not read, by key.
+    unread: BTreeMap<[i32; 4], PageRef>,
+    /// Offsets of every page read or named.
+    pages: HashSet<u64>,
+    /// Pages read.
+    read: usize,
+}
+
+/// Reads `buf.len()` bytes at a file offset.
+pub(super) type ReadAt<'a> = &'a mut dyn FnMut(u64, &mut [u8]) -> std::io::Result<()>;
+
+impl Hierarchy {
+    /// The hierarchy EVLR at `evlr`, points at `point_data`, `points` in the header, and
+    /// the root page (offset, size) named at byte `root_at`, read through `read`.
+    pub(super) fn open(
+        evlr: (u64, u64),
+        point_data: (u64, u64),
+        points: u64,
+        (root, root_at): ((u64, u64), u64),
+        read: ReadAt<'_>,
+    ) -> Result<Hierarchy, (u64, String)> {
+        let mut h = Hierarchy {
+            evlr,
+            point_data,
+            points,
+            nodes: Vec::new(),
+            keys: HashMap::new(),
+            unread: BTreeMap::new(),
+            pages: HashSet::new(),
+            read: 0,
+        };
+        let root = h.name_page(root.0, root.1, root_at)?;
+        h.read_page(root, read)?;
+        Ok(h)
+    }
+
+    /// Nodes holding points in the pages read, by level then key.
+    pub(super) fn nodes(&self) -> Vec<Node> {
+        let mut nodes = self.nodes.clone();
+        nodes.sort();
+        nodes
+    }
+
+    /// Keys of the child pages named and not read.
+    pub(super) fn unread(&self) -> Vec<[i32; 4]> {
+        self.unread.keys().copied().collect()
+    }
+
+    /// Pages read and pages named but not read.
+    pub(super) fn pages(&self) -> (usize, usize) {
+        (self.read, self.unread.len())
+    }
+
+    /// Read the child page of `key` (nothing when it is not an unread page).
+    pub(super) fn read_key(
+        &mut self,
+        key: [i32; 4],
+        read: ReadAt<'_>,
+    ) -> Result<(), (u64, String)> {
+        match self.unread.remove(&key) {
+            Some(page) => self.read_page(page, read),
+            None => Ok(()),
+        }
+    }
+
+    /// Read every page not read yet.
+    pub(super) fn read_all(&mut self, read: ReadAt<'_>) -> Result<(), (u64, String)> {
+        while let Some((_, page)) = self.unread.pop_first() {
+            self.read_page(page, read)?;
+        }
+        Ok(())
+    }
+
+    /// Check a page named at byte `named_at` and remember its offset.
+    fn name_page(
+        &mut self,
+        offset: u64,
+        size: u64,
+        named_at: u64,
+    ) -> Result<PageRef, (u64, String)> {
+        let (base, end) = self.evlr;
+        if offset < base || offset.saturating_add(size) > end || size == 0 || !size.is_multiple_of(32) {
+            return Err((
+                named_at,
+                format!("a hierarchy page of {size} bytes at {offset}: expected a whole number of 32-byte entries inside the hierarchy EVLR ({base}..{end})"),
+            ));
+        }
+        if !self.pages.insert(offset) {
+            return Err((
+                named_at,
+                format!(
+                    "the hierarchy page at {offset} is referenced twice (a cycle among the pages)"
+                ),
+            ));
+        }
+        Ok(PageRef {
+            offset,
+            size,
+            named_at,
+        })
+    }
+
+    /// Read one page, check its entries and add them.
+    fn read_page(&mut self, page: PageRef, read: ReadAt<'_>) -> Result<(), (u64, String)> {
+        let mut data = vec![0u8; page.size as usize];
+        read(page.offset, &mut data).map_err(|e| {
+            (
+                page.named_at,
+                format!(
+                    "the hierarchy page of {} bytes at {}: {e}",
+                    page.size, page.offset
+                ),
+            )
+        })?;
+        let mut listed = Vec::new();
+        for (k, e) in data.chunks_exact(32).enumerate() {
+            let at = page.offset + 32 * k as u64;
+            let i32_at = |o: usize| i32::from_le_bytes(e[o..o + 4].try_into().expect("4"));
+            let key = [i32_at(0), i32_at(4), i32_at(8), i32_at(12)];
+            let target = u64::from_le_bytes(e[16..24].try_into().expect("8"));
+            let (bytes, points) = (i32_at(24), i32_at(28));
+            let fail = |m: String| (at, format!("hierarchy entry {key:?}: {m}"));
+            let side = if (0..=MAX_LEVEL).contains(&key[0]) {
+                1i64 << key[0]
+            } else {
+                return Err(fail(format!("level {}: expected 0..={MAX_LEVEL}", key[0])));
+            };
+            if key[1..].iter().any(|&c| c < 0 || c as i64 >= side) {
+                return Err(fail(format!(
+                    "x, y, z must lie in 0..{side} at level {}",
+                    key[0]
+                )));
+            }
+            let first = self
+                .keys
+                .get(&key)
+                .copied()
+                .or_else(|| self.unread.get(&key).map(|p| p.named_at));
+            if let Some(first) = first {
+                return Err(fail(format!(
+                    "the key is listed twice (first at byte {first})"
+                )));
+            }
+            listed.push((key, at));
+            if points == -1 {
+                if bytes <= 0 {
+                    return Err(fail(format!("a child page of {bytes} bytes")));
+                }
+                // The page's entry for this key comes again inside it.
+                let child = self.name_page(target, bytes as u64, at)?;
+                self.unread.insert(key, child);
+                continue;
+            }
+            if points < 0 || bytes < 0 {
+                return Err(fail(format!(
+                    "{points} points in {bytes} bytes: expected counts of 0 or more (-1: a child page)"
+                )));
+            }
+            let (points, bytes) = (points as u64, bytes as u64);
+            let (start, end) = self.point_data;
+            if points > 0 {
+                if target < start || target.saturating_add(bytes) > end || bytes == 0 {
+                    return Err(fail(format!(
+                        "its chunk ({bytes} bytes at {target}) must lie in the point data ({start}..{end})"
+                    )));
+                }
+                if points > 1_000_000 + bytes {
+                    return Err(fail(format!(
+                        "{points} points in {bytes} compressed bytes: more than 1,000,000 plus one a byte"
+                    )));
+                }
+                self.nodes.push(Node {
+                    key,
+                    offset: target,
+                    bytes,
+                    points,
+                });
+            }
+            self.keys.insert(key, at);
+        }
+        self.read += 1;
+        // Every key below the root under a key of the hierarchy (its parent listed).
+        for (key, at) in listed {
+            let parent = [key[0] - 1, key[1] / 2, key[2] / 2, key[3] / 2];
+            if key[0] > 0 && !self.keys.contains_key(&parent) && !self.unread.contains_key(&parent)
+            {
+                return Err((
+                    at,
+                    format!(
+                        "hierarchy entry {key:?}: its parent {parent:?} is not in the hierarchy"
+                    ),
+                ));
+            }
+        }
+        if self.unread.is_empty() {
+            let total: u64 = self.nodes.iter().map(|n| n.points).sum();
+            if total != self.points {
+                return Err((
+                    247,
+                    format!(
+                        "the header declares {} points, the hierarchy's nodes hold {total}",
+                        self.points
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}

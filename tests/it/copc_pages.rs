@@ -1,0 +1,134 @@
+//! The COPC hierarchy read a page at a time (issue 28, item 1). laspy's
+//! `simple_with_page.copc.laz` keeps the subtree under (2, 0, 0, 0) (5 of its 65 nodes)
+//! in a child page: opening reads the root page only, a view that does not reach that key
+//! leaves the child page unread, one that does reads it, and every cut equals the one made
+//! with the whole hierarchy read first. A damaged child page is an error naming its entry's
+//! byte when a view reaches it, not before.
+
+use arbvis::camera::{Camera, Projection};
+use arbvis::points::copc::Copc;
+use arbvis::points::copc_lod::{select, View};
+
+use crate::common::{data_file, temp_dir};
+
+const FILE: &str = "points/simple_with_page.copc.laz";
+
+fn camera(projection: Projection, zoom: f64, rotation: [f64; 4]) -> Camera {
+    Camera {
+        projection,
+        rotation: glam::DQuat::from_array(rotation).normalize().to_array(),
+        zoom,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn opening_reads_the_root_page_and_a_view_reads_what_it_reaches() {
+    let lazy = Copc::open(&data_file(FILE)).unwrap();
+    assert_eq!(lazy.pages(), (1, 1));
+    assert_eq!(lazy.nodes_read().len(), 60);
+    assert_eq!(lazy.unread_pages(), [[2, 0, 0, 0]]);
+    let front = camera(Projection::Orthographic, 1.0, [0.0, 0.0, 0.0, 1.0]);
+    // A thumbnail: only the root is over 150 px; the child page stays unread.
+    let small = select(&lazy, &View::of(&front, [64, 48]), 1_000_000, 150.0).unwrap();
+    assert_eq!(small.nodes.len(), 1);
+    assert_eq!(lazy.pages(), (1, 1));
+    // 1600 x 900 takes every node of levels 0-2, (2, 0, 0, 0) among them: its page is read.
+    let large = select(&lazy, &View::of(&front, [1600, 900]), 1_000_000, 150.0).unwrap();
+    assert_eq!(large.nodes.len(), 1 + 4 + 12);
+    assert!(large.nodes.iter().any(|n| n.key == [2, 0, 0, 0]));
+    assert_eq!(lazy.pages(), (2, 0));
+    assert_eq!(lazy.nodes_read().len(), 65);
+}
+
+#[test]
+fn every_cut_equals_the_cut_of_the_whole_hierarchy() {
+    let eager = Copc::open(&data_file(FILE)).unwrap();
+    assert_eq!(eager.all_nodes().unwrap().len(), 65);
+    assert_eq!(eager.pages(), (2, 0));
+    // Rotated cameras, both projections, zooms from the whole cloud to a corner, odd
+    // sizes, budgets from under the root to every point, with and without a pixel size.
+    let mut reached = 0;
+    let mut left = 0;
+    for (k, rotation) in [
+        [0.0, 0.0, 0.0, 1.0],
+        [0.3, -0.5, 0.1, 0.8],
+        [0.2, 0.6, -0.1, 0.75],
+        [-0.7, 0.1, 0.4, 0.3],
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        for projection in [Projection::Orthographic, Projection::Perspective] {
+            for zoom in [0.6, 1.7, 4.5] {
+                for (budget, pixels) in [(10, 0.0), (100, 150.0), (400, 0.0), (1065, 150.0)] {
+                    let size = [317 + 200 * k as u32, 233];
+                    let view = View::of(&camera(projection, zoom, rotation), size);
+                    let lazy = Copc::open(&data_file(FILE)).unwrap();
+                    let cut = select(&lazy, &view, budget, pixels).unwrap();
+                    assert_eq!(
+                        cut,
+                        select(&eager, &view, budget, pixels).unwrap(),
+                        "{rotation:?} {projection:?} zoom {zoom} budget {budget}"
+                    );
+                    // The child page is read exactly when the cut reaches its key.
+                    let has = cut
+                        .nodes
+                        .iter()
+                        .any(|n| n.key[0] >= 2 && n.key[1..] == [0, 0, 0]);
+                    assert_eq!(lazy.pages(), if has { (2, 0) } else { (1, 1) });
+                    reached += usize::from(has);
+                    left += usize::from(!has);
+                }
+            }
+        }
+    }
+    // Both cases were met.
+    assert!(reached > 0 && left > 0, "{reached} {left}");
+}
+
+#[test]
+fn a_damaged_child_page_is_an_error_when_a_view_reaches_it() {
+    let bytes = std::fs::read(data_file(FILE)).unwrap();
+    // The child page: the root page's entry for (2, 0, 0, 0) names it.
+    let vlr = 375 + 54;
+    let root = u64::from_le_bytes(bytes[vlr + 40..vlr + 48].try_into().unwrap()) as usize;
+    let size = u64::from_le_bytes(bytes[vlr + 48..vlr + 56].try_into().unwrap()) as usize;
+    let entry = (root..root + size)
+        .step_by(32)
+        .find(|&e| bytes[e + 28..e + 32] == (-1i32).to_le_bytes())
+        .expect("a child page");
+    let page = u64::from_le_bytes(bytes[entry + 16..entry + 24].try_into().unwrap()) as usize;
+    // Its second entry at level 99.
+    let mut b = bytes.clone();
+    b[page + 32..page + 36].copy_from_slice(&99i32.to_le_bytes());
+    let path = temp_dir("copc-pages").join("page.copc.laz");
+    std::fs::write(&path, &b).unwrap();
+    let c = Copc::open(&path).expect("the root page is sound");
+    let front = camera(Projection::Orthographic, 1.0, [0.0, 0.0, 0.0, 1.0]);
+    select(&c, &View::of(&front, [64, 48]), 1_000_000, 150.0).expect("the root only");
+    let e = select(&c, &View::of(&front, [1600, 900]), 1_000_000, 150.0)
+        .expect_err("the page is reached")
+        .to_string();
+    assert!(
+        e.contains("page.copc.laz")
+            && e.contains(&format!("at byte {}", page + 32))
+            && e.contains("level 99"),
+        "{e}"
+    );
+    // `inspect` reads every page: the same error.
+    let e = arbvis::points::inspect(&path)
+        .expect_err("refused")
+        .to_string();
+    assert!(e.contains("level 99"), "{e}");
+    // A page named past the hierarchy EVLR: refused where it is named (the root page, read
+    // at opening), naming the entry.
+    let mut b = bytes.clone();
+    b[entry + 16..entry + 24].copy_from_slice(&(bytes.len() as u64).to_le_bytes());
+    std::fs::write(&path, &b).unwrap();
+    let e = Copc::open(&path).err().expect("refused").to_string();
+    assert!(
+        e.contains(&format!("at byte {entry}")) && e.contains("inside the hierarchy EVLR"),
+        "{e}"
+    );
+}
