@@ -122,7 +122,11 @@ impl Hierarchy {
         named_at: u64,
     ) -> Result<PageRef, (u64, String)> {
         let (base, end) = self.evlr;
-        if offset < base || offset.saturating_add(size) > end || size == 0 || !size.is_multiple_of(32) {
+        if offset < base
+            || offset.saturating_add(size) > end
+            || size == 0
+            || !size.is_multiple_of(32)
+        {
             return Err((
                 named_at,
                 format!("a hierarchy page of {size} bytes at {offset}: expected a whole number of 32-byte entries inside the hierarchy EVLR ({base}..{end})"),

@@ -132,3 +132,89 @@ fn a_damaged_child_page_is_an_error_when_a_view_reaches_it() {
         "{e}"
     );
 }
+
+/// laspy reads every point of a COPC file (`CopcReader.query()`, following its pages):
+/// "X Y Z" lines of the raw integers, sorted.
+const LASPY_XYZ: &str = r#"
+import sys, laspy
+with laspy.CopcReader.open(sys.argv[1]) as r:
+    p = r.query()
+rows = sorted("%d %d %d" % (x, y, z) for x, y, z in zip(p.X, p.Y, p.Z))
+print("\n".join(rows))
+"#;
+
+/// A cloud deep enough for child pages (a broad spread and a tight cluster that goes
+/// down level after level), converted: the root page holds the top four levels and names
+/// the pages below; arbvis and laspy read every point through them.
+#[test]
+fn the_writer_pages_a_deep_hierarchy_and_laspy_reads_it() {
+    let dir = temp_dir("copc-pages-write");
+    let ply = dir.join("deep.ply");
+    let mut seed = 0x2545_f491_u64;
+    let mut next = move || {
+        seed = seed
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut text = String::from(
+        "ply\nformat ascii 1.0\nelement vertex 5000\nproperty double x\nproperty double y\nproperty double z\nend_header\n",
+    );
+    for k in 0..5000 {
+        let (spread, centre) = if k < 2000 { (100.0, 0.0) } else { (0.05, 37.3) };
+        let p = [next(), next(), next()].map(|v| centre + spread * v);
+        text.push_str(&format!("{:.4} {:.4} {:.4}\n", p[0], p[1], p[2]));
+    }
+    std::fs::write(&ply, text).unwrap();
+    let out = dir.join("deep.copc.laz");
+    crate::common::stdout_of(
+        std::process::Command::new(env!("CARGO_BIN_EXE_arbvis"))
+            .arg("convert")
+            .arg(&ply)
+            .arg(&out)
+            .args(["--node-points", "50"]),
+    );
+    let c = Copc::open(&out).unwrap();
+    let (read, unread) = c.pages();
+    assert_eq!(read, 1);
+    assert!(unread > 0, "a deep cloud's hierarchy is paged");
+    assert!(
+        c.nodes_read().iter().all(|n| n.key[0] < 5),
+        "the root page: levels 0-4"
+    );
+    let nodes = c.all_nodes().unwrap();
+    assert!(
+        nodes.iter().any(|n| n.key[0] >= 5),
+        "deeper levels in child pages"
+    );
+    assert_eq!(nodes.iter().map(|n| n.points).sum::<u64>(), 5000);
+    // arbvis's reader: every point through the pages, as raw integers.
+    let mut ours = Vec::new();
+    for n in &nodes {
+        let pd = c.read_node(n).unwrap();
+        let cols = crate::common::las_columns(&pd);
+        ours.extend(crate::common::rows_of(&cols[..3], pd.len()));
+    }
+    ours.sort();
+    assert_eq!(ours.len(), 5000);
+    // And as a scene's cloud, every budget's whole-level cut read through the pages.
+    let cloud = arbvis::points::PointSource::copc(out.clone(), 1 << 40)
+        .load(std::path::Path::new("."))
+        .unwrap();
+    assert_eq!(cloud.len(), 5000);
+    if !crate::common::python_has(
+        "import laspy, lazrs",
+        "python3 with laspy and lazrs is missing (pip install laspy lazrs)",
+    ) {
+        return;
+    }
+    let theirs: Vec<String> = crate::common::stdout_of(
+        std::process::Command::new("python3")
+            .args(["-c", LASPY_XYZ])
+            .arg(&out),
+    )
+    .lines()
+    .map(str::to_string)
+    .collect();
+    assert!(ours == theirs, "laspy reads other points");
+}

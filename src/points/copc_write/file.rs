@@ -1,5 +1,6 @@
 //! The COPC file as it is written: header and VLRs (rewritten with the final numbers at
-//! the end), one LAZ chunk per node, the chunk table, the hierarchy EVLR.
+//! the end), one LAZ chunk per node, the chunk table, the hierarchy EVLR (its pages:
+//! `pages`).
 
 use std::fs::File;
 use std::io::{BufWriter, Seek, SeekFrom, Write};
@@ -28,7 +29,7 @@ pub(super) struct CopcFile {
     laz: LazVlr,
     point_start: u64,
     record: usize,
-    entries: Vec<(Key, u64, u64, u64)>,
+    entries: Vec<super::pages::Entry>,
     chunks: ChunkTable,
     pending: Vec<(Key, Vec<u8>)>,
     pending_bytes: usize,
@@ -276,16 +277,7 @@ impl CopcFile {
             .map_err(|e| PointsError::io(&self.path, e))?;
         self.write(&table)?;
         let evlr_at = self.at;
-        let mut page = Vec::with_capacity(32 * self.entries.len());
-        self.entries.sort_by_key(|e| e.0);
-        for (key, offset, bytes, points) in &self.entries {
-            for v in key {
-                page.extend_from_slice(&v.to_le_bytes());
-            }
-            page.extend_from_slice(&offset.to_le_bytes());
-            page.extend_from_slice(&(*bytes as i32).to_le_bytes());
-            page.extend_from_slice(&(*points as i32).to_le_bytes());
-        }
+        let (page, root_page) = super::pages::hierarchy(&self.entries, evlr_at + 60);
         let mut evlr = vec![0u8; 60];
         evlr[2..6].copy_from_slice(b"copc");
         evlr[18..20].copy_from_slice(&1000u16.to_le_bytes());
@@ -293,7 +285,7 @@ impl CopcFile {
         evlr[28..37].copy_from_slice(b"hierarchy");
         self.write(&evlr)?;
         self.write(&page)?;
-        let mut head = self.head(source, cube, evlr_at + 60, page.len() as u64);
+        let mut head = self.head(source, cube, evlr_at + 60, root_page);
         head[235..243].copy_from_slice(&evlr_at.to_le_bytes());
         head[243..247].copy_from_slice(&1u32.to_le_bytes());
         debug_assert_eq!(head.len(), self.header.len());

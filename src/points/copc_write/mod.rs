@@ -22,6 +22,7 @@
 
 mod file;
 mod octree;
+mod pages;
 pub(crate) mod records;
 mod source;
 
