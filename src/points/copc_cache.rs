@@ -67,6 +67,11 @@ pub fn get(file: &FileId, key: [i32; 4]) -> Option<Arc<PointData>> {
     Some(e.data.clone())
 }
 
+/// Whether node `key` of `file` is held (its use is not recorded).
+pub fn holds(file: &FileId, key: [i32; 4]) -> bool {
+    cache().entries.contains_key(&(file.clone(), key))
+}
+
 /// Keep node `key` of `file`, dropping the least recently used past the budget.
 pub fn put(file: &FileId, key: [i32; 4], data: Arc<PointData>) {
     let bytes = data.raw_bytes().len() as u64;

@@ -212,7 +212,7 @@ pub(super) fn copc_cloud(
     nodes: &[super::copc::Node],
     stride: u64,
 ) -> Result<(PointCloud, usize), PointsError> {
-    use super::copc_cache::{self, FileId};
+    use super::copc_cache::FileId;
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::sync::Arc;
     let file = FileId::of(copc.path());
@@ -252,12 +252,8 @@ pub(super) fn copc_cloud(
         let decoded: Vec<Arc<PointData>> = batch
             .par_iter()
             .map(|node| {
-                if let Some(d) = copc_cache::get(&file, node.key) {
-                    cached.fetch_add(1, Ordering::Relaxed);
-                    return Ok(d);
-                }
-                let d = Arc::new(copc.read_node(node)?);
-                copc_cache::put(&file, node.key, d.clone());
+                let (d, held) = decoded_node(copc, &file, node)?;
+                cached.fetch_add(usize::from(held), Ordering::Relaxed);
                 Ok(d)
             })
             .collect::<Result<_, PointsError>>()?;
@@ -277,6 +273,34 @@ pub(super) fn copc_cloud(
         message,
     })?;
     Ok((cloud, cached.into_inner()))
+}
+
+/// Node `node` of `copc` (the file `file`) decoded, from the decoded-node cache where it
+/// is held (then `true`), else read and kept there.
+fn decoded_node(
+    copc: &super::copc::Copc,
+    file: &super::copc_cache::FileId,
+    node: &super::copc::Node,
+) -> Result<(std::sync::Arc<PointData>, bool), PointsError> {
+    use super::copc_cache;
+    if let Some(d) = copc_cache::get(file, node.key) {
+        return Ok((d, true));
+    }
+    let d = std::sync::Arc::new(copc.read_node(node)?);
+    copc_cache::put(file, node.key, d.clone());
+    Ok((d, false))
+}
+
+/// Decode `nodes` of `copc` in parallel into the decoded-node cache (those it holds are
+/// passed over).
+pub(super) fn decode_nodes(
+    copc: &super::copc::Copc,
+    nodes: &[super::copc::Node],
+) -> Result<(), PointsError> {
+    let file = super::copc_cache::FileId::of(copc.path());
+    nodes
+        .par_iter()
+        .try_for_each(|node| decoded_node(copc, &file, node).map(|_| ()))
 }
 
 /// Append one decoded node to the columns.

@@ -40,6 +40,7 @@ mod cloud;
 pub mod copc;
 pub mod copc_cache;
 mod copc_hierarchy;
+pub mod copc_load;
 pub mod copc_lod;
 pub mod copc_write;
 pub mod dat;
@@ -230,49 +231,7 @@ impl PointSource {
             PointSource::Las(p) => lasfile::read(&base.join(p))?.cloud,
             PointSource::Ply(p) => plycloud::read(&base.join(p))?.cloud,
             PointSource::Copc(spec) => {
-                let c = copc_cache::open(&base.join(&spec.path))?;
-                let cut = match view {
-                    Some(v) => copc_lod::select(&c, v, spec.points, spec.min_node_pixels)?,
-                    None => {
-                        let (nodes, _) = c.cut(spec.points)?;
-                        let points = nodes.iter().map(|n| n.points).sum();
-                        copc_lod::Cut::whole(nodes, points, spec.points)
-                    }
-                };
-                // Framed by the file's bounds (every budget places the cloud alike).
-                let (cloud, cached) = lasfile::copc_cloud(&c, &cut.nodes, cut.root_stride)?;
-                let deepest = c.info.spacing / f64::from(1u32 << cut.deepest.clamp(0, 30));
-                let spacings = copc_lod::spacings(
-                    &c,
-                    &cut,
-                    (0..cloud.len()).filter_map(|i| cloud.original(i)),
-                );
-                // The cloud holds the nodes in the cut's order; a lone root thinned to a
-                // stride is all of it (several thinned nodes: no node cache).
-                let nodes = if cut.root_stride > 1 {
-                    match cut.nodes.as_slice() {
-                        [root] => vec![(root.key, cloud.len())],
-                        _ => Vec::new(),
-                    }
-                } else {
-                    cut.nodes
-                        .iter()
-                        .map(|n| (n.key, n.points as usize))
-                        .collect()
-                };
-                let loaded = copc_lod::Loaded {
-                    nodes,
-                    spacing: deepest * (cut.root_stride as f64).sqrt() / cloud.scale,
-                    size_scales: spacings
-                        .iter()
-                        .map(|s| (*s as f64 / deepest) as f32)
-                        .collect(),
-                    describe: format!(
-                        "{}; {cached} of its {} nodes from memory",
-                        cut.describe(&c),
-                        cut.nodes.len()
-                    ),
-                };
+                let (cloud, loaded) = copc_load::load(spec, base, view)?;
                 return Ok((cloud, Some(loaded)));
             }
             PointSource::Section(spec) => section::generate(spec)?,

@@ -14,6 +14,7 @@ mod clip;
 mod copc;
 mod copc_lod;
 mod copc_pages;
+mod copc_stages;
 mod copc_write;
 mod data;
 mod docs;

@@ -77,6 +77,48 @@ pub fn prepare_for(
     Ok((cloud, prepared, note))
 }
 
+/// [`prepare_for`] in stages (a COPC cloud: [`crate::points::copc_load`]'s; any other
+/// cloud in one): `each` gets each stage prepared and whether it is the whole cut, and
+/// returns false to stop.
+pub fn prepare_in_stages(
+    scene: &SplatsScene,
+    base: &Path,
+    view: &crate::points::copc_lod::View,
+    stages: crate::points::copc_load::Stages,
+    mut each: impl FnMut(
+        (
+            PointCloud,
+            Prepared,
+            Option<crate::points::copc_lod::Loaded>,
+        ),
+        bool,
+    ) -> bool,
+) -> Result<(), String> {
+    let crate::points::PointSource::Copc(spec) = &scene.cloud else {
+        each(prepare_for(scene, base, Some(view))?, true);
+        return Ok(());
+    };
+    let mut failed = None;
+    crate::points::copc_load::load_in_stages(
+        spec,
+        base,
+        Some(view),
+        stages,
+        |cloud, loaded, whole| {
+            let normals = normals_for(&cloud, scene);
+            match from_cloud(&cloud, scene, normals) {
+                Ok(prepared) => each((cloud, prepared, Some(loaded)), whole),
+                Err(e) => {
+                    failed = Some(e);
+                    false
+                }
+            }
+        },
+    )
+    .map_err(|e| e.to_string())?;
+    failed.map_or(Ok(()), Err)
+}
+
 /// Normals of a scene's cloud (k nearest neighbours, PCA, per layer) and the count of
 /// fallbacks, when the scene lights its surface; `None` otherwise.
 pub fn normals_for(cloud: &PointCloud, scene: &SplatsScene) -> Option<(Vec<[f32; 3]>, usize)> {

@@ -23,8 +23,8 @@ use std::time::{Duration, Instant};
 use super::edl::{EdlPass, EdlView};
 use super::oit::{z_row, OitPass};
 use super::prepare::{
-    from_cloud, normals_for, point_size_for_spacing, prepare_for, Prepared, COLOR_A, COLOR_B,
-    FLOATS_PER_VERTEX, PHONG, VERTEX_COMPONENTS,
+    from_cloud, normals_for, point_size_for_spacing, prepare_for, prepare_in_stages, Prepared,
+    COLOR_A, COLOR_B, FLOATS_PER_VERTEX, PHONG, VERTEX_COMPONENTS,
 };
 use super::reference::{eye_position, view_direction, SplatParams};
 use super::resident::{NodeKey, Resident};
@@ -98,8 +98,10 @@ pub struct SplatsRenderer {
     /// deepest spacing that sizes them.
     scene_point_size: f64,
     spacing: Option<f64>,
-    /// The cut of the view the camera stopped at, being loaded.
+    /// The cut of the view the camera stopped at, being loaded, and how it is handed
+    /// over.
     loading: Option<Loading>,
+    stages: crate::points::copc_load::Stages,
     /// Eye-dome lighting's depth target and programs, made at the first frame's size.
     edl: Option<EdlPass>,
     /// A COPC cut's points' sizes over the scene's (precise tiles and points; empty: all 1).
@@ -158,12 +160,13 @@ type Prepared3 = (
 /// A COPC cut's nodes (key, points, in the cloud's order) and its points' size scales.
 type CutParts = (Vec<(NodeKey, usize)>, Vec<f32>);
 
-/// A COPC cut being loaded on a thread for a view.
+/// A COPC cut being loaded on a thread for a view: its stages (each prepared, and
+/// whether it is the whole cut) arrive on `result`.
 struct Loading {
     view: CloudView,
     /// The settings the cut is prepared with (an edit meanwhile prepares it again).
     params: SplatsScene,
-    result: std::sync::mpsc::Receiver<Result<Prepared3, String>>,
+    result: std::sync::mpsc::Receiver<Result<(Prepared3, bool), String>>,
 }
 
 impl SplatsRenderer {
@@ -265,6 +268,12 @@ impl SplatsRenderer {
         self.install(gpu)
     }
 
+    /// How a COPC cut loaded when the camera stops is handed over (the viewer's stages
+    /// by default).
+    pub fn set_stages(&mut self, stages: crate::points::copc_load::Stages) {
+        self.stages = stages;
+    }
+
     /// Upload a cloud prepared elsewhere.
     pub fn from_prepared(
         gpu: &Gpu,
@@ -324,6 +333,7 @@ impl SplatsRenderer {
             scene_point_size: params.point_size,
             spacing: None,
             loading: None,
+            stages: crate::points::copc_load::Stages::viewer(),
             edl: None,
             size_scales,
             nodes,
@@ -776,47 +786,59 @@ impl Renderer for SplatsRenderer {
             point_size: self.scene_point_size,
             ..self.params.clone()
         };
-        // A cut that has arrived replaces the drawn one.
+        // The next stage of the cut being loaded replaces the drawn one: one stage a
+        // frame, in order, each upload a frame's work (the loader hands them over at
+        // most every `Stages::every`).
         if let Some(loading) = &self.loading {
-            match loading.result.try_recv() {
-                Ok(result) => {
-                    let view = loading.view;
-                    let then = loading.params.clone();
+            let (latest, gone) = match loading.result.try_recv() {
+                Ok(stage) => (Some(stage), false),
+                Err(std::sync::mpsc::TryRecvError::Empty) => (None, false),
+                Err(std::sync::mpsc::TryRecvError::Disconnected) => (None, true),
+            };
+            let (view, then, still) = (loading.view, loading.params.clone(), same(&loading.view));
+            match latest {
+                // A node that cannot be read (a damaged file): the drawn cut stays,
+                // and the status line says why the view was not refined.
+                Some(Err(e)) => {
                     self.loading = None;
-                    // A node that cannot be read (a damaged file): the drawn cut stays,
-                    // and the status line says why the view was not refined.
-                    let loaded = match result {
-                        Ok(loaded) => loaded,
-                        Err(e) => {
-                            let kept = self.cut.take().unwrap_or_default();
-                            let kept = kept
-                                .split("\nnot refined: ")
-                                .next()
-                                .unwrap_or("")
-                                .to_string();
-                            self.cut = Some(format!("{kept}\nnot refined: {e}"));
-                            self.view = Some(view);
-                            return Ok(true);
-                        }
-                    };
+                    let kept = self.cut.take().unwrap_or_default();
+                    let kept = kept
+                        .split("\nnot refined: ")
+                        .next()
+                        .unwrap_or("")
+                        .to_string();
+                    self.cut = Some(format!("{kept}\nnot refined: {e}"));
+                    self.view = Some(view);
+                    return Ok(true);
+                }
+                Some(Ok((loaded, whole))) => {
+                    // The rest is not waited for when it is whole, or the camera moved on.
+                    if whole || !still {
+                        self.loading = None;
+                    }
                     self.replace_cut(gpu, (&params, Some(&then)), view, loaded)?;
                     return Ok(true);
                 }
-                Err(std::sync::mpsc::TryRecvError::Empty) if same(&loading.view) => {
-                    return Ok(false)
-                }
-                Err(_) => self.loading = None,
+                None if still && !gone => return Ok(false),
+                None => self.loading = None,
             }
         }
         if self.view.as_ref().is_some_and(same) {
             return Ok(false);
         }
-        // Load the new view's cut on a thread; the drawn one stays until it arrives.
+        // Load the new view's cut on a thread; the drawn one stays until its first stage
+        // arrives. Dropping the receiver stops the thread at its next stage.
         let (send, result) = std::sync::mpsc::channel();
         let base = self.base.clone();
         let prepared_with = params.clone();
+        let stages = self.stages;
         std::thread::spawn(move || {
-            let _ = send.send(prepare_for(&params, &base, Some(&view)));
+            let done = prepare_in_stages(&params, &base, &view, stages, |stage, whole| {
+                send.send(Ok((stage, whole))).is_ok()
+            });
+            if let Err(e) = done {
+                let _ = send.send(Err(e));
+            }
         });
         self.loading = Some(Loading {
             view,
