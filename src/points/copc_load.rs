@@ -6,7 +6,10 @@
 //! are decoded a batch at a time in the cut's order (largest on screen first, a parent
 //! before its children), and whenever `Stages::every` has passed the nodes ready so far
 //! are handed over as a cloud of their own — those whose ancestors in the cut are ready
-//! too, so coarser points stand in for the children still loading — then the whole cut.
+//! too, so coarser points stand in for the children still loading — when they hold at
+//! least twice the points of the last stage (each stage's cloud is built afresh: the
+//! stages together cost at most about one more build of the whole cut), then the whole
+//! cut.
 //! Each stage is a smaller cut of the same view: never over the budget, and its upload
 //! takes only the nodes the GPU's node cache lacks.
 
@@ -94,10 +97,12 @@ pub fn load_in_stages(
             if last.elapsed() < stages.every {
                 continue;
             }
+            // A stage at least doubles the points of the last: building the stages costs
+            // at most about one more build of the whole cut.
             let part = ready_part(&cut, |n| copc_cache::holds(&file, n.key));
-            if part.nodes.len() > handed && part.nodes.len() < cut.nodes.len() {
-                handed = part.nodes.len();
-                let (cloud, mut loaded) = cloud_of(&c, &part)?;
+            if part.points >= 2 * handed && part.nodes.len() < cut.nodes.len() {
+                handed = part.points.max(1);
+                let (cloud, mut loaded) = cloud_of(&c, &part, None)?;
                 loaded.describe = format!(
                     "{}; loading: {} of the view's {} nodes",
                     loaded.describe,
@@ -111,7 +116,9 @@ pub fn load_in_stages(
             }
         }
     }
-    let (cloud, loaded) = cloud_of(&c, &cut)?;
+    // Nodes decoded by the stages count as read, not as held from an earlier cut.
+    let held = cut.nodes.len() - missing.len();
+    let (cloud, loaded) = cloud_of(&c, &cut, Some(held))?;
     each(cloud, loaded, true);
     Ok(())
 }
@@ -156,9 +163,11 @@ pub fn ready_part(cut: &Cut, ready: impl Fn(&Node) -> bool) -> Cut {
 }
 
 /// The cloud of `cut`'s nodes (framed by the file's bounds: every budget places it
-/// alike) and what it holds.
-fn cloud_of(c: &Copc, cut: &Cut) -> Result<(PointCloud, Loaded), PointsError> {
+/// alike) and what it holds; `held`: how many of its nodes were held decoded before the
+/// cut was loaded (else those its build found held).
+fn cloud_of(c: &Copc, cut: &Cut, held: Option<usize>) -> Result<(PointCloud, Loaded), PointsError> {
     let (cloud, cached) = lasfile::copc_cloud(c, &cut.nodes, cut.root_stride)?;
+    let cached = held.unwrap_or(cached);
     let deepest = c.info.spacing / f64::from(1u32 << cut.deepest.clamp(0, 30));
     let spacings = copc_lod::spacings(c, cut, (0..cloud.len()).filter_map(|i| cloud.original(i)));
     // The cloud holds the nodes in the cut's order; a lone root thinned to a stride is

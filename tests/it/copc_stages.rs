@@ -1,9 +1,9 @@
 //! A COPC cut loaded in stages (issue 28, item 3: "a few loads and uploads a frame"). The
 //! missing nodes are decoded a batch at a time; each stage hands over the nodes ready so
 //! far whose ancestors in the cut are ready: a smaller cut of the same view, within the
-//! budget, growing, and last the whole cut, equal to the cut loaded in one go. In the
-//! renderer each stage replaces the drawn cut (the node cache uploads what it lacks),
-//! and the last draws the picture a renderer built afresh for the view draws.
+//! budget, at least doubling, and last the whole cut, equal to the cut loaded in one go.
+//! In the renderer each stage replaces the drawn cut (the node cache uploads what it
+//! lacks), and the last draws the picture a renderer built afresh for the view draws.
 
 use std::collections::HashMap;
 use std::time::Duration;
@@ -83,7 +83,7 @@ fn stages_grow_within_the_budget_and_end_with_the_whole_cut() {
         .enumerate()
         .map(|(i, (k, _))| (*k, i))
         .collect();
-    let mut before = 0;
+    let (mut before, mut before_points) = (0, 0);
     for (cloud, loaded, _) in &stages {
         let keys: Vec<[i32; 4]> = loaded.nodes.iter().map(|(k, _)| *k).collect();
         // Growing, never whole, within the budget, in the whole cut's order.
@@ -97,6 +97,10 @@ fn stages_grow_within_the_budget_and_end_with_the_whole_cut() {
         let points: usize = loaded.nodes.iter().map(|(_, p)| p).sum();
         assert_eq!(points, cloud.len());
         assert!(points <= 700);
+        // Each stage at least doubles the last (the stages' builds stay within one more
+        // build of the whole cut).
+        assert!(points >= 2 * before_points, "{before_points} then {points}");
+        before_points = points;
         let at: Vec<usize> = keys.iter().map(|k| order[k]).collect();
         assert!(at.windows(2).all(|w| w[0] < w[1]), "{at:?}");
         // Every node's parent drawn too (coarse points stand in for what is loading).
@@ -207,7 +211,10 @@ fn the_renderer_draws_each_stage_and_ends_with_the_fresh_picture() {
         std::thread::sleep(Duration::from_millis(1));
     }
     let status = r.status().unwrap();
-    assert!(partial >= 1, "no stage was drawn before the whole cut: {status}");
+    assert!(
+        partial >= 1,
+        "no stage was drawn before the whole cut: {status}"
+    );
     let mut settings = scene.settings();
     settings.view = View::of(&near, scene.size);
     let mut fresh = arbvis::catalog::build(gpu, &scene.technique, &settings, kind).unwrap();
