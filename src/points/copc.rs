@@ -25,6 +25,7 @@ use las::{Header, PointData, PointDataBuilder};
 use laz::record::{LayeredPointRecordDecompressor, RecordDecompressor};
 
 use super::copc_hierarchy::Hierarchy;
+pub use super::copc_hierarchy::Node;
 use super::guarded;
 use super::PointsError;
 
@@ -60,19 +61,6 @@ fn default_min_node_pixels() -> f64 {
 
 fn default_budget() -> u64 {
     1_000_000
-}
-
-/// One octree node: its key, where its chunk lies and how many points it holds.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub struct Node {
-    /// Level (0: the root), then x, y, z in `0..2^level`.
-    pub key: [i32; 4],
-    /// Byte offset of its LAZ chunk.
-    pub offset: u64,
-    /// Compressed bytes.
-    pub bytes: u64,
-    /// Points.
-    pub points: u64,
 }
 
 /// An open COPC file: header, octree description and the hierarchy pages read so far.

@@ -15,10 +15,21 @@
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 
-use super::copc::Node;
-
 /// Deepest octree level read (keys are i32: 2^30 nodes a side is far past any survey).
 const MAX_LEVEL: i32 = 30;
+
+/// One octree node: its key, where its chunk lies and how many points it holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub struct Node {
+    /// Level (0: the root), then x, y, z in `0..2^level`.
+    pub key: [i32; 4],
+    /// Byte offset of its LAZ chunk.
+    pub offset: u64,
+    /// Compressed bytes.
+    pub bytes: u64,
+    /// Points.
+    pub points: u64,
+}
 
 /// A page not read yet: where it lies and the byte of the entry that names it.
 #[derive(Debug, Clone, Copy)]

@@ -135,16 +135,7 @@ pub fn ready_part(cut: &Cut, ready: impl Fn(&Node) -> bool) -> Cut {
     let mut taken = vec![false; cut.nodes.len()];
     for (i, n) in cut.nodes.iter().enumerate() {
         // The nearest ancestor in the cut (a parent always precedes its children).
-        let mut k = n.key;
-        let parent = loop {
-            if k[0] == 0 {
-                break None;
-            }
-            k = [k[0] - 1, k[1] >> 1, k[2] >> 1, k[3] >> 1];
-            if let Some(&p) = index.get(&k) {
-                break Some(p);
-            }
-        };
+        let parent = copc_lod::nearest_ancestor(n.key, &index);
         taken[i] = ready(n) && parent.is_none_or(|p| taken[p]);
     }
     let nodes: Vec<Node> = cut

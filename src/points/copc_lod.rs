@@ -242,17 +242,7 @@ fn select_known(
     let mut children: Vec<Vec<usize>> = vec![Vec::new(); known.len()];
     let mut roots = Vec::new();
     for (i, n) in known.iter().enumerate() {
-        let mut k = n.key();
-        let parent = loop {
-            if k[0] == 0 {
-                break None;
-            }
-            k = [k[0] - 1, k[1] >> 1, k[2] >> 1, k[3] >> 1];
-            if let Some(&p) = index.get(&k) {
-                break Some(p);
-            }
-        };
-        match parent {
+        match nearest_ancestor(n.key(), &index) {
             Some(p) => children[p].push(i),
             None => roots.push(i),
         }
@@ -328,6 +318,19 @@ fn select_known(
         cut.root_stride = cut.points.div_ceil(budget);
     }
     (cut, wanted)
+}
+
+/// The index of `key`'s nearest ancestor in `index` (none for the root, or when no
+/// ancestor is listed).
+pub fn nearest_ancestor(key: [i32; 4], index: &HashMap<[i32; 4], usize>) -> Option<usize> {
+    let mut k = key;
+    while k[0] > 0 {
+        k = [k[0] - 1, k[1] >> 1, k[2] >> 1, k[3] >> 1];
+        if let Some(&p) = index.get(&k) {
+            return Some(p);
+        }
+    }
+    None
 }
 
 /// The six planes of the view frustum (Gribb and Hartmann): a point is inside when every

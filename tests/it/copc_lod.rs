@@ -13,6 +13,7 @@ use arbvis::points::copc::Copc;
 use arbvis::points::copc_lod::{frame, select, Cut, View};
 use glam::DVec4;
 
+use crate::common::splats::camera_turned as camera;
 use crate::common::splats::{errors, quantile};
 use crate::common::{data_file, stdout_of, temp_dir};
 
@@ -33,16 +34,6 @@ fn copc_scene_file(name: &str, head: &str, keys: &str) -> std::path::PathBuf {
     )
     .unwrap();
     path
-}
-
-fn camera(projection: Projection, zoom: f64, rotation: [f64; 4]) -> Camera {
-    let q = glam::DQuat::from_array(rotation).normalize();
-    Camera {
-        projection,
-        rotation: q.to_array(),
-        zoom,
-        ..Default::default()
-    }
 }
 
 /// The eight corners of a node's cube in the cloud's frame, in clip coordinates.

@@ -5,22 +5,14 @@
 //! with the whole hierarchy read first. A damaged child page is an error naming its entry's
 //! byte when a view reaches it, not before.
 
-use arbvis::camera::{Camera, Projection};
+use arbvis::camera::Projection;
 use arbvis::points::copc::Copc;
 use arbvis::points::copc_lod::{select, View};
 
+use crate::common::splats::camera_turned as camera;
 use crate::common::{data_file, temp_dir};
 
 const FILE: &str = "points/simple_with_page.copc.laz";
-
-fn camera(projection: Projection, zoom: f64, rotation: [f64; 4]) -> Camera {
-    Camera {
-        projection,
-        rotation: glam::DQuat::from_array(rotation).normalize().to_array(),
-        zoom,
-        ..Default::default()
-    }
-}
 
 #[test]
 fn opening_reads_the_root_page_and_a_view_reads_what_it_reaches() {

@@ -13,6 +13,7 @@ use arbvis::points::copc_load::{load, load_in_stages, Stages};
 use arbvis::points::copc_lod::View;
 use arbvis::points::PointSource;
 
+use crate::common::splats::camera_turned as camera;
 use crate::common::{data_file, temp_dir};
 
 /// A copy of laspy's paged file under a new name: the process's decoded-node cache holds
@@ -21,15 +22,6 @@ fn fresh_copy(name: &str) -> std::path::PathBuf {
     let path = temp_dir(name).join("stages.copc.laz");
     std::fs::copy(data_file("points/simple_with_page.copc.laz"), &path).unwrap();
     path
-}
-
-fn camera(projection: Projection, zoom: f64, rotation: [f64; 4]) -> Camera {
-    Camera {
-        projection,
-        rotation: glam::DQuat::from_array(rotation).normalize().to_array(),
-        zoom,
-        ..Default::default()
-    }
 }
 
 /// Every stage's nodes, in order (key -> parent key), for the checks.

@@ -211,3 +211,13 @@ pub fn errors(a: &Image, b: &Image) -> Vec<f32> {
 pub fn quantile(sorted: &[f32], q: f64) -> f32 {
     sorted[((sorted.len() - 1) as f64 * q) as usize]
 }
+
+/// A camera of `projection` at `zoom`, turned by the quaternion `rotation` (normalized).
+pub fn camera_turned(projection: Projection, zoom: f64, rotation: [f64; 4]) -> Camera {
+    Camera {
+        projection,
+        rotation: glam::DQuat::from_array(rotation).normalize().to_array(),
+        zoom,
+        ..Default::default()
+    }
+}
