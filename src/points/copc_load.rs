@@ -14,6 +14,8 @@
 //! takes only the nodes the GPU's node cache lacks.
 
 use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::{Duration, Instant};
 
 use super::cloud::PointCloud;
@@ -22,13 +24,16 @@ use super::copc_cache::{self, FileId};
 use super::copc_lod::{self, Cut, Loaded, View};
 use super::{lasfile, PointsError};
 
-/// When a cut being loaded is handed over before it is whole.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// When a cut being loaded is handed over before it is whole, and when to give up.
+#[derive(Debug, Clone)]
 pub struct Stages {
     /// Missing nodes decoded together (in parallel) between two looks at the clock.
     pub batch: usize,
     /// The least time between two stages (the first counts from the start).
     pub every: Duration,
+    /// Set by whoever no longer wants the cut (the camera moved on): the loading stops
+    /// before its next batch.
+    pub stop: Option<Arc<AtomicBool>>,
 }
 
 impl Stages {
@@ -36,6 +41,7 @@ impl Stages {
     pub const WHOLE: Stages = Stages {
         batch: usize::MAX,
         every: Duration::MAX,
+        stop: None,
     };
 
     /// The viewer's: what is ready every 100 ms, nodes decoded two per core at a time.
@@ -43,7 +49,14 @@ impl Stages {
         Stages {
             batch: 2 * rayon::current_num_threads(),
             every: Duration::from_millis(100),
+            stop: None,
         }
+    }
+
+    fn stopped(&self) -> bool {
+        self.stop
+            .as_ref()
+            .is_some_and(|s| s.load(Ordering::Relaxed))
     }
 }
 
@@ -63,7 +76,8 @@ pub fn load(
 
 /// `spec`'s cloud for `view` handed to `each` in stages (`stages`): each a cloud, what it
 /// holds, and whether it is the whole cut (always the last). `each` returns false to stop
-/// (nobody waits for the rest).
+/// (nobody waits for the rest), as does `stages.stop` when set (then nothing more is
+/// handed over, the whole cut included).
 pub fn load_in_stages(
     spec: &CopcSpec,
     base: &Path,
@@ -93,6 +107,9 @@ pub fn load_in_stages(
         let mut last = start;
         let mut handed = 0;
         for batch in missing.chunks(stages.batch.max(1)) {
+            if stages.stopped() {
+                return Ok(());
+            }
             lasfile::decode_nodes(&c, batch)?;
             if last.elapsed() < stages.every {
                 continue;
@@ -115,6 +132,9 @@ pub fn load_in_stages(
                 last = Instant::now();
             }
         }
+    }
+    if stages.stopped() {
+        return Ok(());
     }
     // Nodes decoded by the stages count as read, not as held from an earlier cut.
     let held = cut.nodes.len() - missing.len();

@@ -43,13 +43,14 @@ fn stages_grow_within_the_budget_and_end_with_the_whole_cut() {
     let every_batch = Stages {
         batch: 3,
         every: Duration::ZERO,
+        stop: None,
     };
     let mut stages = Vec::new();
     load_in_stages(
         &spec,
         std::path::Path::new("/"),
         Some(&view),
-        every_batch,
+        every_batch.clone(),
         |cloud, loaded, whole| {
             stages.push((cloud, loaded, whole));
             true
@@ -122,7 +123,7 @@ fn stages_grow_within_the_budget_and_end_with_the_whole_cut() {
         &spec,
         std::path::Path::new("/"),
         Some(&view),
-        every_batch,
+        every_batch.clone(),
         |_, _, _| {
             calls += 1;
             false
@@ -130,6 +131,32 @@ fn stages_grow_within_the_budget_and_end_with_the_whole_cut() {
     )
     .unwrap();
     assert_eq!(calls, 1);
+    // A stop set by whoever dropped the loading (the viewer, when the camera moves on):
+    // nothing is decoded or handed over.
+    spec.path = fresh_copy("copc-stages-stopped");
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+    let stopped = Stages {
+        stop: Some(stop),
+        ..every_batch
+    };
+    let mut calls = 0;
+    load_in_stages(
+        &spec,
+        std::path::Path::new("/"),
+        Some(&view),
+        stopped,
+        |_, _, _| {
+            calls += 1;
+            true
+        },
+    )
+    .unwrap();
+    assert_eq!(calls, 0);
+    let file = arbvis::points::copc_cache::FileId::of(&spec.path);
+    assert!(
+        !arbvis::points::copc_cache::holds(&file, [0, 0, 0, 0]),
+        "a stopped loading decodes nothing"
+    );
 }
 
 #[test]
@@ -178,6 +205,7 @@ fn the_renderer_draws_each_stage_and_ends_with_the_fresh_picture() {
     r.set_stages(Stages {
         batch: 2,
         every: Duration::ZERO,
+        stop: None,
     });
     let near = camera(Projection::Orthographic, 1.1, [0.05, -0.1, 0.02, 1.0]);
     let mut partial = 0;

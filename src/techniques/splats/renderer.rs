@@ -167,6 +167,14 @@ struct Loading {
     /// The settings the cut is prepared with (an edit meanwhile prepares it again).
     params: SplatsScene,
     result: std::sync::mpsc::Receiver<Result<(Prepared3, bool), String>>,
+    /// Set when this loading is dropped: the loader stops before its next batch.
+    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
+}
+
+impl Drop for Loading {
+    fn drop(&mut self) {
+        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    }
 }
 
 impl SplatsRenderer {
@@ -831,7 +839,11 @@ impl Renderer for SplatsRenderer {
         let (send, result) = std::sync::mpsc::channel();
         let base = self.base.clone();
         let prepared_with = params.clone();
-        let stages = self.stages;
+        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let stages = crate::points::copc_load::Stages {
+            stop: Some(stop.clone()),
+            ..self.stages.clone()
+        };
         std::thread::spawn(move || {
             let done = prepare_in_stages(&params, &base, &view, stages, |stage, whole| {
                 send.send(Ok((stage, whole))).is_ok()
@@ -844,6 +856,7 @@ impl Renderer for SplatsRenderer {
             view,
             params: prepared_with,
             result,
+            stop,
         });
         Ok(false)
     }
