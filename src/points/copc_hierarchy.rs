@@ -9,9 +9,12 @@
 //! Every page lies inside the hierarchy EVLR, a whole number of 32-byte entries, and is
 //! read once (a second reference, a cycle among pages, is refused when it is met). Every
 //! key lies inside the octree, is listed once, and has its parent listed (in a page read
-//! or as a page not yet read); every chunk lies inside the point data with at most
-//! 1,000,000 points plus one per compressed byte (as for LAZ files). Once every page is
-//! read the counts must sum to the header's. An error is (its byte, what was expected).
+//! or as a page not yet read); a child page holds only its key's subtree (what a lazy
+//! reader assumes: laspy's and Potree's do too); every chunk lies inside the point data
+//! with at most 1,000,000 points plus one per compressed byte (as for LAZ files). Once
+//! every page is read the counts must sum to the header's. A page that fails adds nothing
+//! and its error answers every later read (a held file never turns into a partial one).
+//! An error is (its byte, what was expected).
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 
@@ -58,6 +61,16 @@ pub(super) struct Hierarchy {
     pages: HashSet<u64>,
     /// Pages read.
     read: usize,
+    /// The first page that failed its checks: every later read answers with it.
+    failed: Option<(u64, String)>,
+}
+
+/// What reading one page added, taken back when the page fails its checks.
+#[derive(Default)]
+struct Added {
+    nodes: usize,
+    keys: Vec<[i32; 4]>,
+    pages: Vec<([i32; 4], u64)>,
 }
 
 /// Reads `buf.len()` bytes at a file offset.
@@ -82,9 +95,10 @@ impl Hierarchy {
             unread: BTreeMap::new(),
             pages: HashSet::new(),
             read: 0,
+            failed: None,
         };
         let root = h.name_page(root.0, root.1, root_at)?;
-        h.read_page(root, read)?;
+        h.read_page(root, None, read)?;
         Ok(h)
     }
 
@@ -111,16 +125,22 @@ impl Hierarchy {
         key: [i32; 4],
         read: ReadAt<'_>,
     ) -> Result<(), (u64, String)> {
+        if let Some(e) = &self.failed {
+            return Err(e.clone());
+        }
         match self.unread.remove(&key) {
-            Some(page) => self.read_page(page, read),
+            Some(page) => self.read_page(page, Some(key), read),
             None => Ok(()),
         }
     }
 
     /// Read every page not read yet.
     pub(super) fn read_all(&mut self, read: ReadAt<'_>) -> Result<(), (u64, String)> {
-        while let Some((_, page)) = self.unread.pop_first() {
-            self.read_page(page, read)?;
+        if let Some(e) = &self.failed {
+            return Err(e.clone());
+        }
+        while let Some((key, page)) = self.unread.pop_first() {
+            self.read_page(page, Some(key), read)?;
         }
         Ok(())
     }
@@ -158,8 +178,45 @@ impl Hierarchy {
         })
     }
 
-    /// Read one page, check its entries and add them.
-    fn read_page(&mut self, page: PageRef, read: ReadAt<'_>) -> Result<(), (u64, String)> {
+    /// Read one page (the root's, or the child page of `top`), check its entries and add
+    /// them. A page that fails adds nothing, and its error stands for every later read.
+    fn read_page(
+        &mut self,
+        page: PageRef,
+        top: Option<[i32; 4]>,
+        read: ReadAt<'_>,
+    ) -> Result<(), (u64, String)> {
+        let mut added = Added {
+            nodes: self.nodes.len(),
+            ..Added::default()
+        };
+        let result = self.add_page(page, top, read, &mut added);
+        if let Err(e) = &result {
+            self.nodes.truncate(added.nodes);
+            for key in &added.keys {
+                self.keys.remove(key);
+            }
+            for (key, offset) in &added.pages {
+                self.unread.remove(key);
+                self.pages.remove(offset);
+            }
+            // Still unread: a view that reaches it asks for it again and gets the error.
+            if let Some(key) = top {
+                self.unread.insert(key, page);
+            }
+            self.failed = Some(e.clone());
+        }
+        result
+    }
+
+    /// [`Hierarchy::read_page`]'s reading and checks, noting in `added` what it adds.
+    fn add_page(
+        &mut self,
+        page: PageRef,
+        top: Option<[i32; 4]>,
+        read: ReadAt<'_>,
+        added: &mut Added,
+    ) -> Result<(), (u64, String)> {
         let mut data = vec![0u8; page.size as usize];
         read(page.offset, &mut data).map_err(|e| {
             (
@@ -189,6 +246,16 @@ impl Hierarchy {
                     key[0]
                 )));
             }
+            // A child page holds its key's subtree (a reader reads it when a view
+            // reaches that key).
+            if let Some(t) = top {
+                let up = key[0] - t[0];
+                if up < 0 || (1..4).any(|a| key[a] >> up != t[a]) {
+                    return Err(fail(format!(
+                        "a child page holds {t:?} and the keys under it"
+                    )));
+                }
+            }
             let first = self
                 .keys
                 .get(&key)
@@ -207,6 +274,7 @@ impl Hierarchy {
                 // The page's entry for this key comes again inside it.
                 let child = self.name_page(target, bytes as u64, at)?;
                 self.unread.insert(key, child);
+                added.pages.push((key, target));
                 continue;
             }
             if points < 0 || bytes < 0 {
@@ -235,8 +303,8 @@ impl Hierarchy {
                 });
             }
             self.keys.insert(key, at);
+            added.keys.push(key);
         }
-        self.read += 1;
         // Every key below the root under a key of the hierarchy (its parent listed).
         for (key, at) in listed {
             let parent = [key[0] - 1, key[1] / 2, key[2] / 2, key[3] / 2];
@@ -262,6 +330,7 @@ impl Hierarchy {
                 ));
             }
         }
+        self.read += 1;
         Ok(())
     }
 }

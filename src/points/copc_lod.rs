@@ -228,11 +228,14 @@ fn select_known(
     let (origin, scale) = frame(copc);
     let info = copc.info;
     let planes = frustum(&view.view_projection);
-    let known: Vec<Known> = nodes
+    // By key, as the nodes alone are: a page stands where its key's node will, so equal
+    // priorities are taken in the same order before and after it is read.
+    let mut known: Vec<Known> = nodes
         .iter()
         .map(Known::Node)
         .chain(pages.iter().map(|&k| Known::Page(k)))
         .collect();
+    known.sort_by_key(Known::key);
     // Each entry's children: the entries whose nearest present ancestor it is.
     let index: HashMap<[i32; 4], usize> = known
         .iter()

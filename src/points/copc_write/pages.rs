@@ -1,16 +1,16 @@
-//! The hierarchy EVLR's pages. The root page holds the top `PAGE_LEVELS` levels; a node
-//! `PAGE_LEVELS` levels below a page's top that has children heads a page of its own,
-//! named in its parent's page by an entry of -1 points (COPC's child pages), and so on
-//! down. A reader then reads the pages a view reaches, not the whole hierarchy: the
-//! root page of a 10-billion-point file is at most 585 entries (19 KB) where its whole
-//! hierarchy is about 11 MB.
+//! The hierarchy EVLR's pages. A page holds its top node and the `PAGE_LEVELS - 1` levels
+//! under it whole, and an entry for each node `PAGE_LEVELS` levels down: the node itself
+//! when it has no children, else a pointer (-1 points, COPC's child page) to a page that
+//! it heads, and so on down. A reader then reads the pages a view reaches, not the whole
+//! hierarchy: a page holds at most 1 + 8 + 64 + 512 = 585 entries (19 KB), where a
+//! 10-billion-point file's whole hierarchy is about 11 MB.
 
 use std::collections::{BTreeMap, VecDeque};
 
 use super::octree::Key;
 
-/// Levels a page holds from its top down before a node with children heads a page.
-pub(super) const PAGE_LEVELS: i32 = 4;
+/// Levels below a page's top at which a node with children heads a page of its own.
+pub(super) const PAGE_LEVELS: i32 = 3;
 
 /// One hierarchy entry: key, chunk offset, compressed bytes, points.
 pub(super) type Entry = (Key, u64, u64, u64);
@@ -139,22 +139,22 @@ mod tests {
     }
 
     #[test]
-    fn shallow_trees_are_one_page_and_deep_ones_page_below_each_fourth_level() {
-        for depth in 0..=4 {
+    fn shallow_trees_are_one_page_and_deep_ones_page_below_each_third_level() {
+        for depth in 0..=3 {
             let e = full(depth);
             let (bytes, root) = hierarchy(&e, 5000);
             assert_eq!(root, 32 * e.len() as u64, "depth {depth}: one page");
             assert_eq!(bytes.len(), 32 * e.len());
         }
-        // Six levels: the root page holds levels 0-3 and a pointer per level-4 node
-        // (4096 of them), each page a level-4 node and its 8 children.
-        let e = full(5);
+        // Five levels: the root page holds levels 0-2 and a pointer per level-3 node (512
+        // of them), each page a level-3 node and its 8 children.
+        let e = full(4);
         let at = 7000;
         let (bytes, root) = hierarchy(&e, at);
         let all = entries_of(&bytes);
         let pointers: Vec<_> = all.iter().filter(|x| x.3 == -1).collect();
-        assert_eq!(pointers.len(), 4096);
-        assert_eq!(root, 32 * (1 + 8 + 64 + 512 + 4096));
+        assert_eq!(pointers.len(), 512);
+        assert_eq!(root, 32 * (1 + 8 + 64 + 512));
         // Every node once, with its own numbers; every pointer names a page starting
         // with its key, of 9 entries.
         let nodes: BTreeMap<Key, (u64, i32, i32)> = all
@@ -178,13 +178,14 @@ mod tests {
 
     #[test]
     fn a_lone_deep_node_without_children_stays_in_its_parents_page() {
-        // A chain to level 4 with nothing under it, and one chain to level 6.
-        let mut e: Vec<Entry> = (0..=4).map(|l| ([l, 0, 0, 0], 100, 1, 1)).collect();
+        // A chain to level 3 with nothing under it, and one chain to level 6.
+        let mut e: Vec<Entry> = (0..=3).map(|l| ([l, 0, 0, 0], 100, 1, 1)).collect();
         e.extend((1..=6).map(|l| ([l, 1 << (l - 1), 0, 0], 200, 1, 1)));
         let (bytes, root) = hierarchy(&e, 0);
         let all = entries_of(&bytes);
-        // Root page: 0, two level-1..3 chains, (4,0,0,0) as a node, a pointer for (4,8,0,0).
-        assert_eq!(root, 32 * (1 + 3 + 3 + 1 + 1));
+        // Root page: 0, two level-1..2 chains, (3,0,0,0) as a node, a pointer for
+        // (3,4,0,0); its page: (3,4,0,0) down to (6,32,0,0), a node (it has no children).
+        assert_eq!(root, 32 * (1 + 2 + 2 + 1 + 1));
         assert_eq!(all.iter().filter(|x| x.3 == -1).count(), 1);
         assert_eq!(all.len(), e.len() + 1);
     }

@@ -276,6 +276,19 @@ impl SplatsRenderer {
         self.install(gpu)
     }
 
+    /// The drawn cut stays for `view` and its line says why it was not refined (a stage's
+    /// progress dropped: nothing more is coming).
+    fn not_refined(&mut self, view: CloudView, why: &str) {
+        let kept = self.cut.take().unwrap_or_default();
+        let kept = kept.split("\nnot refined: ").next().unwrap_or("");
+        let kept = match kept.split_once("; loading: ") {
+            Some((head, tail)) => format!("{head}{}", tail.find("; ").map_or("", |k| &tail[k..])),
+            None => kept.to_string(),
+        };
+        self.cut = Some(format!("{kept}\nnot refined: {why}"));
+        self.view = Some(view);
+    }
+
     /// How a COPC cut loaded when the camera stops is handed over (the viewer's stages
     /// by default).
     pub fn set_stages(&mut self, stages: crate::points::copc_load::Stages) {
@@ -809,14 +822,7 @@ impl Renderer for SplatsRenderer {
                 // and the status line says why the view was not refined.
                 Some(Err(e)) => {
                     self.loading = None;
-                    let kept = self.cut.take().unwrap_or_default();
-                    let kept = kept
-                        .split("\nnot refined: ")
-                        .next()
-                        .unwrap_or("")
-                        .to_string();
-                    self.cut = Some(format!("{kept}\nnot refined: {e}"));
-                    self.view = Some(view);
+                    self.not_refined(view, &e);
                     return Ok(true);
                 }
                 Some(Ok((loaded, whole))) => {
@@ -828,6 +834,12 @@ impl Renderer for SplatsRenderer {
                     return Ok(true);
                 }
                 None if still && !gone => return Ok(false),
+                // The loader ended without the whole cut (it panicked): say so.
+                None if gone => {
+                    self.loading = None;
+                    self.not_refined(view, "the loader stopped before the whole cut");
+                    return Ok(true);
+                }
                 None => self.loading = None,
             }
         }
