@@ -23,8 +23,8 @@ use std::time::{Duration, Instant};
 use super::edl::{EdlPass, EdlView};
 use super::oit::{z_row, OitPass};
 use super::prepare::{
-    from_cloud, normals_for, point_size_for_spacing, prepare_for, prepare_in_stages, Prepared,
-    COLOR_A, COLOR_B, FLOATS_PER_VERTEX, PHONG, VERTEX_COMPONENTS,
+    from_cloud, normals_for, point_size_for_spacing, prepare_for, Prepared, COLOR_A, COLOR_B,
+    FLOATS_PER_VERTEX, PHONG, VERTEX_COMPONENTS,
 };
 use super::reference::{eye_position, view_direction, SplatParams};
 use super::resident::{NodeKey, Resident};
@@ -45,6 +45,9 @@ use crate::programs::{self, ProgramPair};
 
 use crate::techniques::{Frame, Params, Renderer};
 use crate::vocab::Fidelity;
+
+mod loading;
+use loading::{not_refined, Arrival, Loading, Prepared3};
 
 /// Pixels the precise programs widen a point's size by (half on each side): the
 /// rasterizer's square (its centre snapped to fixed point) then holds every pixel whose
@@ -150,32 +153,8 @@ fn view_bits(view: View) -> [u64; 4] {
     }
 }
 
-/// What [`prepare_for`] makes: the cloud, its preparation and a COPC cut's account.
-type Prepared3 = (
-    PointCloud,
-    Prepared,
-    Option<crate::points::copc_lod::Loaded>,
-);
-
 /// A COPC cut's nodes (key, points, in the cloud's order) and its points' size scales.
 type CutParts = (Vec<(NodeKey, usize)>, Vec<f32>);
-
-/// A COPC cut being loaded on a thread for a view: its stages (each prepared, and
-/// whether it is the whole cut) arrive on `result`.
-struct Loading {
-    view: CloudView,
-    /// The settings the cut is prepared with (an edit meanwhile prepares it again).
-    params: SplatsScene,
-    result: std::sync::mpsc::Receiver<Result<(Prepared3, bool), String>>,
-    /// Set when this loading is dropped: the loader stops before its next batch.
-    stop: std::sync::Arc<std::sync::atomic::AtomicBool>,
-}
-
-impl Drop for Loading {
-    fn drop(&mut self) {
-        self.stop.store(true, std::sync::atomic::Ordering::Relaxed);
-    }
-}
 
 impl SplatsRenderer {
     /// Load and prepare the scene's cloud (relative paths from `base`), then upload;
@@ -274,19 +253,6 @@ impl SplatsRenderer {
         self.size_scales = l.size_scales;
         self.nodes = l.nodes;
         self.install(gpu)
-    }
-
-    /// The drawn cut stays for `view` and its line says why it was not refined (a stage's
-    /// progress dropped: nothing more is coming).
-    fn not_refined(&mut self, view: CloudView, why: &str) {
-        let kept = self.cut.take().unwrap_or_default();
-        let kept = kept.split("\nnot refined: ").next().unwrap_or("");
-        let kept = match kept.split_once("; loading: ") {
-            Some((head, tail)) => format!("{head}{}", tail.find("; ").map_or("", |k| &tail[k..])),
-            None => kept.to_string(),
-        };
-        self.cut = Some(format!("{kept}\nnot refined: {why}"));
-        self.view = Some(view);
     }
 
     /// How a COPC cut loaded when the camera stops is handed over (the viewer's stages
@@ -811,68 +777,44 @@ impl Renderer for SplatsRenderer {
         // frame, in order, each upload a frame's work (the loader hands them over at
         // most every `Stages::every`).
         if let Some(loading) = &self.loading {
-            let (latest, gone) = match loading.result.try_recv() {
-                Ok(stage) => (Some(stage), false),
-                Err(std::sync::mpsc::TryRecvError::Empty) => (None, false),
-                Err(std::sync::mpsc::TryRecvError::Disconnected) => (None, true),
-            };
             let (view, then, still) = (loading.view, loading.params.clone(), same(&loading.view));
-            match latest {
-                // A node that cannot be read (a damaged file): the drawn cut stays,
-                // and the status line says why the view was not refined.
-                Some(Err(e)) => {
-                    self.loading = None;
-                    self.not_refined(view, &e);
-                    return Ok(true);
-                }
-                Some(Ok((loaded, whole))) => {
+            let why = match loading.poll() {
+                Arrival::Waiting if still => return Ok(false),
+                Arrival::Waiting => None,
+                Arrival::Stage(loaded, whole) => {
                     // The rest is not waited for when it is whole, or the camera moved on.
                     if whole || !still {
                         self.loading = None;
                     }
-                    self.replace_cut(gpu, (&params, Some(&then)), view, loaded)?;
+                    self.replace_cut(gpu, (&params, Some(&then)), view, *loaded)?;
                     return Ok(true);
                 }
-                None if still && !gone => return Ok(false),
-                // The loader ended without the whole cut (it panicked): say so.
-                None if gone => {
-                    self.loading = None;
-                    self.not_refined(view, "the loader stopped before the whole cut");
-                    return Ok(true);
-                }
-                None => self.loading = None,
+                // A node that cannot be read (a damaged file), or a loader that died:
+                // the drawn cut stays, and the status line says why the view was not
+                // refined.
+                Arrival::Failed(e) => Some(e),
+                Arrival::Ended => Some("the loader stopped before the whole cut".to_string()),
+            };
+            self.loading = None;
+            if let Some(why) = why {
+                self.cut = Some(not_refined(self.cut.as_deref().unwrap_or(""), &why));
+                self.view = Some(view);
+                return Ok(true);
             }
         }
         if self.view.as_ref().is_some_and(same) {
             return Ok(false);
         }
         // Load the new view's cut on a thread; the drawn one stays until its first stage
-        // arrives. Dropping the receiver stops the thread at its next stage.
-        let (send, result) = std::sync::mpsc::channel();
-        let base = self.base.clone();
-        let prepared_with = params.clone();
-        let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
-        let stages = crate::points::copc_load::Stages {
-            stop: Some(stop.clone()),
-            ..self.stages.clone()
-        };
-        std::thread::spawn(move || {
-            let done = prepare_in_stages(&params, &base, &view, stages, |stage, whole| {
-                send.send(Ok((stage, whole))).is_ok()
-            });
-            if let Err(e) = done {
-                let _ = send.send(Err(e));
-            }
-        });
-        self.loading = Some(Loading {
+        // arrives.
+        self.loading = Some(Loading::start(
             view,
-            params: prepared_with,
-            result,
-            stop,
-        });
+            params,
+            self.base.clone(),
+            &self.stages,
+        ));
         Ok(false)
     }
-
     fn pending(&self) -> bool {
         self.loading.is_some()
     }
