@@ -246,6 +246,19 @@ impl Hierarchy {
                     key[0]
                 )));
             }
+            let first = self
+                .keys
+                .get(&key)
+                .copied()
+                .or_else(|| self.unread.get(&key).map(|p| p.named_at));
+            if let Some(first) = first {
+                return Err(fail(if first == at {
+                    "its entry is read a second time: this page overlaps one read before"
+                        .to_string()
+                } else {
+                    format!("the key is listed twice (first at byte {first})")
+                }));
+            }
             // A child page holds its key's subtree (a reader reads it when a view
             // reaches that key).
             if let Some(t) = top {
@@ -255,16 +268,6 @@ impl Hierarchy {
                         "a child page holds {t:?} and the keys under it"
                     )));
                 }
-            }
-            let first = self
-                .keys
-                .get(&key)
-                .copied()
-                .or_else(|| self.unread.get(&key).map(|p| p.named_at));
-            if let Some(first) = first {
-                return Err(fail(format!(
-                    "the key is listed twice (first at byte {first})"
-                )));
             }
             listed.push((key, at));
             if points == -1 {

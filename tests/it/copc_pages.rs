@@ -122,10 +122,10 @@ fn a_damaged_child_page_is_an_error_when_a_view_reaches_it() {
         .expect_err("refused")
         .to_string();
     assert!(e.contains("level 99"), "{e}");
-    // A child page entry outside its key's subtree (under (2, 0, 0, 0) only: (3, 2, 0, 0)
-    // lies under (2, 1, 0, 0)): refused, naming the entry.
+    // A child page entry outside its key's subtree (under (2, 0, 0, 0) only: (5, 31, 31,
+    // 31) lies under (2, 3, 3, 3)): refused, naming the entry.
     let mut b = bytes.clone();
-    for (o, v) in [(0, 3i32), (4, 2), (8, 0), (12, 0)] {
+    for (o, v) in [(0, 5i32), (4, 31), (8, 31), (12, 31)] {
         b[page + 32 + o..page + 36 + o].copy_from_slice(&v.to_le_bytes());
     }
     let other = temp_dir("copc-pages-subtree").join("subtree.copc.laz");
@@ -135,6 +135,18 @@ fn a_damaged_child_page_is_an_error_when_a_view_reaches_it() {
     assert!(
         e.contains(&format!("at byte {}", page + 32))
             && e.contains("a child page holds [2, 0, 0, 0]"),
+        "{e}"
+    );
+    // A page named inside the root page (its second entry): its entry read again is
+    // refused as an overlap, naming that byte.
+    let mut b = bytes.clone();
+    b[entry + 16..entry + 24].copy_from_slice(&(root as u64 + 32).to_le_bytes());
+    b[entry + 24..entry + 28].copy_from_slice(&32i32.to_le_bytes());
+    std::fs::write(&path, &b).unwrap();
+    let c = Copc::open(&path).expect("the root page is sound");
+    let e = c.all_nodes().expect_err("refused").to_string();
+    assert!(
+        e.contains(&format!("at byte {}", root + 32)) && e.contains("overlaps"),
         "{e}"
     );
     // A page named past the hierarchy EVLR: refused where it is named (the root page, read
@@ -160,7 +172,8 @@ print("\n".join(rows))
 "#;
 
 /// A cloud deep enough for child pages (a broad spread and a tight cluster that goes
-/// down level after level), converted: the root page holds levels 0-3 and names
+/// down level after level), converted: the root page holds levels 0-2 and the level-3
+/// nodes (as entries or as pointers), naming
 /// the pages below; arbvis and laspy read every point through them.
 #[test]
 fn the_writer_pages_a_deep_hierarchy_and_laspy_reads_it() {

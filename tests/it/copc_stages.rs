@@ -244,3 +244,73 @@ fn the_renderer_draws_each_stage_and_ends_with_the_fresh_picture() {
         "the whole cut draws as a renderer built for the view"
     );
 }
+
+/// A stage drawn for a view the camera leaves and comes back to is loaded again: the
+/// renderer does not take the partial cut for the view's whole one (found by a reviewing
+/// helper: it stayed at 3 of 17 nodes, nothing pending).
+#[test]
+fn a_view_left_at_a_stage_and_come_back_to_is_loaded_whole() {
+    use arbvis::techniques::splats::{SplatsRenderer, SplatsScene};
+    use arbvis::techniques::Renderer;
+    let path = fresh_copy("copc-stages-back");
+    let text = format!(
+        "size = [1600, 900]\nfidelity = \"precise\"\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\", points = 700 }} }}\ncolour = \"rgb\"\n",
+        path.display()
+    );
+    let scene = arbvis::scene::Scene::parse(&text, "back.toml").unwrap();
+    let h = crate::common::headless(arbvis::gl::Backend::Egl);
+    let gpu = h.gpu();
+    let kind = scene.programs.resolve(gpu);
+    let arbvis::catalog::TechniqueScene::Splats(params) = &scene.technique else {
+        unreachable!()
+    };
+    let params: &SplatsScene = params;
+    let far = camera(Projection::Orthographic, 0.3, [0.0, 0.0, 0.0, 1.0]);
+    let mut r = SplatsRenderer::new(
+        gpu,
+        kind,
+        scene.fidelity,
+        params,
+        std::path::Path::new("/"),
+        Some(View::of(&far, scene.size)),
+    )
+    .unwrap();
+    r.set_stages(Stages {
+        batch: 2,
+        every: Duration::ZERO,
+        stop: None,
+    });
+    let near = camera(Projection::Orthographic, 1.1, [0.05, -0.1, 0.02, 1.0]);
+    let other = camera(Projection::Perspective, 2.0, [0.3, 0.2, 0.1, 0.9]);
+    // The near view until its first stage is drawn (more are on the way).
+    let start = std::time::Instant::now();
+    assert!(!r.settle(gpu, &near, scene.size).unwrap());
+    while !(r.settle(gpu, &near, scene.size).unwrap() && r.pending()) {
+        assert!(start.elapsed().as_secs() < 30, "no stage arrived");
+        assert!(r.pending(), "the whole cut arrived before a stage");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    assert!(r.status().unwrap().contains("loading: "));
+    // Away and straight back, before the other view's cut answers.
+    r.settle(gpu, &other, scene.size).unwrap();
+    r.settle(gpu, &other, scene.size).unwrap();
+    r.settle(gpu, &near, scene.size).unwrap();
+    let start = std::time::Instant::now();
+    loop {
+        let changed = r.settle(gpu, &near, scene.size).unwrap();
+        if !changed && !r.pending() {
+            break;
+        }
+        assert!(start.elapsed().as_secs() < 30, "the cut never arrived");
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let status = r.status().unwrap();
+    assert!(!status.contains("loading: "), "{status}");
+    // The whole cut: as many nodes as a renderer built for the view.
+    let mut settings = scene.settings();
+    settings.view = View::of(&near, scene.size);
+    let fresh = arbvis::catalog::build(gpu, &scene.technique, &settings, kind).unwrap();
+    let nodes = |s: &str| s.split(" of ").next().unwrap_or("").to_string();
+    let theirs = fresh.status().unwrap();
+    assert_eq!(nodes(&status), nodes(&theirs), "{status}\n{theirs}");
+}

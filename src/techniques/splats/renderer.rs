@@ -97,6 +97,9 @@ pub struct SplatsRenderer {
     /// The view a COPC cloud's nodes were chosen for, and what its cut holds.
     view: Option<CloudView>,
     cut: Option<String>,
+    /// Whether the drawn cut is the whole cut of `view` (or its loading failed, said in
+    /// `cut`): false while a stage of it is drawn.
+    settled: bool,
     /// The scene's point size (a COPC cut's splats may be drawn larger), and the cut's
     /// deepest spacing that sizes them.
     scene_point_size: f64,
@@ -317,6 +320,7 @@ impl SplatsRenderer {
             last_bin: Duration::ZERO,
             view: None,
             cut: None,
+            settled: true,
             scene_point_size: params.point_size,
             spacing: None,
             loading: None,
@@ -782,11 +786,13 @@ impl Renderer for SplatsRenderer {
                 Arrival::Waiting if still => return Ok(false),
                 Arrival::Waiting => None,
                 Arrival::Stage(loaded, whole) => {
-                    // The rest is not waited for when it is whole, or the camera moved on.
+                    // The rest is not waited for when it is whole, or the camera moved on
+                    // (a stage drawn for a view the camera comes back to is loaded again).
                     if whole || !still {
                         self.loading = None;
                     }
                     self.replace_cut(gpu, (&params, Some(&then)), view, *loaded)?;
+                    self.settled = whole;
                     return Ok(true);
                 }
                 // A node that cannot be read (a damaged file), or a loader that died:
@@ -799,10 +805,11 @@ impl Renderer for SplatsRenderer {
             if let Some(why) = why {
                 self.cut = Some(not_refined(self.cut.as_deref().unwrap_or(""), &why));
                 self.view = Some(view);
+                self.settled = true;
                 return Ok(true);
             }
         }
-        if self.view.as_ref().is_some_and(same) {
+        if self.settled && self.view.as_ref().is_some_and(same) {
             return Ok(false);
         }
         // Load the new view's cut on a thread; the drawn one stays until its first stage
