@@ -159,24 +159,51 @@ fn stages_grow_within_the_budget_and_end_with_the_whole_cut() {
     );
 }
 
-#[test]
-fn the_renderer_draws_each_stage_and_ends_with_the_fresh_picture() {
-    use arbvis::techniques::splats::{SplatsRenderer, SplatsScene};
-    use arbvis::techniques::Renderer;
-    let path = fresh_copy("copc-stages-renderer");
+/// A precise 1600x900 scene over a fresh copy of the paged file (budget 700).
+fn staged_scene(name: &str) -> arbvis::scene::Scene {
+    let path = fresh_copy(name);
     let text = format!(
         "size = [1600, 900]\nfidelity = \"precise\"\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\", points = 700 }} }}\ncolour = \"rgb\"\n",
         path.display()
     );
-    let scene = arbvis::scene::Scene::parse(&text, "stages.toml").unwrap();
-    let h = crate::common::headless(arbvis::gl::Backend::Egl);
-    let gpu = h.gpu();
-    let kind = scene.programs.resolve(gpu);
+    arbvis::scene::Scene::parse(&text, "stages.toml").unwrap()
+}
+
+/// `scene`'s renderer drawn for a far view (only the root is over 150 px), handing the
+/// cuts it loads over a stage every 2 nodes.
+fn staged_renderer(
+    gpu: &arbvis::gl::Gpu,
+    scene: &arbvis::scene::Scene,
+    kind: arbvis::gl::ProgramKind,
+) -> arbvis::techniques::splats::SplatsRenderer {
     let arbvis::catalog::TechniqueScene::Splats(params) = &scene.technique else {
         unreachable!()
     };
-    let params: &SplatsScene = params;
-    let base = std::path::Path::new("/");
+    let far = camera(Projection::Orthographic, 0.3, [0.0, 0.0, 0.0, 1.0]);
+    let mut r = arbvis::techniques::splats::SplatsRenderer::new(
+        gpu,
+        kind,
+        scene.fidelity,
+        params,
+        std::path::Path::new("/"),
+        Some(View::of(&far, scene.size)),
+    )
+    .unwrap();
+    r.set_stages(Stages {
+        batch: 2,
+        every: Duration::ZERO,
+        stop: None,
+    });
+    r
+}
+
+#[test]
+fn the_renderer_draws_each_stage_and_ends_with_the_fresh_picture() {
+    use arbvis::techniques::Renderer;
+    let scene = staged_scene("copc-stages-renderer");
+    let h = crate::common::headless(arbvis::gl::Backend::Egl);
+    let gpu = h.gpu();
+    let kind = scene.programs.resolve(gpu);
     let draw = |r: &mut dyn Renderer, camera: &Camera| {
         let target =
             arbvis::gl::Target::new(gpu, 1600, 900, arbvis::gl::TargetFormat::Rgba32f).unwrap();
@@ -189,24 +216,9 @@ fn the_renderer_draws_each_stage_and_ends_with_the_fresh_picture() {
             .unwrap();
         target.read(gpu).unwrap()
     };
-    // The first view, far: only the root is over 150 px.
-    let far = camera(Projection::Orthographic, 0.3, [0.0, 0.0, 0.0, 1.0]);
-    let mut r = SplatsRenderer::new(
-        gpu,
-        kind,
-        scene.fidelity,
-        params,
-        base,
-        Some(View::of(&far, scene.size)),
-    )
-    .unwrap();
+    let mut r = staged_renderer(gpu, &scene, kind);
     let first = r.status().unwrap();
     assert!(first.contains("COPC: 1 of "), "{first}");
-    r.set_stages(Stages {
-        batch: 2,
-        every: Duration::ZERO,
-        stop: None,
-    });
     let near = camera(Projection::Orthographic, 1.1, [0.05, -0.1, 0.02, 1.0]);
     let mut partial = 0;
     let start = std::time::Instant::now();
@@ -250,36 +262,12 @@ fn the_renderer_draws_each_stage_and_ends_with_the_fresh_picture() {
 /// helper: it stayed at 3 of 17 nodes, nothing pending).
 #[test]
 fn a_view_left_at_a_stage_and_come_back_to_is_loaded_whole() {
-    use arbvis::techniques::splats::{SplatsRenderer, SplatsScene};
     use arbvis::techniques::Renderer;
-    let path = fresh_copy("copc-stages-back");
-    let text = format!(
-        "size = [1600, 900]\nfidelity = \"precise\"\n[technique.splats]\ncloud = {{ copc = {{ path = \"{}\", points = 700 }} }}\ncolour = \"rgb\"\n",
-        path.display()
-    );
-    let scene = arbvis::scene::Scene::parse(&text, "back.toml").unwrap();
+    let scene = staged_scene("copc-stages-back");
     let h = crate::common::headless(arbvis::gl::Backend::Egl);
     let gpu = h.gpu();
     let kind = scene.programs.resolve(gpu);
-    let arbvis::catalog::TechniqueScene::Splats(params) = &scene.technique else {
-        unreachable!()
-    };
-    let params: &SplatsScene = params;
-    let far = camera(Projection::Orthographic, 0.3, [0.0, 0.0, 0.0, 1.0]);
-    let mut r = SplatsRenderer::new(
-        gpu,
-        kind,
-        scene.fidelity,
-        params,
-        std::path::Path::new("/"),
-        Some(View::of(&far, scene.size)),
-    )
-    .unwrap();
-    r.set_stages(Stages {
-        batch: 2,
-        every: Duration::ZERO,
-        stop: None,
-    });
+    let mut r = staged_renderer(gpu, &scene, kind);
     let near = camera(Projection::Orthographic, 1.1, [0.05, -0.1, 0.02, 1.0]);
     let other = camera(Projection::Perspective, 2.0, [0.3, 0.2, 0.1, 0.9]);
     // The near view until its first stage is drawn (more are on the way).
