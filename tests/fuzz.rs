@@ -733,9 +733,8 @@ fn template_log() -> Vec<u8> {
     .unwrap()
 }
 
-/// Write `bytes` as `name` of the complete store, open it and read every range and chunk,
-/// then put the file back.
-/// A COPC file of `bytes` opened (header, VLRs, hierarchy) and every node read.
+/// A COPC file of `bytes` opened (header, VLRs, root page), a view's nodes chosen (the
+/// child pages it reaches read), every page and node read.
 fn copc_case(bytes: &[u8]) {
     let path = std::env::temp_dir().join(format!(
         "arbvis-fuzz-copc-{}-{:?}.copc.laz",
@@ -744,6 +743,13 @@ fn copc_case(bytes: &[u8]) {
     ));
     std::fs::write(&path, bytes).unwrap();
     if let Ok(c) = arbvis::points::copc::Copc::open(&path) {
+        // A view first (child pages read as it reaches them), then every page.
+        let camera = arbvis::camera::Camera {
+            zoom: 3.0,
+            ..Default::default()
+        };
+        let view = arbvis::points::copc_lod::View::of(&camera, [640, 480]);
+        let _ = arbvis::points::copc_lod::select(&c, &view, 500, 0.0);
         for node in c.all_nodes().unwrap_or_default().iter() {
             let _ = c.read_node(node);
         }
@@ -752,6 +758,8 @@ fn copc_case(bytes: &[u8]) {
     let _ = std::fs::remove_file(&path);
 }
 
+/// Write `bytes` as `name` of the complete store, open it and read every range and chunk,
+/// then put the file back.
 fn store_case(name: &str, bytes: &[u8]) {
     let store = store_template().join("complete.zarr");
     let file = store.join(name);
