@@ -398,16 +398,7 @@ fn a_refined_cut_uploads_only_what_the_buffer_lacks_and_draws_as_a_fresh_one() {
     let gpu = h.gpu();
     let kind = scene.programs.resolve(gpu);
     let draw = |r: &mut Box<dyn arbvis::techniques::Renderer>, camera: &Camera| {
-        let target =
-            arbvis::gl::Target::new(gpu, 160, 90, arbvis::gl::TargetFormat::Rgba32f).unwrap();
-        let frame = arbvis::techniques::Frame {
-            camera: *camera,
-            width: 160,
-            height: 90,
-        };
-        r.draw(gpu, arbvis::gl::Surface::Target(&target), &frame)
-            .unwrap();
-        target.read(gpu).unwrap()
+        crate::common::splats::draw_renderer(gpu, &mut **r, camera, [160, 90])
     };
     let mut r = arbvis::catalog::build(gpu, &scene.technique, &scene.settings(), kind).unwrap();
     let views = [

@@ -205,16 +205,7 @@ fn the_renderer_draws_each_stage_and_ends_with_the_fresh_picture() {
     let gpu = h.gpu();
     let kind = scene.programs.resolve(gpu);
     let draw = |r: &mut dyn Renderer, camera: &Camera| {
-        let target =
-            arbvis::gl::Target::new(gpu, 1600, 900, arbvis::gl::TargetFormat::Rgba32f).unwrap();
-        let frame = arbvis::techniques::Frame {
-            camera: *camera,
-            width: 1600,
-            height: 900,
-        };
-        r.draw(gpu, arbvis::gl::Surface::Target(&target), &frame)
-            .unwrap();
-        target.read(gpu).unwrap()
+        crate::common::splats::draw_renderer(gpu, r, camera, scene.size)
     };
     let mut r = staged_renderer(gpu, &scene, kind);
     let first = r.status().unwrap();

@@ -123,6 +123,23 @@ pub fn draw_sized(
     target.read(gpu).unwrap()
 }
 
+/// What renderer `r` draws of `camera` into a fresh `size` float target.
+pub fn draw_renderer(
+    gpu: &arbvis::gl::Gpu,
+    r: &mut dyn Renderer,
+    camera: &Camera,
+    size: [u32; 2],
+) -> Image {
+    let target = Target::new(gpu, size[0], size[1], TargetFormat::Rgba32f).unwrap();
+    let frame = Frame {
+        camera: *camera,
+        width: size[0],
+        height: size[1],
+    };
+    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
+    target.read(gpu).unwrap()
+}
+
 /// The f64 reference of the same splats.
 pub fn reference(
     cloud: &PointCloud,
