@@ -1,9 +1,23 @@
 //! `arbvis info`: what the driver is and what it can do for ARB programs.
 
-use crate::gl::{Backend, Caps};
+use crate::gl::{Backend, Caps, EXACT_FILTER};
 
-/// Human-readable report of `caps` on `backend`.
-pub fn format_info(backend: Backend, caps: &Caps) -> String {
+/// How the texture units interpolate, from the largest error of a linear fetch
+/// ([`crate::gl::Gpu::linear_filter_error`]).
+pub fn filtering(filter_error: f32) -> String {
+    if filter_error <= EXACT_FILTER {
+        format!("f32 (largest error {filter_error:.1e})")
+    } else {
+        format!(
+            "coarse (largest error {filter_error:.1e}, 1/{:.0} of a texel step): precise \
+             programs interpolate in the shader",
+            1.0 / filter_error
+        )
+    }
+}
+
+/// Human-readable report of `caps` on `backend`, and the linear filter's measured error.
+pub fn format_info(backend: Backend, caps: &Caps, filter_error: f32) -> String {
     let yes = |b: bool| if b { "yes" } else { "no" };
     let mut s = String::new();
     s += &format!("backend:                 {}\n", backend.name());
@@ -23,6 +37,7 @@ pub fn format_info(backend: Backend, caps: &Caps) -> String {
     s += &format!("texture image units:     {}\n", caps.max_texture_units);
     s += &format!("max 3D texture size:     {}\n", caps.max_3d_texture_size);
     s += &format!("max 2D texture size:     {}\n", caps.max_texture_size);
+    s += &format!("linear filtering:        {}\n", filtering(filter_error));
     for (name, l, frag) in [
         ("fragment", caps.fragment_limits, true),
         ("vertex", caps.vertex_limits, false),
@@ -39,17 +54,20 @@ pub fn format_info(backend: Backend, caps: &Caps) -> String {
 }
 
 /// `arbvis info --json`: the backend and the capabilities, with the fragment and vertex
-/// program limits as nested objects (their fields share names).
-pub fn to_json(backend: Backend, caps: &Caps) -> String {
+/// program limits as nested objects (their fields share names), and the linear
+/// filter's measured error (`linear_filter_error`).
+pub fn to_json(backend: Backend, caps: &Caps, filter_error: f32) -> String {
     #[derive(serde::Serialize)]
     struct Info<'a> {
         backend: &'a str,
         #[serde(flatten)]
         caps: &'a Caps,
+        linear_filter_error: f32,
     }
     serde_json::to_string_pretty(&Info {
         backend: backend.name(),
         caps,
+        linear_filter_error: filter_error,
     })
     .unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()))
 }
@@ -64,9 +82,11 @@ mod tests {
             renderer: "r".into(),
             ..Default::default()
         };
-        let v: serde_json::Value = serde_json::from_str(&to_json(Backend::Osmesa, &caps)).unwrap();
+        let v: serde_json::Value =
+            serde_json::from_str(&to_json(Backend::Osmesa, &caps, 3e-8)).unwrap();
         assert_eq!(v["backend"], "osmesa");
         assert!(v["fragment_limits"]["native_instructions"].is_number());
         assert!(v["vertex_limits"]["local_parameters"].is_number());
+        assert!(v["linear_filter_error"].is_number());
     }
 }

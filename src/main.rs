@@ -625,10 +625,11 @@ fn run(cli: Cli) -> Result<()> {
         Command::Info { backend, json } => {
             let headless = Headless::new(backend)?;
             let caps = headless.gpu().caps();
+            let filter = headless.gpu().linear_filter_error()?;
             if json {
-                println!("{}", arbvis::info::to_json(backend, caps));
+                println!("{}", arbvis::info::to_json(backend, caps, filter));
             } else {
-                print!("{}", arbvis::info::format_info(backend, caps));
+                print!("{}", arbvis::info::format_info(backend, caps, filter));
             }
         }
         Command::Render {

@@ -1,7 +1,7 @@
 //! `Gpu`: one current GL context seen through glow, the ARB entry points, the
 //! driver's capabilities, and the log of every resource created (for `--stats`).
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::ffi::{c_void, CStr};
 use std::rc::Rc;
 use std::sync::Arc;
@@ -126,6 +126,8 @@ pub struct Gpu {
     arb: Option<ArbFns>,
     caps: Caps,
     resources: Rc<RefCell<Vec<Resource>>>,
+    /// [`Gpu::linear_filter_error`], measured on first use.
+    filter_error: Cell<Option<f32>>,
 }
 
 impl Gpu {
@@ -141,6 +143,7 @@ impl Gpu {
             arb: if caps.has_arb() { arb_fns } else { None },
             caps,
             resources: Rc::default(),
+            filter_error: Cell::new(None),
         };
         gl_check!(gpu)?;
         Ok(gpu)
@@ -163,6 +166,21 @@ impl Gpu {
     /// The driver's capabilities.
     pub fn caps(&self) -> &Caps {
         &self.caps
+    }
+
+    /// [`super::filter_probe`]'s measurement, once made (`Gpu::linear_filter_error`).
+    pub(super) fn filter_error_cache(&self) -> &Cell<Option<f32>> {
+        &self.filter_error
+    }
+
+    /// How many resources the log holds, and dropping those after the first `n` (for a
+    /// measurement whose objects are gone when it returns).
+    pub(super) fn logged_resources(&self) -> usize {
+        self.resources.borrow().len()
+    }
+
+    pub(super) fn forget_resources_after(&self, n: usize) {
+        self.resources.borrow_mut().truncate(n);
     }
 
     /// Drain `glGetError`; the first error becomes `Err`, naming `file:line`.

@@ -8,6 +8,7 @@
 mod arb;
 mod draw;
 mod error;
+mod filter_probe;
 mod gpu;
 mod headless;
 mod mesh;
@@ -21,6 +22,7 @@ pub mod window;
 
 pub use draw::{draw, draw_counted, Blend, DrawCall, Primitive};
 pub use error::{error_name, CompileError, GlError, GlResult};
+pub use filter_probe::EXACT_FILTER;
 pub use gpu::{renderer_is_software, ArbLimits, Caps, Gpu, Resource};
 pub use headless::{Backend, Headless, OSMESA_LIBRARIES};
 pub use mesh::Mesh;

@@ -93,6 +93,7 @@ fn info_reports_arb_support_and_limits() {
         "instructions:",
         "temporaries:",
         "texture indirections:",
+        "linear filtering:",
     ] {
         assert!(stdout.contains(field), "missing {field}:\n{stdout}");
     }
@@ -105,6 +106,8 @@ fn info_reports_arb_support_and_limits() {
             "{stdout}"
         );
         assert!(stdout.contains("software renderer:       yes"), "{stdout}");
+        // llvmpipe interpolates in f32: the probe's 64 fetches are exact to rounding.
+        assert!(stdout.contains("linear filtering:        f32"), "{stdout}");
     }
     let json = arbvis(&["info", "--json", "--backend", "osmesa"]);
     let (j, _) = text(&json);
@@ -115,6 +118,7 @@ fn info_reports_arb_support_and_limits() {
     assert!(v["arb_fragment_program"].is_boolean());
     assert!(v["fragment_limits"]["native_tex_indirections"].is_number());
     assert!(v["vertex_limits"]["native_instructions"].is_number());
+    assert!(v["linear_filter_error"].is_number(), "{j}");
 }
 
 #[test]
