@@ -120,7 +120,13 @@ pub fn build(
         }
         TechniqueScene::Opacity3d(params) => Box::new(opacity3d::Opacity3dRenderer::new(
             gpu,
-            opacity3d::renderer::resolve_kind(params, fidelity, programs, kind),
+            opacity3d::renderer::resolve_kind(
+                params,
+                fidelity,
+                programs,
+                kind,
+                gpu.filters_exactly()?,
+            ),
             fidelity,
             params,
             base,

@@ -32,6 +32,9 @@ pub const OPACITY3D_SLICE_PRECISE_ARBFP: ProgramText = program!("opacity3d/slice
 pub const OPACITY3D_SLICE_PRECISE_FRAG: ProgramText = program!("opacity3d/slice_precise.frag");
 /// Precise single-pass ray caster (new, GLSL only), a template like the slicing one.
 pub const OPACITY3D_RAYCAST_FRAG: ProgramText = program!("opacity3d/raycast.frag");
+/// The precise 3D-opacity programs' linear reads (GLSL, tagged), joined where a template
+/// says `// @sampling`: in the texture unit or, where its weights are coarse, the shader.
+pub const OPACITY3D_SAMPLING_GLSL: ProgramText = program!("common/sampling.glsl");
 /// The probes of `arbvis bench --breakdown` (new, GLSL), a template.
 pub const OPACITY3D_PROBE_FRAG: ProgramText = program!("opacity3d/probe.frag");
 
@@ -174,6 +177,7 @@ pub fn all_texts() -> Vec<ProgramText> {
         OPACITY3D_SLICE_PRECISE_ARBFP,
         OPACITY3D_SLICE_PRECISE_FRAG,
         OPACITY3D_RAYCAST_FRAG,
+        OPACITY3D_SAMPLING_GLSL,
         OPACITY3D_PROBE_FRAG,
         CELLPROJ_SEED_VERTEX_CG,
         CELLPROJ_SEED_FRAGMENT_CG,

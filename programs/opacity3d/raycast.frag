@@ -28,7 +28,9 @@
 // 6 = box size; 7 = box half size; 8 = orthographic: the ray direction (unit) /
 // perspective: the eye; 9 = (bricks per unit texture coordinate, stop alpha); paged:
 // 10 = (window size in level-0 voxels, brick side), 11 = (window's first voxel, 0),
-// 12 = (1 / atlas size in texels, 0), 13 = (first page of the table, 0).
+// 12 = (1 / atlas size in texels, 0), 13 = (first page of the table, 0). Every variant:
+// 16, 17 = window position to NDC (scale, offset), 18..21 = the rows of the inverse
+// view-projection (NDC to the box's coordinates).
 // Output: premultiplied colour and coverage, blended ONE, ONE_MINUS_SRC_ALPHA.
 in vec4 v_texcoord0;
 uniform sampler3D texture0;
@@ -38,20 +40,20 @@ uniform sampler2D texture4;  // [tertiary]
 uniform sampler3D texture5;  // [skip]
 uniform sampler2D texture6;  // [preint]
 uniform sampler1D texture6;  // [baked]
-uniform vec4 program_local[10];  // [!paged]
-uniform vec4 program_local[14];  // [paged]
+uniform vec4 program_local[22];
 uniform sampler3D texture7;  // [paged]
 out vec4 frag_color;
+// @sampling
 
 vec4 classify(vec3 tc) {
     vec4 lookup = program_local[5];
-    vec4 coord = textureLod(texture0, tc, 0.0) * lookup.x + lookup.y;
-    vec4 lut = textureLod(texture2, vec2(coord.@1, 0.5), 0.0);
+    vec4 coord = volume_at(texture0, tc) * lookup.x + lookup.y;
+    vec4 lut = table_at(texture2, vec2(coord.@1, 0.5));
     vec4 col = program_local[1] * lut;
-    lut = textureLod(texture3, vec2(coord.@2, 0.5), 0.0);  // [secondary]
+    lut = table_at(texture3, vec2(coord.@2, 0.5));  // [secondary]
     col = program_local[2] * lut + col;  // [sum secondary]
     col = col * (program_local[2] * lut);  // [product secondary]
-    lut = textureLod(texture4, vec2(coord.@3, 0.5), 0.0);  // [tertiary]
+    lut = table_at(texture4, vec2(coord.@3, 0.5));  // [tertiary]
     col = program_local[3] * lut + col;  // [sum tertiary]
     col = col * (program_local[3] * lut);  // [product tertiary]
     col = col * lookup.z;  // [sum]
@@ -63,9 +65,17 @@ void main() {
     vec4 lookup = program_local[5];  // [preint]
     vec3 size = program_local[6].xyz;
     vec3 half_size = program_local[7].xyz;
-    vec3 p_exit = v_texcoord0.xyz * size - half_size;
+    // The pixel's own ray: its centre unprojected (not the far face's interpolated
+    // coordinate, which a rasterizer that snaps vertices to its sub-pixel grid moves by
+    // up to 1/512 pixel), and where it leaves the box.
+    vec4 ndc = vec4(gl_FragCoord.xyz, 1.0) * program_local[16] + program_local[17];
+    vec4 h_ray = vec4(dot(program_local[18], ndc), dot(program_local[19], ndc),
+                      dot(program_local[20], ndc), dot(program_local[21], ndc));
+    vec3 on_ray = h_ray.xyz / h_ray.w;
     vec3 dir = program_local[8].xyz;  // [orthographic]
-    vec3 dir = normalize(p_exit - program_local[8].xyz);  // [perspective]
+    vec3 dir = normalize(on_ray - program_local[8].xyz);  // [perspective]
+    vec3 to_far = (half_size - on_ray * sign(dir)) / max(abs(dir), vec3(1e-20));
+    vec3 p_exit = on_ray + dir * min(min(to_far.x, to_far.y), to_far.z);
     // Back from the exit to the entry: the nearest face behind, per axis.
     vec3 q = mix(p_exit, -p_exit, lessThan(dir, vec3(0.0)));
     vec3 back3 = (half_size + q) / max(abs(dir), vec3(1e-20));
@@ -159,14 +169,14 @@ void main() {
     int j = 0;  // [baked]
     for (; j + 1 < full && acc.a < stop; j += 2) {  // [baked]
         vec3 tc = start + delta * float(j);  // [baked]
-        float v0 = textureLod(texture0, tc, 0.0).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
-        float v1 = textureLod(texture0, tc + delta, 0.0).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
-        acc += (1.0 - acc.a) * textureLod(texture6, v0, 0.0);  // [baked]
-        acc += (1.0 - acc.a) * textureLod(texture6, v1, 0.0);  // [baked]
+        float v0 = volume_at(texture0, tc).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
+        float v1 = volume_at(texture0, tc + delta).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
+        acc += (1.0 - acc.a) * step_at(texture6, v0);  // [baked]
+        acc += (1.0 - acc.a) * step_at(texture6, v1);  // [baked]
     }  // [baked]
     if (j < full && acc.a < stop) {  // [baked]
-        float v = textureLod(texture0, start + delta * float(j), 0.0).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
-        acc += (1.0 - acc.a) * textureLod(texture6, v, 0.0);  // [baked]
+        float v = volume_at(texture0, start + delta * float(j)).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
+        acc += (1.0 - acc.a) * step_at(texture6, v);  // [baked]
     }  // [baked]
     float done = min(first + float(full) * h, chord);  // [jitter]
     float rest = chord - done;  // [jitter]
@@ -181,11 +191,11 @@ void main() {
     float rest = max(chord - full * h, 0.0);  // [preint]
     vec3 delta = dir * h / size;  // [preint]
     vec3 start = (p_exit - dir * chord + half_size) / size;  // [preint]
-    float front = textureLod(texture0, start, 0.0).r * lookup.x + lookup.y;  // [preint]
+    float front = volume_at(texture0, start).r * lookup.x + lookup.y;  // [preint]
     int steps = int(full);  // [preint]
     for (int j = 1; j <= steps && acc.a < stop; j++) {  // [preint]
-        float back = textureLod(texture0, start + delta * float(j), 0.0).r * lookup.x + lookup.y;  // [preint]
-        acc += (1.0 - acc.a) * textureLod(texture6, vec2(front, back), 0.0);  // [preint]
+        float back = volume_at(texture0, start + delta * float(j)).r * lookup.x + lookup.y;  // [preint]
+        acc += (1.0 - acc.a) * step_at(texture6, vec2(front, back));  // [preint]
         front = back;  // [preint]
     }  // [preint]
     if (rest > 1e-4 * h && acc.a < stop) {  // [preint]

@@ -7,8 +7,9 @@ uniform sampler3D texture0;
 uniform sampler2D texture2;
 uniform sampler2D texture3;  // [secondary]
 uniform sampler2D texture4;  // [tertiary]
-uniform vec4 program_local[10];
+uniform vec4 program_local[22];
 out vec4 frag_color;
+// @sampling
 void main() {
     vec4 correction = program_local[4];
     vec4 lookup = program_local[5];
@@ -16,19 +17,25 @@ void main() {
     vec3 half_size = program_local[7].xyz;
     vec3 ray = program_local[8].xyz;
     vec3 axis = program_local[9].xyz;
-    vec4 v = texture(texture0, v_texcoord0.xyz);
+    // The sample: the pixel's centre unprojected at the slice's depth (constant on a
+    // view-aligned slice), not the interpolated texture coordinate, which a rasterizer
+    // that snaps vertices to its sub-pixel grid moves by up to 1/512 pixel.
+    vec4 ndc = vec4(gl_FragCoord.xyz, 1.0) * program_local[16] + program_local[17];
+    vec4 h_p = vec4(dot(program_local[18], ndc), dot(program_local[19], ndc),
+                    dot(program_local[20], ndc), dot(program_local[21], ndc));
+    vec3 p = h_p.xyz / h_p.w;
+    vec4 v = volume_at(texture0, (p + half_size) / size);
     vec4 coord = v * lookup.x + lookup.y;
-    vec4 lut = texture(texture2, vec2(coord.@1));
+    vec4 lut = table_at(texture2, vec2(coord.@1));
     vec4 col = program_local[1] * lut;
-    lut = texture(texture3, vec2(coord.@2));  // [secondary]
+    lut = table_at(texture3, vec2(coord.@2));  // [secondary]
     col = program_local[2] * lut + col;  // [sum secondary]
     col = col * (program_local[2] * lut);  // [product secondary]
-    lut = texture(texture4, vec2(coord.@3));  // [tertiary]
+    lut = table_at(texture4, vec2(coord.@3));  // [tertiary]
     col = program_local[3] * lut + col;  // [sum tertiary]
     col = col * (program_local[3] * lut);  // [product tertiary]
     col = clamp(col * lookup.z, 0.0, 1.0);  // [sum]
     col = clamp(col, 0.0, 1.0);  // [product]
-    vec3 p = v_texcoord0.xyz * size - half_size;
     vec3 q = p * ray;  // [orthographic]
     vec3 w = axis;  // [orthographic]
     float spacing = correction.y;  // [orthographic]

@@ -18,7 +18,7 @@ use super::gpu::Gpu;
 use super::position;
 
 /// How many `program.local` slots the one API exposes per stage.
-pub const MAX_LOCALS: usize = 16;
+pub const MAX_LOCALS: usize = 24;
 /// Texture units whose GLSL samplers (`texture0`..) are bound by name.
 pub const MAX_UNITS: u32 = 16;
 

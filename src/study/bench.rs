@@ -473,7 +473,13 @@ pub fn run(
                         (TechniqueScene::Opacity3d(p), Some(prepared)) => {
                             Box::new(Opacity3dRenderer::from_prepared(
                                 gpu,
-                                resolve_kind(p, s.fidelity, s.programs, kind),
+                                resolve_kind(
+                                    p,
+                                    s.fidelity,
+                                    s.programs,
+                                    kind,
+                                    gpu.filters_exactly()?,
+                                ),
                                 s.fidelity,
                                 p,
                                 &s.base,

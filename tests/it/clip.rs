@@ -14,7 +14,7 @@ use arbvis::scene::{Fidelity, Scene, SceneError};
 use arbvis::techniques::clip::ClipSpec;
 use arbvis::techniques::opacity3d::prepare::prepare;
 use arbvis::techniques::opacity3d::reference::reference_clipped;
-use arbvis::techniques::opacity3d::Raycast;
+use arbvis::techniques::opacity3d::{Interpolation, Raycast};
 use common::{headless, temp_dir, LEVEL};
 use common::{opacity3d as params, opacity3d_mut as params_mut};
 
@@ -105,15 +105,22 @@ fn multires_draws_what_the_single_texture_draws() {
 
 /// ARB and GLSL texts of the same path with the clip composed in: the existing
 /// unclipped bound is one 8-bit level (tests/opacity3d.rs), kept here (measured: identical
-/// on llvmpipe, faithful and precise slicing, both lookups).
+/// on llvmpipe, faithful and precise slicing, both lookups). Both read through the texture
+/// units: the ARB clip test has no shader interpolation, so on a driver with coarse
+/// units `auto` would compare the units' clip with the shader's.
 #[test]
 fn arb_and_glsl_agree_with_a_clip() {
     let h = headless(Backend::Egl);
     for fidelity in ["faithful", "precise"] {
         for multires in [true, false] {
             let clip = format!("shape = {CARVED}\nmultires = {multires}\nblock = 4");
-            let arb = render_on(&h, &with(fidelity, "arb", None, &clip)).unwrap();
-            let glsl = render_on(&h, &with(fidelity, "glsl", None, &clip)).unwrap();
+            let units = |programs: &str| {
+                let mut s = with(fidelity, programs, None, &clip);
+                params_mut(&mut s).interpolation = Interpolation::TextureUnit;
+                s
+            };
+            let arb = render_on(&h, &units("arb")).unwrap();
+            let glsl = render_on(&h, &units("glsl")).unwrap();
             assert_eq!(arb.program_kind, ProgramKind::Arb);
             assert_eq!(glsl.program_kind, ProgramKind::Glsl);
             let d = arb.image.compare(&glsl.image, 0.0).unwrap();
@@ -214,13 +221,19 @@ fn precise_meets_the_clipped_reference() {
         }
         let textures = clip_of(&s);
         let grid = textures.single.grid;
-        let gpu = render(&h, &s);
         let emulated = reference_of(&s, 2.0, |x| textures.single.keeps(grid.to_texcoord(x)));
-        let (max, _, _) = rgb_error(&gpu, &emulated, LEVEL as f64);
-        assert!(
-            max < 1e-4,
-            "{what}: ray caster against the emulated texture: {max:.2e}"
-        );
+        // The clip values interpolated by the texture unit where it filters in f32, and
+        // in the shader (forced here; where the units' weights are coarse, `auto`).
+        for interpolation in [Interpolation::Shader, Interpolation::Auto] {
+            params_mut(&mut s).interpolation = interpolation;
+            let (max, _, _) = rgb_error(&render(&h, &s), &emulated, LEVEL as f64);
+            eprintln!("{what}, {interpolation:?}: against the emulated texture {max:.2e}");
+            assert!(
+                max < 1e-4,
+                "{what}, {interpolation:?}: ray caster against the emulated texture: {max:.2e}"
+            );
+        }
+        let gpu = render(&h, &s);
         let analytic = reference_of(&s, 2.0, |x| textures.shape.inside(x));
         let (max, rmse, over) = rgb_error(&gpu, &analytic, LEVEL as f64);
         eprintln!("ray caster against the analytic clip, {what}: max {max:.2e} rmse {rmse:.2e}, {over} pixels over 1/255");
@@ -409,7 +422,7 @@ fn the_composed_arb_text_holds_the_verbatim_body() {
                     .unwrap();
             assert_eq!(verbatim, on_disk, "{file}.arbfp embedded as stored");
             let pair = faithful_pair(ProgramKind::Arb, combine);
-            let composed = compose(pair, &stage, Path3d::Slicing).unwrap();
+            let composed = compose(pair, &stage, Path3d::Slicing, false).unwrap();
             let text = &composed.fragment.text;
             assert!(text.starts_with("!!ARBfp1.0\n# arbvis clip"), "{text}");
             assert!(text.ends_with(&verbatim["!!ARBfp1.0".len()..]), "{text}");

@@ -50,6 +50,21 @@ pub fn glsl_function(lookup: Lookup) -> String {
     text.text.to_string()
 }
 
+/// [`glsl_function`] with the read of the clip values (the linearly filtered texture: the
+/// single one, or the DATA) interpolated in the shader by `lerp3`, which the host program
+/// defines (`programs/common/sampling.glsl`, carried by the precise 3D-opacity programs):
+/// for drivers whose texture units keep coarse weights. The INDEX read stays (NEAREST).
+pub fn glsl_function_exact(lookup: Lookup) -> String {
+    let unit = match lookup {
+        Lookup::Single => INDEX_UNIT,
+        Lookup::Multires(_) => DATA_UNIT,
+    };
+    glsl_function(lookup).replace(
+        &format!("texture(texture{unit}, "),
+        &format!("lerp3(texture{unit}, "),
+    )
+}
+
 /// Unit of the single-resolution texture, or of the INDEX.
 pub const INDEX_UNIT: u32 = 7;
 /// Unit of the DATA texture.
@@ -279,7 +294,7 @@ mod tests {
         let text = "#version 330\nuniform vec4 program_local[6];\nin vec4 v;\nvoid main() {\n    x();\n}\n";
         let out =
             compose_glsl(text, "float clip_value(vec3 p) { return 1.0; }\n", "v.xyz").unwrap();
-        assert!(out.contains("uniform vec4 program_local[16];"), "{out}");
+        assert!(out.contains("uniform vec4 program_local[24];"), "{out}");
         assert!(!out.contains("program_local[6]"));
         let f = out.find("float clip_value").unwrap();
         let m = out.find("void main()").unwrap();
@@ -302,7 +317,7 @@ mod tests {
             out.find("vec4 classify(vec3 tc) {\n    if (clip_value(tc) < 0.5) return vec4(0.0);");
         assert!(c.is_some_and(|c| f < c), "{out}");
         assert!(!out.contains("discard"), "{out}");
-        assert!(out.contains("program_local[16]"), "{out}");
+        assert!(out.contains("program_local[24]"), "{out}");
         assert!(compose_glsl_at(text, "", "vec4 shade(", "").is_err());
     }
 }

@@ -43,7 +43,8 @@ use crate::gl::{GlError, GlResult, Gpu, ProgramKind, ProgramText};
 use crate::programs::ProgramPair;
 use crate::techniques::clip::multires::IndexEncoding;
 use crate::techniques::clip::stage::{
-    arb_prologue, compose_arb, compose_glsl, compose_glsl_at, glsl_function, ClipStage, Lookup,
+    arb_prologue, compose_arb, compose_glsl, compose_glsl_at, glsl_function, glsl_function_exact,
+    ClipStage, Lookup,
 };
 use crate::techniques::clip::stats::ClipStats;
 use crate::techniques::clip::{ClipSpec, ClipTextures};
@@ -94,17 +95,26 @@ pub fn build(
     })
 }
 
-/// `pair`'s fragment program (drawn on `path`) with `stage`'s clip test composed in.
-pub fn compose(pair: ProgramPair, stage: &ClipStage, path: Path3d) -> GlResult<ProgramPair> {
+/// `pair`'s fragment program (drawn on `path`) with `stage`'s clip test composed in; with
+/// `exact` (a precise GLSL program whose linear reads are the shader's) the clip values
+/// are interpolated in the shader too.
+pub fn compose(
+    pair: ProgramPair,
+    stage: &ClipStage,
+    path: Path3d,
+    exact: bool,
+) -> GlResult<ProgramPair> {
     let text = &pair.fragment.text;
+    let function = match exact {
+        true => glsl_function_exact(stage.lookup),
+        false => stage.glsl_function(),
+    };
     let composed = match (pair.kind, path) {
         (ProgramKind::Arb, _) => compose_arb(text, &stage.arb_prologue(ARB_COORD)),
-        (ProgramKind::Glsl, Path3d::Slicing) => {
-            compose_glsl(text, &stage.glsl_function(), GLSL_COORD)
-        }
+        (ProgramKind::Glsl, Path3d::Slicing) => compose_glsl(text, &function, GLSL_COORD),
         (ProgramKind::Glsl, Path3d::Raycast) => compose_glsl_at(
             text,
-            &stage.glsl_function(),
+            &function,
             CLASSIFY,
             "if (clip_value(tc) < 0.5) return vec4(0.0);",
         ),

@@ -108,6 +108,22 @@ fn unit_coefficients() -> [f64; 4] {
     [1.0; 4]
 }
 
+/// Where precise mode interpolates its linearly filtered textures. GL leaves the precision
+/// of `GL_LINEAR` to the driver: llvmpipe's is f32, NVIDIA's texture units keep 8-bit
+/// weights (up to 1e-2 off after a steep table).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Interpolation {
+    /// In the shader where the driver's texture units interpolate coarsely (measured
+    /// once per context), else in the units.
+    #[default]
+    Auto,
+    /// The texture units, whatever their precision (fastest).
+    TextureUnit,
+    /// The shader (`texelFetch` and f32 `mix`; GLSL programs).
+    Shader,
+}
+
 /// `[technique.opacity3d]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -124,6 +140,9 @@ pub struct Opacity3dScene {
     /// Filtering of the colour tables.
     #[serde(default = "linear")]
     pub table_filter: Filter,
+    /// Precise mode: where the linear filtering of the volume and tables is computed.
+    #[serde(default)]
+    pub interpolation: Interpolation,
     /// Opacity correction; by default on when precise, off when faithful (which has none).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub opacity_correction: Option<bool>,

@@ -33,7 +33,7 @@
 
 use glam::DVec3;
 
-use super::programs::{raycast_pair, Variant};
+use super::programs::{raycast_pair, ShaderFilter, Variant};
 use super::renderer::{eye, far_faces, toward_viewer};
 use super::{corrected, Combine, Opacity3dScene};
 use crate::camera::Projection;
@@ -111,6 +111,7 @@ pub struct PagedPass {
     projection: Projection,
     combine: Combine,
     present: [bool; 3],
+    filter: ShaderFilter,
     mesh: Option<Mesh>,
     table: Option<(Texture, [usize; 3])>,
 }
@@ -120,6 +121,7 @@ fn program(
     combine: Combine,
     present: [bool; 3],
     projection: Projection,
+    filter: ShaderFilter,
 ) -> GlResult<Program> {
     let pair = raycast_pair(Variant {
         combine,
@@ -130,6 +132,7 @@ fn program(
         jitter: false,
         baked: false,
         paged: true,
+        filter,
     });
     Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)
 }
@@ -139,11 +142,13 @@ impl PagedPass {
     pub fn new(gpu: &Gpu, params: &Opacity3dScene) -> GlResult<PagedPass> {
         let present = params.attributes().map(|a| a.is_some());
         let projection = Projection::Orthographic;
+        let filter = ShaderFilter::for_scene(params, gpu.filters_exactly()?);
         Ok(PagedPass {
-            program: program(gpu, params.combine, present, projection)?,
+            program: program(gpu, params.combine, present, projection, filter)?,
             projection,
             combine: params.combine,
             present,
+            filter,
             mesh: None,
             table: None,
         })
@@ -152,10 +157,12 @@ impl PagedPass {
     /// The program, rebuilt when the combination changed.
     pub fn program_for(&mut self, gpu: &Gpu, params: &Opacity3dScene) -> GlResult<&Program> {
         let present = params.attributes().map(|a| a.is_some());
-        if params.combine != self.combine || present != self.present {
+        let filter = ShaderFilter::for_scene(params, gpu.filters_exactly()?);
+        if params.combine != self.combine || present != self.present || filter != self.filter {
             self.combine = params.combine;
             self.present = present;
-            self.program = program(gpu, self.combine, present, self.projection)?;
+            self.filter = filter;
+            self.program = program(gpu, self.combine, present, self.projection, filter)?;
         }
         Ok(&self.program)
     }
@@ -176,7 +183,13 @@ impl PagedPass {
     ) -> GlResult<()> {
         if frame.camera.projection != self.projection {
             self.projection = frame.camera.projection;
-            self.program = program(gpu, self.combine, self.present, self.projection)?;
+            self.program = program(
+                gpu,
+                self.combine,
+                self.present,
+                self.projection,
+                self.filter,
+            )?;
         }
         let half = pyr.half();
         if self.mesh.is_none() {
@@ -241,6 +254,7 @@ impl PagedPass {
         let f = table.first.map(|v| v as f64);
         p.set_local(gpu, 13, [f[0], f[1], f[2], 0.0])?;
         p.set_transform(gpu, super::renderer::model_view_projection(frame))?;
+        super::renderer::send_pixel_rays(gpu, p, surface, frame)?;
         let (Some(mesh), Some((page, _))) = (&self.mesh, &self.table) else {
             return Ok(());
         };

@@ -20,9 +20,9 @@
 
 use std::borrow::Cow;
 
-use super::Combine;
+use super::{Combine, Interpolation, Opacity3dScene};
 use crate::camera::Projection;
-use crate::gl::{ProgramKind, ProgramText};
+use crate::gl::{Filter, ProgramKind, ProgramText};
 use crate::programs::{self, with_transform, ProgramPair};
 
 /// What a precise program is specialized to.
@@ -45,6 +45,47 @@ pub struct Variant {
     /// Ray caster only: a store's bricks through the page table (point sampling, no
     /// jitter; the atlas holds v3o2's packing, G primary, B secondary, R tertiary).
     pub paged: bool,
+    /// Which linear reads interpolate in the shader (GLSL only).
+    pub filter: ShaderFilter,
+}
+
+/// Which of a precise program's linearly filtered textures it interpolates itself
+/// (`texelFetch` and f32 `mix`, `programs/common/sampling.glsl`) instead of the texture
+/// unit: where the driver's units keep coarse weights ([`crate::gl::Gpu::filters_exactly`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ShaderFilter {
+    /// The attribute volume (or a store's brick atlas).
+    pub volume: bool,
+    /// The colour tables.
+    pub tables: bool,
+    /// The ray caster's step table (pre-integrated or baked; always linear).
+    pub steps: bool,
+    /// A clip's values (always linear; the GLSL clip test only).
+    pub clip: bool,
+}
+
+impl ShaderFilter {
+    /// What `params` interpolates in the shader on a driver whose units filter exactly
+    /// (`units_exact`) or not: its linear textures, where `interpolation` says or `auto`
+    /// finds the units coarse.
+    pub fn for_scene(params: &Opacity3dScene, units_exact: bool) -> ShaderFilter {
+        let shader = match params.interpolation {
+            Interpolation::Auto => !units_exact,
+            Interpolation::TextureUnit => false,
+            Interpolation::Shader => true,
+        };
+        ShaderFilter {
+            volume: shader && params.volume_filter == Filter::Linear,
+            tables: shader && params.table_filter == Filter::Linear,
+            steps: shader,
+            clip: shader,
+        }
+    }
+
+    /// Whether any read interpolates in the shader (such a program is GLSL).
+    pub fn any(&self) -> bool {
+        self.volume || self.tables || self.steps || self.clip
+    }
 }
 
 impl Variant {
@@ -79,6 +120,15 @@ impl Variant {
         if self.paged {
             tags.push("paged");
         }
+        for (on, tag) in [
+            (self.filter.volume, "exact_volume"),
+            (self.filter.tables, "exact_tables"),
+            (self.filter.steps, "exact_steps"),
+        ] {
+            if on {
+                tags.push(tag);
+            }
+        }
         tags
     }
 
@@ -105,10 +155,17 @@ impl Variant {
 }
 
 /// Keep the lines whose tags `tags` all holds, drop the tag comments, and put in the
-/// channel letters.
+/// channel letters; a line `// @sampling` becomes the linear reads
+/// ([`programs::OPACITY3D_SAMPLING_GLSL`]), specialized alike.
 pub fn specialize(template: &ProgramText, tags: &[&str], channels: [char; 3]) -> ProgramText {
     let mut out = String::with_capacity(template.text.len());
-    for line in template.text.split_inclusive('\n') {
+    let sampling = programs::OPACITY3D_SAMPLING_GLSL;
+    let lines = template.text.split_inclusive('\n').flat_map(|line| {
+        let include = line.trim() == "// @sampling";
+        let text: &str = if include { &sampling.text } else { line };
+        text.split_inclusive('\n')
+    });
+    for line in lines {
         let (body, newline) = match line.strip_suffix('\n') {
             Some(b) => (b, "\n"),
             None => (line, ""),
@@ -197,17 +254,34 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
                         jitter,
                         baked,
                         paged: false,
+                        filter: ShaderFilter::default(),
+                    };
+                    // The GLSL programs also with every linear read in the shader.
+                    let exact = Variant {
+                        filter: ShaderFilter {
+                            volume: true,
+                            tables: true,
+                            steps: true,
+                            clip: true,
+                        },
+                        ..v
                     };
                     if !(skip || preint || jitter) {
                         pairs.push(slicing_pair(ProgramKind::Arb, v));
                         pairs.push(slicing_pair(ProgramKind::Glsl, v));
+                        pairs.push(slicing_pair(ProgramKind::Glsl, exact));
                     }
                     // Pre-integration and the baked table are for one attribute.
                     if !(preint || baked) || present == [true, false, false] {
                         pairs.push(raycast_pair(v));
+                        pairs.push(raycast_pair(exact));
                     }
                     if !(skip || preint || jitter) {
                         pairs.push(raycast_pair(Variant { paged: true, ..v }));
+                        pairs.push(raycast_pair(Variant {
+                            paged: true,
+                            ..exact
+                        }));
                     }
                 }
             }
@@ -250,6 +324,7 @@ mod tests {
             jitter: false,
             baked: false,
             paged: false,
+            filter: ShaderFilter::default(),
         }
     }
 

@@ -19,7 +19,7 @@ use super::bricks::Bricks;
 use super::clipping::{self, Clip};
 use super::prepare::{prepare, Prepared};
 pub use super::programs::faithful_pair;
-use super::programs::{raycast_pair, slicing_pair, Variant};
+use super::programs::{raycast_pair, slicing_pair, ShaderFilter, Variant};
 use super::slicing::slice_box;
 pub use super::{coefficients, corrected, path, preintegrated, Path3d};
 use super::{Combine, Opacity3dScene};
@@ -88,17 +88,47 @@ pub fn step_table(params: &Opacity3dScene, fidelity: Fidelity, prepared: &Prepar
 }
 
 /// The program kind a scene draws with: the ray caster is GLSL only, so `auto` gives GLSL
-/// there; an explicit `arb` stays (and the renderer says why it cannot).
+/// there; an explicit `arb` stays (and the renderer says why it cannot). A precise clipped
+/// scene on a driver whose texture units filter coarsely (`units_exact` false) also gets
+/// GLSL under `auto`: only the GLSL clip test interpolates its values in the shader.
 pub fn resolve_kind(
     params: &Opacity3dScene,
     fidelity: Fidelity,
     programs: ProgramChoice,
     kind: ProgramKind,
+    units_exact: bool,
 ) -> ProgramKind {
-    if path(params, fidelity) == Path3d::Raycast && programs == ProgramChoice::Auto {
+    let exact_clip = fidelity == Fidelity::Precise
+        && params.clip.is_some()
+        && ShaderFilter::for_scene(params, units_exact).clip;
+    if programs == ProgramChoice::Auto && (path(params, fidelity) == Path3d::Raycast || exact_clip)
+    {
         ProgramKind::Glsl
     } else {
         kind
+    }
+}
+
+/// Which linear reads a precise program makes itself on `gpu` (none when faithful: the
+/// era's texture units, whatever their precision).
+pub fn shader_filter(
+    gpu: &Gpu,
+    params: &Opacity3dScene,
+    fidelity: Fidelity,
+) -> GlResult<ShaderFilter> {
+    Ok(match fidelity {
+        Fidelity::Faithful => ShaderFilter::default(),
+        Fidelity::Precise => ShaderFilter::for_scene(params, gpu.filters_exactly()?),
+    })
+}
+
+/// The filter a texture is made with: NEAREST where the program interpolates it itself
+/// (the ARB programs read texel centres; `texelFetch` ignores the filter).
+pub fn unit_filter(filter: Filter, in_shader: bool) -> Filter {
+    if in_shader {
+        Filter::Nearest
+    } else {
+        filter
     }
 }
 
@@ -120,6 +150,38 @@ pub fn program_pairs() -> Vec<programs::ProgramPair> {
 /// Object space to clip space: the camera's view-projection (the box sits in [-1, 1]³).
 pub fn model_view_projection(frame: &Frame) -> DMat4 {
     frame.camera.view_projection(frame.aspect())
+}
+
+/// The precise programs' per-pixel points (locals 16-21 of `raycast.frag` and
+/// `slice_precise`): window position on `surface` to NDC (scale and offset), and the rows
+/// of the inverse view-projection, so that each pixel unprojects its own centre rather
+/// than trusting an interpolated coordinate.
+pub fn send_pixel_rays(
+    gpu: &Gpu,
+    program: &Program,
+    surface: Surface<'_>,
+    frame: &Frame,
+) -> GlResult<()> {
+    let [x, y, w, h] = match surface {
+        Surface::Window([x, y, w, h]) => [x, y, w, h].map(f64::from),
+        Surface::Target(t) => [0.0, 0.0, t.width() as f64, t.height() as f64],
+    };
+    let (w, h) = (w.max(1.0), h.max(1.0));
+    program.set_local(gpu, 16, [2.0 / w, 2.0 / h, 2.0, 0.0])?;
+    program.set_local(gpu, 17, [-1.0 - 2.0 * x / w, -1.0 - 2.0 * y / h, -1.0, 1.0])?;
+    let inverse = model_view_projection(frame).inverse().transpose();
+    for (i, row) in [
+        inverse.x_axis,
+        inverse.y_axis,
+        inverse.z_axis,
+        inverse.w_axis,
+    ]
+    .iter()
+    .enumerate()
+    {
+        program.set_local(gpu, 18 + i, row.to_array())?;
+    }
+    Ok(())
 }
 
 /// Direction toward the viewer in object space (the slices' normal).
@@ -194,6 +256,8 @@ pub fn far_faces(half: DVec3) -> Vec<f32> {
 /// The 3D-opacity renderer.
 pub struct Opacity3dRenderer {
     kind: ProgramKind,
+    /// The linear reads the precise programs make themselves.
+    filter: ShaderFilter,
     fidelity: Fidelity,
     base: PathBuf,
     params: Opacity3dScene,
@@ -285,6 +349,7 @@ impl Opacity3dRenderer {
             gpu, kind, fidelity, params, &prepared, projection, baked, stage,
         )?;
         let extent = Extent::D3(ni as u32, nj as u32, nk as u32);
+        let filter = shader_filter(gpu, params, fidelity)?;
         let volume = match fidelity {
             Fidelity::Faithful => Texture::new(
                 gpu,
@@ -299,12 +364,13 @@ impl Opacity3dRenderer {
                 "opacity3d packed volume (present attributes in order)",
                 extent,
                 texel_formats(fidelity, prepared.count()).0,
-                params.volume_filter,
+                unit_filter(params.volume_filter, filter.volume),
                 TexelData::U8(&prepared.present_levels()),
             )?,
         };
         let mut renderer = Opacity3dRenderer {
             kind,
+            filter,
             fidelity,
             base: base.to_path_buf(),
             params: params.clone(),
@@ -353,7 +419,7 @@ impl Opacity3dRenderer {
                     gpu,
                     &format!("opacity3d {name} table"),
                     t,
-                    self.params.table_filter,
+                    unit_filter(self.params.table_filter, self.filter.tables),
                     self.fidelity,
                 )?),
                 None => None,
@@ -445,6 +511,12 @@ impl Opacity3dRenderer {
             let half = self.prepared.half;
             p.set_local(gpu, 6, (2.0 * half).extend(0.0).to_array())?;
             p.set_local(gpu, 7, half.extend(0.0).to_array())?;
+            if self.filter.volume && self.path() == Path3d::Slicing {
+                // slice_precise.arbfp's own trilinear (exact_volume): size and 1 / size.
+                let dims = self.prepared.dims.map(|d| d as f64);
+                p.set_local(gpu, 14, [dims[0], dims[1], dims[2], 1.0])?;
+                p.set_local(gpu, 15, [1.0 / dims[0], 1.0 / dims[1], 1.0 / dims[2], 1.0])?;
+            }
         }
         Ok(())
     }
@@ -552,6 +624,7 @@ fn make_program(
         jitter: params.raycast.is_some_and(|r| r.jitter) && !preint,
         baked,
         paged: false,
+        filter: shader_filter(gpu, params, fidelity)?,
     };
     let pair = match (fidelity, path(params, fidelity)) {
         (Fidelity::Faithful, _) => faithful_pair(kind, params.combine),
@@ -568,7 +641,10 @@ fn make_program(
         }
     };
     let pair = match clip {
-        Some(stage) => clipping::compose(pair, stage, path(params, fidelity))?,
+        Some(stage) => {
+            let exact = pair.kind == ProgramKind::Glsl && variant.filter.clip;
+            clipping::compose(pair, stage, path(params, fidelity), exact)?
+        }
         None => pair,
     };
     Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)
@@ -610,6 +686,7 @@ impl Opacity3dRenderer {
             .set_transform(gpu, model_view_projection(frame))?;
         if self.fidelity == Fidelity::Precise {
             self.send_view(gpu, frame)?;
+            send_pixel_rays(gpu, &self.program, surface, frame)?;
         }
         let mut textures: Vec<(u32, &Texture)> = vec![(VOLUME_UNIT, &self.volume)];
         for (a, t) in self.tables.iter().enumerate() {
@@ -682,7 +759,10 @@ impl Renderer for Opacity3dRenderer {
             p.attributes()
                 .map(|a| a.map(|a| (a.volume.clone(), a.attribute, a.quantize)))
         };
-        if data(&old) != data(new) || old.volume_filter != new.volume_filter {
+        if data(&old) != data(new)
+            || old.volume_filter != new.volume_filter
+            || old.interpolation != new.interpolation
+        {
             let prepared = prepare(
                 new,
                 &self.base,
@@ -700,6 +780,7 @@ impl Renderer for Opacity3dRenderer {
             )?;
             return Ok(());
         }
+        self.filter = shader_filter(gpu, new, self.fidelity)?;
         let tables = |p: &Opacity3dScene| p.attributes().map(|a| a.map(|a| a.table.clone()));
         if tables(&old) != tables(new)
             || old.table_filter != new.table_filter
@@ -738,6 +819,7 @@ impl Renderer for Opacity3dRenderer {
             (
                 p.combine,
                 p.raycast.map(|r| (r.brick > 0, r.jitter, r.preintegrate)),
+                (p.table_filter, p.interpolation),
             )
         };
         if shape(&old) != shape(new) || baked != self.baked || clip_changed {
