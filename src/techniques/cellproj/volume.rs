@@ -511,13 +511,19 @@ impl VolumeRenderer {
             let (p, _) = prepared.tet(t);
             for (k, &m) in row.iter().enumerate() {
                 if m == BOUNDARY {
-                    for &c in &FACES[k].0 {
+                    // The face's plane as the tetrahedra texture holds it, so the entry
+                    // layers intersect the pixel's ray with it exactly.
+                    let f = FACES[k].0;
+                    let nrm = normal(p[f[0]], p[f[1]], p[f[2]]);
+                    let plane = [nrm.x, nrm.y, nrm.z, nrm.dot(p[f[0]])].map(|v| v as f32);
+                    for &c in &f {
                         boundary.extend([p[c].x as f32, p[c].y as f32, p[c].z as f32, t as f32]);
+                        boundary.extend(plane);
                     }
                 }
             }
         }
-        let boundary = Mesh::new(gpu, "cellproj volume boundary faces", &[3, 1], &boundary)?;
+        let boundary = Mesh::new(gpu, "cellproj volume boundary faces", &[3, 1, 4], &boundary)?;
         let quad: Vec<f32> = [
             (-1.0, -1.0),
             (1.0, -1.0),
