@@ -120,13 +120,7 @@ pub fn build(
         }
         TechniqueScene::Opacity3d(params) => Box::new(opacity3d::Opacity3dRenderer::new(
             gpu,
-            opacity3d::renderer::resolve_kind(
-                params,
-                fidelity,
-                programs,
-                kind,
-                gpu.filters_exactly()?,
-            ),
+            opacity3d::renderer::resolve_kind(gpu, params, fidelity, programs, kind)?,
             fidelity,
             params,
             base,

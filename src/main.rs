@@ -626,10 +626,13 @@ fn run(cli: Cli) -> Result<()> {
             let headless = Headless::new(backend)?;
             let caps = headless.gpu().caps();
             let filter = headless.gpu().linear_filter_error()?;
+            let interpolation = headless.gpu().interpolation_error()?;
             if json {
-                println!("{}", arbvis::info::to_json(backend, caps, filter));
+                let text = arbvis::info::to_json(backend, caps, filter, interpolation);
+                println!("{text}");
             } else {
-                print!("{}", arbvis::info::format_info(backend, caps, filter));
+                let text = arbvis::info::format_info(backend, caps, filter, interpolation);
+                print!("{text}");
             }
         }
         Command::Render {

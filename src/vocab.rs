@@ -56,6 +56,23 @@ impl TargetFormat {
     }
 }
 
+/// Where a precise mode's interpolation happens. GL leaves its precision to the driver:
+/// llvmpipe filters textures in f32 and interpolates attributes from the true vertices;
+/// NVIDIA's texture units keep 8-bit weights (up to 1e-2 off after a steep table) and its
+/// rasterizer interpolates from vertices snapped to 1/256 pixel (up to 1/512 pixel off).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Interpolation {
+    /// In the shader where the driver's probe (`arbvis info`) finds the hardware coarse,
+    /// else in the hardware.
+    #[default]
+    Auto,
+    /// The texture units and the rasterizer, whatever their precision (fastest).
+    Hardware,
+    /// The shader: texels fetched and mixed in f32, samples from each pixel's centre.
+    Shader,
+}
+
 /// Faithful (the original programs, 8-bit targets, original formulas) or precise
 /// (corrected maths, float targets). DESIGN.md §3.
 #[derive(

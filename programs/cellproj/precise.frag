@@ -16,11 +16,17 @@
 //   face's depth stays, which orders the tetrahedra along a ray just as well and lets
 //   the depth test run before this program), and the colour may be shaded with the
 //   gradient.
+// - with PIXEL_RAYS defined (a rasterizer that interpolates from vertices snapped to its
+//   sub-pixel grid moves an interpolated position by up to 1/512 pixel, which a face seen
+//   nearly edge-on turns into depth), the entry is where the pixel's own ray (its centre
+//   unprojected) meets the face's plane (the interpolated position's, from its
+//   derivatives), and sf the scalar there.
 // program_local[0..3]: ModelViewProj rows; [4]: eye in object space (xyz), w = 1 for
 // perspective, 0 for orthographic; [5]: view direction (orthographic, unit);
-// [6]: x = isovalue count, y = shading on (1) / off (0), z = ambient term.
+// [6]: x = isovalue count, y = shading on (1) / off (0), z = ambient term;
+// [7..10]: inverse ModelViewProj rows; [11]: window position to NDC (scale xy, offset zw).
 // texture0: count x 2 RGBA32F, row 0 the colours, row 1 the values (ascending).
-uniform vec4 program_local[7];
+uniform vec4 program_local[12];
 uniform sampler2D texture0;
 in float v_sf;
 in vec3 v_pos, v_vertex3, v_gradient;
@@ -35,15 +41,29 @@ float exit_along(vec3 D, vec3 aux1, vec3 n, float t) {
 }
 
 void main() {
-    vec3 D = program_local[4].w > 0.5 ? normalize(v_pos - program_local[4].xyz)
+#ifdef PIXEL_RAYS
+    mat4 inv = transpose(mat4(program_local[7], program_local[8], program_local[9],
+                              program_local[10]));
+    vec2 ndc = gl_FragCoord.xy * program_local[11].xy + program_local[11].zw;
+    vec4 near = inv * vec4(ndc, -1.0, 1.0);
+    vec4 far = inv * vec4(ndc, 1.0, 1.0);
+    vec3 o = near.xyz / near.w;
+    vec3 d = normalize(far.xyz / far.w - o);
+    vec3 face = cross(dFdx(v_pos), dFdy(v_pos));
+    float dn = dot(d, face);
+    vec3 entry = abs(dn) > 1e-6 * length(face) ? o + d * (dot(v_pos - o, face) / dn) : v_pos;
+#else
+    vec3 entry = v_pos;
+#endif
+    vec3 D = program_local[4].w > 0.5 ? normalize(entry - program_local[4].xyz)
                                       : program_local[5].xyz;
-    vec3 aux1 = v_vertex3 - v_pos;
+    vec3 aux1 = v_vertex3 - entry;
     float big = 1e30;
     float t = exit_along(D, aux1, v_normal0, big);
     t = exit_along(D, aux1, v_normal1, t);
     t = exit_along(D, aux1, v_normal2, t);
     if (t == big) t = 0.0;
-    float sf = v_sf;
+    float sf = v_sf + dot(v_gradient, entry - v_pos);
     float sb = sf + t * dot(v_gradient, D);
     int count = int(program_local[6].x + 0.5);
     int hit = -1;
@@ -60,7 +80,7 @@ void main() {
     if (hit < 0) discard;
     vec4 c = texelFetch(texture0, ivec2(hit, 0), 0);
 #ifndef ENTRY_DEPTH
-    vec3 p = v_pos + D * (t * best);
+    vec3 p = entry + D * (t * best);
     vec4 clip = vec4(dot(program_local[0], vec4(p, 1.0)), dot(program_local[1], vec4(p, 1.0)),
                      dot(program_local[2], vec4(p, 1.0)), dot(program_local[3], vec4(p, 1.0)));
     gl_FragDepth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);

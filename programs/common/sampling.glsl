@@ -2,7 +2,7 @@
 // template's sampling line (src/techniques/opacity3d/programs.rs). GL leaves the precision
 // of GL_LINEAR to the driver: llvmpipe interpolates in f32, NVIDIA's texture units keep
 // 8-bit weights (off by up to 1/512 of a texel step, 1e-2 after a steep table;
-// src/gl/filter_probe.rs measures it).
+// src/gl/precision.rs measures it).
 // Tags exact_volume, exact_tables, exact_steps: that texture's reads interpolate here, as
 // GL_LINEAR with CLAMP_TO_EDGE defines it (texel space u = s * size - 0.5, the weights its
 // fraction), from texelFetch and f32 mix; without the tag, the texture unit does.

@@ -17,14 +17,16 @@ void main() {
     vec3 half_size = program_local[7].xyz;
     vec3 ray = program_local[8].xyz;
     vec3 axis = program_local[9].xyz;
-    // The sample: the pixel's centre unprojected at the slice's depth (constant on a
-    // view-aligned slice), not the interpolated texture coordinate, which a rasterizer
-    // that snaps vertices to its sub-pixel grid moves by up to 1/512 pixel.
-    vec4 ndc = vec4(gl_FragCoord.xyz, 1.0) * program_local[16] + program_local[17];
-    vec4 h_p = vec4(dot(program_local[18], ndc), dot(program_local[19], ndc),
-                    dot(program_local[20], ndc), dot(program_local[21], ndc));
-    vec3 p = h_p.xyz / h_p.w;
-    vec4 v = volume_at(texture0, (p + half_size) / size);
+    // The sample: the interpolated texture coordinate, or (pixel_points: a rasterizer that
+    // interpolates from vertices snapped to its sub-pixel grid moves it by up to 1/512
+    // pixel) the pixel's centre unprojected at the slice's depth, constant on a
+    // view-aligned slice.
+    vec3 tc = v_texcoord0.xyz;  // [!pixel_points]
+    vec4 ndc = vec4(gl_FragCoord.xyz, 1.0) * program_local[16] + program_local[17];  // [pixel_points]
+    vec4 h_p = vec4(dot(program_local[18], ndc), dot(program_local[19], ndc), dot(program_local[20], ndc), dot(program_local[21], ndc));  // [pixel_points]
+    vec3 tc = (h_p.xyz / h_p.w + half_size) / size;  // [pixel_points]
+    vec3 p = tc * size - half_size;
+    vec4 v = volume_at(texture0, tc);
     vec4 coord = v * lookup.x + lookup.y;
     vec4 lut = table_at(texture2, vec2(coord.@1));
     vec4 col = program_local[1] * lut;

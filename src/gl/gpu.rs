@@ -126,8 +126,8 @@ pub struct Gpu {
     arb: Option<ArbFns>,
     caps: Caps,
     resources: Rc<RefCell<Vec<Resource>>>,
-    /// [`Gpu::linear_filter_error`], measured on first use.
-    filter_error: Cell<Option<f32>>,
+    /// The filter and interpolation errors ([`super::precision`]), measured on first use.
+    precision: Cell<Option<(f32, f32)>>,
 }
 
 impl Gpu {
@@ -143,7 +143,7 @@ impl Gpu {
             arb: if caps.has_arb() { arb_fns } else { None },
             caps,
             resources: Rc::default(),
-            filter_error: Cell::new(None),
+            precision: Cell::new(None),
         };
         gl_check!(gpu)?;
         Ok(gpu)
@@ -168,9 +168,9 @@ impl Gpu {
         &self.caps
     }
 
-    /// [`super::filter_probe`]'s measurement, once made (`Gpu::linear_filter_error`).
-    pub(super) fn filter_error_cache(&self) -> &Cell<Option<f32>> {
-        &self.filter_error
+    /// [`super::precision`]'s measurements, once made.
+    pub(super) fn precision_cache(&self) -> &Cell<Option<(f32, f32)>> {
+        &self.precision
     }
 
     /// How many resources the log holds, and dropping those after the first `n` (for a

@@ -8,11 +8,11 @@
 mod arb;
 mod draw;
 mod error;
-mod filter_probe;
 mod gpu;
 mod headless;
 mod mesh;
 pub mod position;
+mod precision;
 mod program;
 mod state;
 mod target;
@@ -22,10 +22,10 @@ pub mod window;
 
 pub use draw::{draw, draw_counted, Blend, DrawCall, Primitive};
 pub use error::{error_name, CompileError, GlError, GlResult};
-pub use filter_probe::EXACT_FILTER;
 pub use gpu::{renderer_is_software, ArbLimits, Caps, Gpu, Resource};
 pub use headless::{Backend, Headless, OSMESA_LIBRARIES};
 pub use mesh::Mesh;
+pub use precision::{EXACT_FILTER, EXACT_INTERPOLATION};
 pub use program::{Program, ProgramChoice, ProgramKind, ProgramText, MAX_LOCALS, MAX_UNITS};
 pub use state::{SavedState, StateGuard};
 pub use target::{clear, read_window, Surface, Target, TargetFormat};

@@ -32,6 +32,17 @@ pub enum Surface<'a> {
     Window([i32; 4]),
 }
 
+impl Surface<'_> {
+    /// Where draws land in window coordinates, `[x, y, width, height]`: the whole target,
+    /// or the window's viewport (what maps `gl_FragCoord` back to NDC).
+    pub fn rect(&self) -> [f64; 4] {
+        match *self {
+            Surface::Target(t) => [0.0, 0.0, t.width() as f64, t.height() as f64],
+            Surface::Window(v) => v.map(f64::from),
+        }
+    }
+}
+
 /// Clear `surface` (only its viewport, for a window) to `rgba`.
 pub fn clear(gpu: &Gpu, surface: Surface<'_>, rgba: [f32; 4]) -> GlResult<()> {
     let _guard = StateGuard::save(gpu);

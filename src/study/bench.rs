@@ -473,13 +473,7 @@ pub fn run(
                         (TechniqueScene::Opacity3d(p), Some(prepared)) => {
                             Box::new(Opacity3dRenderer::from_prepared(
                                 gpu,
-                                resolve_kind(
-                                    p,
-                                    s.fidelity,
-                                    s.programs,
-                                    kind,
-                                    gpu.filters_exactly()?,
-                                ),
+                                resolve_kind(gpu, p, s.fidelity, s.programs, kind)?,
                                 s.fidelity,
                                 p,
                                 &s.base,

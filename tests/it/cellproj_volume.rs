@@ -69,6 +69,7 @@ pub(crate) fn scene(mode: Mode, volume: VolumeSpec, isovalues: Vec<Isovalue>) ->
         active_only: true,
         order: Default::default(),
         depth: Default::default(),
+        interpolation: Default::default(),
     }
 }
 

@@ -94,6 +94,7 @@ fn info_reports_arb_support_and_limits() {
         "temporaries:",
         "texture indirections:",
         "linear filtering:",
+        "interpolation:",
     ] {
         assert!(stdout.contains(field), "missing {field}:\n{stdout}");
     }
@@ -106,8 +107,13 @@ fn info_reports_arb_support_and_limits() {
             "{stdout}"
         );
         assert!(stdout.contains("software renderer:       yes"), "{stdout}");
-        // llvmpipe interpolates in f32: the probe's 64 fetches are exact to rounding.
+        // llvmpipe filters in f32 and interpolates from the true vertices: the probes
+        // find both exact to rounding.
         assert!(stdout.contains("linear filtering:        f32"), "{stdout}");
+        assert!(
+            stdout.contains("interpolation:           from the true vertices"),
+            "{stdout}"
+        );
     }
     let json = arbvis(&["info", "--json", "--backend", "osmesa"]);
     let (j, _) = text(&json);
@@ -119,6 +125,7 @@ fn info_reports_arb_support_and_limits() {
     assert!(v["fragment_limits"]["native_tex_indirections"].is_number());
     assert!(v["vertex_limits"]["native_instructions"].is_number());
     assert!(v["linear_filter_error"].is_number(), "{j}");
+    assert!(v["interpolation_error"].is_number(), "{j}");
 }
 
 #[test]

@@ -116,7 +116,7 @@ fn arb_and_glsl_agree_with_a_clip() {
             let clip = format!("shape = {CARVED}\nmultires = {multires}\nblock = 4");
             let units = |programs: &str| {
                 let mut s = with(fidelity, programs, None, &clip);
-                params_mut(&mut s).interpolation = Interpolation::TextureUnit;
+                params_mut(&mut s).interpolation = Interpolation::Hardware;
                 s
             };
             let arb = render_on(&h, &units("arb")).unwrap();

@@ -228,6 +228,11 @@ pub struct CellprojScene {
     /// Depth written by the precise programs.
     #[serde(default)]
     pub depth: Depth,
+    /// Precise isosurfaces: whether each fragment's entry is the interpolated position
+    /// (`hardware`) or where the pixel's own ray meets the face (`shader`; `auto`: where
+    /// the rasterizer interpolates from snapped vertices).
+    #[serde(default)]
+    pub interpolation: crate::vocab::Interpolation,
 }
 
 impl crate::techniques::TechniqueParams for CellprojScene {

@@ -15,7 +15,7 @@ use crate::gl::{
 use crate::programs::{self, ProgramPair};
 
 use crate::techniques::{Frame, Params, Renderer};
-use crate::vocab::Fidelity;
+use crate::vocab::{Fidelity, Interpolation};
 
 /// Texture unit of the table (faithful) or isovalue list (precise).
 pub const TABLE_UNIT: u32 = 0;
@@ -108,7 +108,7 @@ pub struct CellprojRenderer {
     built_for: Option<Viewer>,
     ranges: Vec<[f64; 2]>,
     table: Texture,
-    program: Option<(Variant, Depth, Program)>,
+    program: Option<(Variant, Depth, bool, Program)>,
     /// The volume (`mode = "volume"` or `"both"`).
     volume: Option<super::volume::VolumeRenderer>,
     /// Where the scene's files are read from (colour tables).
@@ -315,17 +315,27 @@ impl CellprojRenderer {
     /// compiles the other one once).
     fn program(&mut self, gpu: &Gpu, variant: Variant) -> GlResult<&Program> {
         let depth = self.params.depth;
-        if self.program.as_ref().map(|(v, d, _)| (*v, *d)) != Some((variant, depth)) {
+        let pixel_rays = variant == Variant::Precise
+            && match self.params.interpolation {
+                Interpolation::Auto => !gpu.interpolates_exactly()?,
+                Interpolation::Hardware => false,
+                Interpolation::Shader => true,
+            };
+        let key = Some((variant, depth, pixel_rays));
+        if self.program.as_ref().map(|(v, d, r, _)| (*v, *d, *r)) != key {
             let pair = program_pair(variant, self.kind)?;
-            let fragment = if variant == Variant::Precise && depth == Depth::Entry {
+            let mut fragment = if variant == Variant::Precise && depth == Depth::Entry {
                 entry_depth_fragment(&pair.fragment)
             } else {
                 pair.fragment
             };
+            if pixel_rays {
+                fragment = fragment.with_define("PIXEL_RAYS");
+            }
             let program = Program::new(gpu, pair.kind, &pair.vertex, &fragment)?;
-            self.program = Some((variant, depth, program));
+            self.program = Some((variant, depth, pixel_rays, program));
         }
-        Ok(&self.program.as_ref().expect("set above").2)
+        Ok(&self.program.as_ref().expect("set above").3)
     }
 }
 
@@ -364,13 +374,28 @@ impl Renderer for CellprojRenderer {
                 program.set_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
                 let on = if shading { 1.0 } else { 0.0 };
                 program.set_local(gpu, 6, [count, on, AMBIENT, 0.0])?;
+                // Each pixel's own ray: the inverse transform and window position to NDC.
+                let inv = mvp.inverse().transpose();
+                for (i, row) in [inv.x_axis, inv.y_axis, inv.z_axis, inv.w_axis]
+                    .iter()
+                    .enumerate()
+                {
+                    program.set_local(gpu, 7 + i, row.to_array())?;
+                }
+                let [x, y, w, h] = surface.rect();
+                let (w, h) = (w.max(1.0), h.max(1.0));
+                program.set_local(
+                    gpu,
+                    11,
+                    [2.0 / w, 2.0 / h, -1.0 - 2.0 * x / w, -1.0 - 2.0 * y / h],
+                )?;
             }
         }
         if self.params.isovalues.is_empty() {
             return self.draw_volume(gpu, surface, frame);
         }
         self.build_view(gpu, frame)?;
-        let program = &self.program.as_ref().expect("compiled above").2;
+        let program = &self.program.as_ref().expect("compiled above").3;
         gl::draw(
             gpu,
             surface,

@@ -94,6 +94,7 @@ fn scene_for(points: usize, exit: Exit, active_only: bool) -> CellprojScene {
         active_only,
         order: Default::default(),
         depth: Default::default(),
+        interpolation: Default::default(),
     }
 }
 

@@ -65,6 +65,7 @@ use serde::{Deserialize, Serialize};
 use crate::colortable::TableSpec;
 use crate::gl::Filter;
 use crate::techniques::clip::ClipSpec;
+pub use crate::vocab::Interpolation;
 use crate::vocab::{Fidelity, FieldError};
 use crate::volume::attributes::Attribute;
 use crate::volume::quantize::Quantization;
@@ -108,22 +109,6 @@ fn unit_coefficients() -> [f64; 4] {
     [1.0; 4]
 }
 
-/// Where precise mode interpolates its linearly filtered textures. GL leaves the precision
-/// of `GL_LINEAR` to the driver: llvmpipe's is f32, NVIDIA's texture units keep 8-bit
-/// weights (up to 1e-2 off after a steep table).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Interpolation {
-    /// In the shader where the driver's texture units interpolate coarsely (measured
-    /// once per context), else in the units.
-    #[default]
-    Auto,
-    /// The texture units, whatever their precision (fastest).
-    TextureUnit,
-    /// The shader (`texelFetch` and f32 `mix`; GLSL programs).
-    Shader,
-}
-
 /// `[technique.opacity3d]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -140,7 +125,7 @@ pub struct Opacity3dScene {
     /// Filtering of the colour tables.
     #[serde(default = "linear")]
     pub table_filter: Filter,
-    /// Precise mode: where the linear filtering of the volume and tables is computed.
+    /// Precise mode: where texture filtering and sample positions are computed.
     #[serde(default)]
     pub interpolation: Interpolation,
     /// Opacity correction; by default on when precise, off when faithful (which has none).

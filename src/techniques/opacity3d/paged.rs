@@ -33,7 +33,7 @@
 
 use glam::DVec3;
 
-use super::programs::{raycast_pair, ShaderFilter, Variant};
+use super::programs::{raycast_pair, InShader, Variant};
 use super::renderer::{eye, far_faces, toward_viewer};
 use super::{corrected, Combine, Opacity3dScene};
 use crate::camera::Projection;
@@ -111,7 +111,7 @@ pub struct PagedPass {
     projection: Projection,
     combine: Combine,
     present: [bool; 3],
-    filter: ShaderFilter,
+    filter: InShader,
     mesh: Option<Mesh>,
     table: Option<(Texture, [usize; 3])>,
 }
@@ -121,7 +121,7 @@ fn program(
     combine: Combine,
     present: [bool; 3],
     projection: Projection,
-    filter: ShaderFilter,
+    filter: InShader,
 ) -> GlResult<Program> {
     let pair = raycast_pair(Variant {
         combine,
@@ -142,7 +142,7 @@ impl PagedPass {
     pub fn new(gpu: &Gpu, params: &Opacity3dScene) -> GlResult<PagedPass> {
         let present = params.attributes().map(|a| a.is_some());
         let projection = Projection::Orthographic;
-        let filter = ShaderFilter::for_scene(params, gpu.filters_exactly()?);
+        let filter = super::renderer::shader_filter(gpu, params, crate::vocab::Fidelity::Precise)?;
         Ok(PagedPass {
             program: program(gpu, params.combine, present, projection, filter)?,
             projection,
@@ -157,7 +157,7 @@ impl PagedPass {
     /// The program, rebuilt when the combination changed.
     pub fn program_for(&mut self, gpu: &Gpu, params: &Opacity3dScene) -> GlResult<&Program> {
         let present = params.attributes().map(|a| a.is_some());
-        let filter = ShaderFilter::for_scene(params, gpu.filters_exactly()?);
+        let filter = super::renderer::shader_filter(gpu, params, crate::vocab::Fidelity::Precise)?;
         if params.combine != self.combine || present != self.present || filter != self.filter {
             self.combine = params.combine;
             self.present = present;

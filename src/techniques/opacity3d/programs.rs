@@ -45,15 +45,17 @@ pub struct Variant {
     /// Ray caster only: a store's bricks through the page table (point sampling, no
     /// jitter; the atlas holds v3o2's packing, G primary, B secondary, R tertiary).
     pub paged: bool,
-    /// Which linear reads interpolate in the shader (GLSL only).
-    pub filter: ShaderFilter,
+    /// What the program computes itself instead of the hardware.
+    pub filter: InShader,
 }
 
-/// Which of a precise program's linearly filtered textures it interpolates itself
-/// (`texelFetch` and f32 `mix`, `programs/common/sampling.glsl`) instead of the texture
-/// unit: where the driver's units keep coarse weights ([`crate::gl::Gpu::filters_exactly`]).
+/// What a precise program computes itself instead of the hardware: linear reads of its
+/// filtered textures (`texelFetch` and f32 `mix`, `programs/common/sampling.glsl`) where
+/// the texture units keep coarse weights ([`crate::gl::Gpu::filters_exactly`]), and its
+/// slices' sample points from each pixel's centre where the rasterizer interpolates from
+/// snapped vertices ([`crate::gl::Gpu::interpolates_exactly`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct ShaderFilter {
+pub struct InShader {
     /// The attribute volume (or a store's brick atlas).
     pub volume: bool,
     /// The colour tables.
@@ -62,29 +64,34 @@ pub struct ShaderFilter {
     pub steps: bool,
     /// A clip's values (always linear; the GLSL clip test only).
     pub clip: bool,
+    /// Slicing: each sample is the pixel's centre unprojected at its slice's depth, not
+    /// the interpolated texture coordinate. (The ray caster always unprojects: one ray a
+    /// pixel costs nothing beside its steps.)
+    pub points: bool,
 }
 
-impl ShaderFilter {
-    /// What `params` interpolates in the shader on a driver whose units filter exactly
-    /// (`units_exact`) or not: its linear textures, where `interpolation` says or `auto`
-    /// finds the units coarse.
-    pub fn for_scene(params: &Opacity3dScene, units_exact: bool) -> ShaderFilter {
-        let shader = match params.interpolation {
-            Interpolation::Auto => !units_exact,
-            Interpolation::TextureUnit => false,
-            Interpolation::Shader => true,
+impl InShader {
+    /// What `params` computes in the shader on a driver whose texture units filter
+    /// exactly (`units_exact`) or not and whose rasterizer interpolates from the true
+    /// vertices (`interpolation_exact`) or not: as `interpolation` says, or, under `auto`,
+    /// what the driver does coarsely.
+    pub fn for_scene(
+        params: &Opacity3dScene,
+        units_exact: bool,
+        interpolation_exact: bool,
+    ) -> InShader {
+        let (filters, points) = match params.interpolation {
+            Interpolation::Auto => (!units_exact, !interpolation_exact),
+            Interpolation::Hardware => (false, false),
+            Interpolation::Shader => (true, true),
         };
-        ShaderFilter {
-            volume: shader && params.volume_filter == Filter::Linear,
-            tables: shader && params.table_filter == Filter::Linear,
-            steps: shader,
-            clip: shader,
+        InShader {
+            volume: filters && params.volume_filter == Filter::Linear,
+            tables: filters && params.table_filter == Filter::Linear,
+            steps: filters,
+            clip: filters,
+            points,
         }
-    }
-
-    /// Whether any read interpolates in the shader (such a program is GLSL).
-    pub fn any(&self) -> bool {
-        self.volume || self.tables || self.steps || self.clip
     }
 }
 
@@ -124,6 +131,7 @@ impl Variant {
             (self.filter.volume, "exact_volume"),
             (self.filter.tables, "exact_tables"),
             (self.filter.steps, "exact_steps"),
+            (self.filter.points, "pixel_points"),
         ] {
             if on {
                 tags.push(tag);
@@ -254,15 +262,16 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
                         jitter,
                         baked,
                         paged: false,
-                        filter: ShaderFilter::default(),
+                        filter: InShader::default(),
                     };
                     // The GLSL programs also with every linear read in the shader.
                     let exact = Variant {
-                        filter: ShaderFilter {
+                        filter: InShader {
                             volume: true,
                             tables: true,
                             steps: true,
                             clip: true,
+                            points: true,
                         },
                         ..v
                     };
@@ -324,7 +333,7 @@ mod tests {
             jitter: false,
             baked: false,
             paged: false,
-            filter: ShaderFilter::default(),
+            filter: InShader::default(),
         }
     }
 

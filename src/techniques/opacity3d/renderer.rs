@@ -19,7 +19,7 @@ use super::bricks::Bricks;
 use super::clipping::{self, Clip};
 use super::prepare::{prepare, Prepared};
 pub use super::programs::faithful_pair;
-use super::programs::{raycast_pair, slicing_pair, ShaderFilter, Variant};
+use super::programs::{raycast_pair, slicing_pair, InShader, Variant};
 use super::slicing::slice_box;
 pub use super::{coefficients, corrected, path, preintegrated, Path3d};
 use super::{Combine, Opacity3dScene};
@@ -89,36 +89,33 @@ pub fn step_table(params: &Opacity3dScene, fidelity: Fidelity, prepared: &Prepar
 
 /// The program kind a scene draws with: the ray caster is GLSL only, so `auto` gives GLSL
 /// there; an explicit `arb` stays (and the renderer says why it cannot). A precise clipped
-/// scene on a driver whose texture units filter coarsely (`units_exact` false) also gets
-/// GLSL under `auto`: only the GLSL clip test interpolates its values in the shader.
+/// scene on a driver whose texture units filter coarsely also gets GLSL under `auto`: only
+/// the GLSL clip test interpolates its values in the shader.
 pub fn resolve_kind(
+    gpu: &Gpu,
     params: &Opacity3dScene,
     fidelity: Fidelity,
     programs: ProgramChoice,
     kind: ProgramKind,
-    units_exact: bool,
-) -> ProgramKind {
-    let exact_clip = fidelity == Fidelity::Precise
-        && params.clip.is_some()
-        && ShaderFilter::for_scene(params, units_exact).clip;
-    if programs == ProgramChoice::Auto && (path(params, fidelity) == Path3d::Raycast || exact_clip)
-    {
-        ProgramKind::Glsl
-    } else {
-        kind
+) -> GlResult<ProgramKind> {
+    if programs != ProgramChoice::Auto {
+        return Ok(kind);
     }
+    let glsl = path(params, fidelity) == Path3d::Raycast
+        || (fidelity == Fidelity::Precise
+            && params.clip.is_some()
+            && shader_filter(gpu, params, fidelity)?.clip);
+    Ok(if glsl { ProgramKind::Glsl } else { kind })
 }
 
-/// Which linear reads a precise program makes itself on `gpu` (none when faithful: the
-/// era's texture units, whatever their precision).
-pub fn shader_filter(
-    gpu: &Gpu,
-    params: &Opacity3dScene,
-    fidelity: Fidelity,
-) -> GlResult<ShaderFilter> {
+/// What a precise program computes itself on `gpu` (nothing when faithful: the era's
+/// texture units and rasterizer, whatever their precision).
+pub fn shader_filter(gpu: &Gpu, params: &Opacity3dScene, fidelity: Fidelity) -> GlResult<InShader> {
     Ok(match fidelity {
-        Fidelity::Faithful => ShaderFilter::default(),
-        Fidelity::Precise => ShaderFilter::for_scene(params, gpu.filters_exactly()?),
+        Fidelity::Faithful => InShader::default(),
+        Fidelity::Precise => {
+            InShader::for_scene(params, gpu.filters_exactly()?, gpu.interpolates_exactly()?)
+        }
     })
 }
 
@@ -162,10 +159,7 @@ pub fn send_pixel_rays(
     surface: Surface<'_>,
     frame: &Frame,
 ) -> GlResult<()> {
-    let [x, y, w, h] = match surface {
-        Surface::Window([x, y, w, h]) => [x, y, w, h].map(f64::from),
-        Surface::Target(t) => [0.0, 0.0, t.width() as f64, t.height() as f64],
-    };
+    let [x, y, w, h] = surface.rect();
     let (w, h) = (w.max(1.0), h.max(1.0));
     program.set_local(gpu, 16, [2.0 / w, 2.0 / h, 2.0, 0.0])?;
     program.set_local(gpu, 17, [-1.0 - 2.0 * x / w, -1.0 - 2.0 * y / h, -1.0, 1.0])?;
@@ -257,7 +251,7 @@ pub fn far_faces(half: DVec3) -> Vec<f32> {
 pub struct Opacity3dRenderer {
     kind: ProgramKind,
     /// The linear reads the precise programs make themselves.
-    filter: ShaderFilter,
+    filter: InShader,
     fidelity: Fidelity,
     base: PathBuf,
     params: Opacity3dScene,
