@@ -81,6 +81,9 @@ void main() {
     vec3 back3 = (half_size + q) / max(abs(dir), vec3(1e-20));
     float chord = min(min(back3.x, back3.y), back3.z);
     chord = min(chord, length(p_exit - program_local[8].xyz));  // [perspective]
+    // A pixel the rasterizer covers whose own ray misses the box (its silhouette, where
+    // vertices snap) has nothing to draw.
+    if (!(chord > 0.0)) discard;
     float stop = program_local[9].w;
     vec4 acc = vec4(0.0);
     int steps = max(1, int(ceil(chord / correction.y - 1e-4)));  // [!preint !jitter]

@@ -19,12 +19,21 @@ void main() {
     vec3 axis = program_local[9].xyz;
     // The sample: the interpolated texture coordinate, or (pixel_points: a rasterizer that
     // interpolates from vertices snapped to its sub-pixel grid moves it by up to 1/512
-    // pixel) the pixel's centre unprojected at the slice's depth, constant on a
-    // view-aligned slice.
+    // pixel) where the pixel's own ray meets the slice's plane (the interpolated point's,
+    // normal to the view direction or axis): the ray from the pixel's centre unprojected
+    // onto the near and far planes (locals 16, 17: window position to NDC; 18..21: the
+    // inverse view-projection's rows).
     vec3 tc = v_texcoord0.xyz;  // [!pixel_points]
-    vec4 ndc = vec4(gl_FragCoord.xyz, 1.0) * program_local[16] + program_local[17];  // [pixel_points]
-    vec4 h_p = vec4(dot(program_local[18], ndc), dot(program_local[19], ndc), dot(program_local[20], ndc), dot(program_local[21], ndc));  // [pixel_points]
-    vec3 tc = (h_p.xyz / h_p.w + half_size) / size;  // [pixel_points]
+    vec2 ndc = gl_FragCoord.xy * program_local[16].xy + program_local[17].xy;  // [pixel_points]
+    mat4 inv = transpose(mat4(program_local[18], program_local[19], program_local[20], program_local[21]));  // [pixel_points]
+    vec4 ray_near = inv * vec4(ndc, -1.0, 1.0);  // [pixel_points]
+    vec4 ray_far = inv * vec4(ndc, 1.0, 1.0);  // [pixel_points]
+    vec3 o = ray_near.xyz / ray_near.w;  // [pixel_points]
+    vec3 d = ray_far.xyz / ray_far.w - o;  // [pixel_points]
+    vec3 n = d;  // [pixel_points orthographic]
+    vec3 n = axis;  // [pixel_points perspective]
+    vec3 on_slice = v_texcoord0.xyz * size - half_size;  // [pixel_points]
+    vec3 tc = (o + d * (dot(on_slice - o, n) / dot(d, n)) + half_size) / size;  // [pixel_points]
     vec3 p = tc * size - half_size;
     vec4 v = volume_at(texture0, tc);
     vec4 coord = v * lookup.x + lookup.y;

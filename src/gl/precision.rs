@@ -5,15 +5,18 @@
 //! - **Linear filtering.** llvmpipe interpolates in f32; NVIDIA's texture units (as CUDA's
 //!   guide says of the same hardware) keep the weights in fixed point with 8 fractional
 //!   bits, so a linear fetch can be off by up to half a 256th of the difference between
-//!   neighbouring texels: 1e-3 to 1e-2 after a steep colour table. Probe: 64 fetches
-//!   between two texels (0 and 1, 16-bit unorm as the precise volumes) at fractions exact
-//!   in f32 and not multiples of 1/256; the largest difference from the fraction.
+//!   neighbouring texels: 1e-3 to 1e-2 after a steep colour table. Probe: 256 fetches
+//!   between two texels (0 and 1, 16-bit unorm as the precise volumes) at fractions that
+//!   use the whole f32 mantissa, so weights of any fixed-point width are seen; the largest
+//!   difference from the fraction.
 //! - **Attribute interpolation.** A rasterizer that snaps vertices to its sub-pixel grid
 //!   and interpolates from the snapped positions (NVIDIA: 1/256 pixel) moves an
 //!   interpolated coordinate by up to 1/512 pixel from where the pixel's centre lies on the
 //!   true triangle; llvmpipe interpolates from the unsnapped positions. Probe: one
 //!   triangle with corners off that grid over a 64 x 4 target, carrying its own NDC
 //!   position; the largest difference, in pixels, from the pixel centre's.
+//!
+//! A result that is not a number counts as coarse.
 //!
 //! Each is measured once per context, on first use. Precise programs interpolate textures
 //! in the shader where the filter is coarse, and take their samples from the pixel's own
@@ -29,7 +32,8 @@ use super::texture::{Extent, Filter, TexelData, TexelFormat, Texture};
 use crate::vocab::TargetFormat;
 
 /// The largest filter error taken as f32 interpolation: an f32 lerp between 0 and 1 is
-/// within 6e-8; 8-bit weights are off by at least 1.8e-3 at the probe's fractions.
+/// within 6e-8; 8-bit weights are off by up to 2e-3 (1.8e-3 measured), 13-bit ones by up
+/// to 6e-5.
 pub const EXACT_FILTER: f32 = 1e-5;
 
 /// The largest attribute interpolation error, in pixels, taken as interpolation from the
@@ -43,19 +47,19 @@ const VERTEX: ProgramText = ProgramText::embedded(
      void main() { gl_Position = position; v_ndc = position.xy; }\n",
 );
 
-// Filter: fraction f = (k + 47/128) / 64 for pixel k: exact in f32, 1.47/256 past a
-// multiple of 1/256 (whether a unit rounds or truncates its weights, it is seen). The
-// texture coordinate (0.5 + f) / 2 puts texel space at 0.5 + f, so the exact fetch is f.
-// Interpolation: the pixel centre's NDC from gl_FragCoord against the interpolated one,
-// in pixels (the target is 64 x 4).
+// Filter: for pixel (x, y), u = 0.5 + fract(k * 0.618034 + 0.1234567) with k = x + 64 y,
+// a fraction using the whole f32 mantissa; texture coordinate u / 2 puts texel space at
+// u, so the exact fetch is u - 0.5 (exact in f32). Interpolation: the pixel centre's NDC
+// from gl_FragCoord against the interpolated one, in pixels (the target is 64 x 4).
 const FRAGMENT: ProgramText = ProgramText::embedded(
     "gl/precision_probe.frag",
     "#version 330\nuniform sampler2D texture0;\nin vec2 v_ndc;\nout vec4 frag_color;\n\
      void main() {\n    \
-     float f = (floor(gl_FragCoord.x) + 0.3671875) / 64.0;\n    \
+     float k = floor(gl_FragCoord.x) + 64.0 * floor(gl_FragCoord.y);\n    \
+     float u = 0.5 + fract(k * 0.618034 + 0.1234567);\n    \
      vec2 size = vec2(64.0, 4.0);\n    \
      vec2 off = (v_ndc - (gl_FragCoord.xy * 2.0 / size - 1.0)) * size * 0.5;\n    \
-     frag_color = vec4(texture(texture0, vec2((0.5 + f) / 2.0, 0.5)).r, f, off);\n}\n",
+     frag_color = vec4(texture(texture0, vec2(u / 2.0, 0.5)).r, u - 0.5, off);\n}\n",
 );
 
 /// The probe's triangle (NDC): corners well outside the target, none on a 1/256-pixel
@@ -91,10 +95,12 @@ fn measure(gpu: &Gpu) -> GlResult<(f32, f32)> {
     };
     draw(gpu, Surface::Target(&target), &call)?;
     let image = target.read(gpu)?;
+    // `max` would drop a NaN: anything not a number is infinitely coarse.
+    let worst = |a: f32, b: f32| if b.is_nan() { f32::INFINITY } else { a.max(b) };
     let (mut filter, mut interpolation) = (0f32, 0f32);
     for p in image.data.chunks_exact(4) {
-        filter = filter.max((p[0] - p[1]).abs());
-        interpolation = interpolation.max(p[2].abs()).max(p[3].abs());
+        filter = worst(filter, (p[0] - p[1]).abs());
+        interpolation = worst(worst(interpolation, p[2].abs()), p[3].abs());
     }
     Ok((filter, interpolation))
 }

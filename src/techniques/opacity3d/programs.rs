@@ -275,10 +275,20 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
                         },
                         ..v
                     };
+                    // Slicing with the volume alone in the shader (nearest tables).
+                    let volume_only = Variant {
+                        filter: InShader {
+                            volume: true,
+                            ..InShader::default()
+                        },
+                        ..v
+                    };
                     if !(skip || preint || jitter) {
-                        pairs.push(slicing_pair(ProgramKind::Arb, v));
-                        pairs.push(slicing_pair(ProgramKind::Glsl, v));
-                        pairs.push(slicing_pair(ProgramKind::Glsl, exact));
+                        for kind in [ProgramKind::Arb, ProgramKind::Glsl] {
+                            for variant in [v, exact, volume_only] {
+                                pairs.push(slicing_pair(kind, variant));
+                            }
+                        }
                     }
                     // Pre-integration and the baked table are for one attribute.
                     if !(preint || baked) || present == [true, false, false] {

@@ -21,6 +21,7 @@ use super::prepare::{prepare, Prepared};
 pub use super::programs::faithful_pair;
 use super::programs::{raycast_pair, slicing_pair, InShader, Variant};
 use super::slicing::slice_box;
+use super::Interpolation;
 pub use super::{coefficients, corrected, path, preintegrated, Path3d};
 use super::{Combine, Opacity3dScene};
 use crate::camera::Projection;
@@ -113,6 +114,10 @@ pub fn resolve_kind(
 pub fn shader_filter(gpu: &Gpu, params: &Opacity3dScene, fidelity: Fidelity) -> GlResult<InShader> {
     Ok(match fidelity {
         Fidelity::Faithful => InShader::default(),
+        // The probes only where `auto` asks them.
+        Fidelity::Precise if params.interpolation != Interpolation::Auto => {
+            InShader::for_scene(params, true, true)
+        }
         Fidelity::Precise => {
             InShader::for_scene(params, gpu.filters_exactly()?, gpu.interpolates_exactly()?)
         }
@@ -250,8 +255,11 @@ pub fn far_faces(half: DVec3) -> Vec<f32> {
 /// The 3D-opacity renderer.
 pub struct Opacity3dRenderer {
     kind: ProgramKind,
-    /// The linear reads the precise programs make themselves.
+    /// What the precise programs compute themselves (the textures are made for it).
     filter: InShader,
+    /// What `program` was built to compute itself (an update that fails half-way can leave
+    /// it behind `filter`; the next one rebuilds it).
+    program_filter: InShader,
     fidelity: Fidelity,
     base: PathBuf,
     params: Opacity3dScene,
@@ -365,6 +373,7 @@ impl Opacity3dRenderer {
         let mut renderer = Opacity3dRenderer {
             kind,
             filter,
+            program_filter: filter,
             fidelity,
             base: base.to_path_buf(),
             params: params.clone(),
@@ -816,8 +825,13 @@ impl Renderer for Opacity3dRenderer {
                 (p.table_filter, p.interpolation),
             )
         };
-        if shape(&old) != shape(new) || baked != self.baked || clip_changed {
+        if shape(&old) != shape(new)
+            || baked != self.baked
+            || clip_changed
+            || self.program_filter != self.filter
+        {
             self.baked = baked;
+            self.program_filter = self.filter;
             self.program = make_program(
                 gpu,
                 self.kind,
