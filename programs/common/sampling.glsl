@@ -6,13 +6,20 @@
 // Tags exact_volume, exact_tables, exact_steps: that texture's reads interpolate here, as
 // GL_LINEAR with CLAMP_TO_EDGE defines it (texel space u = s * size - 0.5, the weights its
 // fraction), from texelFetch and f32 mix; without the tag, the texture unit does.
-vec4 lerp3(sampler3D s, vec3 tc) {
-    ivec3 last = textureSize(s, 0) - 1;
-    vec3 p = tc * vec3(last + 1) - 0.5;
+// Texel space u = tc * size - 0.5: the texels below and above (clamped to the edge, as
+// CLAMP_TO_EDGE) and the weights of the upper ones. 2D and 1D reads pass size 1 and
+// coordinate 0.5 in the unused axes.
+void corners(ivec3 size, vec3 tc, out ivec3 lo, out ivec3 hi, out vec3 f) {
+    vec3 p = tc * vec3(size) - 0.5;
     vec3 b = floor(p);
-    vec3 f = p - b;
-    ivec3 lo = clamp(ivec3(b), ivec3(0), last);
-    ivec3 hi = clamp(ivec3(b) + 1, ivec3(0), last);
+    f = p - b;
+    lo = clamp(ivec3(b), ivec3(0), size - 1);
+    hi = clamp(ivec3(b) + 1, ivec3(0), size - 1);
+}
+vec4 lerp3(sampler3D s, vec3 tc) {
+    ivec3 lo, hi;
+    vec3 f;
+    corners(textureSize(s, 0), tc, lo, hi, f);
     vec4 c00 = mix(texelFetch(s, lo, 0), texelFetch(s, ivec3(hi.x, lo.y, lo.z), 0), f.x);
     vec4 c10 = mix(texelFetch(s, ivec3(lo.x, hi.y, lo.z), 0), texelFetch(s, ivec3(hi.x, hi.y, lo.z), 0), f.x);
     vec4 c01 = mix(texelFetch(s, ivec3(lo.x, lo.y, hi.z), 0), texelFetch(s, ivec3(hi.x, lo.y, hi.z), 0), f.x);
@@ -20,23 +27,18 @@ vec4 lerp3(sampler3D s, vec3 tc) {
     return mix(mix(c00, c10, f.y), mix(c01, c11, f.y), f.z);
 }
 vec4 lerp2(sampler2D s, vec2 tc) {
-    ivec2 last = textureSize(s, 0) - 1;
-    vec2 p = tc * vec2(last + 1) - 0.5;
-    vec2 b = floor(p);
-    vec2 f = p - b;
-    ivec2 lo = clamp(ivec2(b), ivec2(0), last);
-    ivec2 hi = clamp(ivec2(b) + 1, ivec2(0), last);
-    vec4 c0 = mix(texelFetch(s, lo, 0), texelFetch(s, ivec2(hi.x, lo.y), 0), f.x);
-    vec4 c1 = mix(texelFetch(s, ivec2(lo.x, hi.y), 0), texelFetch(s, hi, 0), f.x);
+    ivec3 lo, hi;
+    vec3 f;
+    corners(ivec3(textureSize(s, 0), 1), vec3(tc, 0.5), lo, hi, f);
+    vec4 c0 = mix(texelFetch(s, lo.xy, 0), texelFetch(s, ivec2(hi.x, lo.y), 0), f.x);
+    vec4 c1 = mix(texelFetch(s, ivec2(lo.x, hi.y), 0), texelFetch(s, hi.xy, 0), f.x);
     return mix(c0, c1, f.y);
 }
 vec4 lerp1(sampler1D s, float tc) {
-    int last = textureSize(s, 0) - 1;
-    float p = tc * float(last + 1) - 0.5;
-    float b = floor(p);
-    int lo = clamp(int(b), 0, last);
-    int hi = clamp(int(b) + 1, 0, last);
-    return mix(texelFetch(s, lo, 0), texelFetch(s, hi, 0), p - b);
+    ivec3 lo, hi;
+    vec3 f;
+    corners(ivec3(textureSize(s, 0), 1, 1), vec3(tc, 0.5, 0.5), lo, hi, f);
+    return mix(texelFetch(s, lo.x, 0), texelFetch(s, hi.x, 0), f.x);
 }
 vec4 volume_at(sampler3D s, vec3 tc) { return textureLod(s, tc, 0.0); }  // [!exact_volume]
 vec4 volume_at(sampler3D s, vec3 tc) { return lerp3(s, tc); }  // [exact_volume]
