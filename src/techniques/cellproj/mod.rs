@@ -218,8 +218,10 @@ pub struct CellprojScene {
     /// Shade with the gradient as the normal (precise only).
     #[serde(default)]
     pub shading: bool,
-    /// Draw only the tetrahedra whose scalar range holds an isovalue (the others can
-    /// cross nothing); `false` draws every face, as the seed did.
+    /// Draw only the tetrahedra that can add to the picture: for the isosurfaces those
+    /// whose scalar range holds an isovalue (the others can cross nothing), for the
+    /// volume those whose range the transfer function does not map to zero attenuation
+    /// throughout ([`volume::contributing`]); `false` draws every face, as the seed did.
     #[serde(default = "yes")]
     pub active_only: bool,
     /// Face order: the mesh's (view independent) or front to back per view.

@@ -239,18 +239,18 @@ impl CellprojRenderer {
         } else {
             Vec::new()
         };
-        self.volume = Some(
-            super::volume::VolumeRenderer::new(
-                gpu,
-                self.kind,
-                self.fidelity,
-                &spec,
-                transfer,
-                &self.prepared,
-                &isos,
-            )?
-            .with_exit(self.params.exit),
-        );
+        let mut volume = super::volume::VolumeRenderer::new(
+            gpu,
+            self.kind,
+            self.fidelity,
+            &spec,
+            transfer,
+            &self.prepared,
+            &isos,
+        )?
+        .with_exit(self.params.exit);
+        volume.set_active_only(self.params.active_only);
+        self.volume = Some(volume);
         Ok(())
     }
 
@@ -461,6 +461,9 @@ impl Renderer for CellprojRenderer {
         if active_changed || order_changed {
             self.select_active(gpu)?;
         }
+        if let Some(v) = &mut self.volume {
+            v.set_active_only(self.params.active_only);
+        }
         Ok(())
     }
 
@@ -479,8 +482,8 @@ impl Renderer for CellprojRenderer {
         let v = self.volume.as_ref()?;
         let t = v.times();
         Some(format!(
-            "volume: sort {:.1} ms, indices {:.1} ms, {} cycles broken",
-            t.sort_ms, t.upload_ms, t.cycles
+            "volume: {} tetrahedra drawn, sort {:.1} ms, indices {:.1} ms, {} cycles broken",
+            t.drawn, t.sort_ms, t.upload_ms, t.cycles
         ))
     }
 }

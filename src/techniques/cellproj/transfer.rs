@@ -271,6 +271,21 @@ impl Transfer {
         self.at(s)[3] / self.unit
     }
 
+    /// Whether the attenuation is zero everywhere on `[a, b]`: it is piecewise linear and
+    /// never negative, so zero at both ends and at every control point between (both
+    /// values of a repeated one) is zero throughout. A segment whose scalar stays there
+    /// adds nothing (no colour, no opacity).
+    pub fn clear_on(&self, a: f64, b: f64) -> bool {
+        let first = self.s.partition_point(|&x| x < a);
+        self.at(a)[3] == 0.0
+            && self.at(b)[3] == 0.0
+            && self.s[first..]
+                .iter()
+                .zip(&self.rgba[first..])
+                .take_while(|(&x, _)| x <= b)
+                .all(|(_, c)| c[3] == 0.0)
+    }
+
     /// The exact emission-absorption integral over a segment of `length` along which
     /// the scalar runs linearly from `sf` to `sb`: premultiplied colour and opacity. The
     /// segment is cut at every control point it crosses; each piece is exact.
@@ -442,6 +457,51 @@ mod tests {
             s += f(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
         }
         s * h / 3.0
+    }
+
+    /// `clear_on` against the function itself, sampled densely and at every control
+    /// point, on random functions with zero runs, repeated positions and steps.
+    #[test]
+    fn clear_on_agrees_with_the_attenuation_everywhere() {
+        let mut rng = crate::points::section::SplitMix64::new(27);
+        let mut checked = [0usize; 2];
+        for _ in 0..300 {
+            let mut s: Vec<f64> = (0..2 + (rng.next_f64() * 7.0) as usize)
+                .map(|_| (rng.next_f64() * 20.0).floor() / 19.0)
+                .collect();
+            s.sort_by(f64::total_cmp);
+            let rgba = s
+                .iter()
+                .map(|_| {
+                    let a = if rng.next_f64() < 0.6 {
+                        0.0
+                    } else {
+                        rng.next_f64()
+                    };
+                    [rng.next_f64(), rng.next_f64(), rng.next_f64(), a]
+                })
+                .collect();
+            let tf = Transfer { s, rgba, unit: 1.0 };
+            for _ in 0..20 {
+                let (x, y) = (rng.next_f64() * 1.2 - 0.1, rng.next_f64() * 1.2 - 0.1);
+                let (a, b) = (x.min(y), x.max(y));
+                let mut probes: Vec<f64> = (0..=2000)
+                    .map(|i| a + (b - a) * i as f64 / 2000.0)
+                    .collect();
+                probes.extend(tf.s.iter().copied().filter(|&x| x >= a && x <= b));
+                // A repeated position holds two values: just below and just above it.
+                probes.extend(
+                    tf.s.iter()
+                        .flat_map(|&x| [x - 1e-12, x + 1e-12])
+                        .filter(|&x| x >= a && x <= b),
+                );
+                let zero = probes.iter().all(|&x| tf.tau(x) == 0.0);
+                assert_eq!(tf.clear_on(a, b), zero, "{tf:?} on [{a}, {b}]");
+                checked[zero as usize] += 1;
+            }
+        }
+        // Both answers were exercised often enough to mean something.
+        assert!(checked.iter().all(|&n| n > 500), "{checked:?}");
     }
 
     #[test]

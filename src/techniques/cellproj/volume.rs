@@ -12,6 +12,10 @@
 //! instead of 30; the scene's `exit` as for the isosurfaces). No depth test (volume
 //! alone) or the isosurfaces' depth (`mode = "both"`, drawn after them).
 //!
+//! Faithful and both projections leave out the tetrahedra the transfer function keeps
+//! clear ([`contributing`], the scene's `active_only`): their fragments could only blend
+//! zero.
+//!
 //! **Precise `table`**: the same projection (GLSL) with the table in float into a float
 //! target, and the exit guarded (`GUARDED_EXIT`): the nearest plane the ray leaves
 //! through (`D·N > 0`), clamped to `t >= 0`, instead of the seed's smallest positive
@@ -59,6 +63,9 @@ pub struct VolumeTimes {
     pub upload_ms: f64,
     /// Cycles MPVONC broke.
     pub cycles: usize,
+    /// Tetrahedra drawn (faithful and the projections: those that can add to the
+    /// picture, see [`contributing`]; the walk steps through every one).
+    pub drawn: usize,
 }
 
 /// The faithful program pair: the seed's vertex program and `volume.arbfp` (or GLSL
@@ -192,6 +199,13 @@ pub struct VolumeRenderer {
     made_for: Option<VolumeSpec>,
     /// Where faithful computes the exit (the scene's `exit`).
     exit: Exit,
+    /// Each tetrahedron's scalar range `[min, max]`.
+    ranges: Vec<[f64; 2]>,
+    /// Draw only the tetrahedra that can add to the picture (the scene's `active_only`).
+    active_only: bool,
+    /// Per tetrahedron: drawn by the projections ([`contributing`]; all without
+    /// `active_only`).
+    drawn: Vec<bool>,
 }
 
 /// The pre-integrated table: RGBA8 (faithful), or RGBA32F (precise `table`).
@@ -230,6 +244,32 @@ fn table_map(spec: &VolumeSpec, longest: f64) -> [[f64; 4]; 2] {
         [(n - 1.0) / n, (n - 1.0) / n, (m - 1.0) / m / longest, 0.0],
         [0.5 / n, 0.5 / n, 0.5 / m, 0.0],
     ]
+}
+
+/// How far past a texel centre (in texels) a table coordinate may land by rounding: the
+/// f32 map `s (n-1)/n + 1/2n` and the unit's `u n - 1/2` are off by about `n` ulps of 1,
+/// under 1e-4 texel for tables up to 512 wide.
+const MARGIN: f64 = 1e-3;
+
+/// Which tetrahedra can add to the picture: those whose scalar range, widened to every
+/// texel of the pre-integrated table a lookup inside it may read (the two around each
+/// end; [`MARGIN`] for where a coordinate rounds across a texel centre), meets a
+/// non-zero attenuation. The others' segments read only texels of zero colour
+/// and opacity, whose blend leaves the target as it was in 8 bits and in float, so
+/// leaving them out changes no pixel where the exit is right (faithful's exit speckle
+/// can put a segment's back outside its cell's range: that speckle goes with the cell).
+/// The exact projection reads the transfer function itself: the same widening is
+/// conservative for it.
+pub fn contributing(ranges: &[[f64; 2]], transfer: &Transfer, table_side: u32) -> Vec<bool> {
+    let last = (table_side.max(2) - 1) as f64;
+    ranges
+        .par_iter()
+        .map(|&[lo, hi]| {
+            let a = (lo * last - MARGIN).floor().max(0.0) / last;
+            let b = (hi * last + MARGIN).ceil().min(last) / last;
+            !transfer.clear_on(a.min(lo), b.max(hi))
+        })
+        .collect()
 }
 
 /// The most entry layers the precise walk peels: the scene's cap, one for a convex
@@ -365,7 +405,11 @@ impl VolumeRenderer {
             spare: None,
             made_for: None,
             exit: Exit::Auto,
+            ranges: prepared.ranges(),
+            active_only: true,
+            drawn: Vec::new(),
         };
+        r.select_drawn();
         match fidelity {
             Fidelity::Faithful => r.faithful = Some(r.build_faithful(gpu, kind, prepared)?),
             Fidelity::Precise if spec.precise == super::transfer::Precise::Projected => {
@@ -385,6 +429,30 @@ impl VolumeRenderer {
     pub fn with_exit(mut self, exit: Exit) -> VolumeRenderer {
         self.exit = exit;
         self
+    }
+
+    /// Draw only the tetrahedra that can add to the picture (the default), or every one
+    /// as the seed did.
+    pub fn set_active_only(&mut self, active_only: bool) {
+        if active_only != self.active_only {
+            self.active_only = active_only;
+            self.select_drawn();
+        }
+    }
+
+    /// Recompute [`VolumeRenderer::drawn`]'s set for the current transfer function; the
+    /// next faithful draw rebuilds its index buffer when it changed.
+    fn select_drawn(&mut self) {
+        let drawn = match self.active_only {
+            true => contributing(&self.ranges, &self.transfer, self.spec.table_size[0]),
+            false => vec![true; self.ranges.len()],
+        };
+        if drawn != self.drawn {
+            self.drawn = drawn;
+            if let Some(f) = &mut self.faithful {
+                f.built_for = None;
+            }
+        }
     }
 
     fn build_faithful(
@@ -611,6 +679,7 @@ impl VolumeRenderer {
         if let Some(p) = &mut self.precise {
             p.tf = tf_texture(gpu, &self.transfer)?;
         }
+        self.select_drawn();
         Ok(())
     }
 
@@ -648,6 +717,7 @@ impl VolumeRenderer {
         if self.faithful.is_some() {
             self.draw_faithful(gpu, surface, frame, prepared, depth_test)
         } else {
+            self.times.drawn = self.tets;
             self.draw_precise(gpu, surface, frame, prepared)
         }
     }
@@ -678,7 +748,9 @@ impl VolumeRenderer {
         let v = viewer(frame);
         if self.faithful.as_ref().expect("faithful").built_for != Some(v) {
             let t0 = Instant::now();
-            let order = self.order(prepared, v);
+            let mut order = self.order(prepared, v);
+            order.retain(|&t| self.drawn[t as usize]);
+            self.times.drawn = order.len();
             let t1 = Instant::now();
             let indices = front_face_indices(prepared, &order, v);
             let f = self.faithful.as_mut().expect("faithful");
