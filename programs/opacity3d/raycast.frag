@@ -30,7 +30,9 @@
 // 10 = (window size in level-0 voxels, brick side), 11 = (window's first voxel, 0),
 // 12 = (1 / atlas size in texels, 0), 13 = (first page of the table, 0). Every variant:
 // 16, 17 = window position to NDC (scale, offset), 18..21 = the rows of the inverse
-// view-projection (NDC to the box's coordinates).
+// view-projection (NDC to the box's coordinates); point sampling: 22, 23 = the box, in
+// texture coordinates, of the bricks where some sample can have alpha above 0 (the
+// whole volume when not computed): the steps outside it are not taken (margins).
 // Output: premultiplied colour and coverage, blended ONE, ONE_MINUS_SRC_ALPHA.
 in vec4 v_texcoord0;
 uniform sampler3D texture0;
@@ -40,7 +42,7 @@ uniform sampler2D texture4;  // [tertiary]
 uniform sampler3D texture5;  // [skip]
 uniform sampler2D texture6;  // [preint]
 uniform sampler1D texture6;  // [baked]
-uniform vec4 program_local[22];
+uniform vec4 program_local[24];
 uniform sampler3D texture7;  // [paged]
 out vec4 frag_color;
 // @sampling
@@ -58,6 +60,26 @@ vec4 classify(vec3 tc) {
     col = col * (program_local[3] * lut);  // [product tertiary]
     col = col * lookup.z;  // [sum]
     return clamp(col, 0.0, 1.0);
+}
+
+// The steps j0 <= j < j1 of a ray that can lie in the box of locals 22, 23 (samples
+// outside it have alpha 0): `count` steps of length h along tc = entry + along t, step j
+// sampled at t = t0 + (j + 1/2) h, on a chord of length `chord`.
+ivec2 occupied_steps(vec3 entry, vec3 along, float t0, float h, int count, float chord) {
+    vec3 inv = 1.0 / mix(along, vec3(1e-30), equal(along, vec3(0.0)));
+    vec3 ta = (program_local[22].xyz - entry) * inv;
+    vec3 tb = (program_local[23].xyz - entry) * inv;
+    vec3 near = min(ta, tb);
+    vec3 far = max(ta, tb);
+    float t_in = max(max(near.x, near.y), near.z);
+    float t_out = min(min(far.x, far.y), far.z);
+    if (!(t_in <= t_out)) return ivec2(0);
+    t_in = clamp(t_in, 0.0, chord);
+    t_out = clamp(t_out, 0.0, chord);
+    // A step more each way than the box needs: rounding never drops a sample inside it.
+    int j0 = max(int(floor((t_in - t0) / h - 0.5)) - 1, 0);
+    int j1 = min(int(ceil((t_out - t0) / h - 0.5)) + 2, count);
+    return ivec2(j0, max(j0, j1));
 }
 
 void main() {
@@ -127,9 +149,10 @@ void main() {
         float a = 1.0 - pow(1.0 - col.a, k * float(m));  // [paged]
         acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [paged]
     }  // [paged]
-    int j = 0;  // [!preint !jitter !paged]
-    while (j < steps && acc.a < stop) {  // [!preint !jitter !paged]
-        int end = steps;  // [!preint !jitter !paged]
+    ivec2 range = occupied_steps(start - 0.5 * delta, dir / size, 0.0, h, steps, chord);  // [!preint !jitter !paged]
+    int j = range.x;  // [!preint !jitter !paged]
+    while (j < range.y && acc.a < stop) {  // [!preint !jitter !paged]
+        int end = range.y;  // [!preint !jitter !paged]
         vec3 cell = floor((start + delta * float(j)) * bricks);  // [skip]
         // First sample past this brick along each axis (a little early is harmless).
         vec3 lo = cell / bricks;  // [skip]
@@ -137,7 +160,7 @@ void main() {
         vec3 bound = (mix(lo, hi, greaterThan(delta, vec3(0.0))) - start) / safe;  // [skip]
         bound = mix(bound, vec3(1e30), equal(delta, vec3(0.0)));  // [skip]
         float first = ceil(min(min(bound.x, bound.y), bound.z) - 1e-3);  // [skip]
-        end = int(clamp(first, float(j + 1), float(steps)));  // [skip]
+        end = int(clamp(first, float(j + 1), float(range.y)));  // [skip]
         bool empty = texelFetch(texture5, clamp(ivec3(cell), ivec3(0), last), 0).r == 0.0;  // [skip]
         if (empty) { j = end; continue; }  // [skip]
         for (; j < end && acc.a < stop; j++) {  // [!preint !jitter !paged]
@@ -162,22 +185,23 @@ void main() {
     int full = int(max(floor((chord - first) / h + 1e-4), 0.0));  // [jitter]
     vec3 start = entry + along * (first + 0.5 * h);  // [jitter]
     vec3 delta = along * h;  // [jitter]
+    ivec2 range = occupied_steps(entry, along, first, h, full, chord);  // [jitter]
     float k = h * correction.x + correction.z;  // [jitter !baked]
-    for (int j = 0; j < full && acc.a < stop; j++) {  // [jitter !baked]
+    for (int j = range.x; j < range.y && acc.a < stop; j++) {  // [jitter !baked]
         vec4 col = classify(start + delta * float(j));  // [jitter !baked]
         float a = 1.0 - pow(1.0 - col.a, k);  // [jitter !baked]
         acc += (1.0 - acc.a) * vec4(col.rgb * a, a);  // [jitter !baked]
     }  // [jitter !baked]
     // Two steps a turn: half the termination tests.
-    int j = 0;  // [baked]
-    for (; j + 1 < full && acc.a < stop; j += 2) {  // [baked]
+    int j = range.x;  // [baked]
+    for (; j + 1 < range.y && acc.a < stop; j += 2) {  // [baked]
         vec3 tc = start + delta * float(j);  // [baked]
         float v0 = volume_at(texture0, tc).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
         float v1 = volume_at(texture0, tc + delta).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
         acc += (1.0 - acc.a) * step_at(texture6, v0);  // [baked]
         acc += (1.0 - acc.a) * step_at(texture6, v1);  // [baked]
     }  // [baked]
-    if (j < full && acc.a < stop) {  // [baked]
+    if (j < range.y && acc.a < stop) {  // [baked]
         float v = volume_at(texture0, start + delta * float(j)).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
         acc += (1.0 - acc.a) * step_at(texture6, v);  // [baked]
     }  // [baked]

@@ -56,6 +56,7 @@ fn point_sampling(steps_per_voxel: f64) -> Option<Raycast> {
         brick: 0,
         preintegrate: false,
         jitter: false,
+        margins: true,
         bake: false,
     })
 }
@@ -681,6 +682,7 @@ fn whole_step_tables_are_off_with_a_clip() {
             brick: 0,
             preintegrate,
             jitter,
+            margins: true,
             bake,
         })
     };

@@ -440,6 +440,7 @@ fn precise(mut scene: Scene, projection: Projection) -> Scene {
     if let TechniqueScene::Opacity3d(p) = &mut scene.technique {
         p.raycast = Some(Raycast {
             jitter: false,
+            margins: true,
             bake: false,
             ..Raycast::default()
         });

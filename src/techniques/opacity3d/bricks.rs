@@ -1,4 +1,4 @@
-//! Empty-space skipping for the precise ray caster (CPU, no GL): the volume cut into
+//! Empty space for the precise ray caster (CPU, no GL): the volume cut into
 //! bricks of `size³` voxels, each with the range of levels a sample inside it can
 //! interpolate (its voxels and one voxel around them: a trilinear sample at a point of the
 //! brick reads the voxels either side of it), and against the current tables and
@@ -8,7 +8,9 @@
 //! in a product when any one is; an interpolated level between two entries reads between
 //! their alphas (linear) or one of them (nearest), so the largest table alpha over the
 //! entries of the brick's range bounds them all. Skipping the samples of an empty brick
-//! therefore leaves the result unchanged.
+//! therefore leaves the result unchanged. The ray caster clips every ray to the box of
+//! the occupied bricks ([`Bricks::occupied_box`], its margins) and, with a scene's
+//! `brick`, skips the empty bricks inside it too.
 
 use super::prepare::Prepared;
 use super::{coefficients, Combine, Opacity3dScene};
@@ -102,6 +104,31 @@ impl Bricks {
             .collect()
     }
 
+    /// The box, in texture coordinates, of the bricks `occupancy` marks: a brick covers
+    /// the sample points `[b, b + 1) size / n` along each axis (a sample there reads
+    /// only the voxels its range was taken over), so every sample outside the box lies
+    /// in an empty brick and has alpha 0. `None` when no brick is occupied.
+    pub fn occupied_box(&self, prepared: &Prepared, occupancy: &[u8]) -> Option<[[f64; 3]; 2]> {
+        let [ni, nj, _] = self.counts;
+        let mut lo = [usize::MAX; 3];
+        let mut hi = [0usize; 3];
+        for (b, _) in occupancy.iter().enumerate().filter(|(_, &o)| o != 0) {
+            let at = [b % ni, (b / ni) % nj, b / (ni * nj)];
+            for a in 0..3 {
+                lo[a] = lo[a].min(at[a]);
+                hi[a] = hi[a].max(at[a]);
+            }
+        }
+        if lo[0] == usize::MAX {
+            return None;
+        }
+        let d = prepared.dims;
+        Some([
+            std::array::from_fn(|a| (lo[a] * self.size) as f64 / d[a] as f64),
+            std::array::from_fn(|a| (((hi[a] + 1) * self.size) as f64 / d[a] as f64).min(1.0)),
+        ])
+    }
+
     /// Bricks per unit of texture coordinate along each axis (voxels / brick size).
     pub fn per_unit(&self, prepared: &Prepared) -> [f64; 3] {
         prepared.dims.map(|n| n as f64 / self.size as f64)
@@ -165,5 +192,27 @@ mod tests {
         params.primary.coefficients[3] = 1.0;
         params.combine = Combine::Product;
         assert_eq!(b.occupancy(&p, &params), [0, 255, 0, 255]);
+    }
+
+    #[test]
+    fn the_occupied_box_holds_every_occupied_brick_and_no_more() {
+        // 10 x 7 x 5 voxels in bricks of 4: 3 x 2 x 2 bricks, the last ones partial.
+        let p = prepared([10, 7, 5], vec![0; 350]);
+        let b = Bricks::new(&p, 4);
+        assert_eq!(b.counts, [3, 2, 2]);
+        let mut occupancy = vec![0u8; 12];
+        assert_eq!(b.occupied_box(&p, &occupancy), None);
+        // Brick (1, 0, 1) alone: voxels 4..8 of 10, 0..4 of 7, 4..5 of 5 (clamped).
+        occupancy[1 + 3 * 2] = 255;
+        assert_eq!(
+            b.occupied_box(&p, &occupancy),
+            Some([[0.4, 0.0, 0.8], [0.8, 4.0 / 7.0, 1.0]])
+        );
+        // And brick (2, 1, 0): the box spans both.
+        occupancy[2 + 3] = 255;
+        assert_eq!(
+            b.occupied_box(&p, &occupancy),
+            Some([[0.4, 0.0, 0.0], [1.0, 1.0, 1.0]])
+        );
     }
 }

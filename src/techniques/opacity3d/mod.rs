@@ -13,8 +13,9 @@
 //!    ([`programs`]): faithful, the verbatim text on slices ([`slicing`]) perpendicular
 //!    to the view direction, far to near; precise, a program generated for the scene
 //!    (only the attributes present) either on the same slices or, with
-//!    `[technique.opacity3d.raycast]`, as a single-pass GLSL ray caster with
-//!    empty-space skipping ([`bricks`]) and early termination.
+//!    `[technique.opacity3d.raycast]`, as a single-pass GLSL ray caster whose rays
+//!    are clipped to the box of the occupied bricks ([`bricks`]; optionally skipping
+//!    the empty bricks inside it too) and stop early once opaque.
 //!    With `[technique.opacity3d.clip]` ([`clipping`], seed 002) every program has the
 //!    clip test composed in (the verbatim ARB text kept byte for byte after the clip's
 //!    prologue) and only what lies inside the clip object is drawn.
@@ -222,6 +223,11 @@ pub struct Raycast {
     /// 2 steps/voxel) every ray otherwise samples its cells at the same place, and the
     /// error of those settings rises above that of fewer steps.
     pub jitter: bool,
+    /// Clip each ray to the box of the bricks where some sample can have alpha above 0
+    /// ([`bricks::Bricks::occupied_box`]): the clear margins around the data (the air
+    /// around a head, the padding of a survey) are not sampled, and no pixel changes
+    /// (every sample left out has alpha 0). Point sampling, with or without jitter.
+    pub margins: bool,
     /// With jitter and one attribute: full steps read their colour and opacity from a
     /// table baked for the step (no `pow` per sample), where that table is within 1e-5 of
     /// the exact model ([`preint::baked`]). Ignored with a clip (a clipped scene tests
@@ -237,6 +243,7 @@ impl Default for Raycast {
             brick: 0,
             preintegrate: false,
             jitter: true,
+            margins: true,
             bake: true,
         }
     }

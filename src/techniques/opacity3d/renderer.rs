@@ -44,6 +44,14 @@ pub const VOLUME_UNIT: u32 = 0;
 pub const TABLE_UNITS: [u32; 3] = [2, 3, 4];
 /// Unit of the ray caster's brick occupancy.
 pub const BRICK_UNIT: u32 = 5;
+
+/// The whole volume in texture coordinates (the ray caster samples all of it).
+const WHOLE: [[f64; 3]; 2] = [[0.0; 3], [1.0; 3]];
+
+/// Voxels per side of the bricks whose box bounds the ray caster's margins (when the
+/// scene does not skip with its own): small enough to fit round data closely, large
+/// enough that a pass over the volume stays cheap.
+const MARGIN_BRICK: usize = 8;
 /// Unit of the ray caster's pre-integration table.
 pub const PREINT_UNIT: u32 = 6;
 
@@ -269,7 +277,12 @@ pub struct Opacity3dRenderer {
     volume: Texture,
     tables: [Option<Texture>; 3],
     neutral: Option<Texture>,
-    bricks: Option<(Bricks, Texture)>,
+    /// The ray caster's bricks (for skipping or its margins), and their occupancy on
+    /// unit [`BRICK_UNIT`] when it skips empty bricks.
+    bricks: Option<(Bricks, Option<Texture>)>,
+    /// Where the ray caster samples, in texture coordinates (the box of the occupied
+    /// bricks, or the whole volume): locals 22 and 23.
+    occupied: [[f64; 3]; 2],
     preint: Option<Texture>,
     baked: bool,
     mesh: Option<Mesh>,
@@ -384,6 +397,7 @@ impl Opacity3dRenderer {
             tables: [None, None, None],
             neutral: None,
             bricks: None,
+            occupied: WHOLE,
             preint: None,
             baked,
             mesh: None,
@@ -473,30 +487,51 @@ impl Opacity3dRenderer {
         Ok(())
     }
 
-    /// The ray caster's bricks and their occupancy for the current tables.
+    /// The ray caster's bricks and their occupancy for the current tables: a texture for
+    /// empty-space skipping, the occupied box for its margins.
     fn build_bricks(&mut self, gpu: &Gpu) -> GlResult<()> {
         let preint = preintegrated(&self.params, self.fidelity, self.prepared.count());
-        let size = match (&self.params.raycast, self.path()) {
-            (Some(r), Path3d::Raycast) if r.brick > 0 && !preint && !r.jitter => r.brick,
-            _ => {
-                self.bricks = None;
-                return Ok(());
+        self.occupied = WHOLE;
+        let (size, skip, margins) = match (&self.params.raycast, self.path()) {
+            (Some(r), Path3d::Raycast) if !preint => {
+                let skip = r.brick > 0 && !r.jitter;
+                match (skip, r.margins) {
+                    (true, m) => (r.brick, true, m),
+                    (false, true) => (MARGIN_BRICK, false, true),
+                    (false, false) => (0, false, false),
+                }
             }
+            _ => (0, false, false),
         };
+        if size == 0 {
+            self.bricks = None;
+            return Ok(());
+        }
         let bricks = match self.bricks.take() {
             Some((b, _)) if b.size == size => b,
             _ => Bricks::new(&self.prepared, size),
         };
         let occupancy = bricks.occupancy(&self.prepared, &self.params);
-        let [bi, bj, bk] = bricks.counts.map(|c| c as u32);
-        let texture = Texture::new(
-            gpu,
-            "opacity3d brick occupancy (empty-space skipping)",
-            Extent::D3(bi, bj, bk),
-            TexelFormat::R8,
-            Filter::Nearest,
-            TexelData::U8(&occupancy),
-        )?;
+        if margins {
+            // Nothing visible: a box outside the volume, which no ray meets inside it.
+            self.occupied = bricks
+                .occupied_box(&self.prepared, &occupancy)
+                .unwrap_or([[2.0; 3], [2.0; 3]]);
+        }
+        let texture = match skip {
+            true => {
+                let [bi, bj, bk] = bricks.counts.map(|c| c as u32);
+                Some(Texture::new(
+                    gpu,
+                    "opacity3d brick occupancy (empty-space skipping)",
+                    Extent::D3(bi, bj, bk),
+                    TexelFormat::R8,
+                    Filter::Nearest,
+                    TexelData::U8(&occupancy),
+                )?)
+            }
+            false => None,
+        };
         self.bricks = Some((bricks, texture));
         Ok(())
     }
@@ -580,11 +615,14 @@ impl Opacity3dRenderer {
                 let ray = if perspective { eye(frame) } else { -n };
                 p.set_local(gpu, 8, ray.extend(0.0).to_array())?;
                 let per_unit = match &self.bricks {
-                    Some((b, _)) => b.per_unit(&self.prepared),
-                    None => [1.0; 3],
+                    Some((b, Some(_))) => b.per_unit(&self.prepared),
+                    _ => [1.0; 3],
                 };
                 let stop = 1.0 - r.termination;
                 p.set_local(gpu, 9, [per_unit[0], per_unit[1], per_unit[2], stop])?;
+                let [lo, hi] = self.occupied;
+                p.set_local(gpu, 22, [lo[0], lo[1], lo[2], 0.0])?;
+                p.set_local(gpu, 23, [hi[0], hi[1], hi[2], 0.0])?;
             }
             _ => {
                 p.set_local(gpu, 4, [scale, self.spacing / 2.0, offset, 0.0])?;
@@ -698,7 +736,7 @@ impl Opacity3dRenderer {
                 (None, None) => {}
             }
         }
-        if let Some((_, t)) = &self.bricks {
+        if let Some((_, Some(t))) = &self.bricks {
             textures.push((BRICK_UNIT, t));
         }
         if let Some(t) = &self.preint {
