@@ -66,9 +66,17 @@ vec4 classify(vec3 tc) {
 // outside it have alpha 0): `count` steps of length h along tc = entry + along t, step j
 // sampled at t = t0 + (j + 1/2) h, on a chord of length `chord`.
 ivec2 occupied_steps(vec3 entry, vec3 along, float t0, float h, int count, float chord) {
-    vec3 inv = 1.0 / mix(along, vec3(1e-30), equal(along, vec3(0.0)));
-    vec3 ta = (program_local[22].xyz - entry) * inv;
-    vec3 tb = (program_local[23].xyz - entry) * inv;
+    vec3 lo = program_local[22].xyz;
+    vec3 hi = program_local[23].xyz;
+    bvec3 parallel = equal(along, vec3(0.0));
+    vec3 inv = 1.0 / mix(along, vec3(1.0), parallel);
+    vec3 ta = (lo - entry) * inv;
+    vec3 tb = (hi - entry) * inv;
+    // A ray parallel to an axis's faces lies in that slab everywhere (its entry does, on
+    // a face included) or nowhere.
+    bvec3 inside = bvec3(step(lo, entry) * step(entry, hi));
+    ta = mix(ta, mix(vec3(1e30), vec3(-1e30), inside), parallel);
+    tb = mix(tb, vec3(1e30), parallel);
     vec3 near = min(ta, tb);
     vec3 far = max(ta, tb);
     float t_in = max(max(near.x, near.y), near.z);

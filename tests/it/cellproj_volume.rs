@@ -862,3 +862,54 @@ fn clear_tetrahedra_are_left_out_and_no_pixel_moves() {
         }
     }
 }
+
+/// `active_only` switched on with one transfer function and the function changed back
+/// before any draw: the drawn set is the function's that is drawn, not the undone one's
+/// (a function clearer than it would leave out cells it colours).
+#[test]
+fn the_drawn_set_follows_an_edit_undone_before_the_draw() {
+    let h = headless(Backend::Egl);
+    let gpu = h.gpu();
+    let prepared = prepared_of(&grid(13, Field::Waves));
+    let cam = camera(Projection::Orthographic);
+    let frame = Frame {
+        camera: cam,
+        width: SIZE[0],
+        height: SIZE[1],
+    };
+    let mut table = spec(Sort::Mpvonc);
+    table.precise = Precise::Table;
+    let mut bands = banded(Sort::Mpvonc);
+    bands.precise = Precise::Table;
+    let mut all = scene(Mode::Volume, table.clone(), vec![]);
+    all.active_only = false;
+    let mut r = CellprojRenderer::from_prepared(
+        gpu,
+        ProgramKind::Glsl,
+        Fidelity::Precise,
+        &all,
+        prepared.clone(),
+    )
+    .unwrap();
+    let target = Target::with_depth(gpu, SIZE[0], SIZE[1], TargetFormat::Rgba32f).unwrap();
+    target.clear(gpu, BACKGROUND).unwrap();
+    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
+    // Culling on with the banded function, then the first function back, no draw between.
+    let culled_bands = scene(Mode::Volume, bands, vec![]);
+    r.update(gpu, arbvis::techniques::Params::of(&culled_bands))
+        .unwrap();
+    let back = scene(Mode::Volume, table, vec![]);
+    r.update(gpu, arbvis::techniques::Params::of(&back))
+        .unwrap();
+    target.clear(gpu, BACKGROUND).unwrap();
+    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
+    let fresh = draw(
+        &h,
+        &back,
+        &prepared,
+        Fidelity::Precise,
+        ProgramKind::Glsl,
+        cam,
+    );
+    assert!(target.read(gpu).unwrap().data == fresh.data);
+}

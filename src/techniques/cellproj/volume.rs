@@ -656,6 +656,9 @@ impl VolumeRenderer {
         }
         let made_for = self.made_for.take();
         self.stale = false;
+        // Before the early return: `set_active_only` may have chosen the set for an
+        // edit that was then undone.
+        self.select_drawn();
         if made_for.as_ref() == Some(&self.spec) {
             // Changed and changed back before a draw: the textures are right.
             return Ok(());
@@ -679,7 +682,6 @@ impl VolumeRenderer {
         if let Some(p) = &mut self.precise {
             p.tf = tf_texture(gpu, &self.transfer)?;
         }
-        self.select_drawn();
         Ok(())
     }
 

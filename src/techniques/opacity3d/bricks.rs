@@ -12,6 +12,8 @@
 //! the occupied bricks ([`Bricks::occupied_box`], its margins) and, with a scene's
 //! `brick`, skips the empty bricks inside it too.
 
+use rayon::prelude::*;
+
 use super::prepare::Prepared;
 use super::{coefficients, Combine, Opacity3dScene};
 
@@ -38,27 +40,32 @@ impl Bricks {
             let hi = ((b + 1) * size).min(n - 1);
             lo..=hi
         };
-        let mut ranges = Vec::with_capacity(counts.iter().product());
-        for bk in 0..counts[2] {
-            for bj in 0..counts[1] {
-                for bi in 0..counts[0] {
-                    let mut r = [(u8::MAX, u8::MIN); 3];
-                    for k in span(bk, d[2]) {
-                        for j in span(bj, d[1]) {
-                            let row = d[0] * (j + d[1] * k);
-                            for i in span(bi, d[0]) {
-                                for (a, range) in r.iter_mut().enumerate() {
-                                    let v = prepared.byte(row + i, a);
-                                    range.0 = range.0.min(v);
-                                    range.1 = range.1.max(v);
+        // Slabs of bricks in parallel (a large volume is a pass over every voxel).
+        let ranges = (0..counts[2])
+            .into_par_iter()
+            .flat_map_iter(|bk| {
+                let mut slab = Vec::with_capacity(counts[0] * counts[1]);
+                for bj in 0..counts[1] {
+                    for bi in 0..counts[0] {
+                        let mut r = [(u8::MAX, u8::MIN); 3];
+                        for k in span(bk, d[2]) {
+                            for j in span(bj, d[1]) {
+                                let row = d[0] * (j + d[1] * k);
+                                for i in span(bi, d[0]) {
+                                    for (a, range) in r.iter_mut().enumerate() {
+                                        let v = prepared.byte(row + i, a);
+                                        range.0 = range.0.min(v);
+                                        range.1 = range.1.max(v);
+                                    }
                                 }
                             }
                         }
+                        slab.push(r);
                     }
-                    ranges.push(r);
                 }
-            }
-        }
+                slab
+            })
+            .collect();
         Bricks {
             size,
             counts,
