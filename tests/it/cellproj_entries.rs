@@ -5,7 +5,8 @@
 //! entries (the old default) the same views are far off.
 
 use crate::cellproj_volume::{
-    draw_counting_entries, prepared_of, reference_image, scene, slotted, slotted_volume, spec,
+    draw_counting_entries, points_spec, prepared_of, reference_image, scene, slotted,
+    slotted_volume,
 };
 use crate::common::headless;
 use arbvis::camera::{Camera, Projection};
@@ -68,16 +69,15 @@ fn every_entry_is_followed_on_a_stack_of_plates() {
     let h = headless(Backend::Egl);
     let prepared = plates();
     // Faint enough that the tenth plate still shows: about 0.7 transmittance per plate.
+    let points = [
+        [0.0, 1.0, 0.2, 0.1, 0.25],
+        [0.4, 0.1, 0.9, 0.3, 0.35],
+        [0.7, 0.9, 0.8, 0.1, 0.15],
+        [1.0, 0.2, 0.3, 1.0, 0.4],
+    ];
     let volume = |entries| VolumeSpec {
-        points: vec![
-            [0.0, 1.0, 0.2, 0.1, 0.25],
-            [0.4, 0.1, 0.9, 0.3, 0.35],
-            [0.7, 0.9, 0.8, 0.1, 0.15],
-            [1.0, 0.2, 0.3, 1.0, 0.4],
-        ],
-        unit_distance: 0.1,
         entries,
-        ..spec(Sort::Mpvonc)
+        ..points_spec(&points, 0.1, Sort::Mpvonc)
     };
     // Views along the stack, tilted three ways (rays through every plate, entering the
     // side walls too).

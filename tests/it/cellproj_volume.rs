@@ -36,21 +36,27 @@ fn grid(n: usize, field: Field) -> Mesh {
     .unwrap()
 }
 
-/// A transfer function with a narrow bright band (the kind pre-integration exists for)
-/// over a faint ramp; unit distance in the grid's units (the grid spans [0, 1]).
-pub(crate) fn spec(sort: Sort) -> VolumeSpec {
+/// A transfer function of control points `[s, r, g, b, a]`, the rest default.
+pub(crate) fn points_spec(points: &[[f64; 5]], unit_distance: f64, sort: Sort) -> VolumeSpec {
     VolumeSpec {
-        points: vec![
-            [0.0, 0.1, 0.2, 0.9, 0.0],
-            [0.45, 0.2, 0.6, 0.8, 0.3],
-            [0.5, 1.0, 0.9, 0.2, 1.0],
-            [0.55, 0.9, 0.3, 0.1, 0.3],
-            [1.0, 0.8, 0.1, 0.1, 0.6],
-        ],
-        unit_distance: 0.25,
+        points: points.to_vec(),
+        unit_distance,
         sort,
         ..VolumeSpec::default()
     }
+}
+
+/// A transfer function with a narrow bright band (the kind pre-integration exists for)
+/// over a faint ramp; unit distance in the grid's units (the grid spans [0, 1]).
+pub(crate) fn spec(sort: Sort) -> VolumeSpec {
+    let points = [
+        [0.0, 0.1, 0.2, 0.9, 0.0],
+        [0.45, 0.2, 0.6, 0.8, 0.3],
+        [0.5, 1.0, 0.9, 0.2, 1.0],
+        [0.55, 0.9, 0.3, 0.1, 0.3],
+        [1.0, 0.8, 0.1, 0.1, 0.6],
+    ];
+    points_spec(&points, 0.25, sort)
 }
 
 pub(crate) fn scene(mode: Mode, volume: VolumeSpec, isovalues: Vec<Isovalue>) -> CellprojScene {
@@ -89,6 +95,48 @@ fn draw(
     draw_counting_entries(h, params, prepared, fidelity, kind, camera).0
 }
 
+/// A frame of the tests' size seen by `camera`.
+fn frame_of(camera: Camera) -> Frame {
+    Frame {
+        camera,
+        width: SIZE[0],
+        height: SIZE[1],
+    }
+}
+
+/// A target of the tests' size in the format of `fidelity` (RGBA8 faithful, RGBA32F
+/// precise).
+fn target_for(gpu: &arbvis::gl::Gpu, fidelity: Fidelity) -> Target {
+    let format = match fidelity {
+        Fidelity::Faithful => TargetFormat::Rgba8,
+        Fidelity::Precise => TargetFormat::Rgba32f,
+    };
+    Target::with_depth(gpu, SIZE[0], SIZE[1], format).unwrap()
+}
+
+/// A GLSL renderer of `params` on `prepared`.
+fn glsl_renderer(
+    gpu: &arbvis::gl::Gpu,
+    fidelity: Fidelity,
+    params: &CellprojScene,
+    prepared: &Prepared,
+) -> CellprojRenderer {
+    CellprojRenderer::from_prepared(gpu, ProgramKind::Glsl, fidelity, params, prepared.clone())
+        .unwrap()
+}
+
+/// `r`'s picture of `frame` on the cleared `target`.
+fn picture_of(
+    gpu: &arbvis::gl::Gpu,
+    r: &mut CellprojRenderer,
+    target: &Target,
+    frame: &Frame,
+) -> Image {
+    target.clear(gpu, BACKGROUND).unwrap();
+    r.draw(gpu, Surface::Target(target), frame).unwrap();
+    target.read(gpu).unwrap()
+}
+
 /// [`draw`], and the entry layers the precise walk peeled.
 pub(crate) fn draw_counting_entries(
     h: &Headless,
@@ -101,20 +149,8 @@ pub(crate) fn draw_counting_entries(
     let gpu = h.gpu();
     let mut r =
         CellprojRenderer::from_prepared(gpu, kind, fidelity, params, prepared.clone()).unwrap();
-    let format = match fidelity {
-        Fidelity::Faithful => TargetFormat::Rgba8,
-        Fidelity::Precise => TargetFormat::Rgba32f,
-    };
-    let target = Target::with_depth(gpu, SIZE[0], SIZE[1], format).unwrap();
-    target.clear(gpu, BACKGROUND).unwrap();
-    let frame = Frame {
-        camera,
-        width: SIZE[0],
-        height: SIZE[1],
-    };
-    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
-    let entries = r.volume().map_or(0, |v| v.entries());
-    (target.read(gpu).unwrap(), entries)
+    let image = picture_of(gpu, &mut r, &target_for(gpu, fidelity), &frame_of(camera));
+    (image, r.volume().map_or(0, |v| v.entries()))
 }
 
 /// The f64 reference picture of a scene (its volume, and its isosurfaces in `mode = "both"`).
@@ -323,11 +359,7 @@ fn faithful_is_within_its_table_and_target_quantization_and_arb_equals_glsl() {
     )
     .unwrap();
     let target = Target::with_depth(gpu, SIZE[0], SIZE[1], TargetFormat::Rgba8).unwrap();
-    let frame = Frame {
-        camera: camera(Projection::Perspective),
-        width: SIZE[0],
-        height: SIZE[1],
-    };
+    let frame = frame_of(camera(Projection::Perspective));
     let err = r
         .draw(gpu, Surface::Target(&target), &frame)
         .unwrap_err()
@@ -701,11 +733,7 @@ fn transfer_function_edits_draw_what_a_fresh_renderer_draws() {
     let gpu = h.gpu();
     let prepared = prepared_of(&grid(9, Field::Spherical));
     let cam = camera(Projection::Perspective);
-    let frame = Frame {
-        camera: cam,
-        width: SIZE[0],
-        height: SIZE[1],
-    };
+    let frame = frame_of(cam);
     let first = spec(Sort::Centroid);
     // Another function (the band moved and recoloured), another unit, MPVONC.
     let mut second = spec(Sort::Mpvonc);
@@ -717,24 +745,10 @@ fn transfer_function_edits_draw_what_a_fresh_renderer_draws() {
     // Zero bands: the edit changes which tetrahedra are drawn.
     let bands = banded(Sort::Mpvonc);
     for fidelity in [Fidelity::Faithful, Fidelity::Precise] {
-        let format = match fidelity {
-            Fidelity::Faithful => TargetFormat::Rgba8,
-            Fidelity::Precise => TargetFormat::Rgba32f,
-        };
-        let target = Target::with_depth(gpu, SIZE[0], SIZE[1], format).unwrap();
-        let mut r = CellprojRenderer::from_prepared(
-            gpu,
-            ProgramKind::Glsl,
-            fidelity,
-            &scene(Mode::Volume, first.clone(), vec![]),
-            prepared.clone(),
-        )
-        .unwrap();
-        let picture = |r: &mut CellprojRenderer| {
-            target.clear(gpu, BACKGROUND).unwrap();
-            r.draw(gpu, Surface::Target(&target), &frame).unwrap();
-            target.read(gpu).unwrap()
-        };
+        let target = target_for(gpu, fidelity);
+        let first_scene = scene(Mode::Volume, first.clone(), vec![]);
+        let mut r = glsl_renderer(gpu, fidelity, &first_scene, &prepared);
+        let picture = |r: &mut CellprojRenderer| picture_of(gpu, r, &target, &frame);
         picture(&mut r);
         for step in [
             &second, &coarse, &second, &bands, &coarse, &first, &bands, &second,
@@ -757,22 +771,18 @@ fn transfer_function_edits_draw_what_a_fresh_renderer_draws() {
 /// A transfer function that is zero on two bands and at the ends, with uneven colours:
 /// the kind of function that leaves most of a CFD mesh clear.
 fn banded(sort: Sort) -> VolumeSpec {
-    VolumeSpec {
-        points: vec![
-            [0.0, 0.3, 0.7, 0.2, 0.0],
-            [0.31, 0.9, 0.1, 0.4, 0.0],
-            [0.37, 0.2, 0.8, 0.6, 0.7],
-            [0.44, 0.7, 0.3, 0.9, 0.0],
-            [0.66, 0.1, 0.5, 0.3, 0.0],
-            [0.71, 0.95, 0.85, 0.05, 0.9],
-            [0.71, 0.4, 0.2, 0.8, 0.35],
-            [0.83, 0.6, 0.6, 0.1, 0.0],
-            [1.0, 0.2, 0.9, 0.9, 0.0],
-        ],
-        unit_distance: 0.2,
-        sort,
-        ..VolumeSpec::default()
-    }
+    let points = [
+        [0.0, 0.3, 0.7, 0.2, 0.0],
+        [0.31, 0.9, 0.1, 0.4, 0.0],
+        [0.37, 0.2, 0.8, 0.6, 0.7],
+        [0.44, 0.7, 0.3, 0.9, 0.0],
+        [0.66, 0.1, 0.5, 0.3, 0.0],
+        [0.71, 0.95, 0.85, 0.05, 0.9],
+        [0.71, 0.4, 0.2, 0.8, 0.35],
+        [0.83, 0.6, 0.6, 0.1, 0.0],
+        [1.0, 0.2, 0.9, 0.9, 0.0],
+    ];
+    points_spec(&points, 0.2, sort)
 }
 
 /// `active_only` (the default) leaves out the tetrahedra whose range the transfer
@@ -788,12 +798,7 @@ fn clear_tetrahedra_are_left_out_and_no_pixel_moves() {
     let prepared = prepared_of(&grid(13, Field::Waves));
     let total = prepared.tets.len();
     for projection in [Projection::Orthographic, Projection::Perspective] {
-        let cam = camera(projection);
-        let frame = Frame {
-            camera: cam,
-            width: SIZE[0],
-            height: SIZE[1],
-        };
+        let frame = frame_of(camera(projection));
         let mut params = scene(Mode::Volume, banded(Sort::Mpvonc), vec![]);
         params.mesh = arbvis::mesh::MeshSource::Grid(GridSpec {
             points: [13; 3],
@@ -813,25 +818,12 @@ fn clear_tetrahedra_are_left_out_and_no_pixel_moves() {
             let volume = params.volume.as_mut().unwrap();
             volume.precise = method;
             volume.table_size = table_size;
-            let format = match fidelity {
-                Fidelity::Faithful => TargetFormat::Rgba8,
-                Fidelity::Precise => TargetFormat::Rgba32f,
-            };
-            let target = Target::with_depth(gpu, SIZE[0], SIZE[1], format).unwrap();
+            let target = target_for(gpu, fidelity);
             let mut picture = |active_only: bool| {
                 params.active_only = active_only;
-                let mut r = CellprojRenderer::from_prepared(
-                    gpu,
-                    ProgramKind::Glsl,
-                    fidelity,
-                    &params,
-                    prepared.clone(),
-                )
-                .unwrap();
-                target.clear(gpu, BACKGROUND).unwrap();
-                r.draw(gpu, Surface::Target(&target), &frame).unwrap();
-                let drawn = r.volume().unwrap().times().drawn;
-                (target.read(gpu).unwrap(), drawn)
+                let mut r = glsl_renderer(gpu, fidelity, &params, &prepared);
+                let image = picture_of(gpu, &mut r, &target, &frame);
+                (image, r.volume().unwrap().times().drawn)
             };
             let (culled, drawn) = picture(true);
             let (all, every) = picture(false);
@@ -872,28 +864,16 @@ fn the_drawn_set_follows_an_edit_undone_before_the_draw() {
     let gpu = h.gpu();
     let prepared = prepared_of(&grid(13, Field::Waves));
     let cam = camera(Projection::Orthographic);
-    let frame = Frame {
-        camera: cam,
-        width: SIZE[0],
-        height: SIZE[1],
-    };
+    let frame = frame_of(cam);
     let mut table = spec(Sort::Mpvonc);
     table.precise = Precise::Table;
     let mut bands = banded(Sort::Mpvonc);
     bands.precise = Precise::Table;
     let mut all = scene(Mode::Volume, table.clone(), vec![]);
     all.active_only = false;
-    let mut r = CellprojRenderer::from_prepared(
-        gpu,
-        ProgramKind::Glsl,
-        Fidelity::Precise,
-        &all,
-        prepared.clone(),
-    )
-    .unwrap();
-    let target = Target::with_depth(gpu, SIZE[0], SIZE[1], TargetFormat::Rgba32f).unwrap();
-    target.clear(gpu, BACKGROUND).unwrap();
-    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
+    let mut r = glsl_renderer(gpu, Fidelity::Precise, &all, &prepared);
+    let target = target_for(gpu, Fidelity::Precise);
+    picture_of(gpu, &mut r, &target, &frame);
     // Culling on with the banded function, then the first function back, no draw between.
     let culled_bands = scene(Mode::Volume, bands, vec![]);
     r.update(gpu, arbvis::techniques::Params::of(&culled_bands))
@@ -901,8 +881,7 @@ fn the_drawn_set_follows_an_edit_undone_before_the_draw() {
     let back = scene(Mode::Volume, table, vec![]);
     r.update(gpu, arbvis::techniques::Params::of(&back))
         .unwrap();
-    target.clear(gpu, BACKGROUND).unwrap();
-    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
+    let undone = picture_of(gpu, &mut r, &target, &frame);
     let fresh = draw(
         &h,
         &back,
@@ -911,5 +890,5 @@ fn the_drawn_set_follows_an_edit_undone_before_the_draw() {
         ProgramKind::Glsl,
         cam,
     );
-    assert!(target.read(gpu).unwrap().data == fresh.data);
+    assert!(undone.data == fresh.data);
 }
