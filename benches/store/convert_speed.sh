@@ -8,7 +8,7 @@
 #   - `arbvis convert` of amplitude alone and of amplitude + envelope (the default), with
 #     the default compression (lz4) and with zstd level 1 (the default before).
 #
-#   bash benches/store/convert_speed.sh [DIR]
+#   bash benches/store/convert_speed.sh [DIR]     (SETTLE=seconds between runs, 61 default)
 set -euo pipefail
 DIR=${1:-/work/convert-speed}
 mkdir -p "$DIR"
@@ -21,9 +21,13 @@ cat "$SURVEY" > /dev/null   # the survey in the page cache, as a conversion rere
 rm -rf "$DIR/floor.zarr" "$DIR/out"
 "$BIN" convert "$SURVEY" "$DIR/floor.zarr" --attributes none > /dev/null 2>&1
 echo "survey: $bytes bytes; store of amplitude: $(du -sb "$DIR/floor.zarr" | cut -f1) bytes"
+# A file system without a journal (this machine's ext4) skips, on every file it creates,
+# each inode freed in the last 60 s (ext4's recently_deleted): removing the last run's
+# 2,400 chunk files and converting at once spent 30 % of the conversion in that scan
+# (perf, 2026-11-27), a cost no first conversion pays. So each run waits the window out.
 timed() { # LABEL COMMAND...: run after sync, print seconds and MB/s of the survey
     local label=$1; shift
-    rm -rf "$DIR/out" "$DIR/copy"; sync; sleep 1
+    rm -rf "$DIR/out" "$DIR/copy"; sync; sleep "${SETTLE:-61}"
     local s e
     s=$(date +%s.%N); "$@" > /dev/null 2>&1; e=$(date +%s.%N)
     awk -v l="$label" -v s="$s" -v e="$e" -v b="$bytes" \

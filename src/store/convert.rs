@@ -6,10 +6,16 @@
 //!    derived attributes computed trace by trace (one analytic signal per trace gives
 //!    envelope, phase and frequency, [`crate::volume::attributes::derive_trace`]), cut
 //!    into its `ceil(samples / B)` bricks, and each brick written as a zarr chunk of
-//!    every attribute. Columns run in parallel (rayon, two workers per core: one computes
-//!    while the other waits for its chunks to reach the disk).
-//! 2. Levels 1, 2, ...: each brick of level `L` is filtered from the (up to) eight bricks
-//!    of level `L - 1` below it, read back from the store; again in columns, in parallel.
+//!    every attribute. Columns go in quads of 2 x 2, one level-1 column's worth: each
+//!    column's quarter of it is filtered while the column is in memory, and the level-1
+//!    column written after the quad's fourth (for an even `B`, where no 2x2x2 cell
+//!    straddles two columns). Quads run in parallel (rayon, two workers per core: one
+//!    computes while the other waits on the disk).
+//! 2. Levels 2, 3, ... (and level 1 where a quad could not give it: an odd `B`, a resumed
+//!    quad): each brick of level `L` is filtered from the (up to) eight bricks of level
+//!    `L - 1` below it, read back from the store; again in columns, in parallel. The
+//!    filter and the statistics are `filter`'s, the same on both paths, so a
+//!    level is the same bit for bit whichever path made it.
 //! 3. The per-brick ranges and each attribute's statistics are written, and the group's
 //!    `complete` flag set.
 //!
@@ -23,9 +29,10 @@
 //!
 //! # Memory
 //! Each worker holds one column: `samples x B² x (1 + derived attributes)` f32 plus the
-//! transform's f64 buffers (`samples x 48` bytes) and one brick per attribute while
-//! encoding; a level brick reads eight chunks. With `W` workers the conversion holds about
-//! `W x samples x B² x 4 x (attributes + 1)` bytes, whatever the number of traces
+//! transform's f64 buffers (`samples x 48` bytes), its quad's level-1 column (`samples /
+//! 2 x B²` per attribute) and one brick per attribute while encoding; a level brick
+//! reads eight chunks. With `W` workers the conversion holds about `W x samples x B² x 4
+//! x (1.5 attributes + 1)` bytes, whatever the number of traces
 //! ([`memory_bound`]); the reader's chunk cache adds 64 chunks. The bound is checked
 //! against the memory budget before anything is written.
 
@@ -42,6 +49,7 @@ use rustfft::FftPlanner;
 use zarrs::array::{Array, CodecOptions};
 use zarrs::filesystem::FilesystemStore;
 
+use super::filter::{halve, BrickStats, Grid};
 use super::input::Input;
 use super::layout;
 use super::meta::{AttributeMeta, StoreMeta, FORMAT, VERSION};
@@ -106,9 +114,11 @@ pub struct ConvertReport {
 /// Bytes the conversion holds at once with `workers` workers (see the module doc).
 pub fn memory_bound(samples: usize, brick: usize, attributes: usize, workers: usize) -> u64 {
     let column = samples as u64 * (brick * brick) as u64 * 4 * (attributes as u64 + 1);
+    // The level-1 column its quad fills: half the samples, every attribute.
+    let above = samples.div_ceil(2) as u64 * (brick * brick) as u64 * 4 * attributes as u64;
     let fft = samples as u64 * 48;
     let cache = super::reader::CHUNK_CACHE as u64 * (brick as u64).pow(3) * 4;
-    workers as u64 * (column + fft + 9 * (brick as u64).pow(3) * 4) + cache
+    workers as u64 * (column + above + fft + 9 * (brick as u64).pow(3) * 4) + cache
 }
 
 /// The zarr data type name of an attribute: float32 for amplitude and envelope (any
@@ -317,37 +327,36 @@ fn convert_on_workers(
         stop_after: o.stop_after,
         bytes: AtomicU64::new(0),
     };
-    // Level 0 from the input.
+    // Level 0 from the input, in quads of 2 x 2 columns: each quad also gives its level-1
+    // column, filtered in memory.
     let counts = meta.brick_counts(0);
-    let mut units: Vec<[usize; 3]> = (0..counts[2])
+    let (quads_j, quads_k) = (counts[1].div_ceil(2), counts[2].div_ceil(2));
+    let mut quads: Vec<[usize; 2]> = (0..quads_k)
+        .flat_map(|k| (0..quads_j).map(move |j| [j, k]))
+        .collect();
+    let columns = (0..counts[2])
         .flat_map(|k| (0..counts[1]).map(move |j| [0, j, k]))
         .filter(|u| !done.contains_key(u))
-        .collect();
+        .count();
     // An MDIO input's chunks span several columns: convert those columns one after the
-    // other (in tiles), so each chunk is decoded about once.
+    // other (in tiles of quads), so each chunk is decoded about once.
     if let Input::Mdio(m, _) = &src {
-        let t = m.tile(b);
-        units.sort_by_key(|u| (u[2] / t, u[1] / t, u[2] % t, u[1] % t));
+        let t = m.tile(b).div_ceil(2);
+        quads.sort_by_key(|q| (q[1] / t, q[0] / t, q[1] % t, q[0] % t));
     }
     let bar = progress_bar(
         o.progress,
-        (units.len() * b * b) as u64 * src.bytes_per_trace(),
+        (columns * b * b) as u64 * src.bytes_per_trace(),
         &format!("converting {} (level 0)", input.display()),
     );
-    let new: Vec<Unit> = units
+    let new: Vec<Vec<Unit>> = quads
         .par_iter()
-        .map(|&u| {
-            let unit = ctx.level0(&src, u)?;
-            if let Some(bar) = &bar {
-                bar.inc((b * b) as u64 * src.bytes_per_trace());
-            }
-            ctx.finish(unit)
-        })
+        .map(|&q| ctx.quad(&src, q, &done, bar.as_ref()))
         .collect::<Result<_, _>>()?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }
-    done.extend(new.into_iter().map(|u| (u.u, u)));
+    done.extend(new.into_iter().flatten().map(|u| (u.u, u)));
     // Levels above, each from the one below (read back through a reader).
     let reader = Store::open_incomplete(store, meta.clone())?;
     for level in 1..levels {
@@ -393,55 +402,6 @@ struct Ctx<'a> {
     written: AtomicUsize,
     stop_after: Option<usize>,
     bytes: AtomicU64,
-}
-
-/// Range, sums (sum, finite count, non-finite count) and sum of squares of a brick's
-/// values, gathered a run of values at a time.
-#[derive(Default)]
-struct BrickStats {
-    lo: f32,
-    hi: f32,
-    sum: f64,
-    n: f64,
-    bad: f64,
-    squares: f64,
-}
-
-impl BrickStats {
-    fn new() -> BrickStats {
-        BrickStats {
-            lo: f32::INFINITY,
-            hi: f32::NEG_INFINITY,
-            ..Default::default()
-        }
-    }
-
-    fn add(&mut self, values: &[f32]) {
-        let (mut sum, mut squares, mut n) = (0.0f64, 0.0f64, 0usize);
-        for &v in values {
-            if v.is_finite() {
-                self.lo = self.lo.min(v);
-                self.hi = self.hi.max(v);
-                sum += v as f64;
-                squares += v as f64 * v as f64;
-                n += 1;
-            }
-        }
-        self.sum += sum;
-        self.squares += squares;
-        self.n += n as f64;
-        self.bad += (values.len() - n) as f64;
-    }
-
-    /// `[min, max]` (NaN where no value is finite), `[sum, finite, non-finite]`, squares.
-    fn finish(self) -> ([f32; 2], [f64; 3], f64) {
-        let range = if self.lo > self.hi {
-            [f32::NAN; 2]
-        } else {
-            [self.lo, self.hi]
-        };
-        (range, [self.sum, self.n, self.bad], self.squares)
-    }
 }
 
 impl Ctx<'_> {
@@ -556,8 +516,10 @@ impl Ctx<'_> {
         Ok(unit)
     }
 
-    /// One level-0 column: read, derive, cut, write.
-    fn level0(&self, src: &Input, u: [usize; 3]) -> Result<Unit, StoreError> {
+    /// One level-0 column: read, derive, cut, write; its planes (one per attribute,
+    /// `samples x traces`, the sample axis fastest, as stored) are returned for the level
+    /// above.
+    fn level0(&self, src: &Input, u: [usize; 3]) -> Result<(Unit, Vec<Vec<f32>>), StoreError> {
         let b = self.meta.brick;
         let [ni, nj, nk] = self.meta.dims;
         let (j0, k0) = (u[1] * b, u[2] * b);
@@ -593,16 +555,32 @@ impl Ctx<'_> {
         for (a, plane) in planes.iter_mut().enumerate() {
             self.round_to_stored(a, plane);
         }
+        let unit = self.store_column(u, &planes, [j1 - j0, k1 - k0])?;
+        Ok((unit, planes))
+    }
+
+    /// A column of level `u[0]` held whole (`planes`: one per attribute, `samples x
+    /// traces[0] x traces[1]`, samples fastest) cut into its bricks and written.
+    fn store_column(
+        &self,
+        u: [usize; 3],
+        planes: &[Vec<f32>],
+        traces: [usize; 2],
+    ) -> Result<Unit, StoreError> {
+        let b = self.meta.brick;
+        let ni = self.meta.level_dims(u[0])[0];
         let bricks_i = ni.div_ceil(b);
         let mut ranges = vec![Vec::with_capacity(bricks_i); planes.len()];
         let mut sums = vec![[0.0f64; 3]; planes.len()];
         let mut squares = vec![0.0f64; planes.len()];
         let mut chunk = vec![0f32; b * b * b];
-        let (nj_c, nk_c) = (j1 - j0, k1 - k0);
+        let [nj_c, nk_c] = traces;
         for (a, plane) in planes.iter().enumerate() {
             for bi in 0..bricks_i {
                 let (i0, i1) = (bi * b, ((bi + 1) * b).min(ni));
-                chunk.fill(0.0);
+                if i1 - i0 < b || nj_c < b || nk_c < b {
+                    chunk.fill(0.0);
+                }
                 let mut stats = BrickStats::new();
                 for z in 0..nk_c {
                     for y in 0..nj_c {
@@ -617,7 +595,7 @@ impl Ctx<'_> {
                     sums[a][q] += s[q];
                 }
                 squares[a] += sq;
-                self.store_chunk(a, 0, [bi, u[1], u[2]], &chunk)?;
+                self.store_chunk(a, u[0], [bi, u[1], u[2]], &chunk)?;
             }
         }
         Ok(Unit {
@@ -628,7 +606,79 @@ impl Ctx<'_> {
         })
     }
 
-    /// One column of level `u[0]`, filtered from the level below.
+    /// A quad of level-0 columns (`2J .. 2J + 1` x `2K .. 2K + 1`, those of them inside
+    /// the survey and not `done`), one after the other, and, where all of them are new,
+    /// the level-1 column `(J, K)` filtered from them in memory (not read back).
+    fn quad(
+        &self,
+        src: &Input,
+        q: [usize; 2],
+        done: &HashMap<[usize; 3], Unit>,
+        bar: Option<&indicatif::ProgressBar>,
+    ) -> Result<Vec<Unit>, StoreError> {
+        let b = self.meta.brick;
+        let counts = self.meta.brick_counts(0);
+        // Level-1 cells lie within one column only where the brick side is even.
+        let above =
+            self.meta.levels > 1 && b.is_multiple_of(2) && !done.contains_key(&[1, q[0], q[1]]);
+        let members: Vec<[usize; 3]> = (0..2)
+            .flat_map(|dk| (0..2).map(move |dj| [0, 2 * q[0] + dj, 2 * q[1] + dk]))
+            .filter(|u| u[1] < counts[1] && u[2] < counts[2])
+            .collect();
+        let whole = above && members.iter().all(|u| !done.contains_key(u));
+        let n1 = self.meta.level_dims(1);
+        // The level-1 column: its traces and, per attribute, its plane.
+        let traces1: [usize; 2] =
+            std::array::from_fn(|a| ((q[a] + 1) * b).min(n1[a + 1]) - q[a] * b);
+        let mut planes1: Vec<Vec<f32>> = if whole {
+            let len = n1[0] * traces1[0] * traces1[1];
+            vec![vec![0f32; len]; self.attributes.len()]
+        } else {
+            Vec::new()
+        };
+        let mut units = Vec::with_capacity(5);
+        for u in members {
+            if done.contains_key(&u) {
+                continue;
+            }
+            let (unit, planes) = self.level0(src, u)?;
+            if let Some(bar) = bar {
+                bar.inc((b * b) as u64 * src.bytes_per_trace());
+            }
+            units.push(self.finish(unit)?);
+            if !whole {
+                continue;
+            }
+            // This column's quarter of the level-1 column: traces from (dj, dk) B / 2.
+            let ni = self.meta.dims[0];
+            let nj_c = (b * (u[1] + 1)).min(self.meta.dims[1]) - b * u[1];
+            let nk_c = (b * (u[2] + 1)).min(self.meta.dims[2]) - b * u[2];
+            let (y0, z0) = ((u[1] % 2) * b / 2, (u[2] % 2) * b / 2);
+            let to = Grid::dense(n1[0], traces1[0]);
+            for ((a, plane), out) in planes.iter().enumerate().zip(planes1.iter_mut()) {
+                halve(
+                    plane,
+                    Grid::dense(ni, nj_c),
+                    [ni, nj_c, nk_c],
+                    [n1[0], nj_c.div_ceil(2), nk_c.div_ceil(2)],
+                    self.attributes[a] == Attribute::Phase,
+                    &mut out[to.at(0, y0, z0)..],
+                    to,
+                );
+            }
+        }
+        if whole {
+            for (a, plane) in planes1.iter_mut().enumerate() {
+                self.round_to_stored(a, plane);
+            }
+            let unit = self.store_column([1, q[0], q[1]], &planes1, traces1)?;
+            units.push(self.finish(unit)?);
+        }
+        Ok(units)
+    }
+
+    /// One column of level `u[0]`, filtered from the level below read back from the
+    /// store, brick by brick.
     fn upper(&self, below: &Store, u: [usize; 3]) -> Result<Unit, StoreError> {
         let level = u[0];
         let b = self.meta.brick;
@@ -644,58 +694,27 @@ impl Ctx<'_> {
                 let c = [bi, u[1], u[2]];
                 let lo = c.map(|x| x * b);
                 let hi: [usize; 3] = std::array::from_fn(|q| ((c[q] + 1) * b).min(n[q]));
+                let out: [usize; 3] = std::array::from_fn(|q| hi[q] - lo[q]);
                 // The voxels below: 2 lo .. 2 hi, clamped to the level below.
-                let size: [usize; 3] = std::array::from_fn(|q| 2 * (hi[q] - lo[q]));
+                let size = out.map(|x| 2 * x);
                 let below_vals = below.region(a, level - 1, lo.map(|x| 2 * x as i64), size)?;
-                chunk.iter_mut().for_each(|v| *v = 0.0);
-                let mut inside =
-                    Vec::with_capacity((hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]));
-                // Per axis and output voxel: whether the cell's second voxel below exists
-                // (a far face of odd size has only the first).
-                let second: [Vec<bool>; 3] = std::array::from_fn(|q| {
-                    (0..hi[q] - lo[q])
-                        .map(|t| 2 * (lo[q] + t) + 1 < m[q])
-                        .collect()
-                });
-                let (sx, sxy) = (size[0], size[0] * size[1]);
-                for z in 0..hi[2] - lo[2] {
-                    let dzs = if second[2][z] { 2 } else { 1 };
-                    for y in 0..hi[1] - lo[1] {
-                        let dys = if second[1][y] { 2 } else { 1 };
-                        let row = &mut chunk[b * (y + b * z)..][..hi[0] - lo[0]];
-                        for (x, out) in row.iter_mut().enumerate() {
-                            let base = 2 * x + sx * 2 * y + sxy * 2 * z;
-                            let v = if attribute == Attribute::Phase {
-                                below_vals[base]
-                            } else {
-                                let dxs = if second[0][x] { 2 } else { 1 };
-                                let (mut sum, mut n) = (0.0f64, 0u32);
-                                for dz in 0..dzs {
-                                    for dy in 0..dys {
-                                        for dx in 0..dxs {
-                                            let v = below_vals[base + dx + sx * dy + sxy * dz];
-                                            if v.is_finite() {
-                                                sum += v as f64;
-                                                n += 1;
-                                            }
-                                        }
-                                    }
-                                }
-                                if n == 0 {
-                                    f32::NAN
-                                } else {
-                                    (sum / n as f64) as f32
-                                }
-                            };
-                            *out = v;
-                            inside.push(v);
-                        }
+                chunk.fill(0.0);
+                halve(
+                    &below_vals,
+                    Grid::dense(size[0], size[1]),
+                    std::array::from_fn(|q| m[q] - 2 * lo[q]),
+                    out,
+                    attribute == Attribute::Phase,
+                    &mut chunk,
+                    Grid::dense(b, b),
+                );
+                self.round_to_stored(a, &mut chunk);
+                let mut stats = BrickStats::new();
+                for z in 0..out[2] {
+                    for y in 0..out[1] {
+                        stats.add(&chunk[b * (y + b * z)..][..out[0]]);
                     }
                 }
-                self.round_to_stored(a, &mut chunk);
-                self.round_to_stored(a, &mut inside);
-                let mut stats = BrickStats::new();
-                stats.add(&inside);
                 let (range, s, sq) = stats.finish();
                 ranges[a].push(range);
                 for q in 0..3 {

@@ -30,7 +30,8 @@
 //! - [`zarr`]: zarr v3 metadata and chunks read as bounded input (regular files only,
 //!   sizes checked, chunks decoded into their known size).
 //! - [`input`]: the sources read in columns (SEG-Y, NIfTI, raw), never whole.
-//! - [`convert`]: `arbvis convert` (streamed, parallel, resumable; memory bound);
+//! - [`convert`]: `arbvis convert` (streamed, parallel, resumable; memory bound), with
+//!   `filter`: the level filter and a brick's statistics;
 //!   [`progress`]: its lock and progress log.
 //! - [`describe`]: `arbvis inspect STORE`.
 //! - [`mdio`]: MDIO v1 datasets (written by mdio-python) opened in place as one level.
@@ -44,6 +45,7 @@ pub mod check;
 pub mod compression;
 pub mod convert;
 pub mod describe;
+mod filter;
 pub mod input;
 pub mod layout;
 pub mod lod;
