@@ -153,12 +153,52 @@ pub fn data_file(relative: &str) -> std::path::PathBuf {
     path
 }
 
-/// A fresh, empty folder for one test's files (emptied at the start of each run).
+/// A fresh, empty folder for one test's files (emptied at the start of each run). The
+/// first call of a run also removes what earlier runs left behind ([`sweep_stale`]).
 pub fn temp_dir(name: &str) -> std::path::PathBuf {
+    static SWEEP: std::sync::Once = std::sync::Once::new();
+    SWEEP.call_once(|| sweep_stale(&std::env::temp_dir()));
     let d = std::env::temp_dir().join(format!("arbvis-test-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// The process id a test file or folder in the temporary folder was named after
+/// (`arbvis-...-PID` or `arbvis-...-PID-...`: the first all-digit part), if any.
+pub fn owner_pid(name: &str) -> Option<u32> {
+    let rest = name.strip_prefix("arbvis-")?;
+    rest.split(['-', '.'])
+        .find(|part| !part.is_empty() && part.bytes().all(|b| b.is_ascii_digit()))
+        .and_then(|part| part.parse().ok())
+}
+
+/// Remove the `arbvis-*` files and folders in `tmp` named after a process that is no
+/// longer running (where `/proc` tells): the tests name what they write after their
+/// process and most leave it for inspection, so without this every run of the suite
+/// left its 100 MB or so behind for good. Whatever a live process owns stays.
+pub fn sweep_stale(tmp: &std::path::Path) {
+    if !std::path::Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(tmp) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(owner_pid) else {
+            continue;
+        };
+        if std::path::Path::new(&format!("/proc/{pid}")).exists() {
+            continue;
+        }
+        let path = entry.path();
+        // Never follow a link out of the temporary folder: remove the link itself.
+        let _ = match entry.file_type() {
+            Ok(t) if t.is_dir() => std::fs::remove_dir_all(&path),
+            _ => std::fs::remove_file(&path),
+        };
+    }
 }
 
 /// The 3D-opacity parameters of `scene` (a test's own scene: anything else is a bug).
@@ -277,4 +317,46 @@ pub fn rows_of(columns: &[Vec<String>], points: usize) -> Vec<String> {
                 .join(" ")
         })
         .collect()
+}
+
+/// The sweep removes exactly what a finished process left: not a live process's folder,
+/// not a name without a process id, not what a link points to.
+#[test]
+fn the_sweep_removes_only_what_finished_runs_left() {
+    let root = temp_dir("sweep");
+    let tmp = root.join("tmp");
+    let outside = root.join("outside");
+    std::fs::create_dir_all(&tmp).unwrap();
+    std::fs::create_dir_all(&outside).unwrap();
+    std::fs::write(outside.join("keep"), b"x").unwrap();
+    // No process has an id this large (Linux caps them at 2^22).
+    let dead = 3_999_999_999u32;
+    let own = std::process::id();
+    let stale_dir = tmp.join(format!("arbvis-test-copc-lod-render-{dead}"));
+    std::fs::create_dir_all(stale_dir.join("inner")).unwrap();
+    std::fs::write(stale_dir.join("inner/file"), b"x").unwrap();
+    let stale_file = tmp.join(format!("arbvis-fuzz-copc-{dead}-ThreadId(7).copc.laz"));
+    std::fs::write(&stale_file, b"x").unwrap();
+    let stale_link = tmp.join(format!("arbvis-link-{dead}"));
+    std::os::unix::fs::symlink(&outside, &stale_link).unwrap();
+    let live = tmp.join(format!("arbvis-test-i17-open-clip-{own}"));
+    std::fs::create_dir_all(&live).unwrap();
+    let unnamed = tmp.join("arbvis-vtk-points");
+    std::fs::create_dir_all(&unnamed).unwrap();
+    let foreign = tmp.join(format!("other-{dead}"));
+    std::fs::create_dir_all(&foreign).unwrap();
+    assert_eq!(owner_pid("arbvis-test-i17-open-clip-123"), Some(123));
+    assert_eq!(owner_pid("arbvis-vtk-points"), None);
+    sweep_stale(&tmp);
+    for gone in [&stale_dir, &stale_file, &stale_link] {
+        assert!(
+            std::fs::symlink_metadata(gone).is_err(),
+            "{} left",
+            gone.display()
+        );
+    }
+    for kept in [&live, &unnamed, &foreign, &outside.join("keep")] {
+        assert!(kept.exists(), "{} removed", kept.display());
+    }
+    std::fs::remove_dir_all(&root).unwrap();
 }
