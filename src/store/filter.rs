@@ -255,15 +255,10 @@ mod tests {
         src[from.at(0, 0, 0)] = f32::NAN;
         let n = [3, 2, 2];
         let mut out = vec![0f32; 12];
-        halve(
-            &src,
-            from,
-            [n0, n1, n2],
-            n,
-            false,
-            &mut out,
-            Grid::dense(3, 2),
-        );
+        let into = |first: bool, out: &mut [f32]| {
+            halve(&src, from, [n0, n1, n2], n, first, out, Grid::dense(3, 2))
+        };
+        into(false, &mut out);
         for z in 0..2 {
             for y in 0..2 {
                 for x in 0..3 {
@@ -285,15 +280,7 @@ mod tests {
             }
         }
         // Phase keeps each cell's first voxel.
-        halve(
-            &src,
-            from,
-            [n0, n1, n2],
-            n,
-            true,
-            &mut out,
-            Grid::dense(3, 2),
-        );
+        into(true, &mut out);
         assert_eq!(out[1 + 3 * (1 + 2)], src[from.at(2, 2, 2)]);
         assert!(out[0].is_nan());
     }
