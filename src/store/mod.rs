@@ -31,6 +31,7 @@
 //!   sizes checked, chunks decoded into their known size).
 //! - [`input`]: the sources read in columns (SEG-Y, NIfTI, raw), never whole.
 //! - [`convert`]: `arbvis convert` (streamed, parallel, resumable; memory bound), with
+//!   `columns`: one column of a level made, cut into bricks, written and logged;
 //!   `filter`: the level filter and a brick's statistics;
 //!   [`progress`]: its lock and progress log.
 //! - [`describe`]: `arbvis inspect STORE`.
@@ -42,6 +43,7 @@
 
 pub mod cache;
 pub mod check;
+mod columns;
 pub mod compression;
 pub mod convert;
 pub mod describe;
