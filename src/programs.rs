@@ -73,6 +73,12 @@ pub const CELLPROJ_VOLUME_ORTHOGRAPHIC_ARBFP: ProgramText =
 /// GLSL twin of [`CELLPROJ_VOLUME_ORTHOGRAPHIC_ARBFP`].
 pub const CELLPROJ_VOLUME_ORTHOGRAPHIC_FRAG: ProgramText =
     program!("cellproj/volume_orthographic.frag");
+/// Volume, precise `table` with the exit per fragment: the cell's planes per corner,
+/// passed on `flat` (vertex stage).
+pub const CELLPROJ_VOLUME_CELL_VERT: ProgramText = program!("cellproj/volume_cell.vert");
+/// Volume, precise `table` per fragment: the segment between the cell's planes, then the
+/// pre-integrated table.
+pub const CELLPROJ_VOLUME_CELL_FRAG: ProgramText = program!("cellproj/volume_cell.frag");
 /// Volume, precise: the boundary faces for the entry layers (vertex stage).
 pub const CELLPROJ_VOLUME_PEEL_VERT: ProgramText = program!("cellproj/volume_peel.vert");
 /// Volume, precise: one entry layer (depth peeling of the boundary).
@@ -195,6 +201,8 @@ pub fn all_texts() -> Vec<ProgramText> {
         CELLPROJ_VOLUME_FRAG,
         CELLPROJ_VOLUME_ORTHOGRAPHIC_ARBFP,
         CELLPROJ_VOLUME_ORTHOGRAPHIC_FRAG,
+        CELLPROJ_VOLUME_CELL_VERT,
+        CELLPROJ_VOLUME_CELL_FRAG,
         CELLPROJ_VOLUME_PEEL_VERT,
         CELLPROJ_VOLUME_PEEL_FRAG,
         CELLPROJ_VOLUME_WALK_FRAG,

@@ -9,20 +9,6 @@ out vec4 color;
 void main() {
     float t = 10000.0;
     vec3 aux1 = v_vertex3 - v_vOS;
-#ifdef GUARDED_EXIT
-    // Precise `table`: the exit is the nearest plane the ray leaves through (D.N > 0, the
-    // normals outward), its t clamped to >= 0, and a cell with none (flat) has no
-    // segment. The seed's "smallest positive t_i" takes a far plane where rounding makes
-    // the near exit's t_i slightly negative (a ray entering a sliver at an edge).
-    float d;
-    d = dot(v_dir, v_normal0);
-    if (d > 0.0) t = min(t, max(dot(aux1, v_normal0) / d, 0.0));
-    d = dot(v_dir, v_normal1);
-    if (d > 0.0) t = min(t, max(dot(aux1, v_normal1) / d, 0.0));
-    d = dot(v_dir, v_normal2);
-    if (d > 0.0) t = min(t, max(dot(aux1, v_normal2) / d, 0.0));
-    if (t == 10000.0) t = 0.0;
-#else
     float ti;
     ti = dot(aux1, v_normal0) * (1.0 / dot(v_dir, v_normal0));
     if (ti > 0.0) t = min(t, ti);
@@ -30,7 +16,6 @@ void main() {
     if (ti > 0.0) t = min(t, ti);
     ti = dot(aux1, v_normal2) * (1.0 / dot(v_dir, v_normal2));
     if (ti > 0.0) t = min(t, ti);
-#endif
     vec3 coord = vec3(v_sf, v_sf + t * dot(v_gradient, v_dir), t * length(v_dir));
     color = texture(texture0, coord * program_local[0].xyz + program_local[1].xyz);
 }

@@ -601,14 +601,22 @@ fn precise_table_takes_the_nearest_exit_on_slivers() {
     let prepared = boundary_layers();
     let mut volume = spec(Sort::Mpvonc);
     volume.precise = Precise::Table;
-    let p = scene(Mode::Volume, volume, Vec::new());
-    for projection in [Projection::Perspective, Projection::Orthographic] {
+    // Precise `table` per fragment (perspective, or `exit = "fragment"`) bounds each
+    // segment by all four of the cell's planes, drawing one triangle where three faces
+    // face the viewer; per vertex (orthographic) it takes the nearest of three exits.
+    for (projection, exit) in [
+        (Projection::Perspective, Exit::Auto),
+        (Projection::Orthographic, Exit::Auto),
+        (Projection::Orthographic, Exit::Fragment),
+    ] {
+        let mut p = scene(Mode::Volume, volume.clone(), Vec::new());
+        p.exit = exit;
         let cam = camera(projection);
         let table = draw(&h, &p, &prepared, Fidelity::Precise, ProgramKind::Glsl, cam);
         let faithful = draw(&h, &p, &prepared, Fidelity::Faithful, ProgramKind::Arb, cam);
         let (t, _) = scored(&p, &prepared, &table, cam);
         let (f, _) = scored(&p, &prepared, &faithful, cam);
-        eprintln!("slivers {projection:?}: table {t:?}, faithful (the seed's exit) {f:?}");
+        eprintln!("slivers {projection:?} {exit:?}: table {t:?}, faithful (the seed's exit) {f:?}");
         // The seed's "smallest positive t_i" takes a far plane where rounding puts the
         // near exit just behind the entry (a ray entering a sliver at an edge): single
         // pixels 0.19 off here (faithful's printout; the float table before it took the

@@ -79,6 +79,7 @@
 //! from the origin (re-centred in f64); a one-tetrahedron mesh; isovalues outside the
 //! data range (nothing drawn).
 
+pub mod indices;
 pub mod order;
 pub mod preint;
 pub mod prepare;

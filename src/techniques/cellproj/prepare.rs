@@ -16,6 +16,11 @@ pub const VERTEX_COMPONENTS: [usize; 7] = [3, 1, 3, 3, 3, 3, 3];
 /// Sum of [`VERTEX_COMPONENTS`].
 pub const FLOATS_PER_VERTEX: usize = 19;
 
+/// Floats per corner vertex (precise `table` drawn per fragment, [`Prepared::corner_vertices`]):
+/// position 3, scalar 1, the four face planes `(outward unit normal, offset)` 4 each, the
+/// scalar's gradient 3 (generic attributes 0..6).
+pub const CORNER_COMPONENTS: [usize; 7] = [3, 1, 4, 4, 4, 4, 3];
+
 /// The faces of a positively oriented tetrahedron `[0, 1, 2, 3]`, each listed
 /// counter-clockwise seen from outside, with the vertex opposite it.
 pub const FACES: [([usize; 3], usize); 4] = [
@@ -317,6 +322,32 @@ impl Prepared {
             }
         }
         out
+    }
+
+    /// Vertex data of every tetrahedron's four corners: [`CORNER_COMPONENTS`], the planes
+    /// and gradient repeated at each corner (they are the cell's, read `flat`), in
+    /// parallel. A plane `(n, d)` holds the points `x` with `n·x = d`, `n` outward.
+    pub fn corner_vertices(&self) -> Vec<f32> {
+        (0..self.tets.len())
+            .into_par_iter()
+            .flat_map_iter(|t| {
+                let (p, s) = self.tet(t);
+                let mut cell = Vec::with_capacity(19);
+                for (f, _) in FACES {
+                    let n = normal(p[f[0]], p[f[1]], p[f[2]]);
+                    cell.extend([n.x, n.y, n.z, n.dot(p[f[0]])]);
+                }
+                cell.extend(gradient(p, s).to_array());
+                (0..4).flat_map(move |k| {
+                    let corner = [p[k].x, p[k].y, p[k].z, s[k]];
+                    corner
+                        .into_iter()
+                        .chain(cell.clone())
+                        .map(|x| x as f32)
+                        .collect::<Vec<f32>>()
+                })
+            })
+            .collect()
     }
 
     /// The scalar range `[min, max]` over each tetrahedron's corners.
