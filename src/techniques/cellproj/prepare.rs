@@ -328,24 +328,25 @@ impl Prepared {
     /// and gradient repeated at each corner (they are the cell's, read `flat`), in
     /// parallel. A plane `(n, d)` holds the points `x` with `n·x = d`, `n` outward.
     pub fn corner_vertices(&self) -> Vec<f32> {
+        const FLOATS: usize = 23;
         (0..self.tets.len())
             .into_par_iter()
             .flat_map_iter(|t| {
                 let (p, s) = self.tet(t);
-                let mut cell = Vec::with_capacity(19);
-                for (f, _) in FACES {
+                let mut cell = [0.0; FLOATS - 4];
+                for (k, (f, _)) in FACES.iter().enumerate() {
                     let n = normal(p[f[0]], p[f[1]], p[f[2]]);
-                    cell.extend([n.x, n.y, n.z, n.dot(p[f[0]])]);
+                    cell[4 * k..4 * k + 4].copy_from_slice(&[n.x, n.y, n.z, n.dot(p[f[0]])]);
                 }
-                cell.extend(gradient(p, s).to_array());
-                (0..4).flat_map(move |k| {
-                    let corner = [p[k].x, p[k].y, p[k].z, s[k]];
-                    corner
-                        .into_iter()
-                        .chain(cell.clone())
-                        .map(|x| x as f32)
-                        .collect::<Vec<f32>>()
-                })
+                cell[16..].copy_from_slice(&gradient(p, s).to_array());
+                let mut out = [0f32; 4 * FLOATS];
+                for (k, corner) in out.chunks_exact_mut(FLOATS).enumerate() {
+                    let own = [p[k].x, p[k].y, p[k].z, s[k]];
+                    for (o, v) in corner.iter_mut().zip(own.iter().chain(&cell)) {
+                        *o = *v as f32;
+                    }
+                }
+                out
             })
             .collect()
     }
@@ -511,6 +512,52 @@ mod tests {
             let n = normal(p[f[0]], p[f[1]], p[f[2]]);
             assert!(n.dot(p[f[0]] - centre) > 0.0, "face {f:?} points out");
             assert!(!f.contains(&o));
+        }
+    }
+
+    #[test]
+    fn corners_carry_their_cell_planes_and_gradient() {
+        let p = [
+            DVec3::new(0.3, -0.2, 0.1),
+            DVec3::new(1.1, 0.0, 0.2),
+            DVec3::new(0.2, 0.9, -0.1),
+            DVec3::new(0.1, 0.3, 1.3),
+        ];
+        let g = DVec3::new(0.7, -1.9, 0.25);
+        let mesh = crate::mesh::Mesh {
+            points: p.iter().map(|q| q.to_array()).collect(),
+            tets: vec![[0, 1, 2, 3]],
+            ..Default::default()
+        };
+        let s: Vec<f64> = p.iter().map(|q| 0.4 + g.dot(*q)).collect();
+        let prepared = from_mesh(&mesh, &s, "s".into(), [-3.0, 3.0]).unwrap();
+        let (q, sq) = prepared.tet(0);
+        let v = prepared.corner_vertices();
+        let floats: usize = CORNER_COMPONENTS.iter().sum();
+        assert_eq!(v.len(), 4 * floats);
+        let at = |i: usize| v[i] as f64;
+        for (k, corner) in (0..4).map(|k| (k, k * floats)) {
+            let own = DVec3::new(at(corner), at(corner + 1), at(corner + 2));
+            assert!((own - q[k]).length() < 1e-6 && (at(corner + 3) - sq[k]).abs() < 1e-6);
+            // f32 storage: each plane holds its face's corners and has the fourth inside.
+            for (f, (face, opposite)) in FACES.iter().enumerate() {
+                let n = DVec3::new(
+                    at(corner + 4 + 4 * f),
+                    at(corner + 5 + 4 * f),
+                    at(corner + 6 + 4 * f),
+                );
+                let d = at(corner + 7 + 4 * f);
+                assert!((n.length() - 1.0).abs() < 1e-6);
+                for &c in face {
+                    assert!((n.dot(q[c]) - d).abs() < 1e-6, "corner {k} face {f}");
+                }
+                assert!(
+                    n.dot(q[*opposite]) < d - 0.1,
+                    "corner {k} face {f} points in"
+                );
+            }
+            let grad = DVec3::new(at(corner + 20), at(corner + 21), at(corner + 22));
+            assert!((grad - gradient(q, sq)).length() < 1e-5, "{grad}");
         }
     }
 
