@@ -478,6 +478,21 @@ fn isosurfaces_inside_the_volume() {
     let (fa, _) = scored(&p, &prepared, &f, cam);
     eprintln!("both, faithful: {fa:?}");
     assert!(fa.0 < 0.06, "{fa:?}");
+    // Precise `table` in perspective draws each cell from its corners: here its front
+    // faces, whose depth is tested against the isosurfaces' (not the one back face that
+    // stands for three front faces elsewhere).
+    let mut table = spec(Sort::Mpvonc);
+    table.precise = Precise::Table;
+    let p = scene(Mode::Both, table, p.isovalues.clone());
+    let cam = camera(Projection::Perspective);
+    let image = draw(&h, &p, &prepared, Fidelity::Precise, ProgramKind::Glsl, cam);
+    let (all, inner) = scored(&p, &prepared, &image, cam);
+    eprintln!("both, precise table: {all:?} {inner:?}");
+    // A cell the isosurface cuts adds its whole segment when its front face is in front
+    // of the isosurface (the projection's limit, as faithful's): interior RMSE 0.0026
+    // measured. Drawing the back face for three front faces here too would hide such
+    // cells behind the isosurface: 0.035 measured.
+    assert!(inner.0 < 6e-3, "{inner:?}");
 }
 
 #[test]
