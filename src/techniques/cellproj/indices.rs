@@ -22,22 +22,15 @@ fn facing(p: &[DVec3; 4], viewer: Viewer) -> [f64; 4] {
 /// Indices into the face vertices (12 per tetrahedron) of the faces of `order`'s
 /// tetrahedra that may face `viewer` (within [`FACING_MARGIN`]), in that order.
 pub fn front_face_indices(prepared: &Prepared, order: &[u32], viewer: Viewer) -> Vec<u32> {
-    order
-        .par_chunks(4096)
-        .flat_map_iter(|chunk| {
-            let mut out = Vec::with_capacity(chunk.len() * 6);
-            for &t in chunk {
-                let cosines = facing(&prepared.tet(t as usize).0, viewer);
-                for (k, c) in cosines.into_iter().enumerate() {
-                    if c < FACING_MARGIN {
-                        let base = t * 12 + k as u32 * 3;
-                        out.extend([base, base + 1, base + 2]);
-                    }
-                }
+    in_order(order, |t, out| {
+        let cosines = facing(&prepared.tet(t as usize).0, viewer);
+        for (k, c) in cosines.into_iter().enumerate() {
+            if c < FACING_MARGIN {
+                let base = t * 12 + k as u32 * 3;
+                out.extend([base, base + 1, base + 2]);
             }
-            out
-        })
-        .collect()
+        }
+    })
 }
 
 /// Indices into the corner vertices (4 per tetrahedron, [`Prepared::corner_vertices`])
@@ -48,28 +41,34 @@ pub fn front_face_indices(prepared: &Prepared, order: &[u32], viewer: Viewer) ->
 /// a mesh's cells). Its fragments lie at the back of the cell, so `merge` only where
 /// nothing tests their depth.
 pub fn cell_indices(prepared: &Prepared, order: &[u32], viewer: Viewer, merge: bool) -> Vec<u32> {
+    in_order(order, |t, out| {
+        let cosines = facing(&prepared.tet(t as usize).0, viewer);
+        let corner = |i: usize| t * 4 + i as u32;
+        let clear = cosines.iter().filter(|&&c| c < -FACING_MARGIN).count();
+        match cosines.iter().position(|&c| c > FACING_MARGIN) {
+            Some(back) if merge && clear == 3 => {
+                let f = FACES[back].0;
+                out.extend([corner(f[0]), corner(f[2]), corner(f[1])]);
+            }
+            _ => {
+                for (k, c) in cosines.into_iter().enumerate() {
+                    if c < FACING_MARGIN {
+                        out.extend(FACES[k].0.map(corner));
+                    }
+                }
+            }
+        }
+    })
+}
+
+/// What `emit` appends for each of `order`'s tetrahedra, in that order (in parallel).
+fn in_order(order: &[u32], emit: impl Fn(u32, &mut Vec<u32>) + Sync) -> Vec<u32> {
     order
         .par_chunks(4096)
         .flat_map_iter(|chunk| {
-            let mut out = Vec::with_capacity(chunk.len() * 5);
+            let mut out = Vec::with_capacity(chunk.len() * 6);
             for &t in chunk {
-                let cosines = facing(&prepared.tet(t as usize).0, viewer);
-                let corner = |i: usize| t * 4 + i as u32;
-                let clear = cosines.iter().filter(|&&c| c < -FACING_MARGIN).count();
-                let back = cosines.iter().position(|&c| c > FACING_MARGIN);
-                match back {
-                    Some(k) if merge && clear == 3 => {
-                        let f = FACES[k].0;
-                        out.extend([corner(f[0]), corner(f[2]), corner(f[1])]);
-                    }
-                    _ => {
-                        for (k, c) in cosines.into_iter().enumerate() {
-                            if c < FACING_MARGIN {
-                                out.extend(FACES[k].0.map(corner));
-                            }
-                        }
-                    }
-                }
+                emit(t, &mut out);
             }
             out
         })

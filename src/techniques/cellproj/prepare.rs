@@ -515,15 +515,20 @@ mod tests {
         }
     }
 
-    #[test]
-    fn corners_carry_their_cell_planes_and_gradient() {
+    /// A tetrahedron with no symmetry, and a linear field's gradient over it.
+    fn skewed_cell() -> ([DVec3; 4], DVec3) {
         let p = [
             DVec3::new(0.3, -0.2, 0.1),
             DVec3::new(1.1, 0.0, 0.2),
             DVec3::new(0.2, 0.9, -0.1),
             DVec3::new(0.1, 0.3, 1.3),
         ];
-        let g = DVec3::new(0.7, -1.9, 0.25);
+        (p, DVec3::new(0.7, -1.9, 0.25))
+    }
+
+    #[test]
+    fn corners_carry_their_cell_planes_and_gradient() {
+        let (p, g) = skewed_cell();
         let mesh = crate::mesh::Mesh {
             points: p.iter().map(|q| q.to_array()).collect(),
             tets: vec![[0, 1, 2, 3]],
@@ -563,13 +568,7 @@ mod tests {
 
     #[test]
     fn gradient_of_a_linear_field_is_exact() {
-        let p = [
-            DVec3::new(0.3, -0.2, 0.1),
-            DVec3::new(1.1, 0.0, 0.2),
-            DVec3::new(0.2, 0.9, -0.1),
-            DVec3::new(0.1, 0.3, 1.3),
-        ];
-        let g = DVec3::new(0.7, -1.9, 0.25);
+        let (p, g) = skewed_cell();
         let s = p.map(|q| 0.4 + g.dot(q));
         assert!((gradient(p, s) - g).length() < 1e-12);
         let flat = [p[0], p[1], p[2], (p[1] + p[2]) / 2.0];
