@@ -5,6 +5,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::prepare::{Prepared, Viewer, FACES, FACING_MARGIN};
+use crate::camera::Projection;
+use crate::techniques::Frame;
 
 /// Per face of a tetrahedron with corners `p`: the cosine between its outward normal
 /// and the direction from `viewer` (below 0: it faces the viewer; NaN: no area).
@@ -73,6 +75,23 @@ fn in_order(order: &[u32], emit: impl Fn(u32, &mut Vec<u32>) + Sync) -> Vec<u32>
             out
         })
         .collect()
+}
+
+/// The eye in object space (perspective) and the unit view direction (both cameras).
+pub fn eye_and_direction(frame: &Frame) -> (DVec3, DVec3) {
+    let inverse = frame.camera.view().inverse();
+    let eye = inverse.transform_point3(DVec3::ZERO);
+    let dir = inverse.transform_vector3(DVec3::NEG_Z).normalize();
+    (eye, dir)
+}
+
+/// The viewer of a frame, in object space (what [`Order::View`] sorts and culls for).
+pub fn viewer(frame: &Frame) -> Viewer {
+    let (eye, dir) = eye_and_direction(frame);
+    match frame.camera.projection {
+        Projection::Orthographic => Viewer::Parallel(dir),
+        Projection::Perspective => Viewer::Eye(eye),
+    }
 }
 
 #[cfg(test)]

@@ -89,7 +89,7 @@ pub fn program_pair(variant: Variant, kind: ProgramKind) -> GlResult<ProgramPair
     })
 }
 
-pub use super::volume::{eye_and_direction, viewer};
+pub use super::indices::{eye_and_direction, viewer};
 
 /// The cell-projection renderer.
 pub struct CellprojRenderer {
@@ -540,6 +540,7 @@ pub fn program_pairs() -> Vec<ProgramPair> {
         super::volume::faithful_pair(ProgramKind::Glsl, false),
         super::volume::faithful_pair(ProgramKind::Arb, true),
         super::volume::faithful_pair(ProgramKind::Glsl, true),
+        super::volume::cell_pair(),
     ])
     .chain(super::volume::precise_pairs())
     .collect()
