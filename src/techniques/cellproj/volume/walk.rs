@@ -275,18 +275,13 @@ impl Precise {
             }
         }
         let boundary = Mesh::new(gpu, "cellproj volume boundary faces", &[3, 1, 4], &boundary)?;
-        let quad: Vec<f32> = [
-            (-1.0, -1.0),
-            (1.0, -1.0),
-            (1.0, 1.0),
-            (-1.0, -1.0),
-            (1.0, 1.0),
-            (-1.0, 1.0),
-        ]
-        .iter()
-        .flat_map(|&(x, y)| [x, y, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0])
-        .collect();
-        let quad = Mesh::new(gpu, "cellproj volume full-screen quad", &[4, 4], &quad)?;
+        // The walk reads gl_FragCoord, not the quad's texture coordinates.
+        let quad = Mesh::new(
+            gpu,
+            "cellproj volume full-screen quad",
+            &[4, 4],
+            &crate::techniques::quad::quad_vertices(),
+        )?;
         let cap = entry_cap(spec, convex);
         Ok(Precise {
             peel,
