@@ -85,6 +85,9 @@ pub const CELLPROJ_VOLUME_PEEL_VERT: ProgramText = program!("cellproj/volume_pee
 pub const CELLPROJ_VOLUME_PEEL_FRAG: ProgramText = program!("cellproj/volume_peel.frag");
 /// Volume, precise: the neighbour walk (joined with [`CELLPROJ_VOLUME_INTEGRAL_GLSL`]).
 pub const CELLPROJ_VOLUME_WALK_FRAG: ProgramText = program!("cellproj/volume_walk.frag");
+/// Volume, precise `grid`: the mesh resampled to a grid and ray cast (joined with
+/// [`CELLPROJ_VOLUME_INTEGRAL_GLSL`]).
+pub const CELLPROJ_VOLUME_GRID_FRAG: ProgramText = program!("cellproj/volume_grid.frag");
 /// Volume, precise as a projection: exact integral per fragment, CPU order.
 pub const CELLPROJ_VOLUME_PROJECTED_FRAG: ProgramText = program!("cellproj/volume_projected.frag");
 /// Volume, precise: the exact segment integral, a GLSL part joined before a main.
@@ -206,6 +209,7 @@ pub fn all_texts() -> Vec<ProgramText> {
         CELLPROJ_VOLUME_PEEL_VERT,
         CELLPROJ_VOLUME_PEEL_FRAG,
         CELLPROJ_VOLUME_WALK_FRAG,
+        CELLPROJ_VOLUME_GRID_FRAG,
         CELLPROJ_VOLUME_PROJECTED_FRAG,
         CELLPROJ_VOLUME_INTEGRAL_GLSL,
         SPLATS_VERT,

@@ -18,6 +18,8 @@ pub enum TexelFormat {
     Rgba32f,
     /// 1 x f32.
     R32f,
+    /// 2 x f32.
+    Rg32f,
     /// 1 x u8 (normalized; the era's LUMINANCE8).
     R8,
     /// 3 x f16, filled from u8 data (normalized k/255, converted by GL): filtering in
@@ -54,6 +56,7 @@ impl TexelFormat {
             TexelFormat::Rgba8 => 4,
             TexelFormat::Rgba32f => 16,
             TexelFormat::R32f => 4,
+            TexelFormat::Rg32f => 8,
             TexelFormat::R8 => 1,
             TexelFormat::Rgb16f => 6,
             TexelFormat::Rgba32fFromU8 => 16,
@@ -84,7 +87,10 @@ impl TexelFormat {
 
     fn source_kind(self) -> SourceKind {
         match self {
-            TexelFormat::Rgba32f | TexelFormat::R32f | TexelFormat::Rgba16f => SourceKind::F32,
+            TexelFormat::Rgba32f
+            | TexelFormat::R32f
+            | TexelFormat::Rg32f
+            | TexelFormat::Rgba16f => SourceKind::F32,
             TexelFormat::Rgba32ui | TexelFormat::R32ui | TexelFormat::Rg32ui => SourceKind::U32,
             _ => SourceKind::U8,
         }
@@ -96,6 +102,7 @@ impl TexelFormat {
             TexelFormat::Rgba8 => (glow::RGBA8, glow::RGBA, glow::UNSIGNED_BYTE),
             TexelFormat::Rgba32f => (glow::RGBA32F, glow::RGBA, glow::FLOAT),
             TexelFormat::R32f => (glow::R32F, glow::RED, glow::FLOAT),
+            TexelFormat::Rg32f => (glow::RG32F, glow::RG, glow::FLOAT),
             TexelFormat::R8 => (glow::R8, glow::RED, glow::UNSIGNED_BYTE),
             TexelFormat::Rgb16f => (glow::RGB16F, glow::RGB, glow::UNSIGNED_BYTE),
             TexelFormat::Rgba32fFromU8 => (glow::RGBA32F, glow::RGBA, glow::UNSIGNED_BYTE),
@@ -116,6 +123,7 @@ impl TexelFormat {
             TexelFormat::Rgba8 => "RGBA8",
             TexelFormat::Rgba32f => "RGBA32F",
             TexelFormat::R32f => "R32F",
+            TexelFormat::Rg32f => "RG32F",
             TexelFormat::R8 => "R8",
             TexelFormat::Rgb16f => "RGB16F",
             TexelFormat::Rgba32fFromU8 => "RGBA32F",

@@ -69,9 +69,11 @@ pub struct BenchOptions {
     /// 2D fetch (fill rate), the 3D fetch, dependent table fetches, RGBA8 / RGBA32F.
     #[arg(long)]
     pub breakdown: bool,
-    /// Cell-projection volume settings, e.g. centroid:64,mpvonc:128,precise,projected
-    /// (faithful with a table of N x N x N/2 texels, the precise walk, or precise as a
-    /// projection in MPVONC order with the exact integral per fragment).
+    /// Cell-projection volume settings, e.g. centroid:64,mpvonc:128,precise,projected,
+    /// table:128,grid:64 (faithful with a table of N x N x N/2 texels, the precise walk,
+    /// precise as a projection in MPVONC order with the exact integral per fragment or
+    /// with a float table of N x N x N/2, or the mesh resampled to a grid of N points
+    /// along its longest side and ray cast).
     #[arg(long, value_delimiter = ',')]
     pub cellproj: Vec<String>,
     /// Turn the camera this many degrees about the vertical axis before every frame,
@@ -290,6 +292,13 @@ fn cellproj_settings(
                     .with_context(|| format!("--cellproj {name}: the table size after ':'"))?;
                 volume.table_size = [n, (n / 2).max(2)];
             }
+            "grid" => {
+                s.fidelity = Fidelity::Precise;
+                volume.precise = crate::techniques::cellproj::transfer::Precise::Grid;
+                volume.grid = size
+                    .parse()
+                    .with_context(|| format!("--cellproj {name}: the grid's points after ':'"))?;
+            }
             "centroid" | "mpvonc" => {
                 s.fidelity = Fidelity::Faithful;
                 volume.sort = if kind == "centroid" {
@@ -303,7 +312,7 @@ fn cellproj_settings(
                 volume.table_size = [n, (n / 2).max(2)];
             }
             _ => bail!(
-                "--cellproj {name}: centroid:N, mpvonc:N, precise (the walk), projected or table:N"
+                "--cellproj {name}: centroid:N, mpvonc:N, precise (the walk), projected, table:N or grid:N"
             ),
         }
         c.volume = Some(volume);

@@ -56,6 +56,12 @@ pub fn quad_vertices() -> Vec<f32> {
     .collect()
 }
 
+/// A mesh of [`quad_vertices`] (attributes 4 + 4), labelled `label`: the full-screen
+/// passes' quad.
+pub fn quad_mesh(gpu: &Gpu, label: &str) -> GlResult<Mesh> {
+    Mesh::new(gpu, label, &[4, 4], &quad_vertices())
+}
+
 /// The quad's transform: the camera's rotation and zoom; depth halved so a rotated quad
 /// stays inside the clip volume. Identity for the default camera.
 pub fn transform(frame: &Frame) -> DMat4 {
@@ -74,7 +80,7 @@ impl QuadRenderer {
     pub fn new(gpu: &Gpu, kind: ProgramKind, params: &QuadScene) -> GlResult<QuadRenderer> {
         let pair = programs::with_transform(kind, &programs::QUAD_ARBFP, &programs::QUAD_FRAG);
         let program = Program::new(gpu, kind, &pair.vertex, &pair.fragment)?;
-        let mesh = Mesh::new(gpu, "quad", &[4, 4], &quad_vertices())?;
+        let mesh = quad_mesh(gpu, "quad")?;
         let renderer = QuadRenderer { program, mesh };
         renderer.set_colours(gpu, params)?;
         Ok(renderer)

@@ -19,7 +19,9 @@ use egui::{TextureHandle, TextureOptions, Vec2};
 use super::curve;
 use super::widgets::Widgets;
 use crate::colortable::ColorTable;
-use crate::techniques::cellproj::transfer::{Precise, Sort, Transfer, VolumeSpec, MAX_POINTS};
+use crate::techniques::cellproj::transfer::{
+    Precise, Sort, Transfer, VolumeSpec, MAX_GRID, MAX_POINTS,
+};
 use crate::techniques::cellproj::{CellprojScene, Mode};
 
 /// Largest side of the pre-integrated table offered (256² x 256 = 2^24 texels, the most
@@ -221,6 +223,7 @@ pub fn editor(
             (Precise::Walk, "walk"),
             (Precise::Projected, "projected"),
             (Precise::Table, "table"),
+            (Precise::Grid, "grid"),
         ] {
             changed |= w.radio(ui, &format!("Precise {label}"), &mut spec.precise, p);
         }
@@ -242,6 +245,16 @@ pub fn editor(
         "table length",
         true,
     );
+    if spec.precise == Precise::Grid {
+        changed |= w.slider(
+            ui,
+            "Volume grid points",
+            &mut spec.grid,
+            2..=MAX_GRID,
+            "grid points (longest side)",
+            true,
+        );
+    }
     changed
 }
 

@@ -28,7 +28,7 @@ pub(crate) fn prepared_of(mesh: &Mesh) -> Prepared {
     from_mesh(mesh, &s.values, s.name, s.range).unwrap()
 }
 
-fn grid(n: usize, field: Field) -> Mesh {
+pub(crate) fn grid(n: usize, field: Field) -> Mesh {
     generate(&GridSpec {
         points: [n; 3],
         field,
@@ -80,11 +80,11 @@ pub(crate) fn scene(mode: Mode, volume: VolumeSpec, isovalues: Vec<Isovalue>) ->
 }
 
 /// A rotated camera that sees all three axes (no face is edge-on).
-fn camera(projection: Projection) -> Camera {
+pub(crate) fn camera(projection: Projection) -> Camera {
     common::seed_grid_camera(projection)
 }
 
-fn draw(
+pub(crate) fn draw(
     h: &Headless,
     params: &CellprojScene,
     prepared: &Prepared,
@@ -173,7 +173,7 @@ pub(crate) fn reference_image(
 }
 
 /// ((RMSE, max) over the image, (RMSE, max) over interior pixels) against the reference.
-fn scored(
+pub(crate) fn scored(
     params: &CellprojScene,
     prepared: &Prepared,
     image: &Image,
@@ -521,12 +521,10 @@ fn extremes_stay_finite_and_close_to_the_reference() {
     assert!(all.0 < 1e-3, "camera inside: {all:?}");
     // A constant field (sf = sb everywhere; homogeneous segments) and nearly opaque
     // cells (opacity value 1 per 0.002 units: every segment is opaque).
-    let mut flat = grid(5, Field::Planar);
-    flat.point_arrays[0]
-        .values
-        .iter_mut()
-        .for_each(|v| *v = 0.5);
-    let flat = prepared_of(&flat);
+    // (The scalars handed over normalized: a constant's own range maps it to 0, which
+    // the transfer function keeps clear, and the picture would be empty.)
+    let flat = grid(5, Field::Planar);
+    let flat = from_mesh(&flat, &vec![0.5; flat.points.len()], "s".into(), [0.0, 1.0]).unwrap();
     let mut opaque = spec(Sort::Mpvonc);
     opaque.unit_distance = 0.002;
     for (name, prepared, volume) in [
@@ -543,6 +541,12 @@ fn extremes_stay_finite_and_close_to_the_reference() {
             };
             let image = draw(&h, &p, prepared, fidelity, kind, cam);
             assert!(image.data.iter().all(|v| v.is_finite()), "{name}");
+            let lit = image
+                .data
+                .chunks(4)
+                .filter(|p| (p[0] - 0.1).abs() > 0.05)
+                .count();
+            assert!(lit > image.data.len() / 16, "{name}: {lit} pixels lit");
             let (all, _) = scored(&p, prepared, &image, cam);
             eprintln!("{name} {fidelity:?}: {all:?}");
             // Precise: the 1e-3 goal; faithful: 8-bit table and target (the first
@@ -732,6 +736,8 @@ fn malformed_transfer_functions_are_refused_at_their_line_and_column() {
         ("unit_distance = -1.0", 7, "unit_distance"),
         ("table = { builtin = \"nope\" }", 7, "builtin"),
         ("table_size = [1, 64]", 7, "table_size"),
+        ("grid = 1", 7, "grid"),
+        ("precise = \"grid\"\ngrid = 401", 8, "grid"),
     ] {
         let e = Scene::parse(&text(volume), "bad.toml")
             .unwrap_err()
@@ -739,6 +745,13 @@ fn malformed_transfer_functions_are_refused_at_their_line_and_column() {
         assert!(e.starts_with(&format!("bad.toml:{line}:")), "{e}");
         assert!(e.contains(what), "{e}");
     }
+    // Precise `grid` casts the volume alone: with isosurfaces it is refused.
+    let both = text("precise = \"grid\"").replace("mode = \"volume\"", "mode = \"both\"");
+    let e = Scene::parse(&both, "both.toml").unwrap_err().to_string();
+    assert!(
+        e.starts_with("both.toml:") && e.contains("mode = \"volume\""),
+        "{e}"
+    );
     let ok = Scene::parse(
         &text("points = [[0.0, 0, 0, 0, 0], [1.0, 1, 1, 1, 1]]"),
         "ok.toml",
@@ -767,15 +780,35 @@ fn transfer_function_edits_draw_what_a_fresh_renderer_draws() {
     coarse.table_size = coarse.table_size.map(|s| s / 8);
     // Zero bands: the edit changes which tetrahedra are drawn.
     let bands = banded(Sort::Mpvonc);
-    for fidelity in [Fidelity::Faithful, Fidelity::Precise] {
+    // Precise `grid` too, its grid's size edited among the rest (a new grid, not only
+    // new tables).
+    let as_grid = |v: &VolumeSpec, points| VolumeSpec {
+        precise: Precise::Grid,
+        grid: points,
+        ..v.clone()
+    };
+    for (fidelity, grid) in [
+        (Fidelity::Faithful, None),
+        (Fidelity::Precise, None),
+        (Fidelity::Precise, Some(13)),
+    ] {
         let target = target_for(gpu, fidelity);
-        let first_scene = scene(Mode::Volume, first.clone(), vec![]);
+        let steps: Vec<VolumeSpec> = [
+            &second, &coarse, &second, &bands, &coarse, &first, &bands, &second,
+        ]
+        .iter()
+        .enumerate()
+        .map(|(k, &v)| match grid {
+            Some(n) => as_grid(v, if k == 4 { n + 8 } else { n }),
+            None => v.clone(),
+        })
+        .collect();
+        let first = grid.map_or(first.clone(), |n| as_grid(&first, n));
+        let first_scene = scene(Mode::Volume, first, vec![]);
         let mut r = glsl_renderer(gpu, fidelity, &first_scene, &prepared);
         let picture = |r: &mut CellprojRenderer| picture_of(gpu, r, &target, &frame);
         picture(&mut r);
-        for step in [
-            &second, &coarse, &second, &bands, &coarse, &first, &bands, &second,
-        ] {
+        for step in &steps {
             let params = scene(Mode::Volume, step.clone(), vec![]);
             r.update(gpu, arbvis::techniques::Params::of(&params))
                 .unwrap();

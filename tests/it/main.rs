@@ -8,6 +8,7 @@ mod common;
 
 mod cellproj;
 mod cellproj_entries;
+mod cellproj_grid;
 mod cellproj_volume;
 mod cli;
 mod clip;

@@ -95,12 +95,12 @@ pub fn viewer(frame: &Frame) -> Viewer {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::mesh::Mesh;
 
     /// `count` random tetrahedra (positively oriented, some slivers) in the unit box.
-    fn random_cells(count: usize, seed: u64) -> Prepared {
+    pub(crate) fn random_cells(count: usize, seed: u64) -> Prepared {
         let mut state = seed;
         let mut next = move || {
             state ^= state << 13;

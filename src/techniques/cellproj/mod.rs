@@ -318,6 +318,13 @@ impl CellprojScene {
         }
         if let Some(v) = &self.volume {
             v.validate().map_err(|e| e.within("volume"))?;
+            if self.mode == Mode::Both && v.precise == transfer::Precise::Grid {
+                return Err(FieldError::new(
+                    "volume.precise",
+                    "grid casts the volume alone (mode = \"volume\"); the walk and table \
+                     draw it with isosurfaces",
+                ));
+            }
         }
         if !(2..=4096).contains(&self.table_size) {
             return Err(FieldError::new(

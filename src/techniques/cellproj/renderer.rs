@@ -541,6 +541,7 @@ pub fn program_pairs() -> Vec<ProgramPair> {
         super::volume::faithful_pair(ProgramKind::Arb, true),
         super::volume::faithful_pair(ProgramKind::Glsl, true),
         super::volume::cell_pair(),
+        super::volume::grid_pair(),
     ])
     .chain(super::volume::precise_pairs())
     .collect()

@@ -66,6 +66,10 @@ pub struct VolumeSpec {
     /// Precise mode's method.
     #[serde(default)]
     pub precise: Precise,
+    /// Precise `grid`: points along the mesh box's longest side of the grid it is
+    /// resampled onto.
+    #[serde(default = "default_grid")]
+    pub grid: u32,
 }
 
 /// How precise mode draws.
@@ -82,6 +86,10 @@ pub enum Precise {
     /// (RGBA32F table, float target): the era's method without its 8-bit losses, fast;
     /// its error is the table's resolution (and the order's, on non-convex meshes).
     Table,
+    /// The mesh resampled onto a regular grid (`grid` points along its longest side) and
+    /// ray cast with a pre-integrated table: not cell projection, fast where the cells
+    /// are about the grid's size; its error is the resampling's and the table's.
+    Grid,
 }
 
 /// How the table is built.
@@ -104,6 +112,13 @@ pub enum Sort {
     Mpvonc,
     /// By centroid depth, as VTK's projected tetrahedra.
     Centroid,
+}
+
+/// The most points along a side of precise `grid`'s grid (400³ points: 512 MB).
+pub const MAX_GRID: u32 = 400;
+
+fn default_grid() -> u32 {
+    64
 }
 
 fn default_table() -> [u32; 2] {
@@ -137,6 +152,7 @@ impl Default for VolumeSpec {
             build: Default::default(),
             entries: 0,
             precise: Precise::Walk,
+            grid: default_grid(),
         }
     }
 }
@@ -191,6 +207,15 @@ impl VolumeSpec {
                 format!(
                     "{:?}: each in 2..=512 and n² m at most 2^24 texels",
                     self.table_size
+                ),
+            ));
+        }
+        if !(2..=MAX_GRID).contains(&self.grid) {
+            return Err(FieldError::new(
+                "grid",
+                format!(
+                    "{}: points along the longest side, 2..={MAX_GRID}",
+                    self.grid
                 ),
             ));
         }

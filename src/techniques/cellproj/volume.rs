@@ -55,7 +55,10 @@ use crate::programs::{self, ProgramPair};
 use crate::techniques::Frame;
 use crate::vocab::Fidelity;
 
+mod grid;
 mod walk;
+use grid::GridCaster;
+pub use grid::{grid_pair, resample, Resampled};
 use walk::{entry_cap, tf_texture, Precise};
 pub use walk::{precise_pairs, with_integral};
 
@@ -139,6 +142,7 @@ pub struct VolumeRenderer {
     convex: bool,
     faithful: Option<Faithful>,
     precise: Option<Precise>,
+    grid: Option<GridCaster>,
     times: VolumeTimes,
     tets: usize,
     /// The transfer function changed since its textures were made (remade at the next
@@ -269,6 +273,7 @@ impl VolumeRenderer {
             convex,
             faithful: None,
             precise: None,
+            grid: None,
             times: VolumeTimes::default(),
             tets: prepared.tets.len(),
             stale: false,
@@ -290,6 +295,9 @@ impl VolumeRenderer {
             Fidelity::Precise if spec.precise == super::transfer::Precise::Table => {
                 r.float_table = true;
                 r.faithful = Some(r.build_faithful(gpu, ProgramKind::Glsl)?)
+            }
+            Fidelity::Precise if spec.precise == super::transfer::Precise::Grid => {
+                r.grid = Some(GridCaster::new(gpu, prepared, spec, &r.transfer)?)
             }
             Fidelity::Precise => {
                 r.precise = Some(Precise::new(
@@ -417,7 +425,7 @@ impl VolumeRenderer {
 
     /// Whether `old` and `new` differ only in what [`VolumeRenderer::set_transfer`] takes.
     pub fn transfer_only(old: &VolumeSpec, new: &VolumeSpec) -> bool {
-        old.precise == new.precise
+        old.precise == new.precise && old.grid == new.grid
     }
 
     fn refresh(&mut self, gpu: &Gpu) -> GlResult<()> {
@@ -451,6 +459,9 @@ impl VolumeRenderer {
         }
         if let Some(p) = &mut self.precise {
             p.tf = tf_texture(gpu, &self.transfer)?;
+        }
+        if let Some(g) = &mut self.grid {
+            g.set_transfer(gpu, &self.spec, &self.transfer)?;
         }
         Ok(())
     }
@@ -488,6 +499,9 @@ impl VolumeRenderer {
         self.refresh(gpu)?;
         if self.faithful.is_some() {
             self.draw_faithful(gpu, surface, frame, prepared, depth_test)
+        } else if let Some(g) = &self.grid {
+            self.times.drawn = self.tets;
+            g.draw(gpu, surface, frame, &self.spec)
         } else {
             self.times.drawn = self.tets;
             let p = self.precise.as_mut().expect("precise");

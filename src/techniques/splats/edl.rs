@@ -60,12 +60,7 @@ impl EdlPass {
             depth: Target::with_depth(gpu, width, height, TargetFormat::Rgba32f)?,
             depth_program,
             shade,
-            quad: Mesh::new(
-                gpu,
-                "splats EDL quad",
-                &[4, 4],
-                &crate::techniques::quad::quad_vertices(),
-            )?,
+            quad: crate::techniques::quad::quad_mesh(gpu, "splats EDL quad")?,
         })
     }
 

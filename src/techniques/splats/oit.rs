@@ -33,7 +33,7 @@ use crate::gl::{
     self, Blend, DrawCall, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind, Surface, Target,
 };
 use crate::programs;
-use crate::techniques::quad::quad_vertices;
+use crate::techniques::quad::quad_mesh;
 use crate::vocab::TargetFormat;
 
 /// The weight the GPU programs compute (eq. 7), for comparisons with the reference.
@@ -67,7 +67,7 @@ impl OitPass {
         );
         let composite = Program::new(gpu, kind, &pair.vertex, &pair.fragment)?;
         composite.set_transform(gpu, DMat4::IDENTITY)?;
-        let quad = Mesh::new(gpu, "splats OIT composite quad", &[4, 4], &quad_vertices())?;
+        let quad = quad_mesh(gpu, "splats OIT composite quad")?;
         Ok(OitPass {
             accum: Target::new(gpu, width, height, TargetFormat::Rgba32f)?,
             reveal: Target::new(gpu, width, height, TargetFormat::Rgba32f)?,

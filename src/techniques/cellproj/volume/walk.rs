@@ -276,12 +276,7 @@ impl Precise {
         }
         let boundary = Mesh::new(gpu, "cellproj volume boundary faces", &[3, 1, 4], &boundary)?;
         // The walk reads gl_FragCoord, not the quad's texture coordinates.
-        let quad = Mesh::new(
-            gpu,
-            "cellproj volume full-screen quad",
-            &[4, 4],
-            &crate::techniques::quad::quad_vertices(),
-        )?;
+        let quad = crate::techniques::quad::quad_mesh(gpu, "cellproj volume full-screen quad")?;
         let cap = entry_cap(spec, convex);
         Ok(Precise {
             peel,
