@@ -73,7 +73,7 @@ pub struct BenchOptions {
     /// table:128,grid:64 (faithful with a table of N x N x N/2 texels, the precise walk,
     /// precise as a projection in MPVONC order with the exact integral per fragment or
     /// with a float table of N x N x N/2, or the mesh resampled to a grid of N points
-    /// along its longest side and ray cast).
+    /// along its longest side and ray cast, grid:N:F at F steps per spacing).
     #[arg(long, value_delimiter = ',')]
     pub cellproj: Vec<String>,
     /// Turn the camera this many degrees about the vertical axis before every frame,
@@ -295,9 +295,13 @@ fn cellproj_settings(
             "grid" => {
                 s.fidelity = Fidelity::Precise;
                 volume.precise = crate::techniques::cellproj::transfer::Precise::Grid;
-                volume.grid = size
+                let (points, steps) = size.split_once(':').unwrap_or((size, "1"));
+                volume.grid = points
                     .parse()
                     .with_context(|| format!("--cellproj {name}: the grid's points after ':'"))?;
+                volume.grid_steps = steps.parse().with_context(|| {
+                    format!("--cellproj {name}: steps per spacing after the second ':'")
+                })?;
             }
             "centroid" | "mpvonc" => {
                 s.fidelity = Fidelity::Faithful;
@@ -312,7 +316,7 @@ fn cellproj_settings(
                 volume.table_size = [n, (n / 2).max(2)];
             }
             _ => bail!(
-                "--cellproj {name}: centroid:N, mpvonc:N, precise (the walk), projected, table:N or grid:N"
+                "--cellproj {name}: centroid:N, mpvonc:N, precise (the walk), projected, table:N or grid:N[:steps per spacing]"
             ),
         }
         c.volume = Some(volume);

@@ -254,6 +254,14 @@ pub fn editor(
             "grid points (longest side)",
             true,
         );
+        changed |= w.slider(
+            ui,
+            "Volume grid steps",
+            &mut spec.grid_steps,
+            0.25..=16.0,
+            "steps per grid spacing",
+            true,
+        );
     }
     changed
 }

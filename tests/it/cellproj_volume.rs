@@ -737,6 +737,7 @@ fn malformed_transfer_functions_are_refused_at_their_line_and_column() {
         ("table = { builtin = \"nope\" }", 7, "builtin"),
         ("table_size = [1, 64]", 7, "table_size"),
         ("grid = 1", 7, "grid"),
+        ("grid_steps = 0.1", 7, "grid_steps"),
         ("precise = \"grid\"\ngrid = 401", 8, "grid"),
     ] {
         let e = Scene::parse(&text(volume), "bad.toml")

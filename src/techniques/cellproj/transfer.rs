@@ -70,6 +70,9 @@ pub struct VolumeSpec {
     /// resampled onto.
     #[serde(default = "default_grid")]
     pub grid: u32,
+    /// Precise `grid`: steps along a ray per grid spacing.
+    #[serde(default = "default_grid_steps")]
+    pub grid_steps: f64,
 }
 
 /// How precise mode draws.
@@ -121,6 +124,10 @@ fn default_grid() -> u32 {
     64
 }
 
+fn default_grid_steps() -> f64 {
+    1.0
+}
+
 fn default_table() -> [u32; 2] {
     [128, 64]
 }
@@ -153,6 +160,7 @@ impl Default for VolumeSpec {
             entries: 0,
             precise: Precise::Walk,
             grid: default_grid(),
+            grid_steps: default_grid_steps(),
         }
     }
 }
@@ -217,6 +225,13 @@ impl VolumeSpec {
                     "{}: points along the longest side, 2..={MAX_GRID}",
                     self.grid
                 ),
+            ));
+        }
+        let g = self.grid_steps;
+        if !(0.25..=16.0).contains(&g) {
+            return Err(FieldError::new(
+                "grid_steps",
+                format!("{g}: steps per grid spacing, 0.25..=16"),
             ));
         }
         if self.entries > MAX_ENTRIES {

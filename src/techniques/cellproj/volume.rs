@@ -425,7 +425,7 @@ impl VolumeRenderer {
 
     /// Whether `old` and `new` differ only in what [`VolumeRenderer::set_transfer`] takes.
     pub fn transfer_only(old: &VolumeSpec, new: &VolumeSpec) -> bool {
-        old.precise == new.precise && old.grid == new.grid
+        old.precise == new.precise && old.grid == new.grid && old.grid_steps == new.grid_steps
     }
 
     fn refresh(&mut self, gpu: &Gpu) -> GlResult<()> {

@@ -20,10 +20,6 @@ use crate::programs::{self, ProgramPair};
 use crate::techniques::quad::quad_mesh;
 use crate::techniques::Frame;
 
-/// Steps per grid spacing along a ray: two samples per spacing keep the scalar's
-/// trilinear curve along the ray close to the linear piece each step integrates.
-pub const STEPS_PER_SPACING: f64 = 2.0;
-
 /// The mesh's scalar on a regular grid.
 #[derive(Debug, Clone)]
 pub struct Resampled {
@@ -145,6 +141,8 @@ pub(super) struct GridCaster {
     dims: [usize; 3],
     lo: DVec3,
     spacing: f64,
+    /// The step along a ray, in object units (the spacing over the scene's `grid_steps`).
+    step: f64,
 }
 
 impl GridCaster {
@@ -169,7 +167,7 @@ impl GridCaster {
             TexelData::F32(&resampled.texels),
         )?;
         let quad = quad_mesh(gpu, "cellproj volume grid full-screen quad")?;
-        let step = resampled.spacing / STEPS_PER_SPACING;
+        let step = resampled.spacing / spec.grid_steps;
         Ok(GridCaster {
             program,
             quad,
@@ -178,12 +176,8 @@ impl GridCaster {
             dims: resampled.dims,
             lo: resampled.lo,
             spacing: resampled.spacing,
+            step,
         })
-    }
-
-    /// The step along a ray, in object units.
-    fn step(&self) -> f64 {
-        self.spacing / STEPS_PER_SPACING
     }
 
     /// Remake the table for a new transfer function.
@@ -193,7 +187,7 @@ impl GridCaster {
         spec: &VolumeSpec,
         transfer: &Transfer,
     ) -> GlResult<()> {
-        self.table = step_table(gpu, spec, transfer, self.step())?;
+        self.table = step_table(gpu, spec, transfer, self.step)?;
         Ok(())
     }
 
@@ -223,7 +217,7 @@ impl GridCaster {
         let lo = self.lo;
         p.set_local(gpu, 5, [lo.x, lo.y, lo.z, 1.0 / self.spacing])?;
         let [nx, ny, nz] = self.dims.map(|n| n as f64);
-        p.set_local(gpu, 6, [nx, ny, nz, self.step()])?;
+        p.set_local(gpu, 6, [nx, ny, nz, self.step])?;
         let sides = [spec.table_size[0] as f64, LENGTHS as f64];
         p.set_local(gpu, 7, [sides[0], sides[1], spec.termination, 0.0])?;
         gl::draw(
