@@ -18,7 +18,13 @@
    unstructured mappers read the opacity value as attenuation per unit distance, as arbvis
    does), no shading, the same camera, size and background, and renders with
    vtkProjectedTetrahedraMapper (ParaView's default for unstructured volumes),
-   vtkUnstructuredGridVolumeRayCastMapper and vtkUnstructuredGridVolumeZSweepMapper.
+   vtkUnstructuredGridVolumeRayCastMapper and vtkUnstructuredGridVolumeZSweepMapper; and,
+   as the peer of arbvis's precise `grid` (`--mappers resample:N` or `resample:N:F`), the
+   grid resampled once by vtkResampleToImage (N points along the box's longest side, as
+   arbvis's `grid:N`) and ray cast by vtkGPUVolumeRayCastMapper at F samples per spacing
+   (default 2, arbvis's step), automatic sample distances and jittering off. The image
+   ray caster reads an opacity value as opacity per unit distance, so its opacity function
+   is 1 - exp(-a(s)) sampled at 257 points: the same attenuation per unit distance.
 3. Every system is scored as RGB against the one reference (RMSE and the largest channel
    difference over every pixel) and timed per frame (VTK: Render then WaitForCompletion;
    arbvis: clear + draw + glFinish), first frame apart, arbvis and VTK alternating round
@@ -52,6 +58,33 @@ MAPPERS = {
     "ray-cast": "vtkUnstructuredGridVolumeRayCastMapper",
     "zsweep": "vtkUnstructuredGridVolumeZSweepMapper",
 }
+
+
+def mapper_label(name):
+    """The VTK class (and the grid) a `--mappers` name stands for."""
+    if name.startswith("resample:"):
+        return f"vtkResampleToImage {name[len('resample:'):]} + vtkGPUVolumeRayCastMapper"
+    return MAPPERS[name]
+
+
+def resampled(ug, spec):
+    """`ug` on a grid of `N` points along its box's longest side (spec "resample:N[:F]"),
+    and the sample distance of F samples per spacing."""
+    parts = spec.split(":")
+    n = int(parts[1])
+    per_spacing = float(parts[2]) if len(parts) > 2 else 2.0
+    b = ug.GetBounds()
+    extent = np.array([b[1] - b[0], b[3] - b[2], b[5] - b[4]])
+    spacing = extent.max() / (n - 1)
+    dims = [int(np.ceil(e / spacing - 1e-9)) + 1 for e in extent]
+    resample = vtk.vtkResampleToImage()
+    resample.SetInputDataObject(ug)
+    resample.SetUseInputBounds(True)
+    resample.SetSamplingDimensions(*dims)
+    resample.Update()
+    image = resample.GetOutput()
+    image.GetPointData().SetActiveScalars("scalars")
+    return image, spacing / per_spacing
 
 
 def arbvis_bench(args, score):
@@ -92,15 +125,31 @@ class VtkPeer:
         opacity = vtk.vtkPiecewiseFunction()
         for s, r, g, b, a in scene["transfer"]:
             colour.AddRGBPoint(s, r, g, b)
-            opacity.AddPoint(s, a)
+        image = mapper_name.startswith("resample:")
+        if image:
+            # Opacity per unit distance with the same attenuation: 1 - exp(-a(s)).
+            tf = np.array(scene["transfer"])
+            for s in np.linspace(0.0, 1.0, 257):
+                opacity.AddPoint(s, 1.0 - np.exp(-np.interp(s, tf[:, 0], tf[:, 4])))
+        else:
+            for s, r, g, b, a in scene["transfer"]:
+                opacity.AddPoint(s, a)
         prop = vtk.vtkVolumeProperty()
         prop.SetColor(colour)
         prop.SetScalarOpacity(opacity)
         prop.SetScalarOpacityUnitDistance(scene["unit_distance"])
         prop.ShadeOff()
         prop.SetInterpolationTypeToLinear()
-        self.mapper = getattr(vtk, MAPPERS[mapper_name])()
-        self.mapper.SetInputData(ug)
+        if image:
+            grid, distance = resampled(ug, mapper_name)
+            self.mapper = vtk.vtkGPUVolumeRayCastMapper()
+            self.mapper.SetInputData(grid)
+            self.mapper.SetAutoAdjustSampleDistances(0)
+            self.mapper.SetSampleDistance(distance)
+            self.mapper.SetUseJittering(0)
+        else:
+            self.mapper = getattr(vtk, MAPPERS[mapper_name])()
+            self.mapper.SetInputData(ug)
         if hasattr(self.mapper, "SetAutoAdjustImageSampleDistances"):
             # Every pixel cast (no lower-resolution image when a frame runs long), as
             # arbvis draws every pixel: the ray caster's and the z-sweep's quality at its
@@ -115,7 +164,11 @@ class VtkPeer:
         self.window = offscreen_window(renderer, scene)
         self.config = (window_config(self.window) + "; " + mapper_config(self.mapper, [
             "AutoAdjustImageSampleDistances", "ImageSampleDistance", "MaxPixelListSize",
-            "UseFloatingPointFrameBuffer"]))
+            "UseFloatingPointFrameBuffer", "AutoAdjustSampleDistances", "SampleDistance",
+            "UseJittering"]))
+        if image:
+            self.config += f"; grid {list(grid.GetDimensions())}"
+
 
     def frame(self):
         return timed_frame(self.window)
@@ -176,7 +229,7 @@ def main():
         print(f"| arbvis {n} | {statistics.median(v['frames_ms']):.1f} | {v['rmse']:.5f} "
               f"| {v['max_abs']:.3f} |")
     for m, v in peers.items():
-        print(f"| VTK {MAPPERS[m]} | {statistics.median(v['frames_ms']):.1f} | {v['rmse']:.5f} "
+        print(f"| VTK {mapper_label(m)} | {statistics.median(v['frames_ms']):.1f} | {v['rmse']:.5f} "
               f"| {v['max_abs']:.3f} |")
     print("\n| VTK mapper | VTK ms | RMSE | fastest arbvis at equal or lower RMSE | ms | RMSE "
           "| speed-up |\n|---|---|---|---|---|---|---|")
@@ -186,10 +239,10 @@ def main():
                if a["rmse"] is not None and a["rmse"] <= v["rmse"]]
         if fit:
             at, an, ae = min(fit)
-            print(f"| {MAPPERS[m]} | {vt:.1f} | {v['rmse']:.5f} | {an} | {at:.1f} | {ae:.5f} "
+            print(f"| {mapper_label(m)} | {vt:.1f} | {v['rmse']:.5f} | {an} | {at:.1f} | {ae:.5f} "
                   f"| {vt / at:.2f}x |")
         else:
-            print(f"| {MAPPERS[m]} | {vt:.1f} | {v['rmse']:.5f} | none | - | - | - |")
+            print(f"| {mapper_label(m)} | {vt:.1f} | {v['rmse']:.5f} | none | - | - | - |")
     if args.json:
         out = {"arbvis": scored, "arbvis_frames": arb,
                "vtk": [{"mapper": m, "first_ms": v["first_ms"], "frames_ms": v["frames_ms"],
