@@ -14,16 +14,16 @@
 // point where m >= 1/2. texture1: the pre-integrated table (sf, sb, length), lengths 0
 // to the step.
 // program_local[0..3]: inverse ModelViewProj rows; [4]: viewport (width, height, corner
-// x, corner y); [5]: (the grid's first point, 1 / spacing); [6]: (points along x, y, z,
-// step length); [7]: (table size along sf and sb, along the length, termination
-// transmittance).
+// x, corner y); [5]: (the grid's first point, 0); [6]: (points along x, y, z, step
+// length); [7]: (table size along sf and sb, along the length, termination
+// transmittance); [8]: (1 / spacing along x, y, z, 0).
 uniform sampler3D texture0;
 uniform sampler3D texture1;
-uniform vec4 program_local[8];
+uniform vec4 program_local[9];
 out vec4 color;
 
 vec3 grid_lo;
-float inv_spacing;
+vec3 inv_spacing;
 vec3 dims;
 
 // (scalar, inside weight) at object point p.
@@ -54,7 +54,7 @@ void main() {
     float ray_end = length(e);
     vec3 ray_d = e / ray_end;
     grid_lo = program_local[5].xyz;
-    inv_spacing = program_local[5].w;
+    inv_spacing = program_local[8].xyz;
     dims = program_local[6].xyz;
     float dt = program_local[6].w;
     float termination = program_local[7].z;
@@ -75,11 +75,12 @@ void main() {
         float len = min(dt, t_out - t);
         vec2 b = sample_at(ray_o + (t + len) * ray_d);
         // The part inside the mesh: all, none, or up to where the inside weight crosses
-        // 1/2 (the boundary), from the end that is inside.
+        // 1/2 (the boundary), from the end that is inside. A sample with no inside point
+        // around it has no scalar (0 / 0): the crossing takes the other end's.
         float in_a = step(0.5, a.y);
         float in_b = step(0.5, b.y);
         float cut = clamp((a.y - 0.5) / (a.y - b.y + 1e-30), 0.0, 1.0);
-        float s_cut = mix(a.x, b.x, cut);
+        float s_cut = mix(mix(b.x, a.x, step(1e-3, a.y)), mix(a.x, b.x, step(1e-3, b.y)), cut);
         float sf = mix(s_cut, a.x, in_a);
         float sb = mix(s_cut, b.x, in_b);
         float part = in_a * in_b + abs(in_a - in_b) * mix(1.0 - cut, cut, in_a);

@@ -27,8 +27,10 @@ pub struct Resampled {
     pub dims: [usize; 3],
     /// The first point (the object box's low corner).
     pub lo: DVec3,
-    /// Distance between neighbouring points, in object units.
-    pub spacing: f64,
+    /// Distance between neighbouring points along x, y, z, in object units: the box's
+    /// side over its points less one, so the last points lie on the box's upper faces (a
+    /// box-shaped mesh's faces, and a thin mesh's two, fall on grid points).
+    pub spacing: DVec3,
     /// `(s m, m)` per point, x fastest: `m` is 1 where a tetrahedron holds the point and
     /// 0 elsewhere (`s m` then 0).
     pub texels: Vec<f32>,
@@ -43,6 +45,23 @@ impl Resampled {
     }
 }
 
+/// The points along x, y, z of a grid over the box of half-extents `half` with `points`
+/// along its longest side (at least 2 each), and their spacing (each side over its points
+/// less one).
+pub fn layout(half: DVec3, points: u32) -> ([usize; 3], DVec3) {
+    let longest = 2.0 * half.max_element().max(1e-300) / (points.max(2) - 1) as f64;
+    let dims = (2.0 * half / longest)
+        .to_array()
+        .map(|e| (e - 1e-9).ceil().max(1.0) as usize + 1);
+    let spacing = DVec3::from_array(std::array::from_fn(|a| {
+        (2.0 * half[a] / (dims[a] - 1) as f64).max(1e-300)
+    }));
+    (dims, spacing)
+}
+
+/// Bytes per grid point: `(s m, m)` as two f32.
+const POINT_BYTES: u64 = 8;
+
 /// Z planes per parallel slab of the resampling.
 const PLANES: usize = 2;
 
@@ -52,10 +71,7 @@ const PLANES: usize = 2;
 /// held).
 pub fn resample(prepared: &Prepared, points: u32) -> Resampled {
     let half = prepared.half;
-    let spacing = 2.0 * half.max_element().max(1e-300) / (points.max(2) - 1) as f64;
-    let dims = (2.0 * half / spacing)
-        .to_array()
-        .map(|e| (e - 1e-9).ceil().max(1.0) as usize + 1);
+    let (dims, spacing) = layout(half, points);
     let lo = -half;
     let [nx, ny, nz] = dims;
     let index = |v: f64| (v - 1e-9).ceil().max(0.0) as usize;
@@ -63,7 +79,7 @@ pub fn resample(prepared: &Prepared, points: u32) -> Resampled {
     let mut slabs: Vec<Vec<u32>> = vec![Vec::new(); nz.div_ceil(PLANES)];
     for t in 0..prepared.tets.len() {
         let (p, _) = prepared.tet(t);
-        let z = p.map(|q| (q.z - lo.z) / spacing);
+        let z = p.map(|q| (q.z - lo.z) / spacing.z);
         let k0 = index(z.iter().copied().fold(f64::MAX, f64::min));
         let k1 = last(z.iter().copied().fold(f64::MIN, f64::max), nz);
         if k1 < k0 as i64 {
@@ -140,8 +156,9 @@ pub(super) struct GridCaster {
     table: Texture,
     dims: [usize; 3],
     lo: DVec3,
-    spacing: f64,
-    /// The step along a ray, in object units (the spacing over the scene's `grid_steps`).
+    spacing: DVec3,
+    /// The step along a ray, in object units (the longest side's spacing over the scene's
+    /// `grid_steps`).
     step: f64,
 }
 
@@ -156,6 +173,11 @@ impl GridCaster {
         let pair = grid_pair();
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         program.set_transform(gpu, glam::DMat4::IDENTITY)?;
+        let ([nx, ny, nz], _) = layout(prepared.half, spec.grid);
+        crate::budget::check(
+            format!("precise grid's {nx} x {ny} x {nz} points"),
+            crate::budget::times((nx * ny * nz) as u64, POINT_BYTES),
+        )?;
         let resampled = resample(prepared, spec.grid);
         let [nx, ny, nz] = resampled.dims.map(|n| n as u32);
         let grid = Texture::new(
@@ -167,7 +189,7 @@ impl GridCaster {
             TexelData::F32(&resampled.texels),
         )?;
         let quad = quad_mesh(gpu, "cellproj volume grid full-screen quad")?;
-        let step = resampled.spacing / spec.grid_steps;
+        let step = resampled.spacing.max_element() / spec.grid_steps;
         Ok(GridCaster {
             program,
             quad,
@@ -215,7 +237,9 @@ impl GridCaster {
         let (w, h) = (frame.width as f64, frame.height as f64);
         p.set_local(gpu, 4, [w, h, corner[0], corner[1]])?;
         let lo = self.lo;
-        p.set_local(gpu, 5, [lo.x, lo.y, lo.z, 1.0 / self.spacing])?;
+        p.set_local(gpu, 5, [lo.x, lo.y, lo.z, 0.0])?;
+        let inv = 1.0 / self.spacing;
+        p.set_local(gpu, 8, [inv.x, inv.y, inv.z, 0.0])?;
         let [nx, ny, nz] = self.dims.map(|n| n as f64);
         p.set_local(gpu, 6, [nx, ny, nz, self.step])?;
         let sides = [spec.table_size[0] as f64, LENGTHS as f64];
