@@ -279,7 +279,11 @@ fn cellproj_settings(
         let mut volume = c.volume_spec();
         let (kind, size) = name.split_once(':').unwrap_or((name.as_str(), ""));
         match kind {
-            "precise" | "walk" => s.fidelity = Fidelity::Precise,
+            "precise" | "walk" => {
+                // The walk, whatever method the scene itself names.
+                s.fidelity = Fidelity::Precise;
+                volume.precise = crate::techniques::cellproj::transfer::Precise::Walk;
+            }
             "projected" => {
                 s.fidelity = Fidelity::Precise;
                 volume.precise = crate::techniques::cellproj::transfer::Precise::Projected;

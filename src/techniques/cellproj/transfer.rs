@@ -437,6 +437,10 @@ pub fn erfcx_gpu(y: f32) -> f32 {
 /// Dawson's integral `F(x) = exp(-x²) ∫0^x exp(t²) dt` for `x >= 0` (Rybicki's
 /// method as in Numerical Recipes, h = 0.4, six terms; a series below 0.2), in f32.
 pub fn dawson_gpu(x: f32) -> f32 {
+    if x > 20.0 {
+        let r = 1.0 / (x * x);
+        return 0.5 / x * (1.0 + r * (0.5 + 0.75 * r));
+    }
     if x < 0.2 {
         let x2 = x * x;
         return x * (1.0 - (2.0 / 3.0) * x2 * (1.0 - 0.4 * x2 * (1.0 - (2.0 / 7.0) * x2)));
@@ -567,6 +571,34 @@ mod tests {
             // The f32 closed form: erfcx fit 1.2e-7 relative, f32 exp and the
             // cancellation of two terms near 1/(y√π): measured below 3e-6.
             assert!((g - exact).abs() < 1e-5, "gpu {d0} {d1}: {g} vs {exact}");
+        }
+        // Opaque pieces at tiny unit distances (1e29 per piece): finite, and at the large
+        // depth rates' asymptotes: falling from d0, about 1/d0 (1 + 1/d0); rising from 0 to
+        // d1, sqrt(pi / (2 d1)). (The f64 quadrature caps its pieces at 4,096 and is not
+        // the reference past depths of about 1e4.)
+        let falling = |d0: f64| (1.0 + 1.0 / d0) / d0;
+        for (d0, d1, want) in [
+            (1e29f32, 0.0f32, falling(1e29)),
+            (1e29, 1e28, falling(1e29)),
+            (3e5, 10.0, falling(3e5)),
+            (0.0, 1e29, (std::f64::consts::PI / 2e29).sqrt()),
+            (25.0, 0.0, psi(25.0, 0.0)),
+        ] {
+            let g = psi_gpu(d0, d1) as f64;
+            assert!(
+                g.is_finite() && (g - want).abs() <= 1e-3 * want,
+                "{d0} {d1}: {g} vs {want}"
+            );
+        }
+    }
+
+    #[test]
+    fn dawson_past_20_is_the_fit_at_20() {
+        // The asymptotic branch meets the fit where it takes over: both within 1e-6 of
+        // Dawson's F(20) = 0.02503137 (the slope there moves it 1.3e-7 over 1e-4).
+        for x in [19.9999f32, 20.0001] {
+            let f = dawson_gpu(x);
+            assert!((f - 0.025_031_37).abs() < 1e-6, "F({x}) = {f}");
         }
     }
 
