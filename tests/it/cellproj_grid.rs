@@ -192,3 +192,34 @@ fn an_opaque_slab_shows_its_entry_scalar() {
         assert!(all.0 < 0.02, "{:?}: {all:?}", cam.rotation);
     }
 }
+
+/// The grid is held to the memory budget before it is made: 400 points a side is 512 MB
+/// of `(s m, m)` pairs, refused under `--memory-budget 100M` with what it was for; the
+/// same scene at 32 points renders within it.
+#[test]
+fn the_grid_is_held_to_the_memory_budget() {
+    let dir = crate::common::temp_dir("grid-budget");
+    let scene = |points: u32| {
+        format!(
+            "size = [32, 24]\nfidelity = \"precise\"\n[technique.cellproj]\nmesh = {{ grid = {{ points = [9, 9, 9], field = \"spherical\" }} }}\nmode = \"volume\"\n[technique.cellproj.volume]\nprecise = \"grid\"\ngrid = {points}\n"
+        )
+    };
+    for (points, ok) in [(400u32, false), (32, true)] {
+        let path = dir.join(format!("grid{points}.toml"));
+        std::fs::write(&path, scene(points)).unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_arbvis"))
+            .args(["render", "--memory-budget", "100M", "-o"])
+            .arg(dir.join(format!("grid{points}.png")))
+            .arg(&path)
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.success(), ok, "{points}: {text}");
+        if !ok {
+            assert!(
+                text.contains("precise grid's 400 x 400 x 400 points") && text.contains("budget"),
+                "{text}"
+            );
+        }
+    }
+}
