@@ -16,6 +16,8 @@
 //  - empty-space skipping (tag skip, point sampling only): texture5 holds, per brick, 1
 //    where some sample can have alpha > 0 (levels over the brick and one voxel around it
 //    against the tables' alpha), so samples in an empty brick are skipped exactly.
+//  - neighbours (tag neighbours, one attribute, not paged): texture0 holds each voxel's
+//    2x2x2 levels as bytes of an RG32UI texel, so a sample is one fetch (level_at).
 //  - paged (tag paged: a survey from a store): texture0 is the brick atlas, texture7 the
 //    page table, one RGBA32F entry per level-0 brick of the window (the INDEX of seed
 //    002's INDEX-DATA: see src/volume/index_data.rs): w = 2^-level of the resident brick
@@ -35,7 +37,8 @@
 // whole volume when not computed): the steps outside it are not taken (margins).
 // Output: premultiplied colour and coverage, blended ONE, ONE_MINUS_SRC_ALPHA.
 in vec4 v_texcoord0;
-uniform sampler3D texture0;
+uniform sampler3D texture0;  // [!neighbours]
+uniform usampler3D texture0;  // [neighbours]
 uniform sampler2D texture2;
 uniform sampler2D texture3;  // [secondary]
 uniform sampler2D texture4;  // [tertiary]
@@ -47,9 +50,28 @@ uniform sampler3D texture7;  // [paged]
 out vec4 frag_color;
 // @sampling
 
+// The level at texture coordinate tc: the volume unit's linear read, or (tag neighbours,
+// one attribute) the 2x2x2 levels around tc from one texel of neighbour words
+// (Prepared::neighbour_words), interpolated here as GL_LINEAR with CLAMP_TO_EDGE reads
+// them: texel space u = tc * size - 0.5; below the first texel centre (u < 0) every
+// corner is the first texel, so the weights are 0 there.
+vec4 level_at(vec3 tc) { return volume_at(texture0, tc); }  // [!neighbours]
+vec4 level_at(vec3 tc) {  // [neighbours]
+    ivec3 size = textureSize(texture0, 0);  // [neighbours]
+    vec3 u = tc * vec3(size) - 0.5;  // [neighbours]
+    vec3 b = floor(u);  // [neighbours]
+    vec3 f = mix(u - b, vec3(0.0), lessThan(b, vec3(0.0)));  // [neighbours]
+    uvec2 w = texelFetch(texture0, clamp(ivec3(b), ivec3(0), size - 1), 0).xy;  // [neighbours]
+    vec4 near = vec4(uvec4(w.x, w.x >> 8u, w.x >> 16u, w.x >> 24u) & 255u);  // [neighbours]
+    vec4 far = vec4(uvec4(w.y, w.y >> 8u, w.y >> 16u, w.y >> 24u) & 255u);  // [neighbours]
+    vec4 c = mix(near, far, f.z) / 255.0;  // [neighbours]
+    vec2 e = mix(c.xz, c.yw, f.x);  // [neighbours]
+    return vec4(mix(e.x, e.y, f.y));  // [neighbours]
+}  // [neighbours]
+
 vec4 classify(vec3 tc) {
     vec4 lookup = program_local[5];
-    vec4 coord = volume_at(texture0, tc) * lookup.x + lookup.y;
+    vec4 coord = level_at(tc) * lookup.x + lookup.y;
     vec4 lut = table_at(texture2, vec2(coord.@1, 0.5));
     vec4 col = program_local[1] * lut;
     lut = table_at(texture3, vec2(coord.@2, 0.5));  // [secondary]
@@ -204,13 +226,13 @@ void main() {
     int j = range.x;  // [baked]
     for (; j + 1 < range.y && acc.a < stop; j += 2) {  // [baked]
         vec3 tc = start + delta * float(j);  // [baked]
-        float v0 = volume_at(texture0, tc).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
-        float v1 = volume_at(texture0, tc + delta).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
+        float v0 = level_at(tc).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
+        float v1 = level_at(tc + delta).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
         acc += (1.0 - acc.a) * step_at(texture6, v0);  // [baked]
         acc += (1.0 - acc.a) * step_at(texture6, v1);  // [baked]
     }  // [baked]
     if (j < range.y && acc.a < stop) {  // [baked]
-        float v = volume_at(texture0, start + delta * float(j)).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
+        float v = level_at(start + delta * float(j)).r * (4080.0 / 4081.0) + 0.5 / 4081.0;  // [baked]
         acc += (1.0 - acc.a) * step_at(texture6, v);  // [baked]
     }  // [baked]
     float done = min(first + float(full) * h, chord);  // [jitter]
@@ -226,10 +248,10 @@ void main() {
     float rest = max(chord - full * h, 0.0);  // [preint]
     vec3 delta = dir * h / size;  // [preint]
     vec3 start = (p_exit - dir * chord + half_size) / size;  // [preint]
-    float front = volume_at(texture0, start).r * lookup.x + lookup.y;  // [preint]
+    float front = level_at(start).r * lookup.x + lookup.y;  // [preint]
     int steps = int(full);  // [preint]
     for (int j = 1; j <= steps && acc.a < stop; j++) {  // [preint]
-        float back = volume_at(texture0, start + delta * float(j)).r * lookup.x + lookup.y;  // [preint]
+        float back = level_at(start + delta * float(j)).r * lookup.x + lookup.y;  // [preint]
         acc += (1.0 - acc.a) * step_at(texture6, vec2(front, back));  // [preint]
         front = back;  // [preint]
     }  // [preint]

@@ -132,6 +132,7 @@ fn program(
         jitter: false,
         baked: false,
         paged: true,
+        neighbours: false,
         filter,
     });
     Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)

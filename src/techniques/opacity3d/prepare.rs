@@ -59,6 +59,34 @@ impl Prepared {
             .collect()
     }
 
+    /// The one present attribute's levels as the ray caster's neighbour words (tag
+    /// `neighbours` of `programs/opacity3d/raycast.frag`): texel (i, j, k) holds the 2x2x2
+    /// levels from (i, j, k) to (i+1, j+1, k+1), clamped to the last voxel as
+    /// CLAMP_TO_EDGE reads them, one byte each from the low byte up: word 0 the plane k at
+    /// (i, j), (i+1, j), (i, j+1), (i+1, j+1), word 1 the plane k+1 alike. One texel fetch
+    /// a sample instead of the eight of a linear read: llvmpipe gathers every texel of a
+    /// filtered read lane by lane, and that gather was most of a ray caster step.
+    pub fn neighbour_words(&self) -> Vec<u32> {
+        let levels = self.present_levels();
+        let [ni, nj, nk] = self.dims;
+        let at = |i: usize, j: usize, k: usize| -> u32 {
+            levels[i.min(ni - 1) + ni * (j.min(nj - 1) + nj * k.min(nk - 1))] as u32
+        };
+        let plane = |i, j, k| {
+            at(i, j, k) | at(i + 1, j, k) << 8 | at(i, j + 1, k) << 16 | at(i + 1, j + 1, k) << 24
+        };
+        let mut words = Vec::with_capacity(2 * levels.len());
+        for k in 0..nk {
+            for j in 0..nj {
+                for i in 0..ni {
+                    words.push(plane(i, j, k));
+                    words.push(plane(i, j, k + 1));
+                }
+            }
+        }
+        words
+    }
+
     /// Object-space spacing that table alphas are defined for (precise mode's opacity
     /// correction): one voxel along the longest axis.
     pub fn reference_spacing(&self) -> f64 {
@@ -175,6 +203,42 @@ mod tests {
         assert_eq!(p, vec![30, 10, 20, 31, 11, 21]);
         let two = pack([Some(&[10]), Some(&[20]), None], 1);
         assert_eq!(two, vec![0, 10, 20], "2D opacity leaves R at 0");
+    }
+
+    #[test]
+    fn neighbour_words_hold_each_voxels_2x2x2_levels_clamped_at_the_far_edges() {
+        // Odd sizes and distinct levels: a swapped axis or a missed clamp shows.
+        let dims = [3, 2, 5];
+        let n = dims[0] * dims[1] * dims[2];
+        let levels: Vec<u8> = (0..n).map(|v| (v * 37 % 251) as u8).collect();
+        let prepared = Prepared {
+            dims,
+            half: DVec3::ONE,
+            packed: pack([Some(&levels), None, None], n),
+            tables: [Some(ColorTable::builtin("grey").unwrap()), None, None],
+            ranges: [None; 3],
+        };
+        let words = prepared.neighbour_words();
+        assert_eq!(words.len(), 2 * n);
+        let level =
+            |i: usize, j: usize, k: usize| levels[i.min(2) + 3 * (j.min(1) + 2 * k.min(4))] as u32;
+        for k in 0..5 {
+            for j in 0..2 {
+                for i in 0..3 {
+                    let t = 2 * (i + 3 * (j + 2 * k));
+                    for (w, kk) in [(words[t], k), (words[t + 1], k + 1)] {
+                        let bytes = [w & 255, w >> 8 & 255, w >> 16 & 255, w >> 24];
+                        let want = [
+                            level(i, j, kk),
+                            level(i + 1, j, kk),
+                            level(i, j + 1, kk),
+                            level(i + 1, j + 1, kk),
+                        ];
+                        assert_eq!(bytes, want, "texel ({i}, {j}, {k}), plane {kk}");
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -12,7 +12,8 @@
 //! `perspective`, `skip` (the ray caster's empty-space skipping), `preint` (its
 //! pre-integrated classification), `jitter` (its per-pixel step offset), `baked` (its
 //! one-attribute table of step colour and opacity), `paged` (a store's bricks through
-//! its page table, [`super::bricked`]).
+//! its page table, [`super::bricked`]), `neighbours` (one attribute's 2x2x2 levels in
+//! one texel).
 //!
 //! Which paths exist in which language: faithful slicing (verbatim ARB, GLSL port),
 //! precise slicing (ARB and GLSL), the precise ray caster (GLSL only: ARB fragment
@@ -45,6 +46,9 @@ pub struct Variant {
     /// Ray caster only: a store's bricks through the page table (point sampling, no
     /// jitter; the atlas holds v3o2's packing, G primary, B secondary, R tertiary).
     pub paged: bool,
+    /// Ray caster only, one attribute: the volume unit holds each voxel's 2x2x2 levels
+    /// ([`super::prepare::Prepared::neighbour_words`]), one fetch a sample.
+    pub neighbours: bool,
     /// What the program computes itself instead of the hardware.
     pub filter: InShader,
 }
@@ -126,6 +130,9 @@ impl Variant {
         }
         if self.paged {
             tags.push("paged");
+        }
+        if self.neighbours {
+            tags.push("neighbours");
         }
         for (on, tag) in [
             (self.filter.volume, "exact_volume"),
@@ -262,6 +269,7 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
                         jitter,
                         baked,
                         paged: false,
+                        neighbours: false,
                         filter: InShader::default(),
                     };
                     // The GLSL programs also with every linear read in the shader.
@@ -294,6 +302,14 @@ pub fn all_precise_pairs() -> Vec<ProgramPair> {
                     if !(preint || baked) || present == [true, false, false] {
                         pairs.push(raycast_pair(v));
                         pairs.push(raycast_pair(exact));
+                    }
+                    if present == [true, false, false] {
+                        for variant in [v, exact] {
+                            pairs.push(raycast_pair(Variant {
+                                neighbours: true,
+                                ..variant
+                            }));
+                        }
                     }
                     if !(skip || preint || jitter) {
                         pairs.push(raycast_pair(Variant { paged: true, ..v }));
@@ -343,6 +359,7 @@ mod tests {
             jitter: false,
             baked: false,
             paged: false,
+            neighbours: false,
             filter: InShader::default(),
         }
     }

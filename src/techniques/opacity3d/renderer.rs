@@ -275,6 +275,8 @@ pub struct Opacity3dRenderer {
     program: Program,
     projection: Projection,
     volume: Texture,
+    /// Whether `volume` holds neighbour words ([`uses_neighbours`]).
+    neighbours: bool,
     tables: [Option<Texture>; 3],
     neutral: Option<Texture>,
     /// The ray caster's bricks (for skipping or its margins), and their occupancy on
@@ -363,26 +365,9 @@ impl Opacity3dRenderer {
         let program = make_program(
             gpu, kind, fidelity, params, &prepared, projection, baked, stage,
         )?;
-        let extent = Extent::D3(ni as u32, nj as u32, nk as u32);
         let filter = shader_filter(gpu, params, fidelity)?;
-        let volume = match fidelity {
-            Fidelity::Faithful => Texture::new(
-                gpu,
-                "opacity3d packed volume (R tertiary, G primary, B secondary)",
-                extent,
-                TexelFormat::Rgb8,
-                params.volume_filter,
-                TexelData::U8(&prepared.packed),
-            )?,
-            Fidelity::Precise => Texture::new(
-                gpu,
-                "opacity3d packed volume (present attributes in order)",
-                extent,
-                texel_formats(fidelity, prepared.count()).0,
-                unit_filter(params.volume_filter, filter.volume),
-                TexelData::U8(&prepared.present_levels()),
-            )?,
-        };
+        let neighbours = uses_neighbours(params, fidelity, &prepared);
+        let volume = volume_texture(gpu, fidelity, params, &prepared, filter, neighbours)?;
         let mut renderer = Opacity3dRenderer {
             kind,
             filter,
@@ -394,6 +379,7 @@ impl Opacity3dRenderer {
             program,
             projection,
             volume,
+            neighbours,
             tables: [None, None, None],
             neutral: None,
             bricks: None,
@@ -643,6 +629,63 @@ impl Opacity3dRenderer {
     }
 }
 
+/// Whether the volume unit holds neighbour words ([`Prepared::neighbour_words`]): the
+/// precise ray caster of one attribute (a clip's test reads its own units only).
+fn uses_neighbours(params: &Opacity3dScene, fidelity: Fidelity, prepared: &Prepared) -> bool {
+    fidelity == Fidelity::Precise
+        && path(params, fidelity) == Path3d::Raycast
+        && prepared.count() == 1
+}
+
+/// The volume on [`VOLUME_UNIT`]: v3o2's packing (faithful), the present attributes'
+/// levels (precise), or one attribute's neighbour words (the ray caster, `neighbours`;
+/// 8 bytes a voxel against 4, checked against the memory budget before they are made).
+fn volume_texture(
+    gpu: &Gpu,
+    fidelity: Fidelity,
+    params: &Opacity3dScene,
+    prepared: &Prepared,
+    filter: InShader,
+    neighbours: bool,
+) -> GlResult<Texture> {
+    let [ni, nj, nk] = prepared.dims;
+    let extent = Extent::D3(ni as u32, nj as u32, nk as u32);
+    if neighbours {
+        let bytes = (ni * nj * nk) as u64 * 8;
+        crate::budget::check(
+            "the ray caster's neighbour texture (8 bytes a voxel)",
+            bytes,
+        )
+        .map_err(|e| GlError::Data(e.to_string()))?;
+        return Texture::new(
+            gpu,
+            "opacity3d neighbour words (each voxel's 2x2x2 levels)",
+            extent,
+            TexelFormat::Rg32ui,
+            Filter::Nearest,
+            TexelData::U32(&prepared.neighbour_words()),
+        );
+    }
+    match fidelity {
+        Fidelity::Faithful => Texture::new(
+            gpu,
+            "opacity3d packed volume (R tertiary, G primary, B secondary)",
+            extent,
+            TexelFormat::Rgb8,
+            params.volume_filter,
+            TexelData::U8(&prepared.packed),
+        ),
+        Fidelity::Precise => Texture::new(
+            gpu,
+            "opacity3d packed volume (present attributes in order)",
+            extent,
+            texel_formats(fidelity, prepared.count()).0,
+            unit_filter(params.volume_filter, filter.volume),
+            TexelData::U8(&prepared.present_levels()),
+        ),
+    }
+}
+
 /// The program for a fidelity, path and projection, with `clip`'s test composed in.
 #[allow(clippy::too_many_arguments)]
 fn make_program(
@@ -665,6 +708,7 @@ fn make_program(
         jitter: params.raycast.is_some_and(|r| r.jitter) && !preint,
         baked,
         paged: false,
+        neighbours: uses_neighbours(params, fidelity, prepared),
         filter: shader_filter(gpu, params, fidelity)?,
     };
     let pair = match (fidelity, path(params, fidelity)) {
@@ -854,6 +898,13 @@ impl Renderer for Opacity3dRenderer {
                 }
             }
         }
+        let neighbours = uses_neighbours(new, self.fidelity, &self.prepared);
+        let volume_changed = neighbours != self.neighbours;
+        if volume_changed {
+            let (fidelity, filter) = (self.fidelity, self.filter);
+            self.volume = volume_texture(gpu, fidelity, new, &self.prepared, filter, neighbours)?;
+            self.neighbours = neighbours;
+        }
         let table = step_table(new, self.fidelity, &self.prepared);
         let baked = matches!(table, StepTable::Baked(_));
         let shape = |p: &Opacity3dScene| {
@@ -865,6 +916,7 @@ impl Renderer for Opacity3dRenderer {
         };
         if shape(&old) != shape(new)
             || baked != self.baked
+            || volume_changed
             || clip_changed
             || self.program_filter != self.filter
         {
