@@ -283,6 +283,37 @@ fn ray_caster_matches_the_reference_at_its_own_step() {
     }
 }
 
+/// One attribute's ray caster reads its volume through neighbour words (one fetch a
+/// sample, interpolated in the shader); a scene asking for a nearest volume keeps the
+/// plain texture and its nearest reads: the picture follows the nearest reference, not
+/// the linear one.
+#[test]
+fn a_nearest_volume_stays_nearest_in_the_ray_caster() {
+    let h = headless(Backend::Egl);
+    for (name, camera) in views() {
+        let (mut scene, dir) = random_scene("raycast-nearest", 9, [7, 5, 6], 1, "sum");
+        scene.camera = camera;
+        params_mut(&mut scene).raycast = raycast(3.0, 0.0, 0);
+        let linear = reference_of(&scene, &dir, 3.0);
+        params_mut(&mut scene).volume_filter = Filter::Nearest;
+        let nearest = reference_of(&scene, &dir, 3.0);
+        let gpu = render(&h, &scene);
+        let (_, to_nearest) = rgb_error(&gpu, &nearest);
+        let (_, to_linear) = rgb_error(&gpu, &linear);
+        eprintln!(
+            "{name}: RMSE to the nearest reference {to_nearest:.2e}, to the linear {to_linear:.2e}"
+        );
+        // A sample on a voxel face can round to either side in f32 against f64: a few
+        // pixels differ by a level's colour, so the bound is on the RMSE, with the
+        // linear picture an order of magnitude further away.
+        assert!(to_nearest < 2e-3, "{name}: {to_nearest:.2e}");
+        assert!(
+            to_linear > 10.0 * to_nearest,
+            "{name}: {to_linear:.2e} against {to_nearest:.2e}"
+        );
+    }
+}
+
 /// A smooth field of one attribute on 10³ voxels (a wave, or with `ball` a cone around an
 /// off-centre point) and a table clear below level 128.
 fn half_clear_scene(name: &str, ball: bool) -> (Scene, PathBuf) {

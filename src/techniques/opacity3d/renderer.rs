@@ -630,11 +630,13 @@ impl Opacity3dRenderer {
 }
 
 /// Whether the volume unit holds neighbour words ([`Prepared::neighbour_words`]): the
-/// precise ray caster of one attribute (a clip's test reads its own units only).
+/// precise ray caster of one attribute read linearly (a clip's test reads its own units
+/// only; a nearest volume keeps the plain texture).
 fn uses_neighbours(params: &Opacity3dScene, fidelity: Fidelity, prepared: &Prepared) -> bool {
     fidelity == Fidelity::Precise
         && path(params, fidelity) == Path3d::Raycast
         && prepared.count() == 1
+        && params.volume_filter == Filter::Linear
 }
 
 /// The volume on [`VOLUME_UNIT`]: v3o2's packing (faithful), the present attributes'
