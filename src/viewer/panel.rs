@@ -258,10 +258,6 @@ fn controls(
         "UI: {:.1} fps ({:.1} ms)",
         state.fps, state.frame_ms
     ));
-    if !state.volume_info.is_empty() {
-        // The renderer's own lines (a COPC cut, its node cache), recorded for scripts.
-        w.status_text(ui, "Renderer", &state.volume_info);
-    }
     ui.separator();
 
     ui.horizontal_wrapped(|ui| {
@@ -314,7 +310,8 @@ fn controls(
             actions.push(UiAction::ParamsChanged);
         }
         ui.separator();
-        if super::isovalues::editor(ui, c, w) {
+        let range = data.mesh.as_ref().map_or([0.0, 1.0], |m| m.range);
+        if super::isovalues::editor(ui, c, range, w) {
             actions.push(UiAction::ParamsChanged);
         }
     }
@@ -397,6 +394,14 @@ fn controls(
     if !state.status.is_empty() {
         // Recorded for scripts (`print Status`).
         w.status_text(ui, "Status", &state.status);
+    }
+    // Lines whose length and count change from frame to frame come last, below every
+    // control: the frame times wrap to two lines on a slow machine and the renderer's
+    // status appears a frame late, and above the controls either would move them between
+    // the frame a click is aimed and the frame it lands.
+    if !state.volume_info.is_empty() {
+        // The renderer's own lines (a COPC cut, its node cache), recorded for scripts.
+        w.status_text(ui, "Renderer", &state.volume_info);
     }
 }
 

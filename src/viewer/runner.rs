@@ -49,6 +49,10 @@ pub struct ScriptRunner {
     deadline: Option<Instant>,
     last_click: Option<Instant>,
     layout: Option<LayoutCheck>,
+    /// The rectangle the current step's widget had last frame: a pointer action waits
+    /// until it is the same two frames running, so that a layout still settling (a
+    /// panel growing after a click) cannot move the widget under the pointer.
+    aimed_at: Option<egui::Rect>,
 }
 
 fn press(pos: Pos2, button: PointerButton, pressed: bool) -> Event {
@@ -87,12 +91,13 @@ impl ScriptRunner {
         self.started = None;
         self.deadline = None;
         self.layout = None;
+        self.aimed_at = None;
     }
 
     /// Find `label` on screen and the point at `at` (fractions; centre when `None`):
     /// `Ok(None)` while it is still being looked for or scrolled into view.
     fn locate(
-        &self,
+        &mut self,
         step: &Step,
         o: &mut Observed<'_>,
         label: &str,
@@ -116,8 +121,11 @@ impl ScriptRunner {
         if !seen.enabled {
             return Err(self.error(step, format!("{label:?} is disabled")));
         }
-        let (fx, fy) = at.unwrap_or((0.5, 0.5));
         let r = seen.rect;
+        if self.aimed_at.replace(r) != Some(r) && !late {
+            return Ok(None);
+        }
+        let (fx, fy) = at.unwrap_or((0.5, 0.5));
         let p = Pos2::new(r.left() + fx * r.width(), r.top() + fy * r.height());
         // Points exactly on the far edges count as inside.
         if seen.visible.expand(0.01).contains(p) {
