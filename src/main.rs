@@ -57,6 +57,10 @@ enum Command {
         /// Print every GL resource created, with its bytes, and the timings.
         #[arg(long)]
         stats: bool,
+        /// Print what was written (and with --stats the resources and timings) as one
+        /// JSON object on stdout instead of text.
+        #[arg(long)]
+        json: bool,
     },
     /// Print what the loaders see in a file: volumes (SEG-Y, NIfTI: dimensions, ranges,
     /// sample type, byte order, statistics), meshes (VTK legacy, .vtu, gmsh: points, cells
@@ -311,6 +315,20 @@ fn is_copc_name(path: &Path) -> bool {
     path.to_string_lossy().to_lowercase().ends_with(".copc.laz")
 }
 
+/// An output's folder must exist (arbvis creates none): said as the output's fault before
+/// any work is done.
+fn check_output_folder(output: &Path) -> Result<()> {
+    let folder = output.parent().filter(|p| !p.as_os_str().is_empty());
+    match folder {
+        Some(folder) if !folder.is_dir() => bail!(
+            "the output {}: its folder {} does not exist (arbvis creates no folders; make it first)",
+            output.display(),
+            folder.display()
+        ),
+        _ => Ok(()),
+    }
+}
+
 /// `--dry-run`: the command's scene loaded and the files it reads found, nothing run.
 fn dry_run(command: &Command) -> Result<()> {
     let exists = |path: &Path| -> Result<()> {
@@ -324,6 +342,10 @@ fn dry_run(command: &Command) -> Result<()> {
         args.load()?;
     }
     match command {
+        Command::Render {
+            output: Some(output),
+            ..
+        } => check_output_folder(output)?,
         Command::Inspect { file, .. } => exists(file)?,
         Command::Convert { input, store, .. } => {
             exists(input)?;
@@ -502,7 +524,7 @@ impl SceneArgs {
     /// The scene and a name for where it came from.
     fn load(&self) -> Result<(Scene, String)> {
         let (mut scene, origin) = match (&self.scene, &self.demo) {
-            (Some(path), _) => (Scene::load(path)?, path.display().to_string()),
+            (Some(path), _) => (Scene::load_checked(path)?, path.display().to_string()),
             (None, Some(name)) => (Scene::demo(name)?, format!("demo:{name}")),
             (None, None) => bail!("name a scene file or --demo NAME"),
         };
@@ -640,10 +662,12 @@ fn run(cli: Cli) -> Result<()> {
             output,
             backend,
             stats,
+            json,
         } => {
             let Some(output) = output else {
                 bail!("render needs an output file: -o OUT.png");
             };
+            check_output_folder(&output)?;
             let (scene, origin) = scene.load()?;
             let rendered = arbvis::render::render(&scene, backend).map_err(|e| {
                 anyhow::anyhow!(scene.explain_missing(format!("rendering {origin}: {e:#}")))
@@ -653,25 +677,13 @@ fn run(cli: Cli) -> Result<()> {
                 &scene.picture(&rendered.image),
                 &rendered.png_text(&scene, &origin),
             )?;
-            println!(
-                "wrote {} ({}x{}, {} programs, {} target, {} on {})",
-                output.display(),
-                scene.size[0],
-                scene.size[1],
-                rendered.program_kind.name(),
-                scene.target_format().name(),
-                rendered.caps.renderer,
-                backend.name()
-            );
-            if stats {
-                print!("{}", arbvis::render::format_stats(&rendered.resources));
-                if let Some(status) = &rendered.status {
-                    println!("{status}");
-                }
-                println!(
-                    "build {:.3} ms, draw {:.3} ms",
-                    rendered.build_time.as_secs_f64() * 1e3,
-                    rendered.draw_time.as_secs_f64() * 1e3
+            if json {
+                let report = arbvis::render::report_json(&rendered, &scene, &output, stats);
+                println!("{report}");
+            } else {
+                print!(
+                    "{}",
+                    arbvis::render::report_text(&rendered, &scene, &output, stats)
                 );
             }
         }

@@ -110,6 +110,74 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
     })
 }
 
+/// What `arbvis render` prints after writing `output`: the line that says so, and with
+/// `stats` the resources, the renderer's status and the timings.
+pub fn report_text(
+    rendered: &Rendered,
+    scene: &Scene,
+    output: &std::path::Path,
+    stats: bool,
+) -> String {
+    let mut s = format!(
+        "wrote {} ({}x{}, {} programs, {} target, {} on {})\n",
+        output.display(),
+        scene.size[0],
+        scene.size[1],
+        rendered.program_kind.name(),
+        scene.target_format().name(),
+        rendered.caps.renderer,
+        rendered.backend.name()
+    );
+    if stats {
+        s += &format_stats(&rendered.resources);
+        if let Some(status) = &rendered.status {
+            s += &format!("{status}\n");
+        }
+        s += &format!(
+            "build {:.3} ms, draw {:.3} ms\n",
+            rendered.build_time.as_secs_f64() * 1e3,
+            rendered.draw_time.as_secs_f64() * 1e3
+        );
+    }
+    s
+}
+
+/// [`report_text`] as one JSON object (`render --json`): `output`, `size`, `programs`,
+/// `target`, `fidelity`, `technique`, `renderer`, `backend`, and with `stats` also
+/// `resources` (kind, label, bytes each), `resource_bytes`, `status`, `build_ms` and
+/// `draw_ms`.
+pub fn report_json(
+    rendered: &Rendered,
+    scene: &Scene,
+    output: &std::path::Path,
+    stats: bool,
+) -> String {
+    let mut report = serde_json::json!({
+        "output": output.display().to_string(),
+        "size": scene.size,
+        "programs": rendered.program_kind.name(),
+        "target": scene.target_format().name(),
+        "fidelity": scene.fidelity.name(),
+        "technique": scene.technique.name(),
+        "renderer": rendered.caps.renderer,
+        "backend": rendered.backend.name(),
+    });
+    if stats {
+        let resources: Vec<_> = rendered
+            .resources
+            .iter()
+            .map(|r| serde_json::json!({"kind": r.kind, "label": r.label, "bytes": r.bytes}))
+            .collect();
+        let total: u64 = rendered.resources.iter().map(|r| r.bytes).sum();
+        report["resources"] = resources.into();
+        report["resource_bytes"] = total.into();
+        report["status"] = rendered.status.clone().into();
+        report["build_ms"] = (rendered.build_time.as_secs_f64() * 1e3).into();
+        report["draw_ms"] = (rendered.draw_time.as_secs_f64() * 1e3).into();
+    }
+    serde_json::to_string_pretty(&report).unwrap_or_default()
+}
+
 /// `--stats`: every resource, one line each, and the total.
 pub fn format_stats(resources: &[Resource]) -> String {
     let mut s = String::from("GL resources created:\n");

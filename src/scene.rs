@@ -53,6 +53,17 @@ pub struct Scene {
     pub base: std::path::PathBuf,
 }
 
+/// A data file a scene reads ([`Scene::data_files`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DataFile {
+    /// The dotted key that names it, e.g. `technique.opacity3d.primary.volume.segy`.
+    pub key: String,
+    /// The path as the scene writes it.
+    pub written: std::path::PathBuf,
+    /// The path as read: against the scene's folder, absolute.
+    pub resolved: std::path::PathBuf,
+}
+
 impl Scene {
     /// `error` with the scene's `data_from` hint added when a file it reads is missing.
     pub fn explain_missing(&self, error: String) -> String {
@@ -189,6 +200,15 @@ impl Scene {
         Ok(scene)
     }
 
+    /// [`Scene::load`], and every data file it reads found ([`Scene::check_data_files`]):
+    /// what the command line does before it renders, views or benches a scene.
+    pub fn load_checked(path: &Path) -> Result<Scene, SceneError> {
+        let scene = Scene::load(path)?;
+        let text = crate::input::read_text(path, crate::input::MAX_SCENE_BYTES).ok();
+        scene.check_data_files(&path.display().to_string(), text.as_deref())?;
+        Ok(scene)
+    }
+
     /// A built-in demo scene.
     pub fn demo(name: &str) -> Result<Scene, SceneError> {
         let (_, text) = DEMOS
@@ -203,37 +223,89 @@ impl Scene {
         toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot serialize: {e}\n"))
     }
 
-    /// A copy whose relative data paths (volumes, table files, clip meshes and masks) are made absolute against
-    /// [`Scene::base`], so it can be saved anywhere.
-    pub fn with_absolute_paths(&self) -> Scene {
-        let mut scene = self.clone();
-        let base = std::path::absolute(&self.base).unwrap_or_else(|_| self.base.clone());
-        match &mut scene.technique {
+    /// Call `f` on every data file the scene names (volumes, table files, clip meshes and
+    /// masks, meshes, clouds), with the dotted key that holds it.
+    pub fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut std::path::PathBuf)) {
+        match &mut self.technique {
             TechniqueScene::Opacity3d(o) => {
-                for attr in o.attributes_mut().into_iter().flatten() {
+                let names = ["primary", "secondary", "tertiary"];
+                for (attr, name) in o.attributes_mut().into_iter().zip(names) {
+                    let Some(attr) = attr else { continue };
+                    let kind = attr.volume.kind();
                     if let Some(p) = attr.volume.path_mut() {
-                        *p = base.join(&*p);
+                        f(&format!("technique.opacity3d.{name}.volume.{kind}"), p);
                     }
-                    if let Some(f) = &mut attr.table.file {
-                        *f = base.join(&*f);
+                    if let Some(p) = &mut attr.table.file {
+                        f(&format!("technique.opacity3d.{name}.table.file"), p);
                     }
                 }
                 if let Some(clip) = &mut o.clip {
-                    clip.shape.for_each_path(&mut |p| *p = base.join(&*p));
+                    clip.shape
+                        .for_each_path(&mut |p| f("technique.opacity3d.clip.shape", p));
                 }
             }
             TechniqueScene::Cellproj(c) => {
                 if let Some(p) = c.mesh.path_mut() {
-                    *p = base.join(&*p);
+                    f("technique.cellproj.mesh.file", p);
                 }
             }
             TechniqueScene::Splats(s) => {
+                let kind = s.cloud.kind();
                 if let Some(p) = s.cloud.path_mut() {
-                    *p = base.join(&*p);
+                    f(&format!("technique.splats.cloud.{kind}"), p);
                 }
             }
             TechniqueScene::Quad(_) => {}
         }
+    }
+
+    /// Every data file the scene reads: its key, the path as written and as resolved
+    /// against [`Scene::base`].
+    pub fn data_files(&self) -> Vec<DataFile> {
+        let mut files = Vec::new();
+        let base = self.base.clone();
+        self.clone().for_each_data_path(&mut |key, p| {
+            files.push(DataFile {
+                key: key.to_string(),
+                written: p.clone(),
+                resolved: std::path::absolute(base.join(&*p)).unwrap_or_else(|_| base.join(&*p)),
+            })
+        });
+        files
+    }
+
+    /// The first data file the scene reads that does not exist, as an error naming its
+    /// key (at its line in `text`, the scene's own text, where given), the path as
+    /// written and as resolved, and the scene's `data_from` hint.
+    pub fn check_data_files(&self, origin: &str, text: Option<&str>) -> Result<(), SceneError> {
+        let Some(missing) = self.data_files().into_iter().find(|f| !f.resolved.exists()) else {
+            return Ok(());
+        };
+        let (line, column) = text.map_or((1, 1), |t| key_position(t, &missing.key));
+        let relative = if missing.written.is_absolute() {
+            String::new()
+        } else {
+            " (a scene's data paths are relative to the scene's folder)".to_string()
+        };
+        Err(SceneError::Invalid {
+            path: origin.to_string(),
+            line,
+            column,
+            key: missing.key,
+            message: self.explain_missing(format!(
+                "no such file: {:?} as written, {} as resolved{relative}",
+                missing.written.display().to_string(),
+                missing.resolved.display()
+            )),
+        })
+    }
+
+    /// A copy whose relative data paths are made absolute against [`Scene::base`], so it
+    /// can be saved anywhere.
+    pub fn with_absolute_paths(&self) -> Scene {
+        let mut scene = self.clone();
+        let base = std::path::absolute(&self.base).unwrap_or_else(|_| self.base.clone());
+        scene.for_each_data_path(&mut |_, p| *p = base.join(&*p));
         scene.base = base;
         scene
     }

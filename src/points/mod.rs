@@ -249,6 +249,17 @@ impl PointSource {
         }
     }
 
+    /// The scene's word for the kind of source (`las`, `copc`, ...).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            PointSource::Dat(_) => "dat",
+            PointSource::Las(_) => "las",
+            PointSource::Ply(_) => "ply",
+            PointSource::Copc(_) => "copc",
+            PointSource::Section(_) => "section",
+        }
+    }
+
     /// The file it names, if any, for rewriting.
     pub fn path_mut(&mut self) -> Option<&mut PathBuf> {
         match self {

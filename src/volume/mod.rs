@@ -434,6 +434,17 @@ impl VolumeSource {
         }
     }
 
+    /// The scene's word for the kind of source (`segy`, `store`, ...).
+    pub fn kind(&self) -> &'static str {
+        match self {
+            VolumeSource::Segy(_) => "segy",
+            VolumeSource::Nifti(_) => "nifti",
+            VolumeSource::Raw(_) => "raw",
+            VolumeSource::Synthetic(_) => "synthetic",
+            VolumeSource::Store(_) => "store",
+        }
+    }
+
     /// The file it names, if any, for rewriting.
     pub fn path_mut(&mut self) -> Option<&mut PathBuf> {
         match self {

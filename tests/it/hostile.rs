@@ -170,7 +170,12 @@ fn errors_point_at_the_place() {
     refused(
         "missing-data",
         &volume_scene("{ segy = \"not-here.sgy\" }"),
-        &["missing-data", "/not-here.sgy: No such file"],
+        &[
+            "missing-data",
+            // The key at its line and column, the path as written and as resolved.
+            "scene.toml:5:12: technique.opacity3d.primary.volume.segy: no such file: \"not-here.sgy\" as written",
+            "/not-here.sgy as resolved",
+        ],
     );
     // A scene named relative to the current folder: the error shows where it looked.
     let dir = temp_dir("missing-relative");
@@ -188,7 +193,7 @@ fn errors_point_at_the_place() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     let tried = dir.join("scenes/data/not-here.sgy");
     assert!(
-        stderr.contains(&format!("looked for {}", tried.display())),
+        stderr.contains(&format!("{} as resolved", tried.display())),
         "{stderr}"
     );
     // Checks after parsing name line and column.
