@@ -638,7 +638,7 @@ fn cellproj_volume(
         .build(&scene.base, prepared.scale)
         .map_err(anyhow::Error::msg)?;
     let isos = if c.mode == crate::techniques::cellproj::Mode::Both {
-        c.isovalues.clone()
+        c.normalized(prepared.scalar_range).isovalues
     } else {
         Vec::new()
     };

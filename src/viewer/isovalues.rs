@@ -3,12 +3,30 @@
 //! Each edit rewrites only the isosurface table (and the active list) on the next frame.
 
 use super::widgets::Widgets;
-use crate::techniques::cellproj::{CellprojScene, Exit, Isovalue, MAX_ISOVALUES};
+use crate::techniques::cellproj::{CellprojScene, Exit, Isovalue, IsovalueUnits, MAX_ISOVALUES};
 
-/// Draw the editor; true when something changed.
-pub fn editor(ui: &mut egui::Ui, scene: &mut CellprojScene, w: &mut Widgets) -> bool {
+/// Draw the editor; true when something changed. `range` is the scalar's range in its
+/// own units (the values are dragged within it, or within 0..1 where the scene writes
+/// them normalized).
+pub fn editor(
+    ui: &mut egui::Ui,
+    scene: &mut CellprojScene,
+    range: [f64; 2],
+    w: &mut Widgets,
+) -> bool {
     let mut changed = false;
-    ui.label("Isovalues (normalized scalar, colour)");
+    let (lo, hi) = match scene.isovalue_units {
+        IsovalueUnits::Data => (range[0], range[1]),
+        IsovalueUnits::Normalized => (0.0, 1.0),
+    };
+    ui.label(match scene.isovalue_units {
+        IsovalueUnits::Data => format!(
+            "Isovalues (scalar {}..{}, colour)",
+            super::lut3d::short(lo),
+            super::lut3d::short(hi)
+        ),
+        IsovalueUnits::Normalized => "Isovalues (normalized scalar 0..1, colour)".to_string(),
+    });
     let mut remove = None;
     for (i, iso) in scene.isovalues.iter_mut().enumerate() {
         ui.horizontal(|ui| {
@@ -16,8 +34,8 @@ pub fn editor(ui: &mut egui::Ui, scene: &mut CellprojScene, w: &mut Widgets) -> 
                 ui,
                 &format!("Isovalue {}", i + 1),
                 &mut iso.value,
-                0.0..=1.0,
-                0.002,
+                lo..=hi,
+                0.002 * (hi - lo).max(f64::MIN_POSITIVE),
             );
             let mut c = iso.color.map(|v| v as f32);
             let r = ui.color_edit_button_rgba_unmultiplied(&mut c);
@@ -40,10 +58,16 @@ pub fn editor(ui: &mut egui::Ui, scene: &mut CellprojScene, w: &mut Widgets) -> 
         egui::Button::new("Add isovalue"),
     );
     if w.add(ui, "Add isovalue", &r) && r.clicked() {
-        let value = scene
-            .isovalues
-            .last()
-            .map_or(0.5, |i| (i.value + 0.1) % 1.0);
+        // A tenth of the range above the last one (wrapping), else the middle.
+        let span = hi - lo;
+        let value = scene.isovalues.last().map_or(lo + 0.5 * span, |i| {
+            let t = if span > 0.0 {
+                (i.value - lo) / span
+            } else {
+                0.0
+            };
+            lo + ((t + 0.1) % 1.0) * span
+        });
         scene.isovalues.push(Isovalue {
             value,
             color: [1.0, 1.0, 0.0, 1.0],

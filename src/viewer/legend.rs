@@ -21,6 +21,7 @@ use super::overlay::{paint_texts, Ink, Measure, Text};
 use crate::points::section::{facies_colour, FACIES_TABLE, PALETTE};
 use crate::points::UNDEFINED_FACIES;
 use crate::scene::{Scene, TechniqueScene};
+use crate::techniques::cellproj::IsovalueUnits;
 use crate::techniques::splats::prepare::{class_colour, COLOR_A, COLOR_B, LAYERS_IN_PALETTE};
 use crate::techniques::splats::scene::ColourMode;
 
@@ -454,15 +455,22 @@ pub fn legends(
                 .map_or((String::from("scalar"), [0.0, 1.0]), |m| {
                     (m.scalar.clone(), m.range)
                 });
-            let mut isos: Vec<_> = c.isovalues.iter().collect();
+            // Each isovalue in the scalar's units, and normalized beside it where the
+            // scene writes them so.
+            let mut isos = c.isovalues.clone();
             isos.sort_by(|a, b| a.value.total_cmp(&b.value));
+            let normalized = c.isovalue_units == IsovalueUnits::Normalized;
             let plain = lo == 0.0 && hi == 1.0;
             let entries = isos
                 .iter()
                 .map(|i| {
-                    let raw = lo + i.value * (hi - lo);
-                    let label = if plain {
-                        format!("{:.3}", i.value)
+                    let raw = if normalized {
+                        lo + i.value * (hi - lo)
+                    } else {
+                        i.value
+                    };
+                    let label = if plain || !normalized {
+                        lut3d::short(raw)
                     } else {
                         format!("{:.3} = {}", i.value, lut3d::short(raw))
                     };

@@ -14,7 +14,7 @@ use arbvis::render::render_on;
 use arbvis::scene::{Fidelity, Scene, TechniqueScene};
 use arbvis::techniques::cellproj::prepare::{from_mesh, Prepared};
 use arbvis::techniques::cellproj::reference::{agreement, reference, silhouette_pixels, Agreement};
-use arbvis::techniques::cellproj::{CellprojRenderer, CellprojScene, Isovalue};
+use arbvis::techniques::cellproj::{CellprojRenderer, CellprojScene, Isovalue, IsovalueUnits};
 use arbvis::techniques::{Frame, Renderer};
 use arbvis::vocab::Interpolation;
 use common::headless;
@@ -41,6 +41,7 @@ fn params(field: Field, isovalues: Vec<Isovalue>) -> CellprojScene {
         mode: Default::default(),
         volume: None,
         isovalues,
+        isovalue_units: IsovalueUnits::Normalized,
         exit: Default::default(),
         table_size: 256,
         shading: false,

@@ -16,7 +16,9 @@ use arbvis::techniques::cellproj::prepare::{from_mesh, Prepared};
 use arbvis::techniques::cellproj::reference::silhouette_pixels;
 use arbvis::techniques::cellproj::transfer::{Precise, Sort, VolumeSpec};
 use arbvis::techniques::cellproj::volume_reference::{interior_mask, reference, score};
-use arbvis::techniques::cellproj::{CellprojRenderer, CellprojScene, Exit, Isovalue, Mode};
+use arbvis::techniques::cellproj::{
+    CellprojRenderer, CellprojScene, Exit, Isovalue, IsovalueUnits, Mode,
+};
 use arbvis::techniques::{Frame, Renderer};
 use common::headless;
 
@@ -68,6 +70,7 @@ pub(crate) fn scene(mode: Mode, volume: VolumeSpec, isovalues: Vec<Isovalue>) ->
         scalars: ScalarSpec::default(),
         mode,
         isovalues,
+        isovalue_units: IsovalueUnits::Normalized,
         volume: Some(volume),
         exit: Default::default(),
         table_size: 256,

@@ -325,6 +325,8 @@ fn mesh_scenes_render_and_agree_with_the_reference() {
         scene.technique = TechniqueScene::Cellproj(Box::new(c.clone()));
         let r = render_on(&h, &scene).unwrap();
         let prepared = prepare(&c, &scene.base).unwrap();
+        // The scenes write isovalues in the scalar's units; the reference takes them normalized.
+        let c = c.normalized(prepared.scalar_range);
         let hits = reference(&prepared, &c.isovalues, &scene.camera, scene.size);
         let expected = hits.iter().filter(|h| h.is_some()).count();
         assert!(

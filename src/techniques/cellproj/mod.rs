@@ -99,14 +99,47 @@ use crate::vocab::FieldError;
 
 pub use renderer::CellprojRenderer;
 
-/// One isosurface: the normalized scalar value and its colour.
+/// One isosurface: the scalar value and its colour.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Isovalue {
-    /// Value in [0, 1] (scalars are normalized over their range, as the seed did).
+    /// The value in the scalar's own units, or normalized to [0, 1] over its range (as the
+    /// seed wrote them) where the scene says `isovalue_units = "normalized"`.
     pub value: f64,
     /// RGBA colour, each in [0, 1].
     pub color: [f64; 4],
+}
+
+/// `v` with four significant digits, trailing zeros dropped (`0.3554`, `1.641`, `-17.81`).
+fn significant(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (3 - v.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+/// The units of a scene's isovalues.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum IsovalueUnits {
+    /// The scalar's own units: `value = 1.5` is where the scalar is 1.5.
+    #[default]
+    Data,
+    /// Normalized over the scalar's range (`scalars.range`, else its minimum and
+    /// maximum): 0 is the low end, 1 the high end, as the seed wrote them.
+    Normalized,
+}
+
+impl IsovalueUnits {
+    fn is_data(&self) -> bool {
+        *self == IsovalueUnits::Data
+    }
 }
 
 /// Where the exit point is computed.
@@ -206,6 +239,9 @@ pub struct CellprojScene {
     /// The isosurfaces, any order.
     #[serde(default)]
     pub isovalues: Vec<Isovalue>,
+    /// The units of `isovalues`: the scalar's own (the default) or normalized.
+    #[serde(default, skip_serializing_if = "IsovalueUnits::is_data")]
+    pub isovalue_units: IsovalueUnits,
     /// The volume's transfer function and settings (`mode = "volume"` or `"both"`;
     /// defaults when absent).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -338,6 +374,55 @@ impl CellprojScene {
     /// The volume settings (the defaults when the scene gives none).
     pub fn volume_spec(&self) -> transfer::VolumeSpec {
         self.volume.clone().unwrap_or_default()
+    }
+
+    /// The scene with its isovalues normalized over `range` (the prepared scalar range,
+    /// [`prepare::Prepared::scalar_range`]): what the renderers and references draw.
+    pub fn normalized(&self, range: [f64; 2]) -> CellprojScene {
+        let mut scene = self.clone();
+        if scene.isovalue_units == IsovalueUnits::Data {
+            let [lo, hi] = range;
+            let span = hi - lo;
+            for iso in &mut scene.isovalues {
+                // A constant scalar (no span): at the value 0, above it 1, below it -1,
+                // so that only an isovalue equal to the constant lies in [0, 1].
+                iso.value = if span > 0.0 {
+                    (iso.value - lo) / span
+                } else {
+                    (iso.value - lo).signum()
+                };
+            }
+            scene.isovalue_units = IsovalueUnits::Normalized;
+        }
+        scene
+    }
+
+    /// One line for each isovalue outside the scalar's `range` (it can draw nothing),
+    /// naming its key, its value and the range in the scene's units.
+    pub fn range_warnings(&self, range: [f64; 2]) -> Vec<String> {
+        let normalized = self.normalized(range);
+        let (shown, units) = match self.isovalue_units {
+            IsovalueUnits::Data => (range, "the scalar's units"),
+            IsovalueUnits::Normalized => ([0.0, 1.0], "normalized"),
+        };
+        self.isovalues
+            .iter()
+            .zip(&normalized.isovalues)
+            .enumerate()
+            .filter(|(_, (_, n))| !(0.0..=1.0).contains(&n.value))
+            .map(|(i, (iso, _))| {
+                format!(
+                    "technique.cellproj.isovalues.{i}.value = {} lies outside the scalar's range {}..{} ({units}; isovalue_units = \"{}\"): it draws nothing",
+                    iso.value,
+                    significant(shown[0]),
+                    significant(shown[1]),
+                    match self.isovalue_units {
+                        IsovalueUnits::Data => "data",
+                        IsovalueUnits::Normalized => "normalized",
+                    }
+                )
+            })
+            .collect()
     }
 
     /// The isovalues sorted by value (ties keep their order).

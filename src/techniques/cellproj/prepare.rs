@@ -103,6 +103,11 @@ pub fn prepare(scene: &CellprojScene, base: &Path) -> Result<Prepared, String> {
     if let Some(note) = p.left_out(&mesh) {
         eprintln!("arbvis: note: {note}");
     }
+    if scene.mode.isosurfaces() {
+        for warning in scene.range_warnings(p.scalar_range) {
+            eprintln!("arbvis: warning: {warning}");
+        }
+    }
     Ok(p)
 }
 

@@ -197,6 +197,8 @@ impl CellprojRenderer {
         prepared: Prepared,
         base: &Path,
     ) -> GlResult<CellprojRenderer> {
+        // Everything below works on normalized scalars and isovalues.
+        let params = &params.normalized(prepared.scalar_range);
         let (mesh, faces) = if params.mode.isosurfaces() {
             face_mesh(gpu, &prepared, params.order)?
         } else {
@@ -413,6 +415,7 @@ impl Renderer for CellprojRenderer {
     fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
         let new = params.get::<CellprojScene>()?;
         new.validate().map_err(|e| GlError::Data(e.to_string()))?;
+        let new = &new.normalized(self.prepared.scalar_range);
         if new.mesh != self.params.mesh || new.scalars != self.params.scalars {
             return Err(GlError::Invalid(
                 "a new mesh or scalar needs a new renderer".into(),

@@ -23,7 +23,7 @@ use crate::vocab::TargetFormat;
 
 use super::prepare::{from_mesh, Prepared};
 use super::reference::{agreement, reference, silhouette_pixels, Hit};
-use super::{CellprojRenderer, CellprojScene, Exit, Isovalue};
+use super::{CellprojRenderer, CellprojScene, Exit, Isovalue, IsovalueUnits};
 use crate::progress::{Bar, Unit};
 
 /// What to sweep.
@@ -88,6 +88,7 @@ fn scene_for(points: usize, exit: Exit, active_only: bool) -> CellprojScene {
         mode: Default::default(),
         volume: None,
         isovalues: seed_isovalues(),
+        isovalue_units: IsovalueUnits::Normalized,
         exit,
         table_size: 256,
         shading: false,
