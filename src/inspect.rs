@@ -145,6 +145,15 @@ pub fn looks_like(head: &[u8]) -> String {
 
 /// `arbvis inspect`.
 pub fn inspect(path: &Path) -> Result<String, InspectError> {
+    inspect_with(path, crate::volume::segy::KeyBytes::default())
+}
+
+/// [`inspect`] with a SEG-Y file's inline and crossline bytes named (each one not named
+/// is detected).
+pub fn inspect_with(
+    path: &Path,
+    segy_keys: crate::volume::segy::KeyBytes,
+) -> Result<String, InspectError> {
     let io = |error| InspectError::Io {
         path: path.display().to_string(),
         error,
@@ -164,7 +173,7 @@ pub fn inspect(path: &Path) -> Result<String, InspectError> {
     let mut head = Vec::new();
     file.take(4096).read_to_end(&mut head).map_err(io)?;
     match kind(path, &head) {
-        Some(Kind::Nifti | Kind::Segy) => Ok(crate::volume::inspect(path)?),
+        Some(Kind::Nifti | Kind::Segy) => Ok(crate::volume::inspect_with(path, segy_keys)?),
         Some(Kind::Mesh) => Ok(crate::mesh::inspect(path)?),
         Some(Kind::Points) => Ok(crate::points::inspect(path)?),
         Some(Kind::Surface) => {

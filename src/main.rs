@@ -74,6 +74,8 @@ enum Command {
         /// loading the file costs).
         #[arg(long, value_name = "RUNS")]
         time: Option<usize>,
+        #[command(flatten)]
+        segy_keys: SegyKeyArgs,
     },
     /// Time a scene offscreen: clear + draw + finish per frame, the first frame apart,
     /// settings interleaved over rounds. For 3D opacity: sweep faithful / precise slice
@@ -203,7 +205,8 @@ enum Command {
         out: PathBuf,
     },
     /// Convert a survey (SEG-Y, NIfTI-1, raw, an MDIO dataset) into a bricked
-    /// multi-resolution zarr v3 store, or a point cloud (LAS, LAZ, PLY, seed .dat) into a
+    /// multi-resolution zarr v3 store, or a point cloud (LAS, LAZ, PLY, or the splatting paper's
+    /// .dat text: one point per line, x y z and properties) into a
     /// COPC file (when STORE ends in `.copc.laz`: an octree of LAZ chunks, built out of
     /// core, that `{ copc = ... }` scenes draw). A store is laid out as an MDIO v1
     /// dataset, that `{ store = "STORE" }` scenes stream (src/store/). Streams the input (one column of
@@ -212,7 +215,7 @@ enum Command {
     /// levels, ranges and derived attributes to the dataset itself, beside its own arrays.
     Convert {
         /// The survey: SEG-Y, NIfTI-1 (.nii, .nii.gz), raw with --raw-dims, or an MDIO
-        /// dataset (a folder); or a point cloud (LAS, LAZ, PLY, seed .dat) for COPC.
+        /// dataset (a folder); or a point cloud (LAS, LAZ, PLY, the paper's .dat text) for COPC.
         input: PathBuf,
         /// The store's folder (created; an interrupted conversion there is resumed).
         /// Without it, an MDIO dataset given as the input gains the levels in place.
@@ -254,6 +257,8 @@ enum Command {
         /// output.
         #[arg(long, value_parser = clap::value_parser!(u64).range(10_000..))]
         memory_points: Option<u64>,
+        #[command(flatten)]
+        segy_keys: SegyKeyArgs,
     },
     /// Open the desktop viewer (winit + glutin + egui).
     #[cfg(feature = "viewer")]
@@ -516,6 +521,28 @@ struct SceneArgs {
     point_budget: Option<u64>,
 }
 
+/// Where a SEG-Y file keeps its inline and crossline numbers.
+#[derive(Args)]
+struct SegyKeyArgs {
+    /// SEG-Y: the trace-header byte (1-based) where the inline number starts (a 4-byte
+    /// integer; segyio's `iline`). Default: detected (189, as SEG-Y rev 1, or 9 or 17).
+    #[arg(long, value_name = "BYTE")]
+    iline: Option<u16>,
+    /// SEG-Y: the trace-header byte where the crossline number starts (segyio's
+    /// `xline`). Default: detected (193, as SEG-Y rev 1, or 21 or 13).
+    #[arg(long, value_name = "BYTE")]
+    xline: Option<u16>,
+}
+
+impl SegyKeyArgs {
+    fn keys(&self) -> arbvis::volume::segy::KeyBytes {
+        arbvis::volume::segy::KeyBytes {
+            iline: self.iline,
+            xline: self.xline,
+        }
+    }
+}
+
 fn gpu_memory(s: &str) -> Result<String, String> {
     arbvis::budget::parse(s).map(|_| s.to_string())
 }
@@ -699,6 +726,7 @@ fn run(cli: Cli) -> Result<()> {
             raw_offset,
             node_points,
             memory_points,
+            segy_keys,
         } => {
             if let Some(out) = store.as_ref().filter(|s| is_copc_name(s)) {
                 let report = arbvis::points::copc_write::write_copc(
@@ -761,6 +789,7 @@ fn run(cli: Cli) -> Result<()> {
                 derived,
                 compression,
                 raw,
+                segy_keys: segy_keys.keys(),
                 ..Default::default()
             };
             let store = match store {
@@ -1055,13 +1084,19 @@ fn run(cli: Cli) -> Result<()> {
             print!("{}", arbvis::study::summary(&rows));
             println!("wrote {} and {}", csv.display(), png.display());
         }
-        Command::Inspect { file, time } => {
-            print!("{}", arbvis::inspect::inspect(&file)?);
+        Command::Inspect {
+            file,
+            time,
+            segy_keys,
+        } => {
+            let keys = segy_keys.keys();
+            print!("{}", arbvis::inspect::inspect_with(&file, keys)?);
             if let Some(runs) = time.filter(|&r| r > 0) {
                 let mut ms: Vec<f64> = (0..runs.min(1000))
                     .map(|_| {
                         let t = std::time::Instant::now();
-                        arbvis::inspect::inspect(&file).map(|_| t.elapsed().as_secs_f64() * 1e3)
+                        arbvis::inspect::inspect_with(&file, keys)
+                            .map(|_| t.elapsed().as_secs_f64() * 1e3)
                     })
                     .collect::<Result<_, _>>()?;
                 ms.sort_by(f64::total_cmp);

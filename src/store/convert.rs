@@ -71,6 +71,8 @@ pub struct ConvertOptions {
     pub compression: Compression,
     /// A raw input's description.
     pub raw: Option<RawSpec>,
+    /// A SEG-Y input's inline and crossline bytes, where named (else detected).
+    pub segy_keys: crate::volume::segy::KeyBytes,
     /// Draw a progress bar (when stderr is a terminal).
     pub progress: bool,
     /// For tests: stop with [`StoreError::Interrupted`] once this many columns are done
@@ -88,6 +90,7 @@ impl Default for ConvertOptions {
             derived: vec![Attribute::Envelope],
             compression: Compression::default(),
             raw: None,
+            segy_keys: Default::default(),
             progress: true,
             stop_after: None,
         }
@@ -198,7 +201,7 @@ fn convert_on_workers(
             attributes.push(a);
         }
     }
-    let src = Input::open(input, o.raw.as_ref())?;
+    let src = Input::open(input, o.raw.as_ref(), o.segy_keys)?;
     let dims = src.dims();
     let b = o.brick;
     let levels = super::level_count(dims, b);

@@ -59,7 +59,11 @@ fn meta(path: &Path, kind: &str, bytes: u64, facts: Vec<(String, String)>) -> So
 impl Input {
     /// Open `path`: raw when `raw` describes it, NIfTI by extension (`.nii`, `.nii.gz`),
     /// else SEG-Y.
-    pub fn open(path: &Path, raw: Option<&RawSpec>) -> Result<Input, StoreError> {
+    pub fn open(
+        path: &Path,
+        raw: Option<&RawSpec>,
+        segy_keys: crate::volume::segy::KeyBytes,
+    ) -> Result<Input, StoreError> {
         if path.is_dir() && raw.is_none() {
             if !path.join("zarr.json").exists() {
                 if super::mdio::is_mdio_v0(path) {
@@ -165,7 +169,7 @@ impl Input {
                 meta: meta(path, "NIfTI-1", flen, facts),
             }));
         }
-        let s = SegyStream::open(path)?;
+        let s = SegyStream::open_with(path, segy_keys)?;
         let mut m = meta(path, "SEG-Y", len, s.describe());
         let step = |v: &[i32]| [v[0] as i64, v.get(1).map_or(1, |&b| b as i64 - v[0] as i64)];
         m.inlines = Some(step(&s.inlines));
@@ -194,10 +198,10 @@ impl Input {
         }
     }
 
-    /// Voxel size (SEG-Y: one unit per sample, crossline and inline).
+    /// Voxel size (SEG-Y: the survey's proportions, `volume::segy::geometry`).
     pub fn spacing(&self) -> [f64; 3] {
         match self {
-            Input::Segy(..) => [1.0; 3],
+            Input::Segy(s, _) => s.geometry.spacing,
             Input::Flat(f) => f.spacing,
             Input::Memory(v, _) => v.spacing,
             Input::Mdio(_, m) => m.spacing,

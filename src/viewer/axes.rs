@@ -230,6 +230,7 @@ pub fn describe(source: &VolumeSource, base: &Path, dims: [usize; 3]) -> [Axis; 
             let options = ReadOptions {
                 limits: Limits::default(),
                 prestack: s.prestack,
+                keys: s.keys,
             };
             match segy::read(&base.join(&s.path), &options) {
                 Ok(cube) if cube.volume.dims == dims => [
@@ -340,10 +341,7 @@ mod tests {
     #[test]
     fn segy_axes_from_f3() {
         let path = crate::input::data_file("seismic/f3.sgy");
-        let source = VolumeSource::Segy(segy::SegySource {
-            path,
-            prestack: Default::default(),
-        });
+        let source = VolumeSource::Segy(segy::SegySource::new(path));
         let a = describe(&source, Path::new("."), [75, 18, 23]);
         assert_eq!(a[0].name, "time (ms)");
         assert_eq!(a[0].label(74), "296", "75 samples at 4 ms");

@@ -409,6 +409,7 @@ impl VolumeSource {
                 let options = segy::ReadOptions {
                     limits: *limits,
                     prestack: s.prestack,
+                    keys: s.keys,
                 };
                 Ok(segy::read(&base.join(&s.path), &options)?.volume)
             }
@@ -430,7 +431,8 @@ impl VolumeSource {
                 spec.validate().map_err(|e| FieldError::new("synthetic", e))
             }
             VolumeSource::Raw(spec) => spec.validate().map_err(|e| FieldError::new("raw", e)),
-            VolumeSource::Segy(_) | VolumeSource::Nifti(_) | VolumeSource::Store(_) => Ok(()),
+            VolumeSource::Segy(s) => s.keys.validate().map_err(|e| FieldError::new("segy", e)),
+            VolumeSource::Nifti(_) | VolumeSource::Store(_) => Ok(()),
         }
     }
 
@@ -471,6 +473,12 @@ impl VolumeSource {
 /// `arbvis inspect` for volumes: what the loaders see in `path`, the format chosen from
 /// the content (gzip or NIfTI's magic) and the extension; anything else is read as SEG-Y.
 pub fn inspect(path: &Path) -> Result<String, VolumeError> {
+    inspect_with(path, segy::KeyBytes::default())
+}
+
+/// [`inspect`] with a SEG-Y file's inline and crossline bytes named (`inspect --iline 9
+/// --xline 21`); each one not named is detected.
+pub fn inspect_with(path: &Path, keys: segy::KeyBytes) -> Result<String, VolumeError> {
     let name = path.to_string_lossy().to_lowercase();
     if name.ends_with(".nii") || name.ends_with(".nii.gz") {
         return Ok(format!(
@@ -483,7 +491,7 @@ pub fn inspect(path: &Path) -> Result<String, VolumeError> {
     // traces unread): a file whose headers do not fit it fails here, and a file too large
     // to read whole is described from them alone.
     let len = std::fs::metadata(path).map_or(0, |m| m.len());
-    match segy::SegyStream::open(path) {
+    match segy::SegyStream::open_with(path, keys) {
         Ok(stream) if len > INSPECT_WHOLE_MAX => {
             let facts: String = stream
                 .describe()
@@ -501,7 +509,11 @@ pub fn inspect(path: &Path) -> Result<String, VolumeError> {
         _ => {}
     }
     let bytes = read_file(path, u64::MAX)?;
-    match segy::parse(path, &bytes, &segy::ReadOptions::default()) {
+    let options = segy::ReadOptions {
+        keys,
+        ..Default::default()
+    };
+    match segy::parse(path, &bytes, &options) {
         Ok(s) => Ok(format!(
             "{}\n{}{}",
             path.display(),
@@ -510,7 +522,7 @@ pub fn inspect(path: &Path) -> Result<String, VolumeError> {
         )),
         // A pre-stack file cannot be gridded as one cube without a choice: describe its
         // gathers and say how a scene makes that choice.
-        Err(e) => match segy::gathers(path, &bytes) {
+        Err(e) => match segy::gathers(path, &bytes, keys) {
             Ok(g) if g.is_prestack() => Ok(format!("{}\n{}", path.display(), g.describe(path))),
             _ => Err(e),
         },

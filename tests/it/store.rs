@@ -357,13 +357,20 @@ fn fixture(name: &str, dims: [usize; 3], brick: usize) -> (PathBuf, Volume) {
     convert(&sgy, &dir.join("s.zarr"), &o).unwrap();
     let bytes: Vec<u8> = v.values.iter().flat_map(|x| x.to_le_bytes()).collect();
     std::fs::write(dir.join("v.raw"), bytes).unwrap();
+    // The store has the survey's proportions (the SEG-Y reader's geometry: the writer puts
+    // no CDP coordinates, so 25 m bins): so does the raw twin.
+    let mut v = v;
+    v.spacing = arbvis::volume::segy::read(&sgy, &Default::default())
+        .unwrap()
+        .volume
+        .spacing;
     (dir, v)
 }
 
 fn raw_volume(v: &Volume) -> String {
     format!(
-        "{{ raw = {{ path = \"v.raw\", dims = [{}, {}, {}], type = \"f32\" }} }}",
-        v.dims[0], v.dims[1], v.dims[2]
+        "{{ raw = {{ path = \"v.raw\", dims = [{}, {}, {}], type = \"f32\", spacing = {:?} }} }}",
+        v.dims[0], v.dims[1], v.dims[2], v.spacing
     )
 }
 

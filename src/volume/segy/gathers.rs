@@ -1,12 +1,13 @@
 //! What a pre-stack SEG-Y file holds, for `arbvis inspect`: its gathers (the traces at
-//! one inline/crossline position, trace bytes 189-196), their offsets (bytes 37-40),
+//! one inline/crossline position, trace bytes 189-196 or those [`super::keys`] finds), their offsets (bytes 37-40),
 //! samples and values, and how a scene reads it (one offset, or the stack). A post-stack
 //! reader refuses such a file; an inspector describes it.
 
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
-use super::{headers, Headers, SampleFormat, TRACE_HEADER};
+use super::keys::{KeyBytes, Keys};
+use super::{headers_with_keys, Headers, SampleFormat, TRACE_HEADER};
 use crate::volume::VolumeError;
 
 /// The gathers of a SEG-Y file.
@@ -38,6 +39,8 @@ pub struct Gathers {
     pub range: Option<(f32, f32)>,
     /// Samples that are NaN or infinite.
     pub non_finite: usize,
+    /// The trace-header bytes of the inline and crossline numbers.
+    pub keys: Keys,
 }
 
 fn header_i32(bytes: &[u8], at: usize, big: bool) -> i32 {
@@ -50,13 +53,13 @@ fn header_i32(bytes: &[u8], at: usize, big: bool) -> i32 {
 }
 
 /// Read the headers and every trace of SEG-Y bytes (`path` names the file in errors).
-pub fn gathers(path: &Path, bytes: &[u8]) -> Result<Gathers, VolumeError> {
+pub fn gathers(path: &Path, bytes: &[u8], keys: KeyBytes) -> Result<Gathers, VolumeError> {
     let Headers {
         layout: l,
         revision,
         interval_us,
         ..
-    } = headers(path, bytes, bytes.len() as u64)?;
+    } = headers_with_keys(path, bytes, keys)?;
     let mut cells: HashMap<(i32, i32), usize> = HashMap::new();
     let mut offsets: BTreeMap<i32, usize> = BTreeMap::new();
     let (mut il, mut xl) = ((i32::MAX, i32::MIN), (i32::MAX, i32::MIN));
@@ -66,10 +69,7 @@ pub fn gathers(path: &Path, bytes: &[u8]) -> Result<Gathers, VolumeError> {
     for t in 0..l.traces {
         let h = l.first_trace + t * l.trace_len;
         *offsets.entry(header_i32(bytes, h + 36, l.big)).or_default() += 1;
-        let key = (
-            header_i32(bytes, h + 188, l.big),
-            header_i32(bytes, h + 192, l.big),
-        );
+        let key = l.keys.read(&bytes[h..h + TRACE_HEADER], l.big);
         *cells.entry(key).or_default() += 1;
         il = (il.0.min(key.0), il.1.max(key.0));
         xl = (xl.0.min(key.1), xl.1.max(key.1));
@@ -101,6 +101,7 @@ pub fn gathers(path: &Path, bytes: &[u8]) -> Result<Gathers, VolumeError> {
         interval_us,
         range,
         non_finite,
+        keys: l.keys,
     })
 }
 
@@ -135,13 +136,14 @@ impl Gathers {
             |n| n.to_string_lossy().into_owned(),
         );
         format!(
-            "format: SEG-Y rev {}.{}, pre-stack\nsample type: {}\nendianness: {}\ntraces: {}\ngathers: {} (inline/crossline positions, trace bytes 189-196), {per} traces each\ninlines: {}..={}\ncrosslines: {}..={}\noffsets (trace bytes 37-40): {} value{}: {}{}\nsamples: {} per trace, interval {} us, 0..={} ms\nvalues: {values} over all traces{}\na scene reads one offset with volume = {{ segy = {{ path = \"{name}\", prestack = {{ offset = {first} }} }} }}, or the mean of each gather with prestack = \"stack\"\n",
+            "format: SEG-Y rev {}.{}, pre-stack\nsample type: {}\nendianness: {}\ntraces: {}\ngathers: {} (inline/crossline positions, {}), {per} traces each\ninlines: {}..={}\ncrosslines: {}..={}\noffsets (trace bytes 37-40): {} value{}: {}{}\nsamples: {} per trace, interval {} us, 0..={} ms\nvalues: {values} over all traces{}\na scene reads one offset with volume = {{ segy = {{ path = \"{name}\", prestack = {{ offset = {first} }} }} }}, or the mean of each gather with prestack = \"stack\"\n",
             self.revision.0,
             self.revision.1,
             self.format.name(),
             if self.big_endian { "big-endian" } else { "little-endian" },
             self.traces,
             self.gathers,
+            self.keys.describe(),
             self.inlines.0,
             self.inlines.1,
             self.crosslines.0,

@@ -10,6 +10,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use super::keys::{KeyBytes, Keys};
 use super::{SampleFormat, TRACE_HEADER};
 use crate::volume::{Limits, VolumeError};
 
@@ -26,13 +27,16 @@ pub enum Prestack {
     Stack,
 }
 
-/// How to read a SEG-Y file: the limits the volume must fit, and the pre-stack choice.
+/// How to read a SEG-Y file: the limits the volume must fit, the pre-stack choice, and
+/// the trace-header bytes of the inline and crossline numbers.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ReadOptions {
     /// Checked before the samples are decoded.
     pub limits: Limits,
     /// Several traces per cell.
     pub prestack: Prestack,
+    /// The inline and crossline bytes a scene names (else detected).
+    pub keys: KeyBytes,
 }
 
 /// Where the traces sit in the file.
@@ -46,6 +50,8 @@ pub(crate) struct Layout {
     pub big: bool,
     /// Samples per trace as the binary header declares them (bytes 3221-3222).
     pub header_samples: usize,
+    /// The trace-header bytes of the inline and crossline numbers.
+    pub keys: Keys,
 }
 
 /// The gridded samples.
@@ -56,6 +62,9 @@ pub(super) struct Gridded {
     pub crosslines: Vec<i32>,
     /// The distinct offsets the file holds (one entry, usually 0, for post-stack files).
     pub offsets: Vec<i32>,
+    /// The header offsets of the traces at the grid's corners (inline index, crossline
+    /// index) = (0, 0), (0, last), (last, 0), for the survey's geometry.
+    pub corners: [usize; 3],
 }
 
 fn header_i32(bytes: &[u8], at: usize, big: bool) -> i32 {
@@ -96,10 +105,7 @@ pub(super) fn grid(
                 continue;
             }
         }
-        let key = (
-            header_i32(bytes, h + 188, l.big),
-            header_i32(bytes, h + 192, l.big),
-        );
+        let key = l.keys.read(&bytes[h..h + TRACE_HEADER], l.big);
         cells.entry(key).or_default().push(t);
     }
     if cells.is_empty() {
@@ -125,13 +131,14 @@ pub(super) fn grid(
             return Err(VolumeError::Unsupported {
                 path: path.into(),
                 message: format!(
-                    "traces {} and {} (bytes {} and {}) both sit at inline {} crossline {} (bytes 189-196): a pre-stack or otherwise non-gridded file{hint}",
+                    "traces {} and {} (bytes {} and {}) both sit at inline {} crossline {} ({}): a pre-stack or otherwise non-gridded file{hint}",
                     ts[0] + 1,
                     ts[1] + 1,
                     header(ts[0]),
                     header(ts[1]),
                     key.0,
-                    key.1
+                    key.1,
+                    l.keys.describe()
                 ),
             });
         }
@@ -145,7 +152,7 @@ pub(super) fn grid(
         return Err(VolumeError::Unsupported {
             path: path.into(),
             message: format!(
-                "{} traces at {} inline/crossline positions do not fill the grid of {} inlines x {} crosslines (inline {}..={}, crossline {}..={}): an irregular survey that arbvis cannot grid. The binary header declares {} samples per trace of {} (bytes 3221-3222), so the {} bytes after the headers hold {} traces of {} bytes; if that count looks wrong, the header's sample count is",
+                "{} traces at {} inline/crossline positions do not fill the grid of {} inlines x {} crosslines (inline {}..={}, crossline {}..={}; the numbers at {}): an irregular survey that arbvis cannot grid. The binary header declares {} samples per trace of {} (bytes 3221-3222), so the {} bytes after the headers hold {} traces of {} bytes; if that count looks wrong, the header's sample count is",
                 l.traces,
                 cells.len(),
                 inlines.len(),
@@ -154,6 +161,7 @@ pub(super) fn grid(
                 inlines[inlines.len() - 1],
                 crosslines[0],
                 crosslines[crosslines.len() - 1],
+                l.keys.describe(),
                 l.header_samples,
                 l.format.name(),
                 l.traces * l.trace_len,
@@ -182,11 +190,18 @@ pub(super) fn grid(
             }
         }
     }
+    let corner = |k: usize, j: usize| header(cells[&(inlines[k], crosslines[j])][0]);
+    let corners = [
+        corner(0, 0),
+        corner(0, crosslines.len() - 1),
+        corner(inlines.len() - 1, 0),
+    ];
     Ok(Gridded {
         dims,
         values,
         inlines,
         crosslines,
         offsets: offsets.into_iter().collect(),
+        corners,
     })
 }

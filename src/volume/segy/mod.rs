@@ -5,12 +5,15 @@
 //! 10 uint32, 11 uint16, 16 uint8. Byte order: big-endian by the standard; little-endian
 //! when the rev 2 byte-order word (bytes 3297-3300) says so, or when the format code only
 //! makes sense read little-endian (as segyio guesses). Geometry: inline from trace bytes
-//! 189-192, crossline from 193-196; every (inline, crossline) pair must occur exactly once
+//! 189-192, crossline from 193-196, or the bytes a scene names or [`keys`] detects; every
+//! (inline, crossline) pair must occur exactly once
 //! on a full rectangular grid, in any order, or the file is refused as pre-stack or
 //! irregular. The volume's axes are sample (i), crossline (j), inline (k).
 
 mod gathers;
+pub mod geometry;
 mod grid;
+pub mod keys;
 mod source;
 mod stream;
 mod write;
@@ -18,7 +21,9 @@ mod write;
 use std::path::Path;
 
 pub use gathers::{gathers, Gathers};
+pub use geometry::Geometry;
 pub use grid::{Prestack, ReadOptions};
+pub use keys::{KeyBytes, Keys};
 pub use source::SegySource;
 pub use stream::SegyStream;
 pub use write::{write, write_prestack, TraceWriter, WriteOptions};
@@ -286,6 +291,10 @@ pub struct SegyCube {
     pub traces: usize,
     /// The distinct source-receiver offsets of the traces (trace bytes 37-40).
     pub offsets: Vec<i32>,
+    /// The trace-header bytes the inline and crossline numbers were read from.
+    pub keys: Keys,
+    /// The survey's proportions (the volume's spacing) and where they came from.
+    pub geometry: Geometry,
 }
 
 impl SegyCube {
@@ -303,19 +312,24 @@ impl SegyCube {
         };
         let ns = self.volume.dims[0];
         format!(
-            "format: SEG-Y rev {}.{} (bytes 3501-3502), textual header {}\nsample type: {}\nendianness: {}\ntraces: {}\ninlines: {}\ncrosslines: {}\noffsets: {}\nsamples: {} per trace, interval {} us, 0..={} ms\n",
+            "format: SEG-Y rev {}.{} (bytes 3501-3502), textual header {}\nsample type: {}\nendianness: {}\ntraces: {}\ninline/crossline numbers: {}\ninlines: {}\ncrosslines: {}\ngrid: {} inlines x {} crosslines, {} traces\noffsets: {}\nsamples: {} per trace, interval {} us, 0..={} ms\n{}\n",
             self.revision.0,
             self.revision.1,
             if self.ebcdic { "EBCDIC" } else { "ASCII" },
             self.format.name(),
             if self.big_endian { "big-endian" } else { "little-endian" },
             self.traces,
+            self.keys.describe(),
             range(&self.inlines),
             range(&self.crosslines),
+            self.inlines.len(),
+            self.crosslines.len(),
+            self.inlines.len() * self.crosslines.len(),
             range(&self.offsets),
             ns,
             self.interval_us,
             (ns.saturating_sub(1)) as f64 * self.interval_us as f64 / 1000.0,
+            self.geometry.describe(),
         )
     }
 }
@@ -364,7 +378,7 @@ pub(crate) struct Headers {
 
 /// Parse SEG-Y bytes; `path` names the file in errors.
 pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCube, VolumeError> {
-    let h = headers(path, bytes, bytes.len() as u64)?;
+    let h = headers_with_keys(path, bytes, options.keys)?;
     let layout = h.layout;
     let grid::Gridded {
         dims,
@@ -372,10 +386,18 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
         inlines,
         crosslines,
         offsets,
+        corners,
     } = grid::grid(path, bytes, &layout, options)?;
-    // Spacing: one sample, one crossline step and one inline step each count as one unit;
-    // SEG-Y has no common unit for time and distance.
-    let volume = Volume::new(dims, [1.0, 1.0, 1.0], values).map_err(VolumeError::Invalid)?;
+    // Spacing: the survey's proportions (geometry.rs).
+    let geometry = geometry::geometry(h.interval_us, dims[1], dims[2], layout.big, |k, j| {
+        let at = match (k, j) {
+            (0, 0) => corners[0],
+            (0, _) => corners[1],
+            _ => corners[2],
+        };
+        bytes[at..at + TRACE_HEADER].try_into().ok()
+    });
+    let volume = Volume::new(dims, geometry.spacing, values).map_err(VolumeError::Invalid)?;
     Ok(SegyCube {
         volume,
         revision: h.revision,
@@ -387,7 +409,27 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
         crosslines,
         traces: layout.traces,
         offsets,
+        keys: layout.keys,
+        geometry,
     })
+}
+
+/// [`headers`] of a whole file in `bytes`, with the inline and crossline bytes resolved
+/// ([`keys::resolve`]: those named, else detected from the first traces).
+pub(crate) fn headers_with_keys(
+    path: &Path,
+    bytes: &[u8],
+    named: KeyBytes,
+) -> Result<Headers, VolumeError> {
+    let mut h = headers(path, bytes, bytes.len() as u64)?;
+    let l = h.layout;
+    h.layout.keys = keys::resolve(path, named, l.traces, l.big, |t| {
+        let at = l.first_trace + t * l.trace_len;
+        Ok(bytes[at..at + TRACE_HEADER]
+            .try_into()
+            .expect("the layout holds whole traces"))
+    })?;
+    Ok(h)
 }
 
 /// Read the textual, binary and extended headers from `bytes` (the start of a file of
@@ -498,6 +540,7 @@ pub(crate) fn headers(path: &Path, bytes: &[u8], len: u64) -> Result<Headers, Vo
             format,
             big,
             header_samples: declared_samples,
+            keys: Keys::default(),
         },
         revision,
         ebcdic: bytes[0] == 0xC3 || bytes[0] == 0x40,
@@ -566,6 +609,19 @@ mod tests {
         }
     }
 
+    /// `v` as read back from a written file: the writer puts no CDP coordinates, so the
+    /// geometry assumes its bins; a sample is its interval in ms as metres.
+    fn as_read(v: &Volume, interval_us: u16) -> Volume {
+        Volume {
+            spacing: [
+                interval_us as f64 / 1000.0,
+                geometry::ASSUMED_BIN_M,
+                geometry::ASSUMED_BIN_M,
+            ],
+            ..v.clone()
+        }
+    }
+
     fn cube() -> Volume {
         let dims = [5, 3, 4];
         let values = (0..60).map(|n| n as f32 - 20.0).collect();
@@ -599,7 +655,8 @@ mod tests {
                     )
                     .unwrap();
                     assert_eq!(
-                        cube.volume, src,
+                        cube.volume,
+                        as_read(&src, o.interval_us),
                         "format {code} big {big_endian} rev {revision}"
                     );
                     assert_eq!(cube.big_endian, big_endian);
@@ -626,7 +683,7 @@ mod tests {
             parse(Path::new("m"), &swapped, &ReadOptions::default())
                 .unwrap()
                 .volume,
-            v
+            as_read(&v, o.interval_us)
         );
     }
 
@@ -689,7 +746,7 @@ mod tests {
         std::fs::create_dir_all(&dir).unwrap();
         let path = dir.join("gathers.sgy");
         std::fs::write(&path, prestack_file(&a, &b)).unwrap();
-        let g = gathers(&path, &std::fs::read(&path).unwrap()).unwrap();
+        let g = gathers(&path, &std::fs::read(&path).unwrap(), KeyBytes::default()).unwrap();
         assert!(g.is_prestack());
         // The cube is 5 samples x 3 crosslines x 4 inlines: 12 gathers of 2 traces;
         // values -20..=39 (a) and -59..=118 (b = 3a + 1).
@@ -701,7 +758,7 @@ mod tests {
         for want in [
             "format: SEG-Y rev 1.0, pre-stack",
             "traces: 24\n",
-            "gathers: 12 (inline/crossline positions, trace bytes 189-196), 2 traces each",
+            "gathers: 12 (inline/crossline positions, trace bytes 189 and 193 (detected: SEG-Y rev 1's inline and crossline numbers)), 2 traces each",
             "offsets (trace bytes 37-40): 2 values: 100 (12 traces), 300 (12 traces)",
             "samples: 5 per trace, interval 4000 us, 0..=16 ms",
             "values: [-59, 118] over all traces",
@@ -735,10 +792,10 @@ mod tests {
             ..Default::default()
         };
         let near = parse(Path::new("g"), &bytes, &pick(Prestack::Offset(100))).unwrap();
-        assert_eq!(near.volume, a);
+        assert_eq!(near.volume, as_read(&a, 4000));
         assert_eq!(near.offsets, vec![100, 300]);
         let far = parse(Path::new("g"), &bytes, &pick(Prestack::Offset(300))).unwrap();
-        assert_eq!(far.volume, b);
+        assert_eq!(far.volume, as_read(&b, 4000));
         let stack = parse(Path::new("g"), &bytes, &pick(Prestack::Stack)).unwrap();
         for (s, (x, y)) in stack
             .volume

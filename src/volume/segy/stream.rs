@@ -5,7 +5,7 @@
 //! first inline's run of crosslines gives the crossline step and count, the trace count
 //! then the inline count, and the first and last trace of every inline are checked
 //! against that grid. Every trace read later is checked again (its inline and crossline,
-//! bytes 189-196, must be the ones its place implies), so a file that only looks sorted
+//! bytes 189-196 or those named or detected, must be the ones its place implies), so a file that only looks sorted
 //! ends in an error naming the trace and its byte. Any other order is gridded from every
 //! trace header (one small read per trace, 12 bytes per trace held). Pre-stack files
 //! (several traces per cell) are refused.
@@ -16,6 +16,7 @@ use std::os::unix::fs::FileExt;
 use std::path::{Path, PathBuf};
 
 use super::grid::Layout;
+use super::keys::KeyBytes;
 use super::{headers, SampleFormat, TRACE_HEADER};
 use crate::volume::VolumeError;
 
@@ -35,6 +36,8 @@ pub struct SegyStream {
     pub inlines: Vec<i32>,
     /// Crossline numbers, ascending (axis j).
     pub crosslines: Vec<i32>,
+    /// The survey's proportions: one step along samples, crosslines and inlines.
+    pub geometry: super::Geometry,
     order: Order,
 }
 
@@ -58,8 +61,14 @@ fn i32_at(b: &[u8], at: usize, big: bool) -> i32 {
 }
 
 impl SegyStream {
-    /// Open `path`: headers, then the grid (see the module doc).
+    /// Open `path`: headers, then the grid (see the module doc), with the inline and
+    /// crossline numbers where [`super::keys`] finds them.
     pub fn open(path: &Path) -> Result<SegyStream, VolumeError> {
+        SegyStream::open_with(path, KeyBytes::default())
+    }
+
+    /// [`SegyStream::open`] with the inline and crossline bytes `named` (else detected).
+    pub fn open_with(path: &Path, named: KeyBytes) -> Result<SegyStream, VolumeError> {
         let (file, len) = crate::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
         let read_prefix = |n: u64| -> Result<Vec<u8>, VolumeError> {
             let n = n.min(len) as usize;
@@ -84,11 +93,28 @@ impl SegyStream {
             interval_us: h.interval_us,
             inlines: Vec::new(),
             crosslines: Vec::new(),
+            geometry: super::geometry::geometry(0, 1, 1, true, |_, _| None),
             order: Order::Map(Vec::new()),
         };
+        let l = s.layout;
+        s.layout.keys = super::keys::resolve(path, named, l.traces, l.big, |t| {
+            let mut h = [0u8; TRACE_HEADER];
+            s.file
+                .read_exact_at(&mut h, s.offset_of(t))
+                .map_err(|e| VolumeError::io(path, e))?;
+            Ok(h)
+        })?;
         if !s.try_sorted()? {
             s.map_every_trace()?;
         }
+        let (nj, nk) = (s.crosslines.len(), s.inlines.len());
+        s.geometry = super::geometry::geometry(s.interval_us, nj, nk, s.layout.big, |k, j| {
+            let mut h = [0u8; TRACE_HEADER];
+            s.file
+                .read_exact_at(&mut h, s.offset_of(s.trace_of(k, j)))
+                .ok()
+                .map(|_| h)
+        });
         Ok(s)
     }
 
@@ -132,11 +158,8 @@ impl SegyStream {
             .read_exact_at(&mut h, self.offset_of(t))
             .map_err(|e| VolumeError::io(&self.path, e))?;
         let big = self.layout.big;
-        Ok((
-            i32_at(&h, 188, big),
-            i32_at(&h, 192, big),
-            i32_at(&h, 36, big),
-        ))
+        let (il, xl) = self.layout.keys.read(&h, big);
+        Ok((il, xl, i32_at(&h, 36, big)))
     }
 
     /// The inline-sorted grid, if the headers agree with it.
@@ -221,13 +244,14 @@ impl SegyStream {
             return Err(VolumeError::Unsupported {
                 path: self.path.clone(),
                 message: format!(
-                    "traces {} and {} (bytes {} and {}) both sit at inline {} crossline {} (bytes 189-196): a pre-stack or otherwise non-gridded file, which `arbvis convert` does not take (stack it first)",
+                    "traces {} and {} (bytes {} and {}) both sit at inline {} crossline {} ({}): a pre-stack or otherwise non-gridded file, which `arbvis convert` does not take (stack it first)",
                     w[0].2 + 1,
                     w[1].2 + 1,
                     self.offset_of(w[0].2 as usize),
                     self.offset_of(w[1].2 as usize),
                     w[0].0,
-                    w[0].1
+                    w[0].1,
+                    self.layout.keys.describe()
                 ),
             });
         }
@@ -320,14 +344,15 @@ impl SegyStream {
                     let cell = jj + q;
                     let t = self.trace_of(kk, cell);
                     let trace = &buf[(t - lo) * tl..][..tl];
-                    let (il, xl) = (i32_at(trace, 188, big), i32_at(trace, 192, big));
+                    let (il, xl) = self.layout.keys.read(trace, big);
                     if il != self.inlines[kk] || xl != self.crosslines[cell] {
                         return Err(VolumeError::format(
                             &self.path,
-                            self.offset_of(t) + 188,
+                            self.offset_of(t) + self.layout.keys.iline as u64 - 1,
                             format!(
-                                "trace {} holds inline {il} crossline {xl} (bytes 189-196) where the grid read from the headers expects inline {} crossline {}: the file is not in one inline-sorted order",
+                                "trace {} holds inline {il} crossline {xl} ({}) where the grid read from the headers expects inline {} crossline {}: the file is not in one inline-sorted order",
                                 t + 1,
+                                self.layout.keys.describe(),
                                 self.inlines[kk],
                                 self.crosslines[cell]
                             ),
@@ -382,10 +407,18 @@ impl SegyStream {
                 .into(),
             ),
             ("traces".into(), self.layout.traces.to_string()),
+            (
+                "inline/crossline numbers".into(),
+                self.layout.keys.describe(),
+            ),
             ("inlines".into(), range(&self.inlines)),
             ("crosslines".into(), range(&self.crosslines)),
             ("samples per trace".into(), self.layout.samples.to_string()),
             ("sample interval (us)".into(), self.interval_us.to_string()),
+            (
+                "geometry".into(),
+                self.geometry.describe().replace('\n', "; "),
+            ),
             (
                 "trace order".into(),
                 match self.order {

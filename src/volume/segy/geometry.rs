@@ -1,0 +1,193 @@
+//! A survey's proportions: the size of one grid step along the samples, the crosslines and
+//! the inlines, so that a box drawn from a SEG-Y file has the survey's shape.
+//!
+//! Traces: the distance between the CDP coordinates (trace bytes 181-188, scaled by the
+//! coordinate scalar of bytes 71-72) of the grid's corner traces, over the steps between
+//! them. Where the file has none (all zero, equal, or in arc seconds, byte 89-90 = 2) the
+//! bins are taken as [`ASSUMED_BIN_M`], the commonest bin of land and marine surveys, and
+//! `inspect` says so. Samples: the sample interval in time shown as depth at
+//! [`VELOCITY_M_S`] (one millisecond of two-way time as one metre), the convention of
+//! seismic viewers' default vertical scale; a scene's `vertical_exaggeration` stretches it.
+
+/// The velocity that turns two-way time into depth for display: 2000 m/s, so one
+/// millisecond of two-way time is one metre.
+pub const VELOCITY_M_S: f64 = 2000.0;
+
+/// The bin size taken where the file has no usable CDP coordinates (metres).
+pub const ASSUMED_BIN_M: f64 = 25.0;
+
+/// Where the trace spacing came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BinsFrom {
+    /// The CDP coordinates of the corner traces.
+    Coordinates,
+    /// None usable: [`ASSUMED_BIN_M`].
+    Assumed,
+}
+
+/// One grid step along the samples, crosslines and inlines, in metres (samples as depth
+/// at [`VELOCITY_M_S`]), and where the trace steps came from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Geometry {
+    /// Metres per sample, crossline step and inline step.
+    pub spacing: [f64; 3],
+    /// Whether the trace steps were measured.
+    pub bins: BinsFrom,
+}
+
+impl Geometry {
+    /// What `inspect` prints.
+    pub fn describe(&self) -> String {
+        let [s, x, i] = self.spacing;
+        let from = match self.bins {
+            BinsFrom::Coordinates => "from the CDP coordinates of the corner traces".to_string(),
+            BinsFrom::Assumed => format!(
+                "no usable CDP coordinates (bytes 181-188): {ASSUMED_BIN_M} m bins assumed; a scene's spacing sets them"
+            ),
+        };
+        format!(
+            "trace spacing: {} m between crosslines, {} m between inlines ({from})\nsample spacing shown: {} m ({} ms of two-way time at {VELOCITY_M_S} m/s)",
+            round(x),
+            round(i),
+            round(s),
+            round(s * 2000.0 / VELOCITY_M_S)
+        )
+    }
+}
+
+fn round(v: f64) -> f64 {
+    (v * 1000.0).round() / 1000.0
+}
+
+/// The CDP x and y of a trace header, scaled; `None` in arc seconds.
+fn cdp(header: &[u8], big: bool) -> Option<[f64; 2]> {
+    let i16_at = |at: usize| {
+        let a = [header[at], header[at + 1]];
+        if big {
+            i16::from_be_bytes(a)
+        } else {
+            i16::from_le_bytes(a)
+        }
+    };
+    let i32_at = |at: usize| {
+        let a = header[at..at + 4].try_into().expect("4 bytes");
+        if big {
+            i32::from_be_bytes(a)
+        } else {
+            i32::from_le_bytes(a)
+        }
+    };
+    if i16_at(88) == 2 {
+        return None;
+    }
+    let scalar = match i16_at(70) {
+        0 => 1.0,
+        s if s < 0 => 1.0 / -(s as f64),
+        s => s as f64,
+    };
+    Some([i32_at(180) as f64 * scalar, i32_at(184) as f64 * scalar])
+}
+
+/// The geometry of a grid of `nj` crosslines by `nk` inlines sampled every `interval_us`;
+/// `corner(k, j)` is the header of the trace at inline index `k`, crossline index `j`
+/// (asked for the three corners (0, 0), (0, nj - 1) and (nk - 1, 0) only).
+pub(crate) fn geometry(
+    interval_us: u32,
+    nj: usize,
+    nk: usize,
+    big: bool,
+    mut corner: impl FnMut(usize, usize) -> Option<[u8; 240]>,
+) -> Geometry {
+    let sample = interval_us as f64 / 1000.0 * VELOCITY_M_S / 2000.0;
+    let sample = if sample > 0.0 { sample } else { 1.0 };
+    let mut at = |k, j| corner(k, j).and_then(|h| cdp(&h, big));
+    let step = |a: Option<[f64; 2]>, b: Option<[f64; 2]>, n: usize| -> Option<f64> {
+        let (a, b) = (a?, b?);
+        let d = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt() / (n - 1) as f64;
+        (d.is_finite() && d > 0.0).then_some(d)
+    };
+    let origin = at(0, 0);
+    let crossline = if nj > 1 {
+        step(origin, at(0, nj - 1), nj)
+    } else {
+        None
+    };
+    let inline = if nk > 1 {
+        step(origin, at(nk - 1, 0), nk)
+    } else {
+        None
+    };
+    // One measured step stands for the other where the grid has a single line that way.
+    let (crossline, inline, bins) = match (crossline, inline) {
+        (Some(x), Some(i)) => (x, i, BinsFrom::Coordinates),
+        (Some(x), None) if nk == 1 => (x, x, BinsFrom::Coordinates),
+        (None, Some(i)) if nj == 1 => (i, i, BinsFrom::Coordinates),
+        _ => (ASSUMED_BIN_M, ASSUMED_BIN_M, BinsFrom::Assumed),
+    };
+    Geometry {
+        spacing: [sample, crossline, inline],
+        bins,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn header(x: i32, y: i32, scalar: i16) -> [u8; 240] {
+        let mut h = [0u8; 240];
+        h[70..72].copy_from_slice(&scalar.to_be_bytes());
+        h[180..184].copy_from_slice(&x.to_be_bytes());
+        h[184..188].copy_from_slice(&y.to_be_bytes());
+        h
+    }
+
+    #[test]
+    fn steps_from_rotated_corner_coordinates() {
+        // A grid rotated 30 degrees, 12.5 m crossline and 37.5 m inline steps, scalar -100.
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let at = |k: usize, j: usize| {
+            let (u, v) = (j as f64 * 12.5, k as f64 * 37.5);
+            let (x, y) = (500_000.0 + u * c - v * s, 6_000_000.0 + u * s + v * c);
+            Some(header(
+                (x * 100.0).round() as i32,
+                (y * 100.0).round() as i32,
+                -100,
+            ))
+        };
+        let g = geometry(2000, 7, 5, true, at);
+        assert_eq!(g.bins, BinsFrom::Coordinates);
+        assert!(
+            (g.spacing[1] - 12.5).abs() < 1e-3 && (g.spacing[2] - 37.5).abs() < 1e-3,
+            "{g:?}"
+        );
+        // 2 ms of two-way time at 2000 m/s: 2 m.
+        assert_eq!(g.spacing[0], 2.0);
+    }
+
+    #[test]
+    fn no_coordinates_assume_the_common_bin_and_say_so() {
+        let g = geometry(4000, 3, 4, true, |_, _| Some(header(0, 0, 0)));
+        assert_eq!(g.spacing, [4.0, ASSUMED_BIN_M, ASSUMED_BIN_M]);
+        assert!(
+            g.describe().contains("25 m bins assumed"),
+            "{}",
+            g.describe()
+        );
+        // Arc seconds are no lengths.
+        let mut h = header(100, 200, 1);
+        h[88..90].copy_from_slice(&2i16.to_be_bytes());
+        let g = geometry(4000, 3, 4, true, |k, j| {
+            let mut h = h;
+            h[180..184].copy_from_slice(&(100 + 10 * (j + k) as i32).to_be_bytes());
+            Some(h)
+        });
+        assert_eq!(g.bins, BinsFrom::Assumed);
+        // One inline: its crossline step stands for both.
+        let g = geometry(4000, 3, 1, true, |_, j| Some(header(10 * j as i32, 0, 1)));
+        assert_eq!(
+            (g.spacing[1], g.spacing[2], g.bins),
+            (10.0, 10.0, BinsFrom::Coordinates)
+        );
+    }
+}
