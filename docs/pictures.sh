@@ -14,7 +14,7 @@ for demo in splats-section splats-section-precise; do
   "$arbvis" render --demo "$demo" --size 1200x675 -o "$out/$demo.png"
 done
 # Real data (data/, which travels with the clone).
-for s in f3 icbm152 post autzen bunny bracket-volume post-volume; do
+for s in f3 f3-minimal icbm152 post autzen bunny bracket-volume post-volume; do
   "$arbvis" render "scenes/data/$s.toml" -o "$out/data-$s.png"
 done
 "$arbvis" render scenes/data/bracket-volume.toml --fidelity faithful -o "$out/data-bracket-volume-faithful.png"

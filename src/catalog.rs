@@ -58,6 +58,23 @@ impl TechniqueScene {
 }
 
 impl TechniqueScene {
+    /// Defaults that depend on the data a scene names, for the keys its text leaves out
+    /// (`written` tells which dotted keys it writes): a survey's three-quarter view where
+    /// there is no `[camera]`, a lidar cloud's precise splats, and so on
+    /// ([`Opacity3dScene::unwritten_defaults`], [`SplatsScene::unwritten_defaults`]).
+    pub fn unwritten_defaults(
+        &mut self,
+        written: &dyn Fn(&str) -> bool,
+        camera: &mut crate::camera::Camera,
+        fidelity: &mut Fidelity,
+    ) {
+        match self {
+            TechniqueScene::Opacity3d(p) => p.unwritten_defaults(written, camera),
+            TechniqueScene::Splats(p) => p.unwritten_defaults(written, fidelity),
+            TechniqueScene::Quad(_) | TechniqueScene::Cellproj(_) => {}
+        }
+    }
+
     /// The large allocations preparing and drawing it at `size` makes that the scene
     /// alone determines (generated data, grids, lists); files are checked by their loaders.
     pub fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {

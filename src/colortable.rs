@@ -30,6 +30,12 @@ pub struct TableSpec {
     /// replacing the table's own alpha.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub alpha: Vec<[f64; 2]>,
+    /// Alpha from the data's own distribution ([`alpha_from_histogram`]) instead of the
+    /// table's: by default (`None`) for a survey's attribute (SEG-Y) whose scene gives no
+    /// `alpha` and no `file`; `false` keeps the table's own alpha, `true` asks for it on
+    /// any volume.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub alpha_from_data: Option<bool>,
 }
 
 fn default_builtin() -> String {
@@ -43,7 +49,14 @@ impl TableSpec {
             builtin: name.into(),
             file: None,
             alpha: Vec::new(),
+            alpha_from_data: None,
         }
+    }
+
+    /// Whether the alpha is made from the data's distribution, for a volume that is (or
+    /// is not) a survey.
+    pub fn wants_alpha_from_data(&self, survey: bool) -> bool {
+        self.alpha.is_empty() && self.file.is_none() && self.alpha_from_data.unwrap_or(survey)
     }
 
     /// Check what can be checked without reading files: the built-in name and the alpha
@@ -83,6 +96,43 @@ impl Default for TableSpec {
     fn default() -> Self {
         TableSpec::builtin("grey")
     }
+}
+
+/// An alpha per level from how often the levels occur (`counts`, 256 of them). With `p`
+/// the share of values lying closer to the median level than this one: clear for the
+/// closer half (`p <= 0.5`), then `((p - 0.5) / 0.5)^2`, opaque for the farthest. The
+/// common amplitudes (noise, the weak background of a seismic section) vanish and the
+/// rare strong ones (reflections, on either side for signed data) stand out, whatever
+/// the quantization did to the range.
+pub fn alpha_from_histogram(counts: &[u64; 256]) -> [u8; 256] {
+    let total: u64 = counts.iter().sum();
+    if total == 0 {
+        return [0; 256];
+    }
+    let mut seen = 0;
+    let median = counts
+        .iter()
+        .position(|&c| {
+            seen += c;
+            2 * seen >= total
+        })
+        .unwrap_or(128) as i32;
+    // Values at each distance from the median, then the share strictly closer.
+    let mut at_distance = [0u64; 257];
+    for (k, &c) in counts.iter().enumerate() {
+        at_distance[(k as i32 - median).unsigned_abs() as usize] += c;
+    }
+    let mut closer = [0f64; 257];
+    let mut sum = 0;
+    for d in 0..257 {
+        closer[d] = sum as f64 / total as f64;
+        sum += at_distance[d];
+    }
+    std::array::from_fn(|k| {
+        let share = closer[(k as i32 - median).unsigned_abs() as usize];
+        let ramp = ((share - 0.5) / 0.5).max(0.0);
+        (ramp * ramp * 255.0).round() as u8
+    })
 }
 
 /// 256 RGBA entries.

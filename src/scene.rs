@@ -171,6 +171,18 @@ impl Scene {
                 message: parse_message(text, start, e.message()),
             }
         })?;
+        let mut scene = scene;
+        // Defaults that depend on the data the scene names, for the keys it leaves out.
+        if let Ok(written) = text.parse::<toml::Table>() {
+            let written = |key: &str| is_written(&written, key);
+            let Scene {
+                technique,
+                camera,
+                fidelity,
+                ..
+            } = &mut scene;
+            technique.unwritten_defaults(&written, camera, fidelity);
+        }
         let checked = longer_arrays(text, &scene).map_or_else(|| scene.validate(), Err);
         checked.map_err(|e| {
             let (line, column) = key_position(text, &e.key);
@@ -497,6 +509,19 @@ fn parse_message(text: &str, start: usize, message: &str) -> String {
     } else {
         message
     }
+}
+
+/// Whether the scene's text writes the dotted `key` (`camera`, `technique.opacity3d.combine`).
+fn is_written(table: &toml::Table, key: &str) -> bool {
+    let mut parts = key.split('.');
+    let Some(first) = parts.next() else {
+        return false;
+    };
+    let mut value = table.get(first);
+    for part in parts {
+        value = value.and_then(|v| v.as_table()).and_then(|t| t.get(part));
+    }
+    value.is_some()
 }
 
 fn line_column(text: &str, offset: usize) -> (usize, usize) {

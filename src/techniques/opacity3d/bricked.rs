@@ -176,7 +176,7 @@ impl StoreScene {
             brick: meta.brick,
             levels: meta.levels,
             window,
-            spacing: params.spacing.unwrap_or(meta.spacing),
+            spacing: params.spacing_for(meta.spacing),
         };
         let mut attributes = [None; 3];
         for (a, attr) in params.attributes().iter().enumerate() {

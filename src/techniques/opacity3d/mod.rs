@@ -110,6 +110,10 @@ fn unit_coefficients() -> [f64; 4] {
     [1.0; 4]
 }
 
+/// A survey seen from above and to the side, sample (time) axis down the screen, inlines
+/// and crosslines receding: the rotation `scenes/data/f3.toml` was composed with.
+pub const SURVEY_VIEW: [f64; 4] = [0.326506, -0.092296, -0.701057, 0.627211];
+
 /// `[technique.opacity3d]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -136,6 +140,11 @@ pub struct Opacity3dScene {
     /// time and distance: this sets the box's aspect).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spacing: Option<[f64; 3]>,
+    /// How much taller than the file's own proportions the samples' axis is drawn (SEG-Y:
+    /// one millisecond of two-way time as one metre, times this); ignored where `spacing`
+    /// is set. Default 1.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub vertical_exaggeration: Option<f64>,
     /// The primary attribute (G, table on unit 2).
     pub primary: AttributeScene,
     /// The secondary attribute (B, unit 3); absent for 1D opacity.
@@ -282,6 +291,55 @@ impl Opacity3dScene {
         ]
     }
 
+    /// Defaults for a survey (a SEG-Y file as the primary; a store's scene keeps the plain
+    /// defaults, and its percentiles are not computed) where the scene's text leaves the key
+    /// out (`written` tells which dotted keys it writes):
+    /// - no `[camera]`: a three-quarter view from above with time running down the
+    ///   screen ([`SURVEY_VIEW`]), zoomed so that a box of any proportions stays whole at
+    ///   any rotation;
+    /// - one attribute and no `combine`: `product`, whose absent attributes read as a
+    ///   neutral 1 (the sum program divides the one colour by 3);
+    /// - no `quantize`: the 1st to 99th percentiles, so that a few spikes do not squeeze
+    ///   every other amplitude into the table's middle.
+    pub fn unwritten_defaults(
+        &mut self,
+        written: &dyn Fn(&str) -> bool,
+        camera: &mut crate::camera::Camera,
+    ) {
+        if !matches!(self.primary.volume, VolumeSource::Segy(_)) {
+            return;
+        }
+        if !written("camera") {
+            *camera = crate::camera::Camera {
+                rotation: SURVEY_VIEW,
+                // The prepared box's longest half side is 1, so its bounding sphere's
+                // radius is at most sqrt(3); with the viewer's 10 % framing margin.
+                zoom: 0.9 / 3f64.sqrt(),
+                ..Default::default()
+            };
+        }
+        let one = self.secondary.is_none() && self.tertiary.is_none();
+        if one && !written("technique.opacity3d.combine") {
+            self.combine = Combine::Product;
+        }
+        let names = ATTRIBUTE_NAMES;
+        for (attr, name) in self.attributes_mut().into_iter().zip(names) {
+            let Some(attr) = attr else { continue };
+            if !written(&format!("technique.opacity3d.{name}.quantize")) {
+                attr.quantize = Quantization::Percentile([1.0, 99.0]);
+            }
+        }
+    }
+
+    /// The voxel size drawn: the scene's `spacing`, else the file's with the samples'
+    /// axis stretched by `vertical_exaggeration`.
+    pub fn spacing_for(&self, file_spacing: [f64; 3]) -> [f64; 3] {
+        self.spacing.unwrap_or_else(|| {
+            let [s, j, k] = file_spacing;
+            [s * self.vertical_exaggeration.unwrap_or(1.0), j, k]
+        })
+    }
+
     /// Check values that parse but cannot render; the error names the key.
     pub fn validate(&self) -> Result<(), FieldError> {
         if !(1..=MAX_SLICES).contains(&self.slices) {
@@ -295,6 +353,14 @@ impl Opacity3dScene {
                 return Err(FieldError::new(
                     "spacing",
                     format!("{s:?}: must be positive"),
+                ));
+            }
+        }
+        if let Some(e) = self.vertical_exaggeration {
+            if !(e.is_finite() && e > 0.0 && e <= 1000.0) {
+                return Err(FieldError::new(
+                    "vertical_exaggeration",
+                    format!("{e}: must be positive, at most 1000"),
                 ));
             }
         }

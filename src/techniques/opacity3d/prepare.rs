@@ -174,9 +174,7 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> Result<P
             }
         };
         let mut volume = derive(&loaded[index].1, *attribute);
-        if let Some(spacing) = scene.spacing {
-            volume.spacing = spacing;
-        }
+        volume.spacing = scene.spacing_for(volume.spacing);
         derived[a] = Some(volume);
         tables[a] = Some(
             table
@@ -190,7 +188,25 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> Result<P
             (Some(v), Some(t), Some(s)) => Some((v, s.quantize, t.clone())),
             _ => None,
         });
-    from_volumes(inputs)
+    let mut prepared = from_volumes(inputs)?;
+    // Alpha from each attribute's own distribution, where its table asks for it.
+    for (a, attr) in attrs.into_iter().enumerate() {
+        let Some(attr) = attr else { continue };
+        let survey = matches!(attr.volume, VolumeSource::Segy(_));
+        if attr.table.wants_alpha_from_data(survey) {
+            let mut counts = [0u64; 256];
+            for texel in prepared.packed.chunks_exact(3) {
+                counts[texel[CHANNEL[a]] as usize] += 1;
+            }
+            let alpha = crate::colortable::alpha_from_histogram(&counts);
+            if let Some(table) = &mut prepared.tables[a] {
+                for (entry, alpha) in table.entries.iter_mut().zip(alpha) {
+                    entry[3] = alpha;
+                }
+            }
+        }
+    }
+    Ok(prepared)
 }
 
 #[cfg(test)]

@@ -212,6 +212,38 @@ pub const BYTES_PER_POINT: u64 = 450;
 pub const BYTES_PER_TILE: u64 = 16;
 
 impl SplatsScene {
+    /// Defaults for a cloud from a file of the field (LAS, LAZ, COPC, PLY) where the
+    /// scene's text leaves the key out (`written` tells which dotted keys it writes): the
+    /// seed's faithful shaders draw each splat of such a cloud as a ring, so
+    /// - no `fidelity`: precise (the Gaussian falls off from the splat's centre);
+    /// - no `edl`, `lighting` or `programs`: eye-dome lighting at 1 (GLSL), Potree's and
+    ///   CloudCompare's shading for clouds without normals;
+    /// - no `colour`: `elevation` (every cloud has it; `rgb`, `intensity` and
+    ///   `classification` where the file holds them).
+    ///
+    /// The seed's `.dat` sections and the generated one keep the seed's defaults.
+    pub fn unwritten_defaults(&mut self, written: &dyn Fn(&str) -> bool, fidelity: &mut Fidelity) {
+        if !matches!(
+            self.cloud,
+            PointSource::Las(_) | PointSource::Copc(_) | PointSource::Ply(_)
+        ) {
+            return;
+        }
+        let key = |k: &str| written(&format!("technique.splats.{k}"));
+        if !written("fidelity") {
+            *fidelity = Fidelity::Precise;
+        }
+        let arb_asked = written("programs");
+        if !key("edl") && !key("lighting") && !arb_asked && *fidelity == Fidelity::Precise {
+            self.edl = 1.0;
+        }
+        if !key("colour") {
+            self.colour = ColourMode::Elevation;
+        }
+    }
+}
+
+impl SplatsScene {
     /// The large allocations this scene makes that the scene alone determines (a
     /// generated section, the tile lists of an image of `size`); cloud files are held to
     /// the budget by their loaders once their headers are read.
