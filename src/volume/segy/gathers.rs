@@ -43,15 +43,6 @@ pub struct Gathers {
     pub keys: Keys,
 }
 
-fn header_i32(bytes: &[u8], at: usize, big: bool) -> i32 {
-    let a = [bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]];
-    if big {
-        i32::from_be_bytes(a)
-    } else {
-        i32::from_le_bytes(a)
-    }
-}
-
 /// Read the headers and every trace of SEG-Y bytes (`path` names the file in errors).
 pub fn gathers(path: &Path, bytes: &[u8], keys: KeyBytes) -> Result<Gathers, VolumeError> {
     let Headers {
@@ -68,7 +59,9 @@ pub fn gathers(path: &Path, bytes: &[u8], keys: KeyBytes) -> Result<Gathers, Vol
     let width = l.format.bytes();
     for t in 0..l.traces {
         let h = l.first_trace + t * l.trace_len;
-        *offsets.entry(header_i32(bytes, h + 36, l.big)).or_default() += 1;
+        *offsets
+            .entry(super::header_i32(bytes, h + 36, l.big))
+            .or_default() += 1;
         let key = l.keys.read(&bytes[h..h + TRACE_HEADER], l.big);
         *cells.entry(key).or_default() += 1;
         il = (il.0.min(key.0), il.1.max(key.0));

@@ -69,14 +69,7 @@ fn cdp(header: &[u8], big: bool) -> Option<[f64; 2]> {
             i16::from_le_bytes(a)
         }
     };
-    let i32_at = |at: usize| {
-        let a = header[at..at + 4].try_into().expect("4 bytes");
-        if big {
-            i32::from_be_bytes(a)
-        } else {
-            i32::from_le_bytes(a)
-        }
-    };
+    let i32_at = |at: usize| super::header_i32(header, at, big);
     if i16_at(88) == 2 {
         return None;
     }

@@ -67,15 +67,6 @@ pub(super) struct Gridded {
     pub corners: [usize; 3],
 }
 
-fn header_i32(bytes: &[u8], at: usize, big: bool) -> i32 {
-    let a = [bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]];
-    if big {
-        i32::from_be_bytes(a)
-    } else {
-        i32::from_le_bytes(a)
-    }
-}
-
 /// Offsets as a short list for messages.
 fn list(values: &BTreeSet<i32>) -> String {
     let shown: Vec<String> = values.iter().take(12).map(i32::to_string).collect();
@@ -98,7 +89,7 @@ pub(super) fn grid(
     let mut offsets = BTreeSet::new();
     for t in 0..l.traces {
         let h = header(t);
-        let offset = header_i32(bytes, h + 36, l.big);
+        let offset = super::header_i32(bytes, h + 36, l.big);
         offsets.insert(offset);
         if let Prestack::Offset(o) = options.prestack {
             if offset != o {

@@ -100,8 +100,8 @@ impl Keys {
     /// The inline and crossline numbers of one trace header.
     pub fn read(&self, header: &[u8], big: bool) -> (i32, i32) {
         (
-            i32_at(header, self.iline as usize - 1, big),
-            i32_at(header, self.xline as usize - 1, big),
+            super::header_i32(header, self.iline as usize - 1, big),
+            super::header_i32(header, self.xline as usize - 1, big),
         )
     }
 
@@ -115,15 +115,6 @@ impl Keys {
             }
         };
         format!("trace bytes {} and {} ({how})", self.iline, self.xline)
-    }
-}
-
-fn i32_at(b: &[u8], at: usize, big: bool) -> i32 {
-    let a = [b[at], b[at + 1], b[at + 2], b[at + 3]];
-    if big {
-        i32::from_be_bytes(a)
-    } else {
-        i32::from_le_bytes(a)
     }
 }
 
@@ -166,7 +157,7 @@ pub(crate) fn resolve(
         };
         let traces = headers.iter().map(|h| {
             let (il, xl) = keys.read(h, big);
-            (il, xl, i32_at(h, 36, big))
+            (il, xl, super::header_i32(h, 36, big))
         });
         if looks_like_a_grid(traces) {
             return Ok(keys);

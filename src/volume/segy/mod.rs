@@ -334,6 +334,16 @@ impl SegyCube {
     }
 }
 
+/// The 4-byte integer at byte `at` of a header, in the file's byte order.
+pub(crate) fn header_i32(bytes: &[u8], at: usize, big: bool) -> i32 {
+    let a = [bytes[at], bytes[at + 1], bytes[at + 2], bytes[at + 3]];
+    if big {
+        i32::from_be_bytes(a)
+    } else {
+        i32::from_le_bytes(a)
+    }
+}
+
 struct Reader<'a> {
     bytes: &'a [u8],
     big: bool,

@@ -51,15 +51,6 @@ enum Order {
     Map(Vec<u32>),
 }
 
-fn i32_at(b: &[u8], at: usize, big: bool) -> i32 {
-    let a = [b[at], b[at + 1], b[at + 2], b[at + 3]];
-    if big {
-        i32::from_be_bytes(a)
-    } else {
-        i32::from_le_bytes(a)
-    }
-}
-
 impl SegyStream {
     /// Open `path`: headers, then the grid (see the module doc), with the inline and
     /// crossline numbers where [`super::keys`] finds them.
@@ -159,7 +150,7 @@ impl SegyStream {
             .map_err(|e| VolumeError::io(&self.path, e))?;
         let big = self.layout.big;
         let (il, xl) = self.layout.keys.read(&h, big);
-        Ok((il, xl, i32_at(&h, 36, big)))
+        Ok((il, xl, super::header_i32(&h, 36, big)))
     }
 
     /// The inline-sorted grid, if the headers agree with it.
@@ -370,8 +361,8 @@ impl SegyStream {
                             _ => 1.0,
                         };
                         c[at / ns + q] = [
-                            i32_at(trace, 180, big) as f64 * scale,
-                            i32_at(trace, 184, big) as f64 * scale,
+                            super::header_i32(trace, 180, big) as f64 * scale,
+                            super::header_i32(trace, 184, big) as f64 * scale,
                         ];
                     }
                     let dst = &mut out[at + q * ns..][..ns];
