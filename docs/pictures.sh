@@ -18,6 +18,7 @@ for s in f3 f3-minimal icbm152 post autzen bunny bracket-volume post-volume; do
   "$arbvis" render "scenes/data/$s.toml" -o "$out/data-$s.png"
 done
 "$arbvis" render scenes/data/bracket-volume.toml --fidelity faithful -o "$out/data-bracket-volume-faithful.png"
+"$arbvis" render scenes/data/f3-minimal.toml --size 640x480 --legend --axes -o "$out/data-f3-figure.png"
 "$arbvis" render scenes/bench/cellproj-seed-volume.toml -o "$out/cellproj-seed-volume.png"
 # NASA's CFD meshes (`python3 benches/meshes.py nasa` downloads them into target/meshes).
 if [ -f target/meshes/bluntfin.vtk ] && [ -f target/meshes/oxygen-post.vtk ]; then

@@ -7,7 +7,7 @@
 //! vocabulary ([`vocab`], [`budget`], [`input`], [`camera`], [`image`], [`png_io`],
 //! [`colortable`], [`progress`]) → data and GL ([`volume`], [`mesh`], [`points`], [`surface`], [`gl`],
 //! the only `unsafe`) → [`programs`] → [`techniques`] (CPU preparation, GL renderer, CPU
-//! reference) → [`catalog`] → [`scene`] / [`render`] → [`study`] → `viewer`.
+//! reference) → [`catalog`] → [`scene`] / [`render`] / [`annotate`] → [`study`] → `viewer`.
 
 #![deny(unsafe_code)]
 
@@ -16,6 +16,7 @@
 #[cfg(test)]
 extern crate self as arbvis;
 
+pub mod annotate;
 pub mod budget;
 pub mod camera;
 pub mod catalog;

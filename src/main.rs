@@ -61,6 +61,15 @@ enum Command {
         /// JSON object on stdout instead of text.
         #[arg(long)]
         json: bool,
+        /// Draw each colour table with its value range, and the isovalues or classes as
+        /// keys, into the picture (a scene's `legend = true`); off by default, so that
+        /// a picture holds the renderer's pixels alone.
+        #[arg(long)]
+        legend: bool,
+        /// Draw the box's axes with ticks in the data's numbers (inline, crossline and
+        /// time for a survey; x, y, z for a cloud) into the picture (`axes = true`).
+        #[arg(long)]
+        axes: bool,
     },
     /// Print what the loaders see in a file: volumes (SEG-Y, NIfTI: dimensions, ranges,
     /// sample type, byte order, statistics), meshes (VTK legacy, .vtu, gmsh: points, cells
@@ -690,12 +699,16 @@ fn run(cli: Cli) -> Result<()> {
             backend,
             stats,
             json,
+            legend,
+            axes,
         } => {
             let Some(output) = output else {
                 bail!("render needs an output file: -o OUT.png");
             };
             check_output_folder(&output)?;
-            let (scene, origin) = scene.load()?;
+            let (mut scene, origin) = scene.load()?;
+            scene.legend |= legend;
+            scene.axes |= axes;
             let rendered = arbvis::render::render(&scene, backend).map_err(|e| {
                 anyhow::anyhow!(scene.explain_missing(format!("rendering {origin}: {e:#}")))
             })?;

@@ -97,7 +97,15 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
     crate::gl_check!(gpu)?;
     gpu.finish();
     let draw_time = t1.elapsed();
-    let image = target.read(gpu)?;
+    let mut image = target.read(gpu)?;
+    let show = crate::annotate::Show {
+        legend: scene.legend,
+        axes: scene.axes,
+    };
+    if show.legend || show.axes {
+        crate::annotate::draw(&mut image, &scene.camera, &renderer.annotations(), show)
+            .map_err(|e| crate::gl::GlError::Data(format!("drawing the legends and axes: {e}")))?;
+    }
     Ok(Rendered {
         image,
         program_kind: renderer.program_kind(),

@@ -37,6 +37,13 @@ pub struct Scene {
     /// The camera.
     #[serde(default)]
     pub camera: Camera,
+    /// Draw the colour tables (with their value ranges) and keys into offscreen pictures
+    /// (`crate::annotate`); off, so that a picture holds the renderer's pixels alone.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub legend: bool,
+    /// Draw the box's axes with ticks in the data's own numbers into offscreen pictures.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub axes: bool,
     /// The memory budget this scene asks for (`"16G"`, `"75%"`): taken where neither
     /// `--memory-budget` nor `ARBVIS_MEMORY_BUDGET` sets one ([`crate::budget`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]

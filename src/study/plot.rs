@@ -137,14 +137,9 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     })
 }
 
-/// The plots' font (egui's, already a dependency), registered with plotters.
+/// The plots' font: the annotations' ([`crate::annotate::register_font`]).
 fn register_plot_font() -> anyhow::Result<()> {
-    plotters::style::register_font(
-        "sans-serif",
-        plotters::style::FontStyle::Normal,
-        epaint_default_fonts::UBUNTU_LIGHT,
-    )
-    .map_err(|_| anyhow::anyhow!("the plot font did not load"))
+    crate::annotate::register_font().map_err(anyhow::Error::msg)
 }
 
 /// Write a plotters RGB buffer as an opaque PNG (atomically).

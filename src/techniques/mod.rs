@@ -3,6 +3,7 @@
 //! of the same maths. The seed techniques (`opacity3d`, `cellproj`, `clip`, `splats`)
 //! slot in beside `quad`, the foundation's demo.
 
+pub mod annotations;
 pub mod cellproj;
 pub mod clip;
 pub mod opacity3d;
@@ -94,6 +95,11 @@ pub trait Renderer {
     /// clip object (3D opacity with `[technique.opacity3d.clip]`); `None` without one.
     fn clip_stats(&self) -> Option<clip::stats::ClipStats> {
         None
+    }
+    /// What the picture's legends and axes say (`render --legend --axes`): its colour
+    /// tables with their value ranges, keys, and the box's axes in the data's numbers.
+    fn annotations(&self) -> annotations::Annotations {
+        annotations::Annotations::default()
     }
 }
 

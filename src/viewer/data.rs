@@ -13,7 +13,6 @@
 
 use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
 
-use super::axes::{self, section_axes, section_voxels, Axis};
 use super::store_sections::{MapPositions, SectionKey, StoreSections};
 use super::summary::{cloud_units, data_box, CloudSummary, DataBox, MeshSummary};
 use crate::colortable::{ColorTable, TableSpec};
@@ -25,6 +24,7 @@ use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::Opacity3dRenderer;
 use crate::techniques::splats::SplatsRenderer;
 use crate::techniques::Renderer;
+use crate::volume::axes::{self, section_axes, section_voxels, Axis};
 
 /// The 3D-opacity data behind the panels.
 pub struct Volume3d {
@@ -82,7 +82,7 @@ impl SectionGrid {
     /// section at `index` along `axis` points at: the voxel's numbers on the three axes,
     /// inline first, and the trace's map position where the data has one.
     pub fn point(&self, axis: usize, index: usize, across: f32, down: f32) -> String {
-        let (u, w) = super::axes::section_axes(axis);
+        let (u, w) = crate::volume::axes::section_axes(axis);
         let at = |f: f32, n: usize| ((f.max(0.0) * n as f32) as usize).min(n.saturating_sub(1));
         let mut v = [0usize; 3];
         v[axis] = index.min(self.dims[axis].saturating_sub(1));

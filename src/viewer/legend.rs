@@ -22,6 +22,7 @@ use crate::points::section::{facies_colour, FACIES_TABLE, PALETTE};
 use crate::points::UNDEFINED_FACIES;
 use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::cellproj::IsovalueUnits;
+pub use crate::techniques::splats::prepare::class_name;
 use crate::techniques::splats::prepare::{class_colour, COLOR_A, COLOR_B, LAYERS_IN_PALETTE};
 use crate::techniques::splats::scene::ColourMode;
 
@@ -395,32 +396,6 @@ fn rgb(c: [u8; 3]) -> Color32 {
 fn unit(c: [f64; 3]) -> Color32 {
     let b = |v: f64| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
     Color32::from_rgb(b(c[0]), b(c[1]), b(c[2]))
-}
-
-/// An ASPRS classification code's name.
-pub fn class_name(code: i32) -> String {
-    let name = match code {
-        0 => "never classified",
-        1 => "unclassified",
-        2 => "ground",
-        3 => "low vegetation",
-        4 => "medium vegetation",
-        5 => "high vegetation",
-        6 => "building",
-        7 => "low point (noise)",
-        8 => "model key point",
-        9 => "water",
-        10 => "rail",
-        11 => "road surface",
-        13 => "wire guard",
-        14 => "wire conductor",
-        15 => "transmission tower",
-        16 => "wire connector",
-        17 => "bridge deck",
-        18 => "high noise",
-        _ => return format!("class {code}"),
-    };
-    format!("{code} {name}")
 }
 
 /// The legends of what `scene` shows (`ctx` makes the colour-bar textures).

@@ -15,10 +15,10 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use super::axes::{Axis, Numbers};
 use crate::store::Store;
 use crate::techniques::opacity3d::bricked::StoreScene;
 use crate::techniques::opacity3d::Opacity3dScene;
+use crate::volume::axes::{Axis, Numbers};
 use crate::volume::quantize::quantize_value;
 
 /// Map positions (`cdp_x`, `cdp_y`) of a survey's traces, and where the shown window
@@ -129,7 +129,7 @@ impl StoreSections {
     }
 
     /// The sections read since the last call: key and its quantized levels (across
-    /// fastest, as [`super::axes::section_axes`] orders them), or the error.
+    /// fastest, as [`crate::volume::axes::section_axes`] orders them), or the error.
     pub fn arrived(&mut self) -> Vec<Reply> {
         self.replies.try_iter().collect()
     }
@@ -159,7 +159,7 @@ pub fn section_levels(
         .window(attr, region[0], region[1])
         .map_err(|e| e.to_string())?;
     // The window is one voxel thick along `axis`: its voxel 0 there.
-    let (_, voxels) = super::axes::section_voxels(v.dims, axis, 0);
+    let (_, voxels) = crate::volume::axes::section_voxels(v.dims, axis, 0);
     let out = voxels
         .map(|[i, j, k]| quantize_value(v.values[v.index(i, j, k)], low, high))
         .collect();

@@ -11,9 +11,9 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::axes::{span, Axis};
 use super::units::{las_units, Units};
 use crate::points::{PointCloud, PointSource, FACIES, FAULT, LAYER};
+use crate::volume::axes::{span, Axis};
 
 /// Most distinct ids a key lists (beyond, it says how many more there are).
 pub const MAX_IDS: usize = 64;

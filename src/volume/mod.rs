@@ -7,6 +7,7 @@
 //! order of the file: `i` = sample (time), `j` = crossline, `k` = inline.
 
 pub mod attributes;
+pub mod axes;
 pub mod index_data;
 pub mod nifti_file;
 pub mod quantize;

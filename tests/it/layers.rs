@@ -35,7 +35,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("the catalog of techniques", &["catalog"]),
     (
         "scenes and rendering",
-        &["scene", "render", "inspect", "info"],
+        &["scene", "render", "annotate", "inspect", "info"],
     ),
     ("studies", &["study", "techniques::*::study"]),
     ("the viewer", &["viewer"]),

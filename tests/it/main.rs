@@ -6,6 +6,7 @@
 
 mod common;
 
+mod annotate;
 mod cellproj;
 mod cellproj_entries;
 mod cellproj_grid;

@@ -111,7 +111,7 @@ pub struct Isovalue {
 }
 
 /// `v` with four significant digits, trailing zeros dropped (`0.3554`, `1.641`, `-17.81`).
-fn significant(v: f64) -> String {
+pub(crate) fn significant(v: f64) -> String {
     if v == 0.0 || !v.is_finite() {
         return format!("{v}");
     }

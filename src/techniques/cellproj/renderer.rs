@@ -342,6 +342,45 @@ impl CellprojRenderer {
 }
 
 impl Renderer for CellprojRenderer {
+    fn annotations(&self) -> crate::techniques::annotations::Annotations {
+        use crate::techniques::annotations::{rgb8, Annotations, Legend};
+        let [lo, hi] = self.prepared.scalar_range;
+        let name = &self.prepared.scalar_name;
+        let mut legends = Vec::new();
+        if self.params.mode.volume() {
+            if let Ok(transfer) = self.params.volume_spec().build(&self.base, 1.0) {
+                legends.push(Legend::Bar {
+                    title: format!("volume: {name}"),
+                    colours: (0..256)
+                        .map(|k| rgb8(transfer.at(k as f64 / 255.0)))
+                        .collect(),
+                    low: lo,
+                    high: hi,
+                });
+            }
+        }
+        if self.params.mode.isosurfaces() && !self.params.isovalues.is_empty() {
+            // The renderer holds them normalized; the key says the scalar's own values.
+            let keys = self
+                .params
+                .sorted_isovalues()
+                .iter()
+                .map(|i| {
+                    let value = lo + i.value * (hi - lo);
+                    (rgb8(i.color), super::significant(value))
+                })
+                .collect();
+            legends.push(Legend::Keys {
+                title: format!("isovalues: {name}"),
+                keys,
+            });
+        }
+        Annotations {
+            legends,
+            axes: None,
+        }
+    }
+
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
         // Precise scenes drawing both find the isosurfaces in the volume's walk.
         let both_in_walk = self.fidelity == Fidelity::Precise

@@ -815,6 +815,31 @@ impl Opacity3dRenderer {
 }
 
 impl Renderer for Opacity3dRenderer {
+    fn annotations(&self) -> crate::techniques::annotations::Annotations {
+        use crate::techniques::annotations::{colours, Annotations, Legend};
+        let p = &self.prepared;
+        let legends = self
+            .params
+            .attributes()
+            .into_iter()
+            .enumerate()
+            .filter_map(|(a, attr)| {
+                let (attr, table, (low, high)) = (attr?, p.tables[a].as_ref()?, p.ranges[a]?);
+                Some(Legend::Bar {
+                    title: format!("{}: {}", super::ATTRIBUTE_NAMES[a], attr.attribute.name()),
+                    colours: colours(&table.entries),
+                    low,
+                    high,
+                })
+            })
+            .collect();
+        let axes = crate::volume::axes::describe(&self.params.primary.volume, &self.base, p.dims);
+        Annotations {
+            legends,
+            axes: Some((p.half.to_array(), axes)),
+        }
+    }
+
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
         self.draw_slices(gpu, surface, frame, 0..usize::MAX)
     }

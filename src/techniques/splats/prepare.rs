@@ -422,6 +422,32 @@ pub fn point_size_for_spacing(
     scene.point_size.max(covering)
 }
 
+/// An ASPRS classification code's name.
+pub fn class_name(code: i32) -> String {
+    let name = match code {
+        0 => "never classified",
+        1 => "unclassified",
+        2 => "ground",
+        3 => "low vegetation",
+        4 => "medium vegetation",
+        5 => "high vegetation",
+        6 => "building",
+        7 => "low point (noise)",
+        8 => "model key point",
+        9 => "water",
+        10 => "rail",
+        11 => "road surface",
+        13 => "wire guard",
+        14 => "wire conductor",
+        15 => "transmission tower",
+        16 => "wire connector",
+        17 => "bridge deck",
+        18 => "high noise",
+        _ => return format!("class {code}"),
+    };
+    format!("{code} {name}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -682,6 +682,59 @@ impl SplatsRenderer {
 }
 
 impl Renderer for SplatsRenderer {
+    fn annotations(&self) -> crate::techniques::annotations::Annotations {
+        use super::prepare::{class_colour, class_name, COLOR_A, COLOR_B};
+        use super::scene::ColourMode;
+        use crate::techniques::annotations::{Annotations, Legend};
+        let c = &self.cloud;
+        let ramp = |a: [f64; 3], b: [f64; 3]| -> Vec<[u8; 3]> {
+            (0..256)
+                .map(|k| {
+                    let t = k as f64 / 255.0;
+                    std::array::from_fn(|i| ((a[i] + t * (b[i] - a[i])) * 255.0).round() as u8)
+                })
+                .collect()
+        };
+        let [lo, hi] = c.frame;
+        let legend = match self.params.colour {
+            ColourMode::Classification => c.attribute("classification").map(|a| {
+                let mut classes: Vec<i32> = (0..a.values.len())
+                    .filter_map(|i| a.values.get(i).map(|v| v as i32))
+                    .collect();
+                classes.sort_unstable();
+                classes.dedup();
+                Legend::Keys {
+                    title: "classification".into(),
+                    keys: classes
+                        .into_iter()
+                        .map(|k| (class_colour(k), class_name(k)))
+                        .collect(),
+                }
+            }),
+            ColourMode::Elevation => Some(Legend::Bar {
+                title: "elevation".into(),
+                colours: ramp(COLOR_A, COLOR_B),
+                low: lo[2],
+                high: hi[2],
+            }),
+            ColourMode::Intensity => c.attribute("intensity").map(|a| Legend::Bar {
+                title: "intensity".into(),
+                colours: ramp([0.0; 3], [1.0; 3]),
+                low: 0.0,
+                high: a.stats.max.max(1.0),
+            }),
+            _ => None,
+        };
+        // The box the cloud is framed by, in the file's coordinates.
+        let half = std::array::from_fn(|a| ((hi[a] - lo[a]) / (2.0 * c.scale)).max(1e-9));
+        let axes =
+            std::array::from_fn(|a| crate::volume::axes::span(["x", "y", "z"][a], lo[a], hi[a]));
+        Annotations {
+            legends: legend.into_iter().collect(),
+            axes: Some((half, axes)),
+        }
+    }
+
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
         self.draw_splats(gpu, surface, frame)?;
         if self.params.edl > 0.0 {

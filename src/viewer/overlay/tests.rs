@@ -1,7 +1,7 @@
 use super::*;
 use crate::camera::Projection;
-use crate::viewer::axes::{span, Numbers};
 use crate::viewer::fit_zoom;
+use crate::volume::axes::{span, Numbers};
 
 /// Text as a font of this size measures it, about: 0.55 em per character, 1.25 em tall.
 fn measure(t: &str, size: f32) -> Vec2 {

@@ -1,5 +1,5 @@
-//! The volume's three axes in the data's own numbers, for the box labels and the
-//! sections: SEG-Y gives inline and crossline numbers from the trace headers and time in
+//! The volume's three axes in the data's own numbers, for the viewer's box labels and
+//! sections and the axes of offscreen pictures: SEG-Y gives inline and crossline numbers from the trace headers and time in
 //! ms from the sample interval; NIfTI gives millimetres from `pixdim`; raw volumes their
 //! scene spacing; the synthetic cube sample / crossline / inline indices.
 //!
