@@ -228,13 +228,16 @@ pub fn editor(
     } else {
         "click: add · drag: move · right/double click: remove"
     };
-    painter.text(
-        plot.left_top() + Vec2::new(4.0, 2.0),
-        egui::Align2::LEFT_TOP,
-        hint,
+    // Wrapped to the plot's width: a narrow plot (the cell-projection panel's) would
+    // cut a line it cannot hold.
+    let grey = Color32::from_gray(160);
+    let galley = painter.layout(
+        hint.to_string(),
         super::layout::overlay_font(super::layout::MIN_TEXT),
-        Color32::from_gray(160),
+        grey,
+        (plot.width() - 8.0).max(40.0),
     );
+    painter.galley(plot.left_top() + Vec2::new(4.0, 2.0), galley, grey);
     let _ = response.on_hover_text(label);
     edit
 }

@@ -18,7 +18,6 @@
 //! so the whole volume then stays in view at every rotation and window aspect. At start the
 //! scene's zoom is only lowered, never raised.
 
-pub mod axes;
 pub mod check;
 pub mod clip;
 pub mod curve;
@@ -31,6 +30,7 @@ pub mod observed;
 mod options;
 pub mod overlay;
 pub mod panel;
+pub mod remembered;
 pub mod runner;
 pub mod screenshot;
 pub mod script;
@@ -109,9 +109,28 @@ impl App {
 
     fn shutdown(&mut self, event_loop: &ActiveEventLoop) {
         if let Some(mut r) = self.running.take() {
+            self.remember(&r);
             r.egui.destroy();
         }
         event_loop.exit();
+    }
+
+    /// Remember the window's size for the next run (not a scripted one's).
+    fn remember(&self, r: &Running) {
+        if self.script.is_some() {
+            return;
+        }
+        let Some(folder) = remembered::folder() else {
+            return;
+        };
+        let window = r.window.window();
+        let size = window.inner_size().to_logical::<f32>(window.scale_factor());
+        if let Err(e) = remembered::save(&folder, egui::vec2(size.width, size.height)) {
+            eprintln!(
+                "arbvis: note: the window's size was not remembered in {}: {e}",
+                folder.display()
+            );
+        }
     }
 
     /// Ask for a frame at `at` (now when in the past).
@@ -229,6 +248,7 @@ impl ApplicationHandler<Wake> for App {
 
     fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
         if let Some(mut r) = self.running.take() {
+            self.remember(&r);
             r.egui.destroy();
         }
     }

@@ -8,7 +8,6 @@
 
 use egui::{Rect, RichText, Sense, Vec2};
 
-use super::axes::section_axes;
 use super::data::ViewData;
 use super::layout::{self, overlay_font};
 use super::legend;
@@ -20,6 +19,7 @@ use crate::camera::Projection;
 use crate::gl::{Caps, ProgramKind};
 use crate::scene::{Scene, TechniqueScene};
 use crate::vocab::Fidelity;
+use crate::volume::axes::section_axes;
 
 /// What the user asked for this frame.
 #[derive(Debug, Clone, PartialEq)]

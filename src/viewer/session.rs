@@ -95,7 +95,17 @@ impl Running {
                 (s.height as f64 / f) as f32,
             ))
         });
-        let size = layout::first_window(scene.size, opacity3d, usable);
+        // The size the user left the window at (not in a scripted run), within the
+        // screen; else the screen's usable part.
+        let remembered = options
+            .script
+            .is_none()
+            .then(super::remembered::folder)
+            .flatten()
+            .and_then(|f| super::remembered::load(&f))
+            .map(|r| usable.map_or(r, |u| r.min(u)));
+        let size =
+            remembered.unwrap_or_else(|| layout::first_window(scene.size, opacity3d, usable));
         let wanted = layout::first_window(scene.size, opacity3d, None);
         let attributes = Window::default_attributes()
             .with_title(format!("arbvis — {}", options.origin))
@@ -114,10 +124,12 @@ impl Running {
         egui.egui_ctx.set_request_repaint_callback(repaint);
         layout::style(&egui.egui_ctx);
         let mut panel = PanelState {
-            kind: Some(kind),
+            // What draws, which a mode may override (precise cell projection and splat
+            // tiles run GLSL whatever is asked).
+            kind: Some(renderer.program_kind()),
             ..PanelState::default()
         };
-        if size != wanted {
+        if size.x < wanted.x || size.y < wanted.y {
             if let Some([sw, sh]) = screen {
                 panel.status = format!(
                     "the window fits the {sw}x{sh} screen: the view is smaller than the scene's {}x{}",
@@ -255,7 +267,8 @@ impl Running {
                 UiAction::Screenshot => screenshot = true,
                 UiAction::SaveScene => self.save_scene(options),
                 UiAction::SetFidelity => {
-                    let kind = self.renderer.program_kind();
+                    // The scene's own choice, not what the last mode drew with.
+                    let kind = self.scene.programs.resolve(self.window.gpu());
                     self.set_programs(kind);
                 }
                 UiAction::SaveTables => self.save_tables(options),
@@ -396,12 +409,21 @@ impl Running {
             Ok(r) => {
                 self.renderer = r;
                 self.generation += 1;
-                self.panel.kind = Some(kind);
+                let drawn = self.renderer.program_kind();
+                self.panel.kind = Some(drawn);
                 self.scene.programs = match kind {
                     ProgramKind::Arb => crate::gl::ProgramChoice::Arb,
                     ProgramKind::Glsl => crate::gl::ProgramChoice::Glsl,
                 };
-                self.panel.status = format!("programs: {}", kind.name());
+                self.panel.status = if drawn == kind {
+                    format!("programs: {}", kind.name())
+                } else {
+                    format!(
+                        "programs: {} asked; this mode draws with {} only (the choice applies in faithful mode)",
+                        kind.name(),
+                        drawn.name()
+                    )
+                };
             }
             Err(e) => self.fail_action(format!("cannot switch to {}: {e}", kind.name())),
         }

@@ -7,6 +7,7 @@
 use super::legend::class_name;
 use super::summary::CloudSummary;
 use super::widgets::Widgets;
+use crate::points::PointSource;
 use crate::techniques::splats::scene::{ColourMode, DrawChoice, Kernel, Mode, SortChoice};
 use crate::techniques::splats::SplatsScene;
 use crate::vocab::Fidelity;
@@ -41,42 +42,50 @@ pub fn editor(
             }
         });
     }
-    ui.label("Layers shown");
-    ui.horizontal_wrapped(|ui| {
-        for layer in 0..LAYERS {
-            let (label, text) = (format!("Layer {layer}"), layer.to_string());
-            changed |= shown_toggle(ui, w, &mut scene.hide_layers, layer, &label, &text);
-        }
-    });
-    changed |= w.checkbox(
-        ui,
-        "Hide undefined facies",
-        &mut scene.hide_undefined,
-        "Hide undefined facies (-999)",
-    );
-    changed |= w.checkbox(
-        ui,
-        "Faults in white",
-        &mut scene.faults_white,
-        "Faults in white",
-    );
+    // Layers, facies and faults are the geological sections' (the seed's `.dat` and the
+    // generated one); a lidar or scanned cloud has classes, colours and intensity instead.
+    let section = matches!(scene.cloud, PointSource::Section(_) | PointSource::Dat(_));
+    if section {
+        ui.label("Layers shown");
+        ui.horizontal_wrapped(|ui| {
+            for layer in 0..LAYERS {
+                let (label, text) = (format!("Layer {layer}"), layer.to_string());
+                changed |= shown_toggle(ui, w, &mut scene.hide_layers, layer, &label, &text);
+            }
+        });
+        changed |= w.checkbox(
+            ui,
+            "Hide undefined facies",
+            &mut scene.hide_undefined,
+            "Hide undefined facies (-999)",
+        );
+        changed |= w.checkbox(
+            ui,
+            "Faults in white",
+            &mut scene.faults_white,
+            "Faults in white",
+        );
+    }
+    let modes: &[(ColourMode, &str)] = if section {
+        &[
+            (ColourMode::Facies, "facies"),
+            (ColourMode::Layer, "layer"),
+            (ColourMode::Property, "property"),
+            (ColourMode::Elevation, "elevation"),
+        ]
+    } else {
+        &[
+            (ColourMode::Rgb, "rgb"),
+            (ColourMode::Intensity, "intensity"),
+            (ColourMode::Classification, "classification"),
+            (ColourMode::Elevation, "elevation"),
+            (ColourMode::Property, "property"),
+            (ColourMode::Layer, "layer"),
+        ]
+    };
     ui.horizontal_wrapped(|ui| {
         ui.label("Colour by");
-        changed |= w.choice(
-            ui,
-            "Colour",
-            &mut scene.colour,
-            &[
-                (ColourMode::Facies, "facies"),
-                (ColourMode::Layer, "layer"),
-                (ColourMode::Property, "property"),
-                (ColourMode::Rgb, "rgb"),
-                (ColourMode::Intensity, "intensity"),
-                (ColourMode::Classification, "classification"),
-                (ColourMode::Elevation, "elevation"),
-            ],
-            120.0,
-        );
+        changed |= w.choice(ui, "Colour", &mut scene.colour, modes, 120.0);
     });
     let mut property = scene.property.clone();
     // The cloud's own attributes (a LAS file's intensity, GPS time, extra bytes, ...).
@@ -123,7 +132,11 @@ pub fn editor(
         ui,
         "Lighting",
         &mut scene.lighting,
-        "Lighting (normals per layer)",
+        if section {
+            "Lighting (normals per layer)"
+        } else {
+            "Lighting (estimated normals)"
+        },
     );
     ui.horizontal_wrapped(|ui| {
         ui.label("Sort");

@@ -144,7 +144,9 @@ pub fn editor(
         return changed;
     }
     let spec = scene.volume.get_or_insert_with(VolumeSpec::default);
-    ui.label("Volume: opacity per unit distance over the scalar's histogram");
+    ui.add(
+        egui::Label::new("Volume: opacity per unit distance over the scalar's histogram").wrap(),
+    );
     let Some((transfer, table)) = sampled(spec, base) else {
         ui.label("the transfer function's table cannot be built");
         return changed;
@@ -193,8 +195,9 @@ pub fn editor(
             changed = true;
         }
     }
-    // A swatch per control point.
+    // A swatch per control point, said as such.
     ui.horizontal_wrapped(|ui| {
+        ui.label("Point colours");
         for (i, p) in spec.points.iter_mut().enumerate() {
             let mut c = [p[1] as f32, p[2] as f32, p[3] as f32];
             let r = ui.color_edit_button_rgb(&mut c);
@@ -204,13 +207,18 @@ pub fn editor(
             }
         }
     });
-    changed |= w.drag_value(
-        ui,
-        "Unit distance",
-        &mut spec.unit_distance,
-        1e-4..=1e4,
-        0.01,
-    );
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Unit distance").on_hover_text(
+            "the length (in the mesh's units) over which an opacity of 1 absorbs fully",
+        );
+        changed |= w.drag_value(
+            ui,
+            "Unit distance",
+            &mut spec.unit_distance,
+            1e-4..=1e4,
+            0.01,
+        );
+    });
     ui.horizontal_wrapped(|ui| {
         ui.label("Order (faithful)");
         for (sort, label) in [(Sort::Centroid, "centroid"), (Sort::Mpvonc, "MPVONC")] {
