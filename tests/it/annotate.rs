@@ -101,6 +101,10 @@ fn each_technique_says_its_tables_and_keys() {
     let labels: Vec<&str> = keys.iter().map(|k| k.1.as_str()).collect();
     assert_eq!(labels, ["0.7", "1", "1.3"]);
     assert_eq!(keys[0].0, [51, 102, 255]);
+    // Its axes in the file's coordinates: x, y, z over the mesh's bounds.
+    let (_, axes) = a.axes.as_ref().unwrap();
+    let names: Vec<&str> = axes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["x", "y", "z"]);
     // F3: amplitude over its 1-99 % range, and inline / crossline / time axes.
     let f3 = load("scenes/data/f3.toml");
     let a = build(h.gpu(), &f3, kind).unwrap().annotations();

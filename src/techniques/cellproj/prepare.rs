@@ -75,6 +75,8 @@ pub struct Prepared {
     pub scalar_range: [f64; 2],
     /// Object units per mesh-file unit (the box's scale: lengths in the file times this).
     pub scale: f64,
+    /// The mesh's bounding box in the file's coordinates (low corner, high corner).
+    pub bounds: [[f64; 3]; 2],
 }
 
 /// Most layers cell projection draws: the mean number of tetrahedra a line through the
@@ -129,6 +131,7 @@ pub fn from_mesh(
         return Err(format!("{}: the mesh has no tetrahedra", mesh.info.source));
     }
     let (lo, hi) = mesh.bounds().ok_or("the mesh has no points")?;
+    let bounds = [lo, hi];
     let (lo, hi) = (DVec3::from_array(lo), DVec3::from_array(hi));
     // Halves first: `hi - lo` and `lo + hi` overflow near ±1.7e308, their halves do not.
     let centre = lo / 2.0 + hi / 2.0;
@@ -220,6 +223,7 @@ pub fn from_mesh(
         scalar_name,
         scalar_range,
         scale,
+        bounds,
     })
 }
 

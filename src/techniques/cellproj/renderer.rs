@@ -375,9 +375,12 @@ impl Renderer for CellprojRenderer {
                 keys,
             });
         }
+        let [lo, hi] = self.prepared.bounds;
+        let axes =
+            std::array::from_fn(|a| crate::volume::axes::span(["x", "y", "z"][a], lo[a], hi[a]));
         Annotations {
             legends,
-            axes: None,
+            axes: Some((self.prepared.half.to_array(), axes)),
         }
     }
 
