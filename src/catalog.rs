@@ -58,6 +58,17 @@ impl TechniqueScene {
 }
 
 impl TechniqueScene {
+    /// The camera a scene without `[camera]` starts from (and the viewer's Reset camera
+    /// returns to), where the technique's data asks for another than the default.
+    pub fn default_camera(&self) -> Option<crate::camera::Camera> {
+        match self {
+            TechniqueScene::Opacity3d(p) => p.default_camera(),
+            TechniqueScene::Quad(_) | TechniqueScene::Cellproj(_) | TechniqueScene::Splats(_) => {
+                None
+            }
+        }
+    }
+
     /// Defaults that depend on the data a scene names, for the keys its text leaves out
     /// (`written` tells which dotted keys it writes): a survey's three-quarter view where
     /// there is no `[camera]`, a lidar cloud's precise splats, and so on

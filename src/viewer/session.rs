@@ -273,7 +273,8 @@ impl Running {
                 }
                 UiAction::SaveTables => self.save_tables(options),
                 UiAction::ResetCamera => {
-                    self.scene.camera = Camera::default();
+                    // A survey's three-quarter view, as its scene started.
+                    self.scene.camera = self.scene.technique.default_camera().unwrap_or_default();
                     self.fit();
                 }
                 UiAction::FitVolume => self.fit(),

@@ -42,6 +42,8 @@ fn a_minimal_survey_scene_gets_the_surveys_shape_and_a_three_quarter_view() {
     let scene = Scene::parse(&minimal(&f3, ""), "minimal").unwrap();
     let o = opacity3d(&scene);
     assert_eq!(scene.camera.rotation, SURVEY_VIEW);
+    // The viewer's Reset camera returns to the same view.
+    assert_eq!(scene.technique.default_camera(), Some(scene.camera));
     assert_eq!(o.combine, Combine::Product);
     assert_eq!(o.primary.quantize, Quantization::Percentile([1.0, 99.0]));
     // Time (the volume's i, object x) runs down the screen; inline and crossline lie

@@ -114,6 +114,18 @@ fn unit_coefficients() -> [f64; 4] {
 /// and crosslines receding: the rotation `scenes/data/f3.toml` was composed with.
 pub const SURVEY_VIEW: [f64; 4] = [0.326506, -0.092296, -0.701057, 0.627211];
 
+/// A three-quarter view of a survey ([`SURVEY_VIEW`]), zoomed so that a box of any
+/// proportions stays whole at any rotation.
+fn survey_camera() -> crate::camera::Camera {
+    crate::camera::Camera {
+        rotation: SURVEY_VIEW,
+        // The prepared box's longest half side is 1, so its bounding sphere's radius is at
+        // most sqrt(3); with the viewer's 10 % framing margin.
+        zoom: 0.9 / 3f64.sqrt(),
+        ..Default::default()
+    }
+}
+
 /// `[technique.opacity3d]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -310,13 +322,7 @@ impl Opacity3dScene {
             return;
         }
         if !written("camera") {
-            *camera = crate::camera::Camera {
-                rotation: SURVEY_VIEW,
-                // The prepared box's longest half side is 1, so its bounding sphere's
-                // radius is at most sqrt(3); with the viewer's 10 % framing margin.
-                zoom: 0.9 / 3f64.sqrt(),
-                ..Default::default()
-            };
+            *camera = survey_camera();
         }
         let one = self.secondary.is_none() && self.tertiary.is_none();
         if one && !written("technique.opacity3d.combine") {
@@ -329,6 +335,12 @@ impl Opacity3dScene {
                 attr.quantize = Quantization::Percentile([1.0, 99.0]);
             }
         }
+    }
+
+    /// The camera a survey's scene starts from (and the viewer's Reset camera returns
+    /// to); `None` for other volumes, which keep [`crate::camera::Camera::default`].
+    pub fn default_camera(&self) -> Option<crate::camera::Camera> {
+        matches!(self.primary.volume, VolumeSource::Segy(_)).then(survey_camera)
     }
 
     /// The voxel size drawn: the scene's `spacing`, else the file's with the samples'
