@@ -129,17 +129,9 @@ fn text(
 /// A number written briefly: integers whole, others with four significant digits.
 pub fn brief(v: f64) -> String {
     if v.fract() == 0.0 && v.abs() < 1e9 {
-        return format!("{}", v as i64);
-    }
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let decimals = (3 - v.abs().log10().floor() as i32).clamp(0, 9) as usize;
-    let s = format!("{v:.decimals$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
+        format!("{}", v as i64)
     } else {
-        s
+        crate::vocab::significant(v)
     }
 }
 

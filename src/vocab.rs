@@ -177,6 +177,21 @@ impl<T: Ord> Ord for Ranked<T> {
     }
 }
 
+/// `v` with four significant digits, trailing zeros dropped (`0.3554`, `1.641`, `-17.81`);
+/// what warnings, keys and legends print for a value of the data.
+pub fn significant(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let decimals = (3 - v.abs().log10().floor() as i32).clamp(0, 12) as usize;
+    let s = format!("{v:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
 #[cfg(test)]
 mod ranked_tests {
     use super::Ranked;

@@ -11,7 +11,7 @@ use arbvis::render::{build, render_on};
 use arbvis::scene::{Fidelity, Scene};
 use arbvis::techniques::annotations::Legend;
 
-use crate::common::{headless, opacity3d, temp_dir};
+use crate::common::{headless, opacity3d, stdout_of, temp_dir};
 
 fn pixel(image: &arbvis::image::Image, x: i32, y: i32) -> [f32; 4] {
     let i = 4 * (y as usize * image.width as usize + x as usize);
@@ -143,18 +143,13 @@ fn each_technique_says_its_tables_and_keys() {
 fn the_command_line_draws_them_only_when_asked() {
     let dir = temp_dir("annotate-cli");
     let run = |args: &[&str], png: &str| {
-        let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
-            .args([
-                "render", "--demo", "v3o2-sum", "--size", "160x120", "-o", png,
-            ])
-            .args(args)
-            .current_dir(&dir)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
+        stdout_of(
+            Command::new(env!("CARGO_BIN_EXE_arbvis"))
+                .args([
+                    "render", "--demo", "v3o2-sum", "--size", "160x120", "-o", png,
+                ])
+                .args(args)
+                .current_dir(&dir),
         );
         read_png(&dir.join(png)).unwrap().0
     };

@@ -95,7 +95,7 @@ use serde::{Deserialize, Serialize};
 use crate::camera::Projection;
 use crate::mesh::scalars::ScalarSpec;
 use crate::mesh::MeshSource;
-use crate::vocab::FieldError;
+use crate::vocab::{significant, FieldError};
 
 pub use renderer::CellprojRenderer;
 
@@ -108,20 +108,6 @@ pub struct Isovalue {
     pub value: f64,
     /// RGBA colour, each in [0, 1].
     pub color: [f64; 4],
-}
-
-/// `v` with four significant digits, trailing zeros dropped (`0.3554`, `1.641`, `-17.81`).
-pub(crate) fn significant(v: f64) -> String {
-    if v == 0.0 || !v.is_finite() {
-        return format!("{v}");
-    }
-    let decimals = (3 - v.abs().log10().floor() as i32).clamp(0, 12) as usize;
-    let s = format!("{v:.decimals$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
 }
 
 /// The units of a scene's isovalues.

@@ -367,7 +367,7 @@ impl Renderer for CellprojRenderer {
                 .iter()
                 .map(|i| {
                     let value = lo + i.value * (hi - lo);
-                    (rgb8(i.color), super::significant(value))
+                    (rgb8(i.color), crate::vocab::significant(value))
                 })
                 .collect();
             legends.push(Legend::Keys {
