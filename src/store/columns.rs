@@ -74,16 +74,16 @@ impl Ctx<'_> {
         })
     }
 
-    /// A column's traces: the trace mask (live unless every sample is NaN) and,
-    /// where the survey gives them, the CDP coordinates, as `B x B` chunks over
-    /// (inline, crossline).
+    /// A column's traces: the trace mask (the input's, `known`, else live unless every
+    /// sample is NaN) and, where the survey gives them, the CDP coordinates, as `B x B`
+    /// chunks over (inline, crossline).
     fn store_traces(
         &self,
         u: [usize; 3],
-        nj: usize,
-        nk: usize,
+        [nj, nk]: [usize; 2],
         column: &[f32],
         coordinates: &[[f64; 2]],
+        known: Option<Vec<bool>>,
     ) -> Result<(), StoreError> {
         let b = self.meta.brick;
         let index = [u[2] as u64, u[1] as u64];
@@ -92,13 +92,15 @@ impl Ctx<'_> {
             path: self.store.join(what),
             message: format!("chunk {index:?} cannot be written: {e}"),
         };
-        // A trace is live unless every sample is NaN (an MDIO input's dead traces).
         let ni = self.meta.dims[0];
         let mut live = vec![false; b * b];
         for y in 0..nk {
             for x in 0..nj {
-                let trace = &column[(y * nj + x) * ni..][..ni];
-                live[y * b + x] = trace.iter().any(|v| !v.is_nan());
+                let t = y * nj + x;
+                live[y * b + x] = match &known {
+                    Some(mask) => mask[t],
+                    None => column[t * ni..][..ni].iter().any(|v| !v.is_nan()),
+                };
             }
         }
         if let Some(mask) = &self.writers.mask {
@@ -169,7 +171,8 @@ impl Ctx<'_> {
             .is_some()
             .then_some(coordinates.as_mut_slice());
         src.read_column(j0..j1, k0..k1, &mut column, wanted)?;
-        self.store_traces(u, j1 - j0, k1 - k0, &column, &coordinates)?;
+        let known = src.live(j0..j1, k0..k1);
+        self.store_traces(u, [j1 - j0, k1 - k0], &column, &coordinates, known)?;
         self.bytes
             .fetch_add(traces as u64 * src.bytes_per_trace(), Ordering::Relaxed);
         let mut planes: Vec<Vec<f32>> = vec![column];

@@ -515,12 +515,18 @@ pub fn inspect_with(path: &Path, keys: segy::KeyBytes) -> Result<String, VolumeE
         ..Default::default()
     };
     match segy::parse(path, &bytes, &options) {
-        Ok(s) => Ok(format!(
-            "{}\n{}{}",
-            path.display(),
-            s.describe(),
-            describe(&s.volume)
-        )),
+        Ok(s) => {
+            // Dead positions (no trace) are NaN but no sample of the file: the statistics
+            // are the live traces', and their non-finite count the file's own.
+            let mut stats = s.volume.stats();
+            stats.non_finite -= (s.grid.positions() - s.grid.live) * s.volume.dims[0];
+            Ok(format!(
+                "{}\n{}{}",
+                path.display(),
+                s.describe(),
+                describe_with(&s.volume, stats)
+            ))
+        }
         // A pre-stack file cannot be gridded as one cube without a choice: describe its
         // gathers and say how a scene makes that choice.
         Err(e) => match segy::gathers(path, &bytes, keys) {
@@ -535,6 +541,11 @@ pub const INSPECT_WHOLE_MAX: u64 = 1 << 30;
 
 /// Dimensions and value statistics, one item per line.
 pub fn describe(v: &Volume) -> String {
+    describe_with(v, v.stats())
+}
+
+/// [`describe`] with the statistics given.
+fn describe_with(v: &Volume, stats: Stats) -> String {
     format!(
         "dimensions (i, j, k): {} x {} x {} = {} samples\nspacing: {} x {} x {}\n{}",
         v.dims[0],
@@ -544,7 +555,7 @@ pub fn describe(v: &Volume) -> String {
         v.spacing[0],
         v.spacing[1],
         v.spacing[2],
-        v.stats().describe()
+        stats.describe()
     )
 }
 

@@ -160,6 +160,7 @@ mod tests {
             packed: super::super::prepare::pack([Some(&levels), None, None], n),
             tables: [Some(table), None, None],
             ranges: [Some((0.0, 255.0)), None, None],
+            no_data: [crate::volume::quantize::NoData::Absent; 3],
         }
     }
 

@@ -9,7 +9,7 @@ use glam::DVec3;
 use super::{AttributeScene, Opacity3dScene};
 use crate::colortable::ColorTable;
 use crate::volume::attributes::derive;
-use crate::volume::quantize::{quantize, Quantization};
+use crate::volume::quantize::{quantize_level, quantize_value, range, NoData, Quantization};
 use crate::volume::{Limits, Volume, VolumeSource};
 
 /// Everything the renderer uploads, and the CPU references read.
@@ -25,6 +25,10 @@ pub struct Prepared {
     pub tables: [Option<ColorTable>; 3],
     /// Value range each attribute was quantized over.
     pub ranges: [Option<(f64, f64)>; 3],
+    /// What NaN ("no data": an irregular survey's dead traces) became in each attribute's
+    /// levels: a level its table makes transparent, or level 0 reserved with the table's
+    /// entry 0 cleared, so that no data is never drawn.
+    pub no_data: [NoData; 3],
 }
 
 /// Byte of attribute `a` (0 primary, 1 secondary, 2 tertiary) in a packed RGB texel.
@@ -111,7 +115,8 @@ pub fn pack(quantized: [Option<&[u8]>; 3], voxels: usize) -> Vec<u8> {
 }
 
 /// Prepare from volumes already in memory: each present attribute's volume, its
-/// quantization and its table. All volumes must share one grid.
+/// quantization and its table. All volumes must share one grid. NaN samples (no data)
+/// take a level the table makes transparent ([`NoData`]).
 pub fn from_volumes(
     attributes: [Option<(&Volume, Quantization, ColorTable)>; 3],
 ) -> Result<Prepared, String> {
@@ -123,8 +128,9 @@ pub fn from_volumes(
     let mut quantized: [Option<Vec<u8>>; 3] = Default::default();
     let mut ranges = [None; 3];
     let mut tables: [Option<ColorTable>; 3] = Default::default();
+    let mut no_data = [NoData::Absent; 3];
     for (a, attr) in attributes.into_iter().enumerate() {
-        let Some((volume, how, table)) = attr else {
+        let Some((volume, how, mut table)) = attr else {
             continue;
         };
         if volume.dims != first.dims {
@@ -133,9 +139,19 @@ pub fn from_volumes(
                 names[a], volume.dims, first.dims
             ));
         }
-        let q = quantize(volume, how).map_err(|e| format!("{}: {e}", names[a]))?;
-        ranges[a] = Some((q.low, q.high));
-        quantized[a] = Some(q.bytes);
+        let (low, high) = range(volume, how).map_err(|e| format!("{}: {e}", names[a]))?;
+        let alpha: Vec<u8> = table.entries.iter().map(|e| e[3]).collect();
+        no_data[a] = NoData::choose(volume.values.iter().any(|v| v.is_nan()), &alpha);
+        if no_data[a] == NoData::Reserved {
+            table.entries[0] = [0; 4];
+        }
+        let levels = volume
+            .values
+            .iter()
+            .map(|&v| quantize_level(v, low, high, no_data[a]))
+            .collect();
+        ranges[a] = Some((low, high));
+        quantized[a] = Some(levels);
         tables[a] = Some(table);
     }
     let packed = pack([0, 1, 2].map(|a| quantized[a].as_deref()), first.len());
@@ -145,7 +161,19 @@ pub fn from_volumes(
         packed,
         tables,
         ranges,
+        no_data,
     })
+}
+
+/// The table's alpha from the distribution of `volume`'s levels over its quantization
+/// range ([`crate::colortable::alpha_from_histogram`]); NaN samples (no data) are left out.
+fn alpha_from_data(volume: &Volume, how: Quantization) -> Result<[u8; 256], String> {
+    let (low, high) = range(volume, how)?;
+    let mut counts = [0u64; 256];
+    for &v in volume.values.iter().filter(|v| !v.is_nan()) {
+        counts[quantize_value(v, low, high) as usize] += 1;
+    }
+    Ok(crate::colortable::alpha_from_histogram(&counts))
 }
 
 /// Prepare a scene: load each distinct source once (its size checked against `limits`
@@ -182,31 +210,27 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> Result<P
                 .map_err(|e| format!("{} table: {e}", names[a]))?,
         );
     }
+    // Alpha from each attribute's own distribution, where its table asks for it.
     let attrs = scene.attributes();
+    for (a, attr) in attrs.into_iter().enumerate() {
+        let (Some(attr), Some(volume), Some(table)) = (attr, &derived[a], &mut tables[a]) else {
+            continue;
+        };
+        let survey = matches!(attr.volume, VolumeSource::Segy(_));
+        if attr.table.wants_alpha_from_data(survey) {
+            let alpha =
+                alpha_from_data(volume, attr.quantize).map_err(|e| format!("{}: {e}", names[a]))?;
+            for (entry, alpha) in table.entries.iter_mut().zip(alpha) {
+                entry[3] = alpha;
+            }
+        }
+    }
     let inputs: [Option<(&Volume, Quantization, ColorTable)>; 3] =
         std::array::from_fn(|a| match (&derived[a], &tables[a], attrs[a]) {
             (Some(v), Some(t), Some(s)) => Some((v, s.quantize, t.clone())),
             _ => None,
         });
-    let mut prepared = from_volumes(inputs)?;
-    // Alpha from each attribute's own distribution, where its table asks for it.
-    for (a, attr) in attrs.into_iter().enumerate() {
-        let Some(attr) = attr else { continue };
-        let survey = matches!(attr.volume, VolumeSource::Segy(_));
-        if attr.table.wants_alpha_from_data(survey) {
-            let mut counts = [0u64; 256];
-            for texel in prepared.packed.chunks_exact(3) {
-                counts[texel[CHANNEL[a]] as usize] += 1;
-            }
-            let alpha = crate::colortable::alpha_from_histogram(&counts);
-            if let Some(table) = &mut prepared.tables[a] {
-                for (entry, alpha) in table.entries.iter_mut().zip(alpha) {
-                    entry[3] = alpha;
-                }
-            }
-        }
-    }
-    Ok(prepared)
+    from_volumes(inputs)
 }
 
 #[cfg(test)]
@@ -233,6 +257,7 @@ mod tests {
             packed: pack([Some(&levels), None, None], n),
             tables: [Some(ColorTable::builtin("grey").unwrap()), None, None],
             ranges: [None; 3],
+            no_data: [NoData::Absent; 3],
         };
         let words = prepared.neighbour_words();
         assert_eq!(words.len(), 2 * n);
@@ -266,6 +291,7 @@ mod tests {
             packed: pack([Some(&[10, 11]), None, Some(&[30, 31])], 2),
             tables: [Some(grey.clone()), None, Some(grey)],
             ranges: [None; 3],
+            no_data: [NoData::Absent; 3],
         };
         assert_eq!(prepared.present(), [true, false, true]);
         assert_eq!(prepared.present_levels(), vec![10, 30, 11, 31]);

@@ -36,6 +36,7 @@ use crate::techniques::clip::stage as clipping_stage;
 use crate::techniques::clip::stats::ClipStats;
 use crate::techniques::{Frame, Params, Renderer};
 use crate::vocab::Fidelity;
+use crate::volume::quantize::NoData;
 
 /// Texture unit of the packed volume and of the three tables (unit 1 is v3o2's
 /// lighting, unused here).
@@ -412,6 +413,21 @@ impl Opacity3dRenderer {
     /// The path this renderer draws with.
     pub fn path(&self) -> Path3d {
         path(&self.params, self.fidelity)
+    }
+
+    /// Whether `new`'s tables make the level no data took opaque: the volume is then
+    /// quantized again, so that no data stays undrawn ([`NoData::choose`]).
+    fn no_data_moves(&self, new: &Opacity3dScene) -> GlResult<bool> {
+        for (a, attr) in new.attributes().into_iter().enumerate() {
+            let (Some(attr), NoData::Level(level)) = (attr, self.prepared.no_data[a]) else {
+                continue;
+            };
+            let table = attr.table.build(&self.base).map_err(GlError::Data)?;
+            if table.entries[level as usize][3] != 0 {
+                return Ok(true);
+            }
+        }
+        Ok(false)
     }
 
     fn build_tables(&mut self, gpu: &Gpu) -> GlResult<()> {
@@ -874,6 +890,7 @@ impl Renderer for Opacity3dRenderer {
         if data(&old) != data(new)
             || old.volume_filter != new.volume_filter
             || old.interpolation != new.interpolation
+            || self.no_data_moves(new)?
         {
             let prepared = prepare(
                 new,
@@ -900,8 +917,11 @@ impl Renderer for Opacity3dRenderer {
         {
             for (a, attr) in new.attributes().into_iter().enumerate() {
                 if let Some(attr) = attr {
-                    self.prepared.tables[a] =
-                        Some(attr.table.build(&self.base).map_err(GlError::Data)?);
+                    let mut table = attr.table.build(&self.base).map_err(GlError::Data)?;
+                    if self.prepared.no_data[a] == NoData::Reserved {
+                        table.entries[0] = [0; 4];
+                    }
+                    self.prepared.tables[a] = Some(table);
                 }
             }
             self.build_tables(gpu)?;

@@ -82,33 +82,41 @@ fn cdp(header: &[u8], big: bool) -> Option<[f64; 2]> {
 }
 
 /// The geometry of a grid of `nj` crosslines by `nk` inlines sampled every `interval_us`;
-/// `corner(k, j)` is the header of the trace at inline index `k`, crossline index `j`
-/// (asked for the three corners (0, 0), (0, nj - 1) and (nk - 1, 0) only).
+/// `header(k, j)` is the header of the trace at inline index `k`, crossline index `j`
+/// (`None` where no trace is). The steps come from the three corners (0, 0), (0, nj - 1)
+/// and (nk - 1, 0) where all three hold a trace, else (an irregular survey's missing
+/// corner) from a plane fitted through the live traces at `spread` ([`fit_steps`]).
 pub(crate) fn geometry(
     interval_us: u32,
     nj: usize,
     nk: usize,
     big: bool,
-    mut corner: impl FnMut(usize, usize) -> Option<[u8; 240]>,
+    spread: &[(usize, usize)],
+    mut header: impl FnMut(usize, usize) -> Option<[u8; 240]>,
 ) -> Geometry {
     let sample = interval_us as f64 / 1000.0 * VELOCITY_M_S / 2000.0;
     let sample = if sample > 0.0 { sample } else { 1.0 };
-    let mut at = |k, j| corner(k, j).and_then(|h| cdp(&h, big));
+    let mut at = |k, j| header(k, j).and_then(|h| cdp(&h, big));
     let step = |a: Option<[f64; 2]>, b: Option<[f64; 2]>, n: usize| -> Option<f64> {
         let (a, b) = (a?, b?);
         let d = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt() / (n - 1) as f64;
         (d.is_finite() && d > 0.0).then_some(d)
     };
     let origin = at(0, 0);
-    let crossline = if nj > 1 {
-        step(origin, at(0, nj - 1), nj)
+    let far_j = (nj > 1).then(|| at(0, nj - 1));
+    let far_k = (nk > 1).then(|| at(nk - 1, 0));
+    let corners_live = origin.is_some() && far_j != Some(None) && far_k != Some(None);
+    let (crossline, inline) = if corners_live {
+        (
+            far_j.and_then(|b| step(origin, b, nj)),
+            far_k.and_then(|b| step(origin, b, nk)),
+        )
     } else {
-        None
-    };
-    let inline = if nk > 1 {
-        step(origin, at(nk - 1, 0), nk)
-    } else {
-        None
+        let points: Vec<_> = spread
+            .iter()
+            .filter_map(|&(k, j)| at(k, j).map(|c| (j as f64, k as f64, c)))
+            .collect();
+        fit_steps(&points)
     };
     // One measured step stands for the other where the grid has a single line that way.
     let (crossline, inline, bins) = match (crossline, inline) {
@@ -121,6 +129,55 @@ pub(crate) fn geometry(
         spacing: [sample, crossline, inline],
         bins,
     }
+}
+
+/// A live trace for [`fit_steps`]: its crossline index, inline index and CDP `[x, y]`.
+pub(crate) type TracePoint = (f64, f64, [f64; 2]);
+
+/// The CDP step per crossline index and per inline index of a plane `c = o + j u + k v`
+/// fitted by least squares through the points; `None` along an axis the points do not
+/// span (or whose step is zero or not finite).
+pub(crate) fn fit_steps(points: &[TracePoint]) -> (Option<f64>, Option<f64>) {
+    let Some(first) = points.first() else {
+        return (None, None);
+    };
+    let vary_j = points.iter().any(|p| p.0 != first.0);
+    let vary_k = points.iter().any(|p| p.1 != first.1);
+    // Centred sums: the normal equations of the varying columns only.
+    let n = points.len() as f64;
+    let sum = |f: &dyn Fn(&TracePoint) -> f64| points.iter().map(f).sum::<f64>();
+    let (mj, mk) = (sum(&|p| p.0) / n, sum(&|p| p.1) / n);
+    let mc = [sum(&|p| p.2[0]) / n, sum(&|p| p.2[1]) / n];
+    let sjj = sum(&|p| (p.0 - mj) * (p.0 - mj));
+    let skk = sum(&|p| (p.1 - mk) * (p.1 - mk));
+    let sjk = sum(&|p| (p.0 - mj) * (p.1 - mk));
+    let mut u = [0.0; 2];
+    let mut v = [0.0; 2];
+    for a in 0..2 {
+        let sjc = sum(&|p| (p.0 - mj) * (p.2[a] - mc[a]));
+        let skc = sum(&|p| (p.1 - mk) * (p.2[a] - mc[a]));
+        match (vary_j, vary_k) {
+            (true, true) => {
+                let det = sjj * skk - sjk * sjk;
+                if det.abs() <= 1e-12 * sjj * skk {
+                    return (None, None);
+                }
+                u[a] = (sjc * skk - skc * sjk) / det;
+                v[a] = (skc * sjj - sjc * sjk) / det;
+            }
+            (true, false) => u[a] = sjc / sjj,
+            (false, true) => v[a] = skc / skk,
+            (false, false) => {}
+        }
+    }
+    let length = |w: [f64; 2]| {
+        let d = (w[0] * w[0] + w[1] * w[1]).sqrt();
+        (d.is_finite() && d > 0.0).then_some(d)
+    };
+    (
+        vary_j.then(|| length(u)).flatten(),
+        vary_k.then(|| length(v)).flatten(),
+    )
 }
 
 #[cfg(test)]
@@ -148,7 +205,7 @@ mod tests {
                 -100,
             ))
         };
-        let g = geometry(2000, 7, 5, true, at);
+        let g = geometry(2000, 7, 5, true, &[], at);
         assert_eq!(g.bins, BinsFrom::Coordinates);
         assert!(
             (g.spacing[1] - 12.5).abs() < 1e-3 && (g.spacing[2] - 37.5).abs() < 1e-3,
@@ -160,7 +217,7 @@ mod tests {
 
     #[test]
     fn no_coordinates_assume_the_common_bin_and_say_so() {
-        let g = geometry(4000, 3, 4, true, |_, _| Some(header(0, 0, 0)));
+        let g = geometry(4000, 3, 4, true, &[], |_, _| Some(header(0, 0, 0)));
         assert_eq!(g.spacing, [4.0, ASSUMED_BIN_M, ASSUMED_BIN_M]);
         assert!(
             g.describe().contains("25 m bins assumed"),
@@ -170,17 +227,49 @@ mod tests {
         // Arc seconds are no lengths.
         let mut h = header(100, 200, 1);
         h[88..90].copy_from_slice(&2i16.to_be_bytes());
-        let g = geometry(4000, 3, 4, true, |k, j| {
+        let g = geometry(4000, 3, 4, true, &[], |k, j| {
             let mut h = h;
             h[180..184].copy_from_slice(&(100 + 10 * (j + k) as i32).to_be_bytes());
             Some(h)
         });
         assert_eq!(g.bins, BinsFrom::Assumed);
         // One inline: its crossline step stands for both.
-        let g = geometry(4000, 3, 1, true, |_, j| Some(header(10 * j as i32, 0, 1)));
+        let g = geometry(4000, 3, 1, true, &[], |_, j| {
+            Some(header(10 * j as i32, 0, 1))
+        });
         assert_eq!(
             (g.spacing[1], g.spacing[2], g.bins),
             (10.0, 10.0, BinsFrom::Coordinates)
         );
+    }
+
+    #[test]
+    fn a_missing_corner_fits_the_steps_through_the_live_traces() {
+        // The rotated grid again, its (0, 0) corner dead: the plane through the live
+        // traces at the spread gives the same steps.
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let at = |k: usize, j: usize| {
+            if k < 2 && j < 3 {
+                return None;
+            }
+            let (u, v) = (j as f64 * 12.5, k as f64 * 37.5);
+            let (x, y) = (500_000.0 + u * c - v * s, 6_000_000.0 + u * s + v * c);
+            Some(header(
+                (x * 100.0).round() as i32,
+                (y * 100.0).round() as i32,
+                -100,
+            ))
+        };
+        let spread = [(0, 3), (0, 6), (2, 0), (2, 6), (4, 0), (4, 6)];
+        let g = geometry(2000, 7, 5, true, &spread, at);
+        assert_eq!(g.bins, BinsFrom::Coordinates);
+        assert!(
+            (g.spacing[1] - 12.5).abs() < 1e-3 && (g.spacing[2] - 37.5).abs() < 1e-3,
+            "{g:?}"
+        );
+        // Points on one inline measure the crossline step only; none, nothing.
+        let one = [(0.0, 0.0, [0.0, 0.0]), (4.0, 0.0, [30.0, 40.0])];
+        assert_eq!(fit_steps(&one), (Some(12.5), None));
+        assert_eq!(fit_steps(&[]), (None, None));
     }
 }

@@ -3,7 +3,8 @@
 //! (one per source-receiver offset, trace bytes 37-40); the scene then picks one offset
 //! (`prestack = { offset = 400 }`) or stacks them (`prestack = "stack"`: the mean of a
 //! cell's traces, sample by sample, as segyio's stacking examples do). Without a choice a
-//! pre-stack file is refused, naming the offsets it holds.
+//! pre-stack file is refused, naming the offsets it holds. The grid is the lines the
+//! numbers span ([`super::lines`]); a position without a trace is dead (NaN).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -11,6 +12,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use super::keys::{KeyBytes, Keys};
+use super::lines::{Duplicate, GridError, TraceGrid};
 use super::{SampleFormat, TRACE_HEADER};
 use crate::volume::{Limits, VolumeError};
 
@@ -57,14 +59,12 @@ pub(crate) struct Layout {
 /// The gridded samples.
 pub(super) struct Gridded {
     pub dims: [usize; 3],
+    /// Dead positions (no trace) are NaN.
     pub values: Vec<f32>,
-    pub inlines: Vec<i32>,
-    pub crosslines: Vec<i32>,
+    /// The lines and, per position, the (first) trace there.
+    pub grid: TraceGrid,
     /// The distinct offsets the file holds (one entry, usually 0, for post-stack files).
     pub offsets: Vec<i32>,
-    /// The header offsets of the traces at the grid's corners (inline index, crossline
-    /// index) = (0, 0), (0, last), (last, 0), for the survey's geometry.
-    pub corners: [usize; 3],
 }
 
 /// Offsets as a short list for messages.
@@ -109,90 +109,103 @@ pub(super) fn grid(
             ),
         });
     }
+    let hint = if offsets.len() > 1 {
+        format!(
+            ": a pre-stack or otherwise non-gridded file; it holds offsets {} (trace bytes 37-40): set `prestack = {{ offset = N }}` or `prestack = \"stack\"` on this volume in the scene",
+            list(&offsets)
+        )
+    } else {
+        ": a pre-stack or otherwise non-gridded file".to_string()
+    };
+    let offset_of = |t: u32| header(t as usize) as u64;
     if options.prestack != Prestack::Stack {
-        if let Some((key, ts)) = cells.iter().find(|(_, ts)| ts.len() > 1) {
-            let hint = if offsets.len() > 1 {
-                format!(
-                    "; it holds offsets {} (trace bytes 37-40): set `prestack = {{ offset = N }}` or `prestack = \"stack\"` on this volume in the scene",
-                    list(&offsets)
-                )
-            } else {
-                String::new()
+        if let Some((&at, ts)) = cells.iter().find(|(_, ts)| ts.len() > 1) {
+            let d = Duplicate {
+                first: ts[0] as u32,
+                second: ts[1] as u32,
+                at,
             };
-            return Err(VolumeError::Unsupported {
-                path: path.into(),
-                message: format!(
-                    "traces {} and {} (bytes {} and {}) both sit at inline {} crossline {} ({}): a pre-stack or otherwise non-gridded file{hint}",
-                    ts[0] + 1,
-                    ts[1] + 1,
-                    header(ts[0]),
-                    header(ts[1]),
-                    key.0,
-                    key.1,
-                    l.keys.describe()
-                ),
-            });
+            return Err(GridError::Duplicate(d).into_volume_error(path, &l.keys, offset_of, &hint));
         }
     }
-    let mut inlines: Vec<i32> = cells.keys().map(|k| k.0).collect();
-    inlines.dedup();
-    let mut crosslines: Vec<i32> = cells.keys().map(|k| k.1).collect();
-    crosslines.sort_unstable();
-    crosslines.dedup();
-    if inlines.len() * crosslines.len() != cells.len() {
-        return Err(VolumeError::Unsupported {
-            path: path.into(),
-            message: format!(
-                "{} traces at {} inline/crossline positions do not fill the grid of {} inlines x {} crosslines (inline {}..={}, crossline {}..={}; the numbers at {}): an irregular survey that arbvis cannot grid. The binary header declares {} samples per trace of {} (bytes 3221-3222), so the {} bytes after the headers hold {} traces of {} bytes; if that count looks wrong, the header's sample count is",
-                l.traces,
-                cells.len(),
-                inlines.len(),
-                crosslines.len(),
-                inlines[0],
-                inlines[inlines.len() - 1],
-                crosslines[0],
-                crosslines[crosslines.len() - 1],
-                l.keys.describe(),
-                l.header_samples,
-                l.format.name(),
-                l.traces * l.trace_len,
-                l.traces,
-                l.trace_len
-            ),
-        });
+    let trace_grid = TraceGrid::from_keys(
+        cells
+            .iter()
+            .map(|(&(il, xl), ts)| (il, xl, ts[0] as u32))
+            .collect(),
+    )
+    .map_err(|e| e.into_volume_error(path, &l.keys, offset_of, &hint))?;
+    if !trace_grid.is_full() {
+        check_sample_count(
+            path,
+            l,
+            &bytes[header(0)..header(0) + TRACE_HEADER],
+            &trace_grid,
+        )?;
     }
-    let dims = [l.samples, crosslines.len(), inlines.len()];
+    let (inlines, crosslines) = (trace_grid.inlines, trace_grid.crosslines);
+    let dims = [l.samples, crosslines.count, inlines.count];
     options.limits.check(dims, &path.display().to_string())?;
-    let mut values = vec![0f32; l.samples * cells.len()];
+    let mut values =
+        crate::budget::vec_for::<f32>(l.samples * trace_grid.positions(), "a SEG-Y volume")
+            .map_err(|e| VolumeError::Invalid(format!("{}: {e}", path.display())))?;
+    values.resize(l.samples * trace_grid.positions(), f32::NAN);
     let width = l.format.bytes();
-    for (k, &il) in inlines.iter().enumerate() {
-        for (j, &xl) in crosslines.iter().enumerate() {
-            let traces = &cells[&(il, xl)];
-            let out = &mut values[(k * dims[1] + j) * l.samples..][..l.samples];
-            for &t in traces {
-                let start = header(t) + TRACE_HEADER;
-                for (s, v) in out.iter_mut().enumerate() {
-                    *v += l.format.decode(&bytes[start + s * width..], l.big);
-                }
-            }
-            if traces.len() > 1 {
-                let n = traces.len() as f32;
-                out.iter_mut().for_each(|v| *v /= n);
+    for (&(il, xl), traces) in &cells {
+        let (Some(k), Some(j)) = (inlines.index(il), crosslines.index(xl)) else {
+            unreachable!("every number is on its axis's lines");
+        };
+        let out = &mut values[(k * dims[1] + j) * l.samples..][..l.samples];
+        out.fill(0.0);
+        for &t in traces {
+            let start = header(t) + TRACE_HEADER;
+            for (s, v) in out.iter_mut().enumerate() {
+                *v += l.format.decode(&bytes[start + s * width..], l.big);
             }
         }
+        if traces.len() > 1 {
+            let n = traces.len() as f32;
+            out.iter_mut().for_each(|v| *v /= n);
+        }
     }
-    let corner = |k: usize, j: usize| header(cells[&(inlines[k], crosslines[j])][0]);
-    let corners = [
-        corner(0, 0),
-        corner(0, crosslines.len() - 1),
-        corner(inlines.len() - 1, 0),
-    ];
     Ok(Gridded {
         dims,
         values,
-        inlines,
-        crosslines,
+        grid: trace_grid,
         offsets: offsets.into_iter().collect(),
-        corners,
     })
+}
+
+/// A grid with dead positions is also what a wrong sample count makes (every trace header
+/// after the first read from inside the samples), so where the first trace's own count
+/// (bytes 115-116) disagrees with the count in use, the file is refused, saying both,
+/// rather than drawn as a survey of dead traces.
+pub(crate) fn check_sample_count(
+    path: &Path,
+    l: &Layout,
+    first_header: &[u8],
+    grid: &TraceGrid,
+) -> Result<(), VolumeError> {
+    let a = [first_header[114], first_header[115]];
+    let own = if l.big {
+        u16::from_be_bytes(a)
+    } else {
+        u16::from_le_bytes(a)
+    } as usize;
+    if own == 0 || own == l.samples {
+        return Ok(());
+    }
+    Err(VolumeError::format(
+        path,
+        (l.first_trace + 114) as u64,
+        format!(
+            "the binary header declares {} samples per trace of {} (bytes 3221-3222) and the first trace header {own} (bytes 115-116); read with the binary header's count, the traces leave positions of their grid empty ({}): the {} bytes after the headers hold {} traces of {} bytes; if that count looks wrong, the header's sample count is",
+            l.header_samples,
+            l.format.name(),
+            grid.describe(),
+            l.traces * l.trace_len,
+            l.traces,
+            l.trace_len
+        ),
+    ))
 }

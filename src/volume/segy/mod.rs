@@ -14,6 +14,7 @@ mod gathers;
 pub mod geometry;
 mod grid;
 pub mod keys;
+pub mod lines;
 mod source;
 mod stream;
 mod write;
@@ -24,6 +25,7 @@ pub use gathers::{gathers, Gathers};
 pub use geometry::Geometry;
 pub use grid::{Prestack, ReadOptions};
 pub use keys::{KeyBytes, Keys};
+pub use lines::{Lines, TraceGrid};
 pub use source::SegySource;
 pub use stream::SegyStream;
 pub use write::{write, write_prestack, TraceWriter, WriteOptions};
@@ -283,10 +285,13 @@ pub struct SegyCube {
     pub ebcdic: bool,
     /// Sample interval in microseconds.
     pub interval_us: u32,
-    /// Inline numbers, ascending.
+    /// Inline numbers, ascending (the grid's lines, gaps included).
     pub inlines: Vec<i32>,
-    /// Crossline numbers, ascending.
+    /// Crossline numbers, ascending (the grid's lines, gaps included).
     pub crosslines: Vec<i32>,
+    /// The grid: its lines and steps, and which positions hold a trace (the rest are
+    /// dead, NaN in the volume).
+    pub grid: TraceGrid,
     /// Number of traces.
     pub traces: usize,
     /// The distinct source-receiver offsets of the traces (trace bytes 37-40).
@@ -300,19 +305,23 @@ pub struct SegyCube {
 impl SegyCube {
     /// What `arbvis inspect` prints about the headers.
     pub fn describe(&self) -> String {
-        let range = |v: &[i32]| {
-            // Steps in i64: numbers at i32::MIN and i32::MAX are 2^32 - 1 apart.
-            let steps: Vec<i64> = v.windows(2).map(|w| w[1] as i64 - w[0] as i64).collect();
-            let step = match steps.first() {
-                None => return format!("{} (one value)", v[0]),
-                Some(&s) if steps.iter().all(|&t| t == s) => format!("step {s}"),
-                Some(_) => "uneven steps".to_string(),
-            };
-            format!("{}..={} ({} values, {step})", v[0], v[v.len() - 1], v.len())
+        let offsets = match self.offsets.as_slice() {
+            [one] => format!("{one} (one value)"),
+            v => {
+                let even = v
+                    .windows(2)
+                    .all(|w| w[1] as i64 - w[0] as i64 == v[1] as i64 - v[0] as i64);
+                let step = if even {
+                    format!("step {}", v[1] as i64 - v[0] as i64)
+                } else {
+                    "uneven steps".to_string()
+                };
+                format!("{}..={} ({} values, {step})", v[0], v[v.len() - 1], v.len())
+            }
         };
         let ns = self.volume.dims[0];
         format!(
-            "format: SEG-Y rev {}.{} (bytes 3501-3502), textual header {}\nsample type: {}\nendianness: {}\ntraces: {}\ninline/crossline numbers: {}\ninlines: {}\ncrosslines: {}\ngrid: {} inlines x {} crosslines, {} traces\noffsets: {}\nsamples: {} per trace, interval {} us, 0..={} ms\n{}\n",
+            "format: SEG-Y rev {}.{} (bytes 3501-3502), textual header {}\nsample type: {}\nendianness: {}\ntraces: {}\ninline/crossline numbers: {}\ninlines: {}\ncrosslines: {}\n{}\noffsets: {}\nsamples: {} per trace, interval {} us, 0..={} ms\n{}\n",
             self.revision.0,
             self.revision.1,
             if self.ebcdic { "EBCDIC" } else { "ASCII" },
@@ -320,12 +329,10 @@ impl SegyCube {
             if self.big_endian { "big-endian" } else { "little-endian" },
             self.traces,
             self.keys.describe(),
-            range(&self.inlines),
-            range(&self.crosslines),
-            self.inlines.len(),
-            self.crosslines.len(),
-            self.inlines.len() * self.crosslines.len(),
-            range(&self.offsets),
+            self.grid.inlines.describe(),
+            self.grid.crosslines.describe(),
+            self.grid.describe(),
+            offsets,
             ns,
             self.interval_us,
             (ns.saturating_sub(1)) as f64 * self.interval_us as f64 / 1000.0,
@@ -393,20 +400,22 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
     let grid::Gridded {
         dims,
         values,
-        inlines,
-        crosslines,
+        grid,
         offsets,
-        corners,
     } = grid::grid(path, bytes, &layout, options)?;
-    // Spacing: the survey's proportions (geometry.rs).
-    let geometry = geometry::geometry(h.interval_us, dims[1], dims[2], layout.big, |k, j| {
-        let at = match (k, j) {
-            (0, 0) => corners[0],
-            (0, _) => corners[1],
-            _ => corners[2],
-        };
-        bytes[at..at + TRACE_HEADER].try_into().ok()
-    });
+    // Spacing: the survey's proportions (geometry.rs), from live traces.
+    let spread: Vec<(usize, usize)> = grid.spread().iter().map(|&(k, j, _)| (k, j)).collect();
+    let geometry = geometry::geometry(
+        h.interval_us,
+        dims[1],
+        dims[2],
+        layout.big,
+        &spread,
+        |k, j| {
+            let at = layout.first_trace + grid.trace(k, j)? * layout.trace_len;
+            bytes[at..at + TRACE_HEADER].try_into().ok()
+        },
+    );
     let volume = Volume::new(dims, geometry.spacing, values).map_err(VolumeError::Invalid)?;
     Ok(SegyCube {
         volume,
@@ -415,8 +424,9 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
         big_endian: layout.big,
         ebcdic: h.ebcdic,
         interval_us: h.interval_us,
-        inlines,
-        crosslines,
+        inlines: grid.inlines.numbers(),
+        crosslines: grid.crosslines.numbers(),
+        grid,
         traces: layout.traces,
         offsets,
         keys: layout.keys,
@@ -710,15 +720,23 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("pre-stack") && e.contains("p.sgy"), "{e}");
-        // Drop the last trace: 11 traces cannot fill 4 x 3.
-        let e = parse(
+        // Drop the last trace: an irregular survey, its last position dead (NaN).
+        let c = parse(
             Path::new("i.sgy"),
             &bytes[..bytes.len() - trace],
             &ReadOptions::default(),
         )
-        .unwrap_err()
-        .to_string();
-        assert!(e.contains("irregular"), "{e}");
+        .unwrap();
+        assert_eq!(c.volume.dims, v.dims);
+        let [ni, nj, nk] = v.dims;
+        let dead = &c.volume.values[ni * (nj * nk - 1)..];
+        assert!(dead.iter().all(|x| x.is_nan()), "{dead:?}");
+        assert_eq!(c.grid.live, nj * nk - 1);
+        assert!(
+            c.describe().contains("11 live traces, 1 dead"),
+            "{}",
+            c.describe()
+        );
         // Cut inside a trace.
         let e = parse(
             Path::new("t.sgy"),

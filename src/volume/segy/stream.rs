@@ -7,8 +7,10 @@
 //! against that grid. Every trace read later is checked again (its inline and crossline,
 //! bytes 189-196 or those named or detected, must be the ones its place implies), so a file that only looks sorted
 //! ends in an error naming the trace and its byte. Any other order is gridded from every
-//! trace header (one small read per trace, 12 bytes per trace held). Pre-stack files
-//! (several traces per cell) are refused.
+//! trace header (one small read per trace, 12 bytes per trace held), and so is an
+//! irregular survey: its grid is the lines the numbers span ([`super::lines`]), and a
+//! position without a trace reads as NaN (dead). Pre-stack files (several traces per cell)
+//! are refused.
 
 use std::fs::File;
 use std::ops::Range;
@@ -17,6 +19,7 @@ use std::path::{Path, PathBuf};
 
 use super::grid::Layout;
 use super::keys::KeyBytes;
+use super::lines::{Lines, TraceGrid};
 use super::{headers, SampleFormat, TRACE_HEADER};
 use crate::volume::VolumeError;
 
@@ -38,17 +41,10 @@ pub struct SegyStream {
     pub crosslines: Vec<i32>,
     /// The survey's proportions: one step along samples, crosslines and inlines.
     pub geometry: super::Geometry,
-    order: Order,
-}
-
-/// Which trace holds cell `(k, j)`.
-#[derive(Debug)]
-enum Order {
-    /// Inline-sorted: trace `kf * nx + jf`, with `kf`, `jf` reversed where the file's
-    /// numbers descend.
-    Sorted { inline_up: bool, crossline_up: bool },
-    /// Any order: trace number per cell, k-major.
-    Map(Vec<u32>),
+    /// The lines and the trace at each position (none where the survey has no trace).
+    pub grid: TraceGrid,
+    /// Whether the grid came from the inline-sorted shortcut (else from every header).
+    sorted: bool,
 }
 
 impl SegyStream {
@@ -84,8 +80,9 @@ impl SegyStream {
             interval_us: h.interval_us,
             inlines: Vec::new(),
             crosslines: Vec::new(),
-            geometry: super::geometry::geometry(0, 1, 1, true, |_, _| None),
-            order: Order::Map(Vec::new()),
+            geometry: super::geometry::geometry(0, 1, 1, true, &[], |_, _| None),
+            grid: TraceGrid::from_keys(vec![(0, 0, 0)]).expect("one trace"),
+            sorted: false,
         };
         let l = s.layout;
         s.layout.keys = super::keys::resolve(path, named, l.traces, l.big, |t| {
@@ -99,13 +96,15 @@ impl SegyStream {
             s.map_every_trace()?;
         }
         let (nj, nk) = (s.crosslines.len(), s.inlines.len());
-        s.geometry = super::geometry::geometry(s.interval_us, nj, nk, s.layout.big, |k, j| {
-            let mut h = [0u8; TRACE_HEADER];
-            s.file
-                .read_exact_at(&mut h, s.offset_of(s.trace_of(k, j)))
-                .ok()
-                .map(|_| h)
-        });
+        let spread: Vec<(usize, usize)> = s.grid.spread().iter().map(|&(k, j, _)| (k, j)).collect();
+        s.geometry =
+            super::geometry::geometry(s.interval_us, nj, nk, s.layout.big, &spread, |k, j| {
+                let mut h = [0u8; TRACE_HEADER];
+                s.file
+                    .read_exact_at(&mut h, s.offset_of(s.grid.trace(k, j)?))
+                    .ok()
+                    .map(|_| h)
+            });
         Ok(s)
     }
 
@@ -205,19 +204,33 @@ impl SegyStream {
         };
         match (line(il0, il_step, ni), line(xl0, xl_step, nx)) {
             (Some(inlines), Some(crosslines)) => {
+                let lines = |v: &[i32], step: i64| Lines {
+                    first: v[0],
+                    step: step.abs(),
+                    count: v.len(),
+                    present: v.len(),
+                };
+                let (inline_up, crossline_up) = (il_step > 0, xl_step > 0);
+                self.grid = TraceGrid::full(
+                    lines(&inlines, il_step),
+                    lines(&crosslines, xl_step),
+                    |k, j| {
+                        // Trace `kf * nx + jf`, reversed where the file's numbers descend.
+                        let kf = if inline_up { k } else { ni - 1 - k };
+                        let jf = if crossline_up { j } else { nx - 1 - j };
+                        (kf * nx + jf) as u32
+                    },
+                );
                 self.inlines = inlines;
                 self.crosslines = crosslines;
-                self.order = Order::Sorted {
-                    inline_up: il_step > 0,
-                    crossline_up: xl_step > 0,
-                };
+                self.sorted = true;
                 Ok(true)
             }
             _ => Ok(false),
         }
     }
 
-    /// Grid from every trace header (any order).
+    /// Grid from every trace header (any order, any outline).
     fn map_every_trace(&mut self) -> Result<(), VolumeError> {
         let traces = self.layout.traces;
         crate::budget::check("the trace map of a SEG-Y file", traces as u64 * 16)
@@ -227,61 +240,29 @@ impl SegyStream {
             let (il, xl, _) = self.key(t)?;
             keys.push((il, xl, t as u32));
         }
-        keys.sort_unstable();
-        if let Some(w) = keys
-            .windows(2)
-            .find(|w| (w[0].0, w[0].1) == (w[1].0, w[1].1))
-        {
-            return Err(VolumeError::Unsupported {
-                path: self.path.clone(),
-                message: format!(
-                    "traces {} and {} (bytes {} and {}) both sit at inline {} crossline {} ({}): a pre-stack or otherwise non-gridded file, which `arbvis convert` does not take (stack it first)",
-                    w[0].2 + 1,
-                    w[1].2 + 1,
-                    self.offset_of(w[0].2 as usize),
-                    self.offset_of(w[1].2 as usize),
-                    w[0].0,
-                    w[0].1,
-                    self.layout.keys.describe()
-                ),
-            });
+        self.grid = TraceGrid::from_keys(keys).map_err(|e| {
+            e.into_volume_error(
+                &self.path,
+                &self.layout.keys,
+                |t| self.offset_of(t as usize),
+                ": a pre-stack or otherwise non-gridded file, which `arbvis convert` does not take (stack it first)",
+            )
+        })?;
+        if !self.grid.is_full() {
+            let mut first = [0u8; TRACE_HEADER];
+            self.file
+                .read_exact_at(&mut first, self.offset_of(0))
+                .map_err(|e| VolumeError::io(&self.path, e))?;
+            super::grid::check_sample_count(&self.path, &self.layout, &first, &self.grid)?;
         }
-        let mut inlines: Vec<i32> = keys.iter().map(|k| k.0).collect();
-        inlines.dedup();
-        let mut crosslines: Vec<i32> = keys.iter().map(|k| k.1).collect();
-        crosslines.sort_unstable();
-        crosslines.dedup();
-        if inlines.len() * crosslines.len() != traces {
-            return Err(VolumeError::Unsupported {
-                path: self.path.clone(),
-                message: format!(
-                    "{traces} traces do not fill the grid of {} inlines x {} crosslines: an irregular survey that arbvis cannot grid",
-                    inlines.len(),
-                    crosslines.len()
-                ),
-            });
-        }
-        // Sorted by (inline, crossline): k-major, j fastest, exactly the cell order.
-        self.order = Order::Map(keys.iter().map(|k| k.2).collect());
-        self.inlines = inlines;
-        self.crosslines = crosslines;
+        self.inlines = self.grid.inlines.numbers();
+        self.crosslines = self.grid.crosslines.numbers();
         Ok(())
     }
 
-    /// The trace of cell `(k, j)`.
-    fn trace_of(&self, k: usize, j: usize) -> usize {
-        let (ni, nx) = (self.inlines.len(), self.crosslines.len());
-        match &self.order {
-            Order::Sorted {
-                inline_up,
-                crossline_up,
-            } => {
-                let kf = if *inline_up { k } else { ni - 1 - k };
-                let jf = if *crossline_up { j } else { nx - 1 - j };
-                kf * nx + jf
-            }
-            Order::Map(m) => m[k * nx + j] as usize,
-        }
+    /// The trace of cell `(k, j)`, if the survey has one there.
+    fn trace_of(&self, k: usize, j: usize) -> Option<usize> {
+        self.grid.trace(k, j)
     }
 
     /// Read the traces of crosslines `j` and inlines `k` into `out` (sample fastest, then
@@ -313,13 +294,26 @@ impl SegyStream {
         for kk in k.clone() {
             let mut jj = j.start;
             while jj < j.end {
+                // A dead position (no trace): no data.
+                let Some(first) = self.trace_of(kk, jj) else {
+                    out[at..at + ns].fill(f32::NAN);
+                    if let Some(c) = coordinates.as_deref_mut() {
+                        c[at / ns] = [f64::NAN; 2];
+                    }
+                    at += ns;
+                    jj += 1;
+                    continue;
+                };
                 // A run of cells whose traces follow each other in the file (either way).
-                let first = self.trace_of(kk, jj);
                 let mut n = 1;
-                let up = jj + 1 < j.end && self.trace_of(kk, jj + 1) == first + 1;
-                let down = jj + 1 < j.end && first > 0 && self.trace_of(kk, jj + 1) == first - 1;
-                while jj + n < j.end {
-                    let t = self.trace_of(kk, jj + n);
+                let next = |q: usize| {
+                    (jj + q < j.end)
+                        .then(|| self.trace_of(kk, jj + q))
+                        .flatten()
+                };
+                let up = next(1) == Some(first + 1);
+                let down = first > 0 && next(1) == Some(first - 1);
+                while let Some(t) = next(n) {
                     if (up && t == first + n) || (down && t + n == first) {
                         n += 1;
                     } else {
@@ -333,7 +327,7 @@ impl SegyStream {
                     .map_err(|e| VolumeError::io(&self.path, e))?;
                 for q in 0..n {
                     let cell = jj + q;
-                    let t = self.trace_of(kk, cell);
+                    let t = if down { first - q } else { first + q };
                     let trace = &buf[(t - lo) * tl..][..tl];
                     let (il, xl) = self.layout.keys.read(trace, big);
                     if il != self.inlines[kk] || xl != self.crosslines[cell] {
@@ -377,7 +371,6 @@ impl SegyStream {
 
     /// What the headers say, one fact per line (as `arbvis inspect` prints them).
     pub fn describe(&self) -> Vec<(String, String)> {
-        let range = |v: &[i32]| format!("{}..={} ({} values)", v[0], v[v.len() - 1], v.len());
         vec![
             (
                 "format".into(),
@@ -402,8 +395,15 @@ impl SegyStream {
                 "inline/crossline numbers".into(),
                 self.layout.keys.describe(),
             ),
-            ("inlines".into(), range(&self.inlines)),
-            ("crosslines".into(), range(&self.crosslines)),
+            ("inlines".into(), self.grid.inlines.describe()),
+            ("crosslines".into(), self.grid.crosslines.describe()),
+            (
+                "grid".into(),
+                self.grid
+                    .describe()
+                    .trim_start_matches("grid: ")
+                    .to_string(),
+            ),
             ("samples per trace".into(), self.layout.samples.to_string()),
             ("sample interval (us)".into(), self.interval_us.to_string()),
             (
@@ -412,9 +412,10 @@ impl SegyStream {
             ),
             (
                 "trace order".into(),
-                match self.order {
-                    Order::Sorted { .. } => "inline-sorted",
-                    Order::Map(_) => "gridded from every trace header",
+                if self.sorted {
+                    "inline-sorted"
+                } else {
+                    "gridded from every trace header"
                 }
                 .into(),
             ),
@@ -467,7 +468,7 @@ mod tests {
         let bytes = write(&v, &o);
         std::fs::write(&sorted, &bytes).unwrap();
         let s = SegyStream::open(&sorted).unwrap();
-        assert!(matches!(s.order, Order::Sorted { .. }));
+        assert!(s.sorted);
         assert_eq!(s.inlines, vec![10, 11, 12, 13]);
         columns_equal_the_volume(&s, &v);
         // Reverse the trace order: the grid comes from every header.
