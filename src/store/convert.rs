@@ -211,7 +211,7 @@ fn convert_on_workers(
     if in_place && matches!(&src, Input::Mdio(_, m) if m.source_variable.is_none()) {
         return Err(StoreError::invalid(
             input,
-            "an MDIO v0 dataset (zarr v2) cannot gain zarr v3 levels in place: convert it into a store of its own (arbvis convert DATASET STORE)",
+            "a zarr v2 dataset (MDIO v0, or v1 written with zarr format 2) cannot gain zarr v3 levels in place: convert it into a store of its own (arbvis convert DATASET STORE)",
         ));
     }
     let (identity, source_variable) = match &src {
@@ -436,7 +436,9 @@ fn check_disk(store: &Path, meta: &StoreMeta, skip: usize, say: bool) -> Result<
 }
 
 /// An MDIO dataset's root attributes, without an `arbvis` one an earlier run added; an
-/// error if a finished conversion already added its levels.
+/// error if a finished conversion already added its levels and they are whole. Levels
+/// that are damaged (an array or a chunk file missing, deleted halfway) are made again:
+/// the conversion runs as the first did, over every level.
 fn mdio_root_attributes(
     store: &Path,
 ) -> Result<serde_json::Map<String, serde_json::Value>, StoreError> {
@@ -445,9 +447,21 @@ fn mdio_root_attributes(
     let mut attributes = root["attributes"].as_object().cloned().unwrap_or_default();
     if let Some(a) = attributes.remove("arbvis") {
         if a["complete"].as_bool() == Some(true) {
-            return Err(StoreError::invalid(
-                store,
-                "its levels and ranges were added already: the dataset opens as a store as it is",
+            let damage = match super::Store::open(store) {
+                Ok(opened) => opened
+                    .missing_chunk()
+                    .map(|f| format!("{} is missing", f.display())),
+                Err(e) => Some(e.to_string()),
+            };
+            let Some(damage) = damage else {
+                return Err(StoreError::invalid(
+                    store,
+                    "its levels and ranges were added already: the dataset opens as a store as it is",
+                ));
+            };
+            crate::progress::line(&format!(
+                "{}: the levels added earlier are damaged ({damage}): adding them again",
+                store.display()
             ));
         }
     }

@@ -14,12 +14,8 @@ const MAX_FILES_COUNTED: u64 = 10_000_000;
 
 /// The description `inspect` prints for the store at `store`.
 pub fn describe(store: &Path) -> Result<String, StoreError> {
-    if !store.join("zarr.json").exists() && super::mdio::is_mdio_v0(store) {
-        return describe_mdio(store);
-    }
-    let root = super::zarr::read_json(&store.join("zarr.json"))?;
-    if root["attributes"].get("arbvis").is_none() && super::mdio::is_mdio(&root) {
-        return describe_mdio(store);
+    if let Some(flavour) = super::mdio::flavour(store)?.filter(|f| f.in_place()) {
+        return describe_mdio(store, &flavour);
     }
     let meta = super::check::read_meta(store)?;
     let (arrays, _) = super::check::open_arrays(store, &meta)?;
@@ -91,17 +87,19 @@ pub fn describe(store: &Path) -> Result<String, StoreError> {
 }
 
 /// An MDIO dataset: what arbvis draws of it, then every variable of the group.
-fn describe_mdio(store: &Path) -> Result<String, StoreError> {
+fn describe_mdio(store: &Path, flavour: &super::mdio::Flavour) -> Result<String, StoreError> {
+    use super::mdio::Flavour;
     let opened = super::Store::open(store)?;
     let meta = &opened.meta;
     let mut s = String::new();
     let _ = writeln!(s, "{}", store.display());
-    let v0 = super::mdio::is_mdio_v0(store) && !store.join("zarr.json").exists();
+    let v0 = matches!(flavour, Flavour::V0);
+    let zarr_v2 = matches!(flavour, Flavour::V0 | Flavour::V1 { zarr_v2: true, .. });
     let _ = writeln!(
         s,
         "format: {} (zarr {}), read in place: one level, no per-brick ranges",
         meta.source.kind,
-        if v0 { "v2" } else { "v3" }
+        if zarr_v2 { "v2" } else { "v3" }
     );
     for (k, v) in &meta.source.facts {
         let _ = writeln!(s, "  {k}: {v}");
@@ -122,10 +120,10 @@ fn describe_mdio(store: &Path) -> Result<String, StoreError> {
             }
         );
     }
-    if v0 {
+    if zarr_v2 {
         let _ = writeln!(
             s,
-            "levels: none (MDIO keeps one resolution); `arbvis convert {} STORE` writes a store with levels, per-brick ranges and derived attributes (MDIO v0 is not converted in place)",
+            "levels: none (MDIO keeps one resolution); `arbvis convert {} STORE` writes a store with levels, per-brick ranges and derived attributes (a zarr v2 dataset is not converted in place)",
             store.display()
         );
     } else {
@@ -136,7 +134,7 @@ fn describe_mdio(store: &Path) -> Result<String, StoreError> {
         );
     }
     let _ = writeln!(s, "variables:");
-    for folder in variables(store, v0)? {
+    for folder in variables(store, v0, zarr_v2)? {
         let name = folder
             .strip_prefix(store)
             .unwrap_or(&folder)
@@ -181,12 +179,13 @@ fn describe_mdio(store: &Path) -> Result<String, StoreError> {
 
 /// The folders of an MDIO dataset's variables, sorted: the group's children with a
 /// `zarr.json` (v1), or those under `data/` and `metadata/` with a `.zarray` (v0).
-fn variables(store: &Path, v0: bool) -> Result<Vec<std::path::PathBuf>, StoreError> {
-    let (parents, marker) = if v0 {
-        (vec![store.join("data"), store.join("metadata")], ".zarray")
+fn variables(store: &Path, v0: bool, zarr_v2: bool) -> Result<Vec<std::path::PathBuf>, StoreError> {
+    let parents = if v0 {
+        vec![store.join("data"), store.join("metadata")]
     } else {
-        (vec![store.to_path_buf()], "zarr.json")
+        vec![store.to_path_buf()]
     };
+    let marker = if zarr_v2 { ".zarray" } else { "zarr.json" };
     let mut entries = Vec::new();
     for parent in parents {
         let Ok(list) = std::fs::read_dir(&parent) else {

@@ -65,21 +65,16 @@ impl Input {
         segy_keys: crate::volume::segy::KeyBytes,
     ) -> Result<Input, StoreError> {
         if path.is_dir() && raw.is_none() {
-            if !path.join("zarr.json").exists() {
-                if super::mdio::is_mdio_v0(path) {
-                    let (meta, mdio) = super::mdio::open_v0(path)?;
-                    return Ok(Input::Mdio(Box::new(mdio), Box::new(meta)));
+            let Some(flavour) = super::mdio::flavour(path)? else {
+                if !path.join("zarr.json").exists() {
+                    return Err(StoreError::invalid(path, super::check::not_v3(path)));
                 }
-                return Err(StoreError::invalid(path, super::check::not_v3(path)));
-            }
-            let root = super::zarr::read_json(&path.join("zarr.json"))?;
-            if !super::mdio::is_mdio(&root) {
                 return Err(StoreError::invalid(
                     path,
                     "a folder that is not an MDIO dataset: convert reads SEG-Y, NIfTI, raw files and MDIO datasets",
                 ));
-            }
-            let (meta, mdio) = super::mdio::open(path, &root)?;
+            };
+            let (meta, mdio) = super::mdio::open_flavour(path, &flavour)?;
             return Ok(Input::Mdio(Box::new(mdio), Box::new(meta)));
         }
         let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
@@ -171,9 +166,9 @@ impl Input {
         }
         let s = SegyStream::open_with(path, segy_keys)?;
         let mut m = meta(path, "SEG-Y", len, s.describe());
-        let step = |v: &[i32]| [v[0] as i64, v.get(1).map_or(1, |&b| b as i64 - v[0] as i64)];
-        m.inlines = Some(step(&s.inlines));
-        m.crosslines = Some(step(&s.crosslines));
+        let step = |l: &crate::volume::segy::Lines| [l.first as i64, l.step];
+        m.inlines = Some(step(&s.grid.inlines));
+        m.crosslines = Some(step(&s.grid.crosslines));
         m.interval_us = Some(s.interval_us);
         Ok(Input::Segy(s, m))
     }
@@ -228,6 +223,26 @@ impl Input {
         }
     }
 
+    /// Whether each trace of crosslines `j` and inlines `k` is live (crossline fastest),
+    /// where the input knows it: a SEG-Y survey's grid (a position without a trace is
+    /// dead), an MDIO dataset's `trace_mask`. `None` for the others, whose traces are
+    /// live unless every sample is NaN.
+    pub fn live(&self, j: Range<usize>, k: Range<usize>) -> Option<Vec<bool>> {
+        let cells = k.flat_map(|kk| j.clone().map(move |jj| (kk, jj)));
+        match self {
+            Input::Segy(s, _) => Some(
+                cells
+                    .map(|(kk, jj)| s.grid.trace(kk, jj).is_some())
+                    .collect(),
+            ),
+            Input::Mdio(m, meta) => m
+                .live
+                .as_ref()
+                .map(|l| cells.map(|(kk, jj)| l[kk * meta.dims[1] + jj]).collect()),
+            Input::Flat(_) | Input::Memory(..) => None,
+        }
+    }
+
     /// Every sample of crosslines `j` and inlines `k`, sample fastest, into `out`; for
     /// SEG-Y also each trace's CDP x and y into `coordinates` (crossline fastest).
     pub fn read_column(
@@ -250,7 +265,7 @@ impl Input {
                     }
                 }
                 m.column(meta.dims, j, k, out)
-                    .map_err(|e| StoreError::invalid(&m.data.folder, e))
+                    .map_err(|f| f.into_error(&m.variable()))
             }
             Input::Flat(f) => f.read_column(j, k, out),
             Input::Memory(v, _) => {

@@ -149,7 +149,7 @@ pub fn map_coordinates(
 ) -> Result<Option<[Vec<f64>; 2]>, StoreError> {
     let read = |name: &str| -> Result<Option<Vec<f64>>, StoreError> {
         let folder = store.join(name);
-        if !folder.join("zarr.json").exists() {
+        if !array_at(&folder) {
             return Ok(None);
         }
         let array = zarr::open_array(&folder)?;
@@ -175,18 +175,73 @@ pub fn is_mdio_v0(store: &Path) -> bool {
     store.join("data/chunked_012/.zarray").is_file() && store.join(".zattrs").is_file()
 }
 
-/// Open the MDIO dataset at `store`: v1 (whose root `zarr.json` is `root`), or v0.
+/// Which MDIO dataset a folder holds.
+#[derive(Debug, Clone)]
+pub enum Flavour {
+    /// MDIO v1: the root's attributes (`apiVersion`, `attributes.defaultVariableName`) as
+    /// a v3 root document holds them, on zarr v3 (`zarr.json`) or zarr v2 (`.zgroup` and
+    /// `.zattrs`, as mdio-python writes with zarr's `default_zarr_format = 2`).
+    V1 { root: Value, zarr_v2: bool },
+    /// MDIO v0 (zarr v2, `data/chunked_012`).
+    V0,
+}
+
+impl Flavour {
+    /// Whether it is read in place as one level: not a dataset whose levels arbvis added
+    /// beside its arrays (its root then has an `arbvis` attribute, and it opens as a
+    /// store).
+    pub fn in_place(&self) -> bool {
+        match self {
+            Flavour::V1 { root, .. } => root["attributes"].get("arbvis").is_none(),
+            Flavour::V0 => true,
+        }
+    }
+}
+
+/// The MDIO dataset at `store`, if it is one.
+pub fn flavour(store: &Path) -> Result<Option<Flavour>, StoreError> {
+    let v3 = store.join("zarr.json");
+    if std::fs::symlink_metadata(&v3).is_ok() {
+        let root = zarr::read_json(&v3)?;
+        zarr::check_group(&root, &v3)?;
+        return Ok(is_mdio(&root).then_some(Flavour::V1 {
+            root,
+            zarr_v2: false,
+        }));
+    }
+    if store.join(".zgroup").is_file() && store.join(".zattrs").is_file() {
+        let attributes = zarr::read_json(&store.join(".zattrs"))?;
+        let root = serde_json::json!({ "attributes": attributes });
+        if is_mdio(&root) {
+            return Ok(Some(Flavour::V1 {
+                root,
+                zarr_v2: true,
+            }));
+        }
+    }
+    Ok(is_mdio_v0(store).then_some(Flavour::V0))
+}
+
+/// Open the MDIO dataset at `store` of `flavour`.
+pub fn open_flavour(store: &Path, flavour: &Flavour) -> Result<(StoreMeta, Mdio), StoreError> {
+    match flavour {
+        Flavour::V1 { root, zarr_v2 } => assemble(store, parts_v1(store, root, *zarr_v2)?),
+        Flavour::V0 => assemble(store, parts_v0(store)?),
+    }
+}
+
+/// Open the MDIO v1 dataset at `store` on zarr v3, whose root `zarr.json` is `root`.
 pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError> {
-    assemble(store, parts_v1(store, root)?)
+    assemble(store, parts_v1(store, root, false)?)
 }
 
-/// Open an MDIO v0 dataset (zarr v2) at `store`.
-pub fn open_v0(store: &Path) -> Result<(StoreMeta, Mdio), StoreError> {
-    assemble(store, parts_v0(store)?)
+/// Whether an array (zarr v3 `zarr.json` or v2 `.zarray`) is at `folder`.
+fn array_at(folder: &Path) -> bool {
+    folder.join("zarr.json").exists() || folder.join(".zarray").exists()
 }
 
-fn parts_v1(store: &Path, root: &Value) -> Result<Parts, StoreError> {
-    let file = store.join("zarr.json");
+fn parts_v1(store: &Path, root: &Value, zarr_v2: bool) -> Result<Parts, StoreError> {
+    let file = store.join(if zarr_v2 { ".zattrs" } else { "zarr.json" });
     let a = &root["attributes"];
     let api = a["apiVersion"].as_str().unwrap_or("?").to_string();
     let variable = a["attributes"]["defaultVariableName"]
@@ -209,7 +264,7 @@ fn parts_v1(store: &Path, root: &Value) -> Result<Parts, StoreError> {
         .collect();
     let coordinate = |name: &str| -> Result<Option<Vec<f64>>, StoreError> {
         let folder = store.join(name);
-        if name.is_empty() || !folder.join("zarr.json").exists() {
+        if name.is_empty() || !array_at(&folder) {
             return Ok(None);
         }
         Ok(Some(read_whole(&zarr::open_array(&folder)?)?))
@@ -224,7 +279,7 @@ fn parts_v1(store: &Path, root: &Value) -> Result<Parts, StoreError> {
         data.shape.first().copied().unwrap_or(0) as usize,
         data.shape.get(1).copied().unwrap_or(0) as usize,
     );
-    let live = match store.join("trace_mask").join("zarr.json").exists() {
+    let live = match array_at(&store.join("trace_mask")) {
         false => None,
         true => Some(trace_mask(
             &zarr::open_array(&store.join("trace_mask"))?,
@@ -273,7 +328,7 @@ fn parts_v1(store: &Path, root: &Value) -> Result<Parts, StoreError> {
         sum: number("sum"),
         mean: None,
         facts,
-        in_place: true,
+        in_place: !zarr_v2,
         cdp,
     })
 }
@@ -369,14 +424,7 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
         (&coordinates[1], nj, &names[1]),
         (&coordinates[2], ni, &domain),
     ] {
-        if let Some(v) = values {
-            if v.len() != n {
-                return Err(StoreError::invalid(
-                    &store.join(name),
-                    format!("{name} has {} values, {variable} {n} along it", v.len()),
-                ));
-            }
-        }
+        check_coordinate(store, values.as_deref(), n, name, &variable)?;
     }
     let dead = live
         .as_ref()
@@ -487,6 +535,66 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
     ))
 }
 
+/// A dimension coordinate as the axes will number it: present (MDIO writes one per
+/// dimension), as long as the variable is along it, every value finite, and strictly
+/// increasing or strictly decreasing (a repeated or out-of-order value would put two
+/// lines of the survey at one place, or lines out of their order). The error names the
+/// array and the index.
+fn check_coordinate(
+    store: &Path,
+    values: Option<&[f64]>,
+    n: usize,
+    name: &str,
+    variable: &str,
+) -> Result<(), StoreError> {
+    let array = store.join(name);
+    let Some(v) = values else {
+        return Err(StoreError::invalid(
+            &array,
+            format!(
+                "no `{name}` coordinate: {variable} runs along {name}, and an MDIO dataset has one coordinate array per dimension"
+            ),
+        ));
+    };
+    let bad = |m: String| Err(StoreError::invalid(&array, m));
+    if v.len() != n {
+        return bad(format!(
+            "{name} has {} values, {variable} {n} along it",
+            v.len()
+        ));
+    }
+    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        return bad(format!(
+            "{name}[{i}] is {}: coordinates must be finite",
+            v[i]
+        ));
+    }
+    let rising = v.len() < 2 || v[1] > v[0];
+    if let Some(i) = (1..v.len()).find(|&i| {
+        if rising {
+            v[i] <= v[i - 1]
+        } else {
+            v[i] >= v[i - 1]
+        }
+    }) {
+        let what = if v[i] == v[i - 1] {
+            "repeats"
+        } else {
+            "breaks the order of"
+        };
+        return bad(format!(
+            "{name}[{i}] = {} {what} {name}[{}] = {}: coordinates must be unique and {} ",
+            v[i],
+            i - 1,
+            v[i - 1],
+            if rising { "increasing" } else { "decreasing" }
+        )
+        .trim_end()
+        .to_string());
+    }
+    Ok(())
+}
+
 /// The trace mask over (inline, crossline).
 fn trace_mask(mask: &ArrayMeta, nk: usize, nj: usize) -> Result<Vec<bool>, StoreError> {
     if mask.shape != [nk as u64, nj as u64] {
@@ -501,17 +609,56 @@ fn trace_mask(mask: &ArrayMeta, nk: usize, nj: usize) -> Result<Vec<bool>, Store
     Ok(read_whole(mask)?.into_iter().map(|v| v != 0.0).collect())
 }
 
+/// A chunk of the variable that cannot be read: its own index and file (not the brick
+/// being filled, which may span several chunks or lie inside one).
+#[derive(Debug)]
+pub struct ChunkFailure {
+    /// The chunk's index `[inline, crossline, sample]` in the variable's chunk grid.
+    pub index: [u64; 3],
+    /// Its file.
+    pub path: std::path::PathBuf,
+    /// What is wrong.
+    pub message: String,
+}
+
+impl ChunkFailure {
+    /// The store's error for it, naming the variable `array`.
+    pub fn into_error(self, array: &str) -> StoreError {
+        StoreError::Chunk {
+            path: self.path,
+            array: array.to_string(),
+            chunk: self.index,
+            message: self.message,
+        }
+    }
+}
+
 impl Mdio {
+    /// The variable's name in the dataset (`amplitude`, `data/chunked_012`).
+    pub fn variable(&self) -> String {
+        self.data
+            .folder
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+    }
+
     /// One decoded chunk of the variable (cached), or its fill where absent.
-    fn chunk(&self, index: &[u64]) -> Result<Arc<Vec<f32>>, String> {
+    fn chunk(&self, index: &[u64; 3]) -> Result<Arc<Vec<f32>>, ChunkFailure> {
         let mut guard = self.cache.lock().expect("MDIO chunk cache");
         let (cache, tick) = &mut *guard;
         *tick += 1;
-        if let Some((v, t)) = cache.get_mut(index) {
+        if let Some((v, t)) = cache.get_mut(index.as_slice()) {
             *t = *tick;
             return Ok(v.clone());
         }
-        let values = match self.data.read_chunk(index)? {
+        let values = match self
+            .data
+            .read_chunk(index)
+            .map_err(|message| ChunkFailure {
+                index: *index,
+                path: self.data.chunk_file(index),
+                message,
+            })? {
             Some(v) => v,
             None => vec![self.data.fill_value as f32; self.data.chunk_elements()],
         };
@@ -538,7 +685,7 @@ impl Mdio {
         hi: [usize; 3],
         out: &mut [f32],
         [sx, sy]: [usize; 2],
-    ) -> Result<(), String> {
+    ) -> Result<(), ChunkFailure> {
         let [ci, cj, ck] = [
             self.data.chunks[2],
             self.data.chunks[1],
@@ -569,7 +716,12 @@ impl Mdio {
 
     /// Brick `c` (`[i, j, k]` in bricks of `b`): `b³` values, i fastest, from the chunks
     /// it overlaps; dead traces NaN; beyond the survey 0.
-    pub fn brick(&self, dims: [usize; 3], b: usize, c: [usize; 3]) -> Result<Vec<f32>, String> {
+    pub fn brick(
+        &self,
+        dims: [usize; 3],
+        b: usize,
+        c: [usize; 3],
+    ) -> Result<Vec<f32>, ChunkFailure> {
         let lo = c.map(|x| x * b);
         let hi: [usize; 3] = std::array::from_fn(|a| ((c[a] + 1) * b).min(dims[a]));
         let mut out = vec![0f32; b * b * b];
@@ -585,7 +737,7 @@ impl Mdio {
         j: std::ops::Range<usize>,
         k: std::ops::Range<usize>,
         out: &mut [f32],
-    ) -> Result<(), String> {
+    ) -> Result<(), ChunkFailure> {
         let sy = j.len();
         self.read_box(
             dims,

@@ -77,13 +77,16 @@ pub enum StoreError {
         message: String,
     },
     /// A chunk is missing or cannot be decoded.
-    #[error("{path}: chunk {chunk:?} (inline, crossline, sample bricks) of {array}: {message}")]
+    #[error(
+        "{path}: chunk {chunk:?} (its index along inline, crossline, sample) of {array}: {message}"
+    )]
     Chunk {
         /// The chunk's file.
         path: PathBuf,
         /// The array (`amplitude/0`).
         array: String,
-        /// Brick indices `[k, j, i]`.
+        /// The chunk's index `[k, j, i]` in its array's chunk grid (a store's bricks, an
+        /// MDIO variable's own chunks).
         chunk: [u64; 3],
         /// What is wrong.
         message: String,

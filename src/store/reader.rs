@@ -90,18 +90,9 @@ impl Store {
             };
             return Err(StoreError::invalid(path, why));
         }
-        let root_file = path.join("zarr.json");
-        if std::fs::symlink_metadata(&root_file).is_ok() {
-            let root = super::zarr::read_json(&root_file)?;
-            if root["attributes"].get("arbvis").is_none() && super::mdio::is_mdio(&root) {
-                let (meta, mdio) = super::mdio::open(path, &root)?;
-                let mut store = Store::with_arrays(path, meta, (Vec::new(), Vec::new()), false);
-                store.mdio = Some(mdio);
-                return Ok(store);
-            }
-        }
-        if !root_file.exists() && super::mdio::is_mdio_v0(path) {
-            let (meta, mdio) = super::mdio::open_v0(path)?;
+        // An MDIO dataset of any flavour, read in place as one level.
+        if let Some(flavour) = super::mdio::flavour(path)?.filter(|f| f.in_place()) {
+            let (meta, mdio) = super::mdio::open_flavour(path, &flavour)?;
             let mut store = Store::with_arrays(path, meta, (Vec::new(), Vec::new()), false);
             store.mdio = Some(mdio);
             return Ok(store);
@@ -228,7 +219,9 @@ impl Store {
         }
         if let Some(m) = &self.mdio {
             if attr == 0 && level == 0 {
-                let values = Arc::new(m.brick(self.meta.dims, self.meta.brick, c).map_err(fail)?);
+                // A chunk that fails names its own file and index.
+                let brick = m.brick(self.meta.dims, self.meta.brick, c);
+                let values = Arc::new(brick.map_err(|f| f.into_error(&m.variable()))?);
                 self.cache
                     .lock()
                     .expect("chunk cache")
@@ -277,6 +270,34 @@ impl Store {
                 r[0], r[1]
             ))
         }
+    }
+
+    /// The first chunk file of the store's own arrays (its levels and their per-brick
+    /// ranges; an MDIO dataset's variable is not the store's) that is missing: every
+    /// chunk of a finished conversion is written, so one missing is damage.
+    pub fn missing_chunk(&self) -> Option<PathBuf> {
+        let first_level = usize::from(self.meta.source_variable.is_some());
+        for (attr, levels) in self.arrays.iter().enumerate() {
+            for (level, array) in levels.iter().enumerate().skip(first_level) {
+                // The ranges: one chunk of every brick's pair.
+                let ranges = self.range_arrays[attr][level].chunk_file(&[0, 0, 0, 0]);
+                if !ranges.is_file() {
+                    return Some(ranges);
+                }
+                let c = self.meta.brick_counts(level);
+                for k in 0..c[2] as u64 {
+                    for j in 0..c[1] as u64 {
+                        for i in 0..c[0] as u64 {
+                            let file = array.chunk_file(&[k, j, i]);
+                            if !file.is_file() {
+                                return Some(file);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        None
     }
 
     /// Per-brick `[min, max]` of `attr` at `level`, i fastest.

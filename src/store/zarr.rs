@@ -304,6 +304,8 @@ pub struct ArrayMeta {
     pub fill_value: f64,
     /// `bytes` codec's byte order.
     pub big_endian: bool,
+    /// The array-to-bytes codec when it is numcodecs' `zfpy` (else `bytes`).
+    pub zfp: Option<zfp::Zfp>,
     /// Bytes-to-bytes codecs, in the order they encoded.
     pub codecs: Vec<Codec>,
     /// `dimension_names`, where given.
@@ -411,6 +413,63 @@ fn fill(v: &Value, t: DataType, file: &Path) -> Result<f64, StoreError> {
     }
 }
 
+/// The names a zarr v3 array's metadata may hold (the spec's; any other is refused
+/// unless it is an object saying `"must_understand": false`).
+const ARRAY_FIELDS: &[&str] = &[
+    "zarr_format",
+    "node_type",
+    "shape",
+    "data_type",
+    "chunk_grid",
+    "chunk_key_encoding",
+    "fill_value",
+    "codecs",
+    "attributes",
+    "storage_transformers",
+    "dimension_names",
+];
+
+/// The names a zarr v3 group's metadata may hold.
+const GROUP_FIELDS: &[&str] = &[
+    "zarr_format",
+    "node_type",
+    "attributes",
+    "consolidated_metadata",
+];
+
+/// A field of a zarr v3 metadata document that is not one of `known`: the spec (2.1,
+/// "extension definitions") says an implementation must fail to open a node with one,
+/// unless the field is an object whose `must_understand` is `false`.
+fn unknown_fields(doc: &Value, known: &[&str]) -> Result<(), String> {
+    let Some(fields) = doc.as_object() else {
+        return Err("the metadata is not a JSON object".into());
+    };
+    for (name, value) in fields {
+        let optional = value.get("must_understand").and_then(Value::as_bool) == Some(false);
+        if !known.contains(&name.as_str()) && !optional {
+            return Err(format!(
+                "field `{name}` is not one arbvis knows, and it does not say `\"must_understand\": false`: the zarr v3 spec has a reader refuse such a node"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Check a group's `zarr.json` (`doc`, read from `file`) as the spec asks: zarr v3, a
+/// group, no field the reader must understand and does not.
+pub fn check_group(doc: &Value, file: &Path) -> Result<(), StoreError> {
+    if doc.get("zarr_format").and_then(Value::as_u64) != Some(3) {
+        return Err(StoreError::invalid(
+            file,
+            format!(
+                "`zarr_format` is {}: arbvis reads zarr v3",
+                doc.get("zarr_format").unwrap_or(&Value::Null)
+            ),
+        ));
+    }
+    unknown_fields(doc, GROUP_FIELDS).map_err(|m| StoreError::invalid(file, m))
+}
+
 /// The array at `folder` (its `zarr.json`), every field checked.
 pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
     let file = folder.join("zarr.json");
@@ -428,6 +487,7 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
     if doc.get("node_type").and_then(Value::as_str) != Some("array") {
         return Err(invalid("`node_type` is not \"array\"".into()));
     }
+    unknown_fields(&doc, ARRAY_FIELDS).map_err(invalid)?;
     let shape = sizes(field(&doc, "shape", &file)?, "shape", &file, 0)?;
     let type_name = field(&doc, "data_type", &file)?;
     let data_type = type_name
@@ -463,7 +523,11 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
     {
         return Err(invalid("storage transformers: arbvis reads none".into()));
     }
-    let (big_endian, codecs) = codecs(field(&doc, "codecs", &file)?, shape.len(), &file)?;
+    let (big_endian, zfp, codecs) = codecs(
+        field(&doc, "codecs", &file)?,
+        (shape.len(), data_type),
+        &file,
+    )?;
     let dimension_names = match doc.get("dimension_names") {
         None | Some(Value::Null) => None,
         Some(Value::Array(names)) if names.len() == shape.len() => Some(
@@ -490,6 +554,7 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
         data_type,
         fill_value,
         big_endian,
+        zfp,
         codecs,
         dimension_names,
         attributes,
@@ -522,12 +587,18 @@ fn chunk_keys(v: Option<&Value>, file: &Path) -> Result<ChunkKeys, StoreError> {
     }
 }
 
-/// The `bytes` codec's byte order and the bytes-to-bytes codecs, checked.
-fn codecs(v: &Value, axes: usize, file: &Path) -> Result<(bool, Vec<Codec>), StoreError> {
+/// The array-to-bytes codec (`bytes`' byte order, or numcodecs' `zfpy`, little-endian)
+/// and the bytes-to-bytes codecs, checked.
+fn codecs(
+    v: &Value,
+    (axes, data_type): (usize, DataType),
+    file: &Path,
+) -> Result<(bool, Option<zfp::Zfp>, Vec<Codec>), StoreError> {
     let list = v
         .as_array()
         .ok_or_else(|| StoreError::invalid(file, "`codecs`: expected a list"))?;
     let mut big_endian = None;
+    let mut zfp = None;
     let mut after = Vec::new();
     for (i, c) in list.iter().enumerate() {
         let name = c.get("name").and_then(Value::as_str).unwrap_or("");
@@ -558,11 +629,20 @@ fn codecs(v: &Value, axes: usize, file: &Path) -> Result<(bool, Vec<Codec>), Sto
                 blosc_codec(&config).map_err(|e| refuse(&e))?;
                 after.push(Codec::Blosc(config));
             }
-            ("numcodecs.zfpy" | "zfp" | "zfpy", _) => {
+            ("numcodecs.zfpy", false) => {
+                let config = config.cloned().unwrap_or(Value::Null);
+                zfp = Some(zfp::Zfp::new(&config, data_type).map_err(|e| refuse(&e))?);
+                big_endian = Some(false);
+            }
+            ("numcodecs.zfpy", true) => {
                 return Err(refuse(
-                    "lossy ZFP is not read by this build of arbvis; rewrite the variable with a \
-                     lossless codec (e.g. in xarray: ds.to_zarr(new, encoding={VAR: {\"compressors\": \
-                     zarr.codecs.BloscCodec()}}))",
+                    "zfpy turns the array into bytes: it takes the place of `bytes`, not a place after it",
+                ))
+            }
+            ("zfp" | "zfpy" | "numcodecs.zfp", _) => {
+                return Err(refuse(
+                    "not read: arbvis reads numcodecs' zfpy (`numcodecs.zfpy`, as mdio-python \
+                     and zarr-python write ZFP) in place of the `bytes` codec",
                 ))
             }
             ("sharding_indexed", _) => {
@@ -580,7 +660,7 @@ fn codecs(v: &Value, axes: usize, file: &Path) -> Result<(bool, Vec<Codec>), Sto
     }
     let big_endian =
         big_endian.ok_or_else(|| StoreError::invalid(file, "`codecs` has no `bytes` codec"))?;
-    Ok((big_endian, after))
+    Ok((big_endian, zfp, after))
 }
 
 impl ArrayMeta {
@@ -622,8 +702,18 @@ impl ArrayMeta {
 
     /// The most bytes a chunk file may hold: the decoded size grown by each codec's bound.
     pub fn max_encoded_bytes(&self) -> u64 {
-        let decoded = (self.chunk_elements() * self.data_type.size()) as u64;
-        self.codecs.iter().fold(decoded, |n, c| c.bound(n))
+        self.codecs
+            .iter()
+            .fold(self.serialized_bound(), |n, c| c.bound(n))
+    }
+
+    /// The most bytes the array-to-bytes codec makes of a chunk: its raw bytes, or the
+    /// longest zfp stream of its size.
+    fn serialized_bound(&self) -> u64 {
+        match &self.zfp {
+            Some(z) => z.bound(&self.chunks),
+            None => (self.chunk_elements() * self.data_type.size()) as u64,
+        }
     }
 
     /// Chunk `index` decoded to f32 values (the last axis fastest), or `None` where its
@@ -678,7 +768,7 @@ impl ArrayMeta {
         }
         let mut data = crate::input::read_regular(&file, max).map_err(|e| e.to_string())?;
         let decoded = self.chunk_elements() * self.data_type.size();
-        let mut limits = vec![decoded as u64];
+        let mut limits = vec![self.serialized_bound()];
         for c in &self.codecs {
             let last = *limits.last().unwrap_or(&0);
             limits.push(c.bound(last));
@@ -686,6 +776,11 @@ impl ArrayMeta {
         for (k, codec) in self.codecs.iter().enumerate().rev() {
             data = codec
                 .decode(data, limits[k])
+                .map_err(|e| format!("cannot be decoded: {e}"))?;
+        }
+        if let Some(z) = &self.zfp {
+            data = z
+                .decode(&data, &self.chunks, self.data_type)
                 .map_err(|e| format!("cannot be decoded: {e}"))?;
         }
         if data.len() != decoded {
@@ -701,12 +796,12 @@ impl ArrayMeta {
 
     /// The codecs, in words.
     pub fn codec_names(&self) -> String {
-        let bytes = if self.big_endian {
-            "bytes (big-endian)"
-        } else {
-            "bytes"
+        let bytes = match (&self.zfp, self.big_endian) {
+            (Some(z), _) => z.describe(),
+            (None, true) => "bytes (big-endian)".into(),
+            (None, false) => "bytes".into(),
         };
-        let mut names = vec![bytes.to_string()];
+        let mut names = vec![bytes];
         names.extend(self.codecs.iter().map(|c| match c {
             // Blosc's compressor and shuffle, as its configuration names them.
             Codec::Blosc(config) => {
@@ -722,3 +817,4 @@ impl ArrayMeta {
 #[cfg(test)]
 mod tests;
 mod v2;
+pub mod zfp;

@@ -126,7 +126,7 @@ fn an_mdio_v0_dataset_reads_as_the_segy_does_with_dead_traces_as_no_data() {
             "inline: 23, numbers 200..244 (step 2)",
             "data/chunked_012: float32 shape [23, 18, 75], chunks [16, 16, 32], codecs bytes + blosc",
             "metadata/live_mask: bool",
-            "(MDIO v0 is not converted in place)",
+            "(a zarr v2 dataset is not converted in place)",
         ],
     );
     drop(store);

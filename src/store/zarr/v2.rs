@@ -75,9 +75,15 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
             doc["filters"]
         )));
     }
-    let codecs = match doc.get("compressor") {
-        None | Some(Value::Null) => Vec::new(),
-        Some(c) => vec![compressor(c, data_type, &file)?],
+    let (zfp, codecs) = match doc.get("compressor") {
+        None | Some(Value::Null) => (None, Vec::new()),
+        // ZFP replaces the raw bytes: it is the array-to-bytes stage.
+        Some(c) if c.get("id").and_then(Value::as_str) == Some("zfpy") => {
+            let z = super::zfp::Zfp::new(c, data_type)
+                .map_err(|e| invalid(format!("`compressor` {c}: {e}")))?;
+            (Some(z), Vec::new())
+        }
+        Some(c) => (None, vec![compressor(c, data_type, &file)?]),
     };
     let separator = match doc.get("dimension_separator").and_then(Value::as_str) {
         None | Some(".") => '.',
@@ -97,15 +103,27 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
         Ok(Value::Object(m)) => m,
         _ => serde_json::Map::new(),
     };
+    // xarray's convention for v2: the dimension names in `_ARRAY_DIMENSIONS`.
+    let dimension_names = attributes
+        .get("_ARRAY_DIMENSIONS")
+        .and_then(Value::as_array)
+        .filter(|names| names.len() == shape.len())
+        .map(|names| {
+            names
+                .iter()
+                .map(|n| n.as_str().map(str::to_string))
+                .collect()
+        });
     Ok(ArrayMeta {
         folder: folder.to_path_buf(),
         shape,
         chunks,
         data_type,
         fill_value,
-        big_endian,
+        big_endian: big_endian && zfp.is_none(),
+        zfp,
         codecs,
-        dimension_names: None,
+        dimension_names,
         attributes,
         keys: ChunkKeys::V2(separator),
         v2: true,
@@ -137,7 +155,7 @@ fn compressor(c: &Value, t: DataType, file: &Path) -> Result<Codec, StoreError> 
         Some("zstd") => Ok(Codec::Zstd),
         Some("gzip") => Ok(Codec::Gzip),
         Some(id) => Err(refuse(format!(
-            "{id:?} is not a compressor arbvis reads (blosc, zstd, gzip)"
+            "{id:?} is not a compressor arbvis reads (blosc, zstd, gzip, zfpy)"
         ))),
         None => Err(refuse("no `id`".into())),
     }
