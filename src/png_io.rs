@@ -353,6 +353,57 @@ fn remove_stale(dir: &Path, file_name: &str) {
     }
 }
 
+/// The exclusive right to write an output (a store, a COPC file), held until dropped: an
+/// advisory lock (`flock`) on a lock file holding the holder's pid, so that a second
+/// writer is refused naming the first. The kernel releases the lock when its process
+/// ends, however it ends; the file goes when the lock is dropped.
+pub struct WriterLock {
+    file: File,
+    path: PathBuf,
+}
+
+impl WriterLock {
+    /// Take the lock at `path` (created if absent). `Ok(Err(holder))`: another process
+    /// holds it, `holder` says which (`pid 1234`, or `a process` when it wrote none).
+    pub fn acquire(path: &Path) -> std::io::Result<Result<WriterLock, String>> {
+        use std::io::Read;
+        let mut file = std::fs::OpenOptions::new()
+            .read(true)
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(path)?;
+        match file.try_lock() {
+            Ok(()) => {}
+            Err(std::fs::TryLockError::WouldBlock) => {
+                let mut holder = String::new();
+                let _ = (&file).take(64).read_to_string(&mut holder);
+                let holder = holder.trim();
+                return Ok(Err(if holder.is_empty() {
+                    "a process".to_string()
+                } else {
+                    format!("pid {holder}")
+                }));
+            }
+            Err(std::fs::TryLockError::Error(e)) => return Err(e),
+        }
+        file.set_len(0)?;
+        write!(file, "{}", std::process::id())?;
+        file.sync_data()?;
+        Ok(Ok(WriterLock {
+            file,
+            path: path.to_path_buf(),
+        }))
+    }
+}
+
+impl Drop for WriterLock {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_file(&self.path);
+        let _ = self.file.unlock();
+    }
+}
+
 /// Whether process `pid` runs (Linux: `/proc/PID` exists; elsewhere assume it does, so
 /// nothing of a running process is ever removed).
 fn process_alive(pid: u32) -> bool {

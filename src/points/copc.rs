@@ -130,8 +130,9 @@ impl Copc {
     /// Open `path`, checking its header, VLRs, EVLRs and hierarchy.
     pub fn open(path: &Path) -> Result<Copc, PointsError> {
         let bad = |offset: u64, m: String| PointsError::format(path, offset, m);
-        let mut file = File::open(path).map_err(|e| PointsError::io(path, e))?;
-        let len = file.metadata().map_err(|e| PointsError::io(path, e))?.len();
+        // A FIFO, a device or a folder is refused here, never waited on.
+        let (mut file, len) =
+            crate::input::open_regular(path).map_err(|e| PointsError::io(path, e))?;
         let mut head = vec![0u8; HEADER];
         file.read_exact(&mut head).map_err(|_| {
             bad(
@@ -212,7 +213,8 @@ impl Copc {
             return Err(bad(235, format!("the first EVLR at {evlr_start}: must lie between the point data ({point_offset}) and the end ({len})")));
         }
         let mut at = evlr_start;
-        let mut hierarchy = None;
+        // Every hierarchy EVLR: one holding every page, or one a page (copclib).
+        let mut hierarchy = Vec::new();
         for k in 0..evlr_count {
             let mut h = [0u8; EVLR_HEADER as usize];
             if at.checked_add(EVLR_HEADER).is_none_or(|e| e > len) {
@@ -224,7 +226,7 @@ impl Copc {
             read_at(&mut file, at, &mut h).map_err(|e| PointsError::io(path, e))?;
             let size = u64_at(&h, 20);
             if &h[2..6] == b"copc" && h[6..18].iter().all(|&b| b == 0) && u16_at(&h, 18) == 1000 {
-                hierarchy.get_or_insert((at + EVLR_HEADER, at + EVLR_HEADER + size.min(len)));
+                hierarchy.push((at + EVLR_HEADER, at + EVLR_HEADER + size.min(len)));
             }
             at = at
                 .checked_add(EVLR_HEADER)
@@ -278,12 +280,16 @@ impl Copc {
             }
         }
         let root = (u64_at(&info, 40), u64_at(&info, 48));
-        let hierarchy = hierarchy.ok_or_else(|| {
-            bad(
+        if hierarchy.is_empty() {
+            return Err(bad(
                 evlr_start,
                 "no hierarchy EVLR (user `copc`, record 1000)".into(),
-            )
-        })?;
+            ));
+        }
+        // The checks every LAS/LAZ reader runs on the header and VLRs, and the
+        // extra-bytes descriptors against the record: what `render` decodes with, so
+        // `inspect` refuses what `render` would.
+        super::lasfile::stream::check_las_head(path, &mut file, len)?;
         let hierarchy = Hierarchy::open(
             hierarchy,
             (point_offset, evlr_start),

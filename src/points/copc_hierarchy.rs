@@ -6,11 +6,16 @@
 //! read them all. A 10-billion-point file's hierarchy (about 11 MB) is never read whole
 //! to draw a view.
 //!
-//! Every page lies inside the hierarchy EVLR, a whole number of 32-byte entries, and is
-//! read once (a second reference, a cycle among pages, is refused when it is met). Every
-//! key lies inside the octree, is listed once, and has its parent listed (in a page read
-//! or as a page not yet read); a child page holds only its key's subtree (what a lazy
-//! reader assumes: laspy's and Potree's do too); every chunk lies inside the point data
+//! Every page lies inside a hierarchy EVLR (`copc`, record 1000: PDAL, Untwine and laspy
+//! write one holding every page; copclib writes each page as an EVLR of its own, child
+//! pages before their parents), a whole number of 32-byte entries, and is read once (a
+//! second reference, a cycle among pages, is refused when it is met). Every key lies
+//! inside the octree and is listed once; a child page holds only its key's subtree (what
+//! a lazy reader assumes: laspy's, Potree's and copclib's do too). A key whose parent has
+//! no entry is read as copclib reads it (its `GetAllNodes` and `FindNode` return it):
+//! its points are drawn, under its nearest listed ancestor (laspy's `CopcReader` walks
+//! from the root through the keys listed and leaves such a subtree out; docs/splats.md).
+//! Every chunk lies inside the point data
 //! with at most 1,000,000 points plus one per compressed byte (as for LAZ files). Once
 //! every page is read the counts must sum to the header's. A page that fails adds nothing
 //! and its error answers every later read (a held file never turns into a partial one).
@@ -45,8 +50,8 @@ struct PageRef {
 /// The pages read so far and those named but not read.
 #[derive(Debug)]
 pub(super) struct Hierarchy {
-    /// The hierarchy EVLR's bytes: file offsets `start..end`.
-    evlr: (u64, u64),
+    /// The hierarchy EVLRs' data: file offsets `start..end` of each.
+    evlrs: Vec<(u64, u64)>,
     /// The point data: file offsets `start..end` (every chunk lies inside).
     point_data: (u64, u64),
     /// The header's point count (the nodes' sum once every page is read).
@@ -77,17 +82,18 @@ struct Added {
 pub(super) type ReadAt<'a> = &'a mut dyn FnMut(u64, &mut [u8]) -> std::io::Result<()>;
 
 impl Hierarchy {
-    /// The hierarchy EVLR at `evlr`, points at `point_data`, `points` in the header, and
-    /// the root page (offset, size) named at byte `root_at`, read through `read`.
+    /// The hierarchy EVLRs' data at `evlrs`, points at `point_data`, `points` in the
+    /// header, and the root page (offset, size) named at byte `root_at`, read through
+    /// `read`.
     pub(super) fn open(
-        evlr: (u64, u64),
+        evlrs: Vec<(u64, u64)>,
         point_data: (u64, u64),
         points: u64,
         (root, root_at): ((u64, u64), u64),
         read: ReadAt<'_>,
     ) -> Result<Hierarchy, (u64, String)> {
         let mut h = Hierarchy {
-            evlr,
+            evlrs,
             point_data,
             points,
             nodes: Vec::new(),
@@ -152,15 +158,25 @@ impl Hierarchy {
         size: u64,
         named_at: u64,
     ) -> Result<PageRef, (u64, String)> {
-        let (base, end) = self.evlr;
-        if offset < base
-            || offset.saturating_add(size) > end
-            || size == 0
-            || !size.is_multiple_of(32)
-        {
+        let inside = self
+            .evlrs
+            .iter()
+            .any(|&(base, end)| offset >= base && offset.saturating_add(size) <= end);
+        if !inside || size == 0 || !size.is_multiple_of(32) {
+            let evlrs: Vec<String> = self
+                .evlrs
+                .iter()
+                .take(4)
+                .map(|(base, end)| format!("{base}..{end}"))
+                .collect();
+            let more = self.evlrs.len().saturating_sub(4);
             return Err((
                 named_at,
-                format!("a hierarchy page of {size} bytes at {offset}: expected a whole number of 32-byte entries inside the hierarchy EVLR ({base}..{end})"),
+                format!(
+                    "a hierarchy page of {size} bytes at {offset}: expected a whole number of 32-byte entries inside a hierarchy EVLR ({}{})",
+                    evlrs.join(", "),
+                    if more > 0 { format!(" and {more} more") } else { String::new() }
+                ),
             ));
         }
         if !self.pages.insert(offset) {
@@ -227,7 +243,6 @@ impl Hierarchy {
                 ),
             )
         })?;
-        let mut listed = Vec::new();
         for (k, e) in data.chunks_exact(32).enumerate() {
             let at = page.offset + 32 * k as u64;
             let i32_at = |o: usize| i32::from_le_bytes(e[o..o + 4].try_into().expect("4"));
@@ -269,7 +284,6 @@ impl Hierarchy {
                     )));
                 }
             }
-            listed.push((key, at));
             if points == -1 {
                 if bytes <= 0 {
                     return Err(fail(format!("a child page of {bytes} bytes")));
@@ -307,19 +321,6 @@ impl Hierarchy {
             }
             self.keys.insert(key, at);
             added.keys.push(key);
-        }
-        // Every key below the root under a key of the hierarchy (its parent listed).
-        for (key, at) in listed {
-            let parent = [key[0] - 1, key[1] / 2, key[2] / 2, key[3] / 2];
-            if key[0] > 0 && !self.keys.contains_key(&parent) && !self.unread.contains_key(&parent)
-            {
-                return Err((
-                    at,
-                    format!(
-                        "hierarchy entry {key:?}: its parent {parent:?} is not in the hierarchy"
-                    ),
-                ));
-            }
         }
         if self.unread.is_empty() {
             let total: u64 = self.nodes.iter().map(|n| n.points).sum();

@@ -8,9 +8,7 @@
 //! but the lock (a fresh start) or a log to resume from.
 
 use std::collections::HashMap;
-use std::fs::File;
-use std::io::{Read, Write};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
@@ -198,49 +196,22 @@ pub(crate) fn start_log(path: &Path, job: &Job) -> Result<(), StoreError> {
 
 /// The exclusive right to write a store, held until dropped (then the lock file goes).
 pub(crate) struct StoreLock {
-    file: File,
-    path: PathBuf,
+    _lock: crate::png_io::WriterLock,
 }
 
 impl StoreLock {
     /// Take the store's lock, or say which process holds it.
     pub(crate) fn acquire(store: &Path) -> Result<StoreLock, StoreError> {
         let path = store.join(LOCK_FILE);
-        let mut file = std::fs::OpenOptions::new()
-            .read(true)
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&path)
-            .map_err(|e| StoreError::io(&path, e))?;
-        match file.try_lock() {
-            Ok(()) => {}
-            Err(std::fs::TryLockError::WouldBlock) => {
-                let mut holder = String::new();
-                let _ = (&file).take(64).read_to_string(&mut holder);
-                let holder = holder.trim();
-                return Err(StoreError::invalid(
-                    store,
-                    format!(
-                        "another conversion ({}) is writing this store; wait for it, or stop it and run this command again to resume",
-                        if holder.is_empty() { "a process".to_string() } else { format!("pid {holder}") }
-                    ),
-                ));
-            }
-            Err(std::fs::TryLockError::Error(e)) => return Err(StoreError::io(&path, e)),
+        match crate::png_io::WriterLock::acquire(&path).map_err(|e| StoreError::io(&path, e))? {
+            Ok(lock) => Ok(StoreLock { _lock: lock }),
+            Err(holder) => Err(StoreError::invalid(
+                store,
+                format!(
+                    "another conversion ({holder}) is writing this store; wait for it, or stop it and run this command again to resume"
+                ),
+            )),
         }
-        file.set_len(0)
-            .and_then(|_| write!(file, "{}", std::process::id()))
-            .and_then(|_| file.sync_data())
-            .map_err(|e| StoreError::io(&path, e))?;
-        Ok(StoreLock { file, path })
-    }
-}
-
-impl Drop for StoreLock {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_file(&self.path);
-        let _ = self.file.unlock();
     }
 }
 

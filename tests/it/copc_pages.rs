@@ -156,7 +156,7 @@ fn a_damaged_child_page_is_an_error_when_a_view_reaches_it() {
     std::fs::write(&path, &b).unwrap();
     let e = Copc::open(&path).err().expect("refused").to_string();
     assert!(
-        e.contains(&format!("at byte {entry}")) && e.contains("inside the hierarchy EVLR"),
+        e.contains(&format!("at byte {entry}")) && e.contains("inside a hierarchy EVLR"),
         "{e}"
     );
 }

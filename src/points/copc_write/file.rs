@@ -162,7 +162,6 @@ impl CopcFile {
         ));
         vlrs.extend(laz_data);
         let mut count = 2u32;
-        let mut wkt = false;
         for v in &source.vlrs {
             if v.data.len() <= u16::MAX as usize {
                 vlrs.extend(vlr_header(
@@ -173,12 +172,14 @@ impl CopcFile {
                 ));
                 vlrs.extend(&v.data);
                 count += 1;
-                wkt |= v.user_id == "LASF_Projection" && v.record_id == 2112;
             }
         }
         let mut h = vec![0u8; 375];
         h[0..4].copy_from_slice(b"LASF");
-        h[6..8].copy_from_slice(&(if wkt { 16u16 } else { 0 }).to_le_bytes());
+        // Global encoding bit 4 (WKT): LAS 1.4 R15 requires it for point formats 6-10,
+        // whether or not a coordinate system is given (copclib, PDAL and QGIS refuse a
+        // file without it). An input's WKT (2112) and GeoTIFF keys are copied as they are.
+        h[6..8].copy_from_slice(&16u16.to_le_bytes());
         h[24] = 1;
         h[25] = 4;
         let software = format!("arbvis {}", env!("CARGO_PKG_VERSION"));

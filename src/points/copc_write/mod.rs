@@ -80,6 +80,9 @@ pub fn write_copc(
     output: &Path,
     options: &CopcWriteOptions,
 ) -> Result<CopcWriteReport, PointsError> {
+    // One writer per output: a second conversion into the same file is refused naming
+    // the first (as a store's are), never interleaved with it.
+    let _lock = lock(output)?;
     let mut source = source::Source::open(input)?;
     if source.count == 0 {
         return Err(PointsError::unsupported(input, "the cloud has no points"));
@@ -195,6 +198,25 @@ pub fn write_copc(
         });
     }
     unreachable!("the second attempt uses the points' own bounds")
+}
+
+/// The lock on `output` (`.NAME.arbvis-convert.lock` beside it), or the error naming the
+/// process that holds it.
+fn lock(output: &Path) -> Result<crate::png_io::WriterLock, PointsError> {
+    let name = output
+        .file_name()
+        .ok_or_else(|| PointsError::unsupported(output, "not a file path"))?
+        .to_string_lossy();
+    let path = output.with_file_name(format!(".{name}.arbvis-convert.lock"));
+    match crate::png_io::WriterLock::acquire(&path).map_err(|e| PointsError::io(&path, e))? {
+        Ok(lock) => Ok(lock),
+        Err(holder) => Err(PointsError::unsupported(
+            output,
+            format!(
+                "another conversion ({holder}) is writing this file; wait for it, or stop it and run this command again (a conversion starts over)"
+            ),
+        )),
+    }
 }
 
 /// The points' own bounds, from a pass over them (the source rewound before and after).

@@ -218,6 +218,17 @@ pub(super) fn check_head(
             ),
         ));
     }
+    // Formats 6-10 came with LAS 1.4 (R15, 2.4): an older header cannot hold them (its
+    // point count is 32-bit, its readers decode formats 0-5).
+    if point_format >= 6 && version.1 < 4 {
+        return Err(fail(
+            104,
+            format!(
+                "point data format {point_format} in a LAS {}.{} file: formats 6 to 10 need LAS 1.4",
+                version.0, version.1
+            ),
+        ));
+    }
     let record_length = u16_at(b, 105);
     let minimum_record = RECORD_LENGTH[point_format as usize];
     if record_length < minimum_record {

@@ -92,6 +92,22 @@ pub(super) fn read_head(
     Ok((head, checked, start))
 }
 
+/// The checks every LAS/LAZ reader here runs on a file's header and VLRs
+/// ([`check_head`]) and on its extra-bytes descriptors against its records: a COPC file
+/// is opened only when they pass, so `inspect` refuses what `render` refuses.
+pub(crate) fn check_las_head(path: &Path, file: &mut File, len: u64) -> Result<(), PointsError> {
+    let (head, checked, _) = read_head(path, file, len)?;
+    let base = super::header::RECORD_LENGTH[checked.info.point_format as usize] as usize;
+    super::extra::extra_bytes(
+        path,
+        &head,
+        &checked.vlrs,
+        base,
+        checked.info.record_length as usize,
+    )?;
+    Ok(())
+}
+
 impl Records {
     /// Open `path` and check it.
     pub(crate) fn open(path: &Path) -> Result<Records, PointsError> {

@@ -72,9 +72,33 @@ pub fn prepare_for(
         .cloud
         .load_for(base, view)
         .map_err(|e| e.to_string())?;
+    if let Some(warning) = missing_colour(scene, &cloud) {
+        eprintln!("arbvis: warning: {warning}");
+    }
     let normals = normals_for(&cloud, scene);
     let prepared = from_cloud(&cloud, scene, normals)?;
     Ok((cloud, prepared, note))
+}
+
+/// What a scene's `colour` needs and the cloud lacks (its points are then drawn grey):
+/// the warning naming the key, or `None` when the cloud has it.
+pub fn missing_colour(scene: &SplatsScene, cloud: &PointCloud) -> Option<String> {
+    let (word, lacks) = match scene.colour {
+        ColourMode::Rgb if cloud.rgb.is_none() => (
+            "rgb",
+            "no colours (RGB: LAS point formats 2, 3, 5, 7, 8 and 10 have them, 6 has not; PLY red, green, blue)",
+        ),
+        ColourMode::Intensity if cloud.ints("intensity").is_none() => ("intensity", "no intensity"),
+        ColourMode::Classification if cloud.ints("classification").is_none() => {
+            ("classification", "no classification")
+        }
+        ColourMode::Facies if cloud.ints(FACIES).is_none() => ("facies", "no facies column"),
+        ColourMode::Layer if cloud.ints(LAYER).is_none() => ("layer", "no layer column"),
+        _ => return None,
+    };
+    Some(format!(
+        "technique.splats.colour = \"{word}\": the cloud has {lacks}, so its points are drawn grey; colour = \"elevation\" colours any cloud"
+    ))
 }
 
 /// [`prepare_for`] in stages (a COPC cloud: [`crate::points::copc_load`]'s; any other
@@ -99,12 +123,18 @@ pub fn prepare_in_stages(
         return Ok(());
     };
     let mut failed = None;
+    let mut warned = false;
     crate::points::copc_load::load_in_stages(
         spec,
         base,
         Some(view),
         stages,
         |cloud, loaded, whole| {
+            if !std::mem::replace(&mut warned, true) {
+                if let Some(warning) = missing_colour(scene, &cloud) {
+                    eprintln!("arbvis: warning: {warning}");
+                }
+            }
             let normals = normals_for(&cloud, scene);
             match from_cloud(&cloud, scene, normals) {
                 Ok(prepared) => each((cloud, prepared, Some(loaded)), whole),
