@@ -159,14 +159,16 @@ pub fn inspect_with(
         error,
     };
     if path.is_dir() {
+        // A zarr v3 root, or a zarr v2 one (an MDIO dataset, v0 or v1, written with it).
         if std::fs::symlink_metadata(path.join("zarr.json")).is_ok()
+            || path.join(".zgroup").is_file()
             || crate::store::mdio::is_mdio_v0(path)
         {
             return Ok(crate::store::describe::describe(path)?);
         }
         return Err(InspectError::Unknown {
             path: path.display().to_string(),
-            what: "a folder without zarr.json or an MDIO v0 .zattrs (not a store)".into(),
+            what: "a folder without zarr.json or .zgroup (not a store or an MDIO dataset)".into(),
         });
     }
     let (file, _) = crate::input::open_regular(path).map_err(io)?;

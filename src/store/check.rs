@@ -46,7 +46,7 @@ pub fn not_v3(store: &Path) -> String {
     if mdio_v0 {
         "an MDIO v0 dataset (zarr v2) without its variable data/chunked_012: not a dataset arbvis reads".into()
     } else if v2 {
-        "a zarr v2 store: arbvis reads zarr v3; rewrite it as v3 (e.g. zarr-python 3: zarr.open_group(..., zarr_format=3) and copy the arrays)".into()
+        "a zarr v2 store that is not an MDIO dataset (its .zattrs has no apiVersion): arbvis reads zarr v3 stores and MDIO datasets on zarr v2 or v3; rewrite it as v3 (e.g. zarr-python 3: zarr.open_group(..., zarr_format=3) and copy the arrays)".into()
     } else {
         "no zarr.json: not a zarr store (make one with `arbvis convert SURVEY STORE`)".into()
     }

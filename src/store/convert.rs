@@ -296,14 +296,17 @@ fn convert_on_workers(
     let storage = Arc::new(FilesystemStore::new(store).map_err(|e| StoreError::io(store, e))?);
     // Every zarr.json, written whole (again on a resume: a kill may have cut one).
     let has_cdp = src.has_coordinates();
-    let writers = layout::write_layout(
-        &storage,
-        store,
-        &meta,
-        (o.compression, has_cdp),
-        None,
-        beside.as_ref(),
-    )?;
+    // A resumed conversion keeps the `createdOn` its first run wrote.
+    let created_on = super::zarr::read_json(&store.join("zarr.json"))
+        .ok()
+        .and_then(|root| root["attributes"]["createdOn"].as_str().map(str::to_string))
+        .unwrap_or_else(layout::created_now);
+    let options = layout::LayoutOptions {
+        compression: o.compression,
+        has_cdp,
+        created_on,
+    };
+    let writers = layout::write_layout(&storage, store, &meta, &options, None, beside.as_ref())?;
     let log = Log {
         file: Mutex::new(
             OpenOptions::new()
@@ -376,7 +379,7 @@ fn convert_on_workers(
         store,
         meta.clone(),
         &done,
-        (o.compression, has_cdp),
+        &options,
         beside.as_ref(),
     )?;
     std::fs::remove_file(&log_path).map_err(|e| StoreError::io(&log_path, e))?;
@@ -449,7 +452,7 @@ fn mdio_root_attributes(
         if a["complete"].as_bool() == Some(true) {
             let damage = match super::Store::open(store) {
                 Ok(opened) => opened
-                    .missing_chunk()
+                    .missing_file()
                     .map(|f| format!("{} is missing", f.display())),
                 Err(e) => Some(e.to_string()),
             };
@@ -524,7 +527,7 @@ fn finish_store(
     store: &Path,
     mut meta: StoreMeta,
     done: &HashMap<[usize; 3], Unit>,
-    codecs: (Compression, bool),
+    options: &layout::LayoutOptions,
     beside: Option<&serde_json::Map<String, serde_json::Value>>,
 ) -> Result<StoreMeta, StoreError> {
     let mut totals: BTreeMap<usize, [f64; 3]> = BTreeMap::new();
@@ -595,7 +598,7 @@ fn finish_store(
         })
         .collect();
     // Every zarr.json again, now with the statistics, the root (complete) last.
-    layout::write_layout(storage, store, &meta, codecs, Some(&stats), beside)?;
+    layout::write_layout(storage, store, &meta, options, Some(&stats), beside)?;
     Ok(meta)
 }
 

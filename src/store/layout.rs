@@ -16,8 +16,12 @@
 //!   `time_L`: a data tree aligns a group's dimensions with its parent's of the same
 //!   name), with coordinates that are the means of the cells' level-0 coordinates
 //!   (`xarray.open_datatree` opens every level).
-//! - SEG-Y trace headers (a structured type) are not written: zarrs writes no structured
-//!   types.
+//! - As mdio-python 1.1.3 writes them: the root's `createdOn` (Python's `str` of a UTC
+//!   time); `_FillValue` (xarray's base64 of a float64 NaN) on the float variables and map
+//!   coordinates; `unitsV1` (`{"length": "m"}`) on `cdp_x`, `cdp_y`; `coordinates` on the
+//!   variables and the trace mask; integer dimension coordinates filled with `i32::MAX`.
+//! - SEG-Y trace headers (mdio-python's `headers`, a structured type) are not written
+//!   (docs/stores.md says why).
 //!
 //! Every `zarr.json` is written whole (a temporary renamed into place), and all of them
 //! again when the conversion resumes and when it finishes (with the statistics), the root
@@ -37,6 +41,29 @@ use super::StoreError;
 
 /// The MDIO version whose layout this follows (as multidimio 1.1.3 writes it).
 pub const MDIO_API_VERSION: &str = "1.1.3";
+
+/// What every node of the layout is written with: the chunks' compression, whether the
+/// survey has map coordinates (`cdp_x`, `cdp_y`), and the root's `createdOn`.
+#[derive(Debug, Clone)]
+pub struct LayoutOptions {
+    /// The chunks' codec.
+    pub compression: Compression,
+    /// `cdp_x` and `cdp_y` are written.
+    pub has_cdp: bool,
+    /// The root's `createdOn`, as mdio-python writes it (`2026-12-06 04:52:17.387247+00:00`).
+    pub created_on: String,
+}
+
+/// Now, as mdio-python's `createdOn` says a time (Python's `str` of a UTC datetime).
+pub fn created_now() -> String {
+    chrono::Utc::now()
+        .format("%Y-%m-%d %H:%M:%S%.6f+00:00")
+        .to_string()
+}
+
+/// xarray's `_FillValue` of a float variable whose fill is NaN: the base64 of a
+/// little-endian float64 NaN, as mdio-python's datasets carry it.
+const NAN_FILL_VALUE: &str = "AAAAAAAA+H8=";
 
 /// One attribute's statistics over level 0, as MDIO's `statsV1`.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -146,9 +173,13 @@ fn stats_v1(meta: &StoreMeta, attr: usize, s: &Stats) -> Value {
 }
 
 /// The root group's attributes: MDIO's and `arbvis`.
-fn root_attributes(meta: &StoreMeta) -> Result<Map<String, Value>, serde_json::Error> {
+fn root_attributes(
+    meta: &StoreMeta,
+    created_on: &str,
+) -> Result<Map<String, Value>, serde_json::Error> {
     let mut m = Map::new();
     m.insert("apiVersion".into(), json!(MDIO_API_VERSION));
+    m.insert("createdOn".into(), json!(created_on));
     let name = match meta.domain().as_str() {
         "time" => "PostStack3DTime",
         "depth" => "PostStack3DDepth",
@@ -183,10 +214,11 @@ pub fn write_layout(
     storage: &Arc<FilesystemStore>,
     store: &Path,
     meta: &StoreMeta,
-    (compression, has_cdp): (Compression, bool),
+    options: &LayoutOptions,
     stats: Option<&[Stats]>,
     beside: Option<&Map<String, Value>>,
 ) -> Result<Writers, StoreError> {
+    let (compression, has_cdp) = (options.compression, options.has_cdp);
     let b = meta.brick as u64;
     let domain = meta.domain();
     let dims = ["inline", "crossline", domain.as_str()];
@@ -199,6 +231,7 @@ pub fn write_layout(
         if has_cdp {
             m.insert("coordinates".into(), json!("cdp_x cdp_y"));
         }
+        m.insert("_FillValue".into(), json!(NAN_FILL_VALUE));
         if let Some(s) = stats {
             m.insert("statsV1".into(), stats_v1(meta, attr, &s[attr]));
         }
@@ -259,7 +292,7 @@ pub fn write_layout(
                     vec![n],
                     vec![n],
                     data_type::int32(),
-                    0i32,
+                    i32::MAX,
                     &[name],
                     compression,
                     Map::new(),
@@ -357,7 +390,14 @@ pub fn write_layout(
             zarrs::array::FillValue::from(false),
             &dims[..2],
             compression,
-            Map::new(),
+            if has_cdp {
+                json!({"coordinates": "cdp_x cdp_y"})
+                    .as_object()
+                    .cloned()
+                    .unwrap_or_default()
+            } else {
+                Map::new()
+            },
         )?),
     };
     // In place, the dataset's own trace mask and map coordinates stay as they are.
@@ -373,7 +413,10 @@ pub fn write_layout(
                 f64::NAN,
                 &dims[..2],
                 compression,
-                Map::new(),
+                json!({"unitsV1": {"length": "m"}, "_FillValue": NAN_FILL_VALUE})
+                    .as_object()
+                    .cloned()
+                    .unwrap_or_default(),
             )
         };
         Some([coordinate("/cdp_x")?, coordinate("/cdp_y")?])
@@ -381,7 +424,8 @@ pub fn write_layout(
         None
     };
     // The root last: its `complete` flag only once every other node is written.
-    let mut root = root_attributes(meta).map_err(|e| storage_error(store, e))?;
+    let mut root =
+        root_attributes(meta, &options.created_on).map_err(|e| storage_error(store, e))?;
     if let Some(own) = beside {
         let arbvis = root.remove("arbvis");
         root = own.clone();

@@ -272,11 +272,17 @@ impl Store {
         }
     }
 
-    /// The first chunk file of the store's own arrays (its levels and their per-brick
-    /// ranges; an MDIO dataset's variable is not the store's) that is missing: every
-    /// chunk of a finished conversion is written, so one missing is damage.
-    pub fn missing_chunk(&self) -> Option<PathBuf> {
+    /// The first file of the store's own nodes (its level groups, and their arrays' and
+    /// per-brick ranges' chunks; an MDIO dataset's variable is not the store's) that is
+    /// missing: every one of a finished conversion is written, so one missing is damage.
+    pub fn missing_file(&self) -> Option<PathBuf> {
         let first_level = usize::from(self.meta.source_variable.is_some());
+        for level in 1..self.meta.levels {
+            let group = self.path.join(format!("level_{level}/zarr.json"));
+            if !group.is_file() {
+                return Some(group);
+            }
+        }
         for (attr, levels) in self.arrays.iter().enumerate() {
             for (level, array) in levels.iter().enumerate().skip(first_level) {
                 // The ranges: one chunk of every brick's pair.

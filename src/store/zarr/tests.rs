@@ -351,3 +351,45 @@ fn big_endian_and_integer_types_decode() {
     assert_eq!(DataType::Float64.value(&1.5f64.to_be_bytes(), true), 1.5);
     assert_eq!(DataType::Bool.value(&[2], false), 1.0);
 }
+
+#[test]
+fn fields_a_reader_must_understand_are_refused_as_the_spec_says() {
+    let bytes = r#"[{"name": "bytes", "configuration": {"endian": "little"}}]"#;
+    let plain = array_json("[4]", "[4]", "float32", bytes);
+    let with = |field: &str| format!("{}, {field}}}", &plain[..plain.len() - 1]);
+    // An extension that says it may be ignored is.
+    let dir = temp("must-understand-false");
+    std::fs::create_dir_all(dir.join("a")).unwrap();
+    std::fs::write(
+        dir.join("a/zarr.json"),
+        with(r#""my_extension": {"must_understand": false, "x": 1}"#),
+    )
+    .unwrap();
+    assert!(open_array(&dir.join("a")).is_ok());
+    std::fs::remove_dir_all(&dir).unwrap();
+    // One that says it must be understood, or says nothing (the default is true), is not.
+    for (name, field) in [
+        (
+            "must-understand-true",
+            r#""my_extension": {"must_understand": true}"#,
+        ),
+        ("must-understand-absent", r#""my_extension": {"x": 1}"#),
+        ("unknown-number", r#""my_extension": 3"#),
+    ] {
+        let e = open_error(name, &with(field));
+        assert!(
+            e.contains("field `my_extension`") && e.contains("must_understand"),
+            "{name}: {e}"
+        );
+    }
+    // A group alike.
+    let group = serde_json::json!({"zarr_format": 3, "node_type": "group", "attributes": {},
+        "future": {"must_understand": true}});
+    let e = check_group(&group, Path::new("g/zarr.json"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("field `future`"), "{e}");
+    let group = serde_json::json!({"zarr_format": 3, "node_type": "group",
+        "future": {"must_understand": false}});
+    assert!(check_group(&group, Path::new("g/zarr.json")).is_ok());
+}

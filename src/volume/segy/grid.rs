@@ -134,15 +134,8 @@ pub(super) fn grid(
             .map(|(&(il, xl), ts)| (il, xl, ts[0] as u32))
             .collect(),
     )
-    .map_err(|e| e.into_volume_error(path, &l.keys, offset_of, &hint))?;
-    if !trace_grid.is_full() {
-        check_sample_count(
-            path,
-            l,
-            &bytes[header(0)..header(0) + TRACE_HEADER],
-            &trace_grid,
-        )?;
-    }
+    .map_err(|e| e.into_volume_error(path, &l.keys, offset_of, &hint))
+    .map_err(|e| with_count_hint(e, l))?;
     let (inlines, crosslines) = (trace_grid.inlines, trace_grid.crosslines);
     let dims = [l.samples, crosslines.count, inlines.count];
     options.limits.check(dims, &path.display().to_string())?;
@@ -176,36 +169,24 @@ pub(super) fn grid(
     })
 }
 
-/// A grid with dead positions is also what a wrong sample count makes (every trace header
-/// after the first read from inside the samples), so where the first trace's own count
-/// (bytes 115-116) disagrees with the count in use, the file is refused, saying both,
-/// rather than drawn as a survey of dead traces.
-pub(crate) fn check_sample_count(
-    path: &Path,
-    l: &Layout,
-    first_header: &[u8],
-    grid: &TraceGrid,
-) -> Result<(), VolumeError> {
-    let a = [first_header[114], first_header[115]];
-    let own = if l.big {
-        u16::from_be_bytes(a)
-    } else {
-        u16::from_le_bytes(a)
-    } as usize;
-    if own == 0 || own == l.samples {
-        return Ok(());
+/// `e` with what the binary header's sample count makes of the file, where the numbers
+/// were no survey's lines: a wrong count reads every trace header after the first from
+/// inside the samples.
+pub(crate) fn with_count_hint(e: VolumeError, l: &Layout) -> VolumeError {
+    match e {
+        VolumeError::Unsupported { path, message } if !message.contains("both sit at") => {
+            VolumeError::Unsupported {
+                path,
+                message: format!(
+                    "{message}. The binary header declares {} samples per trace of {} (bytes 3221-3222), so the {} bytes after the headers hold {} traces of {} bytes; if that count looks wrong, the header's sample count is",
+                    l.header_samples,
+                    l.format.name(),
+                    l.traces * l.trace_len,
+                    l.traces,
+                    l.trace_len
+                ),
+            }
+        }
+        other => other,
     }
-    Err(VolumeError::format(
-        path,
-        (l.first_trace + 114) as u64,
-        format!(
-            "the binary header declares {} samples per trace of {} (bytes 3221-3222) and the first trace header {own} (bytes 115-116); read with the binary header's count, the traces leave positions of their grid empty ({}): the {} bytes after the headers hold {} traces of {} bytes; if that count looks wrong, the header's sample count is",
-            l.header_samples,
-            l.format.name(),
-            grid.describe(),
-            l.traces * l.trace_len,
-            l.traces,
-            l.trace_len
-        ),
-    ))
 }

@@ -862,8 +862,8 @@ mod tests {
             "{}",
             c.describe()
         );
-        // A header declaring 60,000 samples: the message says what it declares and
-        // what the file then holds.
+        // A header declaring 60,000 samples: the file holds two traces that long, on a
+        // grid of two positions of four, whose volume is refused for its size, said.
         let v = Volume::new([4, 10, 10], [1.0; 3], vec![1.0; 400]).unwrap();
         let mut bytes = write(&v, &options(SampleFormat::UInt8));
         bytes[3220..3222].copy_from_slice(&60000u16.to_be_bytes());
@@ -873,8 +873,20 @@ mod tests {
         let e = parse(Path::new("s.sgy"), &bytes, &ReadOptions::default())
             .unwrap_err()
             .to_string();
+        assert!(e.contains("[60000, 2, 2]"), "{e}");
+        // Numbers read from inside the samples are no survey's lines: refused with what
+        // the header's count makes of the file.
+        let mut bytes = write(&v, &options(SampleFormat::UInt8));
+        bytes[3220..3222].copy_from_slice(&20u16.to_be_bytes());
+        let n = bytes.len();
+        for (q, b) in bytes[3600 + 260..n].iter_mut().enumerate() {
+            *b = (q * 7919 % 251) as u8;
+        }
+        let e = parse(Path::new("s.sgy"), &bytes, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
         assert!(
-            e.contains("declares 60000 samples per trace") && e.contains("hold 2 traces"),
+            e.contains("declares 20 samples per trace") && e.contains("traces of 260 bytes"),
             "{e}"
         );
     }

@@ -247,14 +247,8 @@ impl SegyStream {
                 |t| self.offset_of(t as usize),
                 ": a pre-stack or otherwise non-gridded file, which `arbvis convert` does not take (stack it first)",
             )
-        })?;
-        if !self.grid.is_full() {
-            let mut first = [0u8; TRACE_HEADER];
-            self.file
-                .read_exact_at(&mut first, self.offset_of(0))
-                .map_err(|e| VolumeError::io(&self.path, e))?;
-            super::grid::check_sample_count(&self.path, &self.layout, &first, &self.grid)?;
-        }
+        })
+        .map_err(|e| super::grid::with_count_hint(e, &self.layout))?;
         self.inlines = self.grid.inlines.numbers();
         self.crosslines = self.grid.crosslines.numbers();
         Ok(())
