@@ -18,15 +18,15 @@
 // count x 2 (row 0 colours, row 1 values); texture4..11: entry layers (tet, t);
 // texture13: RG32UI per tetrahedron (first, count) into texture14, R32UI: the boundary
 // tetrahedra a ray leaving it through the boundary may re-enter at once (see reenter);
-// texture12: what earlier batches of entry layers accumulated (C, 1 - T), where
-// program_local[6].w is 1 (a ray entering more than 8 times is walked 8 entries a pass;
-// the walk then goes on from there and writes the sum so far, unblended).
+// texture12: what earlier batches of entry layers accumulated (C, 1 - T), and texture15
+// (.r) how far along the ray their walks reached, where program_local[6].w is 1 (a ray
+// entering more than 8 times is walked 8 entries a pass; the walk then goes on from
+// there and writes the sum so far, unblended, and in output 1 how far it reached, so an
+// entry a re-entry of an earlier pass walked already is not walked again).
 // program_local[0..3]: inverse ModelViewProj rows; [4]: viewport (width, height,
 // corner x, corner y); [5]: (control points, isovalues, termination transmittance,
 // eye tetrahedron or -1); [6]: (entry layers, 1 / unit distance, most steps, 1 when
-// texture12 holds the earlier batches' sum); [7].x: 1 to look for re-entries (one pass
-// only: across passes `reached` is not kept, and a re-entry walked in one pass would be
-// walked again from its entry layer in the next).
+// texture12 holds the earlier batches' sum); [7].x: 1 to look for re-entries.
 uniform sampler2D texture0;
 uniform usampler2D texture1;
 uniform sampler2D texture3;
@@ -41,8 +41,10 @@ uniform sampler2D texture11;
 uniform sampler2D texture12;
 uniform usampler2D texture13;
 uniform usampler2D texture14;
+uniform sampler2D texture15;
 uniform vec4 program_local[8];
-out vec4 color;
+layout(location = 0) out vec4 color;
+layout(location = 1) out vec4 reach;
 
 const int ROW = 4096;
 const float SLACK = 1.0 / 65536.0;
@@ -180,6 +182,7 @@ void main() {
     inv_unit = program_local[6].y;
     if (program_local[6].w > 0.5) {
         acc = texelFetch(texture12, ivec2(pixel), 0);
+        reached = max(reached, texelFetch(texture15, ivec2(pixel), 0).r);
         // Ended already: opaque (an isosurface) or below the termination.
         done = acc.a >= 1.0 || 1.0 - acc.a < program_local[5].z;
     }
@@ -193,6 +196,9 @@ void main() {
         if (entry.y < reached - 1e-5 * ray_end) continue;
         walk(int(entry.x + 0.5), entry.y);
     }
+    // Nothing accumulated: walking its path again adds nothing, so how far it reached
+    // need not be kept.
     if (acc.a <= 0.0) discard;
     color = acc;
+    reach = vec4(reached, 0.0, 0.0, 1.0);
 }

@@ -73,12 +73,15 @@ pub fn clear(gpu: &Gpu, surface: Surface<'_>, rgba: [f32; 4]) -> GlResult<()> {
     crate::gl_check!(gpu)
 }
 
-/// An owned framebuffer with one colour texture and, when asked for, a 24-bit depth
-/// buffer; deleted on Drop (the framebuffer first, then the texture it held).
+/// An owned framebuffer with one colour texture (or two: a fragment program's outputs 0
+/// and 1) and, when asked for, a 24-bit depth buffer; deleted on Drop (the framebuffer
+/// first, then the textures it held).
 pub struct Target {
     gl: Arc<glow::Context>,
     framebuffer: glow::Framebuffer,
     color: Texture,
+    /// The second colour texture (output 1), where there is one.
+    second: Option<Texture>,
     depth: Option<glow::Renderbuffer>,
     width: u32,
     height: u32,
@@ -99,6 +102,49 @@ impl Target {
         format: TargetFormat,
     ) -> GlResult<Target> {
         Target::create(gpu, width, height, format, true)
+    }
+
+    /// [`Target::new`] with a second colour texture of the same format, written by a
+    /// fragment program's output 1 (`layout(location = 1)`), cleared with the first:
+    /// what one pass leaves for the next beside its colour.
+    pub fn with_second_color(
+        gpu: &Gpu,
+        width: u32,
+        height: u32,
+        format: TargetFormat,
+    ) -> GlResult<Target> {
+        let mut target = Target::create(gpu, width, height, format, false)?;
+        let second = Texture::render_target(gpu, width, height, texel_format(format))?;
+        // SAFETY: a live framebuffer gains a live texture; the binding is restored.
+        let status = unsafe {
+            let gl = &target.gl;
+            let prev_fb = gl.get_parameter_framebuffer(glow::FRAMEBUFFER_BINDING);
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(target.framebuffer));
+            gl.framebuffer_texture_2d(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT1,
+                glow::TEXTURE_2D,
+                Some(second.raw()),
+                0,
+            );
+            gl.draw_buffers(&[glow::COLOR_ATTACHMENT0, glow::COLOR_ATTACHMENT1]);
+            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            gl.clear_color(0.0, 0.0, 0.0, 0.0);
+            gl.clear(glow::COLOR_BUFFER_BIT);
+            gl.bind_framebuffer(glow::FRAMEBUFFER, prev_fb);
+            status
+        };
+        target.second = Some(second);
+        if status != glow::FRAMEBUFFER_COMPLETE {
+            return Err(GlError::Framebuffer(status));
+        }
+        crate::gl_check!(gpu)?;
+        gpu.record(
+            "framebuffer",
+            format!("second colour {width}x{height} {}", format.name()),
+            width as u64 * height as u64 * format.bytes_per_pixel(),
+        );
+        Ok(target)
     }
 
     /// [`Target::new`], or [`Target::with_depth`] when `with_depth`.
@@ -166,6 +212,7 @@ impl Target {
             gl,
             framebuffer,
             color,
+            second: None,
             depth,
             width,
             height,
@@ -208,6 +255,11 @@ impl Target {
     /// The colour texture, to be read by a later draw (not while drawing into it).
     pub fn color(&self) -> &Texture {
         &self.color
+    }
+
+    /// The second colour texture ([`Target::with_second_color`]), if it has one.
+    pub fn second_color(&self) -> Option<&Texture> {
+        self.second.as_ref()
     }
 
     /// Whether it has a depth buffer.

@@ -2,10 +2,14 @@
 //! of ten plates seen along the stack, so that rays enter the mesh ten times and more (more
 //! than one walk pass takes, eight), is within 1e-3 of the f64 reference on every pixel,
 //! silhouettes included, in three rotated views and both projections; capped at four
-//! entries (the old default) the same views are far off.
+//! entries (the old default) the same views are far off. And the slotted mesh, whose
+//! rays graze its slot's wall (a re-entry the entry layers miss), seen behind ten plates:
+//! its entries come in the walk's second pass, and every pixel is within 1e-3 too, what
+//! the walk reached carried from pass to pass so that the search for re-entries runs in
+//! every pass.
 
 use crate::cellproj_volume::{
-    draw_counting_entries, points_spec, prepared_of, reference_image, scene, slotted,
+    draw_counting_entries, points_spec, prepared_of, reference_image, scene, slotted, slotted_mesh,
     slotted_volume,
 };
 use crate::common::headless;
@@ -165,5 +169,89 @@ fn rays_grazing_the_boundary_keep_their_path() {
                 "{rotation:?} {projection:?}: worst {most}, {over} pixels over 1e-3"
             );
         }
+    }
+}
+
+/// The slotted mesh with ten plates in front of it along the view of `rotation` (each a
+/// slab of a 5 x 5 x 21 point grid, square and wide enough to cover it): a ray meets the
+/// plates' ten entries before the slotted body's.
+fn slotted_behind_plates(rotation: [f64; 4]) -> Prepared {
+    use glam::{DQuat, DVec3};
+    let mut mesh = slotted_mesh();
+    let mut plates = generate(&GridSpec {
+        points: [5, 5, 21],
+        field: Field::Oblique,
+    })
+    .unwrap();
+    let keep: Vec<bool> = plates
+        .tets
+        .iter()
+        .map(|t| {
+            let z = t.iter().map(|&i| plates.points[i as usize][2]).sum::<f64>() / 4.0;
+            ((z * 20.0) as usize).is_multiple_of(2)
+        })
+        .collect();
+    let mut k = keep.iter();
+    plates.tets.retain(|_| *k.next().unwrap());
+    let mut k = keep.iter();
+    plates.source_cell.retain(|_| *k.next().unwrap());
+    // Towards the eye, and two directions across it (right-handed: u x v = e).
+    let q = DQuat::from_array(rotation).normalize();
+    let e = q.inverse() * DVec3::Z;
+    let u = e
+        .cross(if e.x.abs() < 0.9 { DVec3::X } else { DVec3::Y })
+        .normalize();
+    let v = e.cross(u);
+    let centre = DVec3::splat(0.5);
+    for p in &mut plates.points {
+        let (x, y, z) = (p[0] / 0.2 - 0.5, p[1] / 0.2 - 0.5, p[2]);
+        *p = (centre + u * (3.0 * x) + v * (3.0 * y) + e * (1.0 + z)).to_array();
+    }
+    let base = mesh.points.len() as u32;
+    mesh.points.extend(&plates.points);
+    let cells = mesh.source_cell.iter().max().map_or(0, |c| c + 1);
+    mesh.tets
+        .extend(plates.tets.iter().map(|t| t.map(|i| i + base)));
+    mesh.source_cell
+        .extend(plates.source_cell.iter().map(|c| c + cells));
+    for (a, b) in mesh.point_arrays.iter_mut().zip(&plates.point_arrays) {
+        a.values.extend(&b.values);
+    }
+    mesh.cell_arrays.clear();
+    prepared_of(&mesh)
+}
+
+#[test]
+fn a_grazing_re_entry_past_the_eighth_entry_is_followed() {
+    let h = headless(Backend::Egl);
+    let volume = slotted_volume(Sort::Mpvonc);
+    let p = scene(Mode::Volume, volume, Vec::new());
+    // A view found by a sweep of 40 random rotations and two zooms: with the search for
+    // re-entries in the first pass only (before), this view's grazing pixel was off by
+    // 1.5e-3. (The sweep's other views off by more were off at a plate's corner, a pixel
+    // its entry face's rasterization took though the exact ray misses the plate; the
+    // search does not touch that, docs/cellproj.md.)
+    let rotation = [-0.335, 0.52, 0.423, 0.662];
+    let prepared = slotted_behind_plates(rotation);
+    for projection in [Projection::Orthographic, Projection::Perspective] {
+        let cam = Camera {
+            projection,
+            rotation,
+            zoom: 1.6,
+            ..Camera::default()
+        };
+        let want = reference_image(&p, &prepared, cam);
+        let (image, entries) =
+            draw_counting_entries(&h, &p, &prepared, Fidelity::Precise, ProgramKind::Glsl, cam);
+        let (most, over) = worst(&image, &want);
+        eprintln!(
+            "behind plates {projection:?}: {entries} entries, worst {most:.2e}, {over} over 1e-3"
+        );
+        assert!(entries > 10, "{projection:?}: {entries} entries");
+        // As above: f32 arithmetic and the 2^-12 termination.
+        assert!(
+            most < 1e-3,
+            "{projection:?}: worst {most}, {over} pixels over 1e-3"
+        );
     }
 }

@@ -388,6 +388,11 @@ pub(crate) fn slotted_volume(sort: Sort) -> VolumeSpec {
 /// and its points stretched (x -> x³, z -> z²), so long thin tetrahedra lie beside short
 /// ones and centroids misorder them.
 pub(crate) fn slotted() -> Prepared {
+    prepared_of(&slotted_mesh())
+}
+
+/// [`slotted`]'s mesh.
+pub(crate) fn slotted_mesh() -> Mesh {
     let mut mesh = grid(8, Field::Oblique);
     for q in &mut mesh.points {
         q[0] = q[0].powi(3);
@@ -409,7 +414,7 @@ pub(crate) fn slotted() -> Prepared {
     mesh.tets.retain(|_| *k.next().unwrap());
     let mut k = keep.iter();
     mesh.source_cell.retain(|_| *k.next().unwrap());
-    prepared_of(&mesh)
+    mesh
 }
 
 #[test]

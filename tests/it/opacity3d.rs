@@ -521,11 +521,23 @@ fn extremes_constant_and_nan_attributes() {
     let constant = render(&h, &scene_for("constant.raw")).image;
     let zeros = render(&h, &scene_for("zeros.raw")).image;
     assert_eq!(constant.data, zeros.data);
-    // NaN samples quantize to 0, like the finite minimum (1.0 here: sample 0 is NaN).
+    // NaN samples are no data: they take a level the table makes transparent (the one
+    // nearest its middle), never the finite minimum's, so the picture differs from one
+    // where they are the minimum; every pixel stays finite.
     let nan = render(&h, &scene_for("nan.raw")).image;
     let as_min = render(&h, &scene_for("nan_as_min.raw")).image;
-    assert_eq!(nan.data, as_min.data);
+    assert_ne!(nan.data, as_min.data);
     assert!(all_finite_in_unit_range(&nan));
+    let scene = scene_for("nan.raw");
+    let prepared = prepare(params(&scene), &dir, &Default::default()).unwrap();
+    let table = prepared.tables[0].as_ref().unwrap();
+    for v in (0..n * n * n).step_by(3) {
+        let level = prepared.byte(v, 0) as usize;
+        assert_eq!(
+            table.entries[level][3], 0,
+            "sample {v} (NaN) at level {level}"
+        );
+    }
 }
 
 #[test]

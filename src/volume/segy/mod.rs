@@ -878,6 +878,7 @@ mod tests {
         // the header's count makes of the file.
         let mut bytes = write(&v, &options(SampleFormat::UInt8));
         bytes[3220..3222].copy_from_slice(&20u16.to_be_bytes());
+        bytes.resize(3600 + 94 * 260, 0);
         let n = bytes.len();
         for (q, b) in bytes[3600 + 260..n].iter_mut().enumerate() {
             *b = (q * 7919 % 251) as u8;

@@ -388,8 +388,10 @@ impl Precise {
             // The last batch: fewer than a full pool, or at the cap.
             let last = n < p.layers.len() || p.peeled >= most;
             if !last && p.sums.is_empty() {
+                // (C, 1 - T), and how far each pixel's walk reached (output 1).
                 for _ in 0..2 {
-                    p.sums.push(Target::new(gpu, w, h, TargetFormat::Rgba32f)?);
+                    p.sums
+                        .push(Target::with_second_color(gpu, w, h, TargetFormat::Rgba32f)?);
                 }
             }
             let (sum_in, sum_out) = (batch % 2, (batch + 1) % 2);
@@ -410,9 +412,9 @@ impl Precise {
                     (batch > 0) as u8 as f64,
                 ],
             )?;
-            // Re-entries exist only where the boundary is not one convex body, and are
-            // looked for only in a single pass (see volume_walk.frag).
-            let search = last && batch == 0 && !convex;
+            // Re-entries exist only where the boundary is not one convex body; what a
+            // pass's walks reached goes to the next, so every pass looks for them.
+            let search = !convex;
             p.walk
                 .set_local(gpu, 7, [search as u8 as f64, 0.0, 0.0, 0.0])?;
             let mut textures: Vec<(u32, &Texture)> = vec![
@@ -428,6 +430,9 @@ impl Precise {
             }
             if batch > 0 {
                 textures.push((12, p.sums[sum_in].color()));
+                if let Some(reached) = p.sums[sum_in].second_color() {
+                    textures.push((15, reached));
+                }
             }
             if last {
                 return gl::draw(
