@@ -36,7 +36,7 @@ def main():
             if not keep[t]:
                 continue
             rec = traces[t].copy()
-            rec[188:192] = np.frombuffer(new_il[t].tobytes(), np.uint8)
+            rec[188:192] = np.frombuffer(new_il[t:t + 1].tobytes(), np.uint8)
             block.append(rec)
             if len(block) == 4096:
                 f.write(np.concatenate(block).tobytes())

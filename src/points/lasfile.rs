@@ -42,6 +42,7 @@ use rayon::prelude::*;
 mod check;
 mod extra;
 mod header;
+mod laz_chunks;
 pub(crate) mod stream;
 
 use check::{check, laz_bound};

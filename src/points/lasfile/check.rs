@@ -7,6 +7,7 @@ use std::io::Cursor;
 use std::path::Path;
 
 use super::header::{f64_at, text_at, u16_at, u32_at, u64_at, LasInfo, RawVlr, RECORD_LENGTH};
+use super::laz_chunks::{Chunk, LazChunks};
 use crate::points::{PointsError, MAX_POINTS};
 
 /// Points a LAZ file may declare whatever its size (about half a second to decode).
@@ -77,6 +78,8 @@ pub(super) struct Checked {
     pub(super) vlrs: Vec<RawVlr>,
     /// Byte offset of the point count in force (107, or 247 for LAS 1.4's 64-bit one).
     pub(super) count_at: usize,
+    /// A chunked LAZ file's chunks (none for LAS, point-wise LAZ or LAZ without a table).
+    pub(super) laz: Option<LazChunks>,
 }
 
 /// Check the header, VLRs and sizes before the `las` crate reads anything.
@@ -91,6 +94,7 @@ pub(super) fn check_up_to(name: &Path, b: &[u8], max_points: u64) -> Result<Chec
         info,
         mut vlrs,
         count_at,
+        ..
     } = checked;
     let fail = |at: usize, m: String| PointsError::format(name, at as u64, m);
     if info.points > max_points {
@@ -103,15 +107,17 @@ pub(super) fn check_up_to(name: &Path, b: &[u8], max_points: u64) -> Result<Chec
         ));
     }
     evlrs(name, b, info.version, offset_to_points, &mut vlrs)?;
-    if info.compressed {
-        check_laz(name, b, &info, offset_to_points, &vlrs)?;
+    let laz = if info.compressed {
+        check_laz(name, b, &info, offset_to_points, &vlrs)?
     } else {
         check_count(name, &info, offset_to_points, b.len())?;
-    }
+        None
+    };
     Ok(Checked {
         info,
         vlrs,
         count_at,
+        laz,
     })
 }
 
@@ -330,6 +336,7 @@ pub(super) fn check_head(
             info,
             vlrs,
             count_at,
+            laz: None,
         },
         offset_to_points,
     ))
@@ -397,14 +404,15 @@ fn evlrs(
 }
 
 /// LAZ: laszip VLR items against the record, chunk table against the data, and LAZ 1.4
-/// layer sizes against the file.
+/// layer sizes against the file; the chunks that hold the header's points, where the
+/// file is chunked and has a table (each decodable alone, [`super::laz_chunks`]).
 fn check_laz(
     name: &Path,
     b: &[u8],
     info: &LasInfo,
     data_start: usize,
     vlrs: &[RawVlr],
-) -> Result<(), PointsError> {
+) -> Result<Option<LazChunks>, PointsError> {
     let fail = |at: usize, m: String| PointsError::format(name, at as u64, m);
     let Some(vlr) = vlrs
         .iter()
@@ -484,7 +492,7 @@ fn check_laz(
     // The chunk table, located as laz does: offset at the start of the data, else in
     // the last 8 bytes of the file.
     if compressor == 1 {
-        return Ok(()); // point-wise: one stream, no table; points are read in batches
+        return Ok(None); // point-wise: one stream, no table; points are read in batches
     }
     if data_start + 8 > b.len() {
         return Err(fail(
@@ -505,7 +513,7 @@ fn check_laz(
                     .into(),
             ));
         }
-        return Ok(());
+        return Ok(None);
     }
     let table = table as u64;
     if table.checked_add(8).is_none_or(|e| e > b.len() as u64) {
@@ -586,5 +594,39 @@ fn check_laz(
             start = start.saturating_add(e.byte_count);
         }
     }
-    Ok(())
+    // The chunks the declared points reach, each inside the data before the table.
+    let mut chunks = Vec::new();
+    let (mut start, mut left) = (data_start as u64 + 8, info.points);
+    for (k, e) in entries.iter().enumerate() {
+        if left == 0 {
+            break;
+        }
+        let end = start.saturating_add(e.byte_count);
+        if end > table as u64 {
+            return Err(fail(
+                start as usize,
+                format!(
+                    "LAZ chunk {k} ({} bytes from byte {start}) runs past the chunk table at {table}",
+                    e.byte_count
+                ),
+            ));
+        }
+        let points = if variable {
+            e.point_count
+        } else {
+            chunk_size as u64
+        }
+        .min(left);
+        chunks.push(Chunk {
+            start: start as usize,
+            end: end as usize,
+            points,
+        });
+        left -= points;
+        start = end;
+    }
+    Ok(Some(LazChunks {
+        vlr: laz_vlr,
+        chunks,
+    }))
 }

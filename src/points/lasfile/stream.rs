@@ -5,17 +5,20 @@
 //! as the reader checks them (`check::check_head`, at most [`MAX_HEAD`] bytes before the
 //! points) and the records must fit in the file. A LAZ file is held in memory (its
 //! size, not its points', counted against the budget) and checked whole as the reader
-//! checks it, with no limit on its point count; its records are decoded a batch at a
-//! time under `guarded`.
+//! checks it, with no limit on its point count; a chunked one's records are decoded
+//! chunk by chunk in parallel, ahead of the reader ([`super::laz_chunks`]), a point-wise
+//! one's a batch at a time, both under `guarded`.
 
 use std::fs::File;
 use std::io::{BufReader, Cursor, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use las::{PointData, PointDataBuilder, Reader};
 
 use super::check::{check_count, check_head, check_up_to, Checked};
 use super::header::{u32_at, LasInfo, RawVlr};
+use super::laz_chunks::{Decoded, LazChunks};
 use crate::points::{guarded, read_file, PointsError};
 
 /// Bytes of header and VLRs read before the points of an uncompressed file, at most.
@@ -36,10 +39,16 @@ pub(crate) struct CopiedVlr {
 enum Kind {
     /// Uncompressed: the file at the first record.
     Plain { file: BufReader<File>, start: u64 },
-    /// LAZ, decoded from memory.
+    /// LAZ without chunks to decode apart (point-wise), decoded from memory.
     Laz {
         reader: Box<Reader>,
         data: PointData,
+    },
+    /// Chunked LAZ, its chunks decoded in parallel ahead of the reader.
+    Chunked {
+        bytes: Arc<Vec<u8>>,
+        chunks: LazChunks,
+        decoded: Decoded,
     },
 }
 
@@ -120,6 +129,22 @@ impl Records {
             let bytes = read_file(path)?;
             let checked = check_up_to(path, &bytes, u64::MAX)?;
             let vlrs = copied(&bytes, &checked.vlrs);
+            if let Some(chunks) = checked.laz {
+                let bytes = Arc::new(bytes);
+                let record = checked.info.record_length as usize;
+                let decoded = Decoded::start(path, bytes.clone(), chunks.clone(), record);
+                return Ok(Records {
+                    path: path.to_path_buf(),
+                    info: checked.info,
+                    vlrs,
+                    kind: Kind::Chunked {
+                        bytes,
+                        chunks,
+                        decoded,
+                    },
+                    done: 0,
+                });
+            }
             let reader =
                 guarded(|| Reader::new(Cursor::new(bytes))).map_err(|e| PointsError::Decode {
                     path: path.to_path_buf(),
@@ -190,6 +215,16 @@ impl Records {
                 out.extend_from_slice(&data.raw_bytes()[..got as usize * record]);
                 got
             }
+            Kind::Chunked { decoded, .. } => {
+                let got = decoded.next(n, record, out)?;
+                if got == 0 {
+                    return Err(decode(format!(
+                        "the chunks end after {} of the {count} points the header declares",
+                        self.done
+                    )));
+                }
+                got
+            }
         };
         self.done += got;
         Ok(got)
@@ -207,6 +242,14 @@ impl Records {
                     path: self.path.clone(),
                     message: format!("seeking to the first point: {e}"),
                 })?;
+            }
+            Kind::Chunked {
+                bytes,
+                chunks,
+                decoded,
+            } => {
+                let record = self.info.record_length as usize;
+                *decoded = Decoded::start(&self.path, bytes.clone(), chunks.clone(), record);
             }
         }
         self.done = 0;
