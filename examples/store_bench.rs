@@ -401,6 +401,11 @@ fn error(store: &str, n: usize) -> Result<()> {
         "window {lo:?}..{hi:?}: reference in {:.1} s",
         t.elapsed().as_secs_f64()
     );
+    if let Some(codec) = s.lossy() {
+        println!(
+            "the reference is of the decoded values: the survey was compressed lossily ({codec})"
+        );
+    }
     let h = Headless::new(Backend::Egl)?;
     let policies = [
         ("level 0", "level = 0"),

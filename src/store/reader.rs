@@ -174,6 +174,21 @@ impl Store {
         self.mdio.is_some() && self.arrays.is_empty()
     }
 
+    /// How the survey's samples were compressed lossily, where they were (an MDIO
+    /// dataset's ZFP in a lossy mode, read in place or converted): what a reference of
+    /// this store is of, the decoded values, not the survey's own.
+    pub fn lossy(&self) -> Option<String> {
+        if let Some(z) = self.mdio.as_ref().and_then(|m| m.data.zfp.as_ref()) {
+            return z.lossy().then(|| z.describe());
+        }
+        self.meta
+            .source
+            .facts
+            .get("codecs")
+            .filter(|c| c.contains("lossy"))
+            .cloned()
+    }
+
     /// The zarr path of attribute `attr`'s level `level` ([`StoreMeta::array_path`]).
     pub fn array_path(meta: &StoreMeta, attr: usize, level: usize) -> String {
         meta.array_path(attr, level)

@@ -140,6 +140,7 @@ fn every_mdio_flavour_mdio_python_writes_opens() {
                 // Lossless: the SEG-Y's samples, bit for bit.
                 assert_eq!(values, f3.values, "{what}");
                 assert!(!text.contains("lossy"), "{what}: {text}");
+                assert_eq!(store.lossy(), None, "{what}");
             }
             _ => {
                 // Lossy: what zarr-python decodes, bit for bit; inspect says it.
@@ -153,6 +154,7 @@ fn every_mdio_flavour_mdio_python_writes_opens() {
                 );
                 assert_ne!(values, f3.values, "{what}: lossy changes some samples");
                 assert!(text.contains("lossy"), "{what}: {text}");
+                assert!(store.lossy().is_some_and(|c| c.contains("lossy")), "{what}");
             }
         }
         if codec == "reversible" {
@@ -168,6 +170,12 @@ fn every_mdio_flavour_mdio_python_writes_opens() {
         );
         let converted = Store::open(&out).unwrap();
         assert_eq!(level0(&converted), values, "{what}: converted");
+        // A store converted from lossy data says so, as the dataset does.
+        assert_eq!(
+            converted.lossy().is_some(),
+            store.lossy().is_some(),
+            "{what}"
+        );
     }
 }
 
