@@ -111,6 +111,16 @@ for d in names:
 print("same", len(b), len(names))
 "#;
 
+/// [`LASPY_SAME`] on the input and its COPC file: `same POINTS DIMENSIONS`.
+fn laspy_same(input: &Path, out: &Path) -> String {
+    stdout_of(
+        Command::new("python3")
+            .args(["-c", LASPY_SAME])
+            .arg(input)
+            .arg(out),
+    )
+}
+
 #[test]
 fn a_laz_file_becomes_copc_with_every_point_and_attribute() {
     let input = data_file("points/autzen_trim.laz");
@@ -148,12 +158,7 @@ fn a_laz_file_becomes_copc_with_every_point_and_attribute() {
             .collect();
         assert!(left.is_empty(), "{left:?}");
         if has_laspy() {
-            let said = stdout_of(
-                Command::new("python3")
-                    .args(["-c", LASPY_SAME])
-                    .arg(&input)
-                    .arg(&out),
-            );
+            let said = laspy_same(&input, &out);
             assert!(said.starts_with("same 110000"), "{said}");
         }
     }
@@ -479,12 +484,7 @@ fn a_laz_1_4_file_decodes_chunk_by_chunk_with_every_point() {
         &["--memory-points", "40000", "--node-points", "8000"],
     );
     assert!(said.contains("123457 points, point format 7"), "{said}");
-    let same = stdout_of(
-        Command::new("python3")
-            .args(["-c", LASPY_SAME])
-            .arg(&input)
-            .arg(&out),
-    );
+    let same = laspy_same(&input, &out);
     assert!(same.starts_with("same 123457"), "{same}");
     // The header's largest x made too small: a point outside it stops the first pass, the
     // points' own bounds are read in a pass of their own, and the build starts over, the
@@ -500,11 +500,6 @@ fn a_laz_1_4_file_decodes_chunk_by_chunk_with_every_point() {
         &out,
         &["--memory-points", "40000", "--node-points", "8000"],
     );
-    let same = stdout_of(
-        Command::new("python3")
-            .args(["-c", LASPY_SAME])
-            .arg(&input)
-            .arg(&out),
-    );
+    let same = laspy_same(&input, &out);
     assert!(same.starts_with("same 123457"), "{same}");
 }

@@ -15,23 +15,26 @@ use arbvis::store::Store;
 use arbvis::volume::segy;
 
 /// mdio-python's SEG-Y ingestion of the F3 crop's header layout (rev 1: inline at byte 189,
-/// crossline at 193, CDP x/y at 181/185), as its documentation shows it.
-const INGEST: &str = r#"
+/// crossline at 193, CDP x/y at 181/185), as its documentation shows it; written as
+/// `ingest.py`, whose `segy_spec` other tests' scripts import.
+pub(crate) const INGEST: &str = r#"
 import sys
 from mdio import segy_to_mdio
 from mdio.builder.template_registry import get_template
 from segy.standards import get_segy_standard
 from segy.schema import HeaderField
 
-def main():
-    spec = get_segy_standard(1.0).customize(trace_header_fields=[
+def segy_spec():
+    return get_segy_standard(1.0).customize(trace_header_fields=[
         HeaderField(name="inline", byte=189, format="int32"),
         HeaderField(name="crossline", byte=193, format="int32"),
         HeaderField(name="cdp_x", byte=181, format="int32"),
         HeaderField(name="cdp_y", byte=185, format="int32"),
     ])
+
+def main():
     template = sys.argv[3] if len(sys.argv) > 3 else "PostStack3DTime"
-    segy_to_mdio(segy_spec=spec, mdio_template=get_template(template),
+    segy_to_mdio(segy_spec=segy_spec(), mdio_template=get_template(template),
                  input_path=sys.argv[1], output_path=sys.argv[2], overwrite=True)
 
 if __name__ == "__main__":

@@ -25,7 +25,8 @@ fn has_mdio_zfp() -> bool {
 }
 
 /// mdio-python ingests the F3 crop (`argv[1]`) into `argv[2]` on zarr format `argv[3]`
-/// with the amplitude compressed by `argv[4]`: `blosc` (mdio's default) or a ZFP mode;
+/// (the header layout of `mdio.rs`'s `ingest.py`, beside it) with the amplitude
+/// compressed by `argv[4]`: `blosc` (mdio's default) or a ZFP mode;
 /// then zarr-python's decoding of the amplitude goes to `argv[2].f32` (inline, crossline,
 /// time; little-endian).
 const INGEST: &str = r#"
@@ -43,8 +44,7 @@ from mdio.builder.schemas.compressors import ZFP, ZFPMode
 from mdio.builder.schemas.dtype import ScalarType
 from mdio.builder.schemas.chunk_grid import RegularChunkGrid, RegularChunkShape
 from mdio.builder.schemas.v1.variable import VariableMetadata
-from segy.standards import get_segy_standard
-from segy.schema import HeaderField
+from ingest import segy_spec
 
 ZFPS = {
     "reversible": ZFP(mode=ZFPMode.REVERSIBLE),
@@ -64,14 +64,8 @@ class ZfpPostStack(Seismic3DPostStackTemplate):
             metadata=VariableMetadata(chunk_grid=grid, units_v1=self.get_unit_by_key(self._default_variable_name)))
 
 def main():
-    spec = get_segy_standard(1.0).customize(trace_header_fields=[
-        HeaderField(name="inline", byte=189, format="int32"),
-        HeaderField(name="crossline", byte=193, format="int32"),
-        HeaderField(name="cdp_x", byte=181, format="int32"),
-        HeaderField(name="cdp_y", byte=185, format="int32"),
-    ])
     template = get_template("PostStack3DTime") if codec == "blosc" else ZfpPostStack("time")
-    segy_to_mdio(segy_spec=spec, mdio_template=template, input_path=sgy, output_path=out, overwrite=True)
+    segy_to_mdio(segy_spec=segy_spec(), mdio_template=template, input_path=sgy, output_path=out, overwrite=True)
     a = zarr.open_group(out, mode="r")["amplitude"][:]
     a.astype("<f4").tofile(out + ".f32")
 
@@ -80,7 +74,8 @@ if __name__ == "__main__":
 "#;
 
 fn ingest(dir: &Path, format: u8, codec: &str) -> PathBuf {
-    let script = dir.join("ingest.py");
+    std::fs::write(dir.join("ingest.py"), crate::mdio::INGEST).unwrap();
+    let script = dir.join("flavour.py");
     std::fs::write(&script, INGEST).unwrap();
     let out = dir.join(format!("f3-{codec}-v{format}.mdio"));
     stdout_of(

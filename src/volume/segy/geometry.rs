@@ -192,20 +192,18 @@ mod tests {
         h
     }
 
+    /// The header of trace (k, j) of a grid rotated 30 degrees, 12.5 m crossline and 37.5 m
+    /// inline steps, scalar -100.
+    fn rotated(k: usize, j: usize) -> [u8; 240] {
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let (u, v) = (j as f64 * 12.5, k as f64 * 37.5);
+        let (x, y) = (500_000.0 + u * c - v * s, 6_000_000.0 + u * s + v * c);
+        header((x * 100.0).round() as i32, (y * 100.0).round() as i32, -100)
+    }
+
     #[test]
     fn steps_from_rotated_corner_coordinates() {
-        // A grid rotated 30 degrees, 12.5 m crossline and 37.5 m inline steps, scalar -100.
-        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
-        let at = |k: usize, j: usize| {
-            let (u, v) = (j as f64 * 12.5, k as f64 * 37.5);
-            let (x, y) = (500_000.0 + u * c - v * s, 6_000_000.0 + u * s + v * c);
-            Some(header(
-                (x * 100.0).round() as i32,
-                (y * 100.0).round() as i32,
-                -100,
-            ))
-        };
-        let g = geometry(2000, 7, 5, true, &[], at);
+        let g = geometry(2000, 7, 5, true, &[], |k, j| Some(rotated(k, j)));
         assert_eq!(g.bins, BinsFrom::Coordinates);
         assert!(
             (g.spacing[1] - 12.5).abs() < 1e-3 && (g.spacing[2] - 37.5).abs() < 1e-3,
@@ -247,19 +245,7 @@ mod tests {
     fn a_missing_corner_fits_the_steps_through_the_live_traces() {
         // The rotated grid again, its (0, 0) corner dead: the plane through the live
         // traces at the spread gives the same steps.
-        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
-        let at = |k: usize, j: usize| {
-            if k < 2 && j < 3 {
-                return None;
-            }
-            let (u, v) = (j as f64 * 12.5, k as f64 * 37.5);
-            let (x, y) = (500_000.0 + u * c - v * s, 6_000_000.0 + u * s + v * c);
-            Some(header(
-                (x * 100.0).round() as i32,
-                (y * 100.0).round() as i32,
-                -100,
-            ))
-        };
+        let at = |k: usize, j: usize| (k >= 2 || j >= 3).then(|| rotated(k, j));
         let spread = [(0, 3), (0, 6), (2, 0), (2, 6), (4, 0), (4, 6)];
         let g = geometry(2000, 7, 5, true, &spread, at);
         assert_eq!(g.bins, BinsFrom::Coordinates);
