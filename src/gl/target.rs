@@ -73,6 +73,28 @@ pub fn clear(gpu: &Gpu, surface: Surface<'_>, rgba: [f32; 4]) -> GlResult<()> {
     crate::gl_check!(gpu)
 }
 
+/// A framebuffer's colour attachment made: its status checked (complete), GL's errors
+/// checked, and its bytes recorded as `what` (`target`, `second colour`).
+fn completed(
+    gpu: &Gpu,
+    status: u32,
+    what: &str,
+    width: u32,
+    height: u32,
+    format: TargetFormat,
+) -> GlResult<()> {
+    if status != glow::FRAMEBUFFER_COMPLETE {
+        return Err(GlError::Framebuffer(status));
+    }
+    crate::gl_check!(gpu)?;
+    gpu.record(
+        "framebuffer",
+        format!("{what} {width}x{height} {}", format.name()),
+        width as u64 * height as u64 * format.bytes_per_pixel(),
+    );
+    Ok(())
+}
+
 /// An owned framebuffer with one colour texture (or two: a fragment program's outputs 0
 /// and 1) and, when asked for, a 24-bit depth buffer; deleted on Drop (the framebuffer
 /// first, then the textures it held).
@@ -135,15 +157,7 @@ impl Target {
             status
         };
         target.second = Some(second);
-        if status != glow::FRAMEBUFFER_COMPLETE {
-            return Err(GlError::Framebuffer(status));
-        }
-        crate::gl_check!(gpu)?;
-        gpu.record(
-            "framebuffer",
-            format!("second colour {width}x{height} {}", format.name()),
-            width as u64 * height as u64 * format.bytes_per_pixel(),
-        );
+        completed(gpu, status, "second colour", width, height, format)?;
         Ok(target)
     }
 
@@ -218,15 +232,7 @@ impl Target {
             height,
             format,
         };
-        if status != glow::FRAMEBUFFER_COMPLETE {
-            return Err(GlError::Framebuffer(status));
-        }
-        crate::gl_check!(gpu)?;
-        gpu.record(
-            "framebuffer",
-            format!("target {width}x{height} {}", format.name()),
-            width as u64 * height as u64 * format.bytes_per_pixel(),
-        );
+        completed(gpu, status, "target", width, height, format)?;
         if with_depth {
             gpu.record(
                 "renderbuffer",
