@@ -7,6 +7,8 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 
+mod cli;
+
 use arbvis::gl::{Backend, Headless, ProgramChoice, TargetFormat};
 use arbvis::scene::{parse_size, Fidelity, Scene};
 
@@ -38,7 +40,7 @@ enum Command {
     /// Print the GL driver, its profile, ARB program support and native limits.
     Info {
         /// Offscreen backend to ask.
-        #[arg(long, value_enum, default_value_t = Backend::Egl)]
+        #[arg(long, value_parser = cli::backend(), default_value = "egl")]
         backend: Backend,
         /// Print JSON instead of text.
         #[arg(long)]
@@ -52,7 +54,7 @@ enum Command {
         #[arg(short, long, value_parser = png_path)]
         output: Option<PathBuf>,
         /// Offscreen backend.
-        #[arg(long, value_enum, default_value_t = Backend::Egl)]
+        #[arg(long, value_parser = cli::backend(), default_value = "egl")]
         backend: Backend,
         /// Print every GL resource created, with its bytes, and the timings.
         #[arg(long)]
@@ -94,16 +96,16 @@ enum Command {
         #[command(flatten)]
         scene: SceneArgs,
         #[command(flatten)]
-        options: arbvis::study::bench::BenchOptions,
+        options: cli::BenchArgs,
         /// Print JSON instead of text.
         #[arg(long)]
         json: bool,
         /// How to look at the scene: its own camera, or an axis-aligned, rotated or
         /// perspective view.
-        #[arg(long, value_enum, default_value_t = arbvis::study::bench::View::File)]
+        #[arg(long, value_parser = cli::view(), default_value = "file")]
         view: arbvis::study::bench::View,
         /// Offscreen backend.
-        #[arg(long, value_enum, default_value_t = Backend::Egl)]
+        #[arg(long, value_parser = cli::backend(), default_value = "egl")]
         backend: Backend,
     },
     /// Measure what a technique trades between speed and accuracy, and plot it.
@@ -462,7 +464,7 @@ struct SweepArgs {
     #[arg(long, default_value_t = 3)]
     frames: usize,
     /// Offscreen backend.
-    #[arg(long, value_enum, default_value_t = Backend::Egl)]
+    #[arg(long, value_parser = cli::backend(), default_value = "egl")]
     backend: Backend,
 }
 
@@ -508,13 +510,13 @@ struct SceneArgs {
     #[arg(long, value_parser = parse_size)]
     size: Option<[u32; 2]>,
     /// Program kind: arb, glsl, or auto (ARB where the driver has it).
-    #[arg(long, value_enum, ignore_case = true)]
+    #[arg(long, value_parser = cli::programs(), ignore_case = true)]
     programs: Option<ProgramChoice>,
     /// Faithful (original programs, 8-bit) or precise (corrected, float).
-    #[arg(long, value_enum, ignore_case = true)]
+    #[arg(long, value_parser = cli::fidelity(), ignore_case = true)]
     fidelity: Option<Fidelity>,
     /// Colour target precision (default from fidelity).
-    #[arg(long, value_enum, ignore_case = true)]
+    #[arg(long, value_parser = cli::target(), ignore_case = true)]
     target: Option<TargetFormat>,
     /// Transparent background: straight colour with alpha = coverage (default: opaque,
     /// what the screen shows).
@@ -823,6 +825,7 @@ fn run(cli: Cli) -> Result<()> {
             view,
             backend,
         } => {
+            let options = arbvis::study::bench::BenchOptions::from(options);
             options.check()?;
             let (scene, origin) = scene.load()?;
             let scene = view.apply(&scene);

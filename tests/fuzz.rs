@@ -28,9 +28,9 @@
 
 #[path = "it/common/mod.rs"]
 mod common;
-#[path = "../src/mesh/tests/fixtures.rs"]
+#[path = "../crates/arbvis-data/src/mesh/tests/fixtures.rs"]
 mod mesh_fixtures;
-#[path = "../src/mesh/tests/hostile_files.rs"]
+#[path = "../crates/arbvis-data/src/mesh/tests/hostile_files.rs"]
 mod mesh_hostile;
 
 use std::alloc::{GlobalAlloc, Layout, System};

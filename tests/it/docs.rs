@@ -155,12 +155,13 @@ fn words(text: &str) -> Vec<String> {
 /// The repository's own top-level entries that the documents' commands read. Only these are
 /// linked into a working folder: whatever else a user's clone holds (the `f3.zarr` or
 /// `product.png` that following the README leaves) must not change what a command does.
-const REPOSITORY_ENTRIES: [&str; 11] = [
+const REPOSITORY_ENTRIES: [&str; 12] = [
     "ARCHITECTURE.md",
     "Cargo.lock",
     "Cargo.toml",
     "README.md",
     "benches",
+    "crates",
     "data",
     "docs",
     "examples",

@@ -332,7 +332,7 @@ fn the_budget_comes_from_the_flag_then_the_environment_then_the_scene() {
 
 // --- issue 17: meshes ---
 
-#[path = "../../src/mesh/tests/hostile_files.rs"]
+#[path = "../../crates/arbvis-data/src/mesh/tests/hostile_files.rs"]
 mod mesh_hostile;
 
 /// Run `arbvis ARGS` with `env`, killing it (and failing: a hang must fail the test, not

@@ -1,11 +1,14 @@
-//! The house's rule, kept by a test: imports run one way. Every file of `src/` belongs to
-//! a layer (the table [`LAYERS`], drawn in ARCHITECTURE.md), and a file may import only
-//! from its own layer or the ones below; and no files import each other in a circle, in
-//! any layer. A `pub use` re-export is a door, not a use, and test code (`#[cfg(test)]`
-//! items and the files they declare) may reach anywhere.
+//! The house's rule, kept by a test: imports run one way. The workspace's crates are the
+//! coarse layers, and Cargo keeps their order; inside them, every file belongs to a layer
+//! (the table [`LAYERS`]; ARCHITECTURE.md gives it crate by crate), and a file may import
+//! only from its own layer or the ones below; and no files import each other in a circle,
+//! in any layer.
+//! A `pub use` re-export is a door, not a use, and test code (`#[cfg(test)]` items and the
+//! files they declare) may reach anywhere.
 //!
+//! The crates are read as one module tree, as the `arbvis` library names them ([`CRATES`]).
 //! The imports are read from the text: `use` trees, and `crate::`, `super::` and `self::`
-//! paths anywhere in the code, resolved to the longest module of `src/` they name.
+//! paths anywhere in the code, resolved to the longest module they name.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
@@ -39,7 +42,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ),
     ("studies", &["study", "techniques::*::study"]),
     ("the viewer", &["viewer"]),
-    ("the crate root and the binary", &["", "main"]),
+    ("the crate root and the binary", &["", "main", "cli"]),
 ];
 
 type ModPath = Vec<String>;
@@ -359,19 +362,107 @@ struct Graph {
     files: BTreeMap<ModPath, String>,
 }
 
+/// The workspace's crates as one module tree: each crate's folder of sources and the
+/// module its root stands for (`None`: its modules sit at the top, as `arbvis` names them).
+/// A crate's `lib.rs` other than a module's own only declares its modules and names the
+/// crates below (Cargo.toml keeps the crates' order), so it is not read.
+const CRATES: [(&str, Option<&str>); 6] = [
+    ("src", None),
+    ("crates/arbvis-core/src", None),
+    ("crates/arbvis-gl/src", Some("gl")),
+    ("crates/arbvis-data/src", None),
+    ("crates/arbvis-techniques/src", None),
+    ("crates/arbvis-viewer/src", Some("viewer")),
+];
+
+/// The top-level modules of the crates below that a crate's root names for its files
+/// (`crate::scene` in the viewer is arbvis-techniques' `scene`).
+const NAMED_FROM_BELOW: [&str; 23] = [
+    "budget",
+    "camera",
+    "colortable",
+    "image",
+    "input",
+    "png_io",
+    "progress",
+    "vocab",
+    "gl",
+    "mesh",
+    "points",
+    "store",
+    "surface",
+    "volume",
+    "annotate",
+    "catalog",
+    "info",
+    "inspect",
+    "programs",
+    "render",
+    "scene",
+    "study",
+    "techniques",
+];
+
+/// A file's text with its paths written as in one crate: `crate::` inside a crate that is a
+/// module (`gl`, `viewer`) gains that module, and the crates below are named as `crate::`.
+fn as_one_crate(text: &str, own: Option<&str>) -> String {
+    let mut text = text.to_string();
+    if let Some(own) = own {
+        let mut out = String::with_capacity(text.len());
+        let mut rest = text.as_str();
+        while let Some(at) = rest.find("crate::") {
+            out.push_str(&rest[..at + "crate::".len()]);
+            rest = &rest[at + "crate::".len()..];
+            let word: String = rest
+                .chars()
+                .take_while(|c| c.is_alphanumeric() || *c == '_')
+                .collect();
+            if !NAMED_FROM_BELOW.contains(&word.as_str()) {
+                out.push_str(own);
+                out.push_str("::");
+            }
+        }
+        out.push_str(rest);
+        text = out;
+    }
+    for (name, module) in [
+        ("arbvis_core::", "crate::"),
+        ("arbvis_data::", "crate::"),
+        ("arbvis_techniques::", "crate::"),
+        ("arbvis_gl::", "crate::gl::"),
+        ("arbvis_viewer::", "crate::viewer::"),
+    ] {
+        text = text.replace(name, module);
+    }
+    text
+}
+
 fn read_graph() -> Graph {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut sources = BTreeMap::new();
-    let mut stack = vec![src.clone()];
-    while let Some(dir) = stack.pop() {
-        for entry in std::fs::read_dir(&dir).unwrap() {
-            let path = entry.unwrap().path();
-            if path.is_dir() {
-                stack.push(path);
-            } else if path.extension().is_some_and(|e| e == "rs") {
-                let rel = path.strip_prefix(&src).unwrap().to_path_buf();
-                let text = std::fs::read_to_string(&path).unwrap();
-                sources.insert(module_of(&rel), (rel.display().to_string(), text));
+    for (folder, own) in CRATES {
+        let src = root.join(folder);
+        let mut stack = vec![src.clone()];
+        while let Some(dir) = stack.pop() {
+            for entry in std::fs::read_dir(&dir).unwrap() {
+                let path = entry.unwrap().path();
+                if path.is_dir() {
+                    stack.push(path);
+                } else if path.extension().is_some_and(|e| e == "rs") {
+                    let rel = path.strip_prefix(&src).unwrap().to_path_buf();
+                    let is_root = rel == Path::new("lib.rs");
+                    if is_root && own.is_none() && folder != "src" {
+                        continue;
+                    }
+                    let mut module: ModPath = own.iter().map(|m| m.to_string()).collect();
+                    module.extend(module_of(&rel));
+                    let text = as_one_crate(&std::fs::read_to_string(&path).unwrap(), own);
+                    let file = Path::new(folder).join(&rel).display().to_string();
+                    assert!(
+                        sources.insert(module.clone(), (file, text)).is_none(),
+                        "two files are module {module:?}"
+                    );
+                }
             }
         }
     }
@@ -421,7 +512,7 @@ fn every_file_has_a_layer_and_imports_only_downward() {
     for (module, targets) in &g.edges {
         let Some(mine) = layer_of(module) else {
             problems.push(format!(
-                "{} ({}) has no layer: add it to LAYERS in tests/layers.rs and to ARCHITECTURE.md",
+                "{} ({}) has no layer: add it to LAYERS in tests/it/layers.rs and to its crate in ARCHITECTURE.md",
                 name(module),
                 g.files[module]
             ));

@@ -1,0 +1,24 @@
+//! arbvis's techniques — v3o2's 3D opacity, isosurfaces and volumes by cell projection,
+//! multi-resolution clip textures and point-based geological sections — each with its CPU
+//! preparation, GL renderer and f64 CPU reference ([`techniques`]); the program texts
+//! ([`programs`]); the one list of them ([`catalog`]); scenes ([`scene`]), offscreen
+//! rendering ([`render`], [`annotate`]), `inspect` and `info`, and the studies ([`study`]).
+
+#![deny(unsafe_code)]
+
+// The layers below, named as this crate's files name them (`crate::volume`, `crate::gl`, ...).
+#[allow(unused_imports)]
+use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, vocab};
+#[allow(unused_imports)]
+use arbvis_data::{mesh, points, store, surface, volume};
+use arbvis_gl as gl;
+
+pub mod annotate;
+pub mod catalog;
+pub mod info;
+pub mod inspect;
+pub mod programs;
+pub mod render;
+pub mod scene;
+pub mod study;
+pub mod techniques;

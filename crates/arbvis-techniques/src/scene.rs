@@ -1,0 +1,674 @@
+//! The scene model: one technique, its parameters, camera, size, fidelity, program kind
+//! and target precision, read from TOML. Technique issues add variants to
+//! [`TechniqueScene`]; a renderer builds only what its scene names.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::camera::Camera;
+pub use crate::catalog::TechniqueScene;
+use crate::gl::{ProgramChoice, TargetFormat};
+pub use crate::vocab::{Fidelity, FieldError};
+
+/// A whole scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Image size in pixels `[width, height]`.
+    #[serde(default = "default_size")]
+    pub size: [u32; 2],
+    /// Faithful or precise.
+    #[serde(default)]
+    pub fidelity: Fidelity,
+    /// ARB, GLSL or auto.
+    #[serde(default)]
+    pub programs: ProgramChoice,
+    /// Colour target; by default RGBA8 when faithful, RGBA32F when precise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<TargetFormat>,
+    /// Clear colour, RGBA.
+    #[serde(default)]
+    pub background: [f32; 4],
+    /// Write pictures with a transparent background (straight colour, alpha = coverage)
+    /// instead of what the screen shows (opaque, composited over `background`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub transparent: bool,
+    /// The camera.
+    #[serde(default)]
+    pub camera: Camera,
+    /// Draw the colour tables (with their value ranges) and keys into offscreen pictures
+    /// (`crate::annotate`); off, so that a picture holds the renderer's pixels alone.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub legend: bool,
+    /// Draw the box's axes with ticks in the data's own numbers into offscreen pictures.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub axes: bool,
+    /// The memory budget this scene asks for (`"16G"`, `"75%"`): taken where neither
+    /// `--memory-budget` nor `ARBVIS_MEMORY_BUDGET` sets one ([`crate::budget`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub memory_budget: Option<String>,
+    /// How to get the scene's data where it is not in the clone (a download or a
+    /// conversion command), said when a file the scene reads is missing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub data_from: Option<String>,
+    /// The technique and its parameters.
+    pub technique: TechniqueScene,
+    /// Folder that relative data paths are read from: the scene file's folder, or the
+    /// current folder for demos and scenes given as text.
+    #[serde(skip)]
+    pub base: std::path::PathBuf,
+}
+
+/// A data file a scene reads ([`Scene::data_files`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DataFile {
+    /// The dotted key that names it, e.g. `technique.opacity3d.primary.volume.segy`.
+    pub key: String,
+    /// The path as the scene writes it.
+    pub written: std::path::PathBuf,
+    /// The path as read: against the scene's folder, absolute.
+    pub resolved: std::path::PathBuf,
+}
+
+impl Scene {
+    /// `error` with the scene's `data_from` hint added when a file it reads is missing.
+    pub fn explain_missing(&self, error: String) -> String {
+        match &self.data_from {
+            Some(how) if error.contains("no such file") || error.contains("No such file") => {
+                format!("{error}\n  this scene's data is not in the clone: {how}")
+            }
+            _ => error,
+        }
+    }
+}
+
+fn default_size() -> [u32; 2] {
+    [256, 256]
+}
+
+/// Errors reading a scene; each names the file and, for syntax, the line and column.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The file could not be read (not named `source`, so that a `{:#}` chain does not
+    /// print the OS error twice).
+    #[error("{path}: {error}")]
+    Io {
+        /// The scene file.
+        path: String,
+        /// What failed.
+        error: std::io::Error,
+    },
+    /// TOML syntax or a value of the wrong shape.
+    #[error("{path}:{line}:{column}: {message}")]
+    Parse {
+        /// The scene file.
+        path: String,
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What was expected.
+        message: String,
+    },
+    /// Values that parse but cannot be rendered, at the key that holds them.
+    #[error("{path}:{line}:{column}: {key}: {message}")]
+    Invalid {
+        /// The scene file.
+        path: String,
+        /// 1-based line of the key (or of its nearest table present in the text).
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// Dotted key, e.g. `technique.opacity3d.slices`.
+        key: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// No built-in demo of that name.
+    #[error("no demo named {0:?}; demos: {demos}", demos = DEMOS.iter().map(|d| d.0).collect::<Vec<_>>().join(", "))]
+    UnknownDemo(String),
+}
+
+/// Built-in demos: name and scene text (files under `scenes/demo/`).
+pub const DEMOS: &[(&str, &str)] = &[
+    ("quad", include_str!("../../../scenes/demo/quad.toml")),
+    (
+        "v3o2-sum",
+        include_str!("../../../scenes/demo/v3o2-sum.toml"),
+    ),
+    (
+        "v3o2-product",
+        include_str!("../../../scenes/demo/v3o2-product.toml"),
+    ),
+    (
+        "cellproj-planar",
+        include_str!("../../../scenes/demo/cellproj-planar.toml"),
+    ),
+    (
+        "cellproj-spherical",
+        include_str!("../../../scenes/demo/cellproj-spherical.toml"),
+    ),
+    (
+        "cellproj-spherical-precise",
+        include_str!("../../../scenes/demo/cellproj-spherical-precise.toml"),
+    ),
+    (
+        "splats-section",
+        include_str!("../../../scenes/demo/splats-section.toml"),
+    ),
+    (
+        "splats-section-precise",
+        include_str!("../../../scenes/demo/splats-section-precise.toml"),
+    ),
+    (
+        "clip-sphere",
+        include_str!("../../../scenes/demo/clip-sphere.toml"),
+    ),
+    (
+        "clip-mesh",
+        include_str!("../../../scenes/demo/clip-mesh.toml"),
+    ),
+];
+
+impl Scene {
+    /// Parse scene text; `origin` names it in errors.
+    pub fn parse(text: &str, origin: &str) -> Result<Scene, SceneError> {
+        let scene: Scene = toml::from_str(text).map_err(|e| {
+            let start = e.span().map_or(0, |s| s.start);
+            let (line, column) = line_column(text, start);
+            SceneError::Parse {
+                path: origin.to_string(),
+                line,
+                column,
+                message: parse_message(text, start, e.message()),
+            }
+        })?;
+        let mut scene = scene;
+        // Defaults that depend on the data the scene names, for the keys it leaves out.
+        if let Ok(written) = text.parse::<toml::Table>() {
+            let written = |key: &str| is_written(&written, key);
+            let Scene {
+                technique,
+                camera,
+                fidelity,
+                ..
+            } = &mut scene;
+            technique.unwritten_defaults(&written, camera, fidelity);
+        }
+        let checked = longer_arrays(text, &scene).map_or_else(|| scene.validate(), Err);
+        checked.map_err(|e| {
+            let (line, column) = key_position(text, &e.key);
+            SceneError::Invalid {
+                path: origin.to_string(),
+                line,
+                column,
+                key: e.key,
+                message: crate::input::shorten(&e.message, MESSAGE_CHARS),
+            }
+        })?;
+        Ok(scene)
+    }
+
+    /// Read and parse a scene file (a regular file of at most
+    /// [`crate::input::MAX_SCENE_BYTES`], UTF-8).
+    pub fn load(path: &Path) -> Result<Scene, SceneError> {
+        let text =
+            crate::input::read_text(path, crate::input::MAX_SCENE_BYTES).map_err(|error| {
+                SceneError::Io {
+                    path: path.display().to_string(),
+                    error,
+                }
+            })?;
+        let mut scene = Scene::parse(&text, &path.display().to_string())?;
+        scene.base = path.parent().map(Path::to_path_buf).unwrap_or_default();
+        Ok(scene)
+    }
+
+    /// [`Scene::load`], and every data file it reads found ([`Scene::check_data_files`]):
+    /// what the command line does before it renders, views or benches a scene.
+    pub fn load_checked(path: &Path) -> Result<Scene, SceneError> {
+        let scene = Scene::load(path)?;
+        let text = crate::input::read_text(path, crate::input::MAX_SCENE_BYTES).ok();
+        scene.check_data_files(&path.display().to_string(), text.as_deref())?;
+        Ok(scene)
+    }
+
+    /// A built-in demo scene.
+    pub fn demo(name: &str) -> Result<Scene, SceneError> {
+        let (_, text) = DEMOS
+            .iter()
+            .find(|(n, _)| *n == name)
+            .ok_or_else(|| SceneError::UnknownDemo(name.to_string()))?;
+        Scene::parse(text, &format!("demo:{name}"))
+    }
+
+    /// The scene as TOML (what the viewer saves).
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).unwrap_or_else(|e| format!("# cannot serialize: {e}\n"))
+    }
+
+    /// Call `f` on every data file the scene names (volumes, table files, clip meshes and
+    /// masks, meshes, clouds), with the dotted key that holds it.
+    pub fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut std::path::PathBuf)) {
+        match &mut self.technique {
+            TechniqueScene::Opacity3d(o) => {
+                let names = ["primary", "secondary", "tertiary"];
+                for (attr, name) in o.attributes_mut().into_iter().zip(names) {
+                    let Some(attr) = attr else { continue };
+                    let kind = attr.volume.kind();
+                    if let Some(p) = attr.volume.path_mut() {
+                        f(&format!("technique.opacity3d.{name}.volume.{kind}"), p);
+                    }
+                    if let Some(p) = &mut attr.table.file {
+                        f(&format!("technique.opacity3d.{name}.table.file"), p);
+                    }
+                }
+                if let Some(clip) = &mut o.clip {
+                    clip.shape
+                        .for_each_path(&mut |p| f("technique.opacity3d.clip.shape", p));
+                }
+            }
+            TechniqueScene::Cellproj(c) => {
+                if let Some(p) = c.mesh.path_mut() {
+                    f("technique.cellproj.mesh.file", p);
+                }
+            }
+            TechniqueScene::Splats(s) => {
+                let kind = s.cloud.kind();
+                if let Some(p) = s.cloud.path_mut() {
+                    f(&format!("technique.splats.cloud.{kind}"), p);
+                }
+            }
+            TechniqueScene::Quad(_) => {}
+        }
+    }
+
+    /// Every data file the scene reads: its key, the path as written and as resolved
+    /// against [`Scene::base`].
+    pub fn data_files(&self) -> Vec<DataFile> {
+        let mut files = Vec::new();
+        let base = self.base.clone();
+        self.clone().for_each_data_path(&mut |key, p| {
+            files.push(DataFile {
+                key: key.to_string(),
+                written: p.clone(),
+                resolved: std::path::absolute(base.join(&*p)).unwrap_or_else(|_| base.join(&*p)),
+            })
+        });
+        files
+    }
+
+    /// The first data file the scene reads that does not exist, as an error naming its
+    /// key (at its line in `text`, the scene's own text, where given), the path as
+    /// written and as resolved, and the scene's `data_from` hint.
+    pub fn check_data_files(&self, origin: &str, text: Option<&str>) -> Result<(), SceneError> {
+        let Some(missing) = self.data_files().into_iter().find(|f| !f.resolved.exists()) else {
+            return Ok(());
+        };
+        let (line, column) = text.map_or((1, 1), |t| key_position(t, &missing.key));
+        let relative = if missing.written.is_absolute() {
+            String::new()
+        } else {
+            " (a scene's data paths are relative to the scene's folder)".to_string()
+        };
+        Err(SceneError::Invalid {
+            path: origin.to_string(),
+            line,
+            column,
+            key: missing.key,
+            message: self.explain_missing(format!(
+                "no such file: {:?} as written, {} as resolved{relative}",
+                missing.written.display().to_string(),
+                missing.resolved.display()
+            )),
+        })
+    }
+
+    /// A copy whose relative data paths are made absolute against [`Scene::base`], so it
+    /// can be saved anywhere.
+    pub fn with_absolute_paths(&self) -> Scene {
+        let mut scene = self.clone();
+        let base = std::path::absolute(&self.base).unwrap_or_else(|_| self.base.clone());
+        scene.for_each_data_path(&mut |_, p| *p = base.join(&*p));
+        scene.base = base;
+        scene
+    }
+
+    /// The colour a frame is cleared to: transparent black for transparent pictures
+    /// (colour then accumulates premultiplied), else the background.
+    pub fn clear_colour(&self) -> [f32; 4] {
+        if self.transparent {
+            [0.0; 4]
+        } else {
+            self.background
+        }
+    }
+
+    /// A frame as the scene's pictures show it: opaque, or straight colour with
+    /// coverage alpha when `transparent`.
+    pub fn picture(&self, frame: &crate::image::Image) -> crate::image::Image {
+        if self.transparent {
+            frame.unpremultiplied()
+        } else {
+            frame.opaque()
+        }
+    }
+
+    /// The scene's `memory_budget` in bytes, if it names one.
+    pub fn memory_budget_bytes(&self) -> Result<Option<u64>, FieldError> {
+        self.memory_budget
+            .as_deref()
+            .map(crate::budget::parse)
+            .transpose()
+            .map_err(|m| FieldError::new("memory_budget", m))
+    }
+
+    /// What a renderer needs of the scene besides its technique's parameters.
+    pub fn settings(&self) -> crate::catalog::Settings<'_> {
+        crate::catalog::Settings {
+            fidelity: self.fidelity,
+            programs: self.programs,
+            base: &self.base,
+            projection: self.camera.projection,
+            view: crate::points::copc_lod::View::of(&self.camera, self.size),
+        }
+    }
+
+    /// The large allocations rendering this scene makes that the scene alone determines:
+    /// the target, with `read_back` the frame read back and written (f32 RGBA, a flipped
+    /// copy, the picture, the PNG's rows), and the technique's generated data.
+    pub fn memory_estimate(&self, read_back: bool) -> Vec<crate::budget::Estimate> {
+        use crate::budget::Estimate;
+        let [w, h] = self.size;
+        let pixels = w as u64 * h as u64;
+        let format = self.target_format();
+        let mut out = vec![Estimate::of(
+            format!("the {w}x{h} {} target", format.name()),
+            pixels,
+            format.bytes_per_pixel() + 4,
+        )];
+        if read_back {
+            out.push(Estimate::of(
+                format!("reading back and writing the {w}x{h} frame"),
+                pixels,
+                BYTES_PER_READ_PIXEL,
+            ));
+        }
+        out.extend(self.technique.memory_estimate(self.size));
+        out
+    }
+
+    /// The target precision in effect.
+    pub fn target_format(&self) -> TargetFormat {
+        self.target.unwrap_or(self.fidelity.default_target())
+    }
+
+    /// Check values that parse but cannot be rendered; the error names the key.
+    pub fn validate(&self) -> Result<(), FieldError> {
+        let [w, h] = self.size;
+        if !(1..=16384).contains(&w) || !(1..=16384).contains(&h) {
+            return Err(FieldError::new(
+                "size",
+                format!("{w}x{h}: each side must be 1..=16384"),
+            ));
+        }
+        if self.background.iter().any(|v| !v.is_finite()) {
+            return Err(FieldError::new("background", "must be finite"));
+        }
+        self.memory_budget_bytes()?;
+        match &self.technique {
+            TechniqueScene::Opacity3d(o) => {
+                o.validate().map_err(|e| e.within("technique.opacity3d"))
+            }
+            TechniqueScene::Cellproj(c) => c.validate().map_err(|e| e.within("technique.cellproj")),
+            TechniqueScene::Splats(s) => {
+                s.validate().map_err(|e| e.within("technique.splats"))?;
+                s.draw_allowed(self.fidelity, self.programs)
+                    .map_err(|e| e.within("technique.splats"))
+            }
+            TechniqueScene::Quad(_) => Ok(()),
+        }
+    }
+}
+
+/// CPU memory per pixel of a frame read back and written: f32 RGBA as read (16 bytes),
+/// flipped to top-down (16), the picture made from it (16), and the PNG's 16-bit rows (8).
+/// Measured with the target: peak resident memory of a release `arbvis render --demo quad`
+/// grows by 39 bytes a pixel from 2048² to 4096² faithful and 62.5 precise (estimated 64
+/// and 76 with the target's bytes; `/usr/bin/time -f %M`, the 2-core machine).
+pub const BYTES_PER_READ_PIXEL: u64 = 56;
+
+/// Longest message quoted from a scene error (a 50 MB key must not reach the terminal).
+const MESSAGE_CHARS: usize = 300;
+
+/// Line and column of the dotted `key` in `text`, or of its longest prefix that the text
+/// spells out (a value left at its default has no position of its own).
+/// An array in the scene text with more values than its field holds (`size = [32, 32,
+/// 5]`, a quaternion where Euler degrees are read): the TOML reader fills fixed-size
+/// fields from the first values and drops the rest without a word, so the parsed scene,
+/// written back, is compared with the text and the first longer array is an error.
+fn longer_arrays(text: &str, scene: &Scene) -> Option<FieldError> {
+    let original: toml::Table = text.parse().ok()?;
+    let parsed = toml::Value::try_from(scene).ok()?;
+    compare_lengths(&toml::Value::Table(original), &parsed, "")
+}
+
+fn compare_lengths(original: &toml::Value, parsed: &toml::Value, key: &str) -> Option<FieldError> {
+    use toml::Value::{Array, Table};
+    match (original, parsed) {
+        (Array(a), Array(b)) => {
+            if a.len() > b.len() {
+                return Some(FieldError::new(
+                    key,
+                    format!(
+                        "{} values where {} are read (the rest would be ignored)",
+                        a.len(),
+                        b.len()
+                    ),
+                ));
+            }
+            a.iter()
+                .zip(b)
+                .find_map(|(x, y)| compare_lengths(x, y, key))
+        }
+        (Table(a), Table(b)) => a.iter().find_map(|(k, v)| {
+            let sub = if key.is_empty() {
+                k.clone()
+            } else {
+                format!("{key}.{k}")
+            };
+            b.get(k).and_then(|w| compare_lengths(v, w, &sub))
+        }),
+        _ => None,
+    }
+}
+
+fn key_position(text: &str, key: &str) -> (usize, usize) {
+    use toml::de::{DeTable, DeValue};
+    let Ok(root) = DeTable::parse(text) else {
+        return (1, 1);
+    };
+    let mut table = root.get_ref();
+    let mut at = 0;
+    for part in key.split('.') {
+        let Some((k, v)) = table.get_key_value(part) else {
+            break;
+        };
+        at = k.span().start;
+        match v.get_ref() {
+            DeValue::Table(t) => table = t,
+            _ => break,
+        }
+    }
+    line_column(text, at)
+}
+
+/// The parser's message, shortened, with a hint for the commonest slip: a bare word
+/// where TOML needs a quoted string (`fidelity = faithful`).
+fn parse_message(text: &str, start: usize, message: &str) -> String {
+    let rest = text.get(start..).unwrap_or("");
+    let word: String = rest
+        .chars()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '-' || *c == '_')
+        .collect();
+    let bare = !word.is_empty()
+        && word.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
+        && !matches!(word.as_str(), "true" | "false" | "inf" | "nan")
+        && text[..start].trim_end().ends_with('=');
+    let message = crate::input::shorten(message.trim(), MESSAGE_CHARS);
+    if bare {
+        format!("{message} (a word must be quoted: \"{word}\")")
+    } else {
+        message
+    }
+}
+
+/// Whether the scene's text writes the dotted `key` (`camera`, `technique.opacity3d.combine`).
+fn is_written(table: &toml::Table, key: &str) -> bool {
+    let mut parts = key.split('.');
+    let Some(first) = parts.next() else {
+        return false;
+    };
+    let mut value = table.get(first);
+    for part in parts {
+        value = value.and_then(|v| v.as_table()).and_then(|t| t.get(part));
+    }
+    value.is_some()
+}
+
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.len() - before.rfind('\n').map_or(0, |p| p + 1) + 1;
+    (line, column)
+}
+
+/// Parse `WxH` (e.g. `256x256`).
+pub fn parse_size(s: &str) -> Result<[u32; 2], String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?}: expected WIDTHxHEIGHT, e.g. 256x256"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|n| (1..=16384).contains(n))
+            .ok_or_else(|| format!("{s:?}: each side must be a whole number in 1..=16384"))
+    };
+    Ok([parse(w)?, parse(h)?])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn arrays_longer_than_their_field_are_errors() {
+        let (_, base) = DEMOS.iter().find(|(n, _)| *n == "clip-sphere").unwrap();
+        for (from, to, key) in [
+            ("size = [256, 256]", "size = [256, 256, 5]", "size"),
+            (
+                "rotation = [0.326506, -0.092296, -0.701057, 0.627211]",
+                "rotation = [0.326506, -0.092296, -0.701057, 0.627211, 1.0]",
+                "camera.rotation",
+            ),
+            (
+                "coefficients = [1.0, 1.0, 1.0, 0.8]",
+                "coefficients = [1.0, 1.0, 1.0, 0.8, 2.0]",
+                "technique.opacity3d.primary.coefficients",
+            ),
+        ] {
+            assert!(base.contains(from), "{from} not in\n{base}");
+            let text = base.replacen(from, to, 1);
+            let e = Scene::parse(&text, "s.toml").unwrap_err().to_string();
+            assert!(e.contains(key) && e.contains("values where"), "{e}");
+            assert!(e.starts_with("s.toml:"), "{e}");
+        }
+        // Every demo and data scene, written back, has nothing longer than it reads.
+        for (name, _) in DEMOS {
+            Scene::parse(&Scene::demo(name).unwrap().to_toml(), name).unwrap();
+        }
+    }
+
+    #[test]
+    fn every_demo_parses() {
+        for (name, _) in DEMOS {
+            Scene::demo(name).unwrap();
+        }
+    }
+
+    #[test]
+    fn unknown_key_names_line_and_column() {
+        let text = "size = [64, 64]\nbogus = 1\n[technique.quad]\n";
+        match Scene::parse(text, "x.toml") {
+            Err(SceneError::Parse {
+                line,
+                column,
+                message,
+                ..
+            }) => {
+                assert_eq!((line, column), (2, 1), "{message}");
+                assert!(message.contains("bogus"), "{message}");
+            }
+            other => panic!("expected a parse error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn bad_size_is_rejected() {
+        let text = "background = [0.0, 0.0, 0.0, 1.0]\nsize = [0, 64]\n[technique.quad]\n";
+        match Scene::parse(text, "x") {
+            Err(
+                e @ SceneError::Invalid {
+                    line: 2, column: 1, ..
+                },
+            ) => {
+                assert!(e.to_string().starts_with("x:2:1: size: 0x64"), "{e}")
+            }
+            other => panic!("expected an invalid size at 2:1, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn errors_after_parsing_point_at_the_key() {
+        let text = "size = [64, 64]\n[technique.opacity3d]\ncombine = \"sum\"\n  slices = 0\n[technique.opacity3d.primary]\nvolume = { synthetic = { size = [8, 8, 8] } }\n";
+        let e = Scene::parse(text, "s.toml").unwrap_err().to_string();
+        assert!(
+            e.starts_with("s.toml:4:3: technique.opacity3d.slices: slices = 0"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_bare_word_gets_a_hint_and_long_keys_are_shortened() {
+        let e = Scene::parse("fidelity = faithful\n[technique.quad]\n", "a.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("a.toml:1:12:") && e.contains("\"faithful\""),
+            "{e}"
+        );
+        let long = format!("{} = 1\n[technique.quad]\n", "k".repeat(100_000));
+        let e = Scene::parse(&long, "b.toml").unwrap_err().to_string();
+        assert!(
+            e.len() < 2000 && e.contains("more characters"),
+            "{}",
+            e.len()
+        );
+    }
+
+    #[test]
+    fn round_trips_through_toml() {
+        let scene = Scene::demo("quad").unwrap();
+        assert_eq!(Scene::parse(&scene.to_toml(), "again").unwrap(), scene);
+    }
+
+    #[test]
+    fn sizes() {
+        assert_eq!(parse_size("320x240"), Ok([320, 240]));
+        assert!(parse_size("320").is_err());
+        assert!(parse_size("0x5").is_err());
+        assert!(parse_size("axb").is_err());
+    }
+}
