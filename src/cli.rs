@@ -1,12 +1,17 @@
-//! The lower crates' choices as command-line values. clap lives only in this crate, so the
-//! enums of `arbvis-core` and `arbvis-gl` are offered here by name, with the help clap
-//! prints under each flag; the names are the enums' own (`name()`, as scenes write them).
-
-use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+//! What the commands share: the lower crates' choices as command-line values (clap lives
+//! only in this crate, so the enums of `arbvis-core` and `arbvis-gl` are offered here by
+//! name, with the help clap prints under each flag; the names are the enums' own, `name()`,
+//! as scenes write them), the scene a command takes and its overrides ([`SceneArgs`]),
+//! the SEG-Y keys, and the parsers of sizes, demos and output names.
 
 use std::path::PathBuf;
 
+use anyhow::{bail, Result};
+use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+use clap::Args;
+
 use arbvis::gl::{Backend, ProgramChoice, TargetFormat};
+use arbvis::scene::{parse_size, Scene};
 use arbvis::study::bench::{BenchOptions, View};
 use arbvis::vocab::Fidelity;
 
@@ -120,8 +125,8 @@ pub fn view() -> impl TypedValueParser<Value = View> {
 }
 
 /// `arbvis bench`'s options (the doc lines are its help): what to measure.
-#[derive(Debug, Clone, clap::Args)]
-pub struct BenchArgs {
+#[derive(Debug, Clone, Args)]
+pub struct BenchOptionArgs {
     /// Timed frames per setting and round (after the first, timed apart).
     #[arg(long, default_value_t = 5)]
     pub frames: usize,
@@ -168,8 +173,8 @@ pub struct BenchArgs {
     pub turn: f64,
 }
 
-impl From<BenchArgs> for BenchOptions {
-    fn from(a: BenchArgs) -> BenchOptions {
+impl From<BenchOptionArgs> for BenchOptions {
+    fn from(a: BenchOptionArgs) -> BenchOptions {
         BenchOptions {
             frames: a.frames,
             rounds: a.rounds,
@@ -184,5 +189,162 @@ impl From<BenchArgs> for BenchOptions {
             cellproj: a.cellproj,
             turn: a.turn,
         }
+    }
+}
+
+/// Where the scene comes from and what overrides it.
+#[derive(Args)]
+pub struct SceneArgs {
+    /// Scene file (TOML).
+    scene: Option<PathBuf>,
+    /// A built-in demo instead of a file; `--demo` alone lists them. Demos: quad,
+    /// v3o2-sum, v3o2-product, cellproj-planar, cellproj-spherical,
+    /// cellproj-spherical-precise, splats-section, splats-section-precise, clip-sphere,
+    /// clip-mesh.
+    #[arg(long, conflicts_with = "scene", num_args = 0..=1, default_missing_value = "",
+          value_name = "NAME", value_parser = demo_name)]
+    pub demo: Option<String>,
+    /// Image size, e.g. 512x512.
+    #[arg(long, value_parser = parse_size)]
+    size: Option<[u32; 2]>,
+    /// Program kind: arb, glsl, or auto (ARB where the driver has it).
+    #[arg(long, value_parser = programs(), ignore_case = true)]
+    programs: Option<ProgramChoice>,
+    /// Faithful (original programs, 8-bit) or precise (corrected, float).
+    #[arg(long, value_parser = fidelity(), ignore_case = true)]
+    fidelity: Option<Fidelity>,
+    /// Colour target precision (default from fidelity).
+    #[arg(long, value_parser = target(), ignore_case = true)]
+    target: Option<TargetFormat>,
+    /// Transparent background: straight colour with alpha = coverage (default: opaque,
+    /// what the screen shows).
+    #[arg(long)]
+    transparent: bool,
+    /// Texture memory for a survey store's bricks (e.g. 256M, 2G): the GPU brick cache's
+    /// budget (a scene's `[technique.opacity3d.store] gpu_memory`).
+    #[arg(long, value_name = "SIZE", value_parser = gpu_memory)]
+    gpu_memory: Option<String>,
+    /// The most points drawn of a COPC cloud (a scene's `copc = { points = N }`; Potree's
+    /// default is 1000000): the nodes largest on screen first.
+    #[arg(long, value_name = "POINTS")]
+    point_budget: Option<u64>,
+}
+
+/// Where a SEG-Y file keeps its inline and crossline numbers.
+#[derive(Args)]
+pub struct SegyKeyArgs {
+    /// SEG-Y: the trace-header byte (1-based) where the inline number starts (a 4-byte
+    /// integer; segyio's `iline`). Default: detected (189, as SEG-Y rev 1, or 9 or 17).
+    #[arg(long, value_name = "BYTE")]
+    iline: Option<u16>,
+    /// SEG-Y: the trace-header byte where the crossline number starts (segyio's
+    /// `xline`). Default: detected (193, as SEG-Y rev 1, or 21 or 13).
+    #[arg(long, value_name = "BYTE")]
+    xline: Option<u16>,
+}
+
+impl SegyKeyArgs {
+    pub fn keys(&self) -> arbvis::volume::segy::KeyBytes {
+        arbvis::volume::segy::KeyBytes {
+            iline: self.iline,
+            xline: self.xline,
+        }
+    }
+}
+
+/// `--gpu-memory`: a size the memory budget's parser reads, kept as written.
+fn gpu_memory(s: &str) -> Result<String, String> {
+    arbvis::budget::parse(s).map(|_| s.to_string())
+}
+
+impl SceneArgs {
+    /// The scene and a name for where it came from.
+    pub fn load(&self) -> Result<(Scene, String)> {
+        let (mut scene, origin) = match (&self.scene, &self.demo) {
+            (Some(path), _) => (Scene::load_checked(path)?, path.display().to_string()),
+            (None, Some(name)) => (Scene::demo(name)?, format!("demo:{name}")),
+            (None, None) => bail!("name a scene file or --demo NAME"),
+        };
+        if let Some(s) = self.size {
+            scene.size = s;
+        }
+        if let Some(p) = self.programs {
+            scene.programs = p;
+        }
+        if let Some(f) = self.fidelity {
+            scene.fidelity = f;
+        }
+        if let Some(t) = self.target {
+            scene.target = Some(t);
+        }
+        if self.transparent {
+            scene.transparent = true;
+        }
+        if let Some(g) = &self.gpu_memory {
+            if let arbvis::scene::TechniqueScene::Opacity3d(p) = &mut scene.technique {
+                p.store.get_or_insert_with(Default::default).gpu_memory = g.clone();
+            }
+        }
+        if let Some(points) = self.point_budget {
+            match &mut scene.technique {
+                arbvis::scene::TechniqueScene::Splats(p) => match &mut p.cloud {
+                    arbvis::points::PointSource::Copc(spec) => spec.points = points,
+                    _ => bail!("--point-budget: the scene's cloud is not a COPC file"),
+                },
+                _ => bail!("--point-budget: the scene draws no point cloud"),
+            }
+        }
+        if let Some(bytes) = scene
+            .memory_budget_bytes()
+            .map_err(|e| anyhow::anyhow!("{origin}: {e}"))?
+        {
+            arbvis::budget::set_from_scene(bytes);
+        }
+        Ok((scene, origin))
+    }
+}
+
+/// `I,J,K`: three positive sizes.
+pub fn parse_dims(s: &str) -> Result<[usize; 3], String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let sizes: Vec<usize> = parts
+        .iter()
+        .map(|p| p.parse::<usize>().ok().filter(|&n| n > 0))
+        .collect::<Option<_>>()
+        .ok_or_else(|| format!("{s:?}: expected three positive sizes I,J,K, e.g. 512,400,300"))?;
+    sizes
+        .try_into()
+        .map_err(|_| format!("{s:?}: expected three sizes I,J,K, e.g. 512,400,300"))
+}
+
+/// A demo's name, or "" (`--demo` alone: list them).
+fn demo_name(s: &str) -> Result<String, String> {
+    if s.is_empty() || arbvis::scene::DEMOS.iter().any(|d| d.0 == s) {
+        Ok(s.to_string())
+    } else {
+        Err(format!("no demo named {s:?}; demos: {}", demo_list(", ")))
+    }
+}
+
+/// The demos' names joined by `separator`.
+pub fn demo_list(separator: &str) -> String {
+    arbvis::scene::DEMOS
+        .iter()
+        .map(|d| d.0)
+        .collect::<Vec<_>>()
+        .join(separator)
+}
+
+/// An output path ending in `.png` (arbvis writes PNG only: a `.jpg` name would hold a
+/// PNG and mislead every program that trusts the extension).
+pub fn png_path(s: &str) -> Result<PathBuf, String> {
+    let p = PathBuf::from(s);
+    let png = p.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if png {
+        Ok(p)
+    } else {
+        Err(format!(
+            "{s:?}: arbvis writes PNG images only; name the output *.png"
+        ))
     }
 }

@@ -42,7 +42,10 @@ const LAYERS: &[(&str, &[&str])] = &[
     ),
     ("studies", &["study", "techniques::*::study"]),
     ("the viewer", &["viewer"]),
-    ("the crate root and the binary", &["", "main", "cli"]),
+    (
+        "the crate root and the binary",
+        &["", "main", "cli", "commands", "studies"],
+    ),
 ];
 
 type ModPath = Vec<String>;
