@@ -434,9 +434,9 @@ impl Scene {
 
 /// CPU memory per pixel of a frame read back and written: f32 RGBA as read (16 bytes),
 /// flipped to top-down (16), the picture made from it (16), and the PNG's 16-bit rows (8).
-/// Measured with the target: peak resident memory of a release `arbvis render --demo quad`
-/// grows by 39 bytes a pixel from 2048² to 4096² faithful and 62.5 precise (estimated 64
-/// and 76 with the target's bytes; `/usr/bin/time -f %M`, the 2-core machine).
+/// With the target's bytes added, this sum stays above the measured growth of peak
+/// resident memory per pixel, faithful and precise (measured: docs/benchmarks.md, "Memory
+/// estimates and work limits").
 pub const BYTES_PER_READ_PIXEL: u64 = 56;
 
 /// Longest message quoted from a scene error (a 50 MB key must not reach the terminal).

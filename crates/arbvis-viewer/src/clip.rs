@@ -11,8 +11,9 @@
 //! among the kinds (`scene-mesh`, ...) after switching to another. Switching kind keeps
 //! the position, a size and the rotation. Each edit changes the scene; the renderer
 //! rebuilds the clip on that frame only when the clip changed, never on other frames or
-//! other edits (the demo's 64³ clip rebuilds in about 10 ms on llvmpipe's machine, so a
-//! dragged number rebuilds once per frame it changes).
+//! other edits (the demo's 64³ clip rebuilds well within a frame on llvmpipe, so a
+//! dragged number rebuilds once per frame it changes; measured: docs/benchmarks.md,
+//! "Clipping").
 
 use super::widgets::Widgets;
 use crate::techniques::clip::stats::ClipStats;

@@ -1,9 +1,8 @@
 //! How a conversion compresses the chunks it writes.
 //!
 //! The default is blosc with LZ4 over shuffled bytes (the codec family MDIO writes): on a
-//! float survey it makes chunks smaller than zstd level 1 (0.85 against 0.93 of the raw
-//! bytes on `store_bench`'s survey) for under half of zstd's CPU time (1.4 s against 3.2 s
-//! of user time over the uncompressed conversion of that 2.08 GB survey), and decodes faster.
+//! float survey it made smaller chunks than zstd level 1 for less CPU time, and decodes
+//! faster (measured: docs/benchmarks.md, "Figures behind the store's settings").
 
 use std::fmt;
 use std::str::FromStr;

@@ -84,9 +84,10 @@ impl Default for ConvertOptions {
     fn default() -> Self {
         ConvertOptions {
             brick: 64,
-            // Amplitude and envelope: what v3o2's displays start from, at 1.8 times the
-            // survey's disk and twice amplitude's conversion time; phase and frequency
-            // (each another 0.45-0.5 times the disk) on request.
+            // Amplitude and envelope: what v3o2's displays start from, worth the disk and
+            // conversion time they cost beyond amplitude alone; phase and frequency, each
+            // costing more again, on request (measured: docs/benchmarks.md, "Figures
+            // behind the store's settings").
             derived: vec![Attribute::Envelope],
             compression: Compression::default(),
             raw: None,
@@ -164,8 +165,9 @@ fn job_of(
 ///
 /// Columns run on two workers per rayon thread (one per core unless `RAYON_NUM_THREADS`
 /// says otherwise): each chunk write waits for the disk (synced), and a second worker per
-/// core computes meanwhile (on 2 cores, 4 workers convert a 2 GB survey about 15 %
-/// faster than 2). Where twice the workers' memory would pass the budget, one per thread.
+/// core computes meanwhile, which converted faster than one worker per core (measured:
+/// docs/benchmarks.md, "Figures behind the store's settings"). Where twice the workers'
+/// memory would pass the budget, one per thread.
 pub fn convert(
     input: &Path,
     store: &Path,

@@ -26,8 +26,9 @@ use glam::DVec3;
 
 use super::TriangleMesh;
 
-/// Units of work after which the self-intersection search stops (about a second of
-/// one core on the reference machine; see the module doc for what a unit is).
+/// Units of work after which the self-intersection search stops, sized to keep the
+/// search short on one core (measured: docs/benchmarks.md, "Memory estimates and work
+/// limits"; see the module doc for what a unit is).
 pub const MAX_WORK: u64 = 40_000_000;
 
 /// Units an exact triangle-pair test costs on top of considering the pair (six segment
@@ -564,8 +565,9 @@ mod tests {
                 r.self_intersections, 0,
                 "coplanar copies are not tested as crossing"
             );
-            // MAX_WORK is about a second of one core in release; a debug build on a
-            // busy machine takes a few times that. Minutes before the work was bounded.
+            // MAX_WORK keeps the search short in release (docs/benchmarks.md, "Memory
+            // estimates and work limits"); the bound leaves room for a debug build on a
+            // busy machine. Minutes before the work was bounded.
             assert!(took.as_secs_f64() < 30.0, "{took:?}");
         }
     }

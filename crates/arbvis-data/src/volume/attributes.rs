@@ -128,8 +128,10 @@ pub fn derive_trace(
         for (i, d) in dst.iter_mut().enumerate() {
             let v = match attribute {
                 Attribute::Amplitude => trace[i],
-                // The modulus as a square root (a seismic trace's values are far from
-                // overflowing a square; hypot's care costs a tenth of a conversion).
+                // The modulus as a square root: a seismic trace's values are far from
+                // overflowing a square, and hypot's care cost a noticeable share of a
+                // conversion (measured: docs/benchmarks.md, "Figures behind the store's
+                // settings").
                 Attribute::Envelope => (a[i].re * a[i].re + a[i].im * a[i].im).sqrt(),
                 Attribute::Phase => phase[i].to_degrees(),
                 Attribute::CosinePhase => phase[i].cos(),

@@ -57,14 +57,15 @@
 //!   only if its extrapolated exit scalar `sb` reads the texel above `v`, the one in
 //!   front only if its rasterized entry scalar `sf` reads the texel below; where the f32
 //!   rounding of the two sends `sb` down and `sf` up, neither does and the ray sees
-//!   through the surface. On the 17³ planar grid with `v = 0.5` this loses from none to
-//!   43 % of the surface's pixels depending on the view (a quarter to two fifths in 11
-//!   of 12 views tested); an isovalue nearer the face than half a texel (0.5 + 1e-3)
-//!   loses as much, one a texel or more away (0.5 + 1e-2) at most 0.33 %, the table's
-//!   usual quantization (`tests/cellproj.rs`,
-//!   `faithful_loses_isosurfaces_on_shared_faces_as_the_seeds_table_does`). Precise
-//!   mode crosses exactly and draws such surfaces whole (5 pixels of 10,020 lost in
-//!   one view, none in the others).
+//!   through the surface. On the 17³ planar grid with `v = 0.5` this loses a large share
+//!   of the surface's pixels in some views and almost none in others, how much being the
+//!   driver's rounding; an isovalue nearer the face than half a texel (0.5 + 1e-3)
+//!   loses as much, one a texel or more away (0.5 + 1e-2) only the table's usual
+//!   quantization (`tests/it/cellproj.rs`,
+//!   `faithful_loses_isosurfaces_on_shared_faces_as_the_seeds_table_does`, which bounds
+//!   both loosely; measured: docs/benchmarks.md, "Figures behind cell projection's
+//!   settings"). Precise mode crosses exactly and draws such surfaces whole (the test
+//!   allows a loss under 2e-3 of the pixels).
 //! - The exit direction of the orthographic variant is the view direction; the seed's Cg
 //!   (`vertex - EyePos`) is the perspective variant. Used in an orthographic view, the
 //!   per-fragment programs get an eye 10^6 box units back along the view direction, so
@@ -265,10 +266,9 @@ impl crate::techniques::TechniqueParams for CellprojScene {
 }
 
 /// Memory per tetrahedron of a generated grid while it is prepared and drawn: the mesh, the
-/// per-face vertex data and the renderer's copies. Measured: peak resident memory of a
-/// release `arbvis render` of 33³ and 49³ spherical grids (196,608 and 663,552 tetrahedra)
-/// grows by 1,830 bytes per tetrahedron, faithful and precise alike (`/usr/bin/time -f %M`,
-/// the 2-core machine, llvmpipe); rounded up.
+/// per-face vertex data and the renderer's copies; the growth of peak resident memory per
+/// tetrahedron, faithful and precise alike, rounded up (measured: docs/benchmarks.md,
+/// "Memory estimates and work limits").
 pub const BYTES_PER_TET: u64 = 2000;
 
 impl CellprojScene {

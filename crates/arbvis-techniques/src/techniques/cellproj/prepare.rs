@@ -82,10 +82,10 @@ pub struct Prepared {
 /// Most layers cell projection draws: the mean number of tetrahedra a line through the
 /// mesh's box crosses ([`Quality::depth`](crate::mesh::quality::Quality), counted over
 /// the tetrahedra that are drawn). Every layer is a face rasterized at a pixel, so this
-/// bounds the rasterizer's work at about this many fragments per pixel. Measured on
-/// llvmpipe (2 shared cores, release build, 480x360, precise): thin plates stacked
-/// across a whole mesh at a depth of 1,008 drew in 11 s (3.4 s of CPU); at 3,300 a
-/// debug build took 22 s. Meshes whose cells do not overlap stay far below: a grid of
+/// bounds the rasterizer's work at about this many fragments per pixel: near this depth
+/// a frame of thin plates stacked across a whole mesh is already far from interactive
+/// on llvmpipe (measured: docs/benchmarks.md, "Figures behind cell projection's
+/// settings"). Meshes whose cells do not overlap stay far below: a grid of
 /// 16³ hexahedra (24,576 tetrahedra, the seed's size) is at 39, one of 60³ (1.3 million
 /// tetrahedra) at 145, and the depth of such grids grows with the cube root of their
 /// size. Cells stacked on each other with different scalars, or plates across the whole

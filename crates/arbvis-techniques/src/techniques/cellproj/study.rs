@@ -36,7 +36,8 @@ pub struct Options {
     /// Timed frames per setting (median), after one warm-up frame.
     pub frames: usize,
     /// Score against the reference on meshes up to this many points per side (one
-    /// reference per mesh and projection: about 10 s each at a million tetrahedra).
+    /// reference per mesh and projection, slow at a million tetrahedra; measured:
+    /// docs/benchmarks.md, "Figures behind cell projection's settings").
     pub score_up_to: usize,
 }
 

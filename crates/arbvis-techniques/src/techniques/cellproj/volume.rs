@@ -25,8 +25,8 @@
 //! planes and gradient `flat`, the segment between the last plane the ray enters and
 //! the first it leaves, and where three faces face the viewer one triangle (the fourth
 //! face) instead of three: 4 vertices per cell instead of 3 per face, a fifth fewer
-//! triangles (on NASA's Blunt Fin at 48x32, where the vertex side is the frame, 57-61
-//! -> 29 ms on llvmpipe).
+//! triangles, which shortens frames that llvmpipe's vertex side bounds (measured:
+//! docs/benchmarks.md, "Against VTK at its best (2026-11-26)").
 
 //! **Precise** (GLSL, float target): the mesh in textures (face planes, scalar, face
 //! neighbours); passes peel the boundary faces through which rays enter the mesh

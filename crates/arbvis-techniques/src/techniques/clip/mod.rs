@@ -44,14 +44,13 @@
 //! meshes: NaN or empty are errors with position, open ones are decided by the winding
 //! number.
 //!
-//! # Measured (release, 2-core machine; `arbvis study --technique clip` measures them again)
-//! Texture + INDEX-DATA (B = 8) build, seconds (shared machine, ±30 %): sphere 128³
-//! 0.03 + 0.01, 256³ 0.21 + 0.08, 512³ 2.2 + 0.6; 42400-IDGH.stl (11,036 triangles) 128³
-//! 0.09 + 0.01, 256³ 0.33 + 0.07; cow.obj (5,804 triangles) 256³ 0.23 + 0.07. Compression ratio of a sphere of radius 0.35 N at 256³, B = 8,
-//! R8 / R8 / RGBA32F: 0.195 (2,696 of 32,768 blocks; DATA alone is 0.164, the extended
-//! copies costing `(10/8)³ = 1.95` times the blocks). No block size and no INDEX format
-//! reaches 0.16 at 256³ (best 0.171 with an RGBA8 INDEX, which cannot address the slots);
-//! the ratio falls as 1/N: 0.140 at 384³, 0.114 at 512³.
+//! # Cost and compression (`arbvis study --technique clip` measures them)
+//! INDEX-DATA builds in a fraction of the time of the single texture's distance field it
+//! starts from. The compression ratio has a floor set by the paper's extended blocks: at
+//! B = 8 their copies cost `(10/8)³ = 1.95` times the blocks, so for a sphere of radius
+//! 0.35 N at 256³ no block size and no INDEX format reaches the goal of 0.16, and the
+//! ratio falls as 1/N, the boundary's blocks lying on a surface (measured:
+//! docs/benchmarks.md, "Clipping").
 
 mod error;
 pub mod fast_winding;
@@ -206,15 +205,15 @@ fn yes() -> bool {
 }
 
 /// Memory per clip-grid voxel while the clip is built and drawn: the shape's f32
-/// distances, the 8-bit or float single texture and its GPU copy. Measured: peak resident
-/// memory of a release `arbvis render` of a sphere-clipped cube grows by 4.0 bytes a voxel
-/// from a 128³ to a 256³ clip grid with 8³ blocks (`/usr/bin/time -f %M`, the 2-core
-/// machine); the estimate leaves room for float DATA.
+/// distances, the 8-bit or float single texture and its GPU copy; the growth of peak
+/// resident memory per voxel, with room left for float DATA (measured:
+/// docs/benchmarks.md, "Memory estimates and work limits").
 pub const BYTES_PER_CLIP_VOXEL: u64 = 12;
 
 /// Memory per INDEX-DATA block besides the distance field: the INDEX texel (RGBA32F) on
 /// the CPU and the GPU, the block's class while it is sorted, and the DATA of boundary
-/// blocks. Measured as above with 2³ blocks: about 38 bytes a block more than with 8³.
+/// blocks; the growth per block, rounded up (measured: docs/benchmarks.md, "Memory
+/// estimates and work limits").
 pub const BYTES_PER_BLOCK: u64 = 48;
 
 impl ClipSpec {

@@ -206,10 +206,11 @@ impl StoreScene {
     }
 }
 
-/// Time a streaming frame spends uploading what has arrived (a brick of 66³ RGB8 is
-/// 0.86 MB, about a millisecond on llvmpipe): the frame stays interactive, and once the
-/// camera stops a frame takes in everything the loader has read since the last one
-/// (8 bricks a frame made the full picture of a 1 GB survey take 113 frames, 110 s).
+/// Time a streaming frame spends uploading what has arrived, a time rather than a count
+/// of bricks (a brick of 66³ RGB8 is 0.86 MB, quick to upload on llvmpipe): the frame
+/// stays interactive, and once the camera stops a frame takes in everything the loader
+/// has read since the last one, where a small fixed count a frame made the full picture
+/// take many frames (measured: docs/benchmarks.md, "Figures behind the store's settings").
 const UPLOAD_TIME: std::time::Duration = std::time::Duration::from_millis(30);
 
 /// The bricked 3D-opacity renderer.

@@ -17,21 +17,12 @@
 //! is left out whole, so the clip boundary is placed to within half a slice spacing along
 //! each ray; the ray caster places it to within half a step.
 //!
-//! # Measured cost (`arbvis bench`, release, llvmpipe on the shared 2-core machine)
-//! The clip-sphere demo (64³ x 3 attributes, inverted sphere, B = 8) at 256², its view,
-//! against the same scene without a clip and with the single-resolution texture; median
-//! frame ms, the median of three interleaved runs (`arbvis bench SCENE --size 256x256
-//! --frames 5 --rounds 2 --faithful 128 --precise 128 --raycast 1`; load average 6, so
-//! ±10 %):
-//!
-//! | path | no clip | single | INDEX-DATA |
-//! |---|---|---|---|
-//! | faithful, 128 slices | 60 | 80 (+32 %) | 99 (+65 %) |
-//! | precise, 128 slices | 100 | 116 (+16 %) | 126 (+26 %) |
-//! | ray caster, 1 step/voxel | 58 | 88 (+52 %) | 90 (+56 %) |
-//!
-//! As the seed found, INDEX-DATA is slower than the single texture (two dependent
-//! fetches); on the ray caster, whose samples all pay the lookup, the two cost alike.
+//! # Cost
+//! The clip-sphere demo (64³ x 3 attributes, inverted sphere, B = 8), timed by
+//! `arbvis bench` against the same scene without a clip and with the single-resolution
+//! texture (measured: docs/benchmarks.md, "Clipping"): every path pays for the clip. As
+//! the seed found, INDEX-DATA is slower than the single texture (two dependent fetches);
+//! on the ray caster, whose samples all pay the lookup, the two cost alike.
 
 use std::borrow::Cow;
 use std::path::Path;

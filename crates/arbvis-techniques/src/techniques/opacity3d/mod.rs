@@ -186,10 +186,9 @@ impl crate::techniques::TechniqueParams for Opacity3dScene {
 
 /// Memory per voxel of each generated attribute while it is prepared and drawn: the f32
 /// samples, the derived attribute, the quantized levels, the packed texture and its GPU
-/// copy. Measured: peak resident memory of a release `arbvis render` of 128³ and 192³
-/// synthetic cubes grows by 9.8 bytes a voxel with one attribute and 21.5 with three
-/// (faithful and precise alike; `/usr/bin/time -f %M`, the 2-core machine); rounded up
-/// for the first.
+/// copy; the growth of peak resident memory per voxel with one attribute, faithful and
+/// precise alike, rounded up (measured: docs/benchmarks.md, "Memory estimates and work
+/// limits").
 pub const BYTES_PER_VOXEL: u64 = 12;
 
 impl Opacity3dScene {
@@ -231,8 +230,8 @@ pub struct Raycast {
     pub termination: f64,
     /// Voxels per side of the bricks of empty-space skipping (0: no skipping; point
     /// sampling only). Off by default: on the bench scenes few bricks are empty and the
-    /// per-brick bookkeeping made frames 1.6x slower (205 against 325 ms, 256² of the
-    /// 256³ cube on llvmpipe).
+    /// per-brick bookkeeping made frames slower than it saved (measured:
+    /// docs/benchmarks.md, "3D opacity: figures behind its settings").
     pub brick: usize,
     /// Pre-integrated classification for a one-attribute scene ([`preint`]); ignored
     /// with several attributes or without opacity correction. Off by default: it wins

@@ -208,7 +208,8 @@ pub fn eye(frame: &Frame) -> DVec3 {
 /// its entry; half floats put it up to 0.06 texel off) and f32 tables, filtered in float.
 /// The precise volume holds only the present attributes (`count` channels); one
 /// attribute is stored as f32 (the same k/255, 4 bytes a voxel), which llvmpipe filters
-/// 15-20 % faster than 16-bit unorm (ray caster, cube scene at 256², interleaved).
+/// faster than 16-bit unorm (measured: docs/benchmarks.md, "3D opacity: figures behind
+/// its settings").
 pub fn texel_formats(fidelity: Fidelity, count: usize) -> (TexelFormat, TexelFormat) {
     match fidelity {
         Fidelity::Faithful => (TexelFormat::Rgb8, TexelFormat::Rgba8),

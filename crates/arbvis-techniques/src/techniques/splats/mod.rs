@@ -8,12 +8,13 @@
 //!   would discard what should blend), so each frame the camera moved the points are
 //!   sorted by their distance to the eye (orthographic: depth along the view). The
 //!   seed sorted its point structs with `std::sort` and a comparator computing both
-//!   distances (~35 ms for 570k points), then re-uploaded the whole buffer; kept here
-//!   as [`sort::SortMethod::Seed`], the baseline. The fast paths compute one key per
-//!   point and sort (key, index) pairs ([`sort::SortMethod::Keys`]) or radix-sort them
-//!   in parallel ([`sort::SortMethod::Radix`]), yielding an index buffer to upload
-//!   instead of the points; [`sort::SortCache`] skips the sort when the camera did not
-//!   move. All methods are stable (ties in index order) and agree.
+//!   distances (slow: docs/benchmarks.md, "Figures behind the splats' settings"), then
+//!   re-uploaded the whole buffer; kept here as [`sort::SortMethod::Seed`], the
+//!   baseline. The fast paths compute one key per point and sort (key, index) pairs
+//!   ([`sort::SortMethod::Keys`]) or radix-sort them in parallel
+//!   ([`sort::SortMethod::Radix`]), yielding an index buffer to upload instead of the
+//!   points; [`sort::SortCache`] skips the sort when the camera did not move. All
+//!   methods are stable (ties in index order) and agree.
 //! - **Order-independent alternative**: weighted blended OIT (McGuire & Bavoil 2013)
 //!   needs no sort; [`oit`] draws it on the GPU (two float targets and a composite),
 //!   [`reference::weighted_blended`] composites it on the CPU so its error against
@@ -26,7 +27,8 @@
 //!   frame the camera moved, a back-to-front list of splats per screen tile in parallel
 //!   on the CPU and composites each pixel from its tile's list in one gather pass: the
 //!   same splats without the per-point setup cost of `GL_POINTS` on software drivers
-//!   (README, "Splats": 13x faster than VTK's point Gaussian mapper where points reach 3.1x).
+//!   (far faster than points against VTK's point Gaussian mapper; measured:
+//!   docs/benchmarks.md, "Splats").
 //! - **Reference** ([`reference`](mod@reference)): the f64 compositing of the same splats (GL's point
 //!   clipping, size clamping and point-sprite coverage; the seed's footprints as
 //!   written beside precise ones) that the renderer is scored against.

@@ -212,8 +212,9 @@ fn estimate_group(points: &[[f32; 3]], k: usize, progress: &Progress) -> Vec<Est
 
 /// The distinct positions of `points` (-0 and +0 alike), how often each occurs, and
 /// which one each point is. The tree holds each position once: a k-d tree of many
-/// coincident points is searched in full by every query at that spot (60,000 copies
-/// of one point took 25 s in a test build), and points at one position share one
+/// coincident points is searched in full by every query at that spot (many copies of
+/// one point made the search crawl in a test build; measured: docs/benchmarks.md,
+/// "Figures behind the splats' settings"), and points at one position share one
 /// normal anyway.
 fn distinct(points: &[[f32; 3]]) -> (Vec<[f32; 3]>, Vec<u32>, Vec<u32>) {
     let bits = |p: &[f32; 3]| p.map(|c| (c + 0.0).to_bits());

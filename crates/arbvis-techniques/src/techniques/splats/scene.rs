@@ -192,18 +192,18 @@ fn default_tile() -> u32 {
 }
 
 /// Default tile side in pixels: for 1.3-pixel splats at 1600x900 on llvmpipe, the camera
-/// turning, tiles of 1, 2, 3, 4 and 8 pixels took 75, 75, 95, 106 and over 137 ms per
-/// frame; 2 lists a quarter fewer entries than 1.
+/// turning, tiles of 2 pixels were as fast as tiles of 1 with fewer list entries, and
+/// larger tiles slower (measured: docs/benchmarks.md, "Figures behind the splats'
+/// settings").
 pub const DEFAULT_TILE: u32 = 2;
 
 /// Largest point size asked for (GL clamps to its own range, 255 on llvmpipe).
 pub const MAX_POINT_SIZE: f64 = 4096.0;
 
 /// Memory per point of a generated section while it is prepared and drawn: the cloud's
-/// attributes, colours, normals, sort keys and the GPU's copies. Measured: peak resident
-/// memory of a release `arbvis render` of 1 M and 2 M points at 1600x900 grows by 336
-/// bytes a point unlit and 430 lit (`/usr/bin/time -f %M`, the 2-core machine, llvmpipe);
-/// rounded up.
+/// attributes, colours, normals, sort keys and the GPU's copies: the growth of peak
+/// resident memory per point, lit or not, rounded up (measured: docs/benchmarks.md,
+/// "Memory estimates and work limits").
 pub const BYTES_PER_POINT: u64 = 450;
 
 /// Memory per tile of `draw = "tiles"`: its list's start on the CPU and in the texture the

@@ -48,9 +48,10 @@
 //!   and small enough for the cache: each is finished by LSD passes of up to 8 bits
 //!   into a per-task buffer, the last pass writing indices straight into the order,
 //!   buckets in parallel. Small inputs run on one thread. [`RadixScratch`] keeps the
-//!   buffers between frames (fresh pages cost about a tenth of the sort). Three full
-//!   LSD passes of 11 bits over the whole array were memory-bound (6.2 ms for 570k
-//!   points here); this layout does about half the memory traffic (4.5-4.7 ms).
+//!   buffers between frames (fresh pages were a noticeable share of the sort). Three
+//!   full LSD passes of 11 bits over the whole array were memory-bound; this layout does
+//!   about half the memory traffic, and sorted faster (measured: docs/benchmarks.md,
+//!   "Figures behind the splats' settings").
 //!
 //! [`SortCache`] returns the previous order untouched when the view did not change (same
 //! bits) and the point count is the same; call [`SortCache::invalidate`] when the

@@ -4,11 +4,11 @@
 //!
 //! # Why
 //!
-//! On llvmpipe every `GL_POINT` costs about 0.24 µs of single-threaded vertex and point
-//! setup before any pixel is touched (`examples/point_floor`: 135 ms for 570k sprites
-//! that draw nothing), so no point renderer gets under that floor. Here the per-point
-//! work is plain parallel Rust on every core, and the GPU's work is per pixel, where
-//! llvmpipe spreads it over its threads and SIMD lanes.
+//! On llvmpipe every `GL_POINT` costs single-threaded vertex and point setup before any
+//! pixel is touched (`examples/point_floor` times sprites that draw nothing; measured:
+//! docs/benchmarks.md, "Figures behind the splats' settings"), so no point renderer gets
+//! under that floor. Here the per-point work is plain parallel Rust on every core, and
+//! the GPU's work is per pixel, where llvmpipe spreads it over its threads and SIMD lanes.
 //!
 //! # How
 //!
