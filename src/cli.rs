@@ -13,6 +13,8 @@ use clap::Args;
 use arbvis::gl::{Backend, ProgramChoice, TargetFormat};
 use arbvis::scene::{parse_size, Scene};
 use arbvis::study::bench::{BenchOptions, View};
+use arbvis::techniques::opacity3d::Opacity3dScene;
+use arbvis::techniques::splats::SplatsScene;
 use arbvis::vocab::Fidelity;
 
 /// A parser of one of `choices` (value, help), its name matched without regard to case.
@@ -281,18 +283,18 @@ impl SceneArgs {
             scene.transparent = true;
         }
         if let Some(g) = &self.gpu_memory {
-            if let arbvis::scene::TechniqueScene::Opacity3d(p) = &mut scene.technique {
+            if let Some(p) = scene.technique.get_mut::<Opacity3dScene>() {
                 p.store.get_or_insert_with(Default::default).gpu_memory = g.clone();
             }
         }
         if let Some(points) = self.point_budget {
-            match &mut scene.technique {
-                arbvis::scene::TechniqueScene::Splats(p) => match &mut p.cloud {
-                    arbvis::points::PointSource::Copc(spec) => spec.points = points,
-                    _ => bail!("--point-budget: the scene's cloud is not a COPC file"),
-                },
-                _ => bail!("--point-budget: the scene draws no point cloud"),
-            }
+            let Some(p) = scene.technique.get_mut::<SplatsScene>() else {
+                bail!("--point-budget: the scene draws no point cloud");
+            };
+            let arbvis::points::PointSource::Copc(spec) = &mut p.cloud else {
+                bail!("--point-budget: the scene's cloud is not a COPC file");
+            };
+            spec.points = points;
         }
         if let Some(bytes) = scene
             .memory_budget_bytes()

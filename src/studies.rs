@@ -11,6 +11,7 @@ use arbvis::scene::Scene;
 use arbvis::techniques::{cellproj, clip, splats};
 
 use crate::cli;
+use arbvis::techniques::cellproj::CellprojScene;
 
 // `arbvis study`'s arguments (the help is the `Study` command's).
 #[derive(Args)]
@@ -254,7 +255,7 @@ fn cellproj_volume_study(a: &StudyArgs) -> Result<()> {
 /// A volume study case from a cell-projection scene (its camera, mesh and transfer
 /// function).
 fn volume_case(name: &str, scene: &Scene) -> Result<cellproj::study::volume::Case> {
-    let arbvis::scene::TechniqueScene::Cellproj(c) = &scene.technique else {
+    let Some(c) = scene.technique.get::<CellprojScene>() else {
         bail!("{name}: not a cell-projection scene");
     };
     let prepared = cellproj::prepare::prepare(c, &scene.base).map_err(anyhow::Error::msg)?;
@@ -265,7 +266,7 @@ fn volume_case(name: &str, scene: &Scene) -> Result<cellproj::study::volume::Cas
     };
     Ok(cellproj::study::volume::Case {
         name: name.to_string(),
-        scene: (**c).clone(),
+        scene: c.clone(),
         prepared,
         camera,
     })

@@ -1,25 +1,29 @@
-//! Every technique in one list, where each registers what the layers above need: its
-//! scene parameters (a variant of [`TechniqueScene`], `[technique.NAME]` in TOML), how its
-//! renderer is built ([`build`]) and the program pairs it can draw with
-//! ([`all_program_pairs`], for the compile-everything test).
+//! Every technique in one list: [`TechniqueScene`] has a variant per technique (its
+//! scene parameters, `[technique.NAME]` in TOML), and each variant's type implements
+//! [`Technique`] once (validation, data paths, memory estimate, defaults, program pairs,
+//! the renderer). What the layers above ask of "the scene's technique" goes through the
+//! methods here, which match the list in one macro; code that needs one technique's
+//! parameters asks for them by type ([`TechniqueScene::get`]).
 //!
 //! The catalog sits above the techniques and below the scene: techniques never import it
 //! (their renderers take their own parameters through [`crate::techniques::Params`]), so
 //! adding a technique touches its own folder and this file.
 
-use std::path::Path;
+use std::any::Any;
+use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::camera::Projection;
+use crate::camera::Camera;
 use crate::gl::{GlResult, Gpu, ProgramChoice, ProgramKind};
 use crate::programs::ProgramPair;
-use crate::techniques::cellproj::{self, CellprojScene};
-use crate::techniques::opacity3d::{self, Opacity3dScene};
-use crate::techniques::quad::{self, QuadScene};
-use crate::techniques::splats::{self, SplatsScene};
-use crate::techniques::{Params, Renderer};
-use crate::vocab::Fidelity;
+use crate::techniques::cellproj::CellprojScene;
+use crate::techniques::opacity3d::Opacity3dScene;
+use crate::techniques::quad::QuadScene;
+use crate::techniques::splats::SplatsScene;
+pub use crate::techniques::Settings;
+use crate::techniques::{Params, Renderer, Technique};
+use crate::vocab::{Fidelity, FieldError};
 
 /// Which technique and its parameters; in TOML a `[technique.NAME]` table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -35,82 +39,139 @@ pub enum TechniqueScene {
     Splats(Box<SplatsScene>),
 }
 
+macro_rules! from_parameters {
+    ($($variant:ident($type:ty) => $wrap:expr),*) => {$(
+        impl From<$type> for TechniqueScene {
+            /// The technique of these parameters.
+            fn from(p: $type) -> TechniqueScene {
+                TechniqueScene::$variant($wrap(p))
+            }
+        }
+    )*};
+}
+
+from_parameters!(
+    Quad(QuadScene) => std::convert::identity,
+    Opacity3d(Opacity3dScene) => Box::new,
+    Cellproj(CellprojScene) => Box::new,
+    Splats(SplatsScene) => Box::new
+);
+
+/// `$body` with `$p` bound to the parameters of whichever technique `$scene` holds (`&T`,
+/// or `&mut T` with `mut`): the one place that lists the variants for the methods below.
+macro_rules! each_technique {
+    ($scene:expr, |$p:ident| $body:expr) => {
+        match $scene {
+            TechniqueScene::Quad($p) => $body,
+            TechniqueScene::Opacity3d(boxed) => {
+                let $p = &**boxed;
+                $body
+            }
+            TechniqueScene::Cellproj(boxed) => {
+                let $p = &**boxed;
+                $body
+            }
+            TechniqueScene::Splats(boxed) => {
+                let $p = &**boxed;
+                $body
+            }
+        }
+    };
+    ($scene:expr, |mut $p:ident| $body:expr) => {
+        match $scene {
+            TechniqueScene::Quad($p) => $body,
+            TechniqueScene::Opacity3d(boxed) => {
+                let $p = &mut **boxed;
+                $body
+            }
+            TechniqueScene::Cellproj(boxed) => {
+                let $p = &mut **boxed;
+                $body
+            }
+            TechniqueScene::Splats(boxed) => {
+                let $p = &mut **boxed;
+                $body
+            }
+        }
+    };
+}
+
+/// The technique's name and its [`Technique`] implementation's answer, for a `T` known
+/// only by the trait.
+fn name_of<T: Technique>(_: &T) -> &'static str {
+    T::NAME
+}
+
 impl TechniqueScene {
     /// Technique name as written in scenes.
     pub fn name(&self) -> &'static str {
-        match self {
-            TechniqueScene::Quad(_) => "quad",
-            TechniqueScene::Opacity3d(_) => "opacity3d",
-            TechniqueScene::Cellproj(_) => "cellproj",
-            TechniqueScene::Splats(_) => "splats",
-        }
+        each_technique!(self, |p| name_of(p))
     }
 
     /// The parameters as a renderer's [`Renderer::update`] takes them.
     pub fn params(&self) -> Params<'_> {
-        match self {
-            TechniqueScene::Quad(p) => Params::of(p),
-            TechniqueScene::Opacity3d(p) => Params::of(&**p),
-            TechniqueScene::Cellproj(p) => Params::of(&**p),
-            TechniqueScene::Splats(p) => Params::of(&**p),
-        }
+        each_technique!(self, |p| Params::of(p))
     }
-}
 
-impl TechniqueScene {
+    /// The parameters as technique `T`'s, where the scene draws `T`.
+    pub fn get<T: Technique>(&self) -> Option<&T> {
+        each_technique!(self, |p| (p as &dyn Any).downcast_ref::<T>())
+    }
+
+    /// The parameters as technique `T`'s to change, where the scene draws `T`.
+    pub fn get_mut<T: Technique>(&mut self) -> Option<&mut T> {
+        each_technique!(self, |mut p| (p as &mut dyn Any).downcast_mut::<T>())
+    }
+
+    /// Check values that parse but cannot render at `fidelity` with `programs`; the
+    /// error's key is the dotted key from the scene's root.
+    pub fn validate(&self, fidelity: Fidelity, programs: ProgramChoice) -> Result<(), FieldError> {
+        let within = format!("technique.{}", self.name());
+        each_technique!(self, |p| Technique::validate(p, fidelity, programs))
+            .map_err(|e| e.within(&within))
+    }
+
+    /// Call `f` on every data file the parameters name, with the dotted key that holds
+    /// it (from the scene's root).
+    pub fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut PathBuf)) {
+        let within = format!("technique.{}", self.name());
+        let f = &mut |key: &str, path: &mut PathBuf| f(&format!("{within}.{key}"), path);
+        each_technique!(self, |mut p| Technique::for_each_data_path(p, f))
+    }
+
     /// The camera a scene without `[camera]` starts from (and the viewer's Reset camera
     /// returns to), where the technique's data asks for another than the default.
-    pub fn default_camera(&self) -> Option<crate::camera::Camera> {
-        match self {
-            TechniqueScene::Opacity3d(p) => p.default_camera(),
-            TechniqueScene::Quad(_) | TechniqueScene::Cellproj(_) | TechniqueScene::Splats(_) => {
-                None
-            }
-        }
+    pub fn default_camera(&self) -> Option<Camera> {
+        each_technique!(self, |p| Technique::default_camera(p))
     }
 
     /// Defaults that depend on the data a scene names, for the keys its text leaves out
     /// (`written` tells which dotted keys it writes): a survey's three-quarter view where
-    /// there is no `[camera]`, a lidar cloud's precise splats, and so on
-    /// ([`Opacity3dScene::unwritten_defaults`], [`SplatsScene::unwritten_defaults`]).
+    /// there is no `[camera]`, a lidar cloud's precise splats, and so on.
     pub fn unwritten_defaults(
         &mut self,
         written: &dyn Fn(&str) -> bool,
-        camera: &mut crate::camera::Camera,
+        camera: &mut Camera,
         fidelity: &mut Fidelity,
     ) {
-        match self {
-            TechniqueScene::Opacity3d(p) => p.unwritten_defaults(written, camera),
-            TechniqueScene::Splats(p) => p.unwritten_defaults(written, fidelity),
-            TechniqueScene::Quad(_) | TechniqueScene::Cellproj(_) => {}
-        }
+        each_technique!(self, |mut p| Technique::unwritten_defaults(
+            p, written, camera, fidelity
+        ))
+    }
+
+    /// The technique as the frames drawn while the user interacts draw it, at
+    /// 1/`divisor` of the image's resolution ([`Technique::for_interaction`]).
+    pub fn for_interaction(&self, divisor: u32) -> TechniqueScene {
+        let mut reduced = self.clone();
+        each_technique!(&mut reduced, |mut p| Technique::for_interaction(p, divisor));
+        reduced
     }
 
     /// The large allocations preparing and drawing it at `size` makes that the scene
     /// alone determines (generated data, grids, lists); files are checked by their loaders.
     pub fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
-        match self {
-            TechniqueScene::Quad(_) => Vec::new(),
-            TechniqueScene::Opacity3d(p) => p.memory_estimate(),
-            TechniqueScene::Cellproj(p) => p.memory_estimate(),
-            TechniqueScene::Splats(p) => p.memory_estimate(size),
-        }
+        each_technique!(self, |p| Technique::memory_estimate(p, size))
     }
-}
-
-/// What a renderer needs of the scene besides its own parameters.
-#[derive(Debug, Clone, Copy)]
-pub struct Settings<'a> {
-    /// Faithful or precise.
-    pub fidelity: Fidelity,
-    /// The program kind the scene asked for (`auto` resolved to `kind` by the caller).
-    pub programs: ProgramChoice,
-    /// The folder relative data paths are read from.
-    pub base: &'a Path,
-    /// The camera's projection when the renderer is built.
-    pub projection: Projection,
-    /// The first view (camera and image size): what a COPC cloud's nodes are chosen for.
-    pub view: crate::points::copc_lod::View,
 }
 
 /// Build the renderer for `technique`, with programs of `kind`; nothing else is created.
@@ -120,60 +181,15 @@ pub fn build(
     settings: &Settings<'_>,
     kind: ProgramKind,
 ) -> GlResult<Box<dyn Renderer>> {
-    let Settings {
-        fidelity,
-        programs,
-        base,
-        projection,
-        view,
-    } = *settings;
-    Ok(match technique {
-        TechniqueScene::Quad(params) => Box::new(quad::QuadRenderer::new(gpu, kind, params)?),
-        TechniqueScene::Opacity3d(params)
-            if opacity3d::bricked::store_of(params)
-                .map_err(crate::gl::GlError::Data)?
-                .is_some() =>
-        {
-            // Precise draws a store with a GLSL ray caster: `auto` takes GLSL there.
-            let kind = if fidelity == crate::vocab::Fidelity::Precise
-                && programs == crate::gl::ProgramChoice::Auto
-            {
-                crate::gl::ProgramKind::Glsl
-            } else {
-                kind
-            };
-            Box::new(opacity3d::bricked::BrickedRenderer::new(
-                gpu, kind, fidelity, params, base, None,
-            )?)
-        }
-        TechniqueScene::Opacity3d(params) => Box::new(opacity3d::Opacity3dRenderer::new(
-            gpu,
-            opacity3d::renderer::resolve_kind(gpu, params, fidelity, programs, kind)?,
-            fidelity,
-            params,
-            base,
-            projection,
-        )?),
-        TechniqueScene::Splats(params) => Box::new(splats::SplatsRenderer::new(
-            gpu,
-            kind,
-            fidelity,
-            params,
-            base,
-            Some(view),
-        )?),
-        TechniqueScene::Cellproj(params) => Box::new(cellproj::CellprojRenderer::new(
-            gpu, kind, fidelity, params, base,
-        )?),
-    })
+    each_technique!(technique, |p| Technique::build(p, gpu, settings, kind))
 }
 
 /// Every program pair the techniques can draw with, both kinds (the compile-everything
 /// test): each technique lists its own.
 pub fn all_program_pairs() -> Vec<ProgramPair> {
-    let mut pairs = quad::program_pairs();
-    pairs.extend(opacity3d::renderer::program_pairs());
-    pairs.extend(cellproj::renderer::program_pairs());
-    pairs.extend(splats::renderer::program_pairs());
+    let mut pairs = QuadScene::program_pairs();
+    pairs.extend(Opacity3dScene::program_pairs());
+    pairs.extend(CellprojScene::program_pairs());
+    pairs.extend(SplatsScene::program_pairs());
     pairs
 }

@@ -251,37 +251,7 @@ impl Scene {
     /// Call `f` on every data file the scene names (volumes, table files, clip meshes and
     /// masks, meshes, clouds), with the dotted key that holds it.
     pub fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut std::path::PathBuf)) {
-        match &mut self.technique {
-            TechniqueScene::Opacity3d(o) => {
-                let names = ["primary", "secondary", "tertiary"];
-                for (attr, name) in o.attributes_mut().into_iter().zip(names) {
-                    let Some(attr) = attr else { continue };
-                    let kind = attr.volume.kind();
-                    if let Some(p) = attr.volume.path_mut() {
-                        f(&format!("technique.opacity3d.{name}.volume.{kind}"), p);
-                    }
-                    if let Some(p) = &mut attr.table.file {
-                        f(&format!("technique.opacity3d.{name}.table.file"), p);
-                    }
-                }
-                if let Some(clip) = &mut o.clip {
-                    clip.shape
-                        .for_each_path(&mut |p| f("technique.opacity3d.clip.shape", p));
-                }
-            }
-            TechniqueScene::Cellproj(c) => {
-                if let Some(p) = c.mesh.path_mut() {
-                    f("technique.cellproj.mesh.file", p);
-                }
-            }
-            TechniqueScene::Splats(s) => {
-                let kind = s.cloud.kind();
-                if let Some(p) = s.cloud.path_mut() {
-                    f(&format!("technique.splats.cloud.{kind}"), p);
-                }
-            }
-            TechniqueScene::Quad(_) => {}
-        }
+        self.technique.for_each_data_path(f)
     }
 
     /// Every data file the scene reads: its key, the path as written and as resolved
@@ -417,18 +387,7 @@ impl Scene {
             return Err(FieldError::new("background", "must be finite"));
         }
         self.memory_budget_bytes()?;
-        match &self.technique {
-            TechniqueScene::Opacity3d(o) => {
-                o.validate().map_err(|e| e.within("technique.opacity3d"))
-            }
-            TechniqueScene::Cellproj(c) => c.validate().map_err(|e| e.within("technique.cellproj")),
-            TechniqueScene::Splats(s) => {
-                s.validate().map_err(|e| e.within("technique.splats"))?;
-                s.draw_allowed(self.fidelity, self.programs)
-                    .map_err(|e| e.within("technique.splats"))
-            }
-            TechniqueScene::Quad(_) => Ok(()),
-        }
+        self.technique.validate(self.fidelity, self.programs)
     }
 }
 

@@ -22,6 +22,7 @@ use crate::techniques::cellproj::prepare::from_mesh;
 use crate::techniques::cellproj::CellprojRenderer;
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::Opacity3dRenderer;
+use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::splats::SplatsRenderer;
 use crate::techniques::Renderer;
 use crate::volume::axes::{self, section_axes, section_voxels, Axis};
@@ -251,9 +252,7 @@ impl ViewData {
         scene: &Scene,
         a: usize,
     ) -> Option<(&ColorTable, &TextureHandle)> {
-        let TechniqueScene::Opacity3d(o) = &scene.technique else {
-            return None;
-        };
+        let o = scene.technique.get::<Opacity3dScene>()?;
         let spec = &o.attributes()[a]?.table;
         let stale = self.tables[a].as_ref().is_none_or(|(s, _, _)| s != spec);
         if stale {

@@ -15,7 +15,8 @@ use super::curve;
 use super::data::ViewData;
 use super::widgets::Widgets;
 use crate::colortable::BUILTINS;
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
+use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::opacity3d::{Combine, MAX_SLICES};
 
 /// Width of the editor's panel in points: the grid and curves fit without clipping.
@@ -54,7 +55,7 @@ pub fn editor(
     // Tables first (they borrow the scene immutably).
     let tables: [Option<(crate::colortable::ColorTable, egui::TextureId)>; 3] =
         std::array::from_fn(|a| data.table(&ctx, scene, a).map(|(t, x)| (t.clone(), x.id())));
-    let TechniqueScene::Opacity3d(o) = &mut scene.technique else {
+    let Some(o) = scene.technique.get_mut::<Opacity3dScene>() else {
         return edit;
     };
     ui.heading("lut 3D");

@@ -17,7 +17,11 @@ use super::volume_view::InteractiveQuality;
 use super::widgets::Widgets;
 use crate::camera::Projection;
 use crate::gl::{Caps, ProgramKind};
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
+use crate::techniques::cellproj::CellprojScene;
+use crate::techniques::opacity3d::Opacity3dScene;
+use crate::techniques::quad::QuadScene;
+use crate::techniques::splats::SplatsScene;
 use crate::vocab::Fidelity;
 use crate::volume::axes::section_axes;
 
@@ -147,7 +151,7 @@ pub fn show(
     let mut actions = Vec::new();
     state.widgets.begin_frame();
     let camera_before = scene.camera;
-    let opacity3d = matches!(scene.technique, TechniqueScene::Opacity3d(_));
+    let opacity3d = scene.technique.get::<Opacity3dScene>().is_some();
     let sections_shown = opacity3d && state.sections.show && data.section_grid().is_some();
     let sizes = layout::panels(ui.max_rect().size(), opacity3d, sections_shown);
 
@@ -281,7 +285,7 @@ fn controls(
         ] {
             if w.radio(ui, label, &mut scene.fidelity, f) {
                 // Tiles are precise only: faithful draws the seed's points.
-                if let TechniqueScene::Splats(sp) = &mut scene.technique {
+                if let Some(sp) = scene.technique.get_mut::<SplatsScene>() {
                     if f == Fidelity::Faithful {
                         sp.draw = crate::techniques::splats::scene::DrawChoice::Points;
                     }
@@ -291,19 +295,19 @@ fn controls(
         }
     });
     let fidelity = scene.fidelity;
-    if let TechniqueScene::Splats(sp) = &mut scene.technique {
+    if let Some(sp) = scene.technique.get_mut::<SplatsScene>() {
         ui.separator();
         if super::splats::editor(ui, sp, fidelity, data.cloud.as_ref(), w) {
             actions.push(UiAction::ParamsChanged);
         }
     }
-    if let TechniqueScene::Opacity3d(o) = &mut scene.technique {
+    if let Some(o) = scene.technique.get_mut::<Opacity3dScene>() {
         ui.separator();
         if super::clip::editor(ui, o, &mut state.clip, w) {
             actions.push(UiAction::ParamsChanged);
         }
     }
-    if let TechniqueScene::Cellproj(c) = &mut scene.technique {
+    if let Some(c) = scene.technique.get_mut::<CellprojScene>() {
         ui.separator();
         let counts = data.mesh.as_ref().map(|m| m.histogram.as_slice());
         if super::transfer::editor(ui, c, &scene.base, counts, &mut state.transfer, w) {
@@ -315,7 +319,7 @@ fn controls(
             actions.push(UiAction::ParamsChanged);
         }
     }
-    if let TechniqueScene::Quad(q) = &mut scene.technique {
+    if let Some(q) = scene.technique.get_mut::<QuadScene>() {
         ui.label("Quad colours");
         for (label, colour) in [("Left", &mut q.left), ("Right", &mut q.right)] {
             ui.horizontal(|ui| {
@@ -372,7 +376,7 @@ fn controls(
         &mut state.overlay,
         "Box, axes and legends",
     );
-    if matches!(scene.technique, TechniqueScene::Opacity3d(_)) {
+    if scene.technique.get::<Opacity3dScene>().is_some() {
         w.checkbox(ui, "Sections", &mut state.sections.show, "Sections");
     }
     w.checkbox(

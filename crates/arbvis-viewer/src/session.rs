@@ -24,7 +24,8 @@ use crate::camera::{Arcball, Camera, Projection};
 use crate::gl::window::GlWindow;
 use crate::gl::{self, ProgramKind, Surface};
 use crate::png_io;
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
+use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::{Frame, Renderer};
 
 /// Margin kept around the volume's bounding sphere when framing.
@@ -81,7 +82,7 @@ impl Running {
         repaint: impl Fn(egui::RequestRepaintInfo) + Send + Sync + 'static,
     ) -> anyhow::Result<Running> {
         let mut scene = options.scene.clone();
-        let opacity3d = matches!(scene.technique, TechniqueScene::Opacity3d(_));
+        let opacity3d = scene.technique.get::<Opacity3dScene>().is_some();
         // The window fits the monitor (winit knows its size once the loop runs).
         let monitor = event_loop
             .primary_monitor()
@@ -546,7 +547,7 @@ impl Running {
 /// `arbvis-table-ROLE.table` in `dir`, and point the scene at the files.
 fn save_tables(scene: &mut Scene, dir: &std::path::Path) -> Result<Vec<String>, String> {
     let base = scene.base.clone();
-    let TechniqueScene::Opacity3d(o) = &mut scene.technique else {
+    let Some(o) = scene.technique.get_mut::<Opacity3dScene>() else {
         return Err("this scene has no colour tables".into());
     };
     let mut written = Vec::new();

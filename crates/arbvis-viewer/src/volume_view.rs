@@ -158,24 +158,6 @@ fn fresh_target(
     })
 }
 
-/// The technique with its slice count divided by `divisor` (at least one).
-pub fn reduced(technique: &TechniqueScene, divisor: u32) -> TechniqueScene {
-    let mut t = technique.clone();
-    match &mut t {
-        TechniqueScene::Opacity3d(o) => o.slices = (o.slices / divisor as usize).max(1),
-        // A volume's pre-integrated table a quarter (half quality) or an eighth (quarter)
-        // of each side: 64 to 512 times fewer integrals while a transfer-function drag
-        // rebuilds it every frame (the renderer remakes it only when it draws).
-        TechniqueScene::Cellproj(c) if c.mode.volume() && divisor > 1 => {
-            let mut spec = c.volume_spec();
-            spec.table_size = spec.table_size.map(|s| (s / (2 * divisor)).max(8).min(s));
-            c.volume = Some(spec);
-        }
-        _ => {}
-    }
-    t
-}
-
 impl VolumeView {
     /// Draw the full-quality picture again (a streaming renderer has more data for it).
     pub fn refine(&mut self) {
@@ -237,7 +219,7 @@ impl VolumeView {
             renderer.needs_depth(),
         )?;
         target.clear(gpu, key.background)?;
-        renderer.update(gpu, reduced(technique, d).params())?;
+        renderer.update(gpu, technique.for_interaction(d).params())?;
         let drawn = renderer.draw(gpu, Surface::Target(&target), &frame);
         renderer.update(gpu, technique.params())?;
         drawn?;

@@ -24,10 +24,12 @@ use serde::{Deserialize, Serialize};
 use crate::gl::{Headless, ProgramKind, Surface, Target};
 use crate::image::Image;
 use crate::progress::{Bar, Unit};
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
+use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::reference::reference_clipped;
 use crate::techniques::opacity3d::renderer::{path, preintegrated, resolve_kind, Path3d};
+use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::opacity3d::{Opacity3dRenderer, Raycast};
 use crate::techniques::{Frame, Renderer};
 use crate::vocab::Fidelity;
@@ -176,12 +178,12 @@ pub fn settings(scene: &Scene, options: &BenchOptions) -> Result<Vec<Setting>> {
         && options.precise.is_empty()
         && options.raycast.is_empty()
         && options.raycast_preint.is_empty());
-    if let TechniqueScene::Cellproj(c) = &scene.technique {
+    if let Some(c) = scene.technique.get::<CellprojScene>() {
         if !options.cellproj.is_empty() {
             return cellproj_settings(scene, c, &options.cellproj);
         }
     }
-    let TechniqueScene::Opacity3d(base) = &scene.technique else {
+    let Some(base) = scene.technique.get::<Opacity3dScene>() else {
         if sweeping {
             bail!("--faithful, --precise and --raycast[-preint] sweep 3D-opacity scenes only");
         }
@@ -208,7 +210,7 @@ pub fn settings(scene: &Scene, options: &BenchOptions) -> Result<Vec<Setting>> {
         let mut s = scene.clone();
         s.fidelity = fidelity;
         s.target = None;
-        if let TechniqueScene::Opacity3d(p) = &mut s.technique {
+        if let Some(p) = s.technique.get_mut::<Opacity3dScene>() {
             f(p);
             p.validate()
                 .map_err(|e| anyhow::anyhow!("{name}: {}: {}", e.key, e.message))?;
@@ -241,7 +243,7 @@ pub fn settings(scene: &Scene, options: &BenchOptions) -> Result<Vec<Setting>> {
             };
             let mut probe = scene.clone();
             probe.fidelity = Fidelity::Precise;
-            if let TechniqueScene::Opacity3d(p) = &mut probe.technique {
+            if let Some(p) = probe.technique.get_mut::<Opacity3dScene>() {
                 p.raycast = Some(r);
             }
             with(raycast_name(&r, &probe), Fidelity::Precise, &|p| {
@@ -314,7 +316,7 @@ fn cellproj_settings(
         c.volume = Some(volume);
         c.validate()
             .map_err(|e| anyhow::anyhow!("--cellproj {name}: {}: {}", e.key, e.message))?;
-        s.technique = TechniqueScene::Cellproj(Box::new(c));
+        s.technique = c.into();
         out.push(Setting {
             name: name.clone(),
             scene: s,
@@ -324,13 +326,10 @@ fn cellproj_settings(
 }
 
 fn raycast_name(r: &Raycast, scene: &Scene) -> String {
-    let pre = match &scene.technique {
-        TechniqueScene::Opacity3d(p) => {
-            let count = p.attributes().iter().flatten().count();
-            preintegrated(p, scene.fidelity, count)
-        }
-        _ => false,
-    };
+    let pre = scene.technique.get::<Opacity3dScene>().is_some_and(|p| {
+        let count = p.attributes().iter().flatten().count();
+        preintegrated(p, scene.fidelity, count)
+    });
     let exact = !r.jitter && !pre;
     format!(
         "raycast{}{} {} step/voxel",
@@ -380,8 +379,10 @@ pub fn rgb_error(image: &Image, rgb: &[f32]) -> (f64, f64) {
 
 /// Which renderer a setting draws with (one per fidelity, path, programs and target).
 fn slot_key(scene: &Scene, kind: ProgramKind) -> (Fidelity, bool, ProgramKind, TargetFormat) {
-    let raycast = matches!(&scene.technique,
-        TechniqueScene::Opacity3d(p) if path(p, scene.fidelity) == Path3d::Raycast);
+    let raycast = scene
+        .technique
+        .get::<Opacity3dScene>()
+        .is_some_and(|p| path(p, scene.fidelity) == Path3d::Raycast);
     (scene.fidelity, raycast, kind, scene.target_format())
 }
 
@@ -400,7 +401,7 @@ pub fn run(
     mut progress: impl FnMut(&str),
 ) -> Result<Report> {
     let gpu = headless.gpu();
-    if let TechniqueScene::Opacity3d(p) = &scene.technique {
+    if let Some(p) = scene.technique.get::<Opacity3dScene>() {
         if crate::techniques::opacity3d::bricked::store_of(p)
             .map_err(anyhow::Error::msg)?
             .is_some()
@@ -414,8 +415,8 @@ pub fn run(
         }
     }
     let settings = settings(scene, options)?;
-    let prepared = match &scene.technique {
-        TechniqueScene::Opacity3d(p) => {
+    let prepared = match scene.technique.get::<Opacity3dScene>() {
+        Some(p) => {
             let t0 = Instant::now();
             let prepared = prepare(
                 p,
@@ -429,7 +430,7 @@ pub fn run(
             ));
             Some(prepared)
         }
-        _ => None,
+        None => None,
     };
     let volume = cellproj_volume(scene, options, &mut progress)?;
     let (reference_rgb, reference_s) = match (&prepared, &volume, options.score) {
@@ -474,20 +475,21 @@ pub fn run(
                     &mut slots[n]
                 }
                 None => {
-                    let renderer: Box<dyn Renderer> = match (&s.technique, &prepared) {
-                        (TechniqueScene::Opacity3d(p), Some(prepared)) => {
-                            Box::new(Opacity3dRenderer::from_prepared(
-                                gpu,
-                                resolve_kind(gpu, p, s.fidelity, s.programs, kind)?,
-                                s.fidelity,
-                                p,
-                                &s.base,
-                                prepared.clone(),
-                                s.camera.projection,
-                            )?)
-                        }
-                        _ => crate::render::build(gpu, s, kind)?,
-                    };
+                    let renderer: Box<dyn Renderer> =
+                        match (s.technique.get::<Opacity3dScene>(), &prepared) {
+                            (Some(p), Some(prepared)) => {
+                                Box::new(Opacity3dRenderer::from_prepared(
+                                    gpu,
+                                    resolve_kind(gpu, p, s.fidelity, s.programs, kind)?,
+                                    s.fidelity,
+                                    p,
+                                    &s.base,
+                                    prepared.clone(),
+                                    s.camera.projection,
+                                )?)
+                            }
+                            _ => crate::render::build(gpu, s, kind)?,
+                        };
                     let target = if renderer.needs_depth() {
                         Target::with_depth(gpu, w, h, s.target_format())?
                     } else {
@@ -581,12 +583,12 @@ pub fn run(
 }
 
 fn new_measured(setting: &Setting, s: &Scene, kind: ProgramKind, first: f64) -> Measured {
-    let (path, slices, steps) = match &s.technique {
-        TechniqueScene::Opacity3d(p) => match path(p, s.fidelity) {
+    let (path, slices, steps) = match s.technique.get::<Opacity3dScene>() {
+        Some(p) => match path(p, s.fidelity) {
             Path3d::Raycast => ("raycast", None, p.raycast.map(|r| r.steps_per_voxel)),
             Path3d::Slicing => ("slicing", Some(p.slices), None),
         },
-        _ => ("", None, None),
+        None => ("", None, None),
     };
     Measured {
         technique: s.technique.name().to_string(),
@@ -613,7 +615,7 @@ fn cellproj_volume(
         f64,
     )>,
 > {
-    let TechniqueScene::Cellproj(c) = &scene.technique else {
+    let Some(c) = scene.technique.get::<CellprojScene>() else {
         return Ok(None);
     };
     if !c.mode.volume() || !(options.score || options.export.is_some()) {
@@ -667,7 +669,7 @@ fn reference_key(scene: &Scene, oversample: f64) -> ReferenceKey {
     s.fidelity = Fidelity::Precise;
     s.target = None;
     s.programs = Default::default();
-    if let TechniqueScene::Opacity3d(p) = &mut s.technique {
+    if let Some(p) = s.technique.get_mut::<Opacity3dScene>() {
         p.slices = 1;
         p.raycast = None;
         p.opacity_correction = None;
@@ -696,7 +698,7 @@ fn reference_rgb(
             return Ok((rgb, 0.0));
         }
     }
-    let TechniqueScene::Opacity3d(params) = &scene.technique else {
+    let Some(params) = scene.technique.get::<Opacity3dScene>() else {
         bail!("--score needs a 3D-opacity scene");
     };
     let t0 = Instant::now();

@@ -18,11 +18,12 @@ use crate::gl::{
     TexelFormat, Texture,
 };
 use crate::programs::{self, with_transform};
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
 use crate::techniques::opacity3d::prepare::Prepared;
 use crate::techniques::opacity3d::programs::specialize;
 use crate::techniques::opacity3d::renderer::{model_view_projection, toward_viewer};
 use crate::techniques::opacity3d::slicing::slice_box;
+use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::Frame;
 use crate::vocab::TargetFormat;
 
@@ -86,7 +87,7 @@ pub fn run(
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<Measured>> {
     let gpu = headless.gpu();
-    let TechniqueScene::Opacity3d(params) = &scene.technique else {
+    let Some(params) = scene.technique.get::<Opacity3dScene>() else {
         anyhow::bail!("--breakdown needs a 3D-opacity scene");
     };
     let [w, h] = scene.size;

@@ -13,9 +13,10 @@ use glam::DVec3;
 use serde::Serialize;
 
 use crate::camera::Projection;
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
 use crate::techniques::opacity3d::prepare::Prepared;
 use crate::techniques::opacity3d::renderer::coefficients;
+use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::opacity3d::ATTRIBUTE_NAMES;
 
 #[derive(Serialize)]
@@ -88,7 +89,7 @@ fn camera_json(scene: &Scene) -> CameraJson {
 
 /// Write the peer's files into `dir` (created if needed).
 pub fn write(dir: &Path, scene: &Scene, prepared: &Prepared, oversample: f64) -> Result<()> {
-    let TechniqueScene::Opacity3d(params) = &scene.technique else {
+    let Some(params) = scene.technique.get::<Opacity3dScene>() else {
         anyhow::bail!("--export needs a 3D-opacity or cell-projection volume scene");
     };
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;

@@ -22,7 +22,7 @@ use std::time::Instant;
 use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target};
 use crate::image::Image;
 use crate::progress::{Bar, Unit};
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::reference::reference;
 use crate::techniques::opacity3d::{Opacity3dRenderer, Opacity3dScene};
@@ -116,7 +116,7 @@ pub fn study_scene(options: &StudyOptions) -> Scene {
     )
     .expect("the built-in study scene parses");
     scene.size = [options.size, options.size];
-    if let TechniqueScene::Opacity3d(o) = &mut scene.technique {
+    if let Some(o) = scene.technique.get_mut::<Opacity3dScene>() {
         for attr in o.attributes_mut().into_iter().flatten() {
             attr.volume = VolumeSource::Synthetic(SyntheticSpec {
                 size: [options.volume; 3],
@@ -128,10 +128,10 @@ pub fn study_scene(options: &StudyOptions) -> Scene {
 }
 
 fn params(scene: &Scene) -> &Opacity3dScene {
-    match &scene.technique {
-        TechniqueScene::Opacity3d(o) => o,
-        _ => unreachable!("study scenes are opacity3d"),
-    }
+    scene
+        .technique
+        .get::<Opacity3dScene>()
+        .expect("study scenes are opacity3d")
 }
 
 /// Time one setting: build from `prepared`, one warm-up frame, `frames` timed frames.
@@ -257,7 +257,7 @@ pub fn run(
         let mut scene = base_scene.clone();
         scene.fidelity = fidelity;
         scene.target = Some(target);
-        if let TechniqueScene::Opacity3d(o) = &mut scene.technique {
+        if let Some(o) = scene.technique.get_mut::<Opacity3dScene>() {
             o.slices = slices;
             o.opacity_correction = Some(correction);
         }

@@ -12,9 +12,13 @@ pub mod rays;
 pub mod splats;
 
 use std::any::Any;
+use std::path::{Path, PathBuf};
 
-use crate::camera::Camera;
-use crate::gl::{GlError, GlResult, Gpu, ProgramKind, Surface};
+use crate::budget::Estimate;
+use crate::camera::{Camera, Projection};
+use crate::gl::{GlError, GlResult, Gpu, ProgramChoice, ProgramKind, Surface};
+use crate::programs::ProgramPair;
+use crate::vocab::{Fidelity, FieldError};
 
 /// What changes from frame to frame.
 #[derive(Debug, Clone, Copy)]
@@ -103,12 +107,75 @@ pub trait Renderer {
     }
 }
 
-/// A technique's scene parameters (`[technique.NAME]`), as [`Renderer::update`] takes
-/// them: each technique's scene type implements it, so the renderers need not know the
-/// list of techniques (that list, `crate::catalog::TechniqueScene`, sits above them).
-pub trait TechniqueParams: Any {
+/// One technique, implemented once by its scene parameters' type (`[technique.NAME]` in
+/// TOML): what the scene, the catalog and the layers above need of it. The catalog
+/// (`crate::catalog`, above the techniques) is the one list of the implementors; nothing
+/// else names that list, and a technique names none of the others.
+pub trait Technique: Any + Sized {
     /// The technique's name as written in scenes.
     const NAME: &'static str;
+    /// Check values that parse but cannot render, in a scene drawn at `fidelity` with
+    /// `programs`; the error's key is relative to `[technique.NAME]`.
+    fn validate(&self, fidelity: Fidelity, programs: ProgramChoice) -> Result<(), FieldError>;
+    /// Call `f` on every data file the parameters name, with its key relative to
+    /// `[technique.NAME]` (e.g. `primary.volume.file`).
+    fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut PathBuf)) {
+        let _ = f;
+    }
+    /// The large allocations preparing and drawing it at `size` makes that the
+    /// parameters alone determine (generated data, grids, lists); files are held to the
+    /// budget by their loaders.
+    fn memory_estimate(&self, size: [u32; 2]) -> Vec<Estimate> {
+        let _ = size;
+        Vec::new()
+    }
+    /// The camera a scene without `[camera]` starts from (and the viewer's Reset camera
+    /// returns to), where the data asks for another than the default.
+    fn default_camera(&self) -> Option<Camera> {
+        None
+    }
+    /// Defaults that depend on the data the parameters name, for the keys a scene's text
+    /// leaves out (`written` tells which dotted keys it writes, from the scene's root).
+    fn unwritten_defaults(
+        &mut self,
+        written: &dyn Fn(&str) -> bool,
+        camera: &mut Camera,
+        fidelity: &mut Fidelity,
+    ) {
+        let _ = (written, camera, fidelity);
+    }
+    /// Cheaper parameters of the same picture for the frames drawn while the user
+    /// interacts, at 1/`divisor` of the image's resolution (the viewer); by default the
+    /// same parameters.
+    fn for_interaction(&mut self, divisor: u32) {
+        let _ = divisor;
+    }
+    /// Every program pair its renderers can draw with, both kinds (the
+    /// compile-everything test).
+    fn program_pairs() -> Vec<ProgramPair>;
+    /// Its renderer, with programs of `kind` (`settings.programs` resolved); nothing
+    /// else is created.
+    fn build(
+        &self,
+        gpu: &Gpu,
+        settings: &Settings<'_>,
+        kind: ProgramKind,
+    ) -> GlResult<Box<dyn Renderer>>;
+}
+
+/// What a renderer needs of the scene besides its technique's parameters.
+#[derive(Debug, Clone, Copy)]
+pub struct Settings<'a> {
+    /// Faithful or precise.
+    pub fidelity: Fidelity,
+    /// The program kind the scene asked for (`auto` resolved to `kind` by the caller).
+    pub programs: ProgramChoice,
+    /// The folder relative data paths are read from.
+    pub base: &'a Path,
+    /// The camera's projection when the renderer is built.
+    pub projection: Projection,
+    /// The first view (camera and image size): what a COPC cloud's nodes are chosen for.
+    pub view: crate::points::copc_lod::View,
 }
 
 /// Some technique's parameters; a renderer takes its own with [`Params::get`].
@@ -120,7 +187,7 @@ pub struct Params<'a> {
 
 impl<'a> Params<'a> {
     /// Wrap one technique's parameters.
-    pub fn of<T: TechniqueParams>(params: &'a T) -> Params<'a> {
+    pub fn of<T: Technique>(params: &'a T) -> Params<'a> {
         Params {
             params,
             name: T::NAME,
@@ -128,7 +195,7 @@ impl<'a> Params<'a> {
     }
 
     /// The parameters as technique `T`'s, or an error naming both techniques.
-    pub fn get<T: TechniqueParams>(&self) -> GlResult<&'a T> {
+    pub fn get<T: Technique>(&self) -> GlResult<&'a T> {
         self.params.downcast_ref::<T>().ok_or_else(|| {
             GlError::Invalid(format!("{} renderer given a {} scene", T::NAME, self.name))
         })

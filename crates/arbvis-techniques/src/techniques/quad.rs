@@ -12,7 +12,7 @@
 use glam::{DMat4, DVec3};
 use serde::{Deserialize, Serialize};
 
-use super::{Frame, Params, Renderer, TechniqueParams};
+use super::{Frame, Params, Renderer, Settings, Technique};
 use crate::gl::{self, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface};
 use crate::image::Image;
 use crate::programs;
@@ -27,8 +27,24 @@ pub struct QuadScene {
     pub right: [f64; 4],
 }
 
-impl TechniqueParams for QuadScene {
+impl Technique for QuadScene {
     const NAME: &'static str = "quad";
+
+    fn validate(
+        &self,
+        _: crate::vocab::Fidelity,
+        _: gl::ProgramChoice,
+    ) -> Result<(), crate::vocab::FieldError> {
+        Ok(())
+    }
+
+    fn program_pairs() -> Vec<programs::ProgramPair> {
+        program_pairs()
+    }
+
+    fn build(&self, gpu: &Gpu, _: &Settings<'_>, kind: ProgramKind) -> GlResult<Box<dyn Renderer>> {
+        Ok(Box::new(QuadRenderer::new(gpu, kind, self)?))
+    }
 }
 
 impl Default for QuadScene {

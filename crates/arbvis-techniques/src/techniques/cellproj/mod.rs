@@ -94,9 +94,10 @@ pub mod volume_reference;
 use serde::{Deserialize, Serialize};
 
 use crate::camera::Projection;
+use crate::gl::ProgramChoice;
 use crate::mesh::scalars::ScalarSpec;
 use crate::mesh::MeshSource;
-use crate::vocab::{significant, FieldError};
+use crate::vocab::{significant, Fidelity, FieldError};
 
 pub use renderer::CellprojRenderer;
 
@@ -261,8 +262,52 @@ pub struct CellprojScene {
     pub interpolation: crate::vocab::Interpolation,
 }
 
-impl crate::techniques::TechniqueParams for CellprojScene {
+impl crate::techniques::Technique for CellprojScene {
     const NAME: &'static str = "cellproj";
+
+    fn validate(&self, _: Fidelity, _: ProgramChoice) -> Result<(), FieldError> {
+        CellprojScene::validate(self)
+    }
+
+    fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut std::path::PathBuf)) {
+        if let Some(p) = self.mesh.path_mut() {
+            f("mesh.file", p);
+        }
+    }
+
+    fn memory_estimate(&self, _: [u32; 2]) -> Vec<crate::budget::Estimate> {
+        CellprojScene::memory_estimate(self)
+    }
+
+    /// A volume's pre-integrated table a quarter (half quality) or an eighth (quarter)
+    /// of each side: 64 to 512 times fewer integrals while a transfer-function drag
+    /// rebuilds it every frame (the renderer remakes it only when it draws).
+    fn for_interaction(&mut self, divisor: u32) {
+        if self.mode.volume() && divisor > 1 {
+            let mut spec = self.volume_spec();
+            spec.table_size = spec.table_size.map(|s| (s / (2 * divisor)).max(8).min(s));
+            self.volume = Some(spec);
+        }
+    }
+
+    fn program_pairs() -> Vec<crate::programs::ProgramPair> {
+        renderer::program_pairs()
+    }
+
+    fn build(
+        &self,
+        gpu: &crate::gl::Gpu,
+        settings: &crate::techniques::Settings<'_>,
+        kind: crate::gl::ProgramKind,
+    ) -> crate::gl::GlResult<Box<dyn crate::techniques::Renderer>> {
+        Ok(Box::new(CellprojRenderer::new(
+            gpu,
+            kind,
+            settings.fidelity,
+            self,
+            settings.base,
+        )?))
+    }
 }
 
 /// Memory per tetrahedron of a generated grid while it is prepared and drawn: the mesh, the

@@ -30,9 +30,10 @@ use super::texture::{ClipGrid, ClipTexture};
 use super::{ClipError, ClipSpec, ShapeSpec};
 use crate::gl::{Headless, Surface, Target};
 use crate::progress::{Bar, Unit};
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
 use crate::techniques::opacity3d::prepare::prepare;
 use crate::techniques::opacity3d::reference::reference_clipped;
+use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::Frame;
 use crate::techniques::Params;
 use crate::volume::Limits;
@@ -284,7 +285,7 @@ pub fn frame_scene(options: &Options) -> anyhow::Result<Scene> {
         "scenes/bench/clip-sphere-study.toml",
     )?;
     scene.size = [options.image; 2];
-    let TechniqueScene::Opacity3d(p) = &mut scene.technique else {
+    let Some(p) = scene.technique.get_mut::<Opacity3dScene>() else {
         anyhow::bail!("the clip study scene is not a 3D-opacity scene");
     };
     let n = options.frame_volume;
@@ -327,7 +328,7 @@ pub fn frames(
         width: w,
         height: h,
     };
-    let TechniqueScene::Opacity3d(base) = &scene.technique else {
+    let Some(base) = scene.technique.get::<Opacity3dScene>() else {
         unreachable!("frame_scene makes a 3D-opacity scene");
     };
     let mut settings: Vec<(String, Option<ClipSpec>)> = vec![("no clip".into(), None)];
@@ -362,7 +363,7 @@ pub fn frames(
         let clipped = clip.is_some();
         let mut p = base.clone();
         p.clip = clip;
-        renderer.update(gpu, Params::of(&*p))?;
+        renderer.update(gpu, Params::of(&p))?;
         let mut times = Vec::new();
         for i in 0..=options.frames.max(1) {
             let t0 = Instant::now();
@@ -413,7 +414,7 @@ fn reference_rgb(
     oversample: f64,
     progress: &mut impl FnMut(&str),
 ) -> anyhow::Result<Vec<f32>> {
-    let TechniqueScene::Opacity3d(params) = &scene.technique else {
+    let Some(params) = scene.technique.get::<Opacity3dScene>() else {
         anyhow::bail!("the clip study scene is not a 3D-opacity scene");
     };
     let t0 = Instant::now();

@@ -65,7 +65,7 @@ pub mod slicing;
 use serde::{Deserialize, Serialize};
 
 use crate::colortable::TableSpec;
-use crate::gl::Filter;
+use crate::gl::{Filter, ProgramChoice};
 use crate::techniques::clip::ClipSpec;
 pub use crate::vocab::Interpolation;
 use crate::vocab::{Fidelity, FieldError};
@@ -180,8 +180,93 @@ pub struct Opacity3dScene {
     pub store: Option<bricked::StoreView>,
 }
 
-impl crate::techniques::TechniqueParams for Opacity3dScene {
+impl crate::techniques::Technique for Opacity3dScene {
     const NAME: &'static str = "opacity3d";
+
+    fn validate(&self, _: Fidelity, _: ProgramChoice) -> Result<(), FieldError> {
+        Opacity3dScene::validate(self)
+    }
+
+    fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut std::path::PathBuf)) {
+        for (attr, name) in self.attributes_mut().into_iter().zip(ATTRIBUTE_NAMES) {
+            let Some(attr) = attr else { continue };
+            let kind = attr.volume.kind();
+            if let Some(p) = attr.volume.path_mut() {
+                f(&format!("{name}.volume.{kind}"), p);
+            }
+            if let Some(p) = &mut attr.table.file {
+                f(&format!("{name}.table.file"), p);
+            }
+        }
+        if let Some(clip) = &mut self.clip {
+            clip.shape.for_each_path(&mut |p| f("clip.shape", p));
+        }
+    }
+
+    fn memory_estimate(&self, _: [u32; 2]) -> Vec<crate::budget::Estimate> {
+        Opacity3dScene::memory_estimate(self)
+    }
+
+    fn default_camera(&self) -> Option<crate::camera::Camera> {
+        Opacity3dScene::default_camera(self)
+    }
+
+    fn unwritten_defaults(
+        &mut self,
+        written: &dyn Fn(&str) -> bool,
+        camera: &mut crate::camera::Camera,
+        _: &mut Fidelity,
+    ) {
+        Opacity3dScene::unwritten_defaults(self, written, camera)
+    }
+
+    /// The slice count divided by `divisor` (at least one).
+    fn for_interaction(&mut self, divisor: u32) {
+        self.slices = (self.slices / divisor as usize).max(1);
+    }
+
+    fn program_pairs() -> Vec<crate::programs::ProgramPair> {
+        renderer::program_pairs()
+    }
+
+    /// A survey store is drawn brick by brick ([`bricked::BrickedRenderer`]; precise
+    /// with a GLSL ray caster, which `auto` then takes); other volumes whole.
+    fn build(
+        &self,
+        gpu: &crate::gl::Gpu,
+        settings: &crate::techniques::Settings<'_>,
+        kind: crate::gl::ProgramKind,
+    ) -> crate::gl::GlResult<Box<dyn crate::techniques::Renderer>> {
+        let fidelity = settings.fidelity;
+        if bricked::store_of(self)
+            .map_err(crate::gl::GlError::Data)?
+            .is_some()
+        {
+            let kind = if fidelity == Fidelity::Precise && settings.programs == ProgramChoice::Auto
+            {
+                crate::gl::ProgramKind::Glsl
+            } else {
+                kind
+            };
+            return Ok(Box::new(bricked::BrickedRenderer::new(
+                gpu,
+                kind,
+                fidelity,
+                self,
+                settings.base,
+                None,
+            )?));
+        }
+        let kind = renderer::resolve_kind(gpu, self, fidelity, settings.programs, kind)?;
+        Ok(Box::new(Opacity3dRenderer::new(
+            gpu,
+            kind,
+            fidelity,
+            self,
+            settings.base,
+            settings.projection,
+        )?))
+    }
 }
 
 /// Memory per voxel of each generated attribute while it is prepared and drawn: the f32

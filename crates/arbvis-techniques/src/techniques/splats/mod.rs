@@ -52,3 +52,58 @@ pub mod tiles;
 
 pub use renderer::SplatsRenderer;
 pub use scene::SplatsScene;
+
+/// Splats as the catalog lists them: the scene's checks and defaults (`scene.rs`), the
+/// renderer (`renderer.rs`).
+impl crate::techniques::Technique for SplatsScene {
+    const NAME: &'static str = "splats";
+
+    fn validate(
+        &self,
+        fidelity: crate::vocab::Fidelity,
+        programs: crate::gl::ProgramChoice,
+    ) -> Result<(), crate::vocab::FieldError> {
+        SplatsScene::validate(self)?;
+        self.draw_allowed(fidelity, programs)
+    }
+
+    fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut std::path::PathBuf)) {
+        let kind = self.cloud.kind();
+        if let Some(p) = self.cloud.path_mut() {
+            f(&format!("cloud.{kind}"), p);
+        }
+    }
+
+    fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
+        SplatsScene::memory_estimate(self, size)
+    }
+
+    fn unwritten_defaults(
+        &mut self,
+        written: &dyn Fn(&str) -> bool,
+        _: &mut crate::camera::Camera,
+        fidelity: &mut crate::vocab::Fidelity,
+    ) {
+        SplatsScene::unwritten_defaults(self, written, fidelity)
+    }
+
+    fn program_pairs() -> Vec<crate::programs::ProgramPair> {
+        renderer::program_pairs()
+    }
+
+    fn build(
+        &self,
+        gpu: &crate::gl::Gpu,
+        settings: &crate::techniques::Settings<'_>,
+        kind: crate::gl::ProgramKind,
+    ) -> crate::gl::GlResult<Box<dyn crate::techniques::Renderer>> {
+        Ok(Box::new(SplatsRenderer::new(
+            gpu,
+            kind,
+            settings.fidelity,
+            self,
+            settings.base,
+            Some(settings.view),
+        )?))
+    }
+}

@@ -168,10 +168,6 @@ pub struct SplatsScene {
     pub volume: VolumeSpec,
 }
 
-impl crate::techniques::TechniqueParams for SplatsScene {
-    const NAME: &'static str = "splats";
-}
-
 fn porosity() -> String {
     crate::points::POROSITY.into()
 }

@@ -25,7 +25,8 @@ use crate::gl::{Headless, Surface, Target};
 use crate::points::section::{generate, SectionSpec};
 use crate::points::{PointCloud, PointSource};
 use crate::progress::{Bar, Unit};
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
+use crate::techniques::splats::SplatsScene;
 use crate::techniques::{self, Frame};
 use crate::vocab::Fidelity;
 
@@ -176,14 +177,14 @@ pub fn frames(
         "scenes/bench/splats-section-study.toml",
     )?;
     scene.size = options.size;
-    let TechniqueScene::Splats(params) = &mut scene.technique else {
+    let Some(params) = scene.technique.get_mut::<SplatsScene>() else {
         anyhow::bail!("the splats study scene is not a splat scene");
     };
     params.cloud = PointSource::Section(SectionSpec {
         points: options.frame_points,
         seed: 1,
     });
-    let base = (**params).clone();
+    let base = params.clone();
     let mut settings: Vec<(String, Fidelity, super::SplatsScene)> = [
         SortChoice::Seed,
         SortChoice::Keys,
@@ -230,7 +231,7 @@ pub fn frames(
             _ => {
                 let mut s = scene.clone();
                 s.fidelity = fidelity;
-                s.technique = TechniqueScene::Splats(Box::new(p.clone()));
+                s.technique = p.clone().into();
                 let kind = s.programs.resolve(gpu);
                 &mut built
                     .insert((fidelity, crate::render::build(gpu, &s, kind)?))

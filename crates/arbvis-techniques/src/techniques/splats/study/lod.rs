@@ -12,8 +12,9 @@ use crate::gl::Headless;
 use crate::points::copc::Copc;
 use crate::points::copc_lod::{select, View};
 use crate::points::PointSource;
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
 use crate::study::bench::{self, BenchOptions};
+use crate::techniques::splats::SplatsScene;
 
 /// One budget measured.
 #[derive(Debug, Clone, PartialEq)]
@@ -33,7 +34,7 @@ pub struct LodRow {
 /// The scene with `budget` and no pixel size.
 fn with_budget(scene: &Scene, budget: u64) -> Result<Scene> {
     let mut s = scene.clone();
-    let TechniqueScene::Splats(p) = &mut s.technique else {
+    let Some(p) = s.technique.get_mut::<SplatsScene>() else {
         bail!("the splats-lod study needs a splats scene");
     };
     let PointSource::Copc(spec) = &mut p.cloud else {
@@ -52,13 +53,13 @@ pub fn lod(
     frames: usize,
     mut progress: impl FnMut(&str),
 ) -> Result<Vec<LodRow>> {
-    let path = match &scene.technique {
-        TechniqueScene::Splats(p) => match &p.cloud {
-            PointSource::Copc(spec) => scene.base.join(&spec.path),
-            _ => bail!("the splats-lod study needs a scene whose cloud is a COPC file"),
-        },
-        _ => bail!("the splats-lod study needs a splats scene"),
+    let Some(p) = scene.technique.get::<SplatsScene>() else {
+        bail!("the splats-lod study needs a splats scene");
     };
+    let PointSource::Copc(spec) = &p.cloud else {
+        bail!("the splats-lod study needs a scene whose cloud is a COPC file");
+    };
+    let path = scene.base.join(&spec.path);
     let copc = Copc::open(&path).with_context(|| format!("opening {}", path.display()))?;
     progress(&format!(
         "splats-lod: the reference, all {} points of {}",
