@@ -12,6 +12,7 @@ use arbvis::camera::{Camera, Projection};
 use arbvis::points::copc_load::{load, load_in_stages, Stages};
 use arbvis::points::copc_lod::View;
 use arbvis::points::PointSource;
+use arbvis::techniques::Streaming;
 
 use crate::common::splats::camera_turned as camera;
 use crate::common::{data_file, temp_dir};

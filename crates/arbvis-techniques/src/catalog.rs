@@ -15,7 +15,7 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 
 use crate::camera::Camera;
-use crate::gl::{GlResult, Gpu, ProgramChoice, ProgramKind};
+use crate::gl::{GlError, GlResult, Gpu, ProgramChoice, ProgramKind};
 use crate::programs::ProgramPair;
 use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::Opacity3dScene;
@@ -24,6 +24,7 @@ use crate::techniques::splats::SplatsScene;
 pub use crate::techniques::Settings;
 use crate::techniques::{Params, Renderer, Technique};
 use crate::vocab::{Fidelity, FieldError};
+use crate::volume::Limits;
 
 /// Which technique and its parameters; in TOML a `[technique.NAME]` table.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -182,6 +183,50 @@ pub fn build(
     kind: ProgramKind,
 ) -> GlResult<Box<dyn Renderer>> {
     each_technique!(technique, |p| Technique::build(p, gpu, settings, kind))
+}
+
+/// A technique's prepared data ([`Technique::Prepared`]), boxed, so that a caller that
+/// keeps it (the viewer, between renderers of another program kind) need not name the
+/// technique that made it.
+pub type PreparedData = Box<dyn Any>;
+
+/// Check `technique`'s parameters, then load and prepare its data within `limits`
+/// ([`Technique::prepare`]).
+pub fn prepare(
+    technique: &TechniqueScene,
+    settings: &Settings<'_>,
+    limits: &Limits,
+) -> GlResult<PreparedData> {
+    each_technique!(technique, |p| Technique::prepare(p, settings, limits)
+        .map(|d| Box::new(d) as PreparedData))
+}
+
+/// The renderer of what [`prepare`] made for `technique`, with programs of `kind`.
+pub fn renderer(
+    technique: &TechniqueScene,
+    gpu: &Gpu,
+    settings: &Settings<'_>,
+    kind: ProgramKind,
+    prepared: PreparedData,
+) -> GlResult<Box<dyn Renderer>> {
+    each_technique!(technique, |p| renderer_of(p, gpu, settings, kind, prepared))
+}
+
+/// [`Technique::renderer`] of `prepared`, which must be `T`'s.
+fn renderer_of<T: Technique>(
+    technique: &T,
+    gpu: &Gpu,
+    settings: &Settings<'_>,
+    kind: ProgramKind,
+    prepared: PreparedData,
+) -> GlResult<Box<dyn Renderer>> {
+    let prepared = prepared.downcast::<T::Prepared>().map_err(|_| {
+        GlError::Invalid(format!(
+            "the {} renderer was given another technique's prepared data",
+            T::NAME
+        ))
+    })?;
+    technique.renderer(gpu, settings, kind, *prepared)
 }
 
 /// Every program pair the techniques can draw with, both kinds (the compile-everything

@@ -15,15 +15,16 @@ use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
 
 use super::store_sections::{MapPositions, SectionKey, StoreSections};
 use super::summary::{cloud_units, data_box, CloudSummary, DataBox, MeshSummary};
+use crate::catalog;
 use crate::colortable::{ColorTable, TableSpec};
 use crate::gl::{GlError, Gpu, ProgramKind};
-use crate::scene::{Scene, TechniqueScene};
-use crate::techniques::cellproj::prepare::from_mesh;
-use crate::techniques::cellproj::CellprojRenderer;
+use crate::scene::Scene;
+use crate::techniques::cellproj::prepare::Prepared as PreparedMesh;
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::Opacity3dRenderer;
 use crate::techniques::opacity3d::Opacity3dScene;
-use crate::techniques::splats::SplatsRenderer;
+use crate::techniques::splats::prepare::PreparedCloud;
+use crate::techniques::splats::SplatsScene;
 use crate::techniques::Renderer;
 use crate::volume::axes::{self, section_axes, section_voxels, Axis};
 
@@ -99,76 +100,63 @@ impl SectionGrid {
     }
 }
 
-/// Build the scene's renderer with programs of `kind`, keeping its prepared data.
+/// Build the scene's renderer with programs of `kind` through the catalog
+/// ([`catalog::prepare`], then [`catalog::renderer`]), keeping what the panels show of
+/// the prepared data: a cloud's or a mesh's summary; for 3D opacity the voxels themselves
+/// ([`build_volume`]).
 pub fn build(
     gpu: &Gpu,
     scene: &Scene,
     kind: ProgramKind,
     data: &mut ViewData,
 ) -> Result<Box<dyn Renderer>, GlError> {
-    let data_error = |e: String| GlError::Data(e);
-    let params = match &scene.technique {
-        TechniqueScene::Opacity3d(params) => params,
-        TechniqueScene::Splats(params) => {
-            // Prepared here (as `SplatsRenderer::new` would) to keep the cloud's key.
-            // A COPC cloud's nodes are chosen for the first view, and again whenever
-            // the camera stops (`Renderer::settle`).
-            params.validate().map_err(|e| data_error(e.to_string()))?;
-            let view = crate::points::copc_lod::View::of(&scene.camera, scene.size);
-            let loaded =
-                crate::techniques::splats::prepare::prepare_for(params, &scene.base, Some(&view))
-                    .map_err(data_error)?;
-            data.cloud = Some(CloudSummary::of(
-                &loaded.0,
+    if let Some(params) = scene.technique.get::<Opacity3dScene>() {
+        return build_volume(gpu, scene, params, kind, data);
+    }
+    data.volume = None;
+    let settings = scene.settings();
+    let limits = crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size);
+    let prepared = catalog::prepare(&scene.technique, &settings, &limits)?;
+    data.summarize(scene, prepared.as_ref());
+    catalog::renderer(&scene.technique, gpu, &settings, kind, prepared)
+}
+
+impl ViewData {
+    /// What the panels show of a technique's prepared data: a cloud's box, units and
+    /// attributes; a mesh's box in its file's coordinates and its scalar's histogram.
+    fn summarize(&mut self, scene: &Scene, prepared: &dyn std::any::Any) {
+        if let (Some((cloud, _, _)), Some(params)) = (
+            prepared.downcast_ref::<PreparedCloud>(),
+            scene.technique.get::<SplatsScene>(),
+        ) {
+            self.cloud = Some(CloudSummary::of(
+                cloud,
                 &cloud_units(&params.cloud, &scene.base),
             ));
-            return Ok(Box::new(SplatsRenderer::upload(
-                gpu,
-                kind,
-                scene.fidelity,
-                params,
-                &scene.base,
-                Some(view),
-                loaded,
-            )?));
         }
-        TechniqueScene::Cellproj(params) => {
-            // Prepared here (as `cellproj::prepare::prepare` does) to keep the mesh's box
-            // in its file coordinates.
-            params.validate().map_err(|e| data_error(e.to_string()))?;
-            let mesh = params
-                .mesh
-                .load(&scene.base)
-                .map_err(|e| data_error(e.to_string()))?;
-            let scalars = params
-                .scalars
-                .evaluate(&mesh)
-                .map_err(|e| data_error(e.to_string()))?;
-            let prepared = from_mesh(&mesh, &scalars.values, scalars.name, scalars.range)
-                .map_err(data_error)?;
-            if let Some((lo, hi)) = mesh.bounds() {
-                let longest = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
-                let scale = if longest > 0.0 { 2.0 / longest } else { 1.0 };
-                data.mesh = Some(MeshSummary {
-                    data_box: data_box(lo, hi, scale, &Default::default()),
-                    scalar: prepared.scalar_name.clone(),
-                    range: prepared.scalar_range,
-                    histogram: super::transfer::histogram(&scalars.values, prepared.scalar_range),
-                });
-            }
-            return Ok(Box::new(CellprojRenderer::from_prepared(
-                gpu,
-                kind,
-                scene.fidelity,
-                params,
-                prepared,
-            )?));
+        if let Some(mesh) = prepared.downcast_ref::<PreparedMesh>() {
+            let [lo, hi] = mesh.bounds;
+            let longest = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+            let scale = if longest > 0.0 { 2.0 / longest } else { 1.0 };
+            self.mesh = Some(MeshSummary {
+                data_box: data_box(lo, hi, scale, &Default::default()),
+                scalar: mesh.scalar_name.clone(),
+                range: mesh.scalar_range,
+                histogram: super::transfer::histogram(&mesh.scalars, mesh.scalar_range),
+            });
         }
-        TechniqueScene::Quad(_) => {
-            data.volume = None;
-            return crate::render::build(gpu, scene, kind);
-        }
-    };
+    }
+}
+
+/// 3D opacity's renderer: a survey store streamed, else the volume prepared once and kept,
+/// so that switching programs or fidelity re-uploads without reading files again.
+fn build_volume(
+    gpu: &Gpu,
+    scene: &Scene,
+    params: &Opacity3dScene,
+    kind: ProgramKind,
+    data: &mut ViewData,
+) -> Result<Box<dyn Renderer>, GlError> {
     // A survey store is streamed: frames draw what is resident and refine.
     if crate::techniques::opacity3d::bricked::store_of(params)
         .ok()

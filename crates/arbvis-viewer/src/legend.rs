@@ -20,11 +20,14 @@ use super::lut3d;
 use super::overlay::{paint_texts, Ink, Measure, Text};
 use crate::points::section::{facies_colour, FACIES_TABLE, PALETTE};
 use crate::points::UNDEFINED_FACIES;
-use crate::scene::{Scene, TechniqueScene};
+use crate::scene::Scene;
+use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::cellproj::IsovalueUnits;
+use crate::techniques::opacity3d::Opacity3dScene;
 pub use crate::techniques::splats::prepare::class_name;
 use crate::techniques::splats::prepare::{class_colour, COLOR_A, COLOR_B, LAYERS_IN_PALETTE};
 use crate::techniques::splats::scene::ColourMode;
+use crate::techniques::splats::SplatsScene;
 
 /// Padding around and between legends (points).
 pub const PAD: f32 = 8.0;
@@ -398,7 +401,8 @@ fn unit(c: [f64; 3]) -> Color32 {
     Color32::from_rgb(b(c[0]), b(c[1]), b(c[2]))
 }
 
-/// The legends of what `scene` shows (`ctx` makes the colour-bar textures).
+/// The legends of what `scene` shows (`ctx` makes the colour-bar textures): each
+/// technique's own, from what its panels keep in `data`.
 pub fn legends(
     ctx: &egui::Context,
     scene: &Scene,
@@ -406,170 +410,190 @@ pub fn legends(
     transfer: Option<TextureId>,
 ) -> Vec<Legend> {
     let mut out = Vec::new();
-    match &scene.technique {
-        TechniqueScene::Opacity3d(o) => {
-            let ranges = data.volume.as_ref().map(|v| v.prepared.ranges);
-            for (a, attr) in o.attributes().into_iter().enumerate() {
-                let (Some(attr), Some(Some((lo, hi)))) = (attr, ranges.map(|r| r[a])) else {
-                    continue;
-                };
-                if let Some((_, texture)) = data.table(ctx, scene, a) {
-                    out.push(Legend::Bar {
-                        title: format!("{}: {}", lut3d::ROLES[a], attr.attribute.name()),
-                        texture: texture.id(),
-                        lo: lut3d::short(lo),
-                        hi: lut3d::short(hi),
-                    });
-                }
-            }
-        }
-        TechniqueScene::Cellproj(c) => {
-            let (name, [lo, hi]) = data
-                .mesh
-                .as_ref()
-                .map_or((String::from("scalar"), [0.0, 1.0]), |m| {
-                    (m.scalar.clone(), m.range)
-                });
-            // Each isovalue in the scalar's units, and normalized beside it where the
-            // scene writes them so.
-            let mut isos = c.isovalues.clone();
-            isos.sort_by(|a, b| a.value.total_cmp(&b.value));
-            let normalized = c.isovalue_units == IsovalueUnits::Normalized;
-            let plain = lo == 0.0 && hi == 1.0;
-            let entries = isos
-                .iter()
-                .map(|i| {
-                    let raw = if normalized {
-                        lo + i.value * (hi - lo)
-                    } else {
-                        i.value
-                    };
-                    let label = if plain || !normalized {
-                        lut3d::short(raw)
-                    } else {
-                        format!("{:.3} = {}", i.value, lut3d::short(raw))
-                    };
-                    (unit([i.color[0], i.color[1], i.color[2]]), label)
-                })
-                .collect();
-            if let (true, Some(texture)) = (c.mode.volume(), transfer) {
-                out.push(Legend::Bar {
-                    title: format!("volume: {name}"),
-                    texture,
-                    lo: lut3d::short(lo),
-                    hi: lut3d::short(hi),
-                });
-            }
-            if c.mode.isosurfaces() {
-                out.push(Legend::Key {
-                    title: format!("isovalues\nof {name}"),
-                    entries,
-                });
-            }
-        }
-        TechniqueScene::Splats(sp) => {
-            let Some(s) = &data.cloud else { return out };
-            let fault =
-                (sp.faults_white && s.faults).then(|| (Color32::WHITE, "fault".to_string()));
-            let key = |title: &str, mut entries: Vec<(Color32, String)>, more: usize| {
-                if more > 0 {
-                    entries.push((Color32::TRANSPARENT, format!("and {more} more ids")));
-                }
-                entries.extend(fault.clone());
-                Legend::Key {
-                    title: title.to_string(),
-                    entries,
-                }
-            };
-            let gradient = |title: &str, from, to, range: Option<[f64; 2]>| {
-                let [lo, hi] = range.unwrap_or([0.0, 0.0]);
-                Legend::Gradient {
-                    title: title.to_string(),
-                    from,
-                    to,
-                    lo: lut3d::short(lo),
-                    hi: lut3d::short(hi),
-                }
-            };
-            match sp.colour {
-                ColourMode::Facies => {
-                    let entries = s
-                        .facies
-                        .iter()
-                        .filter(|&&f| !(sp.hide_undefined && f == UNDEFINED_FACIES))
-                        .map(|&f| {
-                            let name = FACIES_TABLE
-                                .iter()
-                                .find(|(id, _, _)| *id == f)
-                                .map_or(format!("facies {f}"), |(_, n, _)| format!("{n} ({f})"));
-                            (rgb(facies_colour(f)), name)
-                        })
-                        .collect();
-                    out.push(key("facies", entries, s.more[0]));
-                }
-                ColourMode::Layer => {
-                    let entries = s
-                        .layers
-                        .iter()
-                        .filter(|l| !sp.hide_layers.contains(l))
-                        .map(|&l| {
-                            let c = PALETTE[l.rem_euclid(LAYERS_IN_PALETTE) as usize];
-                            (rgb(c), format!("layer {l}"))
-                        })
-                        .collect();
-                    out.push(key("layers", entries, s.more[1]));
-                }
-                ColourMode::Classification => {
-                    let entries = s
-                        .classes
-                        .iter()
-                        .filter(|c| !sp.hide_classes.contains(c))
-                        .map(|&c| (rgb(class_colour(c)), class_name(c)))
-                        .collect();
-                    out.push(key("classes", entries, s.more[2]));
-                }
-                ColourMode::Property => {
-                    out.push(gradient(
-                        &sp.property,
-                        unit(COLOR_A),
-                        unit(COLOR_B),
-                        s.range(&sp.property),
-                    ));
-                }
-                ColourMode::Elevation => {
-                    out.push(gradient(
-                        "elevation",
-                        unit(COLOR_A),
-                        unit(COLOR_B),
-                        Some(s.elevation),
-                    ));
-                }
-                ColourMode::Intensity => {
-                    let max = s.range("intensity").map_or(1.0, |r| r[1].max(1.0));
-                    out.push(gradient(
-                        "intensity",
-                        Color32::BLACK,
-                        Color32::WHITE,
-                        Some([0.0, max]),
-                    ));
-                }
-                ColourMode::Rgb => {}
-            }
-            if !matches!(
-                sp.colour,
-                ColourMode::Facies | ColourMode::Layer | ColourMode::Classification
-            ) {
-                if let Some(f) = fault {
-                    out.push(Legend::Key {
-                        title: String::new(),
-                        entries: vec![f],
-                    });
-                }
-            }
-        }
-        TechniqueScene::Quad(_) => {}
+    if let Some(o) = scene.technique.get::<Opacity3dScene>() {
+        volume_legends(ctx, scene, o, data, &mut out);
+    } else if let Some(c) = scene.technique.get::<CellprojScene>() {
+        mesh_legends(c, data, transfer, &mut out);
+    } else if let Some(sp) = scene.technique.get::<SplatsScene>() {
+        cloud_legends(sp, data, &mut out);
     }
     out
+}
+
+/// 3D opacity: a colour bar per attribute, over its value range.
+fn volume_legends(
+    ctx: &egui::Context,
+    scene: &Scene,
+    o: &Opacity3dScene,
+    data: &mut ViewData,
+    out: &mut Vec<Legend>,
+) {
+    let ranges = data.volume.as_ref().map(|v| v.prepared.ranges);
+    for (a, attr) in o.attributes().into_iter().enumerate() {
+        let (Some(attr), Some(Some((lo, hi)))) = (attr, ranges.map(|r| r[a])) else {
+            continue;
+        };
+        if let Some((_, texture)) = data.table(ctx, scene, a) {
+            out.push(Legend::Bar {
+                title: format!("{}: {}", lut3d::ROLES[a], attr.attribute.name()),
+                texture: texture.id(),
+                lo: lut3d::short(lo),
+                hi: lut3d::short(hi),
+            });
+        }
+    }
+}
+
+/// Cell projection: the transfer function's bar (volume mode) and the isovalues as keys.
+fn mesh_legends(
+    c: &CellprojScene,
+    data: &ViewData,
+    transfer: Option<TextureId>,
+    out: &mut Vec<Legend>,
+) {
+    let (name, [lo, hi]) = data
+        .mesh
+        .as_ref()
+        .map_or((String::from("scalar"), [0.0, 1.0]), |m| {
+            (m.scalar.clone(), m.range)
+        });
+    // Each isovalue in the scalar's units, and normalized beside it where the
+    // scene writes them so.
+    let mut isos = c.isovalues.clone();
+    isos.sort_by(|a, b| a.value.total_cmp(&b.value));
+    let normalized = c.isovalue_units == IsovalueUnits::Normalized;
+    let plain = lo == 0.0 && hi == 1.0;
+    let entries = isos
+        .iter()
+        .map(|i| {
+            let raw = if normalized {
+                lo + i.value * (hi - lo)
+            } else {
+                i.value
+            };
+            let label = if plain || !normalized {
+                lut3d::short(raw)
+            } else {
+                format!("{:.3} = {}", i.value, lut3d::short(raw))
+            };
+            (unit([i.color[0], i.color[1], i.color[2]]), label)
+        })
+        .collect();
+    if let (true, Some(texture)) = (c.mode.volume(), transfer) {
+        out.push(Legend::Bar {
+            title: format!("volume: {name}"),
+            texture,
+            lo: lut3d::short(lo),
+            hi: lut3d::short(hi),
+        });
+    }
+    if c.mode.isosurfaces() {
+        out.push(Legend::Key {
+            title: format!("isovalues\nof {name}"),
+            entries,
+        });
+    }
+}
+
+/// Splats: the colouring's classes as keys, or its gradient, and the faults' white.
+fn cloud_legends(sp: &SplatsScene, data: &ViewData, out: &mut Vec<Legend>) {
+    let Some(s) = &data.cloud else { return };
+    let fault = (sp.faults_white && s.faults).then(|| (Color32::WHITE, "fault".to_string()));
+    let key = |title: &str, mut entries: Vec<(Color32, String)>, more: usize| {
+        if more > 0 {
+            entries.push((Color32::TRANSPARENT, format!("and {more} more ids")));
+        }
+        entries.extend(fault.clone());
+        Legend::Key {
+            title: title.to_string(),
+            entries,
+        }
+    };
+    let gradient = |title: &str, from, to, range: Option<[f64; 2]>| {
+        let [lo, hi] = range.unwrap_or([0.0, 0.0]);
+        Legend::Gradient {
+            title: title.to_string(),
+            from,
+            to,
+            lo: lut3d::short(lo),
+            hi: lut3d::short(hi),
+        }
+    };
+    match sp.colour {
+        ColourMode::Facies => {
+            let entries = s
+                .facies
+                .iter()
+                .filter(|&&f| !(sp.hide_undefined && f == UNDEFINED_FACIES))
+                .map(|&f| {
+                    let name = FACIES_TABLE
+                        .iter()
+                        .find(|(id, _, _)| *id == f)
+                        .map_or(format!("facies {f}"), |(_, n, _)| format!("{n} ({f})"));
+                    (rgb(facies_colour(f)), name)
+                })
+                .collect();
+            out.push(key("facies", entries, s.more[0]));
+        }
+        ColourMode::Layer => {
+            let entries = s
+                .layers
+                .iter()
+                .filter(|l| !sp.hide_layers.contains(l))
+                .map(|&l| {
+                    let c = PALETTE[l.rem_euclid(LAYERS_IN_PALETTE) as usize];
+                    (rgb(c), format!("layer {l}"))
+                })
+                .collect();
+            out.push(key("layers", entries, s.more[1]));
+        }
+        ColourMode::Classification => {
+            let entries = s
+                .classes
+                .iter()
+                .filter(|c| !sp.hide_classes.contains(c))
+                .map(|&c| (rgb(class_colour(c)), class_name(c)))
+                .collect();
+            out.push(key("classes", entries, s.more[2]));
+        }
+        ColourMode::Property => {
+            out.push(gradient(
+                &sp.property,
+                unit(COLOR_A),
+                unit(COLOR_B),
+                s.range(&sp.property),
+            ));
+        }
+        ColourMode::Elevation => {
+            out.push(gradient(
+                "elevation",
+                unit(COLOR_A),
+                unit(COLOR_B),
+                Some(s.elevation),
+            ));
+        }
+        ColourMode::Intensity => {
+            let max = s.range("intensity").map_or(1.0, |r| r[1].max(1.0));
+            out.push(gradient(
+                "intensity",
+                Color32::BLACK,
+                Color32::WHITE,
+                Some([0.0, max]),
+            ));
+        }
+        ColourMode::Rgb => {}
+    }
+    if !matches!(
+        sp.colour,
+        ColourMode::Facies | ColourMode::Layer | ColourMode::Classification
+    ) {
+        if let Some(f) = fault {
+            out.push(Legend::Key {
+                title: String::new(),
+                entries: vec![f],
+            });
+        }
+    }
 }
 
 #[cfg(test)]

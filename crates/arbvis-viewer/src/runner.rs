@@ -2,19 +2,20 @@
 //! (press, move, release) or a request to the viewer (resize, idle, measure), and is
 //! checked to have taken effect before the next begins. Errors name the script line.
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use anyhow::anyhow;
 use egui::{Event, Modifiers, PointerButton, Pos2};
 
 use super::check::LayoutCheck;
 pub use super::observed::Observed;
-use super::script::{Action, ClickKind, MeasureMode, Script, Step};
-use super::widgets::SetRequest;
+use super::script::{Action, MeasureMode, Script, Step};
 use crate::camera::Camera;
 
 /// Frames a step may wait for its widget to appear or take effect.
 const PATIENCE: u32 = 30;
+
+mod actions;
 
 /// What the script asks of this frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -55,7 +56,7 @@ pub struct ScriptRunner {
     aimed_at: Option<egui::Rect>,
 }
 
-fn press(pos: Pos2, button: PointerButton, pressed: bool) -> Event {
+pub(super) fn press(pos: Pos2, button: PointerButton, pressed: bool) -> Event {
     Event::PointerButton {
         pos,
         button,
@@ -147,261 +148,64 @@ impl ScriptRunner {
         }
         self.frames_in_step += 1;
         let mut events = Vec::new();
-        let mut done = false;
-        match &step.action {
-            Action::Wait(n) => done = self.frames_in_step > *n,
-            Action::Quit => return Ok(ScriptStep::Quit),
+        let outcome = match &step.action {
+            Action::Wait(n) => Outcome::done_if(self.frames_in_step > *n),
+            Action::Quit => Outcome::Now(ScriptStep::Quit),
             Action::Click { label, at, kind } => {
-                let button = match kind {
-                    ClickKind::Secondary => PointerButton::Secondary,
-                    _ => PointerButton::Primary,
-                };
-                let presses = if *kind == ClickKind::Double { 2 } else { 1 };
-                // egui counts a click soon after the last as its double (or triple).
-                let recent = self
-                    .last_click
-                    .is_some_and(|t| t.elapsed() < Duration::from_millis(400));
-                if self.phase == 0 && !(presses == 2 && recent) {
-                    if let Some(p) = self.locate(&step, o, label, *at)? {
-                        o.widgets.hits.clear();
-                        self.point = p;
-                        self.last_click = Some(Instant::now());
-                        events.push(Event::PointerMoved(p));
-                        events.push(press(p, button, true));
-                        self.phase = 1;
-                        if presses == 2 {
-                            // A double click in one frame: egui times clicks by frame, and
-                            // a slow frame between them would make two single clicks.
-                            events.push(press(p, button, false));
-                            events.push(press(p, button, true));
-                            events.push(press(p, button, false));
-                            self.phase = 2;
-                        }
-                    }
-                } else if self.phase == 0 {
-                } else if self.phase < 2 {
-                    events.push(press(self.point, button, self.phase.is_multiple_of(2)));
-                    self.phase += 1;
-                } else {
-                    o.widgets.focus = None;
-                    if !o.widgets.hits.contains(label) {
-                        return Err(
-                            self.error(&step, format!("the click on {label:?} did nothing"))
-                        );
-                    }
-                    done = true;
-                }
+                self.click(&step, o, (label, *at, *kind), &mut events)?
             }
             Action::DragOn { label, at, by } => {
-                let d = egui::vec2(by.0, by.1);
-                match self.phase {
-                    0 => {
-                        if let Some(p) = self.locate(&step, o, label, Some(*at))? {
-                            o.widgets.hits.clear();
-                            self.point = p;
-                            events.push(Event::PointerMoved(p));
-                            events.push(press(p, PointerButton::Primary, true));
-                            self.phase = 1;
-                        }
-                    }
-                    1 | 2 => {
-                        let f = self.phase as f32 / 2.0;
-                        events.push(Event::PointerMoved(self.point + d * f));
-                        self.phase += 1;
-                    }
-                    3 => {
-                        events.push(press(self.point + d, PointerButton::Primary, false));
-                        self.phase += 1;
-                    }
-                    _ => {
-                        o.widgets.focus = None;
-                        if !o.widgets.hits.contains(label) {
-                            return Err(
-                                self.error(&step, format!("the drag on {label:?} did nothing"))
-                            );
-                        }
-                        done = true;
-                    }
-                }
+                self.drag_on(&step, o, (label, *at, *by), &mut events)?
             }
-            Action::Drag(dx, dy) => {
-                let c = o.view.center();
-                let d = egui::vec2(*dx, *dy);
-                match self.phase {
-                    0 => {
-                        self.camera = Some(o.camera);
-                        events.push(Event::PointerMoved(c));
-                        events.push(press(c, PointerButton::Primary, true));
-                    }
-                    1 => events.push(Event::PointerMoved(c + d * 0.5)),
-                    2 => events.push(Event::PointerMoved(c + d)),
-                    3 => events.push(press(c + d, PointerButton::Primary, false)),
-                    _ => {
-                        if d != egui::Vec2::ZERO && self.camera == Some(o.camera) {
-                            return Err(self.error(&step, "the drag did not turn the camera"));
-                        }
-                        done = true;
-                    }
-                }
-                self.phase += 1;
-            }
-            Action::Scroll(dy) => {
-                if self.phase == 0 {
-                    self.camera = Some(o.camera);
-                    let c = o.view.center();
-                    events.push(Event::PointerMoved(c));
-                    events.push(Event::MouseWheel {
-                        unit: egui::MouseWheelUnit::Point,
-                        delta: egui::vec2(0.0, *dy),
-                        phase: egui::TouchPhase::Move,
-                        source: egui::MouseWheelSource::Wheel,
-                        modifiers: Modifiers::NONE,
-                    });
-                    self.phase = 1;
-                } else if self.camera.is_some_and(|c| c.zoom != o.camera.zoom) {
-                    // Let egui's smooth scrolling finish.
-                    done = self.frames_in_step > 20;
-                } else if self.frames_in_step > PATIENCE {
-                    return Err(self.error(&step, "the scroll did not zoom"));
-                }
-            }
-            Action::Set { label, value } => {
-                if self.phase == 0 {
-                    o.widgets.focus = Some(label.clone());
-                    o.widgets.set = Some(SetRequest {
-                        label: label.clone(),
-                        value: value.clone(),
-                        outcome: None,
-                    });
-                    self.phase = 1;
-                } else {
-                    match o.widgets.set.as_ref().and_then(|s| s.outcome.clone()) {
-                        Some(Ok(())) => done = true,
-                        Some(Err(e)) => return Err(self.error(&step, e)),
-                        None if self.frames_in_step > PATIENCE => {
-                            return Err(self.error(
-                                &step,
-                                format!(
-                                    "no widget labelled {label:?} took the value; widgets: {:?}",
-                                    o.widgets.labels()
-                                ),
-                            ))
-                        }
-                        None => {}
-                    }
-                    if done {
-                        o.widgets.set = None;
-                        o.widgets.focus = None;
-                    }
-                }
-            }
-            Action::Key(name) => {
-                let key = egui::Key::from_name(name)
-                    .ok_or_else(|| self.error(&step, format!("no key {name:?}")))?;
-                let event = |pressed| Event::Key {
-                    key,
-                    physical_key: None,
-                    pressed,
-                    repeat: false,
-                    modifiers: Modifiers::NONE,
-                };
-                match self.phase {
-                    0 => {
-                        o.widgets.hits.clear();
-                        events.push(event(true));
-                    }
-                    1 => events.push(event(false)),
-                    _ => {
-                        if !o.widgets.hits.contains(&format!("key {name}")) {
-                            return Err(self.error(
-                                &step,
-                                format!("key {name} did nothing (shortcuts: Home, F12)"),
-                            ));
-                        }
-                        done = true;
-                    }
-                }
-                self.phase += 1;
-            }
-            Action::Resize(w, h) => {
-                if self.phase == 0 {
-                    self.phase = 1;
-                    return Ok(ScriptStep::Resize(*w, *h));
-                }
-                if o.window == [*w, *h] {
-                    done = true;
-                } else if self.frames_in_step > PATIENCE {
-                    return Err(self.error(
-                        &step,
-                        format!("the window is {}x{}, not {w}x{h}", o.window[0], o.window[1]),
-                    ));
-                }
-            }
-            Action::Idle(ms) => {
-                let now = Instant::now();
-                let deadline = *self.deadline.get_or_insert_with(|| {
-                    self.frames_at = o.frames;
-                    now + Duration::from_millis(*ms)
-                });
-                if now < deadline {
-                    return Ok(ScriptStep::Idle(deadline));
-                }
-                let drawn = o.frames.saturating_sub(self.frames_at + 1);
-                println!(
-                    "idle: {drawn} frames drawn in {ms} ms (script line {})",
-                    step.line
-                );
-                done = true;
-            }
-            Action::Print(label) => match o.widgets.text_of(label) {
-                Some(text) => {
-                    println!("print {label}: {text} (script line {})", step.line);
-                    done = true;
-                }
-                None if self.frames_in_step > PATIENCE => {
-                    return Err(self.error(&step, format!("no text labelled {label:?}")))
-                }
-                None => {}
-            },
+            Action::Drag(dx, dy) => self.drag(&step, o, egui::vec2(*dx, *dy), &mut events)?,
+            Action::Scroll(dy) => self.scroll(&step, o, *dy, &mut events)?,
+            Action::Set { label, value } => self.set(&step, o, label, value)?,
+            Action::Key(name) => self.key(&step, o, name, &mut events)?,
+            Action::Resize(w, h) => self.resize(&step, o, [*w, *h])?,
+            Action::Idle(ms) => self.idle(&step, o, *ms),
+            Action::Print(label) => self.print(&step, o, label)?,
             Action::CheckLayout => {
                 let check = self.layout.get_or_insert_with(LayoutCheck::default);
                 match check.step(o) {
-                    Ok(finished) => done = finished,
+                    Ok(finished) => Outcome::done_if(finished),
                     Err(e) => return Err(self.error(&step, e)),
                 }
             }
             Action::WindowShot => {
                 if self.phase == 0 {
                     self.phase = 1;
-                    return Ok(ScriptStep::WindowShot);
-                }
-                done = true;
-            }
-            Action::Measure(n, mode) => {
-                let now = Instant::now();
-                let t0 = *self.started.get_or_insert(now);
-                if self.frames_in_step > *n {
-                    let ms = now.duration_since(t0).as_secs_f64() * 1e3 / *n as f64;
-                    println!(
-                        "measure {}: {n} frames, {ms:.1} ms per frame ({:.2} fps), view {}x{}, window {}x{}, interactive quality {} (script line {})",
-                        mode.name(),
-                        1e3 / ms.max(1e-9),
-                        o.view_px[0],
-                        o.view_px[1],
-                        o.window[0],
-                        o.window[1],
-                        o.quality,
-                        step.line
-                    );
-                    done = true;
+                    Outcome::Now(ScriptStep::WindowShot)
                 } else {
-                    return Ok(ScriptStep::Measure(*mode));
+                    Outcome::Done
                 }
             }
-        }
-        if done {
-            self.next();
+            Action::Measure(n, mode) => self.measure(&step, o, *n, *mode),
+        };
+        match outcome {
+            Outcome::Now(wish) => return Ok(wish),
+            Outcome::Done => self.next(),
+            Outcome::Pending => {}
         }
         Ok(ScriptStep::Events(events))
+    }
+}
+
+/// What a step came to this frame.
+pub(super) enum Outcome {
+    /// Still going: the frame's events are injected and the step goes on next frame.
+    Pending,
+    /// Finished: the frame's events are injected and the next step starts.
+    Done,
+    /// This wish instead of events; the step goes on next frame.
+    Now(ScriptStep),
+}
+
+impl Outcome {
+    fn done_if(done: bool) -> Outcome {
+        if done {
+            Outcome::Done
+        } else {
+            Outcome::Pending
+        }
     }
 }

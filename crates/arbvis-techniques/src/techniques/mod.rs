@@ -19,6 +19,7 @@ use crate::camera::{Camera, Projection};
 use crate::gl::{GlError, GlResult, Gpu, ProgramChoice, ProgramKind, Surface};
 use crate::programs::ProgramPair;
 use crate::vocab::{Fidelity, FieldError};
+use crate::volume::Limits;
 
 /// What changes from frame to frame.
 #[derive(Debug, Clone, Copy)]
@@ -39,27 +40,12 @@ impl Frame {
 }
 
 /// A technique's long-lived GL state (programs, textures, buffers), drawn once per frame.
+/// What only some renderers can do is asked of them as its own small trait
+/// ([`Streaming`], [`DrawInParts`]); `dyn Renderer` offers each with a default for the
+/// renderers without it ([`Renderer::pending`]-style calls below).
 pub trait Renderer {
     /// Draw one frame onto `surface` (already cleared by the caller).
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()>;
-    /// Draw part `part` of `parts` of the frame, so that a viewer can spread a slow frame
-    /// over several UI frames: parts `0..parts` drawn in order leave exactly what
-    /// [`Renderer::draw`] leaves. By default part 0 draws everything.
-    fn draw_part(
-        &mut self,
-        gpu: &Gpu,
-        surface: Surface<'_>,
-        frame: &Frame,
-        part: usize,
-        parts: usize,
-    ) -> GlResult<()> {
-        let _ = parts;
-        if part == 0 {
-            self.draw(gpu, surface, frame)
-        } else {
-            Ok(())
-        }
-    }
     /// Take changed parameters (the viewer's editors); resends what changed. Parameters
     /// of another technique are an error.
     fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()>;
@@ -68,28 +54,6 @@ pub trait Renderer {
     /// Whether its surface needs a depth buffer (opaque geometry with a depth test).
     fn needs_depth(&self) -> bool {
         false
-    }
-    /// Streaming (the viewer): draw what is at hand and refine over later frames, instead
-    /// of waiting for all the data a full-quality frame needs (offscreen renders). Only
-    /// renderers that stream data (a survey store) care.
-    fn set_streaming(&mut self, streaming: bool) {
-        let _ = streaming;
-    }
-    /// Whether a streaming renderer still has data on its way (the viewer keeps drawing).
-    fn pending(&self) -> bool {
-        false
-    }
-    /// The user is still at `camera` on an image of `size` (the viewer, once the camera
-    /// stops): a renderer whose data depend on the view (a COPC cloud's nodes) loads what
-    /// that view needs; true when it did (the picture must be drawn again).
-    fn settle(
-        &mut self,
-        gpu: &Gpu,
-        camera: &crate::camera::Camera,
-        size: [u32; 2],
-    ) -> GlResult<bool> {
-        let _ = (gpu, camera, size);
-        Ok(false)
     }
     /// A line for the viewer about the last frame's CPU work (e.g. the sort time).
     fn status(&self) -> Option<String> {
@@ -104,6 +68,91 @@ pub trait Renderer {
     /// tables with their value ranges, keys, and the box's axes in the data's numbers.
     fn annotations(&self) -> annotations::Annotations {
         annotations::Annotations::default()
+    }
+    /// Its data arriving over frames, where they do ([`Streaming`]).
+    fn streaming(&self) -> Option<&dyn Streaming> {
+        None
+    }
+    /// [`Renderer::streaming`], to change.
+    fn streaming_mut(&mut self) -> Option<&mut dyn Streaming> {
+        None
+    }
+    /// Its frame drawn in parts, where one frame can be slow ([`DrawInParts`]).
+    fn in_parts(&mut self) -> Option<&mut dyn DrawInParts> {
+        None
+    }
+}
+
+/// A renderer whose data arrive over frames: a survey store's bricks, a COPC cloud's cut
+/// for the view where the camera stopped.
+pub trait Streaming {
+    /// Streaming (the viewer): draw what is at hand and refine over later frames, instead
+    /// of waiting for all the data a full-quality frame needs (offscreen renders).
+    fn set_streaming(&mut self, streaming: bool) {
+        let _ = streaming;
+    }
+    /// Whether data are still on their way (the viewer keeps drawing).
+    fn pending(&self) -> bool;
+    /// The user is still at `camera` on an image of `size` (the viewer, once the camera
+    /// stops): load what that view needs; true when a new part arrived (the picture must
+    /// be drawn again).
+    fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> GlResult<bool> {
+        let _ = (gpu, camera, size);
+        Ok(false)
+    }
+}
+
+/// A renderer that can spread a slow frame over several UI frames.
+pub trait DrawInParts {
+    /// Draw part `part` of `parts` of the frame: parts `0..parts` drawn in order leave
+    /// exactly what [`Renderer::draw`] leaves.
+    fn draw_part(
+        &mut self,
+        gpu: &Gpu,
+        surface: Surface<'_>,
+        frame: &Frame,
+        part: usize,
+        parts: usize,
+    ) -> GlResult<()>;
+}
+
+/// Each capability asked of any renderer, with what a renderer without it does.
+impl<'a> dyn Renderer + 'a {
+    /// Part `part` of `parts` of the frame ([`DrawInParts`]); a renderer without parts
+    /// draws everything as part 0.
+    pub fn draw_part(
+        &mut self,
+        gpu: &Gpu,
+        surface: Surface<'_>,
+        frame: &Frame,
+        part: usize,
+        parts: usize,
+    ) -> GlResult<()> {
+        match self.in_parts() {
+            Some(renderer) => renderer.draw_part(gpu, surface, frame, part, parts),
+            None if part == 0 => self.draw(gpu, surface, frame),
+            None => Ok(()),
+        }
+    }
+
+    /// [`Streaming::set_streaming`]; nothing for a renderer that does not stream.
+    pub fn set_streaming(&mut self, streaming: bool) {
+        if let Some(renderer) = self.streaming_mut() {
+            renderer.set_streaming(streaming);
+        }
+    }
+
+    /// [`Streaming::pending`]; false for a renderer that does not stream.
+    pub fn pending(&self) -> bool {
+        self.streaming().is_some_and(|r| r.pending())
+    }
+
+    /// [`Streaming::settle`]; false (nothing new) for a renderer that does not stream.
+    pub fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> GlResult<bool> {
+        match self.streaming_mut() {
+            Some(renderer) => renderer.settle(gpu, camera, size),
+            None => Ok(false),
+        }
     }
 }
 
@@ -153,14 +202,33 @@ pub trait Technique: Any + Sized {
     /// Every program pair its renderers can draw with, both kinds (the
     /// compile-everything test).
     fn program_pairs() -> Vec<ProgramPair>;
-    /// Its renderer, with programs of `kind` (`settings.programs` resolved); nothing
-    /// else is created.
+    /// What the CPU makes before the renderer: the data loaded, derived and laid out (no
+    /// GL; `()` where there is nothing).
+    type Prepared: Any;
+    /// Check the parameters, then load and prepare the data (relative paths from
+    /// `settings.base`) within `limits`.
+    fn prepare(&self, settings: &Settings<'_>, limits: &Limits) -> GlResult<Self::Prepared>;
+    /// The renderer of what [`Technique::prepare`] made, with programs of `kind`
+    /// (`settings.programs` resolved).
+    fn renderer(
+        &self,
+        gpu: &Gpu,
+        settings: &Settings<'_>,
+        kind: ProgramKind,
+        prepared: Self::Prepared,
+    ) -> GlResult<Box<dyn Renderer>>;
+    /// Prepare (within the GL's largest 3D texture), then make the renderer; nothing else
+    /// is created.
     fn build(
         &self,
         gpu: &Gpu,
         settings: &Settings<'_>,
         kind: ProgramKind,
-    ) -> GlResult<Box<dyn Renderer>>;
+    ) -> GlResult<Box<dyn Renderer>> {
+        let limits = Limits::for_max_side(gpu.caps().max_3d_texture_size);
+        let prepared = self.prepare(settings, &limits)?;
+        self.renderer(gpu, settings, kind, prepared)
+    }
 }
 
 /// What a renderer needs of the scene besides its technique's parameters.

@@ -42,7 +42,19 @@ impl Technique for QuadScene {
         program_pairs()
     }
 
-    fn build(&self, gpu: &Gpu, _: &Settings<'_>, kind: ProgramKind) -> GlResult<Box<dyn Renderer>> {
+    type Prepared = ();
+
+    fn prepare(&self, _: &Settings<'_>, _: &crate::volume::Limits) -> GlResult<()> {
+        Ok(())
+    }
+
+    fn renderer(
+        &self,
+        gpu: &Gpu,
+        _: &Settings<'_>,
+        kind: ProgramKind,
+        _: (),
+    ) -> GlResult<Box<dyn Renderer>> {
         Ok(Box::new(QuadRenderer::new(gpu, kind, self)?))
     }
 }

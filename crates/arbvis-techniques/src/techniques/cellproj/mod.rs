@@ -294,17 +294,30 @@ impl crate::techniques::Technique for CellprojScene {
         renderer::program_pairs()
     }
 
-    fn build(
+    type Prepared = prepare::Prepared;
+
+    fn prepare(
+        &self,
+        settings: &crate::techniques::Settings<'_>,
+        _: &crate::volume::Limits,
+    ) -> crate::gl::GlResult<prepare::Prepared> {
+        CellprojScene::validate(self).map_err(|e| crate::gl::GlError::Data(e.to_string()))?;
+        prepare::prepare(self, settings.base).map_err(crate::gl::GlError::Data)
+    }
+
+    fn renderer(
         &self,
         gpu: &crate::gl::Gpu,
         settings: &crate::techniques::Settings<'_>,
         kind: crate::gl::ProgramKind,
+        prepared: prepare::Prepared,
     ) -> crate::gl::GlResult<Box<dyn crate::techniques::Renderer>> {
-        Ok(Box::new(CellprojRenderer::new(
+        Ok(Box::new(CellprojRenderer::upload(
             gpu,
             kind,
             settings.fidelity,
             self,
+            prepared,
             settings.base,
         )?))
     }

@@ -175,7 +175,7 @@ impl CellprojRenderer {
             .validate()
             .map_err(|e| GlError::Data(e.to_string()))?;
         let prepared = prepare(params, base).map_err(GlError::Data)?;
-        CellprojRenderer::build(gpu, kind, fidelity, params, prepared, base)
+        CellprojRenderer::upload(gpu, kind, fidelity, params, prepared, base)
     }
 
     /// Upload a mesh prepared elsewhere (tests craft meshes in memory).
@@ -186,10 +186,12 @@ impl CellprojRenderer {
         params: &CellprojScene,
         prepared: Prepared,
     ) -> GlResult<CellprojRenderer> {
-        CellprojRenderer::build(gpu, kind, fidelity, params, prepared, Path::new("."))
+        CellprojRenderer::upload(gpu, kind, fidelity, params, prepared, Path::new("."))
     }
 
-    fn build(
+    /// Upload `prepared`, the scene's relative paths (a transfer function's table file)
+    /// read from `base`.
+    pub fn upload(
         gpu: &Gpu,
         kind: ProgramKind,
         fidelity: Fidelity,

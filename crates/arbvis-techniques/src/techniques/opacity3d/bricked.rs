@@ -60,7 +60,7 @@ use crate::gl::{
 use crate::store::lod::{self, BrickId, Pyramid, View};
 use crate::store::Store;
 use crate::techniques::opacity3d::brick_cache::{BrickCache, Packing};
-use crate::techniques::{Frame, Params, Renderer};
+use crate::techniques::{Frame, Params, Renderer, Streaming};
 use crate::vocab::{Fidelity, FieldError};
 use crate::volume::quantize::{quantize_level, NoData, Quantization};
 use crate::volume::VolumeSource;
@@ -855,14 +855,6 @@ impl Renderer for BrickedRenderer {
         }
     }
 
-    fn set_streaming(&mut self, streaming: bool) {
-        self.streaming = streaming;
-    }
-
-    fn pending(&self) -> bool {
-        self.streaming && self.last.2 > 0
-    }
-
     fn status(&self) -> Option<String> {
         let s = self.cache.stats();
         let levels: Vec<String> = s
@@ -888,6 +880,24 @@ impl Renderer for BrickedRenderer {
             line += &format!("; {} bricks failed: {e}", s.failed);
         }
         Some(line)
+    }
+
+    fn streaming(&self) -> Option<&dyn Streaming> {
+        Some(self)
+    }
+
+    fn streaming_mut(&mut self) -> Option<&mut dyn Streaming> {
+        Some(self)
+    }
+}
+
+impl Streaming for BrickedRenderer {
+    fn set_streaming(&mut self, streaming: bool) {
+        self.streaming = streaming;
+    }
+
+    fn pending(&self) -> bool {
+        self.streaming && self.last.2 > 0
     }
 }
 

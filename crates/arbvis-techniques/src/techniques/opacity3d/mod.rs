@@ -229,19 +229,37 @@ impl crate::techniques::Technique for Opacity3dScene {
         renderer::program_pairs()
     }
 
-    /// A survey store is drawn brick by brick ([`bricked::BrickedRenderer`]; precise
-    /// with a GLSL ray caster, which `auto` then takes); other volumes whole.
-    fn build(
+    /// The volume prepared whole; `None` for a survey store, streamed by its renderer.
+    type Prepared = Option<prepare::Prepared>;
+
+    fn prepare(
         &self,
-        gpu: &crate::gl::Gpu,
         settings: &crate::techniques::Settings<'_>,
-        kind: crate::gl::ProgramKind,
-    ) -> crate::gl::GlResult<Box<dyn crate::techniques::Renderer>> {
-        let fidelity = settings.fidelity;
+        limits: &crate::volume::Limits,
+    ) -> crate::gl::GlResult<Option<prepare::Prepared>> {
         if bricked::store_of(self)
             .map_err(crate::gl::GlError::Data)?
             .is_some()
         {
+            return Ok(None);
+        }
+        Opacity3dScene::validate(self).map_err(|e| crate::gl::GlError::Data(e.to_string()))?;
+        prepare::prepare(self, settings.base, limits)
+            .map(Some)
+            .map_err(crate::gl::GlError::Data)
+    }
+
+    /// A survey store is drawn brick by brick ([`bricked::BrickedRenderer`]; precise
+    /// with a GLSL ray caster, which `auto` then takes); other volumes whole.
+    fn renderer(
+        &self,
+        gpu: &crate::gl::Gpu,
+        settings: &crate::techniques::Settings<'_>,
+        kind: crate::gl::ProgramKind,
+        prepared: Option<prepare::Prepared>,
+    ) -> crate::gl::GlResult<Box<dyn crate::techniques::Renderer>> {
+        let fidelity = settings.fidelity;
+        let Some(prepared) = prepared else {
             let kind = if fidelity == Fidelity::Precise && settings.programs == ProgramChoice::Auto
             {
                 crate::gl::ProgramKind::Glsl
@@ -256,14 +274,15 @@ impl crate::techniques::Technique for Opacity3dScene {
                 settings.base,
                 None,
             )?));
-        }
+        };
         let kind = renderer::resolve_kind(gpu, self, fidelity, settings.programs, kind)?;
-        Ok(Box::new(Opacity3dRenderer::new(
+        Ok(Box::new(Opacity3dRenderer::from_prepared(
             gpu,
             kind,
             fidelity,
             self,
             settings.base,
+            prepared,
             settings.projection,
         )?))
     }

@@ -34,7 +34,7 @@ use crate::programs;
 
 use crate::techniques::clip::stage as clipping_stage;
 use crate::techniques::clip::stats::ClipStats;
-use crate::techniques::{Frame, Params, Renderer};
+use crate::techniques::{DrawInParts, Frame, Params, Renderer};
 use crate::vocab::Fidelity;
 use crate::volume::quantize::NoData;
 
@@ -861,25 +861,6 @@ impl Renderer for Opacity3dRenderer {
         self.draw_slices(gpu, surface, frame, 0..usize::MAX)
     }
 
-    /// Part `part` of `parts` is the `part`-th run of consecutive slices, back to front.
-    fn draw_part(
-        &mut self,
-        gpu: &Gpu,
-        surface: Surface<'_>,
-        frame: &Frame,
-        part: usize,
-        parts: usize,
-    ) -> GlResult<()> {
-        self.update_mesh(gpu, frame)?;
-        let n = self.slice_ends.len();
-        let parts = parts.clamp(1, n.max(1));
-        if part >= parts {
-            return Ok(());
-        }
-        let slices = part * n / parts..(part + 1) * n / parts;
-        self.draw_slices(gpu, surface, frame, slices)
-    }
-
     fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
         let new = params.get::<Opacity3dScene>()?;
         new.validate().map_err(|e| GlError::Data(e.to_string()))?;
@@ -993,6 +974,31 @@ impl Renderer for Opacity3dRenderer {
 
     fn clip_stats(&self) -> Option<ClipStats> {
         self.clip.as_ref().map(|c| c.stats)
+    }
+
+    fn in_parts(&mut self) -> Option<&mut dyn DrawInParts> {
+        Some(self)
+    }
+}
+
+impl DrawInParts for Opacity3dRenderer {
+    /// Part `part` of `parts` is the `part`-th run of consecutive slices, back to front.
+    fn draw_part(
+        &mut self,
+        gpu: &Gpu,
+        surface: Surface<'_>,
+        frame: &Frame,
+        part: usize,
+        parts: usize,
+    ) -> GlResult<()> {
+        self.update_mesh(gpu, frame)?;
+        let n = self.slice_ends.len();
+        let parts = parts.clamp(1, n.max(1));
+        if part >= parts {
+            return Ok(());
+        }
+        let slices = part * n / parts..(part + 1) * n / parts;
+        self.draw_slices(gpu, surface, frame, slices)
     }
 }
 

@@ -91,19 +91,34 @@ impl crate::techniques::Technique for SplatsScene {
         renderer::program_pairs()
     }
 
-    fn build(
+    type Prepared = prepare::PreparedCloud;
+
+    /// The cloud loaded (a COPC cloud's nodes chosen for the first view) and prepared.
+    fn prepare(
+        &self,
+        settings: &crate::techniques::Settings<'_>,
+        _: &crate::volume::Limits,
+    ) -> crate::gl::GlResult<prepare::PreparedCloud> {
+        SplatsScene::validate(self).map_err(|e| crate::gl::GlError::Data(e.to_string()))?;
+        prepare::prepare_for(self, settings.base, Some(&settings.view))
+            .map_err(crate::gl::GlError::Data)
+    }
+
+    fn renderer(
         &self,
         gpu: &crate::gl::Gpu,
         settings: &crate::techniques::Settings<'_>,
         kind: crate::gl::ProgramKind,
+        prepared: prepare::PreparedCloud,
     ) -> crate::gl::GlResult<Box<dyn crate::techniques::Renderer>> {
-        Ok(Box::new(SplatsRenderer::new(
+        Ok(Box::new(SplatsRenderer::upload(
             gpu,
             kind,
             settings.fidelity,
             self,
             settings.base,
             Some(settings.view),
+            prepared,
         )?))
     }
 }

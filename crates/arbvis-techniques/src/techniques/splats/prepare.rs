@@ -55,19 +55,19 @@ pub fn prepare(scene: &SplatsScene, base: &Path) -> Result<(PointCloud, Prepared
     Ok((cloud, prepared))
 }
 
+/// What [`prepare_for`] makes: the cloud, its preparation and a COPC cut's account.
+pub type PreparedCloud = (
+    PointCloud,
+    Prepared,
+    Option<crate::points::copc_lod::Loaded>,
+);
+
 /// [`prepare`], a COPC cloud's nodes chosen for `view`; with what a COPC cut holds.
 pub fn prepare_for(
     scene: &SplatsScene,
     base: &Path,
     view: Option<&crate::points::copc_lod::View>,
-) -> Result<
-    (
-        PointCloud,
-        Prepared,
-        Option<crate::points::copc_lod::Loaded>,
-    ),
-    String,
-> {
+) -> Result<PreparedCloud, String> {
     let (cloud, note) = scene
         .cloud
         .load_for(base, view)

@@ -43,7 +43,7 @@ use crate::points::copc_lod::View as CloudView;
 use crate::points::PointCloud;
 use crate::programs::{self, ProgramPair};
 
-use crate::techniques::{Frame, Params, Renderer};
+use crate::techniques::{Frame, Params, Renderer, Streaming};
 use crate::vocab::Fidelity;
 
 mod loading;
@@ -818,6 +818,35 @@ impl Renderer for SplatsRenderer {
         self.program.kind()
     }
 
+    fn status(&self) -> Option<String> {
+        let mut line = self.frame_status();
+        if let (Some([uploaded, nodes, evicted]), Some(r)) = (self.last_upload, &self.resident) {
+            line = format!(
+                "node cache: {uploaded} of the cut's {nodes} nodes uploaded, {evicted} evicted; {} nodes resident in room for {} points\n{line}",
+                r.len(),
+                r.capacity()
+            );
+        }
+        Some(match &self.cut {
+            Some(cut) => format!("{cut}\n{line}"),
+            None => line,
+        })
+    }
+
+    fn streaming(&self) -> Option<&dyn Streaming> {
+        Some(self)
+    }
+
+    fn streaming_mut(&mut self) -> Option<&mut dyn Streaming> {
+        Some(self)
+    }
+}
+
+impl Streaming for SplatsRenderer {
+    fn pending(&self) -> bool {
+        self.loading.is_some()
+    }
+
     fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> GlResult<bool> {
         if self.cut.is_none() {
             return Ok(false);
@@ -874,24 +903,6 @@ impl Renderer for SplatsRenderer {
             &self.stages,
         ));
         Ok(false)
-    }
-    fn pending(&self) -> bool {
-        self.loading.is_some()
-    }
-
-    fn status(&self) -> Option<String> {
-        let mut line = self.frame_status();
-        if let (Some([uploaded, nodes, evicted]), Some(r)) = (self.last_upload, &self.resident) {
-            line = format!(
-                "node cache: {uploaded} of the cut's {nodes} nodes uploaded, {evicted} evicted; {} nodes resident in room for {} points\n{line}",
-                r.len(),
-                r.capacity()
-            );
-        }
-        Some(match &self.cut {
-            Some(cut) => format!("{cut}\n{line}"),
-            None => line,
-        })
     }
 }
 

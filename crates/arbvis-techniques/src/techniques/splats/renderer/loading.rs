@@ -8,14 +8,12 @@ use std::sync::mpsc::{Receiver, TryRecvError};
 use std::sync::Arc;
 
 use crate::points::copc_load::Stages;
-use crate::points::copc_lod::{Loaded, View as CloudView};
-use crate::points::PointCloud;
-use crate::techniques::splats::prepare::{prepare_in_stages, Prepared};
+use crate::points::copc_lod::View as CloudView;
+use crate::techniques::splats::prepare::prepare_in_stages;
 use crate::techniques::splats::scene::SplatsScene;
 
-/// What [`prepare_for`](crate::techniques::splats::prepare::prepare_for) makes: the
-/// cloud, its preparation and a COPC cut's account.
-pub(super) type Prepared3 = (PointCloud, Prepared, Option<Loaded>);
+/// What [`prepare_for`](crate::techniques::splats::prepare::prepare_for) makes.
+pub(super) type Prepared3 = crate::techniques::splats::prepare::PreparedCloud;
 
 /// A COPC cut being loaded on a thread for a view.
 pub(super) struct Loading {
