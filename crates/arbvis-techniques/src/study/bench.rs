@@ -21,7 +21,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::gl::{Headless, ProgramKind, Surface, Target};
+use crate::gl::{Gpu, Headless, ProgramKind, Surface, Target};
 use crate::image::Image;
 use crate::progress::{Bar, Unit};
 use crate::scene::Scene;
@@ -401,37 +401,9 @@ pub fn run(
     mut progress: impl FnMut(&str),
 ) -> Result<Report> {
     let gpu = headless.gpu();
-    if let Some(p) = scene.technique.get::<Opacity3dScene>() {
-        if crate::techniques::opacity3d::bricked::store_of(p)
-            .map_err(anyhow::Error::msg)?
-            .is_some()
-        {
-            bail!(
-                "bench sweeps and scores scenes whose volume is loaded whole; this scene streams a store, \
-                 whose frames depend on what is resident: time it with `arbvis render SCENE --stats` (build \
-                 and draw times of the full picture) or `bash benches/store/run.sh` (first picture, turning \
-                 frames, memory)"
-            );
-        }
-    }
+    refuse_stores(scene)?;
     let settings = settings(scene, options)?;
-    let prepared = match scene.technique.get::<Opacity3dScene>() {
-        Some(p) => {
-            let t0 = Instant::now();
-            let prepared = prepare(
-                p,
-                &scene.base,
-                &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
-            )
-            .map_err(anyhow::Error::msg)?;
-            progress(&format!(
-                "prepared the data in {:.1} s",
-                t0.elapsed().as_secs_f64()
-            ));
-            Some(prepared)
-        }
-        None => None,
-    };
+    let prepared = prepare_volume(gpu, scene, &mut progress)?;
     let volume = cellproj_volume(scene, options, &mut progress)?;
     let (reference_rgb, reference_s) = match (&prepared, &volume, options.score) {
         (Some(prepared), _, true) => {
@@ -466,64 +438,10 @@ pub fn run(
                 round + 1,
                 setting.name
             ));
-            let s = &setting.scene;
-            let kind = s.programs.resolve(gpu);
-            let key = slot_key(s, kind);
-            let slot = match slots.iter().position(|x| x.key == key) {
-                Some(n) => {
-                    slots[n].renderer.update(gpu, s.technique.params())?;
-                    &mut slots[n]
-                }
-                None => {
-                    let renderer: Box<dyn Renderer> =
-                        match (s.technique.get::<Opacity3dScene>(), &prepared) {
-                            (Some(p), Some(prepared)) => {
-                                Box::new(Opacity3dRenderer::from_prepared(
-                                    gpu,
-                                    resolve_kind(gpu, p, s.fidelity, s.programs, kind)?,
-                                    s.fidelity,
-                                    p,
-                                    &s.base,
-                                    prepared.clone(),
-                                    s.camera.projection,
-                                )?)
-                            }
-                            _ => crate::render::build(gpu, s, kind)?,
-                        };
-                    let target = if renderer.needs_depth() {
-                        Target::with_depth(gpu, w, h, s.target_format())?
-                    } else {
-                        Target::new(gpu, w, h, s.target_format())?
-                    };
-                    slots.push(Slot {
-                        key,
-                        renderer,
-                        target,
-                    });
-                    slots.last_mut().expect("just pushed")
-                }
-            };
-            let mut frame = frame;
-            let turn = glam::DQuat::from_rotation_y(options.turn.to_radians());
-            let mut one = || -> Result<f64> {
-                if options.turn != 0.0 {
-                    frame.camera.rotation = (frame.camera.quat() * turn).to_array();
-                }
-                let t0 = Instant::now();
-                slot.target.clear(gpu, s.clear_colour())?;
-                slot.renderer
-                    .draw(gpu, Surface::Target(&slot.target), &frame)?;
-                gpu.finish();
-                Ok(t0.elapsed().as_secs_f64() * 1e3)
-            };
-            let first = one()?;
-            let mut times = Vec::with_capacity(options.frames);
-            for _ in 0..options.frames.max(1) {
-                times.push(one()?);
-            }
-            arbvis_gl::gl_check!(gpu)?;
+            let slot = slot_for(gpu, &mut slots, &setting.scene, prepared.as_ref(), [w, h])?;
+            let (first, times) = time_frames(gpu, slot, &setting.scene, frame, options)?;
             let entry = results[i].get_or_insert_with(|| {
-                new_measured(setting, s, slot.renderer.program_kind(), first)
+                new_measured(setting, &setting.scene, slot.renderer.program_kind(), first)
             });
             if round == 0 {
                 if let Some(rgb) = &reference_rgb {
@@ -559,15 +477,6 @@ pub fn run(
             &mut progress,
         )?);
     }
-    let settings = results
-        .into_iter()
-        .map(|mut m| {
-            m.median_ms = median(&m.frames_ms);
-            m.min_ms = m.frames_ms.iter().copied().fold(f64::INFINITY, f64::min);
-            m.max_ms = m.frames_ms.iter().copied().fold(0.0, f64::max);
-            m
-        })
-        .collect();
     let caps = gpu.caps();
     Ok(Report {
         scene: origin.to_string(),
@@ -578,8 +487,128 @@ pub fn run(
         rounds: options.rounds.max(1),
         oversample: options.score.then_some(options.oversample),
         reference_s,
-        settings,
+        settings: results.into_iter().map(summarized).collect(),
     })
+}
+
+/// A store's frames depend on what is resident: bench sweeps and scores whole volumes.
+fn refuse_stores(scene: &Scene) -> Result<()> {
+    if let Some(p) = scene.technique.get::<Opacity3dScene>() {
+        if crate::techniques::opacity3d::bricked::store_of(p)
+            .map_err(anyhow::Error::msg)?
+            .is_some()
+        {
+            bail!(
+                "bench sweeps and scores scenes whose volume is loaded whole; this scene streams a store, \
+                 whose frames depend on what is resident: time it with `arbvis render SCENE --stats` (build \
+                 and draw times of the full picture) or `bash benches/store/run.sh` (first picture, turning \
+                 frames, memory)"
+            );
+        }
+    }
+    Ok(())
+}
+
+/// A 3D-opacity scene's volume, prepared once for every setting (timed, said).
+fn prepare_volume(
+    gpu: &Gpu,
+    scene: &Scene,
+    progress: &mut impl FnMut(&str),
+) -> Result<Option<Prepared>> {
+    let Some(p) = scene.technique.get::<Opacity3dScene>() else {
+        return Ok(None);
+    };
+    let t0 = Instant::now();
+    let prepared = prepare(
+        p,
+        &scene.base,
+        &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
+    )
+    .map_err(anyhow::Error::msg)?;
+    progress(&format!(
+        "prepared the data in {:.1} s",
+        t0.elapsed().as_secs_f64()
+    ));
+    Ok(Some(prepared))
+}
+
+/// The renderer and target setting `s` draws with: one already made for its
+/// [`slot_key`], given the setting's parameters, or a new one of `w` x `h` pixels (3D
+/// opacity's from the shared `prepared` volume).
+fn slot_for<'a>(
+    gpu: &Gpu,
+    slots: &'a mut Vec<Slot>,
+    s: &Scene,
+    prepared: Option<&Prepared>,
+    [w, h]: [u32; 2],
+) -> Result<&'a mut Slot> {
+    let kind = s.programs.resolve(gpu);
+    let key = slot_key(s, kind);
+    if let Some(n) = slots.iter().position(|x| x.key == key) {
+        slots[n].renderer.update(gpu, s.technique.params())?;
+        return Ok(&mut slots[n]);
+    }
+    let renderer: Box<dyn Renderer> = match (s.technique.get::<Opacity3dScene>(), prepared) {
+        (Some(p), Some(prepared)) => Box::new(Opacity3dRenderer::from_prepared(
+            gpu,
+            resolve_kind(gpu, p, s.fidelity, s.programs, kind)?,
+            s.fidelity,
+            p,
+            &s.base,
+            prepared.clone(),
+            s.camera.projection,
+        )?),
+        _ => crate::render::build(gpu, s, kind)?,
+    };
+    let target = if renderer.needs_depth() {
+        Target::with_depth(gpu, w, h, s.target_format())?
+    } else {
+        Target::new(gpu, w, h, s.target_format())?
+    };
+    slots.push(Slot {
+        key,
+        renderer,
+        target,
+    });
+    Ok(slots.last_mut().expect("just pushed"))
+}
+
+/// The first frame's time and `options.frames` more (ms) of setting `s` from `frame`:
+/// clear, draw, finish, the camera turned by `options.turn` before each.
+fn time_frames(
+    gpu: &Gpu,
+    slot: &mut Slot,
+    s: &Scene,
+    mut frame: Frame,
+    options: &BenchOptions,
+) -> Result<(f64, Vec<f64>)> {
+    let turn = glam::DQuat::from_rotation_y(options.turn.to_radians());
+    let mut one = || -> Result<f64> {
+        if options.turn != 0.0 {
+            frame.camera.rotation = (frame.camera.quat() * turn).to_array();
+        }
+        let t0 = Instant::now();
+        slot.target.clear(gpu, s.clear_colour())?;
+        slot.renderer
+            .draw(gpu, Surface::Target(&slot.target), &frame)?;
+        gpu.finish();
+        Ok(t0.elapsed().as_secs_f64() * 1e3)
+    };
+    let first = one()?;
+    let mut times = Vec::with_capacity(options.frames);
+    for _ in 0..options.frames.max(1) {
+        times.push(one()?);
+    }
+    arbvis_gl::gl_check!(gpu)?;
+    Ok((first, times))
+}
+
+/// A setting's median, fastest and slowest frame from its times.
+fn summarized(mut m: Measured) -> Measured {
+    m.median_ms = median(&m.frames_ms);
+    m.min_ms = m.frames_ms.iter().copied().fold(f64::INFINITY, f64::min);
+    m.max_ms = m.frames_ms.iter().copied().fold(0.0, f64::max);
+    m
 }
 
 fn new_measured(setting: &Setting, s: &Scene, kind: ProgramKind, first: f64) -> Measured {

@@ -62,7 +62,7 @@ use crate::store::Store;
 use crate::techniques::opacity3d::brick_cache::{BrickCache, Packing};
 use crate::techniques::{Frame, Params, Renderer, Streaming};
 use crate::vocab::{Fidelity, FieldError};
-use crate::volume::quantize::{quantize_level, NoData, Quantization};
+use crate::volume::quantize::{NoData, Quantization};
 use crate::volume::VolumeSource;
 
 /// `[technique.opacity3d.store]`: how a store is streamed.
@@ -320,77 +320,8 @@ impl BrickedRenderer {
                 )
             }
         };
-        // Brick ranges as levels, grown by the neighbours (a brick's border voxels).
-        let mut levels = Vec::with_capacity(meta.levels);
-        for level in 0..meta.levels {
-            let counts = meta.brick_counts(level);
-            let n = counts.iter().product::<usize>();
-            let mut per = vec![[(0u8, 0u8); 3]; n];
-            for (a, at) in attrs.iter().enumerate() {
-                let Some((index, low, high, no_data)) = *at else {
-                    continue;
-                };
-                let ranges = store
-                    .ranges(index, level)
-                    .map_err(|e| GlError::Data(e.to_string()))?;
-                let q = |v: f32| quantize_level(v, low, high, no_data);
-                let nan = no_data != NoData::Absent;
-                for k in 0..counts[2] {
-                    for j in 0..counts[1] {
-                        for i in 0..counts[0] {
-                            let (mut lo, mut hi) = (255u8, 0u8);
-                            for dk in k.saturating_sub(1)..=(k + 1).min(counts[2] - 1) {
-                                for dj in j.saturating_sub(1)..=(j + 1).min(counts[1] - 1) {
-                                    for di in i.saturating_sub(1)..=(i + 1).min(counts[0] - 1) {
-                                        let r = ranges[di + counts[0] * (dj + counts[1] * dk)];
-                                        if r[0] <= r[1] {
-                                            lo = lo.min(q(r[0]));
-                                            hi = hi.max(q(r[1]));
-                                        }
-                                    }
-                                }
-                            }
-                            if nan || lo > hi {
-                                lo = 0;
-                            }
-                            per[i + counts[0] * (j + counts[1] * k)][a] = (lo, hi);
-                        }
-                    }
-                }
-            }
-            levels.push(per);
-        }
-        // A coarse level is the mean of the one below, so its range can be narrower than
-        // its children's (a reflection's peak averages away): a parent takes the union of
-        // its children's ranges, so that leaving out a brick that looks transparent never
-        // leaves out a visible brick under it.
-        for level in 1..levels.len() {
-            let (below, here) = levels.split_at_mut(level);
-            let (fine, coarse) = (&below[level - 1], &mut here[0]);
-            let fc = meta.brick_counts(level - 1);
-            let cc = meta.brick_counts(level);
-            for k in 0..cc[2] {
-                for j in 0..cc[1] {
-                    for i in 0..cc[0] {
-                        let at = i + cc[0] * (j + cc[1] * k);
-                        for (dk, dj, di) in (0..8).map(|n| (n >> 2, (n >> 1) & 1, n & 1)) {
-                            let c = [2 * i + di, 2 * j + dj, 2 * k + dk];
-                            if (0..3).any(|a| c[a] >= fc[a]) {
-                                continue;
-                            }
-                            let child = fine[c[0] + fc[0] * (c[1] + fc[1] * c[2])];
-                            for a in 0..3 {
-                                let (lo, hi) = child[a];
-                                if lo <= hi {
-                                    let r = &mut coarse[at][a];
-                                    *r = (r.0.min(lo), r.1.max(hi));
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
+        // Which levels each brick may hold: what lets `draw` leave out clear bricks.
+        let levels = super::brick_ranges::brick_ranges(&store, &attrs).map_err(GlError::Data)?;
         let pair = faithful_pair(kind, params.combine);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         let paged = match fidelity {

@@ -50,6 +50,7 @@
 //! volumes of different grids (an error naming both).
 
 pub mod brick_cache;
+pub mod brick_ranges;
 pub mod bricked;
 pub mod bricks;
 pub mod clipping;
