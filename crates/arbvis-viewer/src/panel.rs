@@ -255,7 +255,6 @@ fn controls(
     caps: &Caps,
     actions: &mut Vec<UiAction>,
 ) {
-    let w = &mut state.widgets;
     ui.heading("arbvis");
     ui.label(RichText::new(format!("{} | {}", caps.renderer, caps.version)).small());
     ui.label(format!(
@@ -263,7 +262,43 @@ fn controls(
         state.fps, state.frame_ms
     ));
     ui.separator();
+    programs_and_fidelity(ui, scene, state, caps, actions);
+    technique_editors(ui, scene, data, state, actions);
+    ui.separator();
+    view_options(ui, scene, state, actions);
+    ui.separator();
+    let w = &mut state.widgets;
+    ui.horizontal_wrapped(|ui| {
+        if w.button(ui, "Screenshot") {
+            actions.push(UiAction::Screenshot);
+        }
+        if w.button(ui, "Save scene") {
+            actions.push(UiAction::SaveScene);
+        }
+    });
+    if !state.status.is_empty() {
+        // Recorded for scripts (`print Status`).
+        w.status_text(ui, "Status", &state.status);
+    }
+    // Lines whose length and count change from frame to frame come last, below every
+    // control: the frame times wrap to two lines on a slow machine and the renderer's
+    // status appears a frame late, and above the controls either would move them between
+    // the frame a click is aimed and the frame it lands.
+    if !state.volume_info.is_empty() {
+        // The renderer's own lines (a COPC cut, its node cache), recorded for scripts.
+        w.status_text(ui, "Renderer", &state.volume_info);
+    }
+}
 
+/// The program kind (ARB where the driver has it) and the fidelity.
+fn programs_and_fidelity(
+    ui: &mut egui::Ui,
+    scene: &mut Scene,
+    state: &mut PanelState,
+    caps: &Caps,
+    actions: &mut Vec<UiAction>,
+) {
+    let w = &mut state.widgets;
     ui.horizontal_wrapped(|ui| {
         ui.label("Programs");
         for (kind, label, enabled) in [
@@ -294,6 +329,17 @@ fn controls(
             }
         }
     });
+}
+
+/// The scene's technique's own editors.
+fn technique_editors(
+    ui: &mut egui::Ui,
+    scene: &mut Scene,
+    data: &ViewData,
+    state: &mut PanelState,
+    actions: &mut Vec<UiAction>,
+) {
+    let w = &mut state.widgets;
     let fidelity = scene.fidelity;
     if let Some(sp) = scene.technique.get_mut::<SplatsScene>() {
         ui.separator();
@@ -333,8 +379,16 @@ fn controls(
             });
         }
     }
-    ui.separator();
+}
 
+/// The camera, the interactive quality and what is drawn over the picture.
+fn view_options(
+    ui: &mut egui::Ui,
+    scene: &mut Scene,
+    state: &mut PanelState,
+    actions: &mut Vec<UiAction>,
+) {
+    let w = &mut state.widgets;
     ui.label("Camera: drag the view to turn, scroll to zoom");
     ui.horizontal_wrapped(|ui| {
         for (p, label) in [
@@ -385,28 +439,6 @@ fn controls(
         &mut scene.transparent,
         "Transparent screenshots",
     );
-    ui.separator();
-
-    ui.horizontal_wrapped(|ui| {
-        if w.button(ui, "Screenshot") {
-            actions.push(UiAction::Screenshot);
-        }
-        if w.button(ui, "Save scene") {
-            actions.push(UiAction::SaveScene);
-        }
-    });
-    if !state.status.is_empty() {
-        // Recorded for scripts (`print Status`).
-        w.status_text(ui, "Status", &state.status);
-    }
-    // Lines whose length and count change from frame to frame come last, below every
-    // control: the frame times wrap to two lines on a slow machine and the renderer's
-    // status appears a frame late, and above the controls either would move them between
-    // the frame a click is aimed and the frame it lands.
-    if !state.volume_info.is_empty() {
-        // The renderer's own lines (a COPC cut, its node cache), recorded for scripts.
-        w.status_text(ui, "Renderer", &state.volume_info);
-    }
 }
 
 /// The three sections of one attribute, each with its index slider.

@@ -16,7 +16,7 @@ use super::layout;
 use super::lut3d;
 use super::observed::Observed;
 use super::options::ViewerOptions;
-use super::panel::{self, PanelState, UiAction};
+use super::panel::{self, PanelOutput, PanelState, UiAction};
 use super::screenshot;
 use super::script::MeasureMode;
 use super::volume_view::{Key, Pending, VolumeView, SETTLE};
@@ -209,17 +209,7 @@ impl Running {
         measure: Option<MeasureMode>,
     ) -> anyhow::Result<Option<Instant>> {
         let now = Instant::now();
-        let dt = now.duration_since(self.last_frame).as_secs_f64().max(1e-6);
-        self.last_frame = now;
-        let a = if self.panel.frame_ms == 0.0 { 1.0 } else { 0.2 };
-        self.panel.frame_ms = self.panel.frame_ms * (1.0 - a) + dt * 1e3 * a;
-        self.panel.fps = 1e3 / self.panel.frame_ms.max(1e-6);
-        if matches!(measure, Some(MeasureMode::Full | MeasureMode::Interactive)) {
-            // Turn a little each frame, as a slow drag would.
-            let q = DQuat::from_rotation_y(2f64.to_radians()) * self.scene.camera.quat();
-            self.scene.camera.rotation = q.to_array();
-        }
-
+        self.count_frame(now, measure);
         let caps = self.window.gpu().caps().clone();
         let mut out = None;
         let (scene, data, panel) = (&mut self.scene, &mut self.data, &mut self.panel);
@@ -230,75 +220,12 @@ impl Running {
         self.view_rect = out.view;
         self.shown_rect = out.shown;
 
-        // Camera from pointer input on the view.
-        let view_size = DVec2::new(out.view.width() as f64, out.view.height() as f64);
-        let local = |p: egui::Pos2| {
-            DVec2::new((p.x - out.view.min.x) as f64, (p.y - out.view.min.y) as f64)
-        };
-        if let Some(p) = out.input.drag_start {
-            self.arcball.begin(&self.scene.camera, local(p), view_size);
-            self.dragging = true;
-        }
-        if let Some(p) = out.input.drag_to {
-            self.arcball
-                .drag(&mut self.scene.camera, local(p), view_size);
-        }
-        if out.input.drag_end {
-            self.arcball.end();
-            self.dragging = false;
-        }
-        if out.input.scroll != 0.0 {
-            let z = self.scene.camera.zoom * (out.input.scroll as f64 / 200.0).exp();
-            self.scene.camera.zoom = z.clamp(0.1, 10.0);
-        }
-
-        let mut screenshot = false;
-        for action in &out.actions {
-            match action {
-                UiAction::SetPrograms(kind) => self.set_programs(*kind),
-                UiAction::ParamsChanged => {
-                    match self
-                        .renderer
-                        .update(self.window.gpu(), self.scene.technique.params())
-                    {
-                        Ok(()) => self.generation += 1,
-                        Err(e) => self.fail_action(format!("error: {e}")),
-                    }
-                }
-                UiAction::Screenshot => screenshot = true,
-                UiAction::SaveScene => self.save_scene(options),
-                UiAction::SetFidelity => {
-                    // The scene's own choice, not what the last mode drew with.
-                    let kind = self.scene.programs.resolve(self.window.gpu());
-                    self.set_programs(kind);
-                }
-                UiAction::SaveTables => self.save_tables(options),
-                UiAction::ResetCamera => {
-                    // A survey's three-quarter view, as its scene started.
-                    self.scene.camera = self.scene.technique.default_camera().unwrap_or_default();
-                    self.fit();
-                }
-                UiAction::FitVolume => self.fit(),
-            }
-        }
+        self.turn_camera(&out);
+        let screenshot = self.take_actions(&out.actions, options);
 
         // Read each frame (a copy): the clip's cost after any rebuild above.
         self.panel.clip.stats = self.renderer.clip_stats();
-
-        // The 3D view in window pixels (GL's origin is the bottom left); the scene's size
-        // follows it.
-        let ppp = self.egui.egui_ctx.pixels_per_point();
-        let win = self.window.window().inner_size();
-        let to_px = |r: egui::Rect| {
-            let x = (r.min.x * ppp).round() as i32;
-            let w = ((r.max.x * ppp).round() as i32 - x).max(1);
-            let top = (r.min.y * ppp).round() as i32;
-            let h = ((r.max.y * ppp).round() as i32 - top).max(1);
-            [x, win.height as i32 - top - h, w, h]
-        };
-        self.view_px = to_px(out.view);
-        self.shown_px = to_px(out.shown);
-        self.scene.size = [self.view_px[2] as u32, self.view_px[3] as u32];
+        let win = self.place_view(&out);
 
         if out.edited || out.input.scroll != 0.0 || out.input.drag_end {
             self.last_edit = Some(now);
@@ -371,6 +298,96 @@ impl Running {
             Pending::Building => Some(Instant::now()),
             Pending::Refine => Some(self.last_edit.unwrap_or(now) + SETTLE),
         })
+    }
+
+    /// The frame time and rate the panel shows; a measuring run turns the camera a little
+    /// each frame, as a slow drag would.
+    fn count_frame(&mut self, now: Instant, measure: Option<MeasureMode>) {
+        let dt = now.duration_since(self.last_frame).as_secs_f64().max(1e-6);
+        self.last_frame = now;
+        let a = if self.panel.frame_ms == 0.0 { 1.0 } else { 0.2 };
+        self.panel.frame_ms = self.panel.frame_ms * (1.0 - a) + dt * 1e3 * a;
+        self.panel.fps = 1e3 / self.panel.frame_ms.max(1e-6);
+        if matches!(measure, Some(MeasureMode::Full | MeasureMode::Interactive)) {
+            let q = DQuat::from_rotation_y(2f64.to_radians()) * self.scene.camera.quat();
+            self.scene.camera.rotation = q.to_array();
+        }
+    }
+
+    /// The camera from pointer input on the view: the arcball's drag, the wheel's zoom.
+    fn turn_camera(&mut self, out: &PanelOutput) {
+        let view_size = DVec2::new(out.view.width() as f64, out.view.height() as f64);
+        let local = |p: egui::Pos2| {
+            DVec2::new((p.x - out.view.min.x) as f64, (p.y - out.view.min.y) as f64)
+        };
+        if let Some(p) = out.input.drag_start {
+            self.arcball.begin(&self.scene.camera, local(p), view_size);
+            self.dragging = true;
+        }
+        if let Some(p) = out.input.drag_to {
+            self.arcball
+                .drag(&mut self.scene.camera, local(p), view_size);
+        }
+        if out.input.drag_end {
+            self.arcball.end();
+            self.dragging = false;
+        }
+        if out.input.scroll != 0.0 {
+            let z = self.scene.camera.zoom * (out.input.scroll as f64 / 200.0).exp();
+            self.scene.camera.zoom = z.clamp(0.1, 10.0);
+        }
+    }
+
+    /// Do what the panel asked this frame; true when it asked for a screenshot.
+    fn take_actions(&mut self, actions: &[UiAction], options: &ViewerOptions) -> bool {
+        let mut screenshot = false;
+        for action in actions {
+            match action {
+                UiAction::SetPrograms(kind) => self.set_programs(*kind),
+                UiAction::ParamsChanged => {
+                    match self
+                        .renderer
+                        .update(self.window.gpu(), self.scene.technique.params())
+                    {
+                        Ok(()) => self.generation += 1,
+                        Err(e) => self.fail_action(format!("error: {e}")),
+                    }
+                }
+                UiAction::Screenshot => screenshot = true,
+                UiAction::SaveScene => self.save_scene(options),
+                UiAction::SetFidelity => {
+                    // The scene's own choice, not what the last mode drew with.
+                    let kind = self.scene.programs.resolve(self.window.gpu());
+                    self.set_programs(kind);
+                }
+                UiAction::SaveTables => self.save_tables(options),
+                UiAction::ResetCamera => {
+                    // A survey's three-quarter view, as its scene started.
+                    self.scene.camera = self.scene.technique.default_camera().unwrap_or_default();
+                    self.fit();
+                }
+                UiAction::FitVolume => self.fit(),
+            }
+        }
+        screenshot
+    }
+
+    /// The 3D view and the picture shown in window pixels (GL's origin is the bottom
+    /// left); the scene's size follows the view. Returns the window's size.
+    fn place_view(&mut self, out: &PanelOutput) -> winit::dpi::PhysicalSize<u32> {
+        let ppp = self.egui.egui_ctx.pixels_per_point();
+        let win = self.window.window().inner_size();
+        let to_px = |r: egui::Rect| {
+            let x = (r.min.x * ppp).round() as i32;
+            let w = ((r.max.x * ppp).round() as i32 - x).max(1);
+            let top = (r.min.y * ppp).round() as i32;
+            let h = ((r.max.y * ppp).round() as i32 - top).max(1);
+            [x, win.height as i32 - top - h, w, h]
+        };
+        self.view_px = to_px(out.view);
+        self.shown_px = to_px(out.shown);
+        self.scene.size = [self.view_px[2] as u32, self.view_px[3] as u32];
+        win
     }
 
     /// Zoom so that the whole volume (mesh, cloud) stays in view.

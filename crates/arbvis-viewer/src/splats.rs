@@ -27,6 +27,26 @@ pub fn editor(
     cloud: Option<&CloudSummary>,
     w: &mut Widgets,
 ) -> bool {
+    // Layers, facies and faults are the geological sections' (the seed's `.dat` and the
+    // generated one); a lidar or scanned cloud has classes, colours and intensity instead.
+    let section = matches!(scene.cloud, PointSource::Section(_) | PointSource::Dat(_));
+    let mut changed = shown(ui, scene, cloud, section, w);
+    changed |= colouring(ui, scene, cloud, section, w);
+    ui.separator();
+    changed |= footprints(ui, scene, fidelity, section, w);
+    ui.separator();
+    changed |= volume_mode(ui, scene, w);
+    changed
+}
+
+/// Which classes (and, for a section, layers, undefined facies and faults) are shown.
+fn shown(
+    ui: &mut egui::Ui,
+    scene: &mut SplatsScene,
+    cloud: Option<&CloudSummary>,
+    section: bool,
+    w: &mut Widgets,
+) -> bool {
     let mut changed = false;
     // The classes the cloud holds, and any the scene hides (a COPC cut may not hold them).
     let mut classes: Vec<i32> = cloud.map_or(Vec::new(), |c| c.classes.clone());
@@ -42,9 +62,6 @@ pub fn editor(
             }
         });
     }
-    // Layers, facies and faults are the geological sections' (the seed's `.dat` and the
-    // generated one); a lidar or scanned cloud has classes, colours and intensity instead.
-    let section = matches!(scene.cloud, PointSource::Section(_) | PointSource::Dat(_));
     if section {
         ui.label("Layers shown");
         ui.horizontal_wrapped(|ui| {
@@ -66,6 +83,18 @@ pub fn editor(
             "Faults in white",
         );
     }
+    changed
+}
+
+/// What the colour says: the mode (a section's, or a lidar cloud's) and the property.
+fn colouring(
+    ui: &mut egui::Ui,
+    scene: &mut SplatsScene,
+    cloud: Option<&CloudSummary>,
+    section: bool,
+    w: &mut Widgets,
+) -> bool {
+    let mut changed = false;
     let modes: &[(ColourMode, &str)] = if section {
         &[
             (ColourMode::Facies, "facies"),
@@ -101,7 +130,19 @@ pub fn editor(
             changed = true;
         }
     });
-    ui.separator();
+    changed
+}
+
+/// Each splat's footprint: size, kernel, lighting, sort, and (precise) points or tiles
+/// and eye-dome lighting.
+fn footprints(
+    ui: &mut egui::Ui,
+    scene: &mut SplatsScene,
+    fidelity: Fidelity,
+    section: bool,
+    w: &mut Widgets,
+) -> bool {
+    let mut changed = false;
     changed |= w.slider(
         ui,
         "Point size",
@@ -177,7 +218,12 @@ pub fn editor(
             false,
         );
     });
-    ui.separator();
+    changed
+}
+
+/// Volume mode: the property as density, its threshold and range.
+fn volume_mode(ui: &mut egui::Ui, scene: &mut SplatsScene, w: &mut Widgets) -> bool {
+    let mut changed = false;
     let mut volume = scene.mode == Mode::Volume;
     if w.checkbox(
         ui,

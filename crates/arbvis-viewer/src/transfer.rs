@@ -207,6 +207,14 @@ pub fn editor(
             }
         }
     });
+    changed |= settings(ui, spec, w);
+    changed
+}
+
+/// The volume's settings beside its curve: unit distance, the faithful and precise
+/// orders, the table's and the grid's sizes.
+fn settings(ui: &mut egui::Ui, spec: &mut VolumeSpec, w: &mut Widgets) -> bool {
+    let mut changed = false;
     ui.horizontal_wrapped(|ui| {
         ui.label("Unit distance").on_hover_text(
             "the length (in the mesh's units) over which an opacity of 1 absorbs fully",

@@ -189,94 +189,7 @@ pub fn run(
         } else {
             ProgramKind::Glsl
         };
-        use Projection::{Orthographic as Ortho, Perspective as Persp};
-        let (faithful, precise, glsl) = (Fidelity::Faithful, Fidelity::Precise, ProgramKind::Glsl);
-        let settings = [
-            (
-                "seed: faithful per-vertex, all tets (ortho)",
-                faithful,
-                kind,
-                Exit::Vertex,
-                Ortho,
-                false,
-                false,
-            ),
-            (
-                "seed: faithful per-fragment, all tets (persp)",
-                faithful,
-                kind,
-                Exit::Fragment,
-                Persp,
-                false,
-                false,
-            ),
-            (
-                "faithful per-vertex (ortho)",
-                faithful,
-                kind,
-                Exit::Vertex,
-                Ortho,
-                true,
-                false,
-            ),
-            (
-                "faithful per-fragment (ortho)",
-                faithful,
-                kind,
-                Exit::Fragment,
-                Ortho,
-                true,
-                false,
-            ),
-            (
-                "faithful per-fragment (persp)",
-                faithful,
-                kind,
-                Exit::Fragment,
-                Persp,
-                true,
-                false,
-            ),
-            (
-                "precise (ortho)",
-                precise,
-                glsl,
-                Exit::Auto,
-                Ortho,
-                true,
-                false,
-            ),
-            (
-                "precise (persp)",
-                precise,
-                glsl,
-                Exit::Auto,
-                Persp,
-                true,
-                false,
-            ),
-            // Front to back per view, back faces dropped, entry depth (the camera
-            // is still: the per-view rebuild happens once, before the timed frames).
-            (
-                "faithful per-vertex, view order (ortho)",
-                faithful,
-                kind,
-                Exit::Vertex,
-                Ortho,
-                true,
-                true,
-            ),
-            (
-                "precise, view order (ortho)",
-                precise,
-                glsl,
-                Exit::Auto,
-                Ortho,
-                true,
-                true,
-            ),
-        ];
-        for (name, fidelity, kind, exit, projection, active_only, view_order) in settings {
+        for (name, fidelity, kind, exit, projection, active_only, view_order) in sweep(kind) {
             bar.set_message(&format!("cell projection, {tets} tets: {name}"));
             let mut params = scene_for(points, exit, active_only);
             if view_order {
@@ -334,6 +247,110 @@ pub fn run(
         }
     }
     Ok(rows)
+}
+
+/// One setting of the sweep: its name, fidelity, program kind, exit, projection, whether
+/// only active tetrahedra are drawn, and whether in view order.
+type Setting = (
+    &'static str,
+    Fidelity,
+    ProgramKind,
+    Exit,
+    Projection,
+    bool,
+    bool,
+);
+
+/// The settings each mesh is drawn with; `kind` is the faithful programs' (ARB where the
+/// driver has it), precise is GLSL.
+fn sweep(kind: ProgramKind) -> [Setting; SETTINGS as usize] {
+    use Projection::{Orthographic as Ortho, Perspective as Persp};
+    let (faithful, precise, glsl) = (Fidelity::Faithful, Fidelity::Precise, ProgramKind::Glsl);
+    [
+        (
+            "seed: faithful per-vertex, all tets (ortho)",
+            faithful,
+            kind,
+            Exit::Vertex,
+            Ortho,
+            false,
+            false,
+        ),
+        (
+            "seed: faithful per-fragment, all tets (persp)",
+            faithful,
+            kind,
+            Exit::Fragment,
+            Persp,
+            false,
+            false,
+        ),
+        (
+            "faithful per-vertex (ortho)",
+            faithful,
+            kind,
+            Exit::Vertex,
+            Ortho,
+            true,
+            false,
+        ),
+        (
+            "faithful per-fragment (ortho)",
+            faithful,
+            kind,
+            Exit::Fragment,
+            Ortho,
+            true,
+            false,
+        ),
+        (
+            "faithful per-fragment (persp)",
+            faithful,
+            kind,
+            Exit::Fragment,
+            Persp,
+            true,
+            false,
+        ),
+        (
+            "precise (ortho)",
+            precise,
+            glsl,
+            Exit::Auto,
+            Ortho,
+            true,
+            false,
+        ),
+        (
+            "precise (persp)",
+            precise,
+            glsl,
+            Exit::Auto,
+            Persp,
+            true,
+            false,
+        ),
+        // Front to back per view, back faces dropped, entry depth (the camera
+        // is still: the per-view rebuild happens once, before the timed frames).
+        (
+            "faithful per-vertex, view order (ortho)",
+            faithful,
+            kind,
+            Exit::Vertex,
+            Ortho,
+            true,
+            true,
+        ),
+        (
+            "precise, view order (ortho)",
+            precise,
+            glsl,
+            Exit::Auto,
+            Ortho,
+            true,
+            true,
+        ),
+    ]
 }
 
 /// Settings per mesh.

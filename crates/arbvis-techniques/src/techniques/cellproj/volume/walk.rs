@@ -298,6 +298,46 @@ impl Precise {
         })
     }
 
+    /// Peel up to a pool of entry layers, at most `most` in all; returns how many. Layer 0
+    /// of a later batch reads the previous batch's last (the pool's last), which it
+    /// overwrites only at its own end.
+    fn peel_batch(&mut self, gpu: &Gpu, most: usize) -> GlResult<usize> {
+        let p = self;
+        let mut n = 0;
+        while n < p.layers.len() && p.peeled < most {
+            let k = n;
+            p.layers[k].clear(gpu, [-1.0, -1.0, 0.0, 0.0])?;
+            let after = p.peeled > 0;
+            p.peel
+                .set_local(gpu, 5, [after as u8 as f64, 0.0, 0.0, 0.0])?;
+            let previous = if k > 0 { k - 1 } else { p.layers.len() - 1 };
+            let textures: Vec<(u32, &Texture)> = if after {
+                vec![(3, p.layers[previous].color())]
+            } else {
+                Vec::new()
+            };
+            let call = DrawCall {
+                textures: &textures,
+                depth_test: true,
+                cull_back: true,
+                ..DrawCall::new(&p.peel, &p.boundary)
+            };
+            // Without a cap the layers go on until one is empty; with one (a convex
+            // boundary's single layer), no count is needed.
+            let target = Surface::Target(&p.layers[k]);
+            if p.cap.is_none() {
+                if gl::draw_counted(gpu, target, &call)? == 0 {
+                    break;
+                }
+            } else {
+                gl::draw(gpu, target, &call)?;
+            }
+            n += 1;
+            p.peeled += 1;
+        }
+        Ok(n)
+    }
+
     /// Peel the entry layers of `frame`'s view and walk every pixel's ray.
     pub(super) fn draw(
         &mut self,
@@ -351,40 +391,7 @@ impl Precise {
         p.peeled = 0;
         let mut batch = 0;
         loop {
-            // Peel up to BATCH entry layers; layer 0 of a later batch reads the previous
-            // batch's last (the pool's last), which it overwrites only at its own end.
-            let mut n = 0;
-            while n < p.layers.len() && p.peeled < most {
-                let k = n;
-                p.layers[k].clear(gpu, [-1.0, -1.0, 0.0, 0.0])?;
-                let after = p.peeled > 0;
-                p.peel
-                    .set_local(gpu, 5, [after as u8 as f64, 0.0, 0.0, 0.0])?;
-                let previous = if k > 0 { k - 1 } else { p.layers.len() - 1 };
-                let textures: Vec<(u32, &Texture)> = if after {
-                    vec![(3, p.layers[previous].color())]
-                } else {
-                    Vec::new()
-                };
-                let call = DrawCall {
-                    textures: &textures,
-                    depth_test: true,
-                    cull_back: true,
-                    ..DrawCall::new(&p.peel, &p.boundary)
-                };
-                // Without a cap the layers go on until one is empty; with one (a convex
-                // boundary's single layer), no count is needed.
-                let target = Surface::Target(&p.layers[k]);
-                if p.cap.is_none() {
-                    if gl::draw_counted(gpu, target, &call)? == 0 {
-                        break;
-                    }
-                } else {
-                    gl::draw(gpu, target, &call)?;
-                }
-                n += 1;
-                p.peeled += 1;
-            }
+            let n = p.peel_batch(gpu, most)?;
             // The last batch: fewer than a full pool, or at the cap.
             let last = n < p.layers.len() || p.peeled >= most;
             if !last && p.sums.is_empty() {
