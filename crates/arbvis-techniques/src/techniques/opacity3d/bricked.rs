@@ -349,7 +349,8 @@ impl BrickedRenderer {
         };
         r.build_tables(gpu)?;
         for (i, c) in coefficients(&r.params).iter().enumerate() {
-            r.program.set_local(gpu, i + 1, *c)?;
+            r.program
+                .set_local(gpu, super::locals::COEFFICIENTS + i, *c)?;
         }
         Ok(r)
     }
@@ -774,7 +775,8 @@ impl Renderer for BrickedRenderer {
             self.program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         }
         for (i, c) in coefficients(&self.params).iter().enumerate() {
-            self.program.set_local(gpu, i + 1, *c)?;
+            self.program
+                .set_local(gpu, super::locals::COEFFICIENTS + i, *c)?;
         }
         Ok(())
     }

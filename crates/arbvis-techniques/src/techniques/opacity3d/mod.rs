@@ -54,6 +54,7 @@ pub mod brick_ranges;
 pub mod bricked;
 pub mod bricks;
 pub mod clipping;
+pub mod locals;
 pub mod mirror;
 pub mod paged;
 pub mod preint;

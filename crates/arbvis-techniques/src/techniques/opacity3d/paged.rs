@@ -33,6 +33,7 @@
 
 use glam::DVec3;
 
+use super::locals;
 use super::programs::{raycast_pair, InShader, Variant};
 use super::renderer::{eye, far_faces, toward_viewer};
 use super::{corrected, Combine, Opacity3dScene};
@@ -219,7 +220,7 @@ impl PagedPass {
         }
         let p = &self.program;
         for (i, c) in super::coefficients(params).iter().enumerate() {
-            p.set_local(gpu, i + 1, *c)?;
+            p.set_local(gpu, locals::COEFFICIENTS + i, *c)?;
         }
         let window: [f64; 3] =
             std::array::from_fn(|a| (pyr.window[1][a] - pyr.window[0][a]) as f64);
@@ -233,27 +234,43 @@ impl PagedPass {
         } else {
             (0.0, 1.0)
         };
-        p.set_local(gpu, 4, [scale, reference / r.steps_per_voxel, offset, 0.0])?;
-        p.set_local(gpu, 5, [255.0 / 256.0, 0.5 / 256.0, 1.0 / 3.0, 0.0])?;
-        p.set_local(gpu, 6, (2.0 * half).extend(0.0).to_array())?;
-        p.set_local(gpu, 7, half.extend(0.0).to_array())?;
+        p.set_local(
+            gpu,
+            locals::CORRECTION,
+            [scale, reference / r.steps_per_voxel, offset, 0.0],
+        )?;
+        p.set_local(
+            gpu,
+            locals::LOOKUP,
+            [255.0 / 256.0, 0.5 / 256.0, 1.0 / 3.0, 0.0],
+        )?;
+        p.set_local(gpu, locals::BOX_SIZE, (2.0 * half).extend(0.0).to_array())?;
+        p.set_local(gpu, locals::BOX_HALF, half.extend(0.0).to_array())?;
         let ray = match frame.camera.projection {
             Projection::Perspective => eye(frame),
             Projection::Orthographic => -toward_viewer(frame).normalize(),
         };
-        p.set_local(gpu, 8, ray.extend(0.0).to_array())?;
-        p.set_local(gpu, 9, [1.0, 1.0, 1.0, 1.0 - r.termination])?;
+        p.set_local(gpu, locals::RAY, ray.extend(0.0).to_array())?;
+        p.set_local(gpu, locals::AXIS, [1.0, 1.0, 1.0, 1.0 - r.termination])?;
         let w = pyr.window;
-        p.set_local(gpu, 10, [window[0], window[1], window[2], pyr.brick as f64])?;
         p.set_local(
             gpu,
-            11,
+            locals::PAGED_WINDOW,
+            [window[0], window[1], window[2], pyr.brick as f64],
+        )?;
+        p.set_local(
+            gpu,
+            locals::PAGED_FIRST_VOXEL,
             [w[0][0] as f64, w[0][1] as f64, w[0][2] as f64, 0.0],
         )?;
         let texels = atlas.1.texels().map(|t| 1.0 / t.max(1) as f64);
-        p.set_local(gpu, 12, [texels[0], texels[1], texels[2], 0.0])?;
+        p.set_local(
+            gpu,
+            locals::PAGED_PER_TEXEL,
+            [texels[0], texels[1], texels[2], 0.0],
+        )?;
         let f = table.first.map(|v| v as f64);
-        p.set_local(gpu, 13, [f[0], f[1], f[2], 0.0])?;
+        p.set_local(gpu, locals::PAGED_FIRST_PAGE, [f[0], f[1], f[2], 0.0])?;
         p.set_transform(gpu, super::renderer::model_view_projection(frame))?;
         super::renderer::send_pixel_rays(gpu, p, surface, frame)?;
         let (Some(mesh), Some((page, _))) = (&self.mesh, &self.table) else {

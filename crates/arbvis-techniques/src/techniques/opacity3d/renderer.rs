@@ -17,6 +17,7 @@ use glam::{DMat4, DVec3};
 
 use super::bricks::Bricks;
 use super::clipping::{self, Clip};
+use super::locals;
 use super::prepare::{prepare, Prepared};
 pub use super::programs::faithful_pair;
 use super::programs::{raycast_pair, slicing_pair, InShader, Variant};
@@ -175,8 +176,16 @@ pub fn send_pixel_rays(
 ) -> GlResult<()> {
     let [x, y, w, h] = surface.rect();
     let (w, h) = (w.max(1.0), h.max(1.0));
-    program.set_local(gpu, 16, [2.0 / w, 2.0 / h, 2.0, 0.0])?;
-    program.set_local(gpu, 17, [-1.0 - 2.0 * x / w, -1.0 - 2.0 * y / h, -1.0, 1.0])?;
+    program.set_local(
+        gpu,
+        locals::PIXEL_TO_NDC_SCALE,
+        [2.0 / w, 2.0 / h, 2.0, 0.0],
+    )?;
+    program.set_local(
+        gpu,
+        locals::PIXEL_TO_NDC_OFFSET,
+        [-1.0 - 2.0 * x / w, -1.0 - 2.0 * y / h, -1.0, 1.0],
+    )?;
     let inverse = model_view_projection(frame).inverse().transpose();
     for (i, row) in [
         inverse.x_axis,
@@ -187,7 +196,7 @@ pub fn send_pixel_rays(
     .iter()
     .enumerate()
     {
-        program.set_local(gpu, 18 + i, row.to_array())?;
+        program.set_local(gpu, locals::INVERSE_MVP + i, row.to_array())?;
     }
     Ok(())
 }
@@ -541,22 +550,30 @@ impl Opacity3dRenderer {
 
     fn send_constants(&self, gpu: &Gpu) -> GlResult<()> {
         for (i, c) in coefficients(&self.params).iter().enumerate() {
-            self.program.set_local(gpu, i + 1, *c)?;
+            self.program.set_local(gpu, locals::COEFFICIENTS + i, *c)?;
         }
         if let Some(clip) = &self.clip {
             clip.stage.send(gpu, &self.program)?;
         }
         if self.fidelity == Fidelity::Precise {
             let p = &self.program;
-            p.set_local(gpu, 5, [255.0 / 256.0, 0.5 / 256.0, 1.0 / 3.0, 0.0])?;
+            p.set_local(
+                gpu,
+                locals::LOOKUP,
+                [255.0 / 256.0, 0.5 / 256.0, 1.0 / 3.0, 0.0],
+            )?;
             let half = self.prepared.half;
-            p.set_local(gpu, 6, (2.0 * half).extend(0.0).to_array())?;
-            p.set_local(gpu, 7, half.extend(0.0).to_array())?;
+            p.set_local(gpu, locals::BOX_SIZE, (2.0 * half).extend(0.0).to_array())?;
+            p.set_local(gpu, locals::BOX_HALF, half.extend(0.0).to_array())?;
             if self.filter.volume && self.path() == Path3d::Slicing {
                 // slice_precise.arbfp's own trilinear (exact_volume): size and 1 / size.
                 let dims = self.prepared.dims.map(|d| d as f64);
-                p.set_local(gpu, 14, [dims[0], dims[1], dims[2], 1.0])?;
-                p.set_local(gpu, 15, [1.0 / dims[0], 1.0 / dims[1], 1.0 / dims[2], 1.0])?;
+                p.set_local(gpu, locals::EXACT_SIZE, [dims[0], dims[1], dims[2], 1.0])?;
+                p.set_local(
+                    gpu,
+                    locals::EXACT_INVERSE_SIZE,
+                    [1.0 / dims[0], 1.0 / dims[1], 1.0 / dims[2], 1.0],
+                )?;
             }
         }
         Ok(())
@@ -614,31 +631,39 @@ impl Opacity3dRenderer {
         match (self.path(), &self.params.raycast) {
             (Path3d::Raycast, Some(r)) => {
                 let step = reference / r.steps_per_voxel;
-                p.set_local(gpu, 4, [scale, step, offset, 0.0])?;
+                p.set_local(gpu, locals::CORRECTION, [scale, step, offset, 0.0])?;
                 let ray = if perspective { eye(frame) } else { -n };
-                p.set_local(gpu, 8, ray.extend(0.0).to_array())?;
+                p.set_local(gpu, locals::RAY, ray.extend(0.0).to_array())?;
                 let per_unit = match &self.bricks {
                     Some((b, Some(_))) => b.per_unit(&self.prepared),
                     _ => [1.0; 3],
                 };
                 let stop = 1.0 - r.termination;
-                p.set_local(gpu, 9, [per_unit[0], per_unit[1], per_unit[2], stop])?;
+                p.set_local(
+                    gpu,
+                    locals::AXIS,
+                    [per_unit[0], per_unit[1], per_unit[2], stop],
+                )?;
                 let [lo, hi] = self.occupied;
-                p.set_local(gpu, 22, [lo[0], lo[1], lo[2], 0.0])?;
-                p.set_local(gpu, 23, [hi[0], hi[1], hi[2], 0.0])?;
+                p.set_local(gpu, locals::OCCUPIED_LOW, [lo[0], lo[1], lo[2], 0.0])?;
+                p.set_local(gpu, locals::OCCUPIED_HIGH, [hi[0], hi[1], hi[2], 0.0])?;
             }
             _ => {
-                p.set_local(gpu, 4, [scale, self.spacing / 2.0, offset, 0.0])?;
+                p.set_local(
+                    gpu,
+                    locals::CORRECTION,
+                    [scale, self.spacing / 2.0, offset, 0.0],
+                )?;
                 if perspective {
-                    p.set_local(gpu, 8, eye(frame).extend(0.0).to_array())?;
-                    p.set_local(gpu, 9, n.extend(0.0).to_array())?;
+                    p.set_local(gpu, locals::RAY, eye(frame).extend(0.0).to_array())?;
+                    p.set_local(gpu, locals::AXIS, n.extend(0.0).to_array())?;
                 } else {
                     // Rays run along -n: per axis its sign and 1 / |component|.
                     let r = -n;
                     let sign = r.to_array().map(|c| if c < 0.0 { -1.0 } else { 1.0 });
                     let inv = r.to_array().map(|c| 1.0 / c.abs().max(1e-20));
-                    p.set_local(gpu, 8, [sign[0], sign[1], sign[2], 0.0])?;
-                    p.set_local(gpu, 9, [inv[0], inv[1], inv[2], 0.0])?;
+                    p.set_local(gpu, locals::RAY, [sign[0], sign[1], sign[2], 0.0])?;
+                    p.set_local(gpu, locals::AXIS, [inv[0], inv[1], inv[2], 0.0])?;
                 }
             }
         }
