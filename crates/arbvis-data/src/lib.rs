@@ -17,6 +17,7 @@ use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, vo
 pub mod le;
 pub mod mesh;
 pub mod points;
+pub mod sniff;
 pub mod store;
 pub mod surface;
 pub mod volume;
