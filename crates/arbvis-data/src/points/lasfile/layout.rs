@@ -237,3 +237,74 @@ pub fn vlrs_in_head(b: &[u8]) -> Vec<Vlr> {
     let mut read = from_bytes(b);
     std::iter::from_fn(|| walk.next(&mut read)?.ok()).collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 227-byte LAS 1.2 header followed by VLRs of `sizes` bytes (user `u`, record k).
+    fn head(sizes: &[u16]) -> Vec<u8> {
+        let mut b = vec![0u8; HEADER_MIN];
+        b[0..4].copy_from_slice(b"LASF");
+        b[24..26].copy_from_slice(&[1, 2]);
+        b[94..96].copy_from_slice(&(HEADER_MIN as u16).to_le_bytes());
+        b[100..104].copy_from_slice(&(sizes.len() as u32).to_le_bytes());
+        for (k, &n) in sizes.iter().enumerate() {
+            let mut h = vec![0u8; VLR_HEADER as usize];
+            h[2] = b'u';
+            h[18..20].copy_from_slice(&(k as u16).to_le_bytes());
+            h[20..22].copy_from_slice(&n.to_le_bytes());
+            b.extend(h);
+            b.extend(vec![7u8; n as usize]);
+        }
+        b
+    }
+
+    #[test]
+    fn the_walk_checks_each_record_against_its_end() {
+        let b = head(&[3, 5]);
+        let h = RawHeader::parse(&b).unwrap();
+        assert_eq!((h.version, h.header_size, h.vlr_count), ((1, 2), 227, 2));
+        let mut read = from_bytes(&b);
+        let mut walk = Walk::vlrs(227, 2, b.len() as u64);
+        let a = walk.next(&mut read).unwrap().unwrap();
+        assert_eq!(
+            (a.user_id.as_str(), a.record_id, a.at, a.data),
+            ("u", 0, 227, 281..284)
+        );
+        let c = walk.next(&mut read).unwrap().unwrap();
+        assert_eq!((c.at, c.data), (284, 338..343));
+        assert!(walk.next(&mut read).is_none());
+        assert_eq!(walk.at(), b.len() as u64);
+        // Data past the end, then a header past it: each refused once, the walk over.
+        let mut walk = Walk::vlrs(227, 2, b.len() as u64 - 1);
+        walk.next(&mut read).unwrap().unwrap();
+        match walk.next(&mut read) {
+            Some(Err(WalkError::Data {
+                index: 1,
+                vlr,
+                size: 5,
+            })) => assert_eq!(vlr.at, 284),
+            other => panic!("{other:?}"),
+        }
+        assert!(walk.next(&mut read).is_none());
+        let mut walk = Walk::evlrs(b.len() as u64 - 10, u32::MAX, b.len() as u64);
+        assert!(matches!(
+            walk.next(&mut read),
+            Some(Err(WalkError::Header { index: 0, .. }))
+        ));
+    }
+
+    #[test]
+    fn vlrs_in_head_takes_those_that_fit() {
+        let b = head(&[3, 5]);
+        assert_eq!(vlrs_in_head(&b).len(), 2);
+        assert_eq!(vlrs_in_head(&b[..b.len() - 1]).len(), 1);
+        assert!(vlrs_in_head(b"LASF").is_empty());
+        assert!(vlrs_in_head(&b[4..]).is_empty());
+        let mut many = head(&[]);
+        many[100..104].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert!(vlrs_in_head(&many).is_empty());
+        assert!(RawHeader::parse(&b[..HEADER_MIN - 1]).is_none());
+    }
+}
