@@ -296,7 +296,6 @@ impl<'f, 'a> Piece<'f, 'a> {
     }
 
     /// The `PointData` and `CellData` arrays, decoded.
-    #[allow(clippy::type_complexity)]
     fn data_arrays(&self) -> Result<(Vec<ReadArray>, Vec<ReadArray>), MeshError> {
         let mut point_arrays = Vec::new();
         let mut cell_arrays = Vec::new();
