@@ -14,8 +14,10 @@ extern crate self as arbvis;
 #[allow(unused_imports)]
 use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, vocab};
 
+pub mod le;
 pub mod mesh;
 pub mod points;
+pub mod sniff;
 pub mod store;
 pub mod surface;
 pub mod volume;

@@ -59,50 +59,17 @@ pub enum InspectError {
     },
 }
 
-/// The reader for a file, from its extension or, failing that, its first bytes.
+/// The reader for a file, from its extension or, failing that, its first bytes
+/// ([`arbvis_data::sniff::format`]).
 pub fn kind(path: &Path, head: &[u8]) -> Option<Kind> {
-    let name = path.to_string_lossy().to_lowercase();
-    let ends = |e: &str| name.ends_with(e);
-    if ends(".nii") || ends(".nii.gz") || head.get(344..348) == Some(b"n+1\0") {
-        return Some(Kind::Nifti);
-    }
-    if ends(".sgy") || ends(".segy") {
-        return Some(Kind::Segy);
-    }
-    let text = String::from_utf8_lossy(&head[..head.len().min(256)]);
-    let start = text.trim_start();
-    if ends(".vtk")
-        || ends(".vtu")
-        || ends(".msh")
-        || start.starts_with("# vtk DataFile")
-        || start.starts_with("$MeshFormat")
-        || (start.starts_with("<?xml") || start.starts_with("<VTKFile")) && text.contains("VTKFile")
-    {
-        return Some(Kind::Mesh);
-    }
-    if ends(".las") || ends(".laz") || ends(".ply") || ends(".dat") || head.starts_with(b"LASF") {
-        return Some(Kind::Points);
-    }
-    if ends(".obj") || ends(".stl") {
-        return Some(Kind::Surface);
-    }
-    if looks_like_segy(head) {
-        return Some(Kind::Segy);
-    }
-    None
-}
-
-/// A SEG-Y binary header at byte 3200 with a known sample format code (either order).
-fn looks_like_segy(head: &[u8]) -> bool {
-    let Some(code) = head.get(3224..3226) else {
-        return false;
-    };
-    [
-        u16::from_be_bytes([code[0], code[1]]),
-        u16::from_le_bytes([code[0], code[1]]),
-    ]
-    .iter()
-    .any(|&c| crate::volume::segy::SampleFormat::from_code(c).is_some())
+    use arbvis_data::sniff::Format;
+    Some(match arbvis_data::sniff::format(path, head)? {
+        Format::Nifti => Kind::Nifti,
+        Format::Segy => Kind::Segy,
+        Format::Mesh => Kind::Mesh,
+        Format::Copc | Format::Las | Format::Ply | Format::Dat => Kind::Points,
+        Format::Surface => Kind::Surface,
+    })
 }
 
 /// What a file's first bytes look like, for a file no reader takes.

@@ -4,6 +4,9 @@
 //! `VerticalUnitsGeoKey` 4099). A file that says nothing gets no unit: LAS does not fix
 //! one (autzen's coordinates are in feet).
 //!
+//! The VLRs are found by the data crate's LAS reader
+//! ([`arbvis_data::points::lasfile::layout::vlrs_in_head`]).
+//!
 //! Decisions: only the VLRs between the header and the points are read (at most
 //! [`MAX_HEADER_BYTES`]; a LAS 1.4 WKT kept in an extended VLR after the points is not
 //! looked for); every offset and length is checked against the bytes read, and any
@@ -11,6 +14,9 @@
 
 use std::io::Read;
 use std::path::Path;
+
+use arbvis_data::le::u16_get as u16_at;
+use arbvis_data::points::lasfile::layout::vlrs_in_head;
 
 /// Most bytes read from the start of the file for its header and VLRs.
 pub const MAX_HEADER_BYTES: u64 = 1 << 20;
@@ -36,46 +42,20 @@ pub fn las_units(path: &Path) -> Units {
     from_header(&bytes)
 }
 
-fn u16_at(b: &[u8], at: usize) -> Option<u16> {
-    Some(u16::from_le_bytes(b.get(at..at + 2)?.try_into().ok()?))
-}
-
-fn u32_at(b: &[u8], at: usize) -> Option<u32> {
-    Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
-}
-
 /// The units stated by the VLRs of a LAS header held in `b` (the file's first bytes).
 pub fn from_header(b: &[u8]) -> Units {
     let mut units = Units::default();
-    if b.get(0..4) != Some(b"LASF") {
-        return units;
-    }
-    let (Some(header), Some(count)) = (u16_at(b, 94), u32_at(b, 100)) else {
-        return units;
-    };
-    let mut at = header as usize;
     let mut wkt = None;
     let mut keys = None;
-    for _ in 0..count {
-        let (Some(user), Some(id), Some(len)) = (
-            b.get(at + 2..at + 18),
-            u16_at(b, at + 18),
-            u16_at(b, at + 20),
-        ) else {
-            break;
-        };
-        let data = at + 54..at + 54 + len as usize;
-        let Some(body) = b.get(data.clone()) else {
-            break;
-        };
-        if user.starts_with(b"LASF_Projection") {
-            match id {
+    for vlr in vlrs_in_head(b) {
+        if vlr.user_raw.starts_with(b"LASF_Projection") {
+            let body = &b[vlr.data];
+            match vlr.record_id {
                 2112 => wkt = Some(String::from_utf8_lossy(body).into_owned()),
                 34735 => keys = Some(body.to_vec()),
                 _ => {}
             }
         }
-        at = data.end;
     }
     if let Some(text) = wkt {
         units = from_wkt(&text);

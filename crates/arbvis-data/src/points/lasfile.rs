@@ -40,8 +40,10 @@ use las::{PointData, PointDataBuilder, Reader};
 use rayon::prelude::*;
 
 mod check;
+mod check_laz;
 mod extra;
 mod header;
+pub mod layout;
 mod laz_chunks;
 pub(crate) mod stream;
 

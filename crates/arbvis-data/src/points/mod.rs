@@ -53,6 +53,7 @@ pub mod section;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
+use crate::sniff::Format;
 use serde::{Deserialize, Serialize};
 
 pub use cloud::footprint;
@@ -284,18 +285,12 @@ pub enum FileKind {
 }
 
 impl FileKind {
-    /// The kind of `bytes` named `path`.
+    /// The kind of `bytes` named `path` ([`crate::sniff::point_format`]; COPC is LAS).
     pub fn detect(path: &Path, bytes: &[u8]) -> FileKind {
-        let ext = path
-            .extension()
-            .map(|e| e.to_string_lossy().to_lowercase())
-            .unwrap_or_default();
-        if bytes.starts_with(b"LASF") || ext == "las" || ext == "laz" {
-            FileKind::Las
-        } else if bytes.starts_with(b"ply") || ext == "ply" {
-            FileKind::Ply
-        } else {
-            FileKind::Dat
+        match crate::sniff::point_format(path, bytes) {
+            Format::Copc | Format::Las => FileKind::Las,
+            Format::Ply => FileKind::Ply,
+            _ => FileKind::Dat,
         }
     }
 }
@@ -309,7 +304,7 @@ pub fn inspect(path: &Path) -> Result<String, PointsError> {
     std::fs::File::open(path)
         .and_then(|f| f.take(512).read_to_end(&mut head))
         .map_err(|e| PointsError::io(path, e))?;
-    if copc::is_copc(&head) {
+    if crate::sniff::point_format(path, &head) == Format::Copc {
         let c = copc::Copc::open(path)?;
         return Ok(format!(
             "{}\nformat: COPC (LAZ 1.4, point format {}, {}-byte records), {} points\n{}",

@@ -185,6 +185,7 @@ pub fn convert(
     }
 }
 
+/// [`convert`] on the workers of the rayon pool it runs in.
 fn convert_on_workers(
     input: &Path,
     store: &Path,
@@ -197,117 +198,15 @@ fn convert_on_workers(
             format!("brick {}: must be 2..=512 voxels", o.brick),
         ));
     }
-    let mut attributes = vec![Attribute::Amplitude];
-    for &a in &o.derived {
-        if !attributes.contains(&a) {
-            attributes.push(a);
-        }
-    }
-    let src = Input::open(input, o.raw.as_ref(), o.segy_keys)?;
-    let dims = src.dims();
-    let b = o.brick;
-    let levels = super::level_count(dims, b);
-    // An MDIO dataset converted into itself: levels and ranges beside its own arrays.
-    let in_place = matches!(src, Input::Mdio(..))
-        && std::fs::canonicalize(input).ok() == std::fs::canonicalize(store).ok();
-    if in_place && matches!(&src, Input::Mdio(_, m) if m.source_variable.is_none()) {
-        return Err(StoreError::invalid(
-            input,
-            "a zarr v2 dataset (MDIO v0, or v1 written with zarr format 2) cannot gain zarr v3 levels in place: convert it into a store of its own (arbvis convert DATASET STORE)",
-        ));
-    }
-    let (identity, source_variable) = match &src {
-        Input::Mdio(m, meta) => (
-            m.data.metadata_file(),
-            meta.source_variable.clone().filter(|_| in_place),
-        ),
-        _ => (input.to_path_buf(), None),
-    };
-    let job = job_of(input, &identity, o, &attributes)?;
-    let workers = rayon::current_num_threads().max(1);
-    let bound = memory_bound(dims[0], b, attributes.len(), workers)
-        + match &src {
-            Input::Mdio(m, _) => m.cache_bytes(),
-            _ => 0,
-        };
-    crate::budget::check(
-        format!(
-            "converting {} ({} samples per trace, {b}³ bricks, {} attributes, {workers} workers)",
-            input.display(),
-            dims[0],
-            attributes.len()
-        ),
-        bound,
-    )
-    .map_err(|e| StoreError::Budget(e.to_string()))?;
-    check_work(input, &src, dims, b, attributes.len())?;
-    let in_place_level0 = usize::from(in_place);
+    let attributes = attributes_of(o);
+    let plan = Plan::new(input, store, o, &attributes)?;
+    let meta = plan.meta(o, &attributes);
     let log_path = store.join(PROGRESS_LOG);
-    let meta = StoreMeta {
-        format: FORMAT.into(),
-        version: VERSION,
-        dims,
-        spacing: src.spacing(),
-        brick: b,
-        levels,
-        filter: "box: the mean of each 2x2x2 cell (of the voxels present at a far face of odd size); phase: the cell's first voxel".into(),
-        attributes: attributes
-            .iter()
-            .map(|&a| AttributeMeta {
-                name: a.name().into(),
-                dtype: dtype(a).into(),
-                min: None,
-                max: None,
-                mean: None,
-                non_finite: 0,
-            })
-            .collect(),
-        source: src.source_meta(),
-        compression: o.compression.to_string(),
-        complete: false,
-        source_variable,
-    };
-    if store.exists() && !store.is_dir() {
-        return Err(StoreError::invalid(
-            store,
-            "exists and is not a folder: name a new store",
-        ));
-    }
-    std::fs::create_dir_all(store).map_err(|e| StoreError::io(store, e))?;
-    check_disk(store, &meta, in_place_level0, o.progress)?;
     // One writer at a time; the lock goes when this function returns.
-    let _lock = StoreLock::acquire(store)?;
-    let beside = if in_place {
-        Some(mdio_root_attributes(store)?)
-    } else {
-        None
-    };
-    let mut done: HashMap<[usize; 3], Unit> = if log_path.exists() {
-        read_log(&log_path, &job, &meta)?
-    } else if in_place || holds_nothing(store)? {
-        // A new store, or one killed before its log existed: the log first, whole, so
-        // that from here on any interruption can be resumed.
-        start_log(&log_path, &job)?;
-        HashMap::new()
-    } else {
-        return Err(StoreError::invalid(
-            store,
-            "already exists and holds no interrupted conversion: name a new store (arbvis never overwrites one)",
-        ));
-    };
+    let (_lock, beside, mut done) = open_store(store, &meta, &plan, o, &log_path)?;
     let storage = Arc::new(FilesystemStore::new(store).map_err(|e| StoreError::io(store, e))?);
     // Every zarr.json, written whole (again on a resume: a kill may have cut one).
-    let has_cdp = src.has_coordinates();
-    // A resumed conversion keeps the `createdOn` its first run wrote.
-    let created_on = super::zarr::read_json(&store.join("zarr.json"))
-        .ok()
-        .and_then(|root| root["attributes"]["createdOn"].as_str().map(str::to_string))
-        .unwrap_or_else(layout::created_now);
-    let options = layout::LayoutOptions {
-        compression: o.compression,
-        has_cdp,
-        created_on,
-    };
+    let options = layout_options(store, o, plan.src.has_coordinates());
     let writers = layout::write_layout(&storage, store, &meta, &options, None, beside.as_ref())?;
     let log = Log {
         file: Mutex::new(
@@ -329,53 +228,9 @@ fn convert_on_workers(
         stop_after: o.stop_after,
         bytes: AtomicU64::new(0),
     };
-    // Level 0 from the input, in quads of 2 x 2 columns: each quad also gives its level-1
-    // column, filtered in memory.
-    let counts = meta.brick_counts(0);
-    let (quads_j, quads_k) = (counts[1].div_ceil(2), counts[2].div_ceil(2));
-    let mut quads: Vec<[usize; 2]> = (0..quads_k)
-        .flat_map(|k| (0..quads_j).map(move |j| [j, k]))
-        .collect();
-    let columns = (0..counts[2])
-        .flat_map(|k| (0..counts[1]).map(move |j| [0, j, k]))
-        .filter(|u| !done.contains_key(u))
-        .count();
-    // An MDIO input's chunks span several columns: convert those columns one after the
-    // other (in tiles of quads), so each chunk is decoded about once.
-    if let Input::Mdio(m, _) = &src {
-        let t = m.tile(b).div_ceil(2);
-        quads.sort_by_key(|q| (q[1] / t, q[0] / t, q[1] % t, q[0] % t));
-    }
-    let bar = progress_bar(
-        o.progress,
-        (columns * b * b) as u64 * src.bytes_per_trace(),
-        &format!("converting {} (level 0)", input.display()),
-    );
-    let new: Vec<Vec<Unit>> = quads
-        .par_iter()
-        .map(|&q| ctx.quad(&src, q, &done, bar.as_ref()))
-        .collect::<Result<_, _>>()?;
-    if let Some(bar) = bar {
-        bar.finish_and_clear();
-    }
+    let new = level_zero(&ctx, &plan.src, &done, input, o)?;
     done.extend(new.into_iter().flatten().map(|u| (u.u, u)));
-    // Levels above, each from the one below (read back through a reader).
-    let reader = Store::open_incomplete(store, meta.clone())?;
-    for level in 1..levels {
-        let counts = meta.brick_counts(level);
-        let units: Vec<[usize; 3]> = (0..counts[2])
-            .flat_map(|k| (0..counts[1]).map(move |j| [level, j, k]))
-            .filter(|u| !done.contains_key(u))
-            .collect();
-        let new: Vec<Unit> = units
-            .par_iter()
-            .map(|&u| {
-                let unit = ctx.upper(&reader, u)?;
-                ctx.finish(unit)
-            })
-            .collect::<Result<_, _>>()?;
-        done.extend(new.into_iter().map(|u| (u.u, u)));
-    }
+    upper_levels(&ctx, &mut done)?;
     let meta = finish_store(
         &storage,
         store,
@@ -392,6 +247,237 @@ fn convert_on_workers(
         seconds: start.elapsed().as_secs_f64(),
         meta,
     })
+}
+
+/// The attributes written: amplitude, then each derived one asked for, once.
+fn attributes_of(o: &ConvertOptions) -> Vec<Attribute> {
+    let mut attributes = vec![Attribute::Amplitude];
+    for &a in &o.derived {
+        if !attributes.contains(&a) {
+            attributes.push(a);
+        }
+    }
+    attributes
+}
+
+/// A conversion's input and what follows from it, checked against the budget and the
+/// work it implies before anything is written.
+struct Plan {
+    src: Input,
+    levels: usize,
+    /// An MDIO dataset converted into itself: levels and ranges beside its own arrays.
+    in_place: bool,
+    /// The MDIO variable that is level 0 of amplitude, in place.
+    source_variable: Option<String>,
+    job: Job,
+}
+
+impl Plan {
+    /// Open `input` for `store`.
+    fn new(
+        input: &Path,
+        store: &Path,
+        o: &ConvertOptions,
+        attributes: &[Attribute],
+    ) -> Result<Plan, StoreError> {
+        let src = Input::open(input, o.raw.as_ref(), o.segy_keys)?;
+        let dims = src.dims();
+        let b = o.brick;
+        let levels = super::level_count(dims, b);
+        let in_place = matches!(src, Input::Mdio(..))
+            && std::fs::canonicalize(input).ok() == std::fs::canonicalize(store).ok();
+        if in_place && matches!(&src, Input::Mdio(_, m) if m.source_variable.is_none()) {
+            return Err(StoreError::invalid(
+                input,
+                "a zarr v2 dataset (MDIO v0, or v1 written with zarr format 2) cannot gain zarr v3 levels in place: convert it into a store of its own (arbvis convert DATASET STORE)",
+            ));
+        }
+        let (identity, source_variable) = match &src {
+            Input::Mdio(m, meta) => (
+                m.data.metadata_file(),
+                meta.source_variable.clone().filter(|_| in_place),
+            ),
+            _ => (input.to_path_buf(), None),
+        };
+        let job = job_of(input, &identity, o, attributes)?;
+        let workers = rayon::current_num_threads().max(1);
+        let bound = memory_bound(dims[0], b, attributes.len(), workers)
+            + match &src {
+                Input::Mdio(m, _) => m.cache_bytes(),
+                _ => 0,
+            };
+        crate::budget::check(
+            format!(
+                "converting {} ({} samples per trace, {b}³ bricks, {} attributes, {workers} workers)",
+                input.display(),
+                dims[0],
+                attributes.len()
+            ),
+            bound,
+        )
+        .map_err(|e| StoreError::Budget(e.to_string()))?;
+        check_work(input, &src, dims, b, attributes.len())?;
+        Ok(Plan {
+            src,
+            levels,
+            in_place,
+            source_variable,
+            job,
+        })
+    }
+
+    /// The store's metadata, incomplete (no statistics yet).
+    fn meta(&self, o: &ConvertOptions, attributes: &[Attribute]) -> StoreMeta {
+        let src = &self.src;
+        StoreMeta {
+            format: FORMAT.into(),
+            version: VERSION,
+            dims: src.dims(),
+            spacing: src.spacing(),
+            brick: o.brick,
+            levels: self.levels,
+            filter: "box: the mean of each 2x2x2 cell (of the voxels present at a far face of odd size); phase: the cell's first voxel".into(),
+            attributes: attributes
+                .iter()
+                .map(|&a| AttributeMeta {
+                    name: a.name().into(),
+                    dtype: dtype(a).into(),
+                    min: None,
+                    max: None,
+                    mean: None,
+                    non_finite: 0,
+                })
+                .collect(),
+            source: src.source_meta(),
+            compression: o.compression.to_string(),
+            complete: false,
+            source_variable: self.source_variable.clone(),
+        }
+    }
+}
+
+/// What [`open_store`] returns: the lock held while converting, an MDIO dataset's root
+/// attributes (in place), and the units already written.
+type Opened = (
+    StoreLock,
+    Option<serde_json::Map<String, serde_json::Value>>,
+    HashMap<[usize; 3], Unit>,
+);
+
+/// The store folder, made (with room on its disk) and locked, and the units done: read
+/// from the progress log at `log_path` when resuming; else the log started, in a new
+/// store (or in place).
+fn open_store(
+    store: &Path,
+    meta: &StoreMeta,
+    plan: &Plan,
+    o: &ConvertOptions,
+    log_path: &Path,
+) -> Result<Opened, StoreError> {
+    if store.exists() && !store.is_dir() {
+        return Err(StoreError::invalid(
+            store,
+            "exists and is not a folder: name a new store",
+        ));
+    }
+    std::fs::create_dir_all(store).map_err(|e| StoreError::io(store, e))?;
+    check_disk(store, meta, usize::from(plan.in_place), o.progress)?;
+    let lock = StoreLock::acquire(store)?;
+    let beside = if plan.in_place {
+        Some(mdio_root_attributes(store)?)
+    } else {
+        None
+    };
+    let done = if log_path.exists() {
+        read_log(log_path, &plan.job, meta)?
+    } else if plan.in_place || holds_nothing(store)? {
+        // A new store, or one killed before its log existed: the log first, whole, so
+        // that from here on any interruption can be resumed.
+        start_log(log_path, &plan.job)?;
+        HashMap::new()
+    } else {
+        return Err(StoreError::invalid(
+            store,
+            "already exists and holds no interrupted conversion: name a new store (arbvis never overwrites one)",
+        ));
+    };
+    Ok((lock, beside, done))
+}
+
+/// The layout's options; a resumed conversion keeps the `createdOn` its first run wrote.
+fn layout_options(store: &Path, o: &ConvertOptions, has_cdp: bool) -> layout::LayoutOptions {
+    let created_on = super::zarr::read_json(&store.join("zarr.json"))
+        .ok()
+        .and_then(|root| root["attributes"]["createdOn"].as_str().map(str::to_string))
+        .unwrap_or_else(layout::created_now);
+    layout::LayoutOptions {
+        compression: o.compression,
+        has_cdp,
+        created_on,
+    }
+}
+
+/// Level 0 from the input, in quads of 2 x 2 columns (those not `done`): each quad also
+/// gives its level-1 column, filtered in memory.
+fn level_zero(
+    ctx: &Ctx,
+    src: &Input,
+    done: &HashMap<[usize; 3], Unit>,
+    input: &Path,
+    o: &ConvertOptions,
+) -> Result<Vec<Vec<Unit>>, StoreError> {
+    let b = o.brick;
+    let counts = ctx.meta.brick_counts(0);
+    let (quads_j, quads_k) = (counts[1].div_ceil(2), counts[2].div_ceil(2));
+    let mut quads: Vec<[usize; 2]> = (0..quads_k)
+        .flat_map(|k| (0..quads_j).map(move |j| [j, k]))
+        .collect();
+    let columns = (0..counts[2])
+        .flat_map(|k| (0..counts[1]).map(move |j| [0, j, k]))
+        .filter(|u| !done.contains_key(u))
+        .count();
+    // An MDIO input's chunks span several columns: convert those columns one after the
+    // other (in tiles of quads), so each chunk is decoded about once.
+    if let Input::Mdio(m, _) = src {
+        let t = m.tile(b).div_ceil(2);
+        quads.sort_by_key(|q| (q[1] / t, q[0] / t, q[1] % t, q[0] % t));
+    }
+    let bar = progress_bar(
+        o.progress,
+        (columns * b * b) as u64 * src.bytes_per_trace(),
+        &format!("converting {} (level 0)", input.display()),
+    );
+    let new: Vec<Vec<Unit>> = quads
+        .par_iter()
+        .map(|&q| ctx.quad(src, q, done, bar.as_ref()))
+        .collect::<Result<_, _>>()?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    Ok(new)
+}
+
+/// The levels above 0, each from the one below (read back through a reader): the units
+/// not `done` yet (most of level 1 comes with its quads); each one written is added.
+fn upper_levels(ctx: &Ctx, done: &mut HashMap<[usize; 3], Unit>) -> Result<(), StoreError> {
+    let meta = ctx.meta;
+    let reader = Store::open_incomplete(ctx.store, meta.clone())?;
+    for level in 1..meta.levels {
+        let counts = meta.brick_counts(level);
+        let units: Vec<[usize; 3]> = (0..counts[2])
+            .flat_map(|k| (0..counts[1]).map(move |j| [level, j, k]))
+            .filter(|u| !done.contains_key(u))
+            .collect();
+        let new: Vec<Unit> = units
+            .par_iter()
+            .map(|&u| {
+                let unit = ctx.upper(&reader, u)?;
+                ctx.finish(unit)
+            })
+            .collect::<Result<_, _>>()?;
+        done.extend(new.into_iter().map(|u| (u.u, u)));
+    }
+    Ok(())
 }
 
 /// Bytes the store's chunks can take before compression: every brick of every attribute

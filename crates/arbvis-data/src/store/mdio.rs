@@ -399,26 +399,7 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
     } = parts;
     let vfile = data.metadata_file();
     let domain = names.get(2).cloned().unwrap_or_default();
-    let post_stack = data.shape.len() == 3
-        && names.len() == 3
-        && matches!(domain.as_str(), "time" | "depth" | "sample");
-    if !post_stack {
-        return Err(StoreError::invalid(
-            &vfile,
-            format!(
-                "{variable} has dimensions {names:?}: arbvis draws post-stack 3D variables (inline, crossline, time or depth); a pre-stack or 2D dataset is not drawn"
-            ),
-        ));
-    }
-    let [nk, nj, ni] = [data.shape[0], data.shape[1], data.shape[2]].map(|n| n as usize);
-    for (n, name) in [(ni, &names[2]), (nj, &names[1]), (nk, &names[0])] {
-        if n == 0 || n > super::check::MAX_SIDE {
-            return Err(StoreError::invalid(
-                &vfile,
-                format!("{name}: {n} values: must be 1..={}", super::check::MAX_SIDE),
-            ));
-        }
-    }
+    let [ni, nj, nk] = post_stack_dims(&vfile, &variable, &names, &data.shape)?;
     for (values, n, name) in [
         (&coordinates[0], nk, &names[0]),
         (&coordinates[1], nj, &names[1]),
@@ -452,33 +433,7 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
             format!("{} of {}", l.len() - dead, l.len()),
         );
     }
-    let samples = &coordinates[2];
-    let interval_us = match (samples, domain.as_str()) {
-        (Some(t), "time" | "sample") if t.len() > 1 => {
-            Some(((t[1] - t[0]) * 1000.0).round().max(0.0) as u32)
-        }
-        _ => None,
-    };
-    if let Some(d) = samples {
-        if domain == "depth" {
-            facts.insert("depth".into(), format!("{} .. {} m", d[0], d[d.len() - 1]));
-        }
-    }
-    // The sample axis as the dataset numbers it: its first value and domain.
-    let sample_axis = samples
-        .as_deref()
-        .filter(|d| !d.is_empty())
-        .map(|d| SampleAxis {
-            domain: domain.clone(),
-            unit: match domain.as_str() {
-                "time" => "ms",
-                "depth" => "m",
-                _ => "",
-            }
-            .into(),
-            first: d[0],
-            step: if d.len() > 1 { d[1] - d[0] } else { 1.0 },
-        });
+    let (interval_us, sample_axis) = sample_axis(coordinates[2].as_deref(), &domain, &mut facts);
     let meta = StoreMeta {
         format: format!("MDIO v{}", api.split('.').next().unwrap_or("1")),
         version: 1,
@@ -509,19 +464,8 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
         complete: true,
         source_variable: in_place.then(|| variable.clone()),
     };
-    let bricks = super::brick_counts(meta.dims, BRICK)
-        .iter()
-        .try_fold(1u64, |n, &c| n.checked_mul(c as u64))
-        .filter(|&n| n <= super::check::MAX_BRICKS_PER_LEVEL);
-    if bricks.is_none() {
-        return Err(StoreError::invalid(
-            &vfile,
-            format!("{:?} samples: more bricks than arbvis draws", meta.dims),
-        ));
-    }
-    let along = data.shape[2].div_ceil(data.chunks[2]) as usize;
-    let chunk_bytes = (data.chunk_elements() * 4).max(1) as u64;
-    let capacity = (4 * along).clamp(8, (CHUNK_CACHE_BYTES / chunk_bytes).max(8) as usize);
+    check_bricks(&vfile, meta.dims)?;
+    let capacity = cache_capacity(&data);
     Ok((
         meta,
         Mdio {
@@ -533,6 +477,93 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
             capacity,
         },
     ))
+}
+
+/// The sides (samples, crosslines, inlines) of a post-stack 3D variable (dimensions
+/// inline, crossline and time, depth or sample), each 1 to [`super::check::MAX_SIDE`].
+fn post_stack_dims(
+    vfile: &Path,
+    variable: &str,
+    names: &[String],
+    shape: &[u64],
+) -> Result<[usize; 3], StoreError> {
+    let domain = names.get(2).map_or("", String::as_str);
+    let post_stack =
+        shape.len() == 3 && names.len() == 3 && matches!(domain, "time" | "depth" | "sample");
+    if !post_stack {
+        return Err(StoreError::invalid(
+            vfile,
+            format!(
+                "{variable} has dimensions {names:?}: arbvis draws post-stack 3D variables (inline, crossline, time or depth); a pre-stack or 2D dataset is not drawn"
+            ),
+        ));
+    }
+    let [nk, nj, ni] = [shape[0], shape[1], shape[2]].map(|n| n as usize);
+    for (n, name) in [(ni, &names[2]), (nj, &names[1]), (nk, &names[0])] {
+        if n == 0 || n > super::check::MAX_SIDE {
+            return Err(StoreError::invalid(
+                vfile,
+                format!("{name}: {n} values: must be 1..={}", super::check::MAX_SIDE),
+            ));
+        }
+    }
+    Ok([ni, nj, nk])
+}
+
+/// The sample interval in µs (time or sample axes) and the sample axis as the dataset
+/// numbers it (its first value, step and domain); a depth axis's range goes into
+/// `facts`.
+fn sample_axis(
+    samples: Option<&[f64]>,
+    domain: &str,
+    facts: &mut BTreeMap<String, String>,
+) -> (Option<u32>, Option<SampleAxis>) {
+    let interval_us = match (samples, domain) {
+        (Some(t), "time" | "sample") if t.len() > 1 => {
+            Some(((t[1] - t[0]) * 1000.0).round().max(0.0) as u32)
+        }
+        _ => None,
+    };
+    if let Some(d) = samples {
+        if domain == "depth" {
+            facts.insert("depth".into(), format!("{} .. {} m", d[0], d[d.len() - 1]));
+        }
+    }
+    let axis = samples.filter(|d| !d.is_empty()).map(|d| SampleAxis {
+        domain: domain.to_string(),
+        unit: match domain {
+            "time" => "ms",
+            "depth" => "m",
+            _ => "",
+        }
+        .into(),
+        first: d[0],
+        step: if d.len() > 1 { d[1] - d[0] } else { 1.0 },
+    });
+    (interval_us, axis)
+}
+
+/// A survey of `dims` samples must make no more bricks than arbvis draws.
+fn check_bricks(vfile: &Path, dims: [usize; 3]) -> Result<(), StoreError> {
+    let bricks = super::brick_counts(dims, BRICK)
+        .iter()
+        .try_fold(1u64, |n, &c| n.checked_mul(c as u64))
+        .filter(|&n| n <= super::check::MAX_BRICKS_PER_LEVEL);
+    if bricks.is_none() {
+        return Err(StoreError::invalid(
+            vfile,
+            format!("{dims:?} samples: more bricks than arbvis draws"),
+        ));
+    }
+    Ok(())
+}
+
+/// Chunks the variable's cache holds: four rows of chunks along the samples, at least 8,
+/// within [`CHUNK_CACHE_BYTES`].
+fn cache_capacity(data: &ArrayMeta) -> usize {
+    let along = data.shape[2].div_ceil(data.chunks[2]) as usize;
+    let chunk_bytes = (data.chunk_elements() * 4).max(1) as u64;
+    (4 * along).clamp(8, (CHUNK_CACHE_BYTES / chunk_bytes).max(8) as usize)
 }
 
 /// A dimension coordinate as the axes will number it: present (MDIO writes one per

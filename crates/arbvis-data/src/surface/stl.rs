@@ -197,25 +197,10 @@ impl<'a> Words<'a> {
     }
 }
 
+/// An ASCII STL: `solid NAME`, facets (`facet normal X Y Z`, `outer loop`, 3 or more
+/// `vertex X Y Z`, `endloop`, `endfacet`), `endsolid`; one solid or more.
 fn ascii(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
     let text = super::utf8(name, bytes)?;
-    let mut words = Words {
-        text,
-        at: 0,
-        line: 1,
-        line_start: 0,
-        counted: (0, 0),
-    };
-    let err = |w: &Word, message: String| {
-        SurfaceError::format(
-            name,
-            Position::Line {
-                line: w.line,
-                column: w.column,
-            },
-            message,
-        )
-    };
     // Each corner takes at least `vertex 0 0 0` (14 bytes): the budget holds for the
     // corners the text can hold.
     crate::budget::check(
@@ -225,45 +210,80 @@ fn ascii(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
     .map_err(|e| {
         SurfaceError::format(name, Position::Line { line: 1, column: 1 }, e.to_string())
     })?;
-    let mut corners: Vec<[f64; 3]> = Vec::new();
-    let mut sizes: Vec<u32> = Vec::new();
-    // Expect one keyword; at the end of the text, name the end.
-    macro_rules! expect {
-        ($kw:expr) => {{
-            match words.next() {
-                Some(w) if w.text.eq_ignore_ascii_case($kw) => w,
-                Some(w) => {
-                    return Err(err(
-                        &w,
-                        format!(
-                            "expected `{}`, found {:?}",
-                            $kw,
-                            crate::input::shorten(w.text, 40)
-                        ),
-                    ))
-                }
-                None => {
-                    return Err(SurfaceError::format(
-                        name,
-                        words.position(),
-                        format!("the file ends where `{}` was expected", $kw),
-                    ))
-                }
-            }
-        }};
+    let mut r = Ascii {
+        name,
+        words: Words {
+            text,
+            at: 0,
+            line: 1,
+            line_start: 0,
+            counted: (0, 0),
+        },
+        corners: Vec::new(),
+        sizes: Vec::new(),
+    };
+    while r.solid()? {}
+    if r.sizes.is_empty() {
+        return Err(SurfaceError::format(
+            name,
+            r.words.position(),
+            "no facets in the ASCII STL",
+        ));
     }
-    let number = |words: &mut Words, what: &str| -> Result<f64, SurfaceError> {
-        let Some(w) = words.next() else {
-            return Err(SurfaceError::format(
-                name,
-                words.position(),
-                format!("the file ends where {what} was expected"),
-            ));
+    indexed(name, r.corners, &r.sizes)
+}
+
+/// An ASCII STL being read: the facets' corners and their counts so far.
+struct Ascii<'a> {
+    name: &'a Path,
+    words: Words<'a>,
+    corners: Vec<[f64; 3]>,
+    sizes: Vec<u32>,
+}
+
+impl<'a> Ascii<'a> {
+    /// An error at word `w`.
+    fn err(&self, w: &Word, message: String) -> SurfaceError {
+        SurfaceError::format(
+            self.name,
+            Position::Line {
+                line: w.line,
+                column: w.column,
+            },
+            message,
+        )
+    }
+
+    /// An error where the words stopped (the end of the file).
+    fn at_end(&mut self, message: impl Into<String>) -> SurfaceError {
+        SurfaceError::format(self.name, self.words.position(), message)
+    }
+
+    /// The next word, which must be the keyword `kw` (any case).
+    fn expect(&mut self, kw: &str) -> Result<Word<'a>, SurfaceError> {
+        match self.words.next() {
+            Some(w) if w.text.eq_ignore_ascii_case(kw) => Ok(w),
+            Some(w) => Err(self.err(
+                &w,
+                format!(
+                    "expected `{}`, found {:?}",
+                    kw,
+                    crate::input::shorten(w.text, 40)
+                ),
+            )),
+            None => Err(self.at_end(format!("the file ends where `{kw}` was expected"))),
+        }
+    }
+
+    /// The next word, a finite number (`what` names it in errors).
+    fn number(&mut self, what: &str) -> Result<f64, SurfaceError> {
+        let Some(w) = self.words.next() else {
+            return Err(self.at_end(format!("the file ends where {what} was expected")));
         };
         match w.text.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
-            Ok(v) => Err(err(&w, format!("{what} {v} must be finite"))),
-            Err(_) => Err(err(
+            Ok(v) => Err(self.err(&w, format!("{what} {v} must be finite"))),
+            Err(_) => Err(self.err(
                 &w,
                 format!(
                     "expected {what} (a number), found {:?}",
@@ -271,13 +291,15 @@ fn ascii(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
                 ),
             )),
         }
-    };
-    loop {
-        match words.next() {
-            None => break,
-            Some(w) if w.text.eq_ignore_ascii_case("solid") => words.skip_line(),
+    }
+
+    /// A solid, its facets up to `endsolid`; false at the end of the file.
+    fn solid(&mut self) -> Result<bool, SurfaceError> {
+        match self.words.next() {
+            None => return Ok(false),
+            Some(w) if w.text.eq_ignore_ascii_case("solid") => self.words.skip_line(),
             Some(w) => {
-                return Err(err(
+                return Err(self.err(
                     &w,
                     format!(
                         "expected `solid`, found {:?}",
@@ -287,22 +309,17 @@ fn ascii(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
             }
         }
         loop {
-            let w = match words.next() {
-                Some(w) => w,
-                None => {
-                    return Err(SurfaceError::format(
-                        name,
-                        words.position(),
-                        "the file ends inside a solid: expected `facet` or `endsolid`",
-                    ))
-                }
+            let Some(w) = self.words.next() else {
+                return Err(
+                    self.at_end("the file ends inside a solid: expected `facet` or `endsolid`")
+                );
             };
             if w.text.eq_ignore_ascii_case("endsolid") {
-                words.skip_line();
-                break;
+                self.words.skip_line();
+                return Ok(true);
             }
             if !w.text.eq_ignore_ascii_case("facet") {
-                return Err(err(
+                return Err(self.err(
                     &w,
                     format!(
                         "expected `facet` or `endsolid`, found {:?}",
@@ -310,58 +327,55 @@ fn ascii(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
                     ),
                 ));
             }
-            expect!("normal");
-            for _ in 0..3 {
-                number(&mut words, "a normal component")?;
-            }
-            expect!("outer");
-            let loop_word = expect!("loop");
-            let first = corners.len();
-            loop {
-                let Some(w) = words.next() else {
-                    return Err(SurfaceError::format(
-                        name,
-                        words.position(),
-                        "the file ends inside a loop: expected `vertex` or `endloop`",
-                    ));
-                };
-                if w.text.eq_ignore_ascii_case("endloop") {
-                    break;
-                }
-                if !w.text.eq_ignore_ascii_case("vertex") {
-                    return Err(err(
-                        &w,
-                        format!(
-                            "expected `vertex` or `endloop`, found {:?}",
-                            crate::input::shorten(w.text, 40)
-                        ),
-                    ));
-                }
-                let mut p = [0.0; 3];
-                for c in &mut p {
-                    *c = number(&mut words, "a vertex coordinate")?;
-                }
-                corners.push(p);
-            }
-            let size = corners.len() - first;
-            if size < 3 {
-                return Err(err(
-                    &loop_word,
-                    format!("a loop needs 3 or more vertices, found {size}"),
-                ));
-            }
-            expect!("endfacet");
-            sizes.push(size as u32);
+            self.facet()?;
         }
     }
-    if sizes.is_empty() {
-        return Err(SurfaceError::format(
-            name,
-            words.position(),
-            "no facets in the ASCII STL",
-        ));
+
+    /// A facet after its `facet` keyword: the normal (read, unused), the loop of 3 or
+    /// more vertices, `endfacet`.
+    fn facet(&mut self) -> Result<(), SurfaceError> {
+        self.expect("normal")?;
+        for _ in 0..3 {
+            self.number("a normal component")?;
+        }
+        self.expect("outer")?;
+        let loop_word = self.expect("loop")?;
+        let first = self.corners.len();
+        loop {
+            let Some(w) = self.words.next() else {
+                return Err(
+                    self.at_end("the file ends inside a loop: expected `vertex` or `endloop`")
+                );
+            };
+            if w.text.eq_ignore_ascii_case("endloop") {
+                break;
+            }
+            if !w.text.eq_ignore_ascii_case("vertex") {
+                return Err(self.err(
+                    &w,
+                    format!(
+                        "expected `vertex` or `endloop`, found {:?}",
+                        crate::input::shorten(w.text, 40)
+                    ),
+                ));
+            }
+            let mut p = [0.0; 3];
+            for c in &mut p {
+                *c = self.number("a vertex coordinate")?;
+            }
+            self.corners.push(p);
+        }
+        let size = self.corners.len() - first;
+        if size < 3 {
+            return Err(self.err(
+                &loop_word,
+                format!("a loop needs 3 or more vertices, found {size}"),
+            ));
+        }
+        self.expect("endfacet")?;
+        self.sizes.push(size as u32);
+        Ok(())
     }
-    indexed(name, corners, &sizes)
 }
 
 /// Binary STL bytes for `triangles` (tests and fixtures).

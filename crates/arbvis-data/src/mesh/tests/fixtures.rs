@@ -307,13 +307,49 @@ fn b64(b: &[u8]) -> String {
 
 /// A `.vtu` file of the fixture mesh stored as `cfg` says.
 pub fn vtu(cfg: Vtu) -> Vec<u8> {
+    let mut appended = Vec::new();
+    let mut x = format!(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"{}\" header_type=\"{}\"{}>\n<UnstructuredGrid>\n<FieldData><DataArray type=\"Float64\" Name=\"TIME\" NumberOfTuples=\"1\" format=\"ascii\">0.5</DataArray></FieldData>\n<Piece NumberOfPoints=\"6\" NumberOfCells=\"5\">\n",
+        if cfg.big { "BigEndian" } else { "LittleEndian" },
+        if cfg.header64 { "UInt64" } else { "UInt32" },
+        if cfg.zlib { " compressor=\"vtkZLibDataCompressor\"" } else { "" }
+    );
+    let mut open = "";
+    for (section, a) in &vtu_arrays() {
+        if open != *section {
+            if !open.is_empty() {
+                x += &format!("</{open}>\n");
+            }
+            x += &format!("<{section}>\n");
+            open = section;
+        }
+        x += &vtu_array(a, &cfg, &mut appended);
+    }
+    x += &format!("</{open}>\n</Piece>\n</UnstructuredGrid>\n");
+    let mut b = x.into_bytes();
+    if matches!(cfg.data, VtuData::AppendedRaw | VtuData::AppendedBase64) {
+        let enc = if cfg.data == VtuData::AppendedRaw {
+            "raw"
+        } else {
+            "base64"
+        };
+        b.extend(format!("<AppendedData encoding=\"{enc}\">\n   _").bytes());
+        b.extend(appended);
+        b.extend(b"\n</AppendedData>\n");
+    }
+    b.extend(b"</VTKFile>\n");
+    b
+}
+
+/// The fixture mesh's arrays, each with its section.
+fn vtu_arrays() -> [(&'static str, Arr); 7] {
     let mut offsets = Vec::new();
     let mut o = 0.0;
     for c in CELLS {
         o += c.2.len() as f64;
         offsets.push(o);
     }
-    let arrays = [
+    [
         (
             "PointData",
             Arr {
@@ -380,84 +416,60 @@ pub fn vtu(cfg: Vtu) -> Vec<u8> {
                 values: CELLS.iter().map(|c| c.0 as f64).collect(),
             },
         ),
-    ];
-    let mut appended = Vec::new();
-    let mut x = format!(
-        "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"{}\" header_type=\"{}\"{}>\n<UnstructuredGrid>\n<FieldData><DataArray type=\"Float64\" Name=\"TIME\" NumberOfTuples=\"1\" format=\"ascii\">0.5</DataArray></FieldData>\n<Piece NumberOfPoints=\"6\" NumberOfCells=\"5\">\n",
-        if cfg.big { "BigEndian" } else { "LittleEndian" },
-        if cfg.header64 { "UInt64" } else { "UInt32" },
-        if cfg.zlib { " compressor=\"vtkZLibDataCompressor\"" } else { "" }
+    ]
+}
+
+/// One `DataArray` element stored as `cfg` says (its data added to `appended` when
+/// appended).
+fn vtu_array(a: &Arr, cfg: &Vtu, appended: &mut Vec<u8>) -> String {
+    let mut out = String::new();
+    let head = format!(
+        "<DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\"",
+        a.ty, a.name, a.comps
     );
-    let mut open = "";
-    for (section, a) in &arrays {
-        if open != *section {
-            if !open.is_empty() {
-                x += &format!("</{open}>\n");
-            }
-            x += &format!("<{section}>\n");
-            open = section;
-        }
-        let head = format!(
-            "<DataArray type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\"",
-            a.ty, a.name, a.comps
-        );
-        let bytes = encode_values(a, cfg.big);
-        let (h, d) = binary_parts(&bytes, &cfg);
-        let enc = |h: &[u8], d: &[u8]| {
-            if cfg.joint_base64 {
-                b64(&[h, d].concat())
-            } else {
-                b64(h) + &b64(d)
-            }
-        };
-        match cfg.data {
-            VtuData::Ascii => {
-                x += &format!(
-                    "{head} format=\"ascii\">\n  {}\n</DataArray>\n",
-                    join(&a.values)
-                );
-            }
-            VtuData::Base64 => {
-                let text = enc(&h, &d);
-                // Break the text over lines, as writers do.
-                let lines: Vec<&str> = text
-                    .as_bytes()
-                    .chunks(40)
-                    .map(|c| std::str::from_utf8(c).unwrap())
-                    .collect();
-                x += &format!(
-                    "{head} format=\"binary\">\n  {}\n</DataArray>\n",
-                    lines.join("\n  ")
-                );
-            }
-            VtuData::AppendedRaw | VtuData::AppendedBase64 => {
-                x += &format!(
-                    "{head} format=\"appended\" offset=\"{}\"/>\n",
-                    appended.len()
-                );
-                if cfg.data == VtuData::AppendedRaw {
-                    appended.extend(h);
-                    appended.extend(d);
-                } else {
-                    appended.extend(enc(&h, &d).bytes());
-                }
-            }
-        }
-    }
-    x += &format!("</{open}>\n</Piece>\n</UnstructuredGrid>\n");
-    let mut b = x.into_bytes();
-    if matches!(cfg.data, VtuData::AppendedRaw | VtuData::AppendedBase64) {
-        let enc = if cfg.data == VtuData::AppendedRaw {
-            "raw"
+    let bytes = encode_values(a, cfg.big);
+    let (h, d) = binary_parts(&bytes, cfg);
+    let enc = |h: &[u8], d: &[u8]| {
+        if cfg.joint_base64 {
+            b64(&[h, d].concat())
         } else {
-            "base64"
-        };
-        b.extend(format!("<AppendedData encoding=\"{enc}\">\n   _").bytes());
-        b.extend(appended);
-        b.extend(b"\n</AppendedData>\n");
+            b64(h) + &b64(d)
+        }
+    };
+    match cfg.data {
+        VtuData::Ascii => {
+            out += &format!(
+                "{head} format=\"ascii\">\n  {}\n</DataArray>\n",
+                join(&a.values)
+            );
+        }
+        VtuData::Base64 => {
+            let text = enc(&h, &d);
+            // Break the text over lines, as writers do.
+            let lines: Vec<&str> = text
+                .as_bytes()
+                .chunks(40)
+                .map(|c| std::str::from_utf8(c).unwrap())
+                .collect();
+            out += &format!(
+                "{head} format=\"binary\">\n  {}\n</DataArray>\n",
+                lines.join("\n  ")
+            );
+        }
+        VtuData::AppendedRaw | VtuData::AppendedBase64 => {
+            out += &format!(
+                "{head} format=\"appended\" offset=\"{}\"/>\n",
+                appended.len()
+            );
+            if cfg.data == VtuData::AppendedRaw {
+                appended.extend(h);
+                appended.extend(d);
+            } else {
+                appended.extend(enc(&h, &d).bytes());
+            }
+        }
     }
-    b.extend(b"</VTKFile>\n");
-    b
+    out
 }
 
 /// gmsh 2.2, ASCII or binary (little-endian).

@@ -3,7 +3,8 @@
 
 use std::path::Path;
 
-use super::header::{text_at, RawVlr};
+use super::layout::Vlr as RawVlr;
+use crate::le::text_at;
 use crate::points::PointsError;
 
 /// One extra-bytes attribute: where it is in the record and how to decode it.

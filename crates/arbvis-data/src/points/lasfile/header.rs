@@ -1,5 +1,5 @@
-//! What the LAS reader's parts share: the header facts ([`LasInfo`]), the raw VLRs found
-//! by the checks, the record sizes of the point formats and little-endian readers.
+//! What the LAS reader's parts share: the header facts ([`LasInfo`]) and the record
+//! sizes of the point formats.
 
 use crate::points::{decimals_for, fixed};
 
@@ -64,33 +64,3 @@ impl LasInfo {
 
 /// Bytes of a point record of each format, without extra bytes.
 pub(super) const RECORD_LENGTH: [u16; 11] = [20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67];
-
-/// A variable length record: where its data is in the file.
-pub(super) struct RawVlr {
-    pub(super) user_id: String,
-    pub(super) record_id: u16,
-    /// Byte offset of the record's header.
-    pub(super) at: usize,
-    /// Its data.
-    pub(super) data: std::ops::Range<usize>,
-}
-
-pub(super) fn u16_at(b: &[u8], at: usize) -> u16 {
-    u16::from_le_bytes([b[at], b[at + 1]])
-}
-pub(super) fn u32_at(b: &[u8], at: usize) -> u32 {
-    u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
-}
-pub(super) fn u64_at(b: &[u8], at: usize) -> u64 {
-    let mut a = [0u8; 8];
-    a.copy_from_slice(&b[at..at + 8]);
-    u64::from_le_bytes(a)
-}
-pub(super) fn f64_at(b: &[u8], at: usize) -> f64 {
-    f64::from_bits(u64_at(b, at))
-}
-pub(super) fn text_at(b: &[u8], range: std::ops::Range<usize>) -> String {
-    let s = &b[range];
-    let end = s.iter().position(|&c| c == 0).unwrap_or(s.len());
-    String::from_utf8_lossy(&s[..end]).trim().to_string()
-}

@@ -17,8 +17,10 @@ use std::sync::Arc;
 use las::{PointData, PointDataBuilder, Reader};
 
 use super::check::{check_count, check_head, check_up_to, Checked};
-use super::header::{u32_at, LasInfo, RawVlr};
+use super::header::LasInfo;
+use super::layout::Vlr as RawVlr;
 use super::laz_chunks::{Decoded, LazChunks};
+use crate::le::u32_at;
 use crate::points::{guarded, read_file, PointsError};
 
 /// Bytes of header and VLRs read before the points of an uncompressed file, at most.

@@ -1,5 +1,5 @@
-use super::header::{u32_at, u64_at};
 use super::*;
+use crate::le::{u32_at, u64_at};
 use las::point::{Classification, Format};
 use las::{Builder, Color, Point, Transform, Vector, Vlr, Writer};
 
