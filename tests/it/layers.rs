@@ -31,7 +31,9 @@ const LAYERS: &[(&str, &[&str])] = &[
     ),
     (
         "data and GL",
-        &["volume", "store", "mesh", "points", "surface", "gl"],
+        &[
+            "le", "sniff", "volume", "store", "mesh", "points", "surface", "gl",
+        ],
     ),
     ("program texts", &["programs"]),
     ("techniques", &["techniques"]),

@@ -62,7 +62,7 @@ pub fn point_format(path: &Path, head: &[u8]) -> Format {
         .extension()
         .map(|e| e.to_string_lossy().to_lowercase())
         .unwrap_or_default();
-    if crate::points::copc::is_copc(head) {
+    if is_copc(head) {
         Format::Copc
     } else if head.starts_with(b"LASF") || ext == "las" || ext == "laz" {
         Format::Las
@@ -93,4 +93,16 @@ fn looks_like_segy(head: &[u8]) -> bool {
     ]
     .iter()
     .any(|&c| crate::volume::segy::SampleFormat::from_code(c).is_some())
+}
+
+/// Whether `head` (a file's first bytes) is a COPC file's: LAS 1.4 whose first VLR is
+/// `copc` record 1.
+pub fn is_copc(head: &[u8]) -> bool {
+    use crate::points::lasfile::layout::{HEADER_14 as HEADER, VLR_HEADER};
+    head.len() >= HEADER + VLR_HEADER as usize
+        && head.starts_with(b"LASF")
+        && head[24..26] == [1, 4]
+        && &head[HEADER + 2..HEADER + 6] == b"copc"
+        && head[HEADER + 6..HEADER + 18].iter().all(|&b| b == 0)
+        && u16::from_le_bytes([head[HEADER + 18], head[HEADER + 19]]) == 1
 }

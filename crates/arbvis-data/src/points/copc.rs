@@ -27,7 +27,6 @@ use laz::record::{LayeredPointRecordDecompressor, RecordDecompressor};
 use super::copc_hierarchy::Hierarchy;
 pub use super::copc_hierarchy::Node;
 use super::guarded;
-use super::lasfile::layout::{HEADER_14, VLR_HEADER};
 use super::PointsError;
 use crate::le::u32_at;
 
@@ -97,17 +96,7 @@ pub struct OctreeInfo {
     pub gps_range: [f64; 2],
 }
 
-/// Whether `head` (a file's first bytes) is a COPC file's: LAS 1.4 whose first VLR is
-/// `copc` record 1.
-pub fn is_copc(head: &[u8]) -> bool {
-    const HEADER: usize = HEADER_14;
-    head.len() >= HEADER + VLR_HEADER as usize
-        && head.starts_with(b"LASF")
-        && head[24..26] == [1, 4]
-        && &head[HEADER + 2..HEADER + 6] == b"copc"
-        && head[HEADER + 6..HEADER + 18].iter().all(|&b| b == 0)
-        && u16::from_le_bytes([head[HEADER + 18], head[HEADER + 19]]) == 1
-}
+pub use crate::sniff::is_copc;
 
 /// Fill `buf` from byte `at` of `file`.
 fn read_at(file: &mut (impl Read + Seek), at: u64, buf: &mut [u8]) -> std::io::Result<()> {
