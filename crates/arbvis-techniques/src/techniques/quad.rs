@@ -17,6 +17,11 @@ use crate::gl::{self, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKi
 use crate::image::Image;
 use crate::programs;
 
+/// The program local of the left edge's colour (`program.local[0]`).
+pub const LEFT_LOCAL: usize = 0;
+/// The program local of the right edge's colour (`program.local[1]`).
+pub const RIGHT_LOCAL: usize = 1;
+
 /// Parameters of the quad demo.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -123,8 +128,8 @@ impl QuadRenderer {
         {
             return Err(GlError::Invalid("quad colours must be finite".into()));
         }
-        self.program.set_local(gpu, 0, params.left)?;
-        self.program.set_local(gpu, 1, params.right)
+        self.program.set_local(gpu, LEFT_LOCAL, params.left)?;
+        self.program.set_local(gpu, RIGHT_LOCAL, params.right)
     }
 }
 

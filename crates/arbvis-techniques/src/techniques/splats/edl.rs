@@ -9,6 +9,7 @@
 
 use glam::{DMat4, DVec4};
 
+use super::locals;
 use crate::gl::{
     self, Blend, DrawCall, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind, Surface, Target,
     TargetFormat,
@@ -99,9 +100,13 @@ impl EdlPass {
             Surface::Target(_) => [0.0, 0.0],
             Surface::Window([x, y, _, _]) => [x as f64, y as f64],
         };
-        self.shade.set_local(gpu, 0, [strength, RADIUS, 0.0, 0.0])?;
         self.shade
-            .set_local(gpu, 1, [origin[0], origin[1], 0.0, 0.0])?;
+            .set_local(gpu, locals::EDL_SHADING, [strength, RADIUS, 0.0, 0.0])?;
+        self.shade.set_local(
+            gpu,
+            locals::SURFACE_ORIGIN,
+            [origin[0], origin[1], 0.0, 0.0],
+        )?;
         gl::draw(
             gpu,
             surface,

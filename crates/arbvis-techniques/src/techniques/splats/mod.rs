@@ -38,6 +38,7 @@
 //! describes; [`reference`](mod@reference)'s doc gives the details and the precise versions.
 
 pub mod edl;
+pub mod locals;
 pub mod normals;
 pub mod oit;
 pub mod prepare;

@@ -27,6 +27,7 @@
 
 use glam::{DMat4, DVec4};
 
+use super::locals;
 use super::reference::OitWeight;
 use crate::camera::{Camera, Projection};
 use crate::gl::{
@@ -97,9 +98,9 @@ impl OitPass {
             primitive: Primitive::Points,
             ..DrawCall::new(program, mesh)
         };
-        program.set_local(gpu, 5, [1.0, 0.0, 0.0, 0.0])?;
+        program.set_local(gpu, locals::OIT_ACCUMULATE, [1.0, 0.0, 0.0, 0.0])?;
         let drawn = gl::draw(gpu, Surface::Target(&self.accum), &splats(Blend::Add));
-        program.set_local(gpu, 5, [0.0; 4])?;
+        program.set_local(gpu, locals::OIT_ACCUMULATE, [0.0; 4])?;
         drawn?;
         gl::draw(gpu, Surface::Target(&self.reveal), &splats(Blend::Reveal))?;
         gl::draw(

@@ -21,6 +21,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use super::edl::{EdlPass, EdlView};
+use super::locals;
 use super::oit::{z_row, OitPass};
 use super::prepare::{
     from_cloud, normals_for, point_size_for_spacing, prepare_for, Prepared, COLOR_A, COLOR_B,
@@ -657,17 +658,29 @@ impl SplatsRenderer {
         let volume = if p.mode == Mode::Volume { 1.0 } else { 0.0 };
         let [lo, hi] = self.prepared.range;
         let prog = &self.program;
-        prog.set_local(gpu, 0, [colour, lo, hi, volume])?;
-        prog.set_local(gpu, 1, [COLOR_A[0], COLOR_A[1], COLOR_A[2], 1.0])?;
-        prog.set_local(gpu, 2, [COLOR_B[0], COLOR_B[1], COLOR_B[2], 1.0])?;
+        prog.set_local(gpu, locals::COLOURING, [colour, lo, hi, volume])?;
+        prog.set_local(
+            gpu,
+            locals::GRADIENT_FROM,
+            [COLOR_A[0], COLOR_A[1], COLOR_A[2], 1.0],
+        )?;
+        prog.set_local(
+            gpu,
+            locals::GRADIENT_TO,
+            [COLOR_B[0], COLOR_B[1], COLOR_B[2], 1.0],
+        )?;
         let kernel = if p.kernel == Kernel::Gaussian {
             1.0
         } else {
             0.0
         };
-        prog.set_local(gpu, 3, [kernel, p.gauss_width, 0.0, 0.0])?;
-        prog.set_local(gpu, 4, [p.volume.threshold, p.volume.range, 0.0, 0.0])?;
-        prog.set_local(gpu, 5, [0.0; 4])?;
+        prog.set_local(gpu, locals::KERNEL, [kernel, p.gauss_width, 0.0, 0.0])?;
+        prog.set_local(
+            gpu,
+            locals::TRANSFER,
+            [p.volume.threshold, p.volume.range, 0.0, 0.0],
+        )?;
+        prog.set_local(gpu, locals::OIT_ACCUMULATE, [0.0; 4])?;
         let lighting = if p.lighting && p.mode == Mode::Surface {
             1.0
         } else {

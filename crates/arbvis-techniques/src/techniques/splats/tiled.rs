@@ -6,6 +6,7 @@
 
 use glam::DMat4;
 
+use super::locals;
 use super::tiles::TileLists;
 use crate::gl::{
     self, Blend, DrawCall, Extent, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface,
@@ -178,8 +179,11 @@ impl TilePass {
             Surface::Target(_) => [0, 0],
             Surface::Window([x, y, _, _]) => [x, y],
         };
-        self.program
-            .set_local(gpu, 1, [origin[0] as f64, origin[1] as f64, 0.0, 0.0])?;
+        self.program.set_local(
+            gpu,
+            locals::SURFACE_ORIGIN,
+            [origin[0] as f64, origin[1] as f64, 0.0, 0.0],
+        )?;
         gl::draw(
             gpu,
             surface,
