@@ -81,6 +81,7 @@
 //! data range (nothing drawn).
 
 pub mod indices;
+pub mod locals;
 pub mod order;
 pub mod preint;
 pub mod prepare;

@@ -13,6 +13,7 @@ use crate::gl::{
     ProgramText, Surface, TexelData, TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
+use crate::techniques::cellproj::locals;
 
 use crate::techniques::{Frame, Params, Renderer};
 use crate::vocab::{Fidelity, Interpolation};
@@ -407,26 +408,28 @@ impl Renderer for CellprojRenderer {
                 // The seed's Cg assumes a perspective eye; for a parallel view the eye
                 // goes 10^6 box units back, so `vertex - EyePos` is the view direction.
                 let eye = if perspective { eye } else { -dir * 1.0e6 };
-                program.set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, 1.0])?
+                program.set_vertex_local(gpu, locals::EYE, [eye.x, eye.y, eye.z, 1.0])?
             }
-            Variant::PerVertex => program.set_vertex_local(gpu, 4, [dir.x, dir.y, dir.z, 0.0])?,
+            Variant::PerVertex => {
+                program.set_vertex_local(gpu, locals::EYE, [dir.x, dir.y, dir.z, 0.0])?
+            }
             Variant::Precise => {
                 let t = mvp.transpose();
                 for (i, row) in [t.x_axis, t.y_axis, t.z_axis, t.w_axis].iter().enumerate() {
-                    program.set_local(gpu, i, row.to_array())?;
+                    program.set_local(gpu, locals::MVP_ROWS + i, row.to_array())?;
                 }
                 let w = if perspective { 1.0 } else { 0.0 };
-                program.set_local(gpu, 4, [eye.x, eye.y, eye.z, w])?;
-                program.set_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
+                program.set_local(gpu, locals::EYE, [eye.x, eye.y, eye.z, w])?;
+                program.set_local(gpu, locals::VIEW_DIRECTION, [dir.x, dir.y, dir.z, 0.0])?;
                 let on = if shading { 1.0 } else { 0.0 };
-                program.set_local(gpu, 6, [count, on, AMBIENT, 0.0])?;
+                program.set_local(gpu, locals::ISOSURFACES, [count, on, AMBIENT, 0.0])?;
                 // Each pixel's own ray: the inverse transform and window position to NDC.
                 let inv = mvp.inverse().transpose();
                 for (i, row) in [inv.x_axis, inv.y_axis, inv.z_axis, inv.w_axis]
                     .iter()
                     .enumerate()
                 {
-                    program.set_local(gpu, 7 + i, row.to_array())?;
+                    program.set_local(gpu, locals::INVERSE_MVP + i, row.to_array())?;
                 }
                 let [x, y, w, h] = surface.rect();
                 let (w, h) = (w.max(1.0), h.max(1.0));

@@ -52,6 +52,7 @@ use crate::gl::{
     Surface, TexelData, TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
+use crate::techniques::cellproj::locals;
 use crate::techniques::Frame;
 use crate::vocab::Fidelity;
 
@@ -582,18 +583,22 @@ impl VolumeRenderer {
         program.set_transform(gpu, mvp)?;
         if f.exact {
             let w = if perspective { 1.0 } else { 0.0 };
-            program.set_local(gpu, 4, [eye.x, eye.y, eye.z, w])?;
-            program.set_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
+            program.set_local(gpu, locals::EYE, [eye.x, eye.y, eye.z, w])?;
+            program.set_local(gpu, locals::VIEW_DIRECTION, [dir.x, dir.y, dir.z, 0.0])?;
             let points = self.transfer.s.len() as f64;
-            program.set_local(gpu, 6, [points, 1.0 / self.transfer.unit, 0.0, 0.0])?;
+            program.set_local(
+                gpu,
+                locals::TRANSFER,
+                [points, 1.0 / self.transfer.unit, 0.0, 0.0],
+            )?;
         } else if cells {
             let eye = match perspective {
                 true => eye.extend(1.0),
                 false => dir.extend(0.0),
             };
-            program.set_local(gpu, 0, f.map[0])?;
-            program.set_local(gpu, 1, f.map[1])?;
-            program.set_local(gpu, 2, eye.to_array())?;
+            program.set_local(gpu, locals::TABLE_SCALE, f.map[0])?;
+            program.set_local(gpu, locals::TABLE_OFFSET, f.map[1])?;
+            program.set_local(gpu, locals::CELL_EYE, eye.to_array())?;
         } else {
             // Per vertex: D, normalized (the length is then t). Per fragment: the seed's
             // eye; for a parallel view 10^6 box units back, so `vertex - EyePos` is D.
@@ -602,9 +607,9 @@ impl VolumeRenderer {
                 (None, true) => [eye.x, eye.y, eye.z, 1.0],
                 (None, false) => (-dir * 1.0e6).extend(1.0).to_array(),
             };
-            program.set_vertex_local(gpu, 4, local)?;
-            program.set_local(gpu, 0, f.map[0])?;
-            program.set_local(gpu, 1, f.map[1])?;
+            program.set_vertex_local(gpu, locals::EYE, local)?;
+            program.set_local(gpu, locals::TABLE_SCALE, f.map[0])?;
+            program.set_local(gpu, locals::TABLE_OFFSET, f.map[1])?;
         }
         let unit = if f.exact { 2 } else { 0 };
         let mesh = match cells {

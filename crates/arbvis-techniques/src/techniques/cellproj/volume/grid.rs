@@ -17,6 +17,7 @@ use crate::gl::{
     TexelData, TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
+use crate::techniques::cellproj::locals;
 use crate::techniques::quad::quad_mesh;
 use crate::techniques::Frame;
 
@@ -228,22 +229,30 @@ impl GridCaster {
             .iter()
             .enumerate()
         {
-            p.set_local(gpu, i, row.to_array())?;
+            p.set_local(gpu, locals::MVP_ROWS + i, row.to_array())?;
         }
         let corner = match surface {
             Surface::Target(_) => [0.0, 0.0],
             Surface::Window([x, y, _, _]) => [x as f64, y as f64],
         };
         let (w, h) = (frame.width as f64, frame.height as f64);
-        p.set_local(gpu, 4, [w, h, corner[0], corner[1]])?;
+        p.set_local(gpu, locals::PIXELS, [w, h, corner[0], corner[1]])?;
         let lo = self.lo;
-        p.set_local(gpu, 5, [lo.x, lo.y, lo.z, 0.0])?;
+        p.set_local(gpu, locals::GRID_LOW, [lo.x, lo.y, lo.z, 0.0])?;
         let inv = 1.0 / self.spacing;
-        p.set_local(gpu, 8, [inv.x, inv.y, inv.z, 0.0])?;
+        p.set_local(
+            gpu,
+            locals::GRID_INVERSE_SPACING,
+            [inv.x, inv.y, inv.z, 0.0],
+        )?;
         let [nx, ny, nz] = self.dims.map(|n| n as f64);
-        p.set_local(gpu, 6, [nx, ny, nz, self.step])?;
+        p.set_local(gpu, locals::GRID_DIMS, [nx, ny, nz, self.step])?;
         let sides = [spec.table_size[0] as f64, LENGTHS as f64];
-        p.set_local(gpu, 7, [sides[0], sides[1], spec.termination, 0.0])?;
+        p.set_local(
+            gpu,
+            locals::GRID_TABLE,
+            [sides[0], sides[1], spec.termination, 0.0],
+        )?;
         gl::draw(
             gpu,
             surface,

@@ -17,6 +17,7 @@ use crate::gl::{
     Surface, Target, TargetFormat, TexelData, TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
+use crate::techniques::cellproj::locals;
 use crate::techniques::Frame;
 
 /// `volume_integral.glsl` joined before the main of `fragment` (after its `#version`).
@@ -308,8 +309,11 @@ impl Precise {
             let k = n;
             p.layers[k].clear(gpu, [-1.0, -1.0, 0.0, 0.0])?;
             let after = p.peeled > 0;
-            p.peel
-                .set_local(gpu, 5, [after as u8 as f64, 0.0, 0.0, 0.0])?;
+            p.peel.set_local(
+                gpu,
+                locals::PEEL_AFTER_FIRST,
+                [after as u8 as f64, 0.0, 0.0, 0.0],
+            )?;
             let previous = if k > 0 { k - 1 } else { p.layers.len() - 1 };
             let textures: Vec<(u32, &Texture)> = if after {
                 vec![(3, p.layers[previous].color())]
@@ -366,10 +370,11 @@ impl Precise {
         let rows = [inv.x_axis, inv.y_axis, inv.z_axis, inv.w_axis].map(|r| r.to_array());
         p.peel.set_transform(gpu, mvp)?;
         for (i, row) in rows.iter().enumerate() {
-            p.peel.set_local(gpu, i, *row)?;
-            p.walk.set_local(gpu, i, *row)?;
+            p.peel.set_local(gpu, locals::MVP_ROWS + i, *row)?;
+            p.walk.set_local(gpu, locals::MVP_ROWS + i, *row)?;
         }
-        p.peel.set_local(gpu, 4, [w as f64, h as f64, 0.0, 0.0])?;
+        p.peel
+            .set_local(gpu, locals::PIXELS, [w as f64, h as f64, 0.0, 0.0])?;
         let corner = match surface {
             Surface::Target(_) => [0.0, 0.0],
             Surface::Window([x, y, _, _]) => [x as f64, y as f64],
@@ -381,7 +386,7 @@ impl Precise {
             Projection::Orthographic => -1.0,
         };
         let s = spec;
-        let locals = [transfer.s.len() as f64, p.iso_count as f64, s.termination];
+        let walk_transfer = [transfer.s.len() as f64, p.iso_count as f64, s.termination];
         let inv_unit = 1.0 / transfer.unit;
         // Every boundary face at most once per ray: no more layers than that.
         let most = p
@@ -406,12 +411,15 @@ impl Precise {
             // The surface's corner for the last pass; the sums are targets of their own.
             let at = if last { corner } else { [0.0, 0.0] };
             p.walk
-                .set_local(gpu, 4, [w as f64, h as f64, at[0], at[1]])?;
-            p.walk
-                .set_local(gpu, 5, [locals[0], locals[1], locals[2], eye])?;
+                .set_local(gpu, locals::PIXELS, [w as f64, h as f64, at[0], at[1]])?;
             p.walk.set_local(
                 gpu,
-                6,
+                locals::WALK_TRANSFER,
+                [walk_transfer[0], walk_transfer[1], walk_transfer[2], eye],
+            )?;
+            p.walk.set_local(
+                gpu,
+                locals::WALK_PASS,
                 [
                     n as f64,
                     inv_unit,
@@ -422,8 +430,11 @@ impl Precise {
             // Re-entries exist only where the boundary is not one convex body; what a
             // pass's walks reached goes to the next, so every pass looks for them.
             let search = !convex;
-            p.walk
-                .set_local(gpu, 7, [search as u8 as f64, 0.0, 0.0, 0.0])?;
+            p.walk.set_local(
+                gpu,
+                locals::WALK_SEARCH,
+                [search as u8 as f64, 0.0, 0.0, 0.0],
+            )?;
             let mut textures: Vec<(u32, &Texture)> = vec![
                 (0, &p.tets),
                 (1, &p.neighbours),
