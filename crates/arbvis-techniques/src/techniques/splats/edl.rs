@@ -83,10 +83,18 @@ impl EdlPass {
         self.depth.clear(gpu, [0.0; 4])?;
         let p = &self.depth_program;
         p.set_transform(gpu, view.transform)?;
-        p.set_vertex_local(gpu, 4, view.eye.to_array())?;
-        p.set_vertex_local(gpu, 6, [view.size[0], view.size[1], 0.0, 0.0])?;
-        p.set_vertex_local(gpu, 8, view.z_row.to_array())?;
-        p.set_vertex_local(gpu, 10, [view.size_range[0], view.size_range[1], 0.0, 0.0])?;
+        p.set_vertex_local(gpu, locals::VERTEX_EYE, view.eye.to_array())?;
+        p.set_vertex_local(
+            gpu,
+            locals::VERTEX_SIZING,
+            [view.size[0], view.size[1], 0.0, 0.0],
+        )?;
+        p.set_vertex_local(gpu, locals::VERTEX_Z_ROW, view.z_row.to_array())?;
+        p.set_vertex_local(
+            gpu,
+            locals::VERTEX_SIZES,
+            [view.size_range[0], view.size_range[1], 0.0, 0.0],
+        )?;
         gl::draw(
             gpu,
             Surface::Target(&self.depth),

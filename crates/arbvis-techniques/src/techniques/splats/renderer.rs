@@ -365,19 +365,26 @@ impl SplatsRenderer {
         } else {
             0.0
         };
+        self.program.set_vertex_local(
+            gpu,
+            locals::VERTEX_EYE,
+            [eye.x, eye.y, eye.z, perspective],
+        )?;
+        self.program.set_vertex_local(
+            gpu,
+            locals::VERTEX_VIEW_DIRECTION,
+            [dir.x, dir.y, dir.z, 0.0],
+        )?;
         self.program
-            .set_vertex_local(gpu, 4, [eye.x, eye.y, eye.z, perspective])?;
-        self.program
-            .set_vertex_local(gpu, 5, [dir.x, dir.y, dir.z, 0.0])?;
-        self.program
-            .set_vertex_local(gpu, 8, z_row(camera).to_array())?;
+            .set_vertex_local(gpu, locals::VERTEX_Z_ROW, z_row(camera).to_array())?;
         // The viewport in window coordinates (the precise programs' splat positions):
         // OIT draws into its own targets, whose corner is the origin.
         let viewport = match surface {
             Surface::Window(v) if self.params.sort != SortChoice::Oit => v.map(f64::from),
             _ => [0.0, 0.0, frame.width as f64, frame.height as f64],
         };
-        self.program.set_vertex_local(gpu, 9, viewport)?;
+        self.program
+            .set_vertex_local(gpu, locals::VERTEX_VIEWPORT, viewport)?;
         if self.params.sort == SortChoice::Oit {
             let (w, h) = (frame.width, frame.height);
             if !self.oit.as_ref().is_some_and(|o| o.fits(w, h)) {
@@ -686,10 +693,14 @@ impl SplatsRenderer {
         } else {
             0.0
         };
-        prog.set_vertex_local(gpu, 6, [p.point_size, p.factor, lighting, 0.0])?;
-        prog.set_vertex_local(gpu, 7, PHONG)?;
+        prog.set_vertex_local(
+            gpu,
+            locals::VERTEX_SIZING,
+            [p.point_size, p.factor, lighting, 0.0],
+        )?;
+        prog.set_vertex_local(gpu, locals::VERTEX_PHONG, PHONG)?;
         let [lo, hi] = self.splat_params().size_range;
-        prog.set_vertex_local(gpu, 10, [lo, hi, POINT_MARGIN, 0.0])?;
+        prog.set_vertex_local(gpu, locals::VERTEX_SIZES, [lo, hi, POINT_MARGIN, 0.0])?;
         Ok(())
     }
 }
