@@ -27,7 +27,7 @@ pub use draw::{draw, draw_counted, Blend, DrawCall, Primitive};
 pub use error::{error_name, CompileError, GlError, GlResult};
 pub use gpu::{renderer_is_software, ArbLimits, Caps, Gpu, Resource};
 pub use headless::{Backend, Headless, OSMESA_LIBRARIES};
-pub use mesh::Mesh;
+pub use mesh::{quad_vertices, Mesh};
 pub use precision::{EXACT_FILTER, EXACT_INTERPOLATION};
 pub use program::{Program, ProgramChoice, ProgramKind, ProgramText, MAX_LOCALS, MAX_UNITS};
 pub use state::{SavedState, StateGuard};

@@ -251,3 +251,20 @@ impl Drop for Mesh {
         }
     }
 }
+
+/// Two triangles over clip space [-1, 1]² (the full-screen passes' quad): position
+/// (x, y, z, w) then texture coordinate (u, v, 0, 1), (0, 0) at the bottom left.
+pub fn quad_vertices() -> Vec<f32> {
+    let corner = |x: f32, y: f32| [x, y, 0.0, 1.0, (x + 1.0) / 2.0, (y + 1.0) / 2.0, 0.0, 1.0];
+    [
+        (-1.0, -1.0),
+        (1.0, -1.0),
+        (1.0, 1.0),
+        (-1.0, -1.0),
+        (1.0, 1.0),
+        (-1.0, 1.0),
+    ]
+    .iter()
+    .flat_map(|&(x, y)| corner(x, y))
+    .collect()
+}

@@ -153,20 +153,7 @@ mod tests {
             include_str!("../../../programs/quad/quad.arbfp"),
         );
         let program = Program::new(gpu, ProgramKind::Arb, &vertex, &fragment).unwrap();
-        // Two triangles over the viewport: position xyzw, texture coordinate stqr.
-        let corner = |x: f32, y: f32| [x, y, 0.0, 1.0, (x + 1.0) / 2.0, (y + 1.0) / 2.0, 0.0, 1.0];
-        let vertices: Vec<f32> = [
-            (-1.0, -1.0),
-            (1.0, -1.0),
-            (1.0, 1.0),
-            (-1.0, -1.0),
-            (1.0, 1.0),
-            (-1.0, 1.0),
-        ]
-        .iter()
-        .flat_map(|&(x, y)| corner(x, y))
-        .collect();
-        let mesh = Mesh::new(gpu, "quad", &[4, 4], &vertices).unwrap();
+        let mesh = Mesh::new(gpu, "quad", &[4, 4], &crate::quad_vertices()).unwrap();
         target.clear(gpu, [0.0; 4]).unwrap();
         let call = DrawCall {
             blend: Blend::Over,

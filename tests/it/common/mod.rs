@@ -145,13 +145,8 @@ pub fn lit_pixels(image: &Image, threshold: f32) -> usize {
         .count()
 }
 
-pub fn data_file(relative: &str) -> std::path::PathBuf {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("data")
-        .join(relative);
-    assert!(path.is_file(), "{} is missing from data/", path.display());
-    path
-}
+/// A file under the repository's `data/` (the one helper every crate's tests use).
+pub use arbvis::input::data_file;
 
 /// A fresh, empty folder for one test's files (emptied at the start of each run). The
 /// first call of a run also removes what earlier runs left behind ([`sweep_stale`]).

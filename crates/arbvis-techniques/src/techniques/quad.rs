@@ -73,21 +73,7 @@ impl Default for QuadScene {
     }
 }
 
-/// The quad's vertices: position (x, y, z, w) then texture coordinate (u, v, 0, 1).
-pub fn quad_vertices() -> Vec<f32> {
-    let corner = |x: f32, y: f32| [x, y, 0.0, 1.0, (x + 1.0) / 2.0, (y + 1.0) / 2.0, 0.0, 1.0];
-    [
-        (-1.0, -1.0),
-        (1.0, -1.0),
-        (1.0, 1.0),
-        (-1.0, -1.0),
-        (1.0, 1.0),
-        (-1.0, 1.0),
-    ]
-    .iter()
-    .flat_map(|&(x, y)| corner(x, y))
-    .collect()
-}
+pub use crate::gl::quad_vertices;
 
 /// A mesh of [`quad_vertices`] (attributes 4 + 4), labelled `label`: the full-screen
 /// passes' quad.

@@ -147,46 +147,42 @@ impl Layout<'_> {
         Ok(())
     }
 
-    /// One coordinate array `node` on dimension `name`, its values written.
+    /// One coordinate array `node` on dimension `name`, its values written: int32 where
+    /// every value is whole (and fits), else float64.
     fn coordinate(&self, node: &str, name: &str, values: &[f64]) -> Result<(), StoreError> {
         let (storage, store) = (self.storage, self.store);
-        let compression = self.options.compression;
         let n = values.len() as u64;
         let whole = values.iter().all(|v| v.fract() == 0.0 && v.abs() < 2e9);
+        let make = |kind, fill| {
+            array(
+                storage,
+                store,
+                node,
+                vec![n],
+                vec![n],
+                kind,
+                fill,
+                &[name],
+                self.options.compression,
+                Map::new(),
+            )
+        };
         let subset = ArraySubset::new_with_shape(vec![n]);
-        if whole {
-            let a = array(
-                storage,
-                store,
-                node,
-                vec![n],
-                vec![n],
-                data_type::int32(),
-                i32::MAX,
-                &[name],
-                compression,
-                Map::new(),
-            )?;
+        let stored = if whole {
             let v: Vec<i32> = values.iter().map(|&x| x as i32).collect();
-            a.store_array_subset(&subset, v.as_slice())
-                .map_err(|e| storage_error(store, e))?;
+            make(
+                data_type::int32(),
+                zarrs::array::builder::ArrayBuilderFillValue::from(i32::MAX),
+            )?
+            .store_array_subset(&subset, v.as_slice())
         } else {
-            let a = array(
-                storage,
-                store,
-                node,
-                vec![n],
-                vec![n],
+            make(
                 data_type::float64(),
-                f64::NAN,
-                &[name],
-                compression,
-                Map::new(),
-            )?;
-            a.store_array_subset(&subset, values)
-                .map_err(|e| storage_error(store, e))?;
-        }
-        Ok(())
+                zarrs::array::builder::ArrayBuilderFillValue::from(f64::NAN),
+            )?
+            .store_array_subset(&subset, values)
+        };
+        stored.map_err(|e| storage_error(store, e))
     }
 
     /// Level 0's attributes of data variable `attr`: its map coordinates, fill value and
