@@ -255,7 +255,7 @@ impl SegyKeyArgs {
 }
 
 /// `--gpu-memory`: a size the memory budget's parser reads, kept as written.
-fn gpu_memory(s: &str) -> Result<String, String> {
+fn gpu_memory(s: &str) -> Result<String, arbvis::budget::SizeError> {
     arbvis::budget::parse(s).map(|_| s.to_string())
 }
 

@@ -36,7 +36,7 @@ const LAYERS: &[(&str, &[&str])] = &[
         ],
     ),
     ("program texts", &["programs"]),
-    ("techniques", &["techniques"]),
+    ("techniques", &["techniques", "error"]),
     ("the catalog of techniques", &["catalog"]),
     (
         "scenes and rendering",
@@ -382,7 +382,7 @@ const CRATES: [(&str, Option<&str>); 6] = [
 
 /// The top-level modules of the crates below that a crate's root names for its files
 /// (`crate::scene` in the viewer is arbvis-techniques' `scene`).
-const NAMED_FROM_BELOW: [&str; 23] = [
+const NAMED_FROM_BELOW: [&str; 24] = [
     "budget",
     "camera",
     "colortable",
@@ -399,6 +399,7 @@ const NAMED_FROM_BELOW: [&str; 23] = [
     "volume",
     "annotate",
     "catalog",
+    "error",
     "info",
     "inspect",
     "programs",

@@ -369,20 +369,32 @@ pub fn reserve<T>(v: &mut Vec<T>, more: usize, what: &str) -> Result<(), OverBud
     })
 }
 
+/// A SIZE (`--memory`, `gpu_memory`) that is not one.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum SizeError {
+    /// Not a number with a unit or a percentage.
+    #[error(
+        "{0:?} is not a memory size: write bytes with an optional unit (512M, 16G, 1.5T) \
+         or a share of physical memory (75%)"
+    )]
+    NotASize(String),
+    /// A percentage outside (0, 100].
+    #[error("{0:?}: a share of memory must be in (0, 100] %")]
+    Share(String),
+    /// Below one byte or from 8 EiB up.
+    #[error("{0:?}: a memory budget must be at least 1 byte and below 8 EiB")]
+    Range(String),
+}
+
 /// Parse a SIZE: bytes with an optional K/M/G/T unit (powers of 1024, `B`/`iB` optional),
 /// or a percentage of physical memory.
-pub fn parse(text: &str) -> Result<u64, String> {
+pub fn parse(text: &str) -> Result<u64, SizeError> {
     let t = text.trim();
-    let bad = || {
-        format!(
-            "{text:?} is not a memory size: write bytes with an optional unit (512M, 16G, 1.5T) \
-             or a share of physical memory (75%)"
-        )
-    };
+    let bad = || SizeError::NotASize(text.to_string());
     if let Some(p) = t.strip_suffix('%') {
         let share: f64 = p.trim().parse().map_err(|_| bad())?;
         if !(share > 0.0 && share <= 100.0) {
-            return Err(format!("{text:?}: a share of memory must be in (0, 100] %"));
+            return Err(SizeError::Share(text.to_string()));
         }
         let mem = physical_memory().unwrap_or(8 << 30) as f64;
         return Ok((mem * share / 100.0) as u64);
@@ -402,9 +414,7 @@ pub fn parse(text: &str) -> Result<u64, String> {
     let value: f64 = number.trim().parse().map_err(|_| bad())?;
     let bytes = value * scale as f64;
     if !(bytes.is_finite() && bytes >= 1.0 && bytes < 2f64.powi(63)) {
-        return Err(format!(
-            "{text:?}: a memory budget must be at least 1 byte and below 8 EiB"
-        ));
+        return Err(SizeError::Range(text.to_string()));
     }
     Ok(bytes as u64)
 }

@@ -74,13 +74,13 @@ impl TableSpec {
             ));
         }
         if !self.alpha.is_empty() {
-            check_alpha_curve(&self.alpha).map_err(|m| FieldError::new("alpha", m))?;
+            check_alpha_curve(&self.alpha).map_err(|m| FieldError::new("alpha", m.to_string()))?;
         }
         Ok(())
     }
 
     /// Build the table; relative files are read from `base`.
-    pub fn build(&self, base: &Path) -> Result<ColorTable, String> {
+    pub fn build(&self, base: &Path) -> Result<ColorTable, TableError> {
         let mut table = match &self.file {
             Some(f) => ColorTable::load(&base.join(f))?,
             None => ColorTable::builtin(&self.builtin)?,
@@ -135,6 +135,52 @@ pub fn alpha_from_histogram(counts: &[u64; 256]) -> [u8; 256] {
     })
 }
 
+/// A colour table that cannot be made: an unknown built-in, a table file that cannot be
+/// read or is not 256 lines of `r g b a`, or an alpha curve out of range.
+#[derive(Debug, thiserror::Error)]
+pub enum TableError {
+    /// No built-in table of this name.
+    #[error("no built-in colour table {0:?}; built-ins: {builtins}", builtins = BUILTINS.join(", "))]
+    NoBuiltin(String),
+    /// The table file could not be read or written.
+    #[error("{}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What the system said.
+        source: std::io::Error,
+    },
+    /// A line that is not four integers 0..255.
+    #[error("{origin}:{line}: expected four integers 0..255 (r g b a), found {found:?}")]
+    Line {
+        /// The file (or text) the table came from.
+        origin: String,
+        /// 1-based line.
+        line: usize,
+        /// What the line holds (shortened).
+        found: String,
+    },
+    /// A 257th entry.
+    #[error("{origin}:{line}: more than 256 entries")]
+    TooMany {
+        /// The file (or text) the table came from.
+        origin: String,
+        /// 1-based line of the 257th entry.
+        line: usize,
+    },
+    /// Fewer than 256 entries.
+    #[error("{origin}: {entries} entries; a colour table has exactly 256")]
+    Count {
+        /// The file (or text) the table came from.
+        origin: String,
+        /// How many it holds.
+        entries: usize,
+    },
+    /// An alpha curve whose points are outside 0..1 or not ascending.
+    #[error("alpha curve {0}: points must be [position, alpha] in 0..1, positions ascending")]
+    AlphaCurve(String),
+}
+
 /// 256 RGBA entries.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ColorTable {
@@ -145,7 +191,7 @@ pub struct ColorTable {
 impl ColorTable {
     /// A built-in table by name. Alpha: `seismic` is opaque at both extremes and clear in
     /// the middle (`|2t - 1|`); the others ramp from 0 to 1.
-    pub fn builtin(name: &str) -> Result<ColorTable, String> {
+    pub fn builtin(name: &str) -> Result<ColorTable, TableError> {
         let gradient = match name {
             "viridis" => Some(colorous::VIRIDIS),
             "magma" => Some(colorous::MAGMA),
@@ -180,21 +226,16 @@ impl ColorTable {
                         };
                         [byte(r), byte(g), byte(b), byte((2.0 * t - 1.0).abs())]
                     }
-                    _ => {
-                        return Err(format!(
-                            "no built-in colour table {name:?}; built-ins: {}",
-                            BUILTINS.join(", ")
-                        ))
-                    }
+                    _ => return Err(TableError::NoBuiltin(name.to_string())),
                 })
             })
-            .collect::<Result<Vec<_>, String>>()?;
+            .collect::<Result<Vec<_>, TableError>>()?;
         Ok(ColorTable { entries })
     }
 
     /// Replace alpha by the piecewise-linear curve through `points` (`[position, alpha]`,
     /// both in 0..1, positions ascending); constant beyond the ends.
-    pub fn set_alpha_curve(&mut self, points: &[[f64; 2]]) -> Result<(), String> {
+    pub fn set_alpha_curve(&mut self, points: &[[f64; 2]]) -> Result<(), TableError> {
         check_alpha_curve(points)?;
         for (k, e) in self.entries.iter_mut().enumerate() {
             let t = k as f64 / 255.0;
@@ -210,7 +251,7 @@ impl ColorTable {
     }
 
     /// Parse table text; `origin` names it in errors.
-    pub fn parse(text: &str, origin: &str) -> Result<ColorTable, String> {
+    pub fn parse(text: &str, origin: &str) -> Result<ColorTable, TableError> {
         let mut entries = Vec::with_capacity(256);
         for (n, line) in text.lines().enumerate() {
             let content = line.split('#').next().unwrap_or("").trim();
@@ -224,31 +265,38 @@ impl ColorTable {
                     entries.push([v[0], v[1], v[2], v[3]])
                 }
                 Some(v) if v.len() == 4 => {
-                    return Err(format!("{origin}:{}: more than 256 entries", n + 1))
+                    return Err(TableError::TooMany {
+                        origin: origin.to_string(),
+                        line: n + 1,
+                    })
                 }
                 _ => {
-                    return Err(format!(
-                        "{origin}:{}: expected four integers 0..255 (r g b a), found {:?}",
-                        n + 1,
-                        crate::input::shorten(content, 60)
-                    ))
+                    return Err(TableError::Line {
+                        origin: origin.to_string(),
+                        line: n + 1,
+                        found: crate::input::shorten(content, 60),
+                    })
                 }
             }
         }
         if entries.len() != 256 {
-            return Err(format!(
-                "{origin}: {} entries; a colour table has exactly 256",
-                entries.len()
-            ));
+            return Err(TableError::Count {
+                origin: origin.to_string(),
+                entries: entries.len(),
+            });
         }
         Ok(ColorTable { entries })
     }
 
     /// Read a table file.
-    pub fn load(path: &Path) -> Result<ColorTable, String> {
+    pub fn load(path: &Path) -> Result<ColorTable, TableError> {
         // 256 lines of four numbers with comments: 1 MiB is far beyond any real table.
-        let text = crate::input::read_text(path, crate::input::MAX_SMALL_TEXT_BYTES)
-            .map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = crate::input::read_text(path, crate::input::MAX_SMALL_TEXT_BYTES).map_err(
+            |source| TableError::Io {
+                path: path.to_path_buf(),
+                source,
+            },
+        )?;
         ColorTable::parse(&text, &path.display().to_string())
     }
 
@@ -263,24 +311,26 @@ impl ColorTable {
     }
 
     /// Write the table file atomically.
-    pub fn save(&self, path: &Path) -> Result<(), String> {
-        crate::png_io::write_atomic(path, self.to_text().as_bytes())
-            .map_err(|e| format!("{}: {e}", path.display()))
+    pub fn save(&self, path: &Path) -> Result<(), TableError> {
+        crate::png_io::write_atomic(path, self.to_text().as_bytes()).map_err(|source| {
+            TableError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        })
     }
 }
 
 /// An alpha curve is at least one `[position, alpha]` point, both in 0..1, positions
 /// ascending.
-fn check_alpha_curve(points: &[[f64; 2]]) -> Result<(), String> {
+fn check_alpha_curve(points: &[[f64; 2]]) -> Result<(), TableError> {
     let valid = points
         .iter()
         .all(|p| p.iter().all(|v| v.is_finite() && (0.0..=1.0).contains(v)))
         && points.windows(2).all(|w| w[0][0] <= w[1][0]);
     if points.is_empty() || !valid {
         let shown = crate::input::shorten(&format!("{points:?}"), 120);
-        return Err(format!(
-            "alpha curve {shown}: points must be [position, alpha] in 0..1, positions ascending"
-        ));
+        return Err(TableError::AlphaCurve(shown));
     }
     Ok(())
 }
@@ -318,7 +368,10 @@ mod tests {
             let t = ColorTable::builtin(name).unwrap();
             assert_eq!(t.entries.len(), 256);
         }
-        assert!(ColorTable::builtin("nope").unwrap_err().contains("seismic"));
+        assert!(ColorTable::builtin("nope")
+            .unwrap_err()
+            .to_string()
+            .contains("seismic"));
         let s = ColorTable::builtin("seismic").unwrap();
         assert_eq!(s.entries[0], [0, 0, 255, 255]);
         assert_eq!(s.entries[255], [255, 0, 0, 255]);
@@ -331,7 +384,7 @@ mod tests {
         assert_eq!(ColorTable::parse(&t.to_text(), "t").unwrap(), t);
         let mut bad = t.to_text();
         bad = bad.replacen("\n", "\n1 2 three 4\n", 1);
-        let e = ColorTable::parse(&bad, "my.table").unwrap_err();
+        let e = ColorTable::parse(&bad, "my.table").unwrap_err().to_string();
         assert!(
             e.starts_with("my.table:2:") && e.contains("four integers"),
             "{e}"
@@ -339,6 +392,7 @@ mod tests {
         let short: String = t.to_text().lines().take(100).collect::<Vec<_>>().join("\n");
         assert!(ColorTable::parse(&short, "s")
             .unwrap_err()
+            .to_string()
             .contains("99 entries"));
     }
 

@@ -63,10 +63,6 @@ pub enum GlError {
     /// An argument outside what the call accepts (e.g. texture data of the wrong length).
     #[error("invalid argument: {0}")]
     Invalid(String),
-    /// Data a renderer was asked to draw cannot be used (a volume or table file); the
-    /// message names the file and the position.
-    #[error("{0}")]
-    Data(String),
 }
 
 /// A program compile or link failure, positioned in the program text.

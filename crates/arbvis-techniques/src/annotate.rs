@@ -16,6 +16,7 @@
 //!   parallel to it that lies farthest out on screen, its labels outside the box; an axis
 //!   seen nearly end on (shorter than four text heights) is left out.
 
+use crate::error::AnnotateError;
 use glam::{DVec2, DVec3, DVec4};
 
 use crate::camera::Camera;
@@ -33,13 +34,13 @@ pub struct Show {
 }
 
 /// Register the font plotters draws text in (egui's Ubuntu Light, already a dependency).
-pub fn register_font() -> Result<(), String> {
+pub fn register_font() -> Result<(), AnnotateError> {
     plotters::style::register_font(
         "sans-serif",
         plotters::style::FontStyle::Normal,
         epaint_default_fonts::UBUNTU_LIGHT,
     )
-    .map_err(|_| "the annotation font did not load".to_string())
+    .map_err(|_| AnnotateError::Font)
 }
 
 /// Draw what `show` asks of `annotations` onto `image`, seen from `camera`.
@@ -48,7 +49,7 @@ pub fn draw(
     camera: &Camera,
     annotations: &Annotations,
     show: Show,
-) -> Result<(), String> {
+) -> Result<(), AnnotateError> {
     if !show.legend && !show.axes {
         return Ok(());
     }
@@ -73,7 +74,7 @@ pub fn draw(
         if show.legend {
             draw_legends(&area, &annotations.legends, [w, h], size, ink)?;
         }
-        area.present().map_err(|e| e.to_string())?;
+        area.present().map_err(AnnotateError::Draw)?;
     }
     for (p, (now, was)) in buffer
         .chunks_exact(3)
@@ -115,7 +116,7 @@ fn text(
         plotters::style::text_anchor::HPos,
         plotters::style::text_anchor::VPos,
     ),
-) -> Result<(), String> {
+) -> Result<(), AnnotateError> {
     use plotters::prelude::*;
     use plotters::style::text_anchor::Pos;
     let style = ("sans-serif", size)
@@ -123,7 +124,7 @@ fn text(
         .color(&ink)
         .pos(Pos::new(anchor.0, anchor.1));
     area.draw(&Text::new(s.to_string(), at, style))
-        .map_err(|e| e.to_string())
+        .map_err(AnnotateError::Draw)
 }
 
 /// A number written briefly: integers whole, others with four significant digits.
@@ -162,7 +163,7 @@ fn draw_legends(
     [w, h]: [u32; 2],
     size: f64,
     ink: plotters::style::RGBColor,
-) -> Result<(), String> {
+) -> Result<(), AnnotateError> {
     use plotters::prelude::*;
     use plotters::style::text_anchor::{HPos, VPos};
     let [left, _, width, _] = first_bar(w, h);
@@ -187,10 +188,10 @@ fn draw_legends(
                         [(left + x, y), (left + x + 1, y + bar)],
                         RGBColor(c[0], c[1], c[2]).filled(),
                     ))
-                    .map_err(|e| e.to_string())?;
+                    .map_err(AnnotateError::Draw)?;
                 }
                 area.draw(&Rectangle::new([(left - 1, y - 1), (right, y + bar)], ink))
-                    .map_err(|e| e.to_string())?;
+                    .map_err(AnnotateError::Draw)?;
                 y += bar + 2;
                 text(
                     area,
@@ -219,7 +220,7 @@ fn draw_legends(
                         [(left, y + 1), (left + s, y + 1 + s)],
                         RGBColor(c[0], c[1], c[2]).filled(),
                     ))
-                    .map_err(|e| e.to_string())?;
+                    .map_err(AnnotateError::Draw)?;
                     let at = (left + s + s / 2, y);
                     text(area, name, at, size, ink, (HPos::Left, VPos::Top))?;
                     y += line;
@@ -249,7 +250,7 @@ fn draw_axes(
     axes: &[Axis; 3],
     size: f64,
     ink: plotters::style::RGBColor,
-) -> Result<(), String> {
+) -> Result<(), AnnotateError> {
     use plotters::prelude::*;
     use plotters::style::text_anchor::{HPos, VPos};
     let m = camera.view_projection(size_px[0] as f64 / size_px[1] as f64);
@@ -287,7 +288,7 @@ fn draw_axes(
         let out = (mid - centre).try_normalize().unwrap_or(DVec2::Y);
         let px = |v: DVec2| (v.x.round() as i32, v.y.round() as i32);
         area.draw(&PathElement::new(vec![px(p), px(q)], ink))
-            .map_err(|e| e.to_string())?;
+            .map_err(AnnotateError::Draw)?;
         let anchor = (
             if out.x > 0.3 {
                 HPos::Left
@@ -310,7 +311,7 @@ fn draw_axes(
                 vec![px(at), px(at + out * size * 0.4)],
                 ink,
             ))
-            .map_err(|e| e.to_string())?;
+            .map_err(AnnotateError::Draw)?;
             text(
                 area,
                 &tick.label,

@@ -9,13 +9,14 @@
 //! (their renderers take their own parameters through [`crate::techniques::Params`]), so
 //! adding a technique touches its own folder and this file.
 
+use crate::error::RenderResult;
 use std::any::Any;
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
 use crate::camera::Camera;
-use crate::gl::{GlError, GlResult, Gpu, ProgramChoice, ProgramKind};
+use crate::gl::{GlError, Gpu, ProgramChoice, ProgramKind};
 use crate::programs::ProgramPair;
 use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::Opacity3dScene;
@@ -181,7 +182,7 @@ pub fn build(
     technique: &TechniqueScene,
     settings: &Settings<'_>,
     kind: ProgramKind,
-) -> GlResult<Box<dyn Renderer>> {
+) -> RenderResult<Box<dyn Renderer>> {
     each_technique!(technique, |p| Technique::build(p, gpu, settings, kind))
 }
 
@@ -196,7 +197,7 @@ pub fn prepare(
     technique: &TechniqueScene,
     settings: &Settings<'_>,
     limits: &Limits,
-) -> GlResult<PreparedData> {
+) -> RenderResult<PreparedData> {
     each_technique!(technique, |p| Technique::prepare(p, settings, limits)
         .map(|d| Box::new(d) as PreparedData))
 }
@@ -208,7 +209,7 @@ pub fn renderer(
     settings: &Settings<'_>,
     kind: ProgramKind,
     prepared: PreparedData,
-) -> GlResult<Box<dyn Renderer>> {
+) -> RenderResult<Box<dyn Renderer>> {
     each_technique!(technique, |p| renderer_of(p, gpu, settings, kind, prepared))
 }
 
@@ -219,7 +220,7 @@ fn renderer_of<T: Technique>(
     settings: &Settings<'_>,
     kind: ProgramKind,
     prepared: PreparedData,
-) -> GlResult<Box<dyn Renderer>> {
+) -> RenderResult<Box<dyn Renderer>> {
     let prepared = prepared.downcast::<T::Prepared>().map_err(|_| {
         GlError::Invalid(format!(
             "the {} renderer was given another technique's prepared data",

@@ -1,8 +1,9 @@
 //! arbvis's techniques — v3o2's 3D opacity, isosurfaces and volumes by cell projection,
 //! multi-resolution clip textures and point-based geological sections — each with its CPU
 //! preparation, GL renderer and f64 CPU reference ([`techniques`]); the program texts
-//! ([`programs`]); the one list of them ([`catalog`]); scenes ([`scene`]), offscreen
-//! rendering ([`render`], [`annotate`]), `inspect` and `info`, and the studies ([`study`]).
+//! ([`programs`]); the one list of them ([`catalog`]); what can go wrong ([`error`]);
+//! scenes ([`scene`]), offscreen rendering ([`render`], [`annotate`]), `inspect` and
+//! `info`, and the studies ([`study`]).
 
 #![deny(unsafe_code)]
 
@@ -15,6 +16,7 @@ use arbvis_gl as gl;
 
 pub mod annotate;
 pub mod catalog;
+pub mod error;
 pub mod info;
 pub mod inspect;
 pub mod programs;

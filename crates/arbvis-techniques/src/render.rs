@@ -1,8 +1,9 @@
 //! Offscreen rendering of a scene: context, renderer, target, one frame, read back.
 
+use crate::error::RenderResult;
 use std::time::{Duration, Instant};
 
-use crate::gl::{Backend, Caps, GlResult, Headless, ProgramKind, Resource, Surface, Target};
+use crate::gl::{Backend, Caps, Headless, ProgramKind, Resource, Surface, Target};
 use crate::image::Image;
 use crate::scene::Scene;
 use crate::techniques::{Frame, Renderer};
@@ -56,18 +57,18 @@ pub fn build(
     gpu: &crate::gl::Gpu,
     scene: &Scene,
     kind: ProgramKind,
-) -> GlResult<Box<dyn Renderer>> {
+) -> RenderResult<Box<dyn Renderer>> {
     crate::catalog::build(gpu, &scene.technique, &scene.settings(), kind)
 }
 
 /// Render `scene` offscreen on `backend`.
-pub fn render(scene: &Scene, backend: Backend) -> GlResult<Rendered> {
+pub fn render(scene: &Scene, backend: Backend) -> RenderResult<Rendered> {
     let headless = Headless::new(backend)?;
     render_on(&headless, scene)
 }
 
 /// Render `scene` with an existing context.
-pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
+pub fn render_on(headless: &Headless, scene: &Scene) -> RenderResult<Rendered> {
     let gpu = headless.gpu();
     let kind = scene.programs.resolve(gpu);
     let [width, height] = scene.size;
@@ -103,8 +104,7 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> GlResult<Rendered> {
         axes: scene.axes,
     };
     if show.legend || show.axes {
-        crate::annotate::draw(&mut image, &scene.camera, &renderer.annotations(), show)
-            .map_err(|e| crate::gl::GlError::Data(format!("drawing the legends and axes: {e}")))?;
+        crate::annotate::draw(&mut image, &scene.camera, &renderer.annotations(), show)?;
     }
     Ok(Rendered {
         image,

@@ -331,7 +331,7 @@ impl Scene {
             .as_deref()
             .map(crate::budget::parse)
             .transpose()
-            .map_err(|m| FieldError::new("memory_budget", m))
+            .map_err(|m| FieldError::new("memory_budget", m.to_string()))
     }
 
     /// What a renderer needs of the scene besides its technique's parameters.

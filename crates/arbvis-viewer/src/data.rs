@@ -17,7 +17,8 @@ use super::store_sections::{MapPositions, SectionKey, StoreSections};
 use super::summary::{cloud_units, data_box, CloudSummary, DataBox, MeshSummary};
 use crate::catalog;
 use crate::colortable::{ColorTable, TableSpec};
-use crate::gl::{GlError, Gpu, ProgramKind};
+use crate::error::RenderResult;
+use crate::gl::{Gpu, ProgramKind};
 use crate::scene::Scene;
 use crate::techniques::cellproj::prepare::Prepared as PreparedMesh;
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
@@ -109,7 +110,7 @@ pub fn build(
     scene: &Scene,
     kind: ProgramKind,
     data: &mut ViewData,
-) -> Result<Box<dyn Renderer>, GlError> {
+) -> RenderResult<Box<dyn Renderer>> {
     if let Some(params) = scene.technique.get::<Opacity3dScene>() {
         return build_volume(gpu, scene, params, kind, data);
     }
@@ -156,7 +157,7 @@ fn build_volume(
     params: &Opacity3dScene,
     kind: ProgramKind,
     data: &mut ViewData,
-) -> Result<Box<dyn Renderer>, GlError> {
+) -> RenderResult<Box<dyn Renderer>> {
     // A survey store is streamed: frames draw what is resident and refine.
     if crate::techniques::opacity3d::bricked::store_of(params)
         .ok()
@@ -166,45 +167,40 @@ fn build_volume(
         data.volume = None;
         let mut r = crate::render::build(gpu, scene, kind)?;
         r.set_streaming(true);
-        data.store = StoreSections::open(params, &scene.base).map_err(GlError::Data)?;
+        data.store = StoreSections::open(params, &scene.base)?;
         data.store_levels = [None, None, None];
         data.sections = [None, None, None];
         return Ok(r);
     }
     data.store = None;
-    if data.volume.is_none() {
-        params
-            .validate()
-            .map_err(|e| GlError::Data(e.to_string()))?;
-        let prepared = prepare(
-            params,
-            &scene.base,
-            &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
-        )
-        .map_err(GlError::Data)?;
-        let axes = axes::describe(&params.primary.volume, &scene.base, prepared.dims);
-        let histograms = std::array::from_fn(|a| {
-            prepared.tables[a].as_ref().map(|_| {
-                let mut h = vec![0u32; 256];
-                for v in 0..prepared.packed.len() / 3 {
-                    h[prepared.byte(v, a) as usize] += 1;
-                }
-                h
-            })
-        });
-        data.volume = Some(Volume3d {
-            prepared,
-            axes,
-            histograms,
-        });
-    }
-    let Some(v) = &data.volume else {
-        return Err(GlError::Data("no prepared volume".into()));
+    let volume = match data.volume.take() {
+        Some(volume) => volume,
+        None => {
+            params.validate()?;
+            let limits = crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size);
+            let prepared = prepare(params, &scene.base, &limits)?;
+            let axes = axes::describe(&params.primary.volume, &scene.base, prepared.dims);
+            let histograms = std::array::from_fn(|a| {
+                prepared.tables[a].as_ref().map(|_| {
+                    let mut h = vec![0u32; 256];
+                    for v in 0..prepared.packed.len() / 3 {
+                        h[prepared.byte(v, a) as usize] += 1;
+                    }
+                    h
+                })
+            });
+            Volume3d {
+                prepared,
+                axes,
+                histograms,
+            }
+        }
     };
+    let v = data.volume.insert(volume);
     let mut prepared = v.prepared.clone();
     for (a, attr) in params.attributes().into_iter().enumerate() {
         if let Some(attr) = attr {
-            prepared.tables[a] = Some(attr.table.build(&scene.base).map_err(GlError::Data)?);
+            prepared.tables[a] = Some(attr.table.build(&scene.base)?);
         }
     }
     Ok(Box::new(Opacity3dRenderer::from_prepared(

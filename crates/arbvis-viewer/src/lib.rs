@@ -28,7 +28,7 @@ use arbvis_data::{mesh, points, store, surface, volume};
 use arbvis_gl as gl;
 #[allow(unused_imports)]
 use arbvis_techniques::{
-    annotate, catalog, info, inspect, programs, render, scene, study, techniques,
+    annotate, catalog, error, info, inspect, programs, render, scene, study, techniques,
 };
 
 pub mod check;

@@ -545,6 +545,9 @@ impl Running {
 
     fn save_tables(&mut self, options: &ViewerOptions) {
         match save_tables(&mut self.scene, &options.screenshot_dir) {
+            Ok(paths) if paths.is_empty() => {
+                self.fail_action("cannot save tables: this scene has no colour tables".into())
+            }
             Ok(paths) => self.panel.status = format!("saved {}", paths.join(", ")),
             Err(e) => self.fail_action(format!("cannot save tables: {e}")),
         }
@@ -561,11 +564,15 @@ impl Running {
 }
 
 /// Write each opacity3d table (with its alpha curve applied) as
-/// `arbvis-table-ROLE.table` in `dir`, and point the scene at the files.
-fn save_tables(scene: &mut Scene, dir: &std::path::Path) -> Result<Vec<String>, String> {
+/// `arbvis-table-ROLE.table` in `dir`, and point the scene at the files; none for a
+/// scene without tables.
+fn save_tables(
+    scene: &mut Scene,
+    dir: &std::path::Path,
+) -> Result<Vec<String>, crate::colortable::TableError> {
     let base = scene.base.clone();
     let Some(o) = scene.technique.get_mut::<Opacity3dScene>() else {
-        return Err("this scene has no colour tables".into());
+        return Ok(Vec::new());
     };
     let mut written = Vec::new();
     for (role, attr) in lut3d::ROLES.iter().zip(o.attributes_mut()) {

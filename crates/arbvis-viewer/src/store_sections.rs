@@ -15,7 +15,8 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use crate::store::Store;
+use crate::error::{RenderError, RenderResult};
+use crate::store::{Store, StoreError};
 use crate::techniques::opacity3d::bricked::StoreScene;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::volume::axes::{Axis, Numbers};
@@ -64,7 +65,7 @@ pub struct StoreSections {
 
 impl StoreSections {
     /// The sections of the store `params` names (relative to `base`), if it names one.
-    pub fn open(params: &Opacity3dScene, base: &Path) -> Result<Option<StoreSections>, String> {
+    pub fn open(params: &Opacity3dScene, base: &Path) -> RenderResult<Option<StoreSections>> {
         let Some(StoreScene {
             store,
             pyramid,
@@ -99,7 +100,7 @@ impl StoreSections {
         std::thread::Builder::new()
             .name("arbvis section reader".into())
             .spawn(move || read_sections(&reader, req_rx, rep_tx))
-            .map_err(|e| e.to_string())?;
+            .map_err(RenderError::Thread)?;
         Ok(Some(StoreSections {
             dims,
             half: pyramid.half(),
@@ -154,10 +155,8 @@ pub fn section_levels(
     region: [[usize; 3]; 2],
     low: f64,
     high: f64,
-) -> Result<Vec<u8>, String> {
-    let v = store
-        .window(attr, region[0], region[1])
-        .map_err(|e| e.to_string())?;
+) -> Result<Vec<u8>, StoreError> {
+    let v = store.window(attr, region[0], region[1])?;
     // The window is one voxel thick along `axis`: its voxel 0 there.
     let (_, voxels) = crate::volume::axes::section_voxels(v.dims, axis, 0);
     let out = voxels
@@ -169,7 +168,7 @@ pub fn section_levels(
 /// A section to read: key, voxel region, store attribute, quantization range.
 type Request = (SectionKey, [[usize; 3]; 2], usize, f64, f64);
 /// A section read: key and levels, or the error.
-type Reply = (SectionKey, Result<Vec<u8>, String>);
+type Reply = (SectionKey, Result<Vec<u8>, StoreError>);
 
 fn read_sections(store: &Store, requests: Receiver<Request>, replies: Sender<Reply>) {
     while let Ok(mut next) = requests.recv() {

@@ -147,10 +147,30 @@ pub fn vtk_name(t: i64) -> Option<&'static str> {
     })
 }
 
-/// The cell kind of VTK type `t`, or a message naming the refused type.
-pub fn vtk_kind(t: i64) -> Result<Kind, String> {
+/// A cell type arbvis does not read, as a file's reader reports it (with the cell's
+/// position).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum UnsupportedCell {
+    /// A VTK cell type (legacy `.vtk`, `.vtu`).
+    #[error(
+        "cell type {0} ({name}) is not supported: arbvis reads tetrahedra, hexahedra, voxels, \
+         wedges, pyramids and their quadratic forms, and skips points, lines and faces",
+        name = vtk_name(*.0).unwrap_or("not a VTK cell type")
+    )]
+    Vtk(i64),
+    /// A gmsh element type (`.msh`).
+    #[error(
+        "gmsh element type {0} ({name}) is not supported: arbvis reads tetrahedra (4, 11), \
+         hexahedra (5, 12, 17), prisms (6, 13, 18), pyramids (7, 14, 19) and skips points, \
+         lines and faces",
+        name = gmsh_name(*.0)
+    )]
+    Gmsh(i64),
+}
+
+/// The cell kind of VTK type `t`, or the refused type.
+pub fn vtk_kind(t: i64) -> Result<Kind, UnsupportedCell> {
     use Shape::*;
-    let name = vtk_name(t);
     Ok(match t {
         0 => kind("VTK_EMPTY_CELL", Skip, 0, false),
         1 => kind("VTK_VERTEX", Skip, 1, false),
@@ -180,17 +200,12 @@ pub fn vtk_kind(t: i64) -> Result<Kind, String> {
         32 => kind("VTK_BIQUADRATIC_QUADRATIC_WEDGE", Wedge, 18, true),
         34 => kind("VTK_BIQUADRATIC_TRIANGLE", Skip, 7, false),
         35 => kind("VTK_CUBIC_LINE", Skip, 4, false),
-        _ => {
-            return Err(format!(
-                "cell type {t} ({}) is not supported: arbvis reads tetrahedra, hexahedra, voxels, wedges, pyramids and their quadratic forms, and skips points, lines and faces",
-                name.unwrap_or("not a VTK cell type")
-            ))
-        }
+        _ => return Err(UnsupportedCell::Vtk(t)),
     })
 }
 
-/// The cell kind of gmsh element type `t`, or a message naming the refused type.
-pub fn gmsh_kind(t: i64) -> Result<Kind, String> {
+/// The cell kind of gmsh element type `t`, or the refused type.
+pub fn gmsh_kind(t: i64) -> Result<Kind, UnsupportedCell> {
     use Shape::*;
     Ok(match t {
         1 => kind("VTK_LINE", Skip, 2, false),
@@ -215,12 +230,7 @@ pub fn gmsh_kind(t: i64) -> Result<Kind, String> {
         20 => kind("gmsh 9-node triangle", Skip, 9, false),
         21 => kind("gmsh 10-node triangle", Skip, 10, false),
         26 => kind("VTK_CUBIC_LINE", Skip, 4, false),
-        _ => {
-            return Err(format!(
-                "gmsh element type {t} ({}) is not supported: arbvis reads tetrahedra (4, 11), hexahedra (5, 12, 17), prisms (6, 13, 18), pyramids (7, 14, 19) and skips points, lines and faces",
-                gmsh_name(t)
-            ))
-        }
+        _ => return Err(UnsupportedCell::Gmsh(t)),
     })
 }
 

@@ -80,7 +80,7 @@ impl Input {
         let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
         if let Some(spec) = raw {
             spec.validate()
-                .map_err(|e| VolumeError::Invalid(format!("{}: {e}", path.display())))?;
+                .map_err(|e| VolumeError::Invalid(format!("{}: {}", path.display(), e.message)))?;
             let (file, flen) =
                 crate::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
             let need = spec.dims.iter().map(|&d| d as u64).product::<u64>()

@@ -465,7 +465,8 @@ impl Store {
     ) -> Result<Volume, StoreError> {
         let size: [usize; 3] = std::array::from_fn(|a| hi[a].saturating_sub(lo[a]).max(1));
         let values = self.region(attr, 0, lo.map(|v| v as i64), size)?;
-        Volume::new(size, self.meta.spacing, values).map_err(|e| StoreError::invalid(&self.path, e))
+        Volume::new(size, self.meta.spacing, values)
+            .map_err(|e| StoreError::invalid(&self.path, e.to_string()))
     }
 
     /// Index of attribute `name`, or an error listing the stored ones.

@@ -32,16 +32,20 @@ pub struct Volume {
 
 impl Volume {
     /// A volume of `dims`, checking that `values` has the right length.
-    pub fn new(dims: [usize; 3], spacing: [f64; 3], values: Vec<f32>) -> Result<Volume, String> {
+    pub fn new(
+        dims: [usize; 3],
+        spacing: [f64; 3],
+        values: Vec<f32>,
+    ) -> Result<Volume, VolumeError> {
         let n = dims.iter().try_fold(1usize, |a, &d| a.checked_mul(d));
         if n != Some(values.len()) || dims.contains(&0) {
-            return Err(format!(
+            return Err(VolumeError::Invalid(format!(
                 "volume of {}x{}x{} needs as many samples, got {}",
                 dims[0],
                 dims[1],
                 dims[2],
                 values.len()
-            ));
+            )));
         }
         Ok(Volume {
             dims,
@@ -426,13 +430,10 @@ impl VolumeSource {
 
     /// Check the scene values that can be checked without reading files.
     pub fn validate(&self) -> Result<(), crate::vocab::FieldError> {
-        use crate::vocab::FieldError;
         match self {
-            VolumeSource::Synthetic(spec) => {
-                spec.validate().map_err(|e| FieldError::new("synthetic", e))
-            }
-            VolumeSource::Raw(spec) => spec.validate().map_err(|e| FieldError::new("raw", e)),
-            VolumeSource::Segy(s) => s.keys.validate().map_err(|e| FieldError::new("segy", e)),
+            VolumeSource::Synthetic(spec) => spec.validate().map_err(|e| e.within("synthetic")),
+            VolumeSource::Raw(spec) => spec.validate().map_err(|e| e.within("raw")),
+            VolumeSource::Segy(s) => s.keys.validate().map_err(|e| e.within("segy")),
             VolumeSource::Nifti(_) | VolumeSource::Store(_) => Ok(()),
         }
     }

@@ -366,7 +366,8 @@ fn read_from(
         values.extend_from_slice(chunk);
         Ok(())
     })?;
-    Volume::new(header.dims, header.spacing, values).map_err(|m| VolumeError::format(path, 40, m))
+    Volume::new(header.dims, header.spacing, values)
+        .map_err(|m| VolumeError::format(path, 40, m.to_string()))
 }
 
 fn open(path: &Path) -> Result<(Box<dyn Read>, bool), VolumeError> {

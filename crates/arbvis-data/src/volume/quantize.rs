@@ -9,7 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::Volume;
+use super::{Volume, VolumeError};
 
 /// How the quantization range is chosen.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
@@ -103,7 +103,7 @@ fn no_data_takes_a_transparent_level_or_a_reserved_one() {
 }
 
 /// The range `how` selects for `volume`; `(0, 0)` when no sample is finite.
-pub fn range(volume: &Volume, how: Quantization) -> Result<(f64, f64), String> {
+pub fn range(volume: &Volume, how: Quantization) -> Result<(f64, f64), VolumeError> {
     match how {
         Quantization::MinMax => {
             let s = volume.stats();
@@ -117,17 +117,17 @@ pub fn range(volume: &Volume, how: Quantization) -> Result<(f64, f64), String> {
             if low.is_finite() && high.is_finite() && low <= high {
                 Ok((low, high))
             } else {
-                Err(format!(
+                Err(VolumeError::Invalid(format!(
                     "quantization range [{low}, {high}] must be finite and ordered"
-                ))
+                )))
             }
         }
         Quantization::Percentile([p_low, p_high]) => {
             if !(0.0..=100.0).contains(&p_low) || !(0.0..=100.0).contains(&p_high) || p_low > p_high
             {
-                return Err(format!(
+                return Err(VolumeError::Invalid(format!(
                     "percentiles [{p_low}, {p_high}] must be ordered within 0..100"
-                ));
+                )));
             }
             let mut finite: Vec<f32> = volume
                 .values
@@ -148,7 +148,7 @@ pub fn range(volume: &Volume, how: Quantization) -> Result<(f64, f64), String> {
 }
 
 /// Quantize a whole volume.
-pub fn quantize(volume: &Volume, how: Quantization) -> Result<Quantized, String> {
+pub fn quantize(volume: &Volume, how: Quantization) -> Result<Quantized, VolumeError> {
     let (low, high) = range(volume, how)?;
     let bytes = volume
         .values

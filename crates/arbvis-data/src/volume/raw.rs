@@ -2,6 +2,7 @@
 //! byte offset. The file must hold exactly `offset + ni*nj*nk*bytes` bytes (a size that
 //! does not match is an error, because it usually means wrong dimensions or type).
 
+use crate::vocab::FieldError;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -38,10 +39,13 @@ fn unit_spacing() -> [f64; 3] {
 impl RawSpec {
     /// Check what the scene says: positive dims whose byte size fits 64 bits, positive
     /// finite spacing.
-    pub fn validate(&self) -> Result<(), String> {
-        self.byte_size().map(|_| ())?;
+    pub fn validate(&self) -> Result<(), FieldError> {
+        self.byte_size().map_err(|m| FieldError::new("", m))?;
         if self.spacing.iter().any(|v| !v.is_finite() || *v <= 0.0) {
-            return Err(format!("spacing {:?}: must be positive", self.spacing));
+            return Err(FieldError::new(
+                "",
+                format!("spacing {:?}: must be positive", self.spacing),
+            ));
         }
         Ok(())
     }
@@ -97,5 +101,5 @@ pub fn read(base: &Path, spec: &RawSpec, limits: &super::Limits) -> Result<Volum
         .chunks_exact(width)
         .map(|b| spec.sample.decode(b, big))
         .collect();
-    Volume::new(spec.dims, spec.spacing, values).map_err(VolumeError::Invalid)
+    Volume::new(spec.dims, spec.spacing, values)
 }

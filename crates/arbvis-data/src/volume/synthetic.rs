@@ -3,6 +3,7 @@
 //! convolved with a Ricker wavelet, plus a little noise. Deterministic for a seed.
 //! Axes as in SEG-Y: sample (i, time), crossline (j), inline (k).
 
+use crate::vocab::FieldError;
 use serde::{Deserialize, Serialize};
 
 use super::{Volume, VolumeError};
@@ -63,23 +64,23 @@ pub const MAX_PEAK: f64 = 50.0;
 
 impl SyntheticSpec {
     /// Check the parameters: each side at least 1, `0 < peak <= 50` (Nyquist), noise finite.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), FieldError> {
         if self.size.contains(&0) {
-            return Err(format!(
-                "size {:?}: each side must be at least 1",
-                self.size
+            return Err(FieldError::new(
+                "",
+                format!("size {:?}: each side must be at least 1", self.size),
             ));
         }
         if !(self.peak.is_finite() && self.peak > 0.0 && self.peak <= MAX_PEAK) {
-            return Err(format!(
+            return Err(FieldError::new("", format!(
                 "peak = {}: must be in (0, {MAX_PEAK}] cycles per 100 samples (50 is the Nyquist frequency)",
                 self.peak
-            ));
+            )));
         }
         if !(self.noise.is_finite() && self.noise.abs() <= 1e6) {
-            return Err(format!(
-                "noise = {}: must be finite, at most 1e6",
-                self.noise
+            return Err(FieldError::new(
+                "",
+                format!("noise = {}: must be finite, at most 1e6", self.noise),
             ));
         }
         Ok(())
@@ -89,7 +90,7 @@ impl SyntheticSpec {
 /// The amplitude cube; its size is checked against `limits` before anything is made.
 pub fn amplitude(spec: &SyntheticSpec, limits: &super::Limits) -> Result<Volume, VolumeError> {
     spec.validate()
-        .map_err(|e| VolumeError::Invalid(format!("synthetic volume: {e}")))?;
+        .map_err(|e| VolumeError::Invalid(format!("synthetic volume: {}", e.message)))?;
     limits.check(spec.size, "synthetic volume")?;
     let [ns, nx, ny] = spec.size;
     let mut rng = SplitMix::new(spec.seed);
@@ -149,7 +150,7 @@ pub fn amplitude(spec: &SyntheticSpec, limits: &super::Limits) -> Result<Volume,
             }
         }
     }
-    Volume::new(spec.size, [1.0; 3], values).map_err(VolumeError::Invalid)
+    Volume::new(spec.size, [1.0; 3], values)
 }
 
 #[cfg(test)]

@@ -16,10 +16,11 @@ pub mod plot;
 
 pub use plot::{plot_lines, Chart};
 
+use crate::error::RenderResult;
 use std::path::Path;
 use std::time::Instant;
 
-use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target};
+use crate::gl::{Headless, ProgramKind, Surface, Target};
 use crate::image::Image;
 use crate::progress::{Bar, Unit};
 use crate::scene::Scene;
@@ -141,7 +142,7 @@ fn measure(
     prepared: &Prepared,
     kind: ProgramKind,
     frames: usize,
-) -> GlResult<(f64, Image)> {
+) -> RenderResult<(f64, Image)> {
     let gpu = headless.gpu();
     let [w, h] = scene.size;
     let target = Target::new(gpu, w, h, scene.target_format())?;

@@ -11,12 +11,14 @@ pub mod quad;
 pub mod rays;
 pub mod splats;
 
+use crate::error::RenderResult;
+use crate::gl::GlResult;
 use std::any::Any;
 use std::path::{Path, PathBuf};
 
 use crate::budget::Estimate;
 use crate::camera::{Camera, Projection};
-use crate::gl::{GlError, GlResult, Gpu, ProgramChoice, ProgramKind, Surface};
+use crate::gl::{GlError, Gpu, ProgramChoice, ProgramKind, Surface};
 use crate::programs::ProgramPair;
 use crate::vocab::{Fidelity, FieldError};
 use crate::volume::Limits;
@@ -45,10 +47,10 @@ impl Frame {
 /// renderers without it ([`Renderer::pending`]-style calls below).
 pub trait Renderer {
     /// Draw one frame onto `surface` (already cleared by the caller).
-    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()>;
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()>;
     /// Take changed parameters (the viewer's editors); resends what changed. Parameters
     /// of another technique are an error.
-    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()>;
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> RenderResult<()>;
     /// The program kind in use.
     fn program_kind(&self) -> ProgramKind;
     /// Whether its surface needs a depth buffer (opaque geometry with a depth test).
@@ -96,7 +98,7 @@ pub trait Streaming {
     /// The user is still at `camera` on an image of `size` (the viewer, once the camera
     /// stops): load what that view needs; true when a new part arrived (the picture must
     /// be drawn again).
-    fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> GlResult<bool> {
+    fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> RenderResult<bool> {
         let _ = (gpu, camera, size);
         Ok(false)
     }
@@ -113,7 +115,7 @@ pub trait DrawInParts {
         frame: &Frame,
         part: usize,
         parts: usize,
-    ) -> GlResult<()>;
+    ) -> RenderResult<()>;
 }
 
 /// Each capability asked of any renderer, with what a renderer without it does.
@@ -127,7 +129,7 @@ impl<'a> dyn Renderer + 'a {
         frame: &Frame,
         part: usize,
         parts: usize,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         match self.in_parts() {
             Some(renderer) => renderer.draw_part(gpu, surface, frame, part, parts),
             None if part == 0 => self.draw(gpu, surface, frame),
@@ -148,7 +150,7 @@ impl<'a> dyn Renderer + 'a {
     }
 
     /// [`Streaming::settle`]; false (nothing new) for a renderer that does not stream.
-    pub fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> GlResult<bool> {
+    pub fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> RenderResult<bool> {
         match self.streaming_mut() {
             Some(renderer) => renderer.settle(gpu, camera, size),
             None => Ok(false),
@@ -207,7 +209,7 @@ pub trait Technique: Any + Sized {
     type Prepared: Any;
     /// Check the parameters, then load and prepare the data (relative paths from
     /// `settings.base`) within `limits`.
-    fn prepare(&self, settings: &Settings<'_>, limits: &Limits) -> GlResult<Self::Prepared>;
+    fn prepare(&self, settings: &Settings<'_>, limits: &Limits) -> RenderResult<Self::Prepared>;
     /// The renderer of what [`Technique::prepare`] made, with programs of `kind`
     /// (`settings.programs` resolved).
     fn renderer(
@@ -216,7 +218,7 @@ pub trait Technique: Any + Sized {
         settings: &Settings<'_>,
         kind: ProgramKind,
         prepared: Self::Prepared,
-    ) -> GlResult<Box<dyn Renderer>>;
+    ) -> RenderResult<Box<dyn Renderer>>;
     /// Prepare (within the GL's largest 3D texture), then make the renderer; nothing else
     /// is created.
     fn build(
@@ -224,7 +226,7 @@ pub trait Technique: Any + Sized {
         gpu: &Gpu,
         settings: &Settings<'_>,
         kind: ProgramKind,
-    ) -> GlResult<Box<dyn Renderer>> {
+    ) -> RenderResult<Box<dyn Renderer>> {
         let limits = Limits::for_max_side(gpu.caps().max_3d_texture_size);
         let prepared = self.prepare(settings, &limits)?;
         self.renderer(gpu, settings, kind, prepared)

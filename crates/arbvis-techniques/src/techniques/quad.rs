@@ -9,11 +9,13 @@
 //! `c = mix(left, right, u)` with `left = program.local[0]`, `right = program.local[1]`,
 //! and outputs `(c.rgb * v, c.a)`. [`reference`] computes the same at pixel centres in f64.
 
+use crate::error::RenderResult;
+use crate::gl::GlResult;
 use glam::{DMat4, DVec3};
 use serde::{Deserialize, Serialize};
 
 use super::{Frame, Params, Renderer, Settings, Technique};
-use crate::gl::{self, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface};
+use crate::gl::{self, DrawCall, GlError, Gpu, Mesh, Program, ProgramKind, Surface};
 use crate::image::Image;
 use crate::programs;
 
@@ -49,7 +51,7 @@ impl Technique for QuadScene {
 
     type Prepared = ();
 
-    fn prepare(&self, _: &Settings<'_>, _: &crate::volume::Limits) -> GlResult<()> {
+    fn prepare(&self, _: &Settings<'_>, _: &crate::volume::Limits) -> RenderResult<()> {
         Ok(())
     }
 
@@ -59,7 +61,7 @@ impl Technique for QuadScene {
         _: &Settings<'_>,
         kind: ProgramKind,
         _: (),
-    ) -> GlResult<Box<dyn Renderer>> {
+    ) -> RenderResult<Box<dyn Renderer>> {
         Ok(Box::new(QuadRenderer::new(gpu, kind, self)?))
     }
 }
@@ -96,7 +98,7 @@ pub struct QuadRenderer {
 
 impl QuadRenderer {
     /// Compile the programs of `kind`, upload the quad, set the colours.
-    pub fn new(gpu: &Gpu, kind: ProgramKind, params: &QuadScene) -> GlResult<QuadRenderer> {
+    pub fn new(gpu: &Gpu, kind: ProgramKind, params: &QuadScene) -> RenderResult<QuadRenderer> {
         let pair = programs::with_transform(kind, &programs::QUAD_ARBFP, &programs::QUAD_FRAG);
         let program = Program::new(gpu, kind, &pair.vertex, &pair.fragment)?;
         let mesh = quad_mesh(gpu, "quad")?;
@@ -120,13 +122,17 @@ impl QuadRenderer {
 }
 
 impl Renderer for QuadRenderer {
-    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
         self.program.set_transform(gpu, transform(frame))?;
-        gl::draw(gpu, surface, &DrawCall::new(&self.program, &self.mesh))
+        Ok(gl::draw(
+            gpu,
+            surface,
+            &DrawCall::new(&self.program, &self.mesh),
+        )?)
     }
 
-    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
-        self.set_colours(gpu, params.get::<QuadScene>()?)
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> RenderResult<()> {
+        Ok(self.set_colours(gpu, params.get::<QuadScene>()?)?)
     }
 
     fn program_kind(&self) -> ProgramKind {

@@ -7,6 +7,7 @@
 //! otherwise the first of [`LAYOUTS`] whose numbers look like a grid in the file's first
 //! traces is taken, and rev 1's bytes where none does.
 
+use crate::vocab::FieldError;
 use std::collections::HashSet;
 use std::path::Path;
 
@@ -33,20 +34,23 @@ impl KeyBytes {
     }
 
     /// Each named byte holds a 4-byte integer inside the 240-byte trace header.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), FieldError> {
         for (name, b) in [("iline", self.iline), ("xline", self.xline)] {
             if let Some(b) = b {
                 if !(1..=237).contains(&b) {
-                    return Err(format!(
+                    return Err(FieldError::new("", format!(
                         "{name} = {b}: a 4-byte number's first byte in the 240-byte trace header, 1..=237"
-                    ));
+                    )));
                 }
             }
         }
         if self.iline.is_some() && self.iline == self.xline {
-            return Err(format!(
-                "iline and xline are both byte {}: they must differ",
-                self.iline.unwrap_or(0)
+            return Err(FieldError::new(
+                "",
+                format!(
+                    "iline and xline are both byte {}: they must differ",
+                    self.iline.unwrap_or(0)
+                ),
             ));
         }
         Ok(())
@@ -130,12 +134,10 @@ pub(crate) fn resolve(
     big: bool,
     mut header: impl FnMut(usize) -> Result<[u8; 240], VolumeError>,
 ) -> Result<Keys, VolumeError> {
-    named
-        .validate()
-        .map_err(|message| VolumeError::Unsupported {
-            path: path.into(),
-            message,
-        })?;
+    named.validate().map_err(|e| VolumeError::Unsupported {
+        path: path.into(),
+        message: e.message,
+    })?;
     if let (Some(iline), Some(xline)) = (named.iline, named.xline) {
         return Ok(Keys {
             iline,

@@ -416,7 +416,7 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
             bytes[at..at + TRACE_HEADER].try_into().ok()
         },
     );
-    let volume = Volume::new(dims, geometry.spacing, values).map_err(VolumeError::Invalid)?;
+    let volume = Volume::new(dims, geometry.spacing, values)?;
     Ok(SegyCube {
         volume,
         revision: h.revision,

@@ -147,13 +147,14 @@ pub enum Exit {
 impl Exit {
     /// Whether the exit is computed per vertex for `projection`; per vertex in perspective
     /// is an error (the seed's own caveat).
-    pub fn per_vertex(self, projection: Projection) -> Result<bool, String> {
+    pub fn per_vertex(self, projection: Projection) -> Result<bool, FieldError> {
         match (self, projection) {
             (Exit::Fragment, _) | (Exit::Auto, Projection::Perspective) => Ok(false),
             (Exit::Auto | Exit::Vertex, Projection::Orthographic) => Ok(true),
-            (Exit::Vertex, Projection::Perspective) => Err(
-                "exit = \"vertex\" needs an orthographic camera: in perspective the ray direction varies over a face, so the exit parameters are not affine (the seed computes them per fragment there)".into(),
-            ),
+            (Exit::Vertex, Projection::Perspective) => Err(FieldError::new(
+                "exit",
+                "\"vertex\" needs an orthographic camera: in perspective the ray direction varies over a face, so the exit parameters are not affine (the seed computes them per fragment there)",
+            )),
         }
     }
 }
@@ -301,9 +302,9 @@ impl crate::techniques::Technique for CellprojScene {
         &self,
         settings: &crate::techniques::Settings<'_>,
         _: &crate::volume::Limits,
-    ) -> crate::gl::GlResult<prepare::Prepared> {
-        CellprojScene::validate(self).map_err(|e| crate::gl::GlError::Data(e.to_string()))?;
-        prepare::prepare(self, settings.base).map_err(crate::gl::GlError::Data)
+    ) -> crate::error::RenderResult<prepare::Prepared> {
+        CellprojScene::validate(self)?;
+        prepare::prepare(self, settings.base)
     }
 
     fn renderer(
@@ -312,7 +313,7 @@ impl crate::techniques::Technique for CellprojScene {
         settings: &crate::techniques::Settings<'_>,
         kind: crate::gl::ProgramKind,
         prepared: prepare::Prepared,
-    ) -> crate::gl::GlResult<Box<dyn crate::techniques::Renderer>> {
+    ) -> crate::error::RenderResult<Box<dyn crate::techniques::Renderer>> {
         Ok(Box::new(CellprojRenderer::upload(
             gpu,
             kind,

@@ -7,8 +7,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::{first_crossed, CellprojScene, Isovalue};
+use crate::error::RenderResult;
 use crate::mesh::quality::{self, Quality};
-use crate::mesh::Mesh;
+use crate::mesh::{Mesh, MeshError};
 
 /// Floats per face vertex: position 3, scalar 1, opposite vertex 3, three normals 3
 /// each, gradient 3 (generic attributes 0..6, in this order).
@@ -98,9 +99,9 @@ pub const VERTEX_BYTES_PER_TET: u64 = 12 * FLOATS_PER_VERTEX as u64 * 4;
 
 /// Load and prepare a scene's mesh; relative paths from `base`. What was left out is
 /// told on stderr (one line).
-pub fn prepare(scene: &CellprojScene, base: &Path) -> Result<Prepared, String> {
-    let mesh = scene.mesh.load(base).map_err(|e| e.to_string())?;
-    let scalars = scene.scalars.evaluate(&mesh).map_err(|e| e.to_string())?;
+pub fn prepare(scene: &CellprojScene, base: &Path) -> RenderResult<Prepared> {
+    let mesh = scene.mesh.load(base)?;
+    let scalars = scene.scalars.evaluate(&mesh)?;
     let p = from_mesh(&mesh, &scalars.values, scalars.name, scalars.range)?;
     if let Some(note) = p.left_out(&mesh) {
         eprintln!("arbvis: note: {note}");
@@ -119,18 +120,25 @@ pub fn from_mesh(
     scalars: &[f64],
     scalar_name: String,
     scalar_range: [f64; 2],
-) -> Result<Prepared, String> {
+) -> RenderResult<Prepared> {
     if scalars.len() != mesh.points.len() {
-        return Err(format!(
+        return Err(MeshError::Invalid(format!(
             "{} scalars for {} points",
             scalars.len(),
             mesh.points.len()
-        ));
+        ))
+        .into());
     }
     if mesh.tets.is_empty() {
-        return Err(format!("{}: the mesh has no tetrahedra", mesh.info.source));
+        return Err(MeshError::Invalid(format!(
+            "{}: the mesh has no tetrahedra",
+            mesh.info.source
+        ))
+        .into());
     }
-    let (lo, hi) = mesh.bounds().ok_or("the mesh has no points")?;
+    let (lo, hi) = mesh
+        .bounds()
+        .ok_or_else(|| MeshError::Invalid("the mesh has no points".into()))?;
     let bounds = [lo, hi];
     let (lo, hi) = (DVec3::from_array(lo), DVec3::from_array(hi));
     // Halves first: `hi - lo` and `lo + hi` overflow near ±1.7e308, their halves do not.
@@ -178,7 +186,7 @@ pub fn from_mesh(
     let box_area = quality::box_area_scaled(&mesh.points, unit);
     let depth = if box_area > 0.0 { area / box_area } else { 0.0 };
     if depth > MAX_DEPTH {
-        return Err(format!(
+        return Err(MeshError::Invalid(format!(
             "{}: a line through the mesh crosses {depth:.0} of its {} drawn tetrahedra on average (the sum of their surface areas over the bounding box's), more than the {MAX_DEPTH} layers cell projection draws: its cells overlap or are plates across the whole mesh{}",
             mesh.info.source,
             tets.len(),
@@ -189,7 +197,8 @@ pub fn from_mesh(
                     mesh.source_cell.get(t).copied().unwrap_or(0),
                     mesh.source_cell.get(e).copied().unwrap_or(0)
                 ))
-        ));
+        ))
+        .into());
     }
     crate::budget::check(
         format!(
@@ -198,10 +207,9 @@ pub fn from_mesh(
             tets.len()
         ),
         crate::budget::times(tets.len() as u64, VERTEX_BYTES_PER_TET),
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     if tets.is_empty() {
-        return Err(format!(
+        return Err(MeshError::Invalid(format!(
             "{}: no tetrahedron to draw: of {}, {flat_dropped} are flat (degenerate: zero volume{}) and {dropped} touch a NaN or infinite scalar",
             mesh.info.source,
             mesh.tets.len(),
@@ -209,7 +217,8 @@ pub fn from_mesh(
                 ", the first is tetrahedron {t} of file cell {}",
                 mesh.source_cell.get(t).copied().unwrap_or(0)
             ))
-        ));
+        ))
+        .into());
     }
     Ok(Prepared {
         dropped,

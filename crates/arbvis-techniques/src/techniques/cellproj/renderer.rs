@@ -3,14 +3,16 @@
 //! the fidelity and exit variant; every frame is one draw with back-face culling and a
 //! depth test. Changing isovalues or colours rewrites only the table.
 
+use crate::error::RenderResult;
+use crate::gl::GlResult;
 use std::path::Path;
 
 use super::prepare::{iso_list, iso_table, prepare, Prepared, Viewer, VERTEX_COMPONENTS};
 use super::{CellprojScene, Depth, Order};
 use crate::camera::Projection;
 use crate::gl::{
-    self, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
-    ProgramText, Surface, TexelData, TexelFormat, Texture,
+    self, DrawCall, Extent, Filter, GlError, Gpu, Mesh, Program, ProgramKind, ProgramText, Surface,
+    TexelData, TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
 use crate::techniques::cellproj::locals;
@@ -42,11 +44,11 @@ pub fn variant(
     params: &CellprojScene,
     fidelity: Fidelity,
     projection: Projection,
-) -> GlResult<Variant> {
+) -> RenderResult<Variant> {
     if fidelity == Fidelity::Precise {
         return Ok(Variant::Precise);
     }
-    let per_vertex = params.exit.per_vertex(projection).map_err(GlError::Data)?;
+    let per_vertex = params.exit.per_vertex(projection)?;
     Ok(if per_vertex {
         Variant::PerVertex
     } else {
@@ -61,7 +63,7 @@ pub fn entry_depth_fragment(fragment: &ProgramText) -> ProgramText {
 }
 
 /// The program pair of a variant (precise exists only in GLSL: it loops).
-pub fn program_pair(variant: Variant, kind: ProgramKind) -> GlResult<ProgramPair> {
+pub fn program_pair(variant: Variant, kind: ProgramKind) -> RenderResult<ProgramPair> {
     use programs::*;
     let (vertex, fragment) = match (variant, kind) {
         (Variant::PerFragment, ProgramKind::Arb) => {
@@ -151,7 +153,11 @@ fn table_texture(gpu: &Gpu, params: &CellprojScene, fidelity: Fidelity) -> GlRes
 }
 
 /// The GL mesh of an order, and the CPU copy of the faces [`Order::View`] keeps.
-fn face_mesh(gpu: &Gpu, prepared: &Prepared, order: Order) -> GlResult<(Mesh, Option<Vec<f32>>)> {
+fn face_mesh(
+    gpu: &Gpu,
+    prepared: &Prepared,
+    order: Order,
+) -> RenderResult<(Mesh, Option<Vec<f32>>)> {
     let vertices = prepared.face_vertices();
     let label = "cellproj faces (4 per tetrahedron)";
     Ok(match order {
@@ -171,11 +177,9 @@ impl CellprojRenderer {
         fidelity: Fidelity,
         params: &CellprojScene,
         base: &Path,
-    ) -> GlResult<CellprojRenderer> {
-        params
-            .validate()
-            .map_err(|e| GlError::Data(e.to_string()))?;
-        let prepared = prepare(params, base).map_err(GlError::Data)?;
+    ) -> RenderResult<CellprojRenderer> {
+        params.validate()?;
+        let prepared = prepare(params, base)?;
         CellprojRenderer::upload(gpu, kind, fidelity, params, prepared, base)
     }
 
@@ -186,7 +190,7 @@ impl CellprojRenderer {
         fidelity: Fidelity,
         params: &CellprojScene,
         prepared: Prepared,
-    ) -> GlResult<CellprojRenderer> {
+    ) -> RenderResult<CellprojRenderer> {
         CellprojRenderer::upload(gpu, kind, fidelity, params, prepared, Path::new("."))
     }
 
@@ -199,7 +203,7 @@ impl CellprojRenderer {
         params: &CellprojScene,
         prepared: Prepared,
         base: &Path,
-    ) -> GlResult<CellprojRenderer> {
+    ) -> RenderResult<CellprojRenderer> {
         // Everything below works on normalized scalars and isovalues.
         let params = &params.normalized(prepared.scalar_range);
         let (mesh, faces) = if params.mode.isosurfaces() {
@@ -230,15 +234,13 @@ impl CellprojRenderer {
     }
 
     /// (Re)build the volume when the scene draws one.
-    fn build_volume(&mut self, gpu: &Gpu) -> GlResult<()> {
+    fn build_volume(&mut self, gpu: &Gpu) -> RenderResult<()> {
         self.volume = None;
         if !self.params.mode.volume() {
             return Ok(());
         }
         let spec = self.params.volume_spec();
-        let transfer = spec
-            .build(&self.base, self.prepared.scale)
-            .map_err(GlError::Data)?;
+        let transfer = spec.build(&self.base, self.prepared.scale)?;
         let isos = if self.params.mode == super::Mode::Both {
             self.params.isovalues.clone()
         } else {
@@ -266,7 +268,7 @@ impl CellprojRenderer {
 
     /// Choose the tetrahedra to draw (the active ones, or all): an index list for
     /// [`Order::Mesh`]; for [`Order::View`] the next draw rebuilds its buffer.
-    fn select_active(&mut self, gpu: &Gpu) -> GlResult<()> {
+    fn select_active(&mut self, gpu: &Gpu) -> RenderResult<()> {
         self.drawn = if !self.params.mode.isosurfaces() {
             Vec::new()
         } else if self.params.active_only {
@@ -287,7 +289,7 @@ impl CellprojRenderer {
     }
 
     /// For [`Order::View`], rebuild the face buffer when the viewer moved.
-    fn build_view(&mut self, gpu: &Gpu, frame: &Frame) -> GlResult<()> {
+    fn build_view(&mut self, gpu: &Gpu, frame: &Frame) -> RenderResult<()> {
         let Some(faces) = &self.faces else {
             return Ok(());
         };
@@ -318,7 +320,7 @@ impl CellprojRenderer {
 
     /// The program for `variant`, compiled on first use (a scene switching projection
     /// compiles the other one once).
-    fn program(&mut self, gpu: &Gpu, variant: Variant) -> GlResult<&Program> {
+    fn program(&mut self, gpu: &Gpu, variant: Variant) -> RenderResult<&Program> {
         let depth = self.params.depth;
         let pixel_rays = variant == Variant::Precise
             && match self.params.interpolation {
@@ -387,7 +389,7 @@ impl Renderer for CellprojRenderer {
         }
     }
 
-    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
         // Precise scenes drawing both find the isosurfaces in the volume's walk.
         let both_in_walk = self.fidelity == Fidelity::Precise
             && self.params.mode == super::Mode::Both
@@ -459,14 +461,14 @@ impl Renderer for CellprojRenderer {
         self.draw_volume(gpu, surface, frame)
     }
 
-    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> RenderResult<()> {
         let new = params.get::<CellprojScene>()?;
-        new.validate().map_err(|e| GlError::Data(e.to_string()))?;
+        new.validate()?;
         let new = &new.normalized(self.prepared.scalar_range);
         if new.mesh != self.params.mesh || new.scalars != self.params.scalars {
-            return Err(GlError::Invalid(
-                "a new mesh or scalar needs a new renderer".into(),
-            ));
+            return Err(
+                GlError::Invalid("a new mesh or scalar needs a new renderer".into()).into(),
+            );
         }
         let table_changed =
             new.isovalues != self.params.isovalues || new.table_size != self.params.table_size;
@@ -493,9 +495,7 @@ impl Renderer for CellprojRenderer {
         }
         if transfer_only {
             let spec = self.params.volume_spec();
-            let transfer = spec
-                .build(&self.base, self.prepared.scale)
-                .map_err(GlError::Data)?;
+            let transfer = spec.build(&self.base, self.prepared.scale)?;
             if let Some(v) = &mut self.volume {
                 v.set_transfer(&spec, transfer);
             }
@@ -539,7 +539,7 @@ impl Renderer for CellprojRenderer {
 }
 
 impl CellprojRenderer {
-    fn draw_volume(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+    fn draw_volume(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
         let depth = self.params.mode == super::Mode::Both;
         match &mut self.volume {
             Some(v) => v.draw(gpu, surface, frame, &self.prepared, depth),

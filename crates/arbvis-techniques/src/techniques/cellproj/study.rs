@@ -9,12 +9,13 @@
 
 pub mod volume;
 
+use crate::error::RenderResult;
 use crate::study::median;
 use crate::techniques::Params;
 use std::time::Instant;
 
 use crate::camera::{Camera, Projection};
-use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target};
+use crate::gl::{Headless, ProgramKind, Surface, Target};
 use crate::mesh::grid::{generate, Field, GridSpec};
 use crate::mesh::scalars::ScalarSpec;
 use crate::techniques::{Frame, Renderer};
@@ -120,7 +121,7 @@ fn measure(
     kind: ProgramKind,
     camera: Camera,
     options: &Options,
-) -> GlResult<(f64, f64, crate::image::Image, Vec<f32>)> {
+) -> RenderResult<(f64, f64, crate::image::Image, Vec<f32>)> {
     let gpu = headless.gpu();
     let [w, h] = options.size;
     let target = Target::with_depth(gpu, w, h, TargetFormat::Rgba8)?;
@@ -130,7 +131,7 @@ fn measure(
         width: w,
         height: h,
     };
-    let draw = |r: &mut CellprojRenderer| -> GlResult<f64> {
+    let draw = |r: &mut CellprojRenderer| -> RenderResult<f64> {
         let t0 = Instant::now();
         target.clear(gpu, [0.0, 0.0, 0.0, 1.0])?;
         r.draw(gpu, Surface::Target(&target), &frame)?;

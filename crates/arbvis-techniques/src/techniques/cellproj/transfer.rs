@@ -28,7 +28,7 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::colortable::TableSpec;
+use crate::colortable::{TableError, TableSpec};
 use crate::vocab::FieldError;
 
 /// `[technique.cellproj.volume]`.
@@ -252,7 +252,7 @@ impl VolumeSpec {
 
     /// The transfer function over normalized scalars; `scale` converts mesh units to the
     /// object box's (the unit distance is given in mesh units).
-    pub fn build(&self, base: &Path, scale: f64) -> Result<Transfer, String> {
+    pub fn build(&self, base: &Path, scale: f64) -> Result<Transfer, TableError> {
         let (s, rgba): (Vec<f64>, Vec<[f64; 4]>) = if self.points.is_empty() {
             let table = self.table.build(base)?;
             table

@@ -36,6 +36,8 @@
 //! eight entries at a time: a ray entering more often goes on in the next pass from the
 //! sum so far (two more RGBA32F targets, ping-pong), so no entry is ever dropped.
 
+use crate::error::RenderResult;
+use crate::gl::GlResult;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -48,8 +50,8 @@ use super::transfer::{Sort, Transfer, VolumeSpec};
 use super::Exit;
 use crate::camera::Projection;
 use crate::gl::{
-    self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
-    Surface, TexelData, TexelFormat, Texture,
+    self, Blend, DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, TexelData,
+    TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
 use crate::techniques::cellproj::locals;
@@ -264,7 +266,7 @@ impl VolumeRenderer {
         transfer: Transfer,
         prepared: &Prepared,
         isovalues: &[super::Isovalue],
-    ) -> GlResult<VolumeRenderer> {
+    ) -> RenderResult<VolumeRenderer> {
         let neighbours = neighbours(&prepared.tets);
         let convex = boundary_is_convex(prepared, &neighbours);
         let mut r = VolumeRenderer {
@@ -346,7 +348,7 @@ impl VolumeRenderer {
         }
     }
 
-    fn build_faithful(&self, gpu: &Gpu, kind: ProgramKind) -> GlResult<Faithful> {
+    fn build_faithful(&self, gpu: &Gpu, kind: ProgramKind) -> RenderResult<Faithful> {
         let pair = faithful_pair(kind, true);
         let per_vertex = match self.float_table {
             // Precise `table` guards the exit (see `volume_orthographic.frag`); faithful
@@ -386,7 +388,7 @@ impl VolumeRenderer {
         })
     }
 
-    fn build_projected(&self, gpu: &Gpu) -> GlResult<Faithful> {
+    fn build_projected(&self, gpu: &Gpu) -> RenderResult<Faithful> {
         let pair = &precise_pairs()[2];
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         let table = tf_texture(gpu, &self.transfer)?;
@@ -429,7 +431,7 @@ impl VolumeRenderer {
         old.precise == new.precise && old.grid == new.grid && old.grid_steps == new.grid_steps
     }
 
-    fn refresh(&mut self, gpu: &Gpu) -> GlResult<()> {
+    fn refresh(&mut self, gpu: &Gpu) -> RenderResult<()> {
         if !self.stale {
             return Ok(());
         }
@@ -496,7 +498,7 @@ impl VolumeRenderer {
         frame: &Frame,
         prepared: &Prepared,
         depth_test: bool,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         self.refresh(gpu)?;
         if self.faithful.is_some() {
             self.draw_faithful(gpu, surface, frame, prepared, depth_test)
@@ -532,13 +534,10 @@ impl VolumeRenderer {
         frame: &Frame,
         prepared: &Prepared,
         depth_test: bool,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         let v = viewer(frame);
         let per_vertex = match self.faithful.as_ref().expect("faithful").per_vertex {
-            Some(_) => self
-                .exit
-                .per_vertex(frame.camera.projection)
-                .map_err(GlError::Data)?,
+            Some(_) => self.exit.per_vertex(frame.camera.projection)?,
             None => false,
         };
         // Precise `table` per fragment draws each cell from its corners, one triangle
@@ -617,7 +616,7 @@ impl VolumeRenderer {
             false => &f.faces,
         };
         let mesh = mesh.as_ref().expect("made above");
-        gl::draw(
+        Ok(gl::draw(
             gpu,
             surface,
             &DrawCall {
@@ -627,6 +626,6 @@ impl VolumeRenderer {
                 cull_back: true,
                 ..DrawCall::new(program, mesh)
             },
-        )
+        )?)
     }
 }

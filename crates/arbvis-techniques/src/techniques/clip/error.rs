@@ -14,3 +14,17 @@ pub enum ClipError {
     #[error("{0}")]
     Invalid(String),
 }
+
+/// A program text the clip cannot be composed into.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ComposeError {
+    /// An ARB text without its header.
+    #[error("not an ARB fragment program (no !!ARBfp1.0 header)")]
+    NoArbHeader,
+    /// A GLSL text without the function the clip goes into.
+    #[error("no `{0}` in the GLSL text")]
+    NoFunction(String),
+    /// That function's header without a body.
+    #[error("`{0}` has no body")]
+    NoBody(String),
+}

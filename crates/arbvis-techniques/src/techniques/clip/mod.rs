@@ -52,7 +52,7 @@
 //! ratio falls as 1/N, the boundary's blocks lying on a surface (measured:
 //! docs/benchmarks.md, "Clipping").
 
-mod error;
+pub mod error;
 pub mod fast_winding;
 pub mod grid;
 pub mod mask_field;

@@ -20,12 +20,15 @@
 //! decided by the INDEX fetch alone). Faithful DATA and single textures are 8-bit (the
 //! era's LUMINANCE8), precise ones 32-bit float.
 
+use crate::error::RenderResult;
+use crate::gl::GlResult;
+use crate::techniques::clip::error::ComposeError;
 use glam::DVec3;
 
 use super::multires::{IndexEncoding, MultiRes};
 use super::texture::ClipTexture;
 use super::ClipTextures;
-use crate::gl::{Extent, Filter, GlResult, Gpu, Program, TexelData, TexelFormat, Texture};
+use crate::gl::{Extent, Filter, Gpu, Program, TexelData, TexelFormat, Texture};
 use crate::programs;
 use crate::vocab::Fidelity;
 
@@ -132,14 +135,14 @@ fn scalar_texture(
 impl ClipStage {
     /// Upload what the lookup of `textures` needs at `fidelity` (nothing else: the
     /// single-resolution texture is not uploaded when INDEX-DATA is used).
-    pub fn new(gpu: &Gpu, textures: &ClipTextures, fidelity: Fidelity) -> GlResult<ClipStage> {
+    pub fn new(gpu: &Gpu, textures: &ClipTextures, fidelity: Fidelity) -> RenderResult<ClipStage> {
         match &textures.multires {
             None => ClipStage::single(gpu, &textures.single, fidelity),
             Some(m) => ClipStage::multires(gpu, m, fidelity),
         }
     }
 
-    fn single(gpu: &Gpu, single: &ClipTexture, fidelity: Fidelity) -> GlResult<ClipStage> {
+    fn single(gpu: &Gpu, single: &ClipTexture, fidelity: Fidelity) -> RenderResult<ClipStage> {
         let t = scalar_texture(
             gpu,
             "clip single-resolution texture",
@@ -154,7 +157,7 @@ impl ClipStage {
         })
     }
 
-    fn multires(gpu: &Gpu, m: &MultiRes, fidelity: Fidelity) -> GlResult<ClipStage> {
+    fn multires(gpu: &Gpu, m: &MultiRes, fidelity: Fidelity) -> RenderResult<ClipStage> {
         let encoding = match fidelity {
             Fidelity::Faithful => IndexEncoding::SlotCentre,
             Fidelity::Precise => IndexEncoding::Offset,
@@ -202,7 +205,7 @@ impl ClipStage {
     }
 
     /// Send the lookup's constants to `program`'s fragment locals.
-    pub fn send(&self, gpu: &Gpu, program: &Program) -> GlResult<()> {
+    pub fn send(&self, gpu: &Gpu, program: &Program) -> RenderResult<()> {
         for (i, c) in &self.constants {
             program.set_local(gpu, *i, *c)?;
         }
@@ -223,18 +226,16 @@ impl ClipStage {
 
 /// The ARB program `text` with `prologue` inserted right after its `!!ARBfp1.0` header;
 /// the rest stays byte for byte.
-pub fn compose_arb(text: &str, prologue: &str) -> Result<String, String> {
+pub fn compose_arb(text: &str, prologue: &str) -> Result<String, ComposeError> {
     const HEADER: &str = "!!ARBfp1.0";
-    let body = text
-        .strip_prefix(HEADER)
-        .ok_or_else(|| "not an ARB fragment program (no !!ARBfp1.0 header)".to_string())?;
+    let body = text.strip_prefix(HEADER).ok_or(ComposeError::NoArbHeader)?;
     Ok(format!("{HEADER}\n{prologue}{body}"))
 }
 
 /// The GLSL program `text` with `function` inserted before `void main()`, the first
 /// statement of `main` discarding where `clip_value(coord) < 0.5`, and its
 /// `program_local` array widened to hold the clip's constants.
-pub fn compose_glsl(text: &str, function: &str, coord: &str) -> Result<String, String> {
+pub fn compose_glsl(text: &str, function: &str, coord: &str) -> Result<String, ComposeError> {
     compose_glsl_at(
         text,
         function,
@@ -252,14 +253,14 @@ pub fn compose_glsl_at(
     function: &str,
     signature: &str,
     statement: &str,
-) -> Result<String, String> {
+) -> Result<String, ComposeError> {
     let main = text
         .find(signature)
-        .ok_or_else(|| format!("no `{signature}` in the GLSL text"))?;
+        .ok_or_else(|| ComposeError::NoFunction(signature.to_string()))?;
     let open = text[main..]
         .find('{')
         .map(|o| main + o + 1)
-        .ok_or_else(|| format!("`{signature}` has no body"))?;
+        .ok_or_else(|| ComposeError::NoBody(signature.to_string()))?;
     let locals = format!("uniform vec4 program_local[{}];", crate::gl::MAX_LOCALS);
     let mut head = text[..main].to_string();
     match head.find("uniform vec4 program_local[") {

@@ -24,15 +24,17 @@
 //! The renderers see only resident bricks: [`BrickCache::texture`] or
 //! [`BrickCache::slot`] of a brick id.
 
+use crate::error::{RenderError, RenderResult};
 use std::collections::{HashMap, HashSet};
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use crate::gl::{Extent, Filter, GlResult, Gpu, TexelData, TexelFormat, Texture};
+use crate::gl::{Extent, Filter, Gpu, TexelData, TexelFormat, Texture};
 use crate::store::lod::BrickId;
 use crate::store::reader::Store;
+use crate::store::StoreError;
 use crate::volume::index_data::SlotGrid;
 use crate::volume::quantize::{quantize_level, NoData};
 
@@ -77,7 +79,7 @@ pub struct CacheStats {
 
 enum Reply {
     Loaded(BrickId, Vec<u8>),
-    Failed(BrickId, String),
+    Failed(BrickId, StoreError),
 }
 
 struct Slot {
@@ -100,7 +102,7 @@ pub struct BrickCache {
     slots: Vec<Slot>,
     resident: HashMap<BrickId, usize>,
     asked: HashSet<BrickId>,
-    failed: HashMap<BrickId, String>,
+    failed: HashMap<BrickId, Arc<StoreError>>,
     frame: u64,
     requests: Option<Sender<Vec<BrickId>>>,
     replies: Receiver<Reply>,
@@ -247,7 +249,7 @@ impl BrickCache {
 
     /// Upload bricks that have arrived (without waiting) until `time` has passed;
     /// returns how many.
-    pub fn receive(&mut self, gpu: &Gpu, time: Duration) -> GlResult<usize> {
+    pub fn receive(&mut self, gpu: &Gpu, time: Duration) -> RenderResult<usize> {
         let start = std::time::Instant::now();
         let mut n = 0;
         while n == 0 || start.elapsed() < time {
@@ -264,7 +266,7 @@ impl BrickCache {
 
     /// Wait until every brick of `ids` is resident or failed (asking for the missing ones);
     /// `ids` must fit the cache.
-    pub fn ensure(&mut self, gpu: &Gpu, ids: &[BrickId]) -> GlResult<()> {
+    pub fn ensure(&mut self, gpu: &Gpu, ids: &[BrickId]) -> RenderResult<()> {
         for &id in ids {
             self.touch(id);
         }
@@ -284,20 +286,16 @@ impl BrickCache {
                     self.take(gpu, reply)?;
                     self.touch(id);
                 }
-                Err(_) => {
-                    return Err(crate::gl::GlError::Data(
-                        "the brick loader stopped answering".into(),
-                    ))
-                }
+                Err(_) => return Err(RenderError::Stalled("the brick loader stopped answering")),
             }
         }
     }
 
-    fn take(&mut self, gpu: &Gpu, reply: Reply) -> GlResult<()> {
+    fn take(&mut self, gpu: &Gpu, reply: Reply) -> RenderResult<()> {
         match reply {
             Reply::Failed(id, e) => {
                 self.asked.remove(&id);
-                self.failed.insert(id, e);
+                self.failed.insert(id, Arc::new(e));
                 Ok(())
             }
             Reply::Loaded(id, texels) => {
@@ -334,7 +332,7 @@ impl BrickCache {
 
     /// A new slot while under the budget, else the least recently used one not drawn
     /// this frame.
-    fn free_slot(&mut self, gpu: &Gpu) -> GlResult<Option<usize>> {
+    fn free_slot(&mut self, gpu: &Gpu) -> RenderResult<Option<usize>> {
         if self.slots.len() < self.capacity {
             let s = self.side as u32;
             let texture = match &mut self.atlas {
@@ -376,8 +374,8 @@ impl BrickCache {
     }
 
     /// The first load error of `id`.
-    pub fn error(&self, id: BrickId) -> Option<&str> {
-        self.failed.get(&id).map(String::as_str)
+    pub fn error(&self, id: BrickId) -> Option<Arc<StoreError>> {
+        self.failed.get(&id).cloned()
     }
 
     /// Counts for `--stats` and the viewer.
@@ -397,7 +395,7 @@ impl BrickCache {
             evicted: self.evicted,
             loading: self.asked.len(),
             failed: self.failed.len(),
-            first_error: self.failed.values().next().cloned(),
+            first_error: self.failed.values().next().map(|e| e.to_string()),
         }
     }
 }
@@ -412,7 +410,7 @@ impl Drop for BrickCache {
 }
 
 /// Read and pack one brick: each channel's attribute with its border, quantized.
-pub fn pack_brick(store: &Store, packing: &Packing, id: BrickId) -> Result<Vec<u8>, String> {
+pub fn pack_brick(store: &Store, packing: &Packing, id: BrickId) -> Result<Vec<u8>, StoreError> {
     let side = store.meta.brick + 2;
     let mut texels = vec![0u8; Packing::brick_bytes(side)];
     let c = id.c.map(|x| x as usize);
@@ -420,9 +418,7 @@ pub fn pack_brick(store: &Store, packing: &Packing, id: BrickId) -> Result<Vec<u
         let Some((attr, low, high, no_data)) = *p else {
             continue;
         };
-        let values = store
-            .brick(attr, id.level as usize, c)
-            .map_err(|e| e.to_string())?;
+        let values = store.brick(attr, id.level as usize, c)?;
         for (t, &v) in texels.chunks_exact_mut(3).zip(&values) {
             t[ch] = quantize_level(v, low, high, no_data);
         }

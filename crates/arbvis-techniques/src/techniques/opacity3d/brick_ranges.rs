@@ -7,7 +7,7 @@
 //! union of its children's ranges, so that leaving out a brick that looks transparent
 //! never leaves out a visible brick under it.
 
-use crate::store::Store;
+use crate::store::{Store, StoreError};
 use crate::volume::quantize::{quantize_level, NoData};
 
 /// Per brick of one level (x fastest), per attribute, the lowest and highest quantized
@@ -23,7 +23,7 @@ pub type StoreAttribute = (usize, f64, f64, NoData);
 pub fn brick_ranges(
     store: &Store,
     attrs: &[Option<StoreAttribute>; 3],
-) -> Result<Vec<LevelRanges>, String> {
+) -> Result<Vec<LevelRanges>, StoreError> {
     let meta = &store.meta;
     let counts: Vec<[usize; 3]> = (0..meta.levels).map(|l| meta.brick_counts(l)).collect();
     let mut levels = Vec::with_capacity(meta.levels);
@@ -33,7 +33,7 @@ pub fn brick_ranges(
             let Some((index, low, high, no_data)) = *at else {
                 continue;
             };
-            let ranges = store.ranges(index, level).map_err(|e| e.to_string())?;
+            let ranges = store.ranges(index, level)?;
             let quantize = |v: f32| quantize_level(v, low, high, no_data);
             let grown = grown_by_neighbours(&ranges, level_counts, quantize);
             for (brick, (lo, hi)) in per.iter_mut().zip(grown) {

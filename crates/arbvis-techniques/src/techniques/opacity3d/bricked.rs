@@ -40,6 +40,7 @@
 //! draws what is resident (stand-ins for what is not), asks for the rest, and refines over
 //! the next frames.
 
+use crate::error::{RenderError, RenderResult};
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -50,12 +51,14 @@ use serde::{Deserialize, Serialize};
 use super::paged::{PageTable, PagedPass};
 use super::prepare::CHANNEL;
 use super::programs::faithful_pair;
-use super::renderer::{eye, model_view_projection, neutral_table, table_texture, toward_viewer};
+use super::proxy::{eye, toward_viewer};
+use super::renderer::model_view_projection;
 use super::slicing::{polygon, EDGES};
+use super::textures::{neutral_table, table_texture};
 use super::{coefficients, Combine, Opacity3dScene, ATTRIBUTE_NAMES};
 use crate::camera::Projection;
 use crate::gl::{
-    self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface, Texture,
+    self, Blend, DrawCall, GlError, Gpu, Mesh, Program, ProgramKind, Surface, Texture,
 };
 use crate::store::lod::{self, BrickId, Pyramid, View};
 use crate::store::Store;
@@ -96,7 +99,8 @@ impl Default for StoreView {
 impl StoreView {
     /// Check the values; errors name the key under `store`.
     pub fn validate(&self) -> Result<(), FieldError> {
-        crate::budget::parse(&self.gpu_memory).map_err(|e| FieldError::new("gpu_memory", e))?;
+        crate::budget::parse(&self.gpu_memory)
+            .map_err(|e| FieldError::new("gpu_memory", e.to_string()))?;
         if !(self.pixels.is_finite() && self.pixels > 0.0 && self.pixels <= 1e6) {
             return Err(FieldError::new(
                 "pixels",
@@ -116,7 +120,13 @@ impl StoreView {
 }
 
 /// The store a scene's attributes name, if any (all must name the same one).
-pub fn store_of(params: &Opacity3dScene) -> Result<Option<PathBuf>, String> {
+pub fn store_of(params: &Opacity3dScene) -> Result<Option<PathBuf>, FieldError> {
+    let mixed = || {
+        FieldError::new(
+            "",
+            "every attribute of a scene drawn from a store must name the same store",
+        )
+    };
     let paths: Vec<Option<&PathBuf>> = params
         .attributes()
         .iter()
@@ -131,12 +141,10 @@ pub fn store_of(params: &Opacity3dScene) -> Result<Option<PathBuf>, String> {
             if paths.iter().all(|p| *p == Some(*first)) {
                 Ok(Some((*first).clone()))
             } else {
-                Err("every attribute of a scene drawn from a store must name the same store".into())
+                Err(mixed())
             }
         }
-        _ if paths.iter().any(Option::is_some) => {
-            Err("every attribute of a scene drawn from a store must name the same store".into())
-        }
+        _ if paths.iter().any(Option::is_some) => Err(mixed()),
         _ => Ok(None),
     }
 }
@@ -157,19 +165,23 @@ pub struct StoreScene {
 
 impl StoreScene {
     /// Open the store `params` names (relative to `base`), if it names one.
-    pub fn open(params: &Opacity3dScene, base: &Path) -> Result<Option<StoreScene>, String> {
+    pub fn open(params: &Opacity3dScene, base: &Path) -> RenderResult<Option<StoreScene>> {
         let Some(path) = store_of(params)? else {
             return Ok(None);
         };
-        let store = Arc::new(Store::open(&base.join(&path)).map_err(|e| e.to_string())?);
+        let store = Arc::new(Store::open(&base.join(&path))?);
         let view = params.store.clone().unwrap_or_default();
         let meta = &store.meta;
         let window = view.window.unwrap_or([[0; 3], meta.dims]);
         if (0..3).any(|a| window[1][a] > meta.dims[a]) {
-            return Err(format!(
-                "store.window {window:?} reaches beyond the survey's {:?} voxels",
-                meta.dims
-            ));
+            return Err(FieldError::new(
+                "store.window",
+                format!(
+                    "{window:?} reaches beyond the survey's {:?} voxels",
+                    meta.dims
+                ),
+            )
+            .into());
         }
         let pyramid = Pyramid {
             dims: meta.dims,
@@ -183,16 +195,17 @@ impl StoreScene {
             let Some(attr) = attr else { continue };
             let index = store
                 .attribute_index(attr.attribute.name())
-                .map_err(|e| format!("{}: {e}", ATTRIBUTE_NAMES[a]))?;
+                .map_err(|e| RenderError::from(e).of_attribute(ATTRIBUTE_NAMES[a]))?;
             let am = &meta.attributes[index];
             let (low, high) = match attr.quantize {
                 Quantization::MinMax => (am.min.unwrap_or(0.0), am.max.unwrap_or(0.0)),
                 Quantization::Range([l, h]) => (l, h),
                 Quantization::Percentile(_) => {
-                    return Err(format!(
-                        "{}.quantize: percentiles of a store are not computed; use \"min-max\" or {{ range = [low, high] }}",
-                        ATTRIBUTE_NAMES[a]
-                    ))
+                    return Err(FieldError::new(
+                        format!("{}.quantize", ATTRIBUTE_NAMES[a]),
+                        "percentiles of a store are not computed; use \"min-max\" or { range = [low, high] }",
+                    )
+                    .into())
                 }
             };
             attributes[a] = Some((index, low, high));
@@ -248,28 +261,25 @@ impl BrickedRenderer {
         params: &Opacity3dScene,
         base: &Path,
         gpu_memory: Option<u64>,
-    ) -> GlResult<BrickedRenderer> {
-        params
-            .validate()
-            .map_err(|e| GlError::Data(e.to_string()))?;
+    ) -> RenderResult<BrickedRenderer> {
+        params.validate()?;
         if fidelity == Fidelity::Precise && kind == ProgramKind::Arb {
             return Err(GlError::Unsupported(
                 "a store in precise mode is drawn by a ray caster through its page table, which is GLSL only (ARB fragment programs have no loops): use programs = \"glsl\" or fidelity = \"faithful\"".into(),
-            ));
+            ).into());
         }
         if params.clip.is_some() {
-            return Err(GlError::Unsupported(
-                "a clip object on a store is not supported".into(),
-            ));
+            return Err(
+                GlError::Unsupported("a clip object on a store is not supported".into()).into(),
+            );
         }
         let StoreScene {
             store,
             view,
             pyramid,
             attributes,
-        } = StoreScene::open(params, base)
-            .map_err(GlError::Data)?
-            .ok_or_else(|| GlError::Data("the scene names no store".into()))?;
+        } = StoreScene::open(params, base)?
+            .ok_or_else(|| GlError::Invalid("the scene names no store".into()))?;
         let meta = &store.meta;
         let mut channels = [None; 3];
         let mut attrs = [None; 3];
@@ -281,8 +291,7 @@ impl BrickedRenderer {
                 let alpha: Vec<u8> = match scene_attrs[a] {
                     Some(attr) => attr
                         .table
-                        .build(base)
-                        .map_err(GlError::Data)?
+                        .build(base)?
                         .entries
                         .iter()
                         .map(|e| e[3])
@@ -297,7 +306,7 @@ impl BrickedRenderer {
         }
         let budget = match gpu_memory {
             Some(b) => b,
-            None => crate::budget::parse(&view.gpu_memory).map_err(GlError::Data)?,
+            None => crate::budget::parse(&view.gpu_memory)?,
         };
         let cache = match fidelity {
             Fidelity::Faithful => BrickCache::new(
@@ -321,7 +330,7 @@ impl BrickedRenderer {
             }
         };
         // Which levels each brick may hold: what lets `draw` leave out clear bricks.
-        let levels = super::brick_ranges::brick_ranges(&store, &attrs).map_err(GlError::Data)?;
+        let levels = super::brick_ranges::brick_ranges(&store, &attrs)?;
         let pair = faithful_pair(kind, params.combine);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         let paged = match fidelity {
@@ -355,11 +364,11 @@ impl BrickedRenderer {
         Ok(r)
     }
 
-    fn build_tables(&mut self, gpu: &Gpu) -> GlResult<()> {
+    fn build_tables(&mut self, gpu: &Gpu) -> RenderResult<()> {
         for (a, attr) in self.params.attributes().into_iter().enumerate() {
             match attr {
                 Some(attr) => {
-                    let mut t = attr.table.build(&self.base).map_err(GlError::Data)?;
+                    let mut t = attr.table.build(&self.base)?;
                     if self.no_data[a] == NoData::Reserved {
                         t.entries[0] = [0; 4];
                     }
@@ -537,7 +546,7 @@ impl BrickedRenderer {
         surface: Surface<'_>,
         frame: &Frame,
         order: &[BrickId],
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         let (vertices, ranges) = self.slices(frame, order);
         if vertices.is_empty() {
             return Ok(());
@@ -588,7 +597,7 @@ impl BrickedRenderer {
         surface: Surface<'_>,
         frame: &Frame,
         view: &View,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         let capacity = self.cache.capacity();
         self.cache.begin_frame();
         let drawn = if self.streaming {
@@ -620,19 +629,14 @@ impl BrickedRenderer {
         } else {
             let wanted = self.wanted(view, capacity);
             if wanted.len() > capacity {
-                return Err(GlError::Data(format!(
-                    "the precise ray caster draws in one pass and needs its {} bricks resident at once, more than the {capacity} the GPU budget holds: raise --gpu-memory (or store.gpu_memory), or draw a coarser level",
-                    wanted.len()
-                )));
+                return Err(RenderError::GpuBudget {
+                    bricks: wanted.len(),
+                    capacity,
+                });
             }
             self.cache.ensure(gpu, &wanted)?;
-            if let Some(id) = wanted.iter().find(|&&id| self.cache.has_failed(id)) {
-                return Err(GlError::Data(
-                    self.cache
-                        .error(*id)
-                        .unwrap_or("a brick failed")
-                        .to_string(),
-                ));
+            if let Some(e) = wanted.iter().find_map(|&id| self.cache.error(id)) {
+                return Err(e.into());
             }
             self.last = (wanted.len(), wanted.len(), 0);
             wanted
@@ -705,7 +709,7 @@ fn cut(b: [DVec3; 2], d: &[f64], t: f64, u: DVec3, v: DVec3) -> Vec<DVec3> {
 }
 
 impl Renderer for BrickedRenderer {
-    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
         let view = self.view_of(frame);
         if self.paged.is_some() {
             return self.draw_paged(gpu, surface, frame, &view);
@@ -731,22 +735,17 @@ impl Renderer for BrickedRenderer {
         for batch in order.chunks(self.cache.capacity()) {
             self.cache.begin_frame();
             self.cache.ensure(gpu, batch)?;
-            if let Some(id) = batch.iter().find(|&&id| self.cache.has_failed(id)) {
-                return Err(GlError::Data(
-                    self.cache
-                        .error(*id)
-                        .unwrap_or("a brick failed")
-                        .to_string(),
-                ));
+            if let Some(e) = batch.iter().find_map(|&id| self.cache.error(id)) {
+                return Err(e.into());
             }
             self.draw_bricks(gpu, surface, frame, batch)?;
         }
         Ok(())
     }
 
-    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> RenderResult<()> {
         let new = params.get::<Opacity3dScene>()?;
-        new.validate().map_err(|e| GlError::Data(e.to_string()))?;
+        new.validate()?;
         let data = |p: &Opacity3dScene| {
             (
                 p.attributes()

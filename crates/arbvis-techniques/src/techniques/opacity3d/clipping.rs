@@ -24,13 +24,14 @@
 //! the seed found, INDEX-DATA is slower than the single texture (two dependent fetches);
 //! on the ray caster, whose samples all pay the lookup, the two cost alike.
 
+use crate::error::{RenderError, RenderResult};
 use std::borrow::Cow;
 use std::path::Path;
 use std::time::Instant;
 
 use super::prepare::Prepared;
 use super::Path3d;
-use crate::gl::{GlError, GlResult, Gpu, ProgramKind, ProgramText};
+use crate::gl::{Gpu, ProgramKind, ProgramText};
 use crate::programs::ProgramPair;
 use crate::techniques::clip::multires::IndexEncoding;
 use crate::techniques::clip::stage::{
@@ -70,12 +71,10 @@ pub fn build(
     base: &Path,
     prepared: &Prepared,
     fidelity: Fidelity,
-) -> GlResult<Clip> {
+) -> RenderResult<Clip> {
     let start = Instant::now();
     let max = gpu.caps().max_3d_texture_size.max(1) as usize;
-    let textures = spec
-        .build(base, prepared.dims, prepared.half.to_array(), max)
-        .map_err(|e| GlError::Data(format!("clip: {e}")))?;
+    let textures = spec.build(base, prepared.dims, prepared.half.to_array(), max)?;
     let stage = ClipStage::new(gpu, &textures, fidelity)?;
     let stats = ClipStats::of(&textures, fidelity, start.elapsed().as_secs_f64());
     Ok(Clip {
@@ -94,7 +93,7 @@ pub fn compose(
     stage: &ClipStage,
     path: Path3d,
     exact: bool,
-) -> GlResult<ProgramPair> {
+) -> RenderResult<ProgramPair> {
     let text = &pair.fragment.text;
     let function = match exact {
         true => glsl_function_exact(stage.lookup),
@@ -110,7 +109,10 @@ pub fn compose(
             "if (clip_value(tc) < 0.5) return vec4(0.0);",
         ),
     }
-    .map_err(|e| GlError::Invalid(format!("clip composition of {}: {e}", pair.fragment.name)))?;
+    .map_err(|source| RenderError::Compose {
+        program: pair.fragment.name.to_string(),
+        source,
+    })?;
     Ok(ProgramPair {
         fragment: ProgramText {
             name: Cow::Owned(format!("{} + clip {:?}", pair.fragment.name, stage.lookup)),

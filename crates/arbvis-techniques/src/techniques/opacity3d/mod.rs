@@ -53,6 +53,7 @@ pub mod brick_cache;
 pub mod brick_ranges;
 pub mod bricked;
 pub mod bricks;
+pub mod changes;
 pub mod clipping;
 pub mod locals;
 pub mod mirror;
@@ -60,9 +61,11 @@ pub mod paged;
 pub mod preint;
 pub mod prepare;
 pub mod programs;
+pub mod proxy;
 pub mod reference;
 pub mod renderer;
 pub mod slicing;
+pub mod textures;
 
 use serde::{Deserialize, Serialize};
 
@@ -238,17 +241,12 @@ impl crate::techniques::Technique for Opacity3dScene {
         &self,
         settings: &crate::techniques::Settings<'_>,
         limits: &crate::volume::Limits,
-    ) -> crate::gl::GlResult<Option<prepare::Prepared>> {
-        if bricked::store_of(self)
-            .map_err(crate::gl::GlError::Data)?
-            .is_some()
-        {
+    ) -> crate::error::RenderResult<Option<prepare::Prepared>> {
+        if bricked::store_of(self)?.is_some() {
             return Ok(None);
         }
-        Opacity3dScene::validate(self).map_err(|e| crate::gl::GlError::Data(e.to_string()))?;
-        prepare::prepare(self, settings.base, limits)
-            .map(Some)
-            .map_err(crate::gl::GlError::Data)
+        Opacity3dScene::validate(self)?;
+        prepare::prepare(self, settings.base, limits).map(Some)
     }
 
     /// A survey store is drawn brick by brick ([`bricked::BrickedRenderer`]; precise
@@ -259,7 +257,7 @@ impl crate::techniques::Technique for Opacity3dScene {
         settings: &crate::techniques::Settings<'_>,
         kind: crate::gl::ProgramKind,
         prepared: Option<prepare::Prepared>,
-    ) -> crate::gl::GlResult<Box<dyn crate::techniques::Renderer>> {
+    ) -> crate::error::RenderResult<Box<dyn crate::techniques::Renderer>> {
         let fidelity = settings.fidelity;
         let Some(prepared) = prepared else {
             let kind = if fidelity == Fidelity::Precise && settings.programs == ProgramChoice::Auto

@@ -31,15 +31,17 @@
 //! bricks than fit is refused with the count), and streaming draws what is resident with
 //! the nearest resident ancestors standing in.
 
+use crate::error::RenderResult;
+use crate::gl::GlResult;
 use glam::DVec3;
 
 use super::locals;
 use super::programs::{raycast_pair, InShader, Variant};
-use super::renderer::{eye, far_faces, toward_viewer};
+use super::proxy::{eye, far_faces, toward_viewer};
 use super::{corrected, Combine, Opacity3dScene};
 use crate::camera::Projection;
 use crate::gl::{
-    self, Blend, DrawCall, GlResult, Gpu, Mesh, Program, Surface, TexelData, TexelFormat, Texture,
+    self, Blend, DrawCall, Gpu, Mesh, Program, Surface, TexelData, TexelFormat, Texture,
 };
 use crate::store::lod::{BrickId, Pyramid};
 use crate::techniques::Frame;
@@ -141,7 +143,7 @@ fn program(
 
 impl PagedPass {
     /// The pass for `params` (GLSL: ARB fragment programs have no loops).
-    pub fn new(gpu: &Gpu, params: &Opacity3dScene) -> GlResult<PagedPass> {
+    pub fn new(gpu: &Gpu, params: &Opacity3dScene) -> RenderResult<PagedPass> {
         let present = params.attributes().map(|a| a.is_some());
         let projection = Projection::Orthographic;
         let filter = super::renderer::shader_filter(gpu, params, crate::vocab::Fidelity::Precise)?;
@@ -157,7 +159,7 @@ impl PagedPass {
     }
 
     /// The program, rebuilt when the combination changed.
-    pub fn program_for(&mut self, gpu: &Gpu, params: &Opacity3dScene) -> GlResult<&Program> {
+    pub fn program_for(&mut self, gpu: &Gpu, params: &Opacity3dScene) -> RenderResult<&Program> {
         let present = params.attributes().map(|a| a.is_some());
         let filter = super::renderer::shader_filter(gpu, params, crate::vocab::Fidelity::Precise)?;
         if params.combine != self.combine || present != self.present || filter != self.filter {
@@ -182,7 +184,7 @@ impl PagedPass {
         atlas: (&Texture, SlotGrid),
         table: &PageTable,
         tables: &[(u32, &Texture)],
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         if frame.camera.projection != self.projection {
             self.projection = frame.camera.projection;
             self.program = program(
@@ -279,7 +281,7 @@ impl PagedPass {
         let mut textures: Vec<(u32, &Texture)> =
             vec![(super::renderer::VOLUME_UNIT, atlas.0), (PAGE_UNIT, page)];
         textures.extend_from_slice(tables);
-        gl::draw(
+        Ok(gl::draw(
             gpu,
             surface,
             &DrawCall {
@@ -288,7 +290,7 @@ impl PagedPass {
                 cull_back: true,
                 ..DrawCall::new(&self.program, mesh)
             },
-        )
+        )?)
     }
 }
 

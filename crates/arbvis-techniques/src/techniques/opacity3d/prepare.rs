@@ -8,9 +8,11 @@ use glam::DVec3;
 
 use super::{AttributeScene, Opacity3dScene};
 use crate::colortable::ColorTable;
+use crate::error::{RenderError, RenderResult};
+use crate::vocab::FieldError;
 use crate::volume::attributes::derive;
 use crate::volume::quantize::{quantize_level, quantize_value, range, NoData, Quantization};
-use crate::volume::{Limits, Volume, VolumeSource};
+use crate::volume::{Limits, Volume, VolumeError, VolumeSource};
 
 /// Everything the renderer uploads, and the CPU references read.
 #[derive(Debug, Clone, PartialEq)]
@@ -119,10 +121,10 @@ pub fn pack(quantized: [Option<&[u8]>; 3], voxels: usize) -> Vec<u8> {
 /// take a level the table makes transparent ([`NoData`]).
 pub fn from_volumes(
     attributes: [Option<(&Volume, Quantization, ColorTable)>; 3],
-) -> Result<Prepared, String> {
+) -> RenderResult<Prepared> {
     let first = attributes[0]
         .as_ref()
-        .ok_or("the primary attribute is required")?
+        .ok_or_else(|| FieldError::new("primary", "the primary attribute is required"))?
         .0;
     let names = super::ATTRIBUTE_NAMES;
     let mut quantized: [Option<Vec<u8>>; 3] = Default::default();
@@ -134,12 +136,14 @@ pub fn from_volumes(
             continue;
         };
         if volume.dims != first.dims {
-            return Err(format!(
+            return Err(VolumeError::Invalid(format!(
                 "the {} volume is {:?} but the primary is {:?}: all attributes must share one grid",
                 names[a], volume.dims, first.dims
-            ));
+            ))
+            .into());
         }
-        let (low, high) = range(volume, how).map_err(|e| format!("{}: {e}", names[a]))?;
+        let (low, high) =
+            range(volume, how).map_err(|e| RenderError::from(e).of_attribute(names[a]))?;
         let alpha: Vec<u8> = table.entries.iter().map(|e| e[3]).collect();
         no_data[a] = NoData::choose(volume.values.iter().any(|v| v.is_nan()), &alpha);
         if no_data[a] == NoData::Reserved {
@@ -167,7 +171,7 @@ pub fn from_volumes(
 
 /// The table's alpha from the distribution of `volume`'s levels over its quantization
 /// range ([`crate::colortable::alpha_from_histogram`]); NaN samples (no data) are left out.
-fn alpha_from_data(volume: &Volume, how: Quantization) -> Result<[u8; 256], String> {
+fn alpha_from_data(volume: &Volume, how: Quantization) -> Result<[u8; 256], VolumeError> {
     let (low, high) = range(volume, how)?;
     let mut counts = [0u64; 256];
     for &v in volume.values.iter().filter(|v| !v.is_nan()) {
@@ -178,7 +182,7 @@ fn alpha_from_data(volume: &Volume, how: Quantization) -> Result<[u8; 256], Stri
 
 /// Prepare a scene: load each distinct source once (its size checked against `limits`
 /// before loading), derive, quantize, pack, build tables.
-pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> Result<Prepared, String> {
+pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> RenderResult<Prepared> {
     let mut loaded: Vec<(VolumeSource, Volume)> = Vec::new();
     let mut derived: [Option<Volume>; 3] = Default::default();
     let mut tables: [Option<ColorTable>; 3] = Default::default();
@@ -196,7 +200,7 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> Result<P
         let index = match loaded.iter().position(|(s, _)| s == volume) {
             Some(i) => i,
             None => {
-                let v = volume.load(base, limits).map_err(|e| e.to_string())?;
+                let v = volume.load(base, limits)?;
                 loaded.push((volume.clone(), v));
                 loaded.len() - 1
             }
@@ -207,7 +211,10 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> Result<P
         tables[a] = Some(
             table
                 .build(base)
-                .map_err(|e| format!("{} table: {e}", names[a]))?,
+                .map_err(|source| RenderError::AttributeTable {
+                    attribute: names[a],
+                    source,
+                })?,
         );
     }
     // Alpha from each attribute's own distribution, where its table asks for it.
@@ -218,8 +225,8 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> Result<P
         };
         let survey = matches!(attr.volume, VolumeSource::Segy(_));
         if attr.table.wants_alpha_from_data(survey) {
-            let alpha =
-                alpha_from_data(volume, attr.quantize).map_err(|e| format!("{}: {e}", names[a]))?;
+            let alpha = alpha_from_data(volume, attr.quantize)
+                .map_err(|e| RenderError::from(e).of_attribute(names[a]))?;
             for (entry, alpha) in table.entries.iter_mut().zip(alpha) {
                 entry[3] = alpha;
             }
@@ -308,6 +315,7 @@ mod tests {
             None,
         ])
         .unwrap_err();
+        let e = e.to_string();
         assert!(e.contains("secondary") && e.contains("one grid"), "{e}");
     }
 }

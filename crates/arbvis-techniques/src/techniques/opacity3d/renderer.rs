@@ -11,25 +11,28 @@
 //! With a clip ([`super::clipping`]) every program has the clip test composed in and the
 //! clip's textures sit on units 7 and 8.
 
+use crate::error::RenderResult;
 use std::path::{Path, PathBuf};
 
-use glam::{DMat4, DVec3};
+use glam::DMat4;
 
 use super::bricks::Bricks;
+use super::changes::Changes;
 use super::clipping::{self, Clip};
 use super::locals;
 use super::prepare::{prepare, Prepared};
 pub use super::programs::faithful_pair;
 use super::programs::{raycast_pair, slicing_pair, InShader, Variant};
-use super::slicing::slice_box;
+use super::proxy::{eye, toward_viewer, Proxy};
+use super::textures::unit_filter;
+use super::textures::{neutral_table, table_texture, uses_neighbours, volume_texture};
 use super::Interpolation;
 pub use super::{coefficients, corrected, path, preintegrated, Path3d};
 use super::{Combine, Opacity3dScene};
 use crate::camera::Projection;
-use crate::colortable::ColorTable;
 use crate::gl::{
-    self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramChoice,
-    ProgramKind, Surface, TexelData, TexelFormat, Texture,
+    self, Blend, DrawCall, Extent, Filter, GlError, Gpu, Program, ProgramChoice, ProgramKind,
+    Surface, TexelData, TexelFormat, Texture,
 };
 use crate::programs;
 
@@ -108,7 +111,7 @@ pub fn resolve_kind(
     fidelity: Fidelity,
     programs: ProgramChoice,
     kind: ProgramKind,
-) -> GlResult<ProgramKind> {
+) -> RenderResult<ProgramKind> {
     if programs != ProgramChoice::Auto {
         return Ok(kind);
     }
@@ -121,7 +124,11 @@ pub fn resolve_kind(
 
 /// What a precise program computes itself on `gpu` (nothing when faithful: the era's
 /// texture units and rasterizer, whatever their precision).
-pub fn shader_filter(gpu: &Gpu, params: &Opacity3dScene, fidelity: Fidelity) -> GlResult<InShader> {
+pub fn shader_filter(
+    gpu: &Gpu,
+    params: &Opacity3dScene,
+    fidelity: Fidelity,
+) -> RenderResult<InShader> {
     Ok(match fidelity {
         Fidelity::Faithful => InShader::default(),
         // The probes only where `auto` asks them.
@@ -132,16 +139,6 @@ pub fn shader_filter(gpu: &Gpu, params: &Opacity3dScene, fidelity: Fidelity) -> 
             InShader::for_scene(params, gpu.filters_exactly()?, gpu.interpolates_exactly()?)
         }
     })
-}
-
-/// The filter a texture is made with: NEAREST where the program interpolates it itself
-/// (the ARB programs read texel centres; `texelFetch` ignores the filter).
-pub fn unit_filter(filter: Filter, in_shader: bool) -> Filter {
-    if in_shader {
-        Filter::Nearest
-    } else {
-        filter
-    }
 }
 
 /// Every pair 3D opacity can draw with: the verbatim faithful programs and their GLSL
@@ -173,7 +170,7 @@ pub fn send_pixel_rays(
     program: &Program,
     surface: Surface<'_>,
     frame: &Frame,
-) -> GlResult<()> {
+) -> RenderResult<()> {
     let [x, y, w, h] = surface.rect();
     let (w, h) = (w.max(1.0), h.max(1.0));
     program.set_local(
@@ -199,76 +196,6 @@ pub fn send_pixel_rays(
         program.set_local(gpu, locals::INVERSE_MVP + i, row.to_array())?;
     }
     Ok(())
-}
-
-/// Direction toward the viewer in object space (the slices' normal).
-pub fn toward_viewer(frame: &Frame) -> DVec3 {
-    frame.camera.quat().inverse() * DVec3::Z
-}
-
-/// The eye in object space (perspective).
-pub fn eye(frame: &Frame) -> DVec3 {
-    toward_viewer(frame) * frame.camera.eye_distance()
-}
-
-/// Texel formats of the packed volume and the tables: 8-bit when faithful (filtering in
-/// 8-bit arithmetic, as the original hardware); when precise the same 8-bit values as
-/// 16-bit unorm (k·257/65535 = k/255 exactly, so a level's texel-centre lookup lands on
-/// its entry; half floats put it up to 0.06 texel off) and f32 tables, filtered in float.
-/// The precise volume holds only the present attributes (`count` channels); one
-/// attribute is stored as f32 (the same k/255, 4 bytes a voxel), which llvmpipe filters
-/// faster than 16-bit unorm (measured: docs/benchmarks.md, "3D opacity: figures behind
-/// its settings").
-pub fn texel_formats(fidelity: Fidelity, count: usize) -> (TexelFormat, TexelFormat) {
-    match fidelity {
-        Fidelity::Faithful => (TexelFormat::Rgb8, TexelFormat::Rgba8),
-        Fidelity::Precise => (
-            match count {
-                1 => TexelFormat::R32fFromU8,
-                2 => TexelFormat::Rg16FromU8,
-                _ => TexelFormat::Rgb16FromU8,
-            },
-            TexelFormat::Rgba32fFromU8,
-        ),
-    }
-}
-
-/// The box `[-half, half]` as 12 triangles wound clockwise seen from outside, so that
-/// with back faces culled only the far side of the box is drawn (one fragment per pixel);
-/// vertices `[position xyzw, texcoord xyzw]`.
-pub fn far_faces(half: DVec3) -> Vec<f32> {
-    let mut out = Vec::with_capacity(36 * 8);
-    for axis in 0..3 {
-        for side in [-1.0, 1.0] {
-            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-            let corner = |a: f64, b: f64| {
-                let mut p = DVec3::ZERO;
-                p[axis] = side;
-                p[u] = a;
-                p[v] = b;
-                p
-            };
-            // (u, v, axis) is right-handed: u then v is counter-clockwise seen from +axis.
-            let mut quad = [
-                corner(-1.0, -1.0),
-                corner(1.0, -1.0),
-                corner(1.0, 1.0),
-                corner(-1.0, 1.0),
-            ];
-            if side > 0.0 {
-                quad.reverse();
-            }
-            for i in [0, 1, 2, 0, 2, 3] {
-                let t = (quad[i] + 1.0) / 2.0;
-                let p = quad[i] * half;
-                out.extend_from_slice(&[
-                    p.x as f32, p.y as f32, p.z as f32, 1.0, t.x as f32, t.y as f32, t.z as f32,
-                    1.0,
-                ]);
-            }
-        }
-    }
-    out
 }
 
 /// The 3D-opacity renderer.
@@ -298,29 +225,9 @@ pub struct Opacity3dRenderer {
     occupied: [[f64; 3]; 2],
     preint: Option<Texture>,
     baked: bool,
-    mesh: Option<Mesh>,
-    mesh_key: Option<([u64; 3], usize)>,
-    /// Vertices up to the end of each slice, back to front (for [`Renderer::draw_part`]).
-    slice_ends: Vec<usize>,
-    spacing: f64,
+    /// The slices or the ray caster's box ([`Proxy`]).
+    proxy: Proxy,
     clip: Option<Clip>,
-}
-
-pub(super) fn table_texture(
-    gpu: &Gpu,
-    label: &str,
-    table: &ColorTable,
-    filter: Filter,
-    fidelity: Fidelity,
-) -> GlResult<Texture> {
-    Texture::new(
-        gpu,
-        label,
-        Extent::D2(256, 1),
-        texel_formats(fidelity, 1).1,
-        filter,
-        TexelData::U8(&table.texels()),
-    )
 }
 
 impl Opacity3dRenderer {
@@ -333,16 +240,13 @@ impl Opacity3dRenderer {
         params: &Opacity3dScene,
         base: &Path,
         projection: Projection,
-    ) -> GlResult<Opacity3dRenderer> {
-        params
-            .validate()
-            .map_err(|e| GlError::Data(e.to_string()))?;
+    ) -> RenderResult<Opacity3dRenderer> {
+        params.validate()?;
         let prepared = prepare(
             params,
             base,
             &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
-        )
-        .map_err(GlError::Data)?;
+        )?;
         Opacity3dRenderer::from_prepared(gpu, kind, fidelity, params, base, prepared, projection)
     }
 
@@ -355,16 +259,15 @@ impl Opacity3dRenderer {
         base: &Path,
         prepared: Prepared,
         projection: Projection,
-    ) -> GlResult<Opacity3dRenderer> {
-        params
-            .validate()
-            .map_err(|e| GlError::Data(e.to_string()))?;
+    ) -> RenderResult<Opacity3dRenderer> {
+        params.validate()?;
         let [ni, nj, nk] = prepared.dims;
         let max = gpu.caps().max_3d_texture_size.max(1) as usize;
         if prepared.dims.iter().any(|&d| d > max) {
             return Err(GlError::Unsupported(format!(
                 "volume {ni}x{nj}x{nk} exceeds GL_MAX_3D_TEXTURE_SIZE {max}"
-            )));
+            ))
+            .into());
         }
         let table = step_table(params, fidelity, &prepared);
         let baked = matches!(table, StepTable::Baked(_));
@@ -397,10 +300,7 @@ impl Opacity3dRenderer {
             occupied: WHOLE,
             preint: None,
             baked,
-            mesh: None,
-            mesh_key: None,
-            slice_ends: Vec::new(),
-            spacing: 0.0,
+            proxy: Proxy::None,
             clip,
         };
         renderer.build_tables(gpu)?;
@@ -427,12 +327,12 @@ impl Opacity3dRenderer {
 
     /// Whether `new`'s tables make the level no data took opaque: the volume is then
     /// quantized again, so that no data stays undrawn ([`NoData::choose`]).
-    fn no_data_moves(&self, new: &Opacity3dScene) -> GlResult<bool> {
+    fn no_data_moves(&self, new: &Opacity3dScene) -> RenderResult<bool> {
         for (a, attr) in new.attributes().into_iter().enumerate() {
             let (Some(attr), NoData::Level(level)) = (attr, self.prepared.no_data[a]) else {
                 continue;
             };
-            let table = attr.table.build(&self.base).map_err(GlError::Data)?;
+            let table = attr.table.build(&self.base)?;
             if table.entries[level as usize][3] != 0 {
                 return Ok(true);
             }
@@ -440,7 +340,7 @@ impl Opacity3dRenderer {
         Ok(false)
     }
 
-    fn build_tables(&mut self, gpu: &Gpu) -> GlResult<()> {
+    fn build_tables(&mut self, gpu: &Gpu) -> RenderResult<()> {
         let names = super::ATTRIBUTE_NAMES;
         for (a, name) in names.iter().enumerate() {
             self.tables[a] = match &self.prepared.tables[a] {
@@ -468,7 +368,7 @@ impl Opacity3dRenderer {
     }
 
     /// The ray caster's table on unit 6 (pre-integration or baked), or none.
-    fn upload_step_table(&mut self, gpu: &Gpu, table: StepTable) -> GlResult<()> {
+    fn upload_step_table(&mut self, gpu: &Gpu, table: StepTable) -> RenderResult<()> {
         let (label, extent, data) = match table {
             StepTable::None => {
                 self.preint = None;
@@ -501,7 +401,7 @@ impl Opacity3dRenderer {
 
     /// The ray caster's bricks and their occupancy for the current tables: a texture for
     /// empty-space skipping, the occupied box for its margins.
-    fn build_bricks(&mut self, gpu: &Gpu) -> GlResult<()> {
+    fn build_bricks(&mut self, gpu: &Gpu) -> RenderResult<()> {
         let preint = preintegrated(&self.params, self.fidelity, self.prepared.count());
         self.occupied = WHOLE;
         let (size, skip, margins) = match (&self.params.raycast, self.path()) {
@@ -548,7 +448,7 @@ impl Opacity3dRenderer {
         Ok(())
     }
 
-    fn send_constants(&self, gpu: &Gpu) -> GlResult<()> {
+    fn send_constants(&self, gpu: &Gpu) -> RenderResult<()> {
         for (i, c) in coefficients(&self.params).iter().enumerate() {
             self.program.set_local(gpu, locals::COEFFICIENTS + i, *c)?;
         }
@@ -579,46 +479,13 @@ impl Opacity3dRenderer {
         Ok(())
     }
 
-    fn update_mesh(&mut self, gpu: &Gpu, frame: &Frame) -> GlResult<()> {
-        if self.path() == Path3d::Raycast {
-            // One box, drawn whole: one part.
-            self.slice_ends.clear();
-            if self.mesh_key.is_some() || self.mesh.is_none() {
-                let vertices = far_faces(self.prepared.half);
-                self.mesh = Some(Mesh::new(gpu, "opacity3d box", &[4, 4], &vertices)?);
-                self.mesh_key = None;
-            }
-            return Ok(());
-        }
-        let dir = toward_viewer(frame);
-        let key = (dir.to_array().map(f64::to_bits), self.params.slices);
-        if self.mesh_key == Some(key) && self.mesh.is_some() {
-            return Ok(());
-        }
-        let slices = slice_box(self.prepared.half, dir, self.params.slices);
-        let vertices = slices.triangle_vertices();
-        self.spacing = slices.spacing;
-        self.slice_ends = slices
-            .polygons
-            .iter()
-            .scan(0, |end, p| {
-                *end += 3 * p.positions.len().saturating_sub(2);
-                Some(*end)
-            })
-            .collect();
-        // A mesh without a key is the ray caster's box: replace it.
-        match (&mut self.mesh, self.mesh_key) {
-            (Some(mesh), Some(_)) => mesh.update(gpu, &vertices)?,
-            _ => {
-                self.mesh = Some(Mesh::new(gpu, "opacity3d slices", &[4, 4], &vertices)?);
-            }
-        }
-        self.mesh_key = Some(key);
-        Ok(())
+    fn update_mesh(&mut self, gpu: &Gpu, frame: &Frame) -> RenderResult<()> {
+        let (path, half, slices) = (self.path(), self.prepared.half, self.params.slices);
+        Ok(self.proxy.update(gpu, path, half, frame, slices)?)
     }
 
     /// Precise mode's per-frame locals 4, 8 and 9 (see the program templates).
-    fn send_view(&self, gpu: &Gpu, frame: &Frame) -> GlResult<()> {
+    fn send_view(&self, gpu: &Gpu, frame: &Frame) -> RenderResult<()> {
         let reference = self.prepared.reference_spacing();
         let (scale, offset) = if corrected(&self.params, self.fidelity) {
             (1.0 / reference, 0.0)
@@ -652,7 +519,7 @@ impl Opacity3dRenderer {
                 p.set_local(
                     gpu,
                     locals::CORRECTION,
-                    [scale, self.spacing / 2.0, offset, 0.0],
+                    [scale, self.proxy.spacing() / 2.0, offset, 0.0],
                 )?;
                 if perspective {
                     p.set_local(gpu, locals::RAY, eye(frame).extend(0.0).to_array())?;
@@ -671,65 +538,6 @@ impl Opacity3dRenderer {
     }
 }
 
-/// Whether the volume unit holds neighbour words ([`Prepared::neighbour_words`]): the
-/// precise ray caster of one attribute read linearly (a clip's test reads its own units
-/// only; a nearest volume keeps the plain texture).
-fn uses_neighbours(params: &Opacity3dScene, fidelity: Fidelity, prepared: &Prepared) -> bool {
-    fidelity == Fidelity::Precise
-        && path(params, fidelity) == Path3d::Raycast
-        && prepared.count() == 1
-        && params.volume_filter == Filter::Linear
-}
-
-/// The volume on [`VOLUME_UNIT`]: v3o2's packing (faithful), the present attributes'
-/// levels (precise), or one attribute's neighbour words (the ray caster, `neighbours`;
-/// 8 bytes a voxel against 4, checked against the memory budget before they are made).
-fn volume_texture(
-    gpu: &Gpu,
-    fidelity: Fidelity,
-    params: &Opacity3dScene,
-    prepared: &Prepared,
-    filter: InShader,
-    neighbours: bool,
-) -> GlResult<Texture> {
-    let [ni, nj, nk] = prepared.dims;
-    let extent = Extent::D3(ni as u32, nj as u32, nk as u32);
-    if neighbours {
-        let bytes = (ni * nj * nk) as u64 * 8;
-        crate::budget::check(
-            "the ray caster's neighbour texture (8 bytes a voxel)",
-            bytes,
-        )
-        .map_err(|e| GlError::Data(e.to_string()))?;
-        return Texture::new(
-            gpu,
-            "opacity3d neighbour words (each voxel's 2x2x2 levels)",
-            extent,
-            TexelFormat::Rg32ui,
-            Filter::Nearest,
-            TexelData::U32(&prepared.neighbour_words()),
-        );
-    }
-    match fidelity {
-        Fidelity::Faithful => Texture::new(
-            gpu,
-            "opacity3d packed volume (R tertiary, G primary, B secondary)",
-            extent,
-            TexelFormat::Rgb8,
-            params.volume_filter,
-            TexelData::U8(&prepared.packed),
-        ),
-        Fidelity::Precise => Texture::new(
-            gpu,
-            "opacity3d packed volume (present attributes in order)",
-            extent,
-            texel_formats(fidelity, prepared.count()).0,
-            unit_filter(params.volume_filter, filter.volume),
-            TexelData::U8(&prepared.present_levels()),
-        ),
-    }
-}
-
 /// The program for a fidelity, path and projection, with `clip`'s test composed in.
 #[allow(clippy::too_many_arguments)]
 fn make_program(
@@ -741,7 +549,7 @@ fn make_program(
     projection: Projection,
     baked: bool,
     clip: Option<&clipping_stage::ClipStage>,
-) -> GlResult<Program> {
+) -> RenderResult<Program> {
     let preint = preintegrated(params, fidelity, prepared.count());
     let variant = Variant {
         combine: params.combine,
@@ -764,7 +572,8 @@ fn make_program(
                     "the precise ray caster is GLSL only (ARB fragment programs have no \
                      loops): use programs = \"glsl\" or \"auto\""
                         .into(),
-                ));
+                )
+                .into());
             }
             raycast_pair(variant)
         }
@@ -776,7 +585,7 @@ fn make_program(
         }
         None => pair,
     };
-    Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)
+    Ok(Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?)
 }
 
 impl Opacity3dRenderer {
@@ -788,7 +597,7 @@ impl Opacity3dRenderer {
         surface: Surface<'_>,
         frame: &Frame,
         slices: std::ops::Range<usize>,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         let projection = frame.camera.projection;
         if self.fidelity == Fidelity::Precise && projection != self.projection {
             self.program = make_program(
@@ -805,7 +614,7 @@ impl Opacity3dRenderer {
             self.send_constants(gpu)?;
         }
         self.update_mesh(gpu, frame)?;
-        let ends = &self.slice_ends;
+        let ends = self.proxy.slice_ends();
         let vertex = |s: usize| match s.checked_sub(1) {
             Some(i) => ends.get(i).or(ends.last()).copied().unwrap_or(0),
             None => 0,
@@ -833,11 +642,11 @@ impl Opacity3dRenderer {
         if let Some(clip) = &self.clip {
             textures.extend(clip.stage.textures());
         }
-        let Some(mesh) = &self.mesh else {
+        let Some(mesh) = self.proxy.mesh() else {
             return Ok(());
         };
         let raycast = self.path() == Path3d::Raycast;
-        gl::draw(
+        Ok(gl::draw(
             gpu,
             surface,
             &DrawCall {
@@ -852,7 +661,7 @@ impl Opacity3dRenderer {
                 primitive: Default::default(),
                 ..DrawCall::new(&self.program, mesh)
             },
-        )
+        )?)
     }
 }
 
@@ -882,29 +691,21 @@ impl Renderer for Opacity3dRenderer {
         }
     }
 
-    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
         self.draw_slices(gpu, surface, frame, 0..usize::MAX)
     }
 
-    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> RenderResult<()> {
         let new = params.get::<Opacity3dScene>()?;
-        new.validate().map_err(|e| GlError::Data(e.to_string()))?;
+        new.validate()?;
         let old = std::mem::replace(&mut self.params, new.clone());
-        let data = |p: &Opacity3dScene| {
-            p.attributes()
-                .map(|a| a.map(|a| (a.volume.clone(), a.attribute, a.quantize)))
-        };
-        if data(&old) != data(new)
-            || old.volume_filter != new.volume_filter
-            || old.interpolation != new.interpolation
-            || self.no_data_moves(new)?
-        {
+        let changes = Changes::between(&old, new);
+        if changes.data || self.no_data_moves(new)? {
             let prepared = prepare(
                 new,
                 &self.base,
                 &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
-            )
-            .map_err(GlError::Data)?;
+            )?;
             *self = Opacity3dRenderer::from_prepared(
                 gpu,
                 self.kind,
@@ -917,14 +718,10 @@ impl Renderer for Opacity3dRenderer {
             return Ok(());
         }
         self.filter = shader_filter(gpu, new, self.fidelity)?;
-        let tables = |p: &Opacity3dScene| p.attributes().map(|a| a.map(|a| a.table.clone()));
-        if tables(&old) != tables(new)
-            || old.table_filter != new.table_filter
-            || old.combine != new.combine
-        {
+        if changes.tables {
             for (a, attr) in new.attributes().into_iter().enumerate() {
                 if let Some(attr) = attr {
-                    let mut table = attr.table.build(&self.base).map_err(GlError::Data)?;
+                    let mut table = attr.table.build(&self.base)?;
                     if self.prepared.no_data[a] == NoData::Reserved {
                         table.entries[0] = [0; 4];
                     }
@@ -934,8 +731,7 @@ impl Renderer for Opacity3dRenderer {
             self.build_tables(gpu)?;
         }
         self.build_bricks(gpu)?;
-        let clip_changed = old.clip != new.clip;
-        if clip_changed {
+        if changes.clip {
             let built = match &new.clip {
                 Some(spec) => {
                     clipping::build(gpu, spec, &self.base, &self.prepared, self.fidelity).map(Some)
@@ -961,17 +757,10 @@ impl Renderer for Opacity3dRenderer {
         }
         let table = step_table(new, self.fidelity, &self.prepared);
         let baked = matches!(table, StepTable::Baked(_));
-        let shape = |p: &Opacity3dScene| {
-            (
-                p.combine,
-                p.raycast.map(|r| (r.brick > 0, r.jitter, r.preintegrate)),
-                (p.table_filter, p.interpolation),
-            )
-        };
-        if shape(&old) != shape(new)
+        if changes.program
             || baked != self.baked
             || volume_changed
-            || clip_changed
+            || changes.clip
             || self.program_filter != self.filter
         {
             self.baked = baked;
@@ -986,8 +775,7 @@ impl Renderer for Opacity3dRenderer {
                 baked,
                 self.clip.as_ref().map(|c| &c.stage),
             )?;
-            self.mesh_key = None;
-            self.mesh = None;
+            self.proxy = Proxy::None;
         }
         self.upload_step_table(gpu, table)?;
         self.send_constants(gpu)
@@ -1015,9 +803,9 @@ impl DrawInParts for Opacity3dRenderer {
         frame: &Frame,
         part: usize,
         parts: usize,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         self.update_mesh(gpu, frame)?;
-        let n = self.slice_ends.len();
+        let n = self.proxy.slice_ends().len();
         let parts = parts.clamp(1, n.max(1));
         if part >= parts {
             return Ok(());
@@ -1025,16 +813,4 @@ impl DrawInParts for Opacity3dRenderer {
         let slices = part * n / parts..(part + 1) * n / parts;
         self.draw_slices(gpu, surface, frame, slices)
     }
-}
-
-/// The white table a product reads for an absent attribute (so it multiplies by one).
-pub(super) fn neutral_table(gpu: &Gpu) -> GlResult<Texture> {
-    Texture::new(
-        gpu,
-        "opacity3d neutral table (absent attribute in a product)",
-        Extent::D2(1, 1),
-        TexelFormat::Rgba8,
-        Filter::Nearest,
-        TexelData::U8(&[255; 4]),
-    )
 }

@@ -7,11 +7,12 @@
 //! response)`. Pixels without a point are left as they are. GLSL only; the target and
 //! programs are freed on Drop.
 
+use crate::error::RenderResult;
 use glam::{DMat4, DVec4};
 
 use super::locals;
 use crate::gl::{
-    self, Blend, DrawCall, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind, Surface, Target,
+    self, Blend, DrawCall, Gpu, Mesh, Primitive, Program, ProgramKind, Surface, Target,
     TargetFormat,
 };
 use crate::programs;
@@ -43,7 +44,7 @@ pub struct EdlView {
 
 impl EdlPass {
     /// A pass for frames of `width` x `height`.
-    pub fn new(gpu: &Gpu, width: u32, height: u32) -> GlResult<EdlPass> {
+    pub fn new(gpu: &Gpu, width: u32, height: u32) -> RenderResult<EdlPass> {
         let depth_program = Program::new(
             gpu,
             ProgramKind::Glsl,
@@ -79,7 +80,7 @@ impl EdlPass {
         view: &EdlView,
         strength: f64,
         surface: Surface<'_>,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         self.depth.clear(gpu, [0.0; 4])?;
         let p = &self.depth_program;
         p.set_transform(gpu, view.transform)?;
@@ -115,7 +116,7 @@ impl EdlPass {
             locals::SURFACE_ORIGIN,
             [origin[0], origin[1], 0.0, 0.0],
         )?;
-        gl::draw(
+        Ok(gl::draw(
             gpu,
             surface,
             &DrawCall {
@@ -123,6 +124,6 @@ impl EdlPass {
                 blend: Blend::Multiply,
                 ..DrawCall::new(&self.shade, &self.quad)
             },
-        )
+        )?)
     }
 }

@@ -99,10 +99,9 @@ impl crate::techniques::Technique for SplatsScene {
         &self,
         settings: &crate::techniques::Settings<'_>,
         _: &crate::volume::Limits,
-    ) -> crate::gl::GlResult<prepare::PreparedCloud> {
-        SplatsScene::validate(self).map_err(|e| crate::gl::GlError::Data(e.to_string()))?;
+    ) -> crate::error::RenderResult<prepare::PreparedCloud> {
+        SplatsScene::validate(self)?;
         prepare::prepare_for(self, settings.base, Some(&settings.view))
-            .map_err(crate::gl::GlError::Data)
     }
 
     fn renderer(
@@ -111,7 +110,7 @@ impl crate::techniques::Technique for SplatsScene {
         settings: &crate::techniques::Settings<'_>,
         kind: crate::gl::ProgramKind,
         prepared: prepare::PreparedCloud,
-    ) -> crate::gl::GlResult<Box<dyn crate::techniques::Renderer>> {
+    ) -> crate::error::RenderResult<Box<dyn crate::techniques::Renderer>> {
         Ok(Box::new(SplatsRenderer::upload(
             gpu,
             kind,

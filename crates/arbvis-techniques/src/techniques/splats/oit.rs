@@ -25,13 +25,14 @@
 //! blending (`glBlendFunci`, GL 4.0) and `ARB_draw_buffers` in the ARB programs; the
 //! second draw's cost is measured by [`super::bench`].
 
+use crate::error::RenderResult;
 use glam::{DMat4, DVec4};
 
 use super::locals;
 use super::reference::OitWeight;
 use crate::camera::{Camera, Projection};
 use crate::gl::{
-    self, Blend, DrawCall, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind, Surface, Target,
+    self, Blend, DrawCall, Gpu, Mesh, Primitive, Program, ProgramKind, Surface, Target,
 };
 use crate::programs;
 use crate::techniques::quad::quad_mesh;
@@ -60,7 +61,7 @@ pub struct OitPass {
 
 impl OitPass {
     /// Targets of `width` x `height` and the composite program of `kind`.
-    pub fn new(gpu: &Gpu, kind: ProgramKind, width: u32, height: u32) -> GlResult<OitPass> {
+    pub fn new(gpu: &Gpu, kind: ProgramKind, width: u32, height: u32) -> RenderResult<OitPass> {
         let pair = programs::with_transform(
             kind,
             &programs::SPLATS_OIT_COMPOSITE_ARBFP,
@@ -90,7 +91,7 @@ impl OitPass {
         program: &Program,
         mesh: &Mesh,
         surface: Surface<'_>,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         self.accum.clear(gpu, [0.0; 4])?;
         self.reveal.clear(gpu, [1.0; 4])?;
         let splats = |blend: Blend| DrawCall {
@@ -103,7 +104,7 @@ impl OitPass {
         program.set_local(gpu, locals::OIT_ACCUMULATE, [0.0; 4])?;
         drawn?;
         gl::draw(gpu, Surface::Target(&self.reveal), &splats(Blend::Reveal))?;
-        gl::draw(
+        Ok(gl::draw(
             gpu,
             surface,
             &DrawCall {
@@ -111,6 +112,6 @@ impl OitPass {
                 blend: Blend::Over,
                 ..DrawCall::new(&self.composite, &self.quad)
             },
-        )
+        )?)
     }
 }

@@ -8,9 +8,11 @@ use glam::DVec3;
 
 use super::normals::{estimate_cloud, DEFAULT_K};
 use super::scene::{ColourMode, Kernel, Mode, SplatsScene};
+use crate::error::RenderResult;
 use crate::points::section::{facies_colour, PALETTE};
 use crate::points::{PointCloud, FACIES, FAULT, LAYER, UNDEFINED_FACIES};
 use crate::vocab::Fidelity;
+use crate::vocab::FieldError;
 
 /// Floats per vertex: position 3, colour 3, property value 1, normal 3, size scale 1 (a
 /// COPC point's spacing over the deepest drawn level's; the precise programs multiply the
@@ -50,7 +52,7 @@ pub struct Prepared {
 
 /// Load the scene's cloud (relative paths from `base`) and prepare it; returns the
 /// cloud too (a renderer keeps it to re-prepare after edits without reloading).
-pub fn prepare(scene: &SplatsScene, base: &Path) -> Result<(PointCloud, Prepared), String> {
+pub fn prepare(scene: &SplatsScene, base: &Path) -> RenderResult<(PointCloud, Prepared)> {
     let (cloud, prepared, _) = prepare_for(scene, base, None)?;
     Ok((cloud, prepared))
 }
@@ -67,11 +69,8 @@ pub fn prepare_for(
     scene: &SplatsScene,
     base: &Path,
     view: Option<&crate::points::copc_lod::View>,
-) -> Result<PreparedCloud, String> {
-    let (cloud, note) = scene
-        .cloud
-        .load_for(base, view)
-        .map_err(|e| e.to_string())?;
+) -> RenderResult<PreparedCloud> {
+    let (cloud, note) = scene.cloud.load_for(base, view)?;
     if let Some(warning) = missing_colour(scene, &cloud) {
         eprintln!("arbvis: warning: {warning}");
     }
@@ -117,7 +116,7 @@ pub fn prepare_in_stages(
         ),
         bool,
     ) -> bool,
-) -> Result<(), String> {
+) -> RenderResult<()> {
     let crate::points::PointSource::Copc(spec) = &scene.cloud else {
         each(prepare_for(scene, base, Some(view))?, true);
         return Ok(());
@@ -144,8 +143,7 @@ pub fn prepare_in_stages(
                 }
             }
         },
-    )
-    .map_err(|e| e.to_string())?;
+    )?;
     failed.map_or(Ok(()), Err)
 }
 
@@ -174,7 +172,7 @@ pub fn from_cloud(
     cloud: &PointCloud,
     scene: &SplatsScene,
     normals: Option<(Vec<[f32; 3]>, usize)>,
-) -> Result<Prepared, String> {
+) -> RenderResult<Prepared> {
     let n = cloud.len();
     let layers = cloud.ints(LAYER);
     let facies = cloud.ints(FACIES);
@@ -186,11 +184,15 @@ pub fn from_cloud(
         },
         None if scene.colour == ColourMode::Property || scene.mode == Mode::Volume => {
             let names: Vec<&str> = cloud.attributes.iter().map(|a| a.name.as_str()).collect();
-            return Err(format!(
-                "the cloud has no attribute {:?} (it has: {})",
-                scene.property,
-                names.join(", ")
-            ));
+            return Err(FieldError::new(
+                "property",
+                format!(
+                    "the cloud has no attribute {:?} (it has: {})",
+                    scene.property,
+                    names.join(", ")
+                ),
+            )
+            .into());
         }
         None => vec![f32::NAN; n],
     };

@@ -17,6 +17,8 @@
 //! llvmpipe `gl_PointCoord` is about 2e-3 px off that, which moved rim pixels of a
 //! Gaussian of width 0.35 by up to 0.2.
 
+use crate::error::RenderResult;
+use crate::gl::GlResult;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -37,9 +39,7 @@ use super::tiles::{
     DEFAULT_MAX_ENTRIES,
 };
 use crate::camera::{Camera, Projection};
-use crate::gl::{
-    self, Blend, DrawCall, GlError, GlResult, Gpu, Mesh, Primitive, Program, ProgramKind, Surface,
-};
+use crate::gl::{self, Blend, DrawCall, Gpu, Mesh, Primitive, Program, ProgramKind, Surface};
 use crate::points::copc_lod::View as CloudView;
 use crate::points::PointCloud;
 use crate::programs::{self, ProgramPair};
@@ -170,11 +170,9 @@ impl SplatsRenderer {
         params: &SplatsScene,
         base: &Path,
         view: Option<CloudView>,
-    ) -> GlResult<SplatsRenderer> {
-        params
-            .validate()
-            .map_err(|e| GlError::Data(e.to_string()))?;
-        let loaded = prepare_for(params, base, view.as_ref()).map_err(GlError::Data)?;
+    ) -> RenderResult<SplatsRenderer> {
+        params.validate()?;
+        let loaded = prepare_for(params, base, view.as_ref())?;
         SplatsRenderer::upload(gpu, kind, fidelity, params, base, view, loaded)
     }
 
@@ -188,7 +186,7 @@ impl SplatsRenderer {
         base: &Path,
         view: Option<CloudView>,
         (cloud, prepared, loaded): Prepared3,
-    ) -> GlResult<SplatsRenderer> {
+    ) -> RenderResult<SplatsRenderer> {
         // A COPC cut's splats cover its deepest level's spacing.
         let mut sized = params.clone();
         if let (Some(l), Some(v)) = (&loaded, &view) {
@@ -217,13 +215,13 @@ impl SplatsRenderer {
         (params, prepared_with): (&SplatsScene, Option<&SplatsScene>),
         view: CloudView,
         (cloud, prepared, loaded): Prepared3,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         // Colours, visibility or lighting edited while the cut loaded: prepare it again
         // with the scene as it is now.
         let (cloud, prepared) = match prepared_with {
             Some(then) if then != params => {
                 let normals = normals_for(&cloud, params);
-                let prepared = from_cloud(&cloud, params, normals).map_err(GlError::Data)?;
+                let prepared = from_cloud(&cloud, params, normals)?;
                 (cloud, prepared)
             }
             _ => (cloud, prepared),
@@ -274,7 +272,7 @@ impl SplatsRenderer {
         base: &Path,
         cloud: PointCloud,
         prepared: Prepared,
-    ) -> GlResult<SplatsRenderer> {
+    ) -> RenderResult<SplatsRenderer> {
         let cut = (Vec::new(), Vec::new());
         SplatsRenderer::with_nodes(gpu, kind, fidelity, params, base, (cloud, prepared, cut))
     }
@@ -288,10 +286,8 @@ impl SplatsRenderer {
         params: &SplatsScene,
         base: &Path,
         (cloud, prepared, (nodes, size_scales)): (PointCloud, Prepared, CutParts),
-    ) -> GlResult<SplatsRenderer> {
-        params
-            .draw_allowed(fidelity, crate::gl::ProgramChoice::Auto)
-            .map_err(|e| GlError::Data(e.to_string()))?;
+    ) -> RenderResult<SplatsRenderer> {
+        params.draw_allowed(fidelity, crate::gl::ProgramChoice::Auto)?;
         let pair = program_pair(fidelity, kind);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         let mesh = Mesh::new(
@@ -338,7 +334,7 @@ impl SplatsRenderer {
     }
 
     /// The splats of one frame (tiles, points or OIT), without eye-dome lighting.
-    fn draw_splats(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+    fn draw_splats(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
         if self.tiles.is_some() && self.prepare_tiles(gpu, frame)? {
             if let Some(state) = &self.tiles {
                 let gaussian = if self.params.kernel == Kernel::Gaussian {
@@ -395,7 +391,7 @@ impl SplatsRenderer {
                 return oit.draw(gpu, &self.program, &self.mesh, surface);
             }
         }
-        gl::draw(
+        Ok(gl::draw(
             gpu,
             surface,
             &DrawCall {
@@ -403,7 +399,7 @@ impl SplatsRenderer {
                 primitive: Primitive::Points,
                 ..DrawCall::new(&self.program, &self.mesh)
             },
-        )
+        )?)
     }
 
     /// The frame's line: points drawn, sort or tiles.
@@ -440,7 +436,7 @@ impl SplatsRenderer {
     }
 
     /// Set up the ordering of the current `prepared` and `params`, and the constants.
-    fn install(&mut self, gpu: &Gpu) -> GlResult<()> {
+    fn install(&mut self, gpu: &Gpu) -> RenderResult<()> {
         self.cache = match self.params.sort {
             SortChoice::Keys => Some(SortCache::new(SortMethod::Keys)),
             SortChoice::Radix => Some(SortCache::new(SortMethod::Radix)),
@@ -570,7 +566,7 @@ impl SplatsRenderer {
     }
 
     /// Put the points in back-to-front order for `view` (nothing when it did not move).
-    fn order(&mut self, gpu: &Gpu, view: View) -> GlResult<()> {
+    fn order(&mut self, gpu: &Gpu, view: View) -> RenderResult<()> {
         let bits = view_bits(view);
         let unordered = matches!(self.params.sort, SortChoice::None | SortChoice::Oit);
         if self.ordered_for == Some(bits) || unordered {
@@ -606,7 +602,7 @@ impl SplatsRenderer {
 
     /// Bring the tile pass's colours and lists up to `frame` (nothing that did not
     /// change); `false` when the lists would exceed their bound.
-    fn prepare_tiles(&mut self, gpu: &Gpu, frame: &Frame) -> GlResult<bool> {
+    fn prepare_tiles(&mut self, gpu: &Gpu, frame: &Frame) -> RenderResult<bool> {
         let camera = &frame.camera;
         let size = [frame.width, frame.height];
         let lit = self.params.lighting && self.params.mode == Mode::Surface;
@@ -655,7 +651,7 @@ impl SplatsRenderer {
         Ok(state.entries.is_ok())
     }
 
-    fn send_constants(&self, gpu: &Gpu) -> GlResult<()> {
+    fn send_constants(&self, gpu: &Gpu) -> RenderResult<()> {
         let p = &self.params;
         let colour = if p.colour == ColourMode::Property {
             1.0
@@ -759,7 +755,7 @@ impl Renderer for SplatsRenderer {
         }
     }
 
-    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> GlResult<()> {
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
         self.draw_splats(gpu, surface, frame)?;
         if self.params.edl > 0.0 {
             let (w, h) = (frame.width, frame.height);
@@ -783,12 +779,10 @@ impl Renderer for SplatsRenderer {
         }
         Ok(())
     }
-    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> GlResult<()> {
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> RenderResult<()> {
         let asked = params.get::<SplatsScene>()?;
-        asked.validate().map_err(|e| GlError::Data(e.to_string()))?;
-        asked
-            .draw_allowed(self.fidelity, crate::gl::ProgramChoice::Auto)
-            .map_err(|e| GlError::Data(e.to_string()))?;
+        asked.validate()?;
+        asked.draw_allowed(self.fidelity, crate::gl::ProgramChoice::Auto)?;
         // A COPC cut keeps its splats sized from its spacing over the scene's size.
         let mut sized = asked.clone();
         if let (Some(v), Some(spacing)) = (&self.view, self.spacing) {
@@ -826,8 +820,7 @@ impl Renderer for SplatsRenderer {
             || new.tile != p.tile;
         self.params = new.clone();
         if rebuild {
-            self.prepared =
-                from_cloud(&self.cloud, new, self.normals.clone()).map_err(GlError::Data)?;
+            self.prepared = from_cloud(&self.cloud, new, self.normals.clone())?;
             return self.install(gpu);
         }
         // Tiles bake sizes into the lists and the transfer function into the colours.
@@ -871,7 +864,7 @@ impl Streaming for SplatsRenderer {
         self.loading.is_some()
     }
 
-    fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> GlResult<bool> {
+    fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> RenderResult<bool> {
         if self.cut.is_none() {
             return Ok(false);
         }
@@ -904,7 +897,7 @@ impl Streaming for SplatsRenderer {
                 // A node that cannot be read (a damaged file), or a loader that died:
                 // the drawn cut stays, and the status line says why the view was not
                 // refined.
-                Arrival::Failed(e) => Some(e),
+                Arrival::Failed(e) => Some(e.to_string()),
                 Arrival::Ended => Some("the loader stopped before the whole cut".to_string()),
             };
             self.loading = None;

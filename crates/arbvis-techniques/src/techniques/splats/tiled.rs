@@ -4,13 +4,14 @@
 //! blended `ONE, ONE_MINUS_SRC_ALPHA` over the cleared target. GLSL only (ARB fragment
 //! programs have no loops). All textures are freed on Drop.
 
+use crate::error::{RenderError, RenderResult};
 use glam::DMat4;
 
 use super::locals;
 use super::tiles::TileLists;
 use crate::gl::{
-    self, Blend, DrawCall, Extent, GlError, GlResult, Gpu, Mesh, Program, ProgramKind, Surface,
-    TexelData, TexelFormat, Texture,
+    self, Blend, DrawCall, Extent, GlError, Gpu, Mesh, Program, ProgramKind, Surface, TexelData,
+    TexelFormat, Texture,
 };
 use crate::programs;
 
@@ -42,7 +43,7 @@ fn array_texture(
     label: &str,
     format: TexelFormat,
     texels: usize,
-) -> GlResult<Texture> {
+) -> RenderResult<Texture> {
     let rows = texels.div_ceil(ROW).max(1);
     if let Some(t) = current {
         if let Extent::D2(_, h) = t.extent() {
@@ -53,14 +54,23 @@ fn array_texture(
     }
     let max = gpu.caps().max_texture_size.max(1) as usize;
     if rows > max {
-        return Err(GlError::Data(format!(
-            "{label}: {texels} texels need {rows} rows of {ROW}, more than this driver's \
-             {max} (GL_MAX_TEXTURE_SIZE)"
-        )));
+        return Err(RenderError::TooManyRows {
+            label: label.to_string(),
+            texels,
+            rows,
+            row: ROW,
+            max,
+        });
     }
     let rows = (rows + rows / 4).min(max);
     // The old texture is dropped (freed) before the new one is made.
-    Texture::empty_2d(gpu, label, ROW as u32, rows as u32, format)
+    Ok(Texture::empty_2d(
+        gpu,
+        label,
+        ROW as u32,
+        rows as u32,
+        format,
+    )?)
 }
 
 /// Two triangles per occupied rectangle of `lists`, in normalized device coordinates
@@ -85,7 +95,7 @@ fn upload(
     label: &str,
     format: TexelFormat,
     data: TexelData<'_>,
-) -> GlResult<()> {
+) -> RenderResult<()> {
     let words = match data {
         TexelData::U8(d) => d.len() / 4,
         TexelData::F32(d) => d.len(),
@@ -100,7 +110,7 @@ fn upload(
 
 impl TilePass {
     /// The program; the blocks and textures come with the first lists and colours.
-    pub fn new(gpu: &Gpu) -> GlResult<TilePass> {
+    pub fn new(gpu: &Gpu) -> RenderResult<TilePass> {
         let program = Program::new(
             gpu,
             ProgramKind::Glsl,
@@ -121,7 +131,7 @@ impl TilePass {
     }
 
     /// Upload every point's RGBA (by point index).
-    pub fn set_colours(&mut self, gpu: &Gpu, colours: &[[f32; 4]]) -> GlResult<()> {
+    pub fn set_colours(&mut self, gpu: &Gpu, colours: &[[f32; 4]]) -> RenderResult<()> {
         let data = TexelData::F32(colours.as_flattened());
         upload(
             gpu,
@@ -133,7 +143,7 @@ impl TilePass {
     }
 
     /// Upload the lists of a frame.
-    pub fn set_lists(&mut self, gpu: &Gpu, lists: &TileLists) -> GlResult<()> {
+    pub fn set_lists(&mut self, gpu: &Gpu, lists: &TileLists) -> RenderResult<()> {
         let data = TexelData::U32(&lists.offsets);
         upload(
             gpu,
@@ -158,13 +168,14 @@ impl TilePass {
 
     /// Composite the uploaded lists onto `surface` (the frame the lists were made for);
     /// `kernel` is (1 Gaussian / 0 smoothstep, the Gaussian's width).
-    pub fn draw(&self, gpu: &Gpu, surface: Surface<'_>, kernel: [f64; 2]) -> GlResult<()> {
+    pub fn draw(&self, gpu: &Gpu, surface: Surface<'_>, kernel: [f64; 2]) -> RenderResult<()> {
         let (Some(offsets), Some(entries), Some(colours)) =
             (&self.offsets, &self.entries, &self.colours)
         else {
             return Err(GlError::Invalid(
                 "splat tiles drawn before lists and colours were uploaded".into(),
-            ));
+            )
+            .into());
         };
         if self.blocks.vertex_count() == 0 {
             return Ok(());
@@ -184,7 +195,7 @@ impl TilePass {
             locals::SURFACE_ORIGIN,
             [origin[0] as f64, origin[1] as f64, 0.0, 0.0],
         )?;
-        gl::draw(
+        Ok(gl::draw(
             gpu,
             surface,
             &DrawCall {
@@ -192,6 +203,6 @@ impl TilePass {
                 blend: Blend::PremultipliedOver,
                 ..DrawCall::new(&self.program, &self.blocks)
             },
-        )
+        )?)
     }
 }

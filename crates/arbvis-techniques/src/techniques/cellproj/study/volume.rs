@@ -6,10 +6,11 @@
 //! (sort, index buffer; the rest is the GL's raster and blend), and RGB RMSE and largest
 //! error against the f64 reference over the image and over the mesh's interior.
 
+use crate::error::RenderResult;
 use std::time::Instant;
 
 use crate::camera::{Camera, Projection};
-use crate::gl::{GlResult, Headless, ProgramKind, Surface, Target};
+use crate::gl::{Headless, ProgramKind, Surface, Target};
 use crate::progress::{Bar, Unit};
 use crate::study::median;
 use crate::techniques::{Frame, Renderer};
@@ -204,7 +205,7 @@ pub fn run(
                     width: w,
                     height: h,
                 };
-                let one = |r: &mut CellprojRenderer, frame: &Frame| -> GlResult<f64> {
+                let one = |r: &mut CellprojRenderer, frame: &Frame| -> RenderResult<f64> {
                     let t0 = Instant::now();
                     target.clear(gpu, [0.0, 0.0, 0.0, 1.0])?;
                     r.draw(gpu, Surface::Target(&target), frame)?;
@@ -215,7 +216,7 @@ pub fn run(
                 let image = target.read(gpu)?;
                 let still: Vec<f64> = (0..options.frames.max(1))
                     .map(|_| one(&mut r, &frame))
-                    .collect::<GlResult<_>>()?;
+                    .collect::<RenderResult<_>>()?;
                 let turn = glam::DQuat::from_rotation_y(1f64.to_radians());
                 let (mut moving, mut sort, mut upload) = (Vec::new(), Vec::new(), Vec::new());
                 for _ in 0..options.frames.max(1) {

@@ -6,6 +6,8 @@
 //! resampling's (trilinear between grid points instead of linear in each tetrahedron, the
 //! boundary to within a grid spacing) and the table's.
 
+use crate::error::RenderResult;
+use crate::gl::GlResult;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
@@ -13,8 +15,8 @@ use super::super::preint;
 use super::super::prepare::Prepared;
 use super::super::transfer::{Build, Transfer, VolumeSpec};
 use crate::gl::{
-    self, Blend, DrawCall, Extent, Filter, GlResult, Gpu, Mesh, Program, ProgramKind, Surface,
-    TexelData, TexelFormat, Texture,
+    self, Blend, DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, TexelData,
+    TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
 use crate::techniques::cellproj::locals;
@@ -170,7 +172,7 @@ impl GridCaster {
         prepared: &Prepared,
         spec: &VolumeSpec,
         transfer: &Transfer,
-    ) -> GlResult<GridCaster> {
+    ) -> RenderResult<GridCaster> {
         let pair = grid_pair();
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         program.set_transform(gpu, glam::DMat4::IDENTITY)?;
@@ -209,7 +211,7 @@ impl GridCaster {
         gpu: &Gpu,
         spec: &VolumeSpec,
         transfer: &Transfer,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         self.table = step_table(gpu, spec, transfer, self.step)?;
         Ok(())
     }
@@ -221,7 +223,7 @@ impl GridCaster {
         surface: Surface<'_>,
         frame: &Frame,
         spec: &VolumeSpec,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         let p = &self.program;
         let mvp = frame.camera.view_projection(frame.aspect());
         let inv = mvp.inverse().transpose();
@@ -253,7 +255,7 @@ impl GridCaster {
             locals::GRID_TABLE,
             [sides[0], sides[1], spec.termination, 0.0],
         )?;
-        gl::draw(
+        Ok(gl::draw(
             gpu,
             surface,
             &DrawCall {
@@ -261,7 +263,7 @@ impl GridCaster {
                 blend: Blend::PremultipliedOver,
                 ..DrawCall::new(p, &self.quad)
             },
-        )
+        )?)
     }
 }
 

@@ -2,6 +2,8 @@
 //! the entry layers peeled from the boundary, and the full-screen passes that walk every
 //! pixel's ray through the tetrahedra and integrate it exactly.
 
+use crate::error::{RenderError, RenderResult};
+use crate::gl::GlResult;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -13,8 +15,8 @@ use super::super::Isovalue;
 use crate::camera::Projection;
 use crate::gl::ProgramText;
 use crate::gl::{
-    self, Blend, DrawCall, Extent, Filter, GlError, GlResult, Gpu, Mesh, Program, ProgramKind,
-    Surface, Target, TargetFormat, TexelData, TexelFormat, Texture,
+    self, Blend, DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, Target,
+    TargetFormat, TexelData, TexelFormat, Texture,
 };
 use crate::programs::{self, ProgramPair};
 use crate::techniques::cellproj::locals;
@@ -174,12 +176,17 @@ fn rows_texture(
     format: TexelFormat,
     data: TexelData<'_>,
     texels: usize,
-) -> GlResult<Texture> {
+) -> RenderResult<Texture> {
     let rows = texels.div_ceil(ROW).max(1);
-    if rows > gpu.caps().max_texture_size.max(1) as usize {
-        return Err(GlError::Data(format!(
-            "{label}: {texels} texels need {rows} rows of {ROW}, more than GL_MAX_TEXTURE_SIZE"
-        )));
+    let max = gpu.caps().max_texture_size.max(1) as usize;
+    if rows > max {
+        return Err(RenderError::TooManyRows {
+            label: label.to_string(),
+            texels,
+            rows,
+            row: ROW,
+            max,
+        });
     }
     let texture = Texture::empty_2d(gpu, label, ROW as u32, rows as u32, format)?;
     texture.update_texels(gpu, data)?;
@@ -196,7 +203,7 @@ impl Precise {
         transfer: &Transfer,
         convex: bool,
         isovalues: &[Isovalue],
-    ) -> GlResult<Precise> {
+    ) -> RenderResult<Precise> {
         let [peel, walk, _] = precise_pairs();
         let peel = Program::new(gpu, peel.kind, &peel.vertex, &peel.fragment)?;
         let walk = Program::new(gpu, walk.kind, &walk.vertex, &walk.fragment)?;
@@ -302,7 +309,7 @@ impl Precise {
     /// Peel up to a pool of entry layers, at most `most` in all; returns how many. Layer 0
     /// of a later batch reads the previous batch's last (the pool's last), which it
     /// overwrites only at its own end.
-    fn peel_batch(&mut self, gpu: &Gpu, most: usize) -> GlResult<usize> {
+    fn peel_batch(&mut self, gpu: &Gpu, most: usize) -> RenderResult<usize> {
         let p = self;
         let mut n = 0;
         while n < p.layers.len() && p.peeled < most {
@@ -351,7 +358,7 @@ impl Precise {
         prepared: &Prepared,
         spec: &VolumeSpec,
         transfer: &Transfer,
-    ) -> GlResult<()> {
+    ) -> RenderResult<()> {
         let (w, h) = (frame.width, frame.height);
         let convex = self.convex;
         let p = self;
@@ -453,7 +460,7 @@ impl Precise {
                 }
             }
             if last {
-                return gl::draw(
+                return Ok(gl::draw(
                     gpu,
                     surface,
                     &DrawCall {
@@ -461,7 +468,7 @@ impl Precise {
                         blend: Blend::PremultipliedOver,
                         ..DrawCall::new(&p.walk, &p.quad)
                     },
-                );
+                )?);
             }
             p.sums[sum_out].clear(gpu, [0.0; 4])?;
             gl::draw(

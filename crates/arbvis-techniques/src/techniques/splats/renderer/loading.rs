@@ -7,6 +7,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{Receiver, TryRecvError};
 use std::sync::Arc;
 
+use crate::error::{RenderError, RenderResult};
 use crate::points::copc_load::Stages;
 use crate::points::copc_lod::View as CloudView;
 use crate::techniques::splats::prepare::prepare_in_stages;
@@ -22,7 +23,7 @@ pub(super) struct Loading {
     /// The settings the cut is prepared with (an edit meanwhile prepares it again).
     pub(super) params: SplatsScene,
     /// Its stages (each prepared, and whether it is the whole cut), or why it failed.
-    result: Receiver<Result<(Prepared3, bool), String>>,
+    result: Receiver<RenderResult<(Prepared3, bool)>>,
     /// Set when this loading is dropped: the loader stops before its next batch.
     stop: Arc<AtomicBool>,
 }
@@ -34,7 +35,7 @@ pub(super) enum Arrival {
     /// A stage, and whether it is the whole cut.
     Stage(Box<Prepared3>, bool),
     /// The cut cannot be loaded (a damaged node, say).
-    Failed(String),
+    Failed(RenderError),
     /// The loader ended without the whole cut (it panicked).
     Ended,
 }

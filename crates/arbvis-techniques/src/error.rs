@@ -1,0 +1,149 @@
+//! What can go wrong making or drawing a technique's picture: the GL's errors and every
+//! data layer's, kept as their own types (`#[from]`) so that a caller can still ask which
+//! file and position failed, and each prints the message its layer wrote.
+
+use crate::budget::{OverBudget, SizeError};
+use crate::colortable::TableError;
+use crate::gl::GlError;
+use crate::mesh::MeshError;
+use crate::points::PointsError;
+use crate::store::StoreError;
+use crate::surface::SurfaceError;
+use crate::techniques::clip::error::{ClipError, ComposeError};
+use crate::vocab::FieldError;
+use crate::volume::VolumeError;
+
+/// An error preparing data for a renderer, making one or drawing with it.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// The GL refused (a context, a program, a texture, memory).
+    #[error(transparent)]
+    Gl(#[from] GlError),
+    /// A volume could not be read or used.
+    #[error(transparent)]
+    Volume(#[from] VolumeError),
+    /// A mesh could not be read or used.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// A point cloud could not be read or used.
+    #[error(transparent)]
+    Points(#[from] PointsError),
+    /// A survey store could not be read.
+    #[error(transparent)]
+    Store(#[from] StoreError),
+    /// A surface could not be read.
+    #[error(transparent)]
+    Surface(#[from] SurfaceError),
+    /// A clip could not be prepared.
+    #[error("clip: {0}")]
+    Clip(#[from] ClipError),
+    /// A brick of a survey store failed to load on the loader thread (shared: the
+    /// cache keeps it to answer every frame that asks for the brick).
+    #[error(transparent)]
+    Brick(#[from] std::sync::Arc<StoreError>),
+    /// A colour table could not be made.
+    #[error(transparent)]
+    Table(#[from] TableError),
+    /// A memory size that is not one.
+    #[error(transparent)]
+    Size(#[from] SizeError),
+    /// Over the memory budget.
+    #[error(transparent)]
+    Budget(#[from] OverBudget),
+    /// Parameters that parse but cannot be drawn (the key is relative to the technique's
+    /// table).
+    #[error(transparent)]
+    Parameters(#[from] FieldError),
+    /// The precise ray caster needs more bricks resident at once than the GPU budget
+    /// holds.
+    #[error(
+        "the precise ray caster draws in one pass and needs its {bricks} bricks resident at \
+         once, more than the {capacity} the GPU budget holds: raise --gpu-memory (or \
+         store.gpu_memory), or draw a coarser level"
+    )]
+    GpuBudget {
+        /// Bricks the view needs.
+        bricks: usize,
+        /// Bricks the budget holds.
+        capacity: usize,
+    },
+    /// The clip could not be composed into a program's text.
+    #[error("clip composition of {program}: {source}")]
+    Compose {
+        /// The program.
+        program: String,
+        /// Why.
+        source: ComposeError,
+    },
+    /// A worker thread could not be started.
+    #[error("cannot start a thread: {0}")]
+    Thread(std::io::Error),
+    /// A worker thread stopped answering.
+    #[error("{0}")]
+    Stalled(&'static str),
+    /// A table of more texels than the driver's largest 2D texture holds in rows.
+    #[error(
+        "{label}: {texels} texels need {rows} rows of {row}, more than this driver's {max} \
+         (GL_MAX_TEXTURE_SIZE)"
+    )]
+    TooManyRows {
+        /// The texture.
+        label: String,
+        /// Texels asked for.
+        texels: usize,
+        /// Rows they need.
+        rows: usize,
+        /// Texels per row.
+        row: usize,
+        /// GL_MAX_TEXTURE_SIZE.
+        max: usize,
+    },
+    /// The legends and axes could not be drawn.
+    #[error("drawing the legends and axes: {0}")]
+    Annotate(#[from] AnnotateError),
+    /// One attribute's colour table (3D opacity's `primary`, ...).
+    #[error("{attribute} table: {source}")]
+    AttributeTable {
+        /// The attribute.
+        attribute: &'static str,
+        /// What failed.
+        source: TableError,
+    },
+    /// One attribute's data (3D opacity's `primary`, `secondary`, `tertiary`).
+    #[error("{attribute}: {source}")]
+    Attribute {
+        /// The attribute.
+        attribute: &'static str,
+        /// What failed.
+        source: Box<RenderError>,
+    },
+}
+
+impl RenderError {
+    /// `self`, said of 3D opacity's attribute `attribute`.
+    pub fn of_attribute(self, attribute: &'static str) -> RenderError {
+        RenderError::Attribute {
+            attribute,
+            source: Box::new(self),
+        }
+    }
+}
+
+/// Drawing the legends and axes onto a picture failed ([`crate::annotate`]).
+#[derive(Debug, thiserror::Error)]
+pub enum AnnotateError {
+    /// The font did not register.
+    #[error("the annotation font did not load")]
+    Font,
+    /// plotters could not draw.
+    #[error(transparent)]
+    Draw(#[from] AnnotationDrawing),
+}
+
+/// plotters' error drawing on a bitmap.
+pub type AnnotationDrawing = plotters::drawing::DrawingAreaErrorKind<
+    <plotters::backend::BitMapBackend<'static> as plotters::backend::DrawingBackend>::ErrorType,
+>;
+
+/// A result whose error is a [`RenderError`].
+pub type RenderResult<T> = Result<T, RenderError>;
