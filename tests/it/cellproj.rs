@@ -5,7 +5,7 @@
 use crate::common;
 
 use arbvis::camera::{Camera, Projection};
-use arbvis::gl::{Backend, Headless, ProgramChoice, ProgramKind, Surface, Target, TargetFormat};
+use arbvis::gl::{Backend, Headless, ProgramChoice, ProgramKind, TargetFormat};
 use arbvis::image::Image;
 use arbvis::mesh::grid::{generate, Field, GridSpec};
 use arbvis::mesh::scalars::ScalarSpec;
@@ -15,8 +15,9 @@ use arbvis::scene::{Fidelity, Scene, TechniqueScene};
 use arbvis::techniques::cellproj::prepare::{from_mesh, Prepared};
 use arbvis::techniques::cellproj::reference::{agreement, reference, silhouette_pixels, Agreement};
 use arbvis::techniques::cellproj::{CellprojRenderer, CellprojScene, Isovalue, IsovalueUnits};
-use arbvis::techniques::{Frame, Renderer};
+use arbvis::techniques::Renderer;
 use arbvis::vocab::Interpolation;
+use common::frame::Shot;
 use common::headless;
 
 const BACKGROUND: [f32; 4] = [0.0, 0.0, 0.0, 1.0];
@@ -84,17 +85,10 @@ fn draw(
 ) -> (Image, Vec<f32>) {
     let gpu = h.gpu();
     let mut r = CellprojRenderer::from_prepared(gpu, kind, fidelity, params, prepared).unwrap();
-    let target = Target::with_depth(gpu, size[0], size[1], TargetFormat::Rgba8).unwrap();
-    target.clear(gpu, BACKGROUND).unwrap();
-    let frame = Frame {
-        camera,
-        width: size[0],
-        height: size[1],
-    };
-    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
-    let image = target.read(gpu).unwrap();
-    let depth = target.read_depth(gpu).unwrap().unwrap();
-    (image, depth)
+    Shot::new(size, TargetFormat::Rgba8)
+        .with_depth()
+        .on(BACKGROUND)
+        .draw_with_depth(gpu, &mut r, &camera)
 }
 
 /// [`draw`] in precise mode with GLSL (the only precise programs).
@@ -548,13 +542,9 @@ fn view_order_and_entry_depth_draw_the_same_picture_from_fewer_vertices() {
         let gpu = h.gpu();
         let mut r =
             CellprojRenderer::from_prepared(gpu, kind, fidelity, &fast, prepared.clone()).unwrap();
-        let target = Target::with_depth(gpu, SIZE[0], SIZE[1], TargetFormat::Rgba8).unwrap();
-        let frame = Frame {
-            camera: cam,
-            width: SIZE[0],
-            height: SIZE[1],
-        };
-        r.draw(gpu, Surface::Target(&target), &frame).unwrap();
+        Shot::new(SIZE, TargetFormat::Rgba8)
+            .with_depth()
+            .draw(gpu, &mut r, &cam);
         let all = 12 * r.drawn_tets();
         assert!(
             r.drawn_vertices() < all * 3 / 5,

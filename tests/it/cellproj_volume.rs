@@ -6,7 +6,7 @@
 use crate::common;
 
 use arbvis::camera::{Camera, Projection};
-use arbvis::gl::{Backend, Headless, ProgramKind, Surface, Target, TargetFormat};
+use arbvis::gl::{Backend, Headless, ProgramKind, Surface};
 use arbvis::image::Image;
 use arbvis::mesh::grid::{generate, Field, GridSpec};
 use arbvis::mesh::scalars::ScalarSpec;
@@ -19,7 +19,8 @@ use arbvis::techniques::cellproj::volume_reference::{interior_mask, reference, s
 use arbvis::techniques::cellproj::{
     CellprojRenderer, CellprojScene, Exit, Isovalue, IsovalueUnits, Mode,
 };
-use arbvis::techniques::{Frame, Renderer};
+use arbvis::techniques::Renderer;
+use common::frame::Shot;
 use common::headless;
 
 const BACKGROUND: [f32; 4] = [0.1, 0.1, 0.15, 1.0];
@@ -98,23 +99,12 @@ pub(crate) fn draw(
     draw_counting_entries(h, params, prepared, fidelity, kind, camera).0
 }
 
-/// A frame of the tests' size seen by `camera`.
-fn frame_of(camera: Camera) -> Frame {
-    Frame {
-        camera,
-        width: SIZE[0],
-        height: SIZE[1],
-    }
-}
-
-/// A target of the tests' size in the format of `fidelity` (RGBA8 faithful, RGBA32F
-/// precise).
-fn target_for(gpu: &arbvis::gl::Gpu, fidelity: Fidelity) -> Target {
-    let format = match fidelity {
-        Fidelity::Faithful => TargetFormat::Rgba8,
-        Fidelity::Precise => TargetFormat::Rgba32f,
-    };
-    Target::with_depth(gpu, SIZE[0], SIZE[1], format).unwrap()
+/// How the tests take a frame: their size, the target format of `fidelity` (RGBA8
+/// faithful, RGBA32F precise) with depth, their background.
+fn shot(fidelity: Fidelity) -> Shot {
+    Shot::for_fidelity(SIZE, fidelity)
+        .with_depth()
+        .on(BACKGROUND)
 }
 
 /// A GLSL renderer of `params` on `prepared`.
@@ -126,18 +116,6 @@ fn glsl_renderer(
 ) -> CellprojRenderer {
     CellprojRenderer::from_prepared(gpu, ProgramKind::Glsl, fidelity, params, prepared.clone())
         .unwrap()
-}
-
-/// `r`'s picture of `frame` on the cleared `target`.
-fn picture_of(
-    gpu: &arbvis::gl::Gpu,
-    r: &mut CellprojRenderer,
-    target: &Target,
-    frame: &Frame,
-) -> Image {
-    target.clear(gpu, BACKGROUND).unwrap();
-    r.draw(gpu, Surface::Target(target), frame).unwrap();
-    target.read(gpu).unwrap()
 }
 
 /// [`draw`], and the entry layers the precise walk peeled.
@@ -152,7 +130,7 @@ pub(crate) fn draw_counting_entries(
     let gpu = h.gpu();
     let mut r =
         CellprojRenderer::from_prepared(gpu, kind, fidelity, params, prepared.clone()).unwrap();
-    let image = picture_of(gpu, &mut r, &target_for(gpu, fidelity), &frame_of(camera));
+    let image = shot(fidelity).draw(gpu, &mut r, &camera);
     (image, r.volume().map_or(0, |v| v.entries()))
 }
 
@@ -361,8 +339,9 @@ fn faithful_is_within_its_table_and_target_quantization_and_arb_equals_glsl() {
         prepared.clone(),
     )
     .unwrap();
-    let target = Target::with_depth(gpu, SIZE[0], SIZE[1], TargetFormat::Rgba8).unwrap();
-    let frame = frame_of(camera(Projection::Perspective));
+    let shot = shot(Fidelity::Faithful);
+    let target = shot.target(gpu);
+    let frame = shot.frame(&camera(Projection::Perspective));
     let err = r
         .draw(gpu, Surface::Target(&target), &frame)
         .unwrap_err()
@@ -778,7 +757,6 @@ fn transfer_function_edits_draw_what_a_fresh_renderer_draws() {
     let gpu = h.gpu();
     let prepared = prepared_of(&grid(9, Field::Spherical));
     let cam = camera(Projection::Perspective);
-    let frame = frame_of(cam);
     let first = spec(Sort::Centroid);
     // Another function (the band moved and recoloured), another unit, MPVONC.
     let mut second = spec(Sort::Mpvonc);
@@ -801,7 +779,8 @@ fn transfer_function_edits_draw_what_a_fresh_renderer_draws() {
         (Fidelity::Precise, None),
         (Fidelity::Precise, Some(13)),
     ] {
-        let target = target_for(gpu, fidelity);
+        let shot = shot(fidelity);
+        let target = shot.target(gpu);
         let steps: Vec<VolumeSpec> = [
             &second, &coarse, &second, &bands, &coarse, &first, &bands, &second,
         ]
@@ -815,7 +794,7 @@ fn transfer_function_edits_draw_what_a_fresh_renderer_draws() {
         let first = grid.map_or(first.clone(), |n| as_grid(&first, n));
         let first_scene = scene(Mode::Volume, first, vec![]);
         let mut r = glsl_renderer(gpu, fidelity, &first_scene, &prepared);
-        let picture = |r: &mut CellprojRenderer| picture_of(gpu, r, &target, &frame);
+        let picture = |r: &mut CellprojRenderer| shot.draw_on(gpu, r, &target, &cam);
         picture(&mut r);
         for step in &steps {
             let params = scene(Mode::Volume, step.clone(), vec![]);
@@ -863,7 +842,7 @@ fn clear_tetrahedra_are_left_out_and_no_pixel_moves() {
     let prepared = prepared_of(&grid(13, Field::Waves));
     let total = prepared.tets.len();
     for projection in [Projection::Orthographic, Projection::Perspective] {
-        let frame = frame_of(camera(projection));
+        let cam = camera(projection);
         let mut params = scene(Mode::Volume, banded(Sort::Mpvonc), vec![]);
         params.mesh = arbvis::mesh::MeshSource::Grid(GridSpec {
             points: [13; 3],
@@ -883,11 +862,12 @@ fn clear_tetrahedra_are_left_out_and_no_pixel_moves() {
             let volume = params.volume.as_mut().unwrap();
             volume.precise = method;
             volume.table_size = table_size;
-            let target = target_for(gpu, fidelity);
+            let shot = shot(fidelity);
+            let target = shot.target(gpu);
             let mut picture = |active_only: bool| {
                 params.active_only = active_only;
                 let mut r = glsl_renderer(gpu, fidelity, &params, &prepared);
-                let image = picture_of(gpu, &mut r, &target, &frame);
+                let image = shot.draw_on(gpu, &mut r, &target, &cam);
                 (image, r.volume().unwrap().times().drawn)
             };
             let (culled, drawn) = picture(true);
@@ -929,7 +909,6 @@ fn the_drawn_set_follows_an_edit_undone_before_the_draw() {
     let gpu = h.gpu();
     let prepared = prepared_of(&grid(13, Field::Waves));
     let cam = camera(Projection::Orthographic);
-    let frame = frame_of(cam);
     let mut table = spec(Sort::Mpvonc);
     table.precise = Precise::Table;
     let mut bands = banded(Sort::Mpvonc);
@@ -937,8 +916,9 @@ fn the_drawn_set_follows_an_edit_undone_before_the_draw() {
     let mut all = scene(Mode::Volume, table.clone(), vec![]);
     all.active_only = false;
     let mut r = glsl_renderer(gpu, Fidelity::Precise, &all, &prepared);
-    let target = target_for(gpu, Fidelity::Precise);
-    picture_of(gpu, &mut r, &target, &frame);
+    let shot = shot(Fidelity::Precise);
+    let target = shot.target(gpu);
+    shot.draw_on(gpu, &mut r, &target, &cam);
     // Culling on with the banded function, then the first function back, no draw between.
     let culled_bands = scene(Mode::Volume, bands, vec![]);
     r.update(gpu, arbvis::techniques::Params::of(&culled_bands))
@@ -946,7 +926,7 @@ fn the_drawn_set_follows_an_edit_undone_before_the_draw() {
     let back = scene(Mode::Volume, table, vec![]);
     r.update(gpu, arbvis::techniques::Params::of(&back))
         .unwrap();
-    let undone = picture_of(gpu, &mut r, &target, &frame);
+    let undone = shot.draw_on(gpu, &mut r, &target, &cam);
     let fresh = draw(
         &h,
         &back,

@@ -1,6 +1,7 @@
 //! Shared test harness: contexts, pixel probes with bit-depth tolerances, golden images.
 #![allow(dead_code)]
 
+pub mod frame;
 pub mod hostile_files;
 pub mod splats;
 #[cfg(feature = "viewer")]

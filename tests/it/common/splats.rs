@@ -3,7 +3,7 @@
 //! same splats.
 
 use arbvis::camera::{Camera, Projection};
-use arbvis::gl::{Headless, ProgramKind, Surface, Target, TargetFormat};
+use arbvis::gl::{Headless, ProgramKind, TargetFormat};
 use arbvis::image::Image;
 use arbvis::points::section::{generate, SectionSpec};
 use arbvis::points::PointCloud;
@@ -14,7 +14,9 @@ use arbvis::techniques::splats::reference::{
     composite, eye_position, view_direction, weighted_blended, SplatParams, SplatScene,
 };
 use arbvis::techniques::splats::{SplatsRenderer, SplatsScene};
-use arbvis::techniques::{Frame, Renderer};
+use arbvis::techniques::Renderer;
+
+use super::frame::Shot;
 
 pub const BACKGROUND: [f32; 4] = [0.1, 0.1, 0.15, 1.0];
 pub const SIZE: [u32; 2] = [96, 72];
@@ -111,16 +113,11 @@ pub fn draw_sized(
         prepared,
     )
     .unwrap();
-    let target = Target::new(gpu, size[0], size[1], TargetFormat::Rgba32f).unwrap();
-    target.clear(gpu, BACKGROUND).unwrap();
-    let frame = Frame {
-        camera,
-        width: size[0],
-        height: size[1],
-    };
-    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
+    let image = Shot::new(size, TargetFormat::Rgba32f)
+        .on(BACKGROUND)
+        .draw(gpu, &mut r, &camera);
     assert_eq!(r.program_kind(), kind);
-    target.read(gpu).unwrap()
+    image
 }
 
 /// What renderer `r` draws of `camera` into a fresh `size` float target.
@@ -130,14 +127,7 @@ pub fn draw_renderer(
     camera: &Camera,
     size: [u32; 2],
 ) -> Image {
-    let target = Target::new(gpu, size[0], size[1], TargetFormat::Rgba32f).unwrap();
-    let frame = Frame {
-        camera: *camera,
-        width: size[0],
-        height: size[1],
-    };
-    r.draw(gpu, Surface::Target(&target), &frame).unwrap();
-    target.read(gpu).unwrap()
+    Shot::new(size, TargetFormat::Rgba32f).draw(gpu, r, camera)
 }
 
 /// The f64 reference of the same splats.
