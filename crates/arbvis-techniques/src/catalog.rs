@@ -115,14 +115,25 @@ impl TechniqueScene {
         each_technique!(self, |p| Params::of(p))
     }
 
+    /// The parameters, of whichever technique (for a list of capabilities kept above
+    /// the catalog, such as the viewer's faces).
+    pub fn parameters(&self) -> &dyn Any {
+        each_technique!(self, |p| p as &dyn Any)
+    }
+
+    /// [`TechniqueScene::parameters`], to change.
+    pub fn parameters_mut(&mut self) -> &mut dyn Any {
+        each_technique!(self, |mut p| p as &mut dyn Any)
+    }
+
     /// The parameters as technique `T`'s, where the scene draws `T`.
     pub fn get<T: Technique>(&self) -> Option<&T> {
-        each_technique!(self, |p| (p as &dyn Any).downcast_ref::<T>())
+        self.parameters().downcast_ref::<T>()
     }
 
     /// The parameters as technique `T`'s to change, where the scene draws `T`.
     pub fn get_mut<T: Technique>(&mut self) -> Option<&mut T> {
-        each_technique!(self, |mut p| (p as &mut dyn Any).downcast_mut::<T>())
+        self.parameters_mut().downcast_mut::<T>()
     }
 
     /// Check values that parse but cannot render at `fidelity` with `programs`; the

@@ -145,5 +145,27 @@ pub type AnnotationDrawing = plotters::drawing::DrawingAreaErrorKind<
     <plotters::backend::BitMapBackend<'static> as plotters::backend::DrawingBackend>::ErrorType,
 >;
 
+/// Rows of `row` texels a 2D texture needs to hold `texels` (at least one), within the
+/// driver's largest 2D texture, or [`RenderError::TooManyRows`] naming `label`.
+pub fn texture_rows(
+    gpu: &crate::gl::Gpu,
+    label: &str,
+    texels: usize,
+    row: usize,
+) -> RenderResult<usize> {
+    let rows = texels.div_ceil(row).max(1);
+    let max = gpu.caps().max_texture_size.max(1) as usize;
+    if rows > max {
+        return Err(RenderError::TooManyRows {
+            label: label.to_string(),
+            texels,
+            rows,
+            row,
+            max,
+        });
+    }
+    Ok(rows)
+}
+
 /// A result whose error is a [`RenderError`].
 pub type RenderResult<T> = Result<T, RenderError>;

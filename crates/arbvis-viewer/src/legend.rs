@@ -401,27 +401,8 @@ fn unit(c: [f64; 3]) -> Color32 {
     Color32::from_rgb(b(c[0]), b(c[1]), b(c[2]))
 }
 
-/// The legends of what `scene` shows (`ctx` makes the colour-bar textures): each
-/// technique's own, from what its panels keep in `data`.
-pub fn legends(
-    ctx: &egui::Context,
-    scene: &Scene,
-    data: &mut ViewData,
-    transfer: Option<TextureId>,
-) -> Vec<Legend> {
-    let mut out = Vec::new();
-    if let Some(o) = scene.technique.get::<Opacity3dScene>() {
-        volume_legends(ctx, scene, o, data, &mut out);
-    } else if let Some(c) = scene.technique.get::<CellprojScene>() {
-        mesh_legends(c, data, transfer, &mut out);
-    } else if let Some(sp) = scene.technique.get::<SplatsScene>() {
-        cloud_legends(sp, data, &mut out);
-    }
-    out
-}
-
 /// 3D opacity: a colour bar per attribute, over its value range.
-fn volume_legends(
+pub(crate) fn volume_legends(
     ctx: &egui::Context,
     scene: &Scene,
     o: &Opacity3dScene,
@@ -445,7 +426,7 @@ fn volume_legends(
 }
 
 /// Cell projection: the transfer function's bar (volume mode) and the isovalues as keys.
-fn mesh_legends(
+pub(crate) fn mesh_legends(
     c: &CellprojScene,
     data: &ViewData,
     transfer: Option<TextureId>,
@@ -496,7 +477,7 @@ fn mesh_legends(
 }
 
 /// Splats: the colouring's classes as keys, or its gradient, and the faults' white.
-fn cloud_legends(sp: &SplatsScene, data: &ViewData, out: &mut Vec<Legend>) {
+pub(crate) fn cloud_legends(sp: &SplatsScene, data: &ViewData, out: &mut Vec<Legend>) {
     let Some(s) = &data.cloud else { return };
     let fault = (sp.faults_white && s.faults).then(|| (Color32::WHITE, "fault".to_string()));
     let key = |title: &str, mut entries: Vec<(Color32, String)>, more: usize| {

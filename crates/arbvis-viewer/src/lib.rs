@@ -35,6 +35,7 @@ pub mod check;
 pub mod clip;
 pub mod curve;
 pub mod data;
+pub mod face;
 pub mod isovalues;
 pub mod layout;
 pub mod legend;

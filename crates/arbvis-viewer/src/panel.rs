@@ -9,6 +9,7 @@
 use egui::{Rect, RichText, Sense, Vec2};
 
 use super::data::ViewData;
+use super::face::{self, face_mut, EditContext};
 use super::layout::{self, overlay_font};
 use super::legend;
 use super::lut3d;
@@ -18,9 +19,7 @@ use super::widgets::Widgets;
 use crate::camera::Projection;
 use crate::gl::{Caps, ProgramKind};
 use crate::scene::Scene;
-use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::Opacity3dScene;
-use crate::techniques::quad::QuadScene;
 use crate::techniques::splats::SplatsScene;
 use crate::vocab::Fidelity;
 use crate::volume::axes::section_axes;
@@ -339,44 +338,17 @@ fn technique_editors(
     state: &mut PanelState,
     actions: &mut Vec<UiAction>,
 ) {
-    let w = &mut state.widgets;
-    let fidelity = scene.fidelity;
-    if let Some(sp) = scene.technique.get_mut::<SplatsScene>() {
-        ui.separator();
-        if super::splats::editor(ui, sp, fidelity, data.cloud.as_ref(), w) {
+    let mut cx = EditContext {
+        fidelity: scene.fidelity,
+        base: &scene.base,
+        data,
+        widgets: &mut state.widgets,
+        clip: &mut state.clip,
+        transfer: &mut state.transfer,
+    };
+    if let Some(face) = face_mut(&mut scene.technique) {
+        if face.editors(ui, &mut cx) {
             actions.push(UiAction::ParamsChanged);
-        }
-    }
-    if let Some(o) = scene.technique.get_mut::<Opacity3dScene>() {
-        ui.separator();
-        if super::clip::editor(ui, o, &mut state.clip, w) {
-            actions.push(UiAction::ParamsChanged);
-        }
-    }
-    if let Some(c) = scene.technique.get_mut::<CellprojScene>() {
-        ui.separator();
-        let counts = data.mesh.as_ref().map(|m| m.histogram.as_slice());
-        if super::transfer::editor(ui, c, &scene.base, counts, &mut state.transfer, w) {
-            actions.push(UiAction::ParamsChanged);
-        }
-        ui.separator();
-        let range = data.mesh.as_ref().map_or([0.0, 1.0], |m| m.range);
-        if super::isovalues::editor(ui, c, range, w) {
-            actions.push(UiAction::ParamsChanged);
-        }
-    }
-    if let Some(q) = scene.technique.get_mut::<QuadScene>() {
-        ui.label("Quad colours");
-        for (label, colour) in [("Left", &mut q.left), ("Right", &mut q.right)] {
-            ui.horizontal(|ui| {
-                ui.label(label);
-                let mut c = colour.map(|v| v as f32);
-                let r = ui.color_edit_button_rgba_unmultiplied(&mut c);
-                if w.add(ui, &format!("{label} colour"), &r) && r.changed() {
-                    *colour = c.map(|v| v as f64);
-                    actions.push(UiAction::ParamsChanged);
-                }
-            });
         }
     }
 }
@@ -514,7 +486,7 @@ fn draw_overlay(
             .size()
     };
     let ink = Ink::on(scene.background);
-    let legends = legend::legends(&ctx, scene, data, state.transfer.colours());
+    let legends = face::legends(&ctx, scene, data, state.transfer.colours());
     let placed = legend::layout(rect, &legends, ink, &measure);
     let view = placed.picture(rect);
     legend::paint(&painter, &placed);

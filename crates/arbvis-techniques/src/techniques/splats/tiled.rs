@@ -4,7 +4,7 @@
 //! blended `ONE, ONE_MINUS_SRC_ALPHA` over the cleared target. GLSL only (ARB fragment
 //! programs have no loops). All textures are freed on Drop.
 
-use crate::error::{RenderError, RenderResult};
+use crate::error::{texture_rows, RenderResult};
 use glam::DMat4;
 
 use super::locals;
@@ -52,16 +52,8 @@ fn array_texture(
             }
         }
     }
+    texture_rows(gpu, label, texels, ROW)?;
     let max = gpu.caps().max_texture_size.max(1) as usize;
-    if rows > max {
-        return Err(RenderError::TooManyRows {
-            label: label.to_string(),
-            texels,
-            rows,
-            row: ROW,
-            max,
-        });
-    }
     let rows = (rows + rows / 4).min(max);
     // The old texture is dropped (freed) before the new one is made.
     Ok(Texture::empty_2d(

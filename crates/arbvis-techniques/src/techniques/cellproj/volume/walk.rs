@@ -2,7 +2,7 @@
 //! the entry layers peeled from the boundary, and the full-screen passes that walk every
 //! pixel's ray through the tetrahedra and integrate it exactly.
 
-use crate::error::{RenderError, RenderResult};
+use crate::error::{texture_rows, RenderResult};
 use crate::gl::GlResult;
 use glam::DVec3;
 use rayon::prelude::*;
@@ -177,17 +177,7 @@ fn rows_texture(
     data: TexelData<'_>,
     texels: usize,
 ) -> RenderResult<Texture> {
-    let rows = texels.div_ceil(ROW).max(1);
-    let max = gpu.caps().max_texture_size.max(1) as usize;
-    if rows > max {
-        return Err(RenderError::TooManyRows {
-            label: label.to_string(),
-            texels,
-            rows,
-            row: ROW,
-            max,
-        });
-    }
+    let rows = texture_rows(gpu, label, texels, ROW)?;
     let texture = Texture::empty_2d(gpu, label, ROW as u32, rows as u32, format)?;
     texture.update_texels(gpu, data)?;
     Ok(texture)

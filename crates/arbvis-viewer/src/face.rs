@@ -1,0 +1,204 @@
+//! What the viewer shows of a technique besides its picture: its editors in the panel and
+//! its legends over the picture. Each technique's scene type implements [`Face`] once,
+//! here; [`FACES`] is the viewer's one list of them (the catalog's list, seen from the
+//! viewer, which alone knows egui). A technique without a face shows neither.
+
+use std::any::Any;
+use std::path::Path;
+
+use egui::TextureId;
+
+use super::clip::ClipEditor;
+use super::data::ViewData;
+use super::legend::{self, Legend};
+use super::transfer::TransferState;
+use super::widgets::Widgets;
+use crate::catalog::TechniqueScene;
+use crate::scene::Scene;
+use crate::techniques::cellproj::CellprojScene;
+use crate::techniques::opacity3d::Opacity3dScene;
+use crate::techniques::quad::QuadScene;
+use crate::techniques::splats::SplatsScene;
+use crate::vocab::Fidelity;
+
+/// What an editor may read and keep besides the parameters it edits.
+pub struct EditContext<'a> {
+    /// The scene's fidelity.
+    pub fidelity: Fidelity,
+    /// The folder the scene's relative paths are read from.
+    pub base: &'a Path,
+    /// What the panels keep of the prepared data (a cloud's attributes, a mesh's
+    /// histogram).
+    pub data: &'a ViewData,
+    /// Every labelled control.
+    pub widgets: &'a mut Widgets,
+    /// The clip editor's state.
+    pub clip: &'a mut ClipEditor,
+    /// The transfer function editor's state.
+    pub transfer: &'a mut TransferState,
+}
+
+/// A technique as the viewer shows it.
+pub trait Face {
+    /// Draw the technique's editors into `ui`; true when a parameter changed.
+    fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool;
+    /// Add the technique's legends (colour bars, keys) for `scene` to `out`; `transfer`
+    /// is the transfer function editor's colour strip, where it has one.
+    fn legends(
+        &self,
+        ctx: &egui::Context,
+        scene: &Scene,
+        data: &mut ViewData,
+        transfer: Option<TextureId>,
+        out: &mut Vec<Legend>,
+    ) {
+        let _ = (ctx, scene, data, transfer, out);
+    }
+}
+
+impl Face for QuadScene {
+    fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool {
+        ui.label("Quad colours");
+        let mut changed = false;
+        for (label, colour) in [("Left", &mut self.left), ("Right", &mut self.right)] {
+            ui.horizontal(|ui| {
+                ui.label(label);
+                let mut c = colour.map(|v| v as f32);
+                let r = ui.color_edit_button_rgba_unmultiplied(&mut c);
+                if cx.widgets.add(ui, &format!("{label} colour"), &r) && r.changed() {
+                    *colour = c.map(|v| v as f64);
+                    changed = true;
+                }
+            });
+        }
+        changed
+    }
+}
+
+impl Face for Opacity3dScene {
+    fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool {
+        ui.separator();
+        super::clip::editor(ui, self, cx.clip, cx.widgets)
+    }
+
+    fn legends(
+        &self,
+        ctx: &egui::Context,
+        scene: &Scene,
+        data: &mut ViewData,
+        _: Option<TextureId>,
+        out: &mut Vec<Legend>,
+    ) {
+        legend::volume_legends(ctx, scene, self, data, out);
+    }
+}
+
+impl Face for CellprojScene {
+    fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool {
+        ui.separator();
+        let mesh = cx.data.mesh.as_ref();
+        let counts = mesh.map(|m| m.histogram.as_slice());
+        let edited = super::transfer::editor(ui, self, cx.base, counts, cx.transfer, cx.widgets);
+        ui.separator();
+        let range = mesh.map_or([0.0, 1.0], |m| m.range);
+        super::isovalues::editor(ui, self, range, cx.widgets) || edited
+    }
+
+    fn legends(
+        &self,
+        _: &egui::Context,
+        _: &Scene,
+        data: &mut ViewData,
+        transfer: Option<TextureId>,
+        out: &mut Vec<Legend>,
+    ) {
+        legend::mesh_legends(self, data, transfer, out);
+    }
+}
+
+impl Face for SplatsScene {
+    fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool {
+        ui.separator();
+        super::splats::editor(ui, self, cx.fidelity, cx.data.cloud.as_ref(), cx.widgets)
+    }
+
+    fn legends(
+        &self,
+        _: &egui::Context,
+        _: &Scene,
+        data: &mut ViewData,
+        _: Option<TextureId>,
+        out: &mut Vec<Legend>,
+    ) {
+        legend::cloud_legends(self, data, out);
+    }
+}
+
+/// The face of parameters of type `T`, if `parameters` are.
+fn face_of<T: Face + Any>(parameters: &dyn Any) -> Option<&dyn Face> {
+    parameters.downcast_ref::<T>().map(|t| t as &dyn Face)
+}
+
+/// [`face_of`], to change.
+fn face_of_mut<T: Face + Any>(parameters: &mut dyn Any) -> Option<&mut dyn Face> {
+    parameters.downcast_mut::<T>().map(|t| t as &mut dyn Face)
+}
+
+/// How one technique's face is found in its parameters: to read, and to change.
+type FaceLookup = (
+    fn(&dyn Any) -> Option<&dyn Face>,
+    fn(&mut dyn Any) -> Option<&mut dyn Face>,
+);
+
+/// Every technique with a face: the viewer's one list.
+const FACES: [FaceLookup; 4] = [
+    (face_of::<QuadScene>, face_of_mut::<QuadScene>),
+    (face_of::<Opacity3dScene>, face_of_mut::<Opacity3dScene>),
+    (face_of::<CellprojScene>, face_of_mut::<CellprojScene>),
+    (face_of::<SplatsScene>, face_of_mut::<SplatsScene>),
+];
+
+/// The face of the scene's technique.
+pub fn face(technique: &TechniqueScene) -> Option<&dyn Face> {
+    FACES.iter().find_map(|(of, _)| of(technique.parameters()))
+}
+
+/// [`face`], to edit.
+pub fn face_mut(technique: &mut TechniqueScene) -> Option<&mut dyn Face> {
+    let index = FACES
+        .iter()
+        .position(|(of, _)| of(technique.parameters()).is_some())?;
+    (FACES[index].1)(technique.parameters_mut())
+}
+
+/// The legends of `scene`'s technique, from what its panels keep in `data`.
+pub fn legends(
+    ctx: &egui::Context,
+    scene: &Scene,
+    data: &mut ViewData,
+    transfer: Option<TextureId>,
+) -> Vec<Legend> {
+    let mut out = Vec::new();
+    if let Some(f) = face(&scene.technique) {
+        f.legends(ctx, scene, data, transfer, &mut out);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_demo_technique_has_a_face_found_both_ways() {
+        for (name, _) in crate::scene::DEMOS {
+            let mut scene = Scene::demo(name).unwrap();
+            let technique = scene.technique.name();
+            assert!(face(&scene.technique).is_some(), "{name}: {technique}");
+            assert!(
+                face_mut(&mut scene.technique).is_some(),
+                "{name}: {technique}"
+            );
+        }
+    }
+}
