@@ -20,6 +20,15 @@ done
 "$arbvis" render scenes/data/bracket-volume.toml --fidelity faithful -o "$out/data-bracket-volume-faithful.png"
 "$arbvis" render scenes/data/f3-minimal.toml --size 640x480 --legend --axes -o "$out/data-f3-figure.png"
 "$arbvis" render scenes/bench/cellproj-seed-volume.toml -o "$out/cellproj-seed-volume.png"
+# The README's Python example (scripts/python-tests.sh makes target/python-venv).
+if [ -x target/python-venv/bin/python ]; then
+  (cd "$out" && ../../target/python-venv/bin/python -c '
+import arbvis
+scene = arbvis.Scene.demo("v3o2-sum")
+scene["technique.opacity3d.primary.coefficients"] = [0.0, 0.0, 0.0, 0.0]
+with arbvis.Renderer(scene) as renderer:
+    arbvis.write_png("v3o2-sum-python.png", renderer.render())')
+fi
 # NASA's CFD meshes (`python3 benches/meshes.py nasa` downloads them into target/meshes).
 if [ -f target/meshes/bluntfin.vtk ] && [ -f target/meshes/oxygen-post.vtk ]; then
   "$arbvis" render scenes/meshes/bluntfin-volume.toml -o "$out/nasa-bluntfin-volume.png"

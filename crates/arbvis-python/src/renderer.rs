@@ -1,0 +1,229 @@
+//! `arbvis.Renderer`: a scene kept ready to draw ([`arbvis_techniques::render::Session`]:
+//! GL context, prepared data, programs, target) on a render thread of its own. A GL
+//! context belongs to one thread, and the Python thread that calls may change; so each
+//! renderer owns the thread its context lives on, and a call hands it the scene and waits
+//! for the picture with the GIL released. Renderers in two Python threads draw at once.
+
+use std::sync::mpsc::{channel, Receiver, Sender};
+use std::thread::JoinHandle;
+
+use numpy::ndarray::Array3;
+use numpy::IntoPyArray;
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+
+use arbvis_core::image::Image;
+use arbvis_core::vocab::TargetFormat;
+use arbvis_gl::Backend;
+use arbvis_techniques::error::RenderResult;
+use arbvis_techniques::render::Session;
+use arbvis_techniques::scene::Scene;
+
+use crate::errors;
+use crate::scene::PyScene;
+
+/// The backend named `name` (`egl`, `osmesa`).
+pub fn backend_named(name: &str) -> PyResult<Backend> {
+    match name.to_ascii_lowercase().as_str() {
+        "egl" => Ok(Backend::Egl),
+        "osmesa" => Ok(Backend::Osmesa),
+        _ => Err(PyValueError::new_err(format!(
+            "no backend {name:?}: \"egl\" or \"osmesa\""
+        ))),
+    }
+}
+
+/// What the render thread is asked.
+enum Job {
+    /// Draw the scene; the picture (composited as a PNG shows it) back.
+    Render(Box<Scene>, Sender<RenderResult<Image>>),
+}
+
+/// What the render thread says once its context and renderer are made.
+struct Ready {
+    program_kind: &'static str,
+    backend: &'static str,
+    renderer: String,
+}
+
+/// The render thread: make the session, say so, then draw what is asked until the
+/// renderer is dropped.
+fn serve(scene: Scene, backend: Backend, ready: Sender<RenderResult<Ready>>, jobs: Receiver<Job>) {
+    let mut session = match Session::new(&scene, backend) {
+        Ok(s) => s,
+        Err(e) => {
+            let _ = ready.send(Err(e));
+            return;
+        }
+    };
+    let _ = ready.send(Ok(Ready {
+        program_kind: session.program_kind().name(),
+        backend: session.backend().name(),
+        renderer: session.caps().renderer.clone(),
+    }));
+    while let Ok(job) = jobs.recv() {
+        match job {
+            Job::Render(scene, reply) => {
+                let picture = session.render(&scene).map(|frame| scene.picture(&frame));
+                let _ = reply.send(picture);
+            }
+        }
+    }
+}
+
+/// A renderer of one scene: it keeps its GL context, the prepared data and the programs
+/// between frames, so that a render after a change of camera, size or a technique
+/// parameter costs a frame, not a process. `render()` draws the scene as it is then.
+///
+/// Threads: the renderer draws on a thread of its own (a GL context belongs to one
+/// thread), and every call waits for it with the GIL released; a renderer may be called
+/// from any Python thread, one call at a time, and renderers in two threads draw at once.
+#[pyclass(name = "Renderer", module = "arbvis")]
+pub struct PyRenderer {
+    scene: Py<PyScene>,
+    jobs: Option<Sender<Job>>,
+    thread: Option<JoinHandle<()>>,
+    program_kind: &'static str,
+    backend: &'static str,
+    renderer: String,
+}
+
+#[pymethods]
+impl PyRenderer {
+    /// Load and prepare `scene`'s data and make its renderer on `backend` (`"egl"`, the
+    /// default, or `"osmesa"`).
+    #[new]
+    #[pyo3(signature = (scene, backend = "egl"))]
+    fn new(py: Python<'_>, scene: Py<PyScene>, backend: &str) -> PyResult<PyRenderer> {
+        let backend = backend_named(backend)?;
+        let first = scene.borrow(py).scene.clone();
+        let (jobs, inbox) = channel();
+        let (ready_tx, ready) = channel();
+        let thread = std::thread::Builder::new()
+            .name("arbvis render".into())
+            .spawn(move || serve(first, backend, ready_tx, inbox))
+            .map_err(|e| PyRuntimeError::new_err(format!("cannot start a thread: {e}")))?;
+        let made = py
+            .detach(move || ready.recv())
+            .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?
+            .map_err(errors::from_render)?;
+        Ok(PyRenderer {
+            scene,
+            jobs: Some(jobs),
+            thread: Some(thread),
+            program_kind: made.program_kind,
+            backend: made.backend,
+            renderer: made.renderer,
+        })
+    }
+
+    /// Draw the scene (or `scene`, which becomes the renderer's) as it is now: an
+    /// `(height, width, 4)` numpy array, top row first, as a PNG of it would show it;
+    /// `uint8` for an 8-bit target (faithful), `float32` for a float one (precise), handed
+    /// to numpy without a copy.
+    #[pyo3(signature = (scene = None))]
+    fn render<'py>(
+        &mut self,
+        py: Python<'py>,
+        scene: Option<Py<PyScene>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if let Some(s) = scene {
+            self.scene = s;
+        }
+        let scene = self.scene.borrow(py).scene.clone();
+        let jobs = self
+            .jobs
+            .as_ref()
+            .ok_or_else(|| PyRuntimeError::new_err("the renderer is closed"))?;
+        let (reply, picture) = channel();
+        jobs.send(Job::Render(Box::new(scene), reply))
+            .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?;
+        let image = py
+            .detach(move || picture.recv())
+            .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?
+            .map_err(errors::from_render)?;
+        Ok(to_array(py, image))
+    }
+
+    /// The scene this renderer draws.
+    #[getter]
+    fn scene(&self, py: Python<'_>) -> Py<PyScene> {
+        self.scene.clone_ref(py)
+    }
+
+    /// The program kind it draws with (`"arb"` or `"glsl"`).
+    #[getter]
+    fn program_kind(&self) -> &'static str {
+        self.program_kind
+    }
+
+    /// The backend (`"egl"` or `"osmesa"`).
+    #[getter]
+    fn backend(&self) -> &'static str {
+        self.backend
+    }
+
+    /// The driver's renderer string (e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`).
+    #[getter]
+    fn driver(&self) -> String {
+        self.renderer.clone()
+    }
+
+    /// Free the context, data and thread now (also done when the renderer is collected).
+    fn close(&mut self, py: Python<'_>) {
+        self.jobs = None;
+        if let Some(thread) = self.thread.take() {
+            py.detach(|| {
+                let _ = thread.join();
+            });
+        }
+    }
+
+    fn __enter__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+
+    fn __exit__(
+        &mut self,
+        py: Python<'_>,
+        _exc_type: &Bound<'_, PyAny>,
+        _exc: &Bound<'_, PyAny>,
+        _tb: &Bound<'_, PyAny>,
+    ) {
+        self.close(py);
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "<arbvis.Renderer {} programs on {} ({})>",
+            self.program_kind, self.backend, self.renderer
+        )
+    }
+}
+
+impl Drop for PyRenderer {
+    fn drop(&mut self) {
+        // The thread ends when its inbox closes; it never takes the GIL, so waiting for it
+        // here cannot deadlock.
+        self.jobs = None;
+        if let Some(thread) = self.thread.take() {
+            let _ = thread.join();
+        }
+    }
+}
+
+/// `image` as a numpy array `(height, width, 4)`: its floats moved in without a copy for
+/// a float target, rounded to bytes for an 8-bit one.
+fn to_array(py: Python<'_>, image: Image) -> Bound<'_, PyAny> {
+    let shape = (image.height as usize, image.width as usize, 4);
+    match image.format {
+        TargetFormat::Rgba8 => {
+            let array = Array3::from_shape_vec(shape, image.to_rgba8()).expect("4 values a pixel");
+            array.into_pyarray(py).into_any()
+        }
+        _ => {
+            let array = Array3::from_shape_vec(shape, image.data).expect("4 values a pixel");
+            array.into_pyarray(py).into_any()
+        }
+    }
+}

@@ -1,0 +1,320 @@
+//! `arbvis.Scene`: a scene read from a file, TOML text or a dict, its values read and
+//! written as Python values by dotted key. Every change goes through the same parser and
+//! validation as a scene file, so a bad value raises the `SceneError` a file would, with
+//! its key.
+
+use std::path::PathBuf;
+
+use pyo3::exceptions::PyKeyError;
+use pyo3::prelude::*;
+
+use arbvis_techniques::scene::Scene;
+
+use crate::errors::{self, At};
+
+/// `json.loads(text)`.
+pub fn json_loads<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+/// A Python value as JSON (`json.dumps`), for the scene's parser.
+fn json_of(value: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
+    let text: String = value
+        .py()
+        .import("json")?
+        .call_method1("dumps", (value,))?
+        .extract()?;
+    serde_json::from_str(&text).map_err(|e| {
+        errors::scene_error(
+            format!("not a value a scene holds: {e}"),
+            At {
+                path: None,
+                line: None,
+                column: None,
+                key: None,
+            },
+        )
+    })
+}
+
+/// The scene as a JSON tree.
+fn tree_of(scene: &Scene) -> serde_json::Value {
+    serde_json::to_value(scene).expect("a scene serializes")
+}
+
+/// A scene from a JSON tree, read as TOML text is (the same errors); `key`, the one
+/// changed, names a value of the wrong shape.
+fn scene_of(tree: &serde_json::Value, base: PathBuf, key: Option<&str>) -> PyResult<Scene> {
+    let bad = |message: String| {
+        let message = match key {
+            Some(k) => format!("{k}: {message}"),
+            None => message,
+        };
+        errors::scene_error(
+            message,
+            At {
+                path: None,
+                line: None,
+                column: None,
+                key,
+            },
+        )
+    };
+    let value = toml::Value::try_from(tree).map_err(|e| bad(e.to_string()))?;
+    let text = toml::to_string(&value).map_err(|e| bad(e.to_string()))?;
+    match Scene::parse(&text, "scene") {
+        Ok(mut scene) => {
+            scene.base = base;
+            Ok(scene)
+        }
+        // A value of the wrong shape: the parser's message, at the key changed.
+        Err(arbvis_techniques::scene::SceneError::Parse { message, .. }) => Err(bad(message)),
+        Err(arbvis_techniques::scene::SceneError::Invalid {
+            key: at, message, ..
+        }) => Err(errors::scene_error(
+            format!("{at}: {message}"),
+            At {
+                path: None,
+                line: None,
+                column: None,
+                key: Some(&at),
+            },
+        )),
+        Err(e) => Err(errors::from_scene(e)),
+    }
+}
+
+/// The value at dotted `key` in `tree`.
+fn at<'t>(tree: &'t serde_json::Value, key: &str) -> Option<&'t serde_json::Value> {
+    key.split('.').try_fold(tree, |node, part| node.get(part))
+}
+
+/// Put `value` at dotted `key` in `tree` (tables made on the way); `None` removes it.
+fn put(tree: &mut serde_json::Value, key: &str, value: Option<serde_json::Value>) -> PyResult<()> {
+    let parts: Vec<&str> = key.split('.').collect();
+    let (last, path) = parts.split_last().expect("split gives one part at least");
+    let mut node = tree;
+    for part in path {
+        let map = node
+            .as_object_mut()
+            .ok_or_else(|| PyKeyError::new_err(format!("{key}: {part} is inside a value")))?;
+        node = map
+            .entry(part.to_string())
+            .or_insert_with(|| serde_json::Value::Object(Default::default()));
+    }
+    let map = node
+        .as_object_mut()
+        .ok_or_else(|| PyKeyError::new_err(format!("{key}: not inside a table")))?;
+    match value {
+        Some(v) => {
+            map.insert(last.to_string(), v);
+        }
+        None => {
+            map.remove(*last);
+        }
+    }
+    Ok(())
+}
+
+/// A scene: what to draw (the technique and its parameters) and how (size, fidelity,
+/// programs, camera). Read one with `Scene.load(path)`, `Scene.from_toml(text)`,
+/// `Scene.from_dict(d)` or `Scene.demo(name)`; read and change any value by its dotted
+/// key (`scene["camera.zoom"] = 1.5`), or through the properties below. Each change is
+/// validated as a scene file is (a bad value raises `SceneError` naming the key).
+#[pyclass(name = "Scene", module = "arbvis")]
+#[derive(Clone)]
+pub struct PyScene {
+    /// The scene.
+    pub scene: Scene,
+}
+
+#[pymethods]
+impl PyScene {
+    /// Read a scene file; its relative data paths are read from its folder, and every
+    /// data file it names must exist.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
+        let scene = py
+            .detach(|| Scene::load_checked(&path))
+            .map_err(errors::from_scene)?;
+        Ok(PyScene { scene })
+    }
+
+    /// A scene from TOML text; relative data paths are read from `base` (the current
+    /// folder by default).
+    #[staticmethod]
+    #[pyo3(signature = (text, base = None))]
+    fn from_toml(text: &str, base: Option<PathBuf>) -> PyResult<PyScene> {
+        let mut scene = Scene::parse(text, "scene").map_err(errors::from_scene)?;
+        scene.base = base.unwrap_or_default();
+        Ok(PyScene { scene })
+    }
+
+    /// A scene from a dict shaped as the TOML (`{"size": [256, 256], "technique":
+    /// {"quad": {...}}}`); relative data paths are read from `base`.
+    #[staticmethod]
+    #[pyo3(signature = (d, base = None))]
+    fn from_dict(d: &Bound<'_, PyAny>, base: Option<PathBuf>) -> PyResult<PyScene> {
+        let tree = json_of(d)?;
+        let scene = scene_of(&tree, base.unwrap_or_default(), None)?;
+        Ok(PyScene { scene })
+    }
+
+    /// A built-in demo scene (`arbvis render --demo NAME`).
+    #[staticmethod]
+    fn demo(name: &str) -> PyResult<PyScene> {
+        let scene = Scene::demo(name).map_err(errors::from_scene)?;
+        Ok(PyScene { scene })
+    }
+
+    /// The scene as TOML text (what a scene file holds).
+    fn to_toml(&self) -> String {
+        self.scene.to_toml()
+    }
+
+    /// The scene as a dict shaped as the TOML.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_loads(py, &tree_of(&self.scene).to_string())
+    }
+
+    /// The value at dotted `key` (`"technique.opacity3d.primary.coefficients"`).
+    fn __getitem__<'py>(&self, py: Python<'py>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+        let tree = tree_of(&self.scene);
+        let value = at(&tree, key).ok_or_else(|| PyKeyError::new_err(key.to_string()))?;
+        json_loads(py, &value.to_string())
+    }
+
+    /// Set the value at dotted `key`, validated as a scene file is; `None` removes it
+    /// (its default applies).
+    fn __setitem__(&mut self, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let mut tree = tree_of(&self.scene);
+        let value = if value.is_none() {
+            None
+        } else {
+            Some(json_of(value)?)
+        };
+        put(&mut tree, key, value)?;
+        self.scene = scene_of(&tree, self.scene.base.clone(), Some(key))?;
+        Ok(())
+    }
+
+    /// Whether the scene holds a value at dotted `key`.
+    fn __contains__(&self, key: &str) -> bool {
+        at(&tree_of(&self.scene), key).is_some()
+    }
+
+    /// The technique's name (`quad`, `opacity3d`, `cellproj`, `splats`).
+    #[getter]
+    fn technique(&self) -> &'static str {
+        self.scene.technique.name()
+    }
+
+    /// The technique's parameters as a dict (a copy: change them with
+    /// `scene["technique.NAME.KEY"] = value` or `scene.params = d`).
+    #[getter]
+    fn params<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let key = format!("technique.{}", self.scene.technique.name());
+        self.__getitem__(py, &key)
+    }
+
+    #[setter]
+    fn set_params(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let key = format!("technique.{}", self.scene.technique.name());
+        self.__setitem__(&key, value)
+    }
+
+    /// Image size `(width, height)` in pixels.
+    #[getter]
+    fn size(&self) -> (u32, u32) {
+        (self.scene.size[0], self.scene.size[1])
+    }
+
+    #[setter]
+    fn set_size(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.__setitem__("size", value)
+    }
+
+    /// `"faithful"` (the original programs, 8-bit targets) or `"precise"`.
+    #[getter]
+    fn fidelity(&self) -> &'static str {
+        self.scene.fidelity.name()
+    }
+
+    #[setter]
+    fn set_fidelity(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.__setitem__("fidelity", value)
+    }
+
+    /// `"arb"`, `"glsl"` or `"auto"`.
+    #[getter]
+    fn programs<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.__getitem__(py, "programs")
+    }
+
+    #[setter]
+    fn set_programs(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.__setitem__("programs", value)
+    }
+
+    /// The camera's rotation as a quaternion `(x, y, z, w)`.
+    #[getter]
+    fn rotation(&self) -> (f64, f64, f64, f64) {
+        let [x, y, z, w] = self.scene.camera.rotation;
+        (x, y, z, w)
+    }
+
+    #[setter]
+    fn set_rotation(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.__setitem__("camera.rotation", value)
+    }
+
+    /// The camera's magnification (1: the [-1, 1] square fills the shorter side).
+    #[getter]
+    fn zoom(&self) -> f64 {
+        self.scene.camera.zoom
+    }
+
+    #[setter]
+    fn set_zoom(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.__setitem__("camera.zoom", value)
+    }
+
+    /// `"orthographic"` or `"perspective"`.
+    #[getter]
+    fn projection<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.__getitem__(py, "camera.projection")
+    }
+
+    #[setter]
+    fn set_projection(&mut self, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        self.__setitem__("camera.projection", value)
+    }
+
+    /// The folder relative data paths are read from.
+    #[getter]
+    fn base(&self) -> PathBuf {
+        self.scene.base.clone()
+    }
+
+    #[setter]
+    fn set_base(&mut self, base: PathBuf) {
+        self.scene.base = base;
+    }
+
+    fn __repr__(&self) -> String {
+        let [w, h] = self.scene.size;
+        format!(
+            "<arbvis.Scene {} {w}x{h} {}>",
+            self.scene.technique.name(),
+            self.scene.fidelity.name(),
+        )
+    }
+
+    fn __eq__(&self, other: &PyScene) -> bool {
+        self.scene == other.scene
+    }
+
+    fn __copy__(&self) -> PyScene {
+        self.clone()
+    }
+}

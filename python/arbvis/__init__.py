@@ -1,0 +1,49 @@
+"""arbvis from Python: scenes in, numpy arrays out.
+
+>>> import arbvis
+>>> scene = arbvis.Scene.demo("v3o2-sum")
+>>> scene.zoom = 1.4
+>>> with arbvis.Renderer(scene) as renderer:
+...     image = renderer.render()          # (height, width, 4) uint8
+...     scene["technique.opacity3d.primary.coefficients"] = [0.2, 0.2, 0.2, 0.9]
+...     again = renderer.render()          # a frame, not a new process
+
+`Scene` reads and edits scenes (dotted keys, validated as scene files are);
+`Renderer` keeps its GL context, data and programs between frames; `info()` reports the
+driver; `read_png`, `write_png`, `compare` and `diff_image` read, write and compare pictures
+as the Rust tests do. Errors are `ArbvisError` and its subclasses `SceneError`, `InputError`,
+`GLError`, `RenderError`. The pytest plugin (`arbvis.pytest_plugin`, loaded by pytest)
+adds the `arbvis_image` fixture; `arbvis.dask` renders many views on a Dask cluster.
+"""
+
+from ._arbvis import (  # noqa: F401
+    ArbvisError,
+    GLError,
+    InputError,
+    Renderer,
+    RenderError,
+    Scene,
+    SceneError,
+    __version__,
+    compare,
+    diff_image,
+    info,
+    read_png,
+    write_png,
+)
+
+__all__ = [
+    "ArbvisError",
+    "GLError",
+    "InputError",
+    "RenderError",
+    "Renderer",
+    "Scene",
+    "SceneError",
+    "compare",
+    "diff_image",
+    "info",
+    "read_png",
+    "write_png",
+    "__version__",
+]

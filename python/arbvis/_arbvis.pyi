@@ -1,0 +1,90 @@
+"""Type stubs of the extension module (crates/arbvis-python)."""
+
+from os import PathLike
+from typing import Any, Dict, Optional, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class ArbvisError(Exception):
+    """Every error arbvis raises."""
+
+class SceneError(ArbvisError):
+    """A scene that does not parse or validate."""
+
+    path: Optional[str]
+    line: Optional[int]
+    column: Optional[int]
+    key: Optional[str]
+
+class InputError(ArbvisError):
+    """A data file that cannot be read or used (the message names file and position)."""
+
+class GLError(ArbvisError):
+    """The GL refused: no context, a program that does not compile, out of memory."""
+
+class RenderError(ArbvisError):
+    """Something else went wrong preparing or drawing a picture."""
+
+_Path = Union[str, PathLike]
+
+class Scene:
+    """A scene: the technique and its parameters, size, fidelity, programs, camera."""
+
+    @staticmethod
+    def load(path: _Path) -> "Scene": ...
+    @staticmethod
+    def from_toml(text: str, base: Optional[_Path] = None) -> "Scene": ...
+    @staticmethod
+    def from_dict(d: Dict[str, Any], base: Optional[_Path] = None) -> "Scene": ...
+    @staticmethod
+    def demo(name: str) -> "Scene": ...
+    def to_toml(self) -> str: ...
+    def to_dict(self) -> Dict[str, Any]: ...
+    def __getitem__(self, key: str) -> Any: ...
+    def __setitem__(self, key: str, value: Any) -> None: ...
+    def __contains__(self, key: str) -> bool: ...
+    @property
+    def technique(self) -> str: ...
+    params: Dict[str, Any]
+    size: Tuple[int, int]
+    fidelity: str
+    programs: str
+    rotation: Tuple[float, float, float, float]
+    zoom: float
+    projection: str
+    base: str
+
+class Renderer:
+    """A scene kept ready to draw: context, data and programs kept between frames."""
+
+    def __init__(self, scene: Scene, backend: str = "egl") -> None: ...
+    def render(
+        self, scene: Optional[Scene] = None
+    ) -> Union[npt.NDArray[np.uint8], npt.NDArray[np.float32]]: ...
+    @property
+    def scene(self) -> Scene: ...
+    @property
+    def program_kind(self) -> str: ...
+    @property
+    def backend(self) -> str: ...
+    @property
+    def driver(self) -> str: ...
+    def close(self) -> None: ...
+    def __enter__(self) -> "Renderer": ...
+    def __exit__(self, *exc: Any) -> None: ...
+
+def info(backend: str = "egl") -> Dict[str, Any]: ...
+
+_Image = Union[npt.NDArray[np.uint8], npt.NDArray[np.float32]]
+
+def read_png(path: _Path) -> npt.NDArray[np.uint8]: ...
+def write_png(path: _Path, array: _Image) -> None: ...
+def compare(
+    actual: _Image, expected: _Image, tolerance: float = 1.0 / 255.0
+) -> Optional[Dict[str, Any]]: ...
+def diff_image(
+    actual: _Image, expected: _Image, tolerance: float = 1.0 / 255.0, gain: float = 16.0
+) -> npt.NDArray[np.uint8]: ...

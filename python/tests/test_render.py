@@ -1,0 +1,134 @@
+"""arbvis.Renderer: numpy arrays, frames after edits equal to fresh renderers', goldens,
+errors, two threads."""
+
+import threading
+
+import numpy as np
+import pytest
+
+import arbvis
+
+
+def quad(size=128, programs="arb"):
+    scene = arbvis.Scene.demo("quad")
+    scene.size = (size, size)
+    scene.programs = programs
+    return scene
+
+
+def test_the_quad_equals_the_rust_tests_golden(root):
+    # The golden of tests/it/quad.rs (llvmpipe, ARB, 128x128); one 8-bit level as there.
+    with arbvis.Renderer(quad()) as r:
+        image = r.render()
+        assert r.program_kind == "arb"
+    assert image.shape == (128, 128, 4) and image.dtype == np.uint8
+    golden = arbvis._arbvis.read_png(str(root / "tests/snapshots/quad/quad_arb_128.png"))
+    d = arbvis._arbvis.compare(image, golden, 1.0 / 255.0)
+    assert d["max_abs"] <= 1.0 / 255.0 + 1e-6, d
+
+
+def test_a_precise_picture_is_float32_handed_over_without_a_copy():
+    scene = arbvis.Scene.demo("quad")
+    scene.size = (40, 30)
+    scene.fidelity = "precise"
+    with arbvis.Renderer(scene) as r:
+        image = r.render()
+    assert image.shape == (30, 40, 4) and image.dtype == np.float32
+    # Handed over, not copied: numpy does not own the buffer (Rust's Vec does).
+    assert not image.flags["OWNDATA"]
+    assert image.flags["C_CONTIGUOUS"]
+
+
+@pytest.mark.parametrize("demo", ["v3o2-sum", "quad"])
+def test_frames_after_edits_equal_a_fresh_renderers(demo):
+    scene = arbvis.Scene.demo(demo)
+    scene.size = (72, 56)
+    edits = [
+        ("zoom", 1.3),
+        ("rotation", (0.2, 0.3, 0.1, 0.927)),
+        ("size", (50, 64)),
+    ]
+    if demo == "v3o2-sum":
+        edits.append(("technique.opacity3d.primary.coefficients", [0.7, 0.1, 0.3, 0.2]))
+        edits.append(("technique.opacity3d.slices", 61))
+    else:
+        edits.append(("technique.quad.left", [0.3, 0.9, 0.1, 1.0]))
+    with arbvis.Renderer(scene) as r:
+        first = r.render()
+        for key, value in edits:
+            if key in ("zoom", "rotation", "size"):
+                setattr(scene, key, value)
+            else:
+                scene[key] = value
+            edited = r.render()
+            with arbvis.Renderer(scene) as fresh:
+                expected = fresh.render()
+            assert edited.shape == expected.shape, key
+            assert np.array_equal(edited, expected), key
+        assert not np.array_equal(first.shape, edited.shape) or not np.array_equal(
+            first, edited
+        )
+
+
+def test_a_scene_given_to_render_becomes_the_renderers():
+    with arbvis.Renderer(quad(32)) as r:
+        first = r.render()
+        other = quad(32)
+        other["technique.quad.right"] = [1.0, 1.0, 0.0, 1.0]
+        image = r.render(other)
+        assert r.scene == other
+    with arbvis.Renderer(other) as fresh:
+        assert np.array_equal(image, fresh.render())
+    # The right edge took the new colour (yellow for blue): more green, less blue.
+    assert (image[:, -1, 1] >= first[:, -1, 1]).all() and image[:, -1, 1].sum() > first[:, -1, 1].sum()
+    assert image[:, -1, 2].sum() < first[:, -1, 2].sum()
+
+
+def test_render_errors_are_arbvis_exceptions():
+    scene = arbvis.Scene.demo("quad")
+    scene.programs = "glsl"
+    with arbvis.Renderer(scene) as r:
+        r.render()
+        r.close()
+        with pytest.raises(RuntimeError):
+            r.render()
+    with pytest.raises(ValueError):
+        arbvis.Renderer(scene, backend="vulkan")
+
+
+def test_two_renderers_in_two_threads_draw_what_one_draws_alone():
+    scenes = [arbvis.Scene.demo("v3o2-sum"), arbvis.Scene.demo("quad")]
+    for s in scenes:
+        s.size = (64, 64)
+    alone = []
+    for s in scenes:
+        with arbvis.Renderer(s) as r:
+            alone.append(r.render())
+    together = [None, None]
+
+    def draw(i):
+        with arbvis.Renderer(scenes[i]) as r:
+            for _ in range(3):
+                together[i] = r.render()
+
+    threads = [threading.Thread(target=draw, args=(i,)) for i in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for a, b in zip(alone, together):
+        assert np.array_equal(a, b)
+
+
+def test_osmesa_draws_what_egl_draws():
+    scene = quad(64)
+    with arbvis.Renderer(scene) as egl, arbvis.Renderer(scene, backend="osmesa") as osmesa:
+        assert osmesa.backend == "osmesa"
+        assert np.array_equal(egl.render(), osmesa.render())
+
+
+def test_info_reports_the_driver():
+    report = arbvis.info()
+    assert report["backend"] == "egl"
+    assert report["renderer"]
+    assert report["linear_filter_error"] >= 0
