@@ -10,7 +10,8 @@
 
 `Scene` reads and edits scenes (dotted keys, validated as scene files are);
 `Renderer` keeps its GL context, data and programs between frames; `info()` reports the
-driver; `read_png`, `write_png`, `compare` and `diff_image` read, write and compare pictures
+driver; `inspect(path)` and `convert(src, dst, progress=...)` are the command line's
+`inspect` and `convert`; `read_png`, `write_png`, `compare` and `diff_image` read, write and compare pictures
 as the Rust tests do. Errors are `ArbvisError` and its subclasses `SceneError`, `InputError`,
 `GLError`, `RenderError`. The pytest plugin (`arbvis.pytest_plugin`, loaded by pytest)
 adds the `arbvis_image` fixture; `arbvis.dask` renders many views on a Dask cluster.
@@ -18,6 +19,7 @@ adds the `arbvis_image` fixture; `arbvis.dask` renders many views on a Dask clus
 
 from ._arbvis import (  # noqa: F401
     ArbvisError,
+    Cancelled,
     GLError,
     InputError,
     Renderer,
@@ -26,14 +28,17 @@ from ._arbvis import (  # noqa: F401
     SceneError,
     __version__,
     compare,
+    convert,
     diff_image,
     info,
+    inspect,
     read_png,
     write_png,
 )
 
 __all__ = [
     "ArbvisError",
+    "Cancelled",
     "GLError",
     "InputError",
     "RenderError",
@@ -41,8 +46,10 @@ __all__ = [
     "Scene",
     "SceneError",
     "compare",
+    "convert",
     "diff_image",
     "info",
+    "inspect",
     "read_png",
     "write_png",
     "__version__",

@@ -1,7 +1,7 @@
 """Type stubs of the extension module (crates/arbvis-python)."""
 
 from os import PathLike
-from typing import Any, Dict, Optional, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -27,6 +27,9 @@ class GLError(ArbvisError):
 
 class RenderError(ArbvisError):
     """Something else went wrong preparing or drawing a picture."""
+
+class Cancelled(ArbvisError):
+    """Work stopped on request (a progress callback returned False)."""
 
 _Path = Union[str, PathLike]
 
@@ -77,6 +80,15 @@ class Renderer:
     def __exit__(self, *exc: Any) -> None: ...
 
 def info(backend: str = "egl") -> Dict[str, Any]: ...
+def inspect(path: _Path) -> Dict[str, Any]: ...
+def convert(
+    src: _Path,
+    dst: _Path,
+    brick: int = 64,
+    attributes: List[str] = ["envelope"],
+    compression: str = "lz4",
+    progress: Optional[Callable[[int, int], Optional[bool]]] = None,
+) -> Dict[str, Any]: ...
 
 _Image = Union[npt.NDArray[np.uint8], npt.NDArray[np.float32]]
 

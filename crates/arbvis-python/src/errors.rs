@@ -42,6 +42,14 @@ pyo3::create_exception!(
     "Something else went wrong preparing or drawing a picture."
 );
 
+pyo3::create_exception!(
+    arbvis,
+    Cancelled,
+    ArbvisError,
+    "Work stopped on request (a progress callback returned False); a conversion resumes \
+     when run again."
+);
+
 /// Add the exception types to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -50,6 +58,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("InputError", py.get_type::<InputError>())?;
     m.add("GLError", py.get_type::<GLError>())?;
     m.add("RenderError", py.get_type::<RenderError>())?;
+    m.add("Cancelled", py.get_type::<Cancelled>())?;
     Ok(())
 }
 

@@ -12,6 +12,7 @@ mod errors;
 mod images;
 mod renderer;
 mod scene;
+mod tools;
 
 use pyo3::prelude::*;
 
@@ -46,6 +47,8 @@ fn _arbvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyScene>()?;
     m.add_class::<renderer::PyRenderer>()?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::inspect, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::convert, m)?)?;
     m.add_function(wrap_pyfunction!(images::read_png, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_png, m)?)?;
     m.add_function(wrap_pyfunction!(images::compare, m)?)?;

@@ -37,6 +37,11 @@ pub(super) struct Ctx<'a> {
     pub(super) log_path: &'a Path,
     pub(super) written: AtomicUsize,
     pub(super) stop_after: Option<usize>,
+    pub(super) watch: Option<super::convert::Watch>,
+    /// Columns done before this run (a resumed conversion).
+    pub(super) resumed: usize,
+    /// Columns of the whole store, all levels.
+    pub(super) total: usize,
     pub(super) bytes: AtomicU64,
 }
 
@@ -150,7 +155,18 @@ impl Ctx<'_> {
             .and_then(|_| f.write_all(b"\n"))
             .and_then(|_| f.sync_data())
             .map_err(|e| StoreError::io(self.log_path, e))?;
-        self.written.fetch_add(1, Ordering::SeqCst);
+        let written = self.written.fetch_add(1, Ordering::SeqCst) + 1;
+        drop(f);
+        if let Some(watch) = &self.watch {
+            let done = self.resumed + written;
+            if !(watch.0)(done, self.total) {
+                return Err(StoreError::Interrupted(format!(
+                    "{}: conversion stopped after {done} of {} columns (run it again to resume)",
+                    self.store.display(),
+                    self.total
+                )));
+            }
+        }
         Ok(unit)
     }
 

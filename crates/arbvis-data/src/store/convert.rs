@@ -75,6 +75,9 @@ pub struct ConvertOptions {
     pub segy_keys: crate::volume::segy::KeyBytes,
     /// Draw a progress bar (when stderr is a terminal).
     pub progress: bool,
+    /// Told after every column written: (columns of the store done, all its columns);
+    /// false stops the conversion as an interruption (running it again resumes).
+    pub watch: Option<Watch>,
     /// For tests: stop with [`StoreError::Interrupted`] once this many columns are done
     /// in this run, as a killed process would.
     pub stop_after: Option<usize>,
@@ -93,6 +96,7 @@ impl Default for ConvertOptions {
             raw: None,
             segy_keys: Default::default(),
             progress: true,
+            watch: None,
             stop_after: None,
         }
     }
@@ -114,6 +118,17 @@ pub struct ConvertReport {
 }
 
 /// Bytes the conversion holds at once with `workers` workers (see the module doc).
+/// A conversion's watcher ([`ConvertOptions::watch`]): called with (columns done, all
+/// columns) from the workers; false stops the conversion.
+#[derive(Clone)]
+pub struct Watch(pub Arc<dyn Fn(usize, usize) -> bool + Send + Sync>);
+
+impl std::fmt::Debug for Watch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Watch")
+    }
+}
+
 pub fn memory_bound(samples: usize, brick: usize, attributes: usize, workers: usize) -> u64 {
     let column = samples as u64 * (brick * brick) as u64 * 4 * (attributes as u64 + 1);
     // The level-1 column its quad fills: half the samples, every attribute.
@@ -226,6 +241,11 @@ fn convert_on_workers(
         log_path: &log_path,
         written: AtomicUsize::new(0),
         stop_after: o.stop_after,
+        watch: o.watch.clone(),
+        resumed,
+        total: (0..meta.levels)
+            .map(|l| meta.brick_counts(l)[1] * meta.brick_counts(l)[2])
+            .sum(),
         bytes: AtomicU64::new(0),
     };
     let new = level_zero(&ctx, &plan.src, &done, input, o)?;
