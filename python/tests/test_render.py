@@ -132,3 +132,35 @@ def test_info_reports_the_driver():
     assert report["backend"] == "egl"
     assert report["renderer"]
     assert report["linear_filter_error"] >= 0
+
+
+def test_the_reference_is_what_a_precise_quad_draws():
+    scene = quad(48, "glsl")
+    scene.fidelity = "precise"
+    with arbvis.Renderer(scene) as r:
+        image, reference = r.render(), r.reference()
+    assert reference.dtype == np.float32 and reference.shape == image.shape
+    # RGBA32F: interpolation and arithmetic in f32, relative ~1e-6 on values <= 1; 1e-5
+    # leaves margin for the rasterizer's barycentrics (as tests/it/quad.rs).
+    assert np.abs(image - reference).max() <= 1e-5
+
+
+def test_more_slices_come_closer_to_the_3d_opacity_reference():
+    scene = arbvis.Scene.demo("v3o2-sum")
+    scene.size = (64, 64)
+    scene.fidelity = "precise"
+    errors = []
+    with arbvis.Renderer(scene) as r:
+        reference = r.reference()
+        for slices in (16, 64, 256):
+            scene["technique.opacity3d.slices"] = slices
+            rgb = r.render()[..., :3] - reference[..., :3]
+            errors.append(float(np.sqrt((rgb**2).mean())))
+    assert errors[0] > errors[1] > errors[2], errors
+
+
+def test_a_technique_without_a_reference_says_none():
+    scene = arbvis.Scene.demo("splats-section")
+    scene.size = (32, 32)
+    with arbvis.Renderer(scene) as r:
+        assert r.reference() is None

@@ -14,10 +14,13 @@ use pyo3::prelude::*;
 
 use arbvis_core::image::Image;
 use arbvis_core::vocab::TargetFormat;
+use arbvis_data::volume::Limits;
 use arbvis_gl::Backend;
+use arbvis_techniques::catalog;
 use arbvis_techniques::error::RenderResult;
 use arbvis_techniques::render::Session;
 use arbvis_techniques::scene::Scene;
+use arbvis_techniques::techniques::ReferenceView;
 
 use crate::errors;
 use crate::scene::PyScene;
@@ -42,6 +45,7 @@ enum Job {
 /// What the render thread says once its context and renderer are made.
 struct Ready {
     program_kind: &'static str,
+    max_3d_texture_size: i32,
     backend: &'static str,
     renderer: String,
 }
@@ -58,6 +62,7 @@ fn serve(scene: Scene, backend: Backend, ready: Sender<RenderResult<Ready>>, job
     };
     let _ = ready.send(Ok(Ready {
         program_kind: session.program_kind().name(),
+        max_3d_texture_size: session.caps().max_3d_texture_size,
         backend: session.backend().name(),
         renderer: session.caps().renderer.clone(),
     }));
@@ -84,6 +89,7 @@ pub struct PyRenderer {
     jobs: Option<Sender<Job>>,
     thread: Option<JoinHandle<()>>,
     program_kind: &'static str,
+    max_3d_texture_size: i32,
     backend: &'static str,
     renderer: String,
 }
@@ -112,6 +118,7 @@ impl PyRenderer {
             jobs: Some(jobs),
             thread: Some(thread),
             program_kind: made.program_kind,
+            max_3d_texture_size: made.max_3d_texture_size,
             backend: made.backend,
             renderer: made.renderer,
         })
@@ -143,6 +150,29 @@ impl PyRenderer {
             .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?
             .map_err(errors::from_render)?;
         Ok(to_array(py, image))
+    }
+
+    /// The f64 CPU reference of the scene's picture as it is now (float32, as `render()`
+    /// shows a picture), computed on the CPU with the GIL released: the yardstick the
+    /// precise modes are measured against. None where the technique has none (splats,
+    /// isosurfaces alone, a survey store, a clipped 3D opacity scene).
+    fn reference<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        let scene = self.scene.borrow(py).scene.clone();
+        let limits = Limits::for_max_side(self.max_3d_texture_size);
+        let image = py
+            .detach(|| {
+                let background = scene.clear_colour().map(f64::from);
+                let view = ReferenceView {
+                    camera: scene.camera,
+                    size: scene.size,
+                    background,
+                    base: &scene.base,
+                };
+                catalog::reference(&scene.technique, &scene.settings(), &limits, &view)
+                    .map(|image| image.map(|i| scene.picture(&i)))
+            })
+            .map_err(errors::from_render)?;
+        Ok(image.map(|i| to_array(py, i)))
     }
 
     /// The scene this renderer draws.

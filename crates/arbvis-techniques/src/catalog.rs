@@ -17,13 +17,14 @@ use serde::{Deserialize, Serialize};
 
 use crate::camera::Camera;
 use crate::gl::{GlError, Gpu, ProgramChoice, ProgramKind};
+use crate::image::Image;
 use crate::programs::ProgramPair;
 use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::quad::QuadScene;
 use crate::techniques::splats::SplatsScene;
 pub use crate::techniques::Settings;
-use crate::techniques::{Params, Renderer, Technique};
+use crate::techniques::{Params, ReferenceView, Renderer, Technique};
 use crate::vocab::{Fidelity, FieldError};
 use crate::volume::Limits;
 
@@ -201,6 +202,25 @@ pub fn build(
 /// keeps it (the viewer, between renderers of another program kind) need not name the
 /// technique that made it.
 pub type PreparedData = Box<dyn Any>;
+
+/// The f64 CPU reference of `technique`'s picture for `view`, where it has one: its data
+/// prepared (within `limits`), then [`Technique::reference`].
+pub fn reference(
+    technique: &TechniqueScene,
+    settings: &Settings<'_>,
+    limits: &Limits,
+    view: &ReferenceView<'_>,
+) -> RenderResult<Option<Image>> {
+    fn of<T: Technique>(
+        t: &T,
+        settings: &Settings<'_>,
+        limits: &Limits,
+        view: &ReferenceView<'_>,
+    ) -> RenderResult<Option<Image>> {
+        Ok(t.reference(&t.prepare(settings, limits)?, view))
+    }
+    each_technique!(technique, |p| of(p, settings, limits, view))
+}
 
 /// Check `technique`'s parameters, then load and prepare its data within `limits`
 /// ([`Technique::prepare`]).

@@ -19,6 +19,7 @@ use std::path::{Path, PathBuf};
 use crate::budget::Estimate;
 use crate::camera::{Camera, Projection};
 use crate::gl::{GlError, Gpu, ProgramChoice, ProgramKind, Surface};
+use crate::image::Image;
 use crate::programs::ProgramPair;
 use crate::vocab::{Fidelity, FieldError};
 use crate::volume::Limits;
@@ -219,6 +220,13 @@ pub trait Technique: Any + Sized {
         kind: ProgramKind,
         prepared: Self::Prepared,
     ) -> RenderResult<Box<dyn Renderer>>;
+    /// The f64 CPU reference of the picture `prepared` draws for `view` (RGBA32F, alpha
+    /// the coverage, over the view's background), where the technique has one: the
+    /// yardstick its precise mode is measured against. None by default.
+    fn reference(&self, prepared: &Self::Prepared, view: &ReferenceView<'_>) -> Option<Image> {
+        let _ = (prepared, view);
+        None
+    }
     /// Prepare (within the GL's largest 3D texture), then make the renderer; nothing else
     /// is created.
     fn build(
@@ -231,6 +239,19 @@ pub trait Technique: Any + Sized {
         let prepared = self.prepare(settings, &limits)?;
         self.renderer(gpu, settings, kind, prepared)
     }
+}
+
+/// What a reference picture is computed for ([`Technique::reference`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ReferenceView<'a> {
+    /// The camera.
+    pub camera: Camera,
+    /// `[width, height]` in pixels.
+    pub size: [u32; 2],
+    /// The colour the picture is composited over.
+    pub background: [f64; 4],
+    /// The folder relative data paths (tables) are read from.
+    pub base: &'a Path,
 }
 
 /// What a renderer needs of the scene besides its technique's parameters.

@@ -55,6 +55,16 @@ impl Technique for QuadScene {
         Ok(())
     }
 
+    /// The quad's colours at pixel centres (the quad fills the picture; no camera).
+    fn reference(
+        &self,
+        _: &(),
+        view: &crate::techniques::ReferenceView<'_>,
+    ) -> Option<crate::image::Image> {
+        let [w, h] = view.size;
+        Some(reference_image(self, w, h, gl::TargetFormat::Rgba32f))
+    }
+
     fn renderer(
         &self,
         gpu: &Gpu,

@@ -307,6 +307,32 @@ impl crate::techniques::Technique for CellprojScene {
         prepare::prepare(self, settings.base)
     }
 
+    /// The f64 ray walk through the cells ([`volume_reference::reference`]) of a volume
+    /// (or of both, with its opaque isosurfaces); none for isosurfaces alone, whose
+    /// reference is per-pixel hits rather than a picture.
+    fn reference(
+        &self,
+        prepared: &prepare::Prepared,
+        view: &crate::techniques::ReferenceView<'_>,
+    ) -> Option<crate::image::Image> {
+        if self.mode == Mode::Isosurfaces {
+            return None;
+        }
+        let tf = self.volume_spec().build(view.base, prepared.scale).ok()?;
+        let isovalues = match self.mode {
+            Mode::Both => self.isovalues.clone(),
+            _ => Vec::new(),
+        };
+        Some(volume_reference::reference(
+            prepared,
+            &tf,
+            &isovalues,
+            &view.camera,
+            view.size,
+            view.background,
+        ))
+    }
+
     fn renderer(
         &self,
         gpu: &crate::gl::Gpu,

@@ -251,6 +251,24 @@ impl crate::techniques::Technique for Opacity3dScene {
 
     /// A survey store is drawn brick by brick ([`bricked::BrickedRenderer`]; precise
     /// with a GLSL ray caster, which `auto` then takes); other volumes whole.
+    /// The f64 integral along each pixel's ray ([`reference::reference`], 8 samples per
+    /// reference spacing); none for a store (drawn brick by brick) or a clipped scene.
+    fn reference(
+        &self,
+        prepared: &Option<prepare::Prepared>,
+        view: &crate::techniques::ReferenceView<'_>,
+    ) -> Option<crate::image::Image> {
+        let prepared = prepared.as_ref().filter(|_| self.clip.is_none())?;
+        Some(reference::reference(
+            prepared,
+            self,
+            &view.camera,
+            view.size,
+            view.background,
+            8.0,
+        ))
+    }
+
     fn renderer(
         &self,
         gpu: &crate::gl::Gpu,
