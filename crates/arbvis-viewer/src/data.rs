@@ -3,8 +3,8 @@
 //! colour tables as built from the scene (and as egui textures), and the CPU-made section
 //! images (inline, crossline, time slice) of one attribute coloured by its table.
 //!
-//! Decisions: for 3D opacity the viewer prepares the data itself and hands a copy to
-//! [`Opacity3dRenderer::from_prepared`], so switching programs or fidelity re-uploads
+//! Decisions: for 3D opacity the viewer prepares the data itself and hands a copy to the
+//! technique's renderer ([`catalog::renderer`]), so switching programs or fidelity re-uploads
 //! without reading files again, and histograms and sections read the same bytes the GPU
 //! samples. Sections show the table's colour opaque (its alpha would hide the section where
 //! the volume is clear); pixels are voxels, stretched to the box's physical aspect. A survey
@@ -22,7 +22,6 @@ use crate::gl::{Gpu, ProgramKind};
 use crate::scene::Scene;
 use crate::techniques::cellproj::prepare::Prepared as PreparedMesh;
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
-use crate::techniques::opacity3d::Opacity3dRenderer;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::splats::prepare::PreparedCloud;
 use crate::techniques::splats::SplatsScene;
@@ -203,15 +202,13 @@ fn build_volume(
             prepared.tables[a] = Some(attr.table.build(&scene.base)?);
         }
     }
-    Ok(Box::new(Opacity3dRenderer::from_prepared(
+    catalog::renderer(
+        &scene.technique,
         gpu,
+        &scene.settings(),
         kind,
-        scene.fidelity,
-        params,
-        &scene.base,
-        prepared,
-        scene.camera.projection,
-    )?))
+        Box::new(Some(prepared)),
+    )
 }
 
 impl ViewData {

@@ -37,7 +37,7 @@ pub(super) struct Ctx<'a> {
     pub(super) log_path: &'a Path,
     pub(super) written: AtomicUsize,
     pub(super) stop_after: Option<usize>,
-    pub(super) watch: Option<super::convert::Watch>,
+    pub(super) watch: Option<super::progress::Watch>,
     /// Columns done before this run (a resumed conversion).
     pub(super) resumed: usize,
     /// Columns of the whole store, all levels.

@@ -58,7 +58,7 @@ use crate::volume::attributes::Attribute;
 use crate::volume::raw::RawSpec;
 
 pub use super::compression::Compression;
-pub use super::progress::PROGRESS_LOG;
+pub use super::progress::{Watch, PROGRESS_LOG};
 
 /// How to convert.
 #[derive(Debug, Clone)]
@@ -118,17 +118,6 @@ pub struct ConvertReport {
 }
 
 /// Bytes the conversion holds at once with `workers` workers (see the module doc).
-/// A conversion's watcher ([`ConvertOptions::watch`]): called with (columns done, all
-/// columns) from the workers; false stops the conversion.
-#[derive(Clone)]
-pub struct Watch(pub Arc<dyn Fn(usize, usize) -> bool + Send + Sync>);
-
-impl std::fmt::Debug for Watch {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("Watch")
-    }
-}
-
 pub fn memory_bound(samples: usize, brick: usize, attributes: usize, workers: usize) -> u64 {
     let column = samples as u64 * (brick * brick) as u64 * 4 * (attributes as u64 + 1);
     // The level-1 column its quad fills: half the samples, every attribute.

@@ -229,3 +229,14 @@ pub(crate) fn holds_nothing(store: &Path) -> Result<bool, StoreError> {
     }
     Ok(true)
 }
+
+/// A conversion's watcher (`ConvertOptions::watch`): called with (columns done, all
+/// columns) from the workers; false stops the conversion.
+#[derive(Clone)]
+pub struct Watch(pub std::sync::Arc<dyn Fn(usize, usize) -> bool + Send + Sync>);
+
+impl std::fmt::Debug for Watch {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("Watch")
+    }
+}
