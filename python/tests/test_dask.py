@@ -1,5 +1,6 @@
-"""arbvis.dask on a LocalCluster of two worker processes on loopback: an orbit's views
-equal a single-process render of each, each worker keeps one renderer between tasks."""
+"""arbvis.dask on a LocalCluster of two worker processes on loopback: an orbit of a survey
+store's views equals a single-process render of each, each worker keeps one renderer
+between tasks."""
 
 import numpy as np
 import pytest
@@ -10,9 +11,20 @@ import arbvis.dask
 distributed = pytest.importorskip("dask.distributed")
 
 
-def test_an_orbit_on_two_workers_equals_one_process(tmp_path):
-    scene = arbvis.Scene.demo("v3o2-sum")
-    scene.size = (48, 40)
+def test_an_orbit_of_a_store_on_two_workers_equals_one_process(root, tmp_path):
+    store = tmp_path / "f3.zarr"
+    arbvis.convert(root / "data/seismic/f3.sgy", store, brick=16)
+    scene = arbvis.Scene.from_toml(
+        f"""
+size = [48, 40]
+[technique.opacity3d]
+slices = 64
+[technique.opacity3d.primary]
+volume = {{ store = "{store}" }}
+quantize = {{ range = [-6000.0, 6000.0] }}
+table = {{ builtin = "seismic" }}
+"""
+    )
     views = arbvis.dask.orbit(6)
     with distributed.LocalCluster(
         n_workers=2,
@@ -22,10 +34,13 @@ def test_an_orbit_on_two_workers_equals_one_process(tmp_path):
         dashboard_address=None,
     ) as cluster, distributed.Client(cluster) as client:
         images = arbvis.dask.render_views(client, scene, views)
-        pngs = arbvis.dask.render_views(client, scene, views[:2], out_dir=str(tmp_path))
+        pngs = arbvis.dask.render_views(client, scene, views[:2], out_dir=str(tmp_path / "views"))
         # Every worker that rendered keeps one renderer (the scene's), not one per task.
         kept = client.run(lambda: len(arbvis.dask._RENDERERS))
     assert len(images) == 6
+    # The survey is drawn (not a blank picture that would equal any other).
+    assert all(image[..., :3].any() for image in images)
+    assert not np.array_equal(images[0], images[3])
     assert set(kept.values()) <= {0, 1} and sum(kept.values()) >= 1
     with arbvis.Renderer(scene) as r:
         for rotation, image in zip(views, images):

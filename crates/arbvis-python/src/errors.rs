@@ -70,6 +70,18 @@ pub struct At<'a> {
     pub key: Option<&'a str>,
 }
 
+impl<'a> At<'a> {
+    /// At `key` only (or nowhere): a value set from Python, which has no line.
+    pub fn key(key: Option<&'a str>) -> At<'a> {
+        At {
+            path: None,
+            line: None,
+            column: None,
+            key,
+        }
+    }
+}
+
 /// A `SceneError` saying `message`, with its position as attributes.
 pub fn scene_error(message: String, at: At<'_>) -> PyErr {
     let err = SceneError::new_err(message);
@@ -114,15 +126,7 @@ pub fn from_scene(e: RustSceneError) -> PyErr {
                 key: Some(key),
             },
         ),
-        RustSceneError::UnknownDemo(_) => scene_error(
-            message,
-            At {
-                path: None,
-                line: None,
-                column: None,
-                key: None,
-            },
-        ),
+        RustSceneError::UnknownDemo(_) => scene_error(message, At::key(None)),
     }
 }
 
@@ -146,15 +150,7 @@ pub fn from_render(e: RustRenderError) -> PyErr {
         | RustRenderError::AttributeTable { .. }
         | RustRenderError::Attribute { .. }
         | RustRenderError::Brick(_) => InputError::new_err(message),
-        RustRenderError::Parameters(field) => scene_error(
-            message,
-            At {
-                path: None,
-                line: None,
-                column: None,
-                key: Some(&field.key),
-            },
-        ),
+        RustRenderError::Parameters(field) => scene_error(message, At::key(Some(&field.key))),
         _ => RenderError::new_err(message),
     }
 }

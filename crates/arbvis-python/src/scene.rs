@@ -24,17 +24,8 @@ fn json_of(value: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
         .import("json")?
         .call_method1("dumps", (value,))?
         .extract()?;
-    serde_json::from_str(&text).map_err(|e| {
-        errors::scene_error(
-            format!("not a value a scene holds: {e}"),
-            At {
-                path: None,
-                line: None,
-                column: None,
-                key: None,
-            },
-        )
-    })
+    serde_json::from_str(&text)
+        .map_err(|e| errors::scene_error(format!("not a value a scene holds: {e}"), At::key(None)))
 }
 
 /// The scene as a JSON tree.
@@ -50,15 +41,7 @@ fn scene_of(tree: &serde_json::Value, base: PathBuf, key: Option<&str>) -> PyRes
             Some(k) => format!("{k}: {message}"),
             None => message,
         };
-        errors::scene_error(
-            message,
-            At {
-                path: None,
-                line: None,
-                column: None,
-                key,
-            },
-        )
+        errors::scene_error(message, At::key(key))
     };
     let value = toml::Value::try_from(tree).map_err(|e| bad(e.to_string()))?;
     let text = toml::to_string(&value).map_err(|e| bad(e.to_string()))?;
@@ -73,12 +56,7 @@ fn scene_of(tree: &serde_json::Value, base: PathBuf, key: Option<&str>) -> PyRes
             key: at, message, ..
         }) => Err(errors::scene_error(
             format!("{at}: {message}"),
-            At {
-                path: None,
-                line: None,
-                column: None,
-                key: Some(&at),
-            },
+            At::key(Some(&at)),
         )),
         Err(e) => Err(errors::from_scene(e)),
     }
