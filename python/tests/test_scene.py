@@ -81,3 +81,18 @@ def test_unknown_demo():
     with pytest.raises(arbvis.SceneError) as e:
         arbvis.Scene.demo("nope")
     assert "quad" in str(e.value)
+
+
+def test_values_no_scene_file_could_hold_are_refused_cleanly():
+    with pytest.raises(TypeError):
+        arbvis.Scene.from_dict([1, 2])
+    with pytest.raises(ValueError):
+        arbvis.Scene.from_dict({"size": float("nan")})
+    scene = arbvis.Scene.demo("quad")
+    with pytest.raises(ValueError):
+        scene.zoom = float("inf")
+    with pytest.raises(KeyError):
+        scene["size.width"] = 3
+    with pytest.raises(arbvis.SceneError) as e:
+        scene["camera.rotation"] = [1, 2]
+    assert e.value.key == "camera.rotation"

@@ -19,10 +19,13 @@ pub fn json_loads<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny
 
 /// A Python value as JSON (`json.dumps`), for the scene's parser.
 fn json_of(value: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
-    let text: String = value
-        .py()
+    let py = value.py();
+    // NaN and infinities are no TOML a scene file could hold: json's ValueError says so.
+    let options = pyo3::types::PyDict::new(py);
+    options.set_item("allow_nan", false)?;
+    let text: String = py
         .import("json")?
-        .call_method1("dumps", (value,))?
+        .call_method("dumps", (value,), Some(&options))?
         .extract()?;
     serde_json::from_str(&text)
         .map_err(|e| errors::scene_error(format!("not a value a scene holds: {e}"), At::key(None)))
@@ -133,6 +136,12 @@ impl PyScene {
     #[staticmethod]
     #[pyo3(signature = (d, base = None))]
     fn from_dict(d: &Bound<'_, PyAny>, base: Option<PathBuf>) -> PyResult<PyScene> {
+        if !d.is_instance_of::<pyo3::types::PyDict>() {
+            return Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                "expected a dict shaped as a scene's TOML, got {}",
+                d.get_type().name()?
+            )));
+        }
         let tree = json_of(d)?;
         let scene = scene_of(&tree, base.unwrap_or_default(), None)?;
         Ok(PyScene { scene })
