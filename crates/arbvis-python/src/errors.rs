@@ -71,6 +71,16 @@ pub struct At<'a> {
 }
 
 impl<'a> At<'a> {
+    /// At `line` and `column` of the scene text `path` (and at `key`, where known).
+    pub fn line(path: &'a str, line: usize, column: usize, key: Option<&'a str>) -> At<'a> {
+        At {
+            path: Some(path),
+            line: Some(line),
+            column: Some(column),
+            key,
+        }
+    }
+
     /// At `key` only (or nowhere): a value set from Python, which has no line.
     pub fn key(key: Option<&'a str>) -> At<'a> {
         At {
@@ -102,30 +112,14 @@ pub fn from_scene(e: RustSceneError) -> PyErr {
         RustSceneError::Io { path, .. } => InputError::new_err(format!("{message} ({path})")),
         RustSceneError::Parse {
             path, line, column, ..
-        } => scene_error(
-            message.clone(),
-            At {
-                path: Some(path),
-                line: Some(*line),
-                column: Some(*column),
-                key: None,
-            },
-        ),
+        } => scene_error(message.clone(), At::line(path, *line, *column, None)),
         RustSceneError::Invalid {
             path,
             line,
             column,
             key,
             ..
-        } => scene_error(
-            message.clone(),
-            At {
-                path: Some(path),
-                line: Some(*line),
-                column: Some(*column),
-                key: Some(key),
-            },
-        ),
+        } => scene_error(message.clone(), At::line(path, *line, *column, Some(key))),
         RustSceneError::UnknownDemo(_) => scene_error(message, At::key(None)),
     }
 }

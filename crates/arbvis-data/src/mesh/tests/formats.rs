@@ -236,15 +236,8 @@ fn vtu_lz4_and_several_pieces_are_refused() {
 
 #[test]
 fn gmsh_mixed_elements_conform_and_quadratic_tets_use_corners() {
-    let nodes = [
-        [0.0, 0.0, 0.0],
-        [1.0, 0.0, 0.0],
-        [1.0, 1.0, 0.0],
-        [0.0, 1.0, 0.0],
-        [0.0, 0.0, 1.0],
-        [1.0, 0.0, 1.0],
-        [1.0, 1.0, 1.0],
-        [0.0, 1.0, 1.0],
+    let mut nodes = super::hostile_files::CUBE.to_vec();
+    nodes.extend([
         [0.5, 0.5, 1.8],
         [2.0, 0.0, 0.0],
         [2.0, 0.0, 1.0],
@@ -252,7 +245,7 @@ fn gmsh_mixed_elements_conform_and_quadratic_tets_use_corners() {
         [6.0, 5.0, 5.0],
         [5.0, 6.0, 5.0],
         [5.0, 5.0, 6.0],
-    ];
+    ]);
     let mut s = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n21\n");
     for (i, p) in nodes.iter().enumerate() {
         s += &format!("{} {} {} {}\n", i + 1, p[0], p[1], p[2]);

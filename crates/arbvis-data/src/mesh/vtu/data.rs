@@ -48,15 +48,16 @@ impl File<'_> {
         n: Option<usize>,
         need: &str,
     ) -> Result<Vec<f64>, MeshError> {
-        let n = n.ok_or_else(|| self.err(d, format!("the value count ({need}) overflows")))?;
+        let n = self.count(d, n, need)?;
         let t = self.ty(d)?;
-        if d.format == Format::Ascii {
-            return self.ascii(d, n, need, |c, n| c.ascii_f64(n, "the values").map(|r| r.0));
-        }
-        let data = self.binary(d, n, t, need)?;
-        let mut out = vec_for(n, "values").map_err(|m| self.err(d, m))?;
-        t.decode_f64(&data, self.big, &mut out);
-        Ok(out)
+        self.values(
+            d,
+            n,
+            t,
+            need,
+            |c, n| c.ascii_f64(n, "the values").map(|r| r.0),
+            |data, out| t.decode_f64(data, self.big, out),
+        )
     }
 
     /// `n` integers; `need` says where `n` comes from (for errors).
@@ -66,17 +67,43 @@ impl File<'_> {
         n: Option<usize>,
         need: &str,
     ) -> Result<Vec<i64>, MeshError> {
-        let n = n.ok_or_else(|| self.err(d, format!("the value count ({need}) overflows")))?;
+        let n = self.count(d, n, need)?;
         let t = self.ty(d)?;
         if t.is_float() {
             return Err(self.err(d, format!("{} must be an integer type", t.xml_name())));
         }
+        self.values(
+            d,
+            n,
+            t,
+            need,
+            |c, n| c.ascii_int(n, "the values"),
+            |data, out| t.decode_int(data, self.big, out),
+        )
+    }
+
+    /// The value count, or an error where it overflowed.
+    fn count(&self, d: &ArrayDesc, n: Option<usize>, need: &str) -> Result<usize, MeshError> {
+        n.ok_or_else(|| self.err(d, format!("the value count ({need}) overflows")))
+    }
+
+    /// `n` values of type `t`: read from text by `ascii`, or decoded from the binary
+    /// bytes by `decode`.
+    fn values<T>(
+        &self,
+        d: &ArrayDesc,
+        n: usize,
+        t: Num,
+        need: &str,
+        ascii: impl Fn(&mut Cursor, usize) -> Result<Vec<T>, MeshError>,
+        decode: impl FnOnce(&[u8], &mut Vec<T>),
+    ) -> Result<Vec<T>, MeshError> {
         if d.format == Format::Ascii {
-            return self.ascii(d, n, need, |c, n| c.ascii_int(n, "the values"));
+            return self.ascii(d, n, need, ascii);
         }
         let data = self.binary(d, n, t, need)?;
         let mut out = vec_for(n, "values").map_err(|m| self.err(d, m))?;
-        t.decode_int(&data, self.big, &mut out);
+        decode(&data, &mut out);
         Ok(out)
     }
 
@@ -90,7 +117,7 @@ impl File<'_> {
         n: Option<usize>,
         need: &str,
     ) -> Result<(), MeshError> {
-        let n = n.ok_or_else(|| self.err(d, format!("the value count ({need}) overflows")))?;
+        let n = self.count(d, n, need)?;
         let t = self.ty(d)?;
         if d.format == Format::Ascii {
             let held = count_words(d);

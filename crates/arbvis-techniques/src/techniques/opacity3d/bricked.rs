@@ -54,7 +54,7 @@ use super::programs::faithful_pair;
 use super::proxy::{eye, toward_viewer};
 use super::renderer::model_view_projection;
 use super::slicing::{polygon, EDGES};
-use super::textures::{neutral_table, table_texture};
+use super::textures::{neutral_for, table_texture};
 use super::{coefficients, Combine, Opacity3dScene, ATTRIBUTE_NAMES};
 use crate::camera::Projection;
 use crate::gl::{
@@ -387,16 +387,7 @@ impl BrickedRenderer {
                 }
             }
         }
-        // The precise program leaves absent attributes out; the verbatim product reads all.
-        let missing = self.tables.iter().any(Option::is_none);
-        self.neutral = if missing
-            && self.params.combine == Combine::Product
-            && self.fidelity == Fidelity::Faithful
-        {
-            Some(neutral_table(gpu)?)
-        } else {
-            None
-        };
+        self.neutral = neutral_for(gpu, &self.tables, self.params.combine, self.fidelity)?;
         Ok(())
     }
 

@@ -25,7 +25,7 @@ pub use super::programs::faithful_pair;
 use super::programs::{raycast_pair, slicing_pair, InShader, Variant};
 use super::proxy::{eye, toward_viewer, Proxy};
 use super::textures::unit_filter;
-use super::textures::{neutral_table, table_texture, uses_neighbours, volume_texture};
+use super::textures::{neutral_for, table_texture, uses_neighbours, volume_texture};
 use super::Interpolation;
 pub use super::{coefficients, corrected, path, preintegrated, Path3d};
 use super::{Combine, Opacity3dScene};
@@ -354,16 +354,7 @@ impl Opacity3dRenderer {
                 None => None,
             };
         }
-        // Precise programs leave absent attributes out; the verbatim product reads all three.
-        let missing = self.tables.iter().any(Option::is_none);
-        self.neutral = if missing
-            && self.params.combine == Combine::Product
-            && self.fidelity == Fidelity::Faithful
-        {
-            Some(neutral_table(gpu)?)
-        } else {
-            None
-        };
+        self.neutral = neutral_for(gpu, &self.tables, self.params.combine, self.fidelity)?;
         Ok(())
     }
 

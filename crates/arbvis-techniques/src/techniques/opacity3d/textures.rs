@@ -107,6 +107,23 @@ pub fn volume_texture(
     }
 }
 
+/// The neutral table a faithful product needs where an attribute's table is missing
+/// (`tables`), or none.
+pub fn neutral_for(
+    gpu: &Gpu,
+    tables: &[Option<Texture>; 3],
+    combine: super::Combine,
+    fidelity: Fidelity,
+) -> GlResult<Option<Texture>> {
+    // Precise programs leave absent attributes out; the verbatim product reads all three.
+    let missing = tables.iter().any(Option::is_none);
+    if missing && combine == super::Combine::Product && fidelity == Fidelity::Faithful {
+        Ok(Some(neutral_table(gpu)?))
+    } else {
+        Ok(None)
+    }
+}
+
 /// The white table a product reads for an absent attribute (so it multiplies by one).
 pub fn neutral_table(gpu: &Gpu) -> GlResult<Texture> {
     Texture::new(
