@@ -71,6 +71,12 @@ pub struct RenderArgs {
 
 /// `arbvis render`: one frame offscreen, written as a PNG, and its report.
 pub fn render(a: RenderArgs) -> Result<()> {
+    let done = render_scene(a);
+    arbvis::fetch::print_stats();
+    done
+}
+
+fn render_scene(a: RenderArgs) -> Result<()> {
     let Some(output) = a.output else {
         bail!("render needs an output file: -o OUT.png");
     };
@@ -129,6 +135,7 @@ pub struct InspectArgs {
 pub fn inspect(a: InspectArgs) -> Result<()> {
     let keys = a.segy_keys.keys();
     print!("{}", arbvis::inspect::inspect_with(&a.file, keys)?);
+    arbvis::fetch::print_stats();
     if let Some(runs) = a.time.filter(|&r| r > 0) {
         let mut ms: Vec<f64> = (0..runs.min(1000))
             .map(|_| {
@@ -261,12 +268,17 @@ pub fn convert(a: ConvertArgs) -> Result<()> {
     };
     let store = match &a.store {
         Some(s) => s.clone(),
-        None if a.input.is_dir() => a.input.clone(),
+        None if arbvis::fetch::is_folder(&arbvis::fetch::local_or_url(&a.input)) => a.input.clone(),
         None => bail!("{NO_STORE_NAMED}"),
     };
-    let report = arbvis::store::convert::convert(&a.input, &store, &options)
+    let input = arbvis::fetch::local_or_url(&a.input);
+    if arbvis::fetch::url_of(&store).is_some() {
+        bail!("{}: convert writes a store to a local folder (copy it to object storage with the bucket's own tools: aws s3 sync, rclone)", store.display());
+    }
+    let report = arbvis::store::convert::convert(&input, &store, &options)
         .with_context(|| format!("converting {}", a.input.display()))?;
     print!("{}", arbvis::store::convert::describe(&report, &store));
+    arbvis::fetch::print_stats();
     Ok(())
 }
 

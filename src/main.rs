@@ -199,7 +199,8 @@ fn run(cli: Cli) -> Result<()> {
 /// `--dry-run`: the command's scene loaded and the files it reads found, nothing run.
 fn dry_run(command: &Command) -> Result<()> {
     let exists = |path: &Path| -> Result<()> {
-        if path.exists() {
+        // A URL is checked by its reader (a missing object is a 404 naming it).
+        if arbvis::fetch::is_url(&path.to_string_lossy()) || path.exists() {
             Ok(())
         } else {
             bail!("{}: no such file or folder", path.display())
@@ -216,7 +217,9 @@ fn dry_run(command: &Command) -> Result<()> {
         Command::Inspect(a) => exists(&a.file)?,
         Command::Convert(a) => {
             exists(&a.input)?;
-            if a.store.is_none() && !a.input.is_dir() {
+            if a.store.is_none()
+                && !arbvis::fetch::is_folder(&arbvis::fetch::local_or_url(&a.input))
+            {
                 bail!("{}", commands::NO_STORE_NAMED);
             }
         }

@@ -32,7 +32,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     (
         "data and GL",
         &[
-            "le", "sniff", "volume", "store", "mesh", "points", "surface", "gl",
+            "le", "fetch", "sniff", "volume", "store", "mesh", "points", "surface", "gl",
         ],
     ),
     ("program texts", &["programs"]),
@@ -382,7 +382,7 @@ const CRATES: [(&str, Option<&str>); 6] = [
 
 /// The top-level modules of the crates below that a crate's root names for its files
 /// (`crate::scene` in the viewer is arbvis-techniques' `scene`).
-const NAMED_FROM_BELOW: [&str; 24] = [
+const NAMED_FROM_BELOW: [&str; 25] = [
     "budget",
     "camera",
     "colortable",
@@ -392,6 +392,7 @@ const NAMED_FROM_BELOW: [&str; 24] = [
     "progress",
     "vocab",
     "gl",
+    "fetch",
     "mesh",
     "points",
     "store",

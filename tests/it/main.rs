@@ -37,6 +37,7 @@ mod opacity3d_precise;
 mod pictures;
 mod programs;
 mod quad;
+mod remote;
 mod segy_keys;
 mod splats;
 mod splats_edl;

@@ -346,7 +346,7 @@ coefficients = [0.8, 0.8, 0.8, 0.8]
 }
 
 /// A converted survey and the same values as a raw file, for bricked-against-whole tests.
-fn fixture(name: &str, dims: [usize; 3], brick: usize) -> (PathBuf, Volume) {
+pub(crate) fn fixture(name: &str, dims: [usize; 3], brick: usize) -> (PathBuf, Volume) {
     let dir = temp_dir(name);
     let v = survey(dims);
     let sgy = write_segy(&dir, &v);

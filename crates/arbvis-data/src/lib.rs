@@ -14,6 +14,7 @@ extern crate self as arbvis;
 #[allow(unused_imports)]
 use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, vocab};
 
+pub mod fetch;
 pub mod le;
 pub mod mesh;
 pub mod points;

@@ -125,6 +125,10 @@ pub fn inspect_with(
         path: path.display().to_string(),
         error,
     };
+    let path = &crate::fetch::local_or_url(path);
+    if crate::fetch::url_of(path).is_some() {
+        return inspect_remote(path);
+    }
     if path.is_dir() {
         // A zarr v3 root, or a zarr v2 one (an MDIO dataset, v0 or v1, written with it).
         if std::fs::symlink_metadata(path.join("zarr.json")).is_ok()
@@ -158,6 +162,21 @@ pub fn inspect_with(
             what: looks_like(&head),
         }),
     }
+}
+
+/// `arbvis inspect` of a URL: a store (a zarr group or an MDIO dataset) or a COPC cloud.
+fn inspect_remote(path: &Path) -> Result<String, InspectError> {
+    let name = path.to_string_lossy().to_ascii_lowercase();
+    if name.ends_with(".laz") || name.ends_with(".las") {
+        return Ok(crate::points::inspect(path)?);
+    }
+    if crate::fetch::is_folder(path) {
+        return Ok(crate::store::describe::describe(path)?);
+    }
+    Err(InspectError::Unknown {
+        path: path.display().to_string(),
+        what: "no zarr.json, .zgroup or .zarray there, and not a .copc.laz file: from a URL arbvis reads stores (zarr v3, MDIO) and COPC clouds".into(),
+    })
 }
 
 #[cfg(test)]

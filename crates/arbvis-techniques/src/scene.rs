@@ -263,7 +263,10 @@ impl Scene {
             files.push(DataFile {
                 key: key.to_string(),
                 written: p.clone(),
-                resolved: std::path::absolute(base.join(&*p)).unwrap_or_else(|_| base.join(&*p)),
+                resolved: match crate::fetch::resolve(&base, p) {
+                    url if crate::fetch::url_of(&url).is_some() => url,
+                    local => std::path::absolute(&local).unwrap_or(local),
+                },
             })
         });
         files
@@ -273,7 +276,12 @@ impl Scene {
     /// key (at its line in `text`, the scene's own text, where given), the path as
     /// written and as resolved, and the scene's `data_from` hint.
     pub fn check_data_files(&self, origin: &str, text: Option<&str>) -> Result<(), SceneError> {
-        let Some(missing) = self.data_files().into_iter().find(|f| !f.resolved.exists()) else {
+        // A URL's object is checked when it is read (a 404 names it).
+        let missing = self
+            .data_files()
+            .into_iter()
+            .find(|f| crate::fetch::url_of(&f.resolved).is_none() && !f.resolved.exists());
+        let Some(missing) = missing else {
             return Ok(());
         };
         let (line, column) = text.map_or((1, 1), |t| key_position(t, &missing.key));
@@ -300,7 +308,7 @@ impl Scene {
     pub fn with_absolute_paths(&self) -> Scene {
         let mut scene = self.clone();
         let base = std::path::absolute(&self.base).unwrap_or_else(|_| self.base.clone());
-        scene.for_each_data_path(&mut |_, p| *p = base.join(&*p));
+        scene.for_each_data_path(&mut |_, p| *p = crate::fetch::resolve(&base, p));
         scene.base = base;
         scene
     }

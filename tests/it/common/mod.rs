@@ -3,6 +3,7 @@
 
 pub mod frame;
 pub mod hostile_files;
+pub mod serve;
 pub mod splats;
 #[cfg(feature = "viewer")]
 pub mod viewer;

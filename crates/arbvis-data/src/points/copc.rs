@@ -16,8 +16,6 @@
 //! some corrupt streams), the error naming the node.
 
 use std::collections::BTreeMap;
-use std::fs::File;
-use std::io::{BufReader, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -75,7 +73,8 @@ pub struct Copc {
     hierarchy: Mutex<Hierarchy>,
     header: Header,
     items: Vec<laz::LazItem>,
-    file: Mutex<BufReader<File>>,
+    /// The file, local or remote.
+    file: crate::fetch::File,
 }
 
 /// The COPC info VLR's octree: centre, half-size (centre to a face of the root node) and
@@ -97,12 +96,6 @@ pub struct OctreeInfo {
 }
 
 pub use crate::sniff::is_copc;
-
-/// Fill `buf` from byte `at` of `file`.
-fn read_at(file: &mut (impl Read + Seek), at: u64, buf: &mut [u8]) -> std::io::Result<()> {
-    file.seek(SeekFrom::Start(at))?;
-    file.read_exact(buf)
-}
 
 impl Copc {
     /// The file.
@@ -128,9 +121,8 @@ impl Copc {
     /// Read the child pages of `keys` (keys that name no unread page are passed over).
     pub fn read_pages(&self, keys: &[[i32; 4]]) -> Result<(), PointsError> {
         let mut h = self.hierarchy();
-        let mut file = self.file.lock().unwrap_or_else(|e| e.into_inner());
         for &key in keys {
-            h.read_key(key, &mut |at, buf| read_at(&mut *file, at, buf))
+            h.read_key(key, &mut |at, buf| self.file.read_at(at, buf))
                 .map_err(|(at, m)| PointsError::format(&self.path, at, m))?;
         }
         Ok(())
@@ -140,8 +132,7 @@ impl Copc {
     /// (and the counts checked against the header's).
     pub fn all_nodes(&self) -> Result<Vec<Node>, PointsError> {
         let mut h = self.hierarchy();
-        let mut file = self.file.lock().unwrap_or_else(|e| e.into_inner());
-        h.read_all(&mut |at, buf| read_at(&mut *file, at, buf))
+        h.read_all(&mut |at, buf| self.file.read_at(at, buf))
             .map_err(|(at, m)| PointsError::format(&self.path, at, m))?;
         Ok(h.nodes())
     }
@@ -199,10 +190,9 @@ impl Copc {
             ),
         };
         let mut chunk = vec![0u8; node.bytes as usize];
-        {
-            let mut file = self.file.lock().expect("COPC file");
-            read_at(&mut *file, node.offset, &mut chunk).map_err(|e| what(e.to_string()))?;
-        }
+        self.file
+            .read_at(node.offset, &mut chunk)
+            .map_err(|e| what(e.to_string()))?;
         // A layered chunk: the first point raw, a u32 point count, a u32 size per layer,
         // the layers. `laz` allocates each layer at its declared size: the sizes must fit
         // in the chunk first.
@@ -249,6 +239,27 @@ impl Copc {
             .for_header(&self.header)
             .build_from_bytes(out)
             .map_err(|e| what(e.to_string()))
+    }
+
+    /// Fetch the chunks of `nodes` ahead, when the file is remote: their ranges merged
+    /// where close, many requests at once. A failure is left to the node's own read,
+    /// which names the node.
+    pub fn prefetch(&self, nodes: &[Node]) {
+        let ranges: Vec<std::ops::Range<u64>> = nodes
+            .iter()
+            .map(|n| n.offset..n.offset.saturating_add(n.bytes))
+            .collect();
+        let _ = self.file.prefetch(&ranges);
+    }
+
+    /// The file, local or remote.
+    pub(crate) fn file(&self) -> &crate::fetch::File {
+        &self.file
+    }
+
+    /// The ETag the file had when opened, where it is remote.
+    pub fn etag(&self) -> Option<&str> {
+        self.file.etag()
     }
 
     /// What `inspect` says of the octree (the whole hierarchy read).

@@ -17,6 +17,8 @@ pub struct FileId {
     path: PathBuf,
     len: u64,
     modified: Option<SystemTime>,
+    /// A remote file's ETag.
+    etag: Option<String>,
 }
 
 impl FileId {
@@ -27,6 +29,7 @@ impl FileId {
             path: path.to_path_buf(),
             len: meta.as_ref().map_or(0, |m| m.len()),
             modified: meta.and_then(|m| m.modified().ok()),
+            etag: crate::fetch::version(path),
         }
     }
 }

@@ -86,7 +86,7 @@ pub fn load_in_stages(
     mut each: impl FnMut(PointCloud, Loaded, bool) -> bool,
 ) -> Result<(), PointsError> {
     let start = Instant::now();
-    let c = copc_cache::open(&base.join(&spec.path))?;
+    let c = copc_cache::open(&crate::fetch::resolve(base, &spec.path))?;
     let cut = match view {
         Some(v) => copc_lod::select(&c, v, spec.points, spec.min_node_pixels)?,
         None => {

@@ -224,9 +224,9 @@ pub(super) fn copc_cloud(
     let has_rgb = matches!(copc.format.0, 7 | 8);
     let extras = {
         let path = copc.path();
-        let (mut file, len) =
-            crate::input::open_regular(path).map_err(|e| PointsError::io(path, e))?;
-        let (head, checked, _) = stream::read_head(path, &mut file, len)?;
+        let file = copc.file();
+        let (head, checked, _) =
+            stream::read_head(path, &mut crate::fetch::Cursor::new(file), file.len())?;
         let base = RECORD_LENGTH[copc.format.0 as usize] as usize;
         extra_bytes(path, &head, &checked.vlrs, base, copc.format.1 as usize)?
     };
@@ -251,6 +251,7 @@ pub(super) fn copc_cloud(
     }
     batches.push(&nodes[start..]);
     for batch in batches {
+        prefetch_missing(copc, &file, batch);
         // Nodes decoded for an earlier cut come from the cache.
         let decoded: Vec<Arc<PointData>> = batch
             .par_iter()
@@ -301,9 +302,25 @@ pub(super) fn decode_nodes(
     nodes: &[super::copc::Node],
 ) -> Result<(), PointsError> {
     let file = super::copc_cache::FileId::of(copc.path());
+    prefetch_missing(copc, &file, nodes);
     nodes
         .par_iter()
         .try_for_each(|node| decoded_node(copc, &file, node).map(|_| ()))
+}
+
+/// Fetch ahead the chunks of `nodes` that the decoded-node cache does not hold (a
+/// remote file's: all at once, rather than one request per decoding thread).
+fn prefetch_missing(
+    copc: &super::copc::Copc,
+    file: &super::copc_cache::FileId,
+    nodes: &[super::copc::Node],
+) {
+    let missing: Vec<_> = nodes
+        .iter()
+        .filter(|n| !super::copc_cache::holds(file, n.key))
+        .copied()
+        .collect();
+    copc.prefetch(&missing);
 }
 
 /// Append one decoded node to the columns.

@@ -50,7 +50,6 @@ pub mod plycloud;
 pub mod progress;
 pub mod section;
 
-use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use crate::sniff::Format;
@@ -300,11 +299,15 @@ impl FileKind {
 /// max, median and NaN count. `.dat` files are read with the default columns.
 pub fn inspect(path: &Path) -> Result<String, PointsError> {
     // A COPC file is described from its header and hierarchy, without decoding a point.
+    // From a URL only COPC is read (its first block read once, by the open).
+    let remote = crate::fetch::url_of(path).is_some();
     let mut head = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|f| f.take(512).read_to_end(&mut head))
-        .map_err(|e| PointsError::io(path, e))?;
-    if crate::sniff::point_format(path, &head) == Format::Copc {
+    if !remote {
+        let (file, _) = crate::input::open_regular(path).map_err(|e| PointsError::io(path, e))?;
+        std::io::Read::read_to_end(&mut std::io::Read::take(file, 512), &mut head)
+            .map_err(|e| PointsError::io(path, e))?;
+    }
+    if remote || crate::sniff::point_format(path, &head) == Format::Copc {
         let c = copc::Copc::open(path)?;
         return Ok(format!(
             "{}\nformat: COPC (LAZ 1.4, point format {}, {}-byte records), {} points\n{}",

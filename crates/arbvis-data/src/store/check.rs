@@ -40,9 +40,9 @@ struct GroupAttributes {
 pub fn not_v3(store: &Path) -> String {
     let v2 = [".zgroup", ".zarray", ".zmetadata"]
         .iter()
-        .any(|f| std::fs::symlink_metadata(store.join(f)).is_ok());
-    let mdio_v0 = store.join("data").join(".zgroup").exists()
-        || store.join("metadata").join(".zgroup").exists();
+        .any(|f| crate::fetch::exists(&store.join(f)));
+    let mdio_v0 = crate::fetch::exists(&store.join("data").join(".zgroup"))
+        || crate::fetch::exists(&store.join("metadata").join(".zgroup"));
     if mdio_v0 {
         "an MDIO v0 dataset (zarr v2) without its variable data/chunked_012: not a dataset arbvis reads".into()
     } else if v2 {
@@ -56,11 +56,10 @@ pub fn not_v3(store: &Path) -> String {
 /// line and column) and checked ([`check_meta`]).
 pub fn read_meta(store: &Path) -> Result<StoreMeta, StoreError> {
     let file = store.join("zarr.json");
-    if std::fs::symlink_metadata(&file).is_err() {
+    if !crate::fetch::exists(&file) {
         return Err(StoreError::invalid(store, not_v3(store)));
     }
-    let text = crate::input::read_regular(&file, zarr::MAX_METADATA_BYTES)
-        .and_then(crate::input::utf8)
+    let text = crate::fetch::read_text(&file, zarr::MAX_METADATA_BYTES)
         .map_err(|e| StoreError::io(&file, e))?;
     let mut de = serde_json::Deserializer::from_str(&text);
     let doc: GroupDoc = serde_path_to_error::deserialize(&mut de).map_err(|e| {

@@ -137,6 +137,27 @@ pub fn dtype(a: Attribute) -> &'static str {
     }
 }
 
+/// The length and modification time (seconds) of the file that stands for the input; of
+/// a remote one, its length and a hash of its ETag (a rewritten object is a new input).
+fn identity_of(identity: &Path) -> Result<(u64, u64), StoreError> {
+    if crate::fetch::url_of(identity).is_some() {
+        let bytes = crate::fetch::read_object(identity, super::zarr::MAX_METADATA_BYTES)
+            .map_err(|e| StoreError::io(identity, e))?
+            .map_or(0, |b| b.len() as u64);
+        let etag = crate::fetch::version(identity).unwrap_or_default();
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        std::hash::Hash::hash(&etag, &mut h);
+        return Ok((bytes, std::hash::Hasher::finish(&h) >> 12));
+    }
+    let m = std::fs::metadata(identity).map_err(|e| StoreError::io(identity, e))?;
+    let modified = m
+        .modified()
+        .ok()
+        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
+        .map_or(0, |d| d.as_secs());
+    Ok((m.len(), modified))
+}
+
 /// The job: the input (its length and time taken from `identity`, the file that stands
 /// for it: an MDIO dataset's variable's `zarr.json`) and the options.
 fn job_of(
@@ -145,16 +166,11 @@ fn job_of(
     o: &ConvertOptions,
     attributes: &[Attribute],
 ) -> Result<Job, StoreError> {
-    let m = std::fs::metadata(identity).map_err(|e| StoreError::io(identity, e))?;
-    let modified = m
-        .modified()
-        .ok()
-        .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok())
-        .map_or(0, |d| d.as_secs());
+    let (bytes, modified) = identity_of(identity)?;
     let input = std::fs::canonicalize(input).unwrap_or_else(|_| input.to_path_buf());
     Ok(Job {
         input: input.display().to_string(),
-        bytes: m.len(),
+        bytes,
         modified,
         brick: o.brick,
         attributes: attributes.iter().map(|a| a.name().to_string()).collect(),
@@ -293,8 +309,12 @@ impl Plan {
         let dims = src.dims();
         let b = o.brick;
         let levels = super::level_count(dims, b);
-        let in_place = matches!(src, Input::Mdio(..))
-            && std::fs::canonicalize(input).ok() == std::fs::canonicalize(store).ok();
+        // In place: the same folder (a URL or a store not yet made is never the input).
+        let same = |a: &Path, b: &Path| match (std::fs::canonicalize(a), std::fs::canonicalize(b)) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        };
+        let in_place = matches!(src, Input::Mdio(..)) && same(input, store);
         if in_place && matches!(&src, Input::Mdio(_, m) if m.source_variable.is_none()) {
             return Err(StoreError::invalid(
                 input,

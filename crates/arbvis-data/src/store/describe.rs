@@ -77,12 +77,7 @@ pub fn describe(store: &Path) -> Result<String, StoreError> {
             attr.non_finite
         );
     }
-    let (bytes, files) = disk_use(store);
-    let _ = writeln!(
-        s,
-        "size on disk: {:.1} MB in {files} files",
-        bytes as f64 / 1e6
-    );
+    size_line(&mut s, store);
     Ok(s)
 }
 
@@ -168,12 +163,7 @@ fn describe_mdio(store: &Path, flavour: &super::mdio::Flavour) -> Result<String,
             }
         }
     }
-    let (bytes, files) = disk_use(store);
-    let _ = writeln!(
-        s,
-        "size on disk: {:.1} MB in {files} files",
-        bytes as f64 / 1e6
-    );
+    size_line(&mut s, store);
     Ok(s)
 }
 
@@ -247,6 +237,20 @@ fn progress(store: &Path, meta: &StoreMeta) -> String {
         ),
         Err(e) => format!("INCOMPLETE: no readable progress log ({e})"),
     }
+}
+
+/// The store's size on disk (a remote store's is not listed: HTTP has no listing).
+fn size_line(s: &mut String, store: &Path) {
+    if crate::fetch::url_of(store).is_some() {
+        s.push_str("size: not listed (a remote store)\n");
+        return;
+    }
+    let (bytes, files) = disk_use(store);
+    let _ = writeln!(
+        s,
+        "size on disk: {:.1} MB in {files} files",
+        bytes as f64 / 1e6
+    );
 }
 
 /// Bytes and files under `folder` (links not followed).

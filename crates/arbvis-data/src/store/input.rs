@@ -64,9 +64,9 @@ impl Input {
         raw: Option<&RawSpec>,
         segy_keys: crate::volume::segy::KeyBytes,
     ) -> Result<Input, StoreError> {
-        if path.is_dir() && raw.is_none() {
+        if crate::fetch::is_folder(path) && raw.is_none() {
             let Some(flavour) = super::mdio::flavour(path)? else {
-                if !path.join("zarr.json").exists() {
+                if !crate::fetch::exists(&path.join("zarr.json")) {
                     return Err(StoreError::invalid(path, super::check::not_v3(path)));
                 }
                 return Err(StoreError::invalid(

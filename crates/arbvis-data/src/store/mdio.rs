@@ -172,7 +172,8 @@ pub fn map_coordinates(
 
 /// Whether `store` is an MDIO v0 dataset (zarr v2: `data/chunked_012`).
 pub fn is_mdio_v0(store: &Path) -> bool {
-    store.join("data/chunked_012/.zarray").is_file() && store.join(".zattrs").is_file()
+    crate::fetch::exists(&store.join("data/chunked_012/.zarray"))
+        && crate::fetch::exists(&store.join(".zattrs"))
 }
 
 /// Which MDIO dataset a folder holds.
@@ -201,7 +202,7 @@ impl Flavour {
 /// The MDIO dataset at `store`, if it is one.
 pub fn flavour(store: &Path) -> Result<Option<Flavour>, StoreError> {
     let v3 = store.join("zarr.json");
-    if std::fs::symlink_metadata(&v3).is_ok() {
+    if crate::fetch::exists(&v3) {
         let root = zarr::read_json(&v3)?;
         zarr::check_group(&root, &v3)?;
         return Ok(is_mdio(&root).then_some(Flavour::V1 {
@@ -209,7 +210,8 @@ pub fn flavour(store: &Path) -> Result<Option<Flavour>, StoreError> {
             zarr_v2: false,
         }));
     }
-    if store.join(".zgroup").is_file() && store.join(".zattrs").is_file() {
+    if crate::fetch::exists(&store.join(".zgroup")) && crate::fetch::exists(&store.join(".zattrs"))
+    {
         let attributes = zarr::read_json(&store.join(".zattrs"))?;
         let root = serde_json::json!({ "attributes": attributes });
         if is_mdio(&root) {
@@ -237,7 +239,7 @@ pub fn open(store: &Path, root: &Value) -> Result<(StoreMeta, Mdio), StoreError>
 
 /// Whether an array (zarr v3 `zarr.json` or v2 `.zarray`) is at `folder`.
 fn array_at(folder: &Path) -> bool {
-    folder.join("zarr.json").exists() || folder.join(".zarray").exists()
+    crate::fetch::exists(&folder.join("zarr.json")) || crate::fetch::exists(&folder.join(".zarray"))
 }
 
 fn parts_v1(store: &Path, root: &Value, zarr_v2: bool) -> Result<Parts, StoreError> {
@@ -353,7 +355,7 @@ fn parts_v0(store: &Path) -> Result<Parts, StoreError> {
         data.shape.get(1).copied().unwrap_or(0) as usize,
     );
     let mask = store.join("metadata/live_mask");
-    let live = match mask.join(".zarray").exists() {
+    let live = match crate::fetch::exists(&mask.join(".zarray")) {
         false => None,
         true => Some(trace_mask(&zarr::open_array(&mask)?, nk, nj)?),
     };
@@ -770,6 +772,7 @@ impl Mdio {
         out: &mut [f32],
     ) -> Result<(), ChunkFailure> {
         let sy = j.len();
+        self.prefetch_box([0, j.start, k.start], [dims[0], j.end, k.end]);
         self.read_box(
             dims,
             [0, j.start, k.start],
@@ -777,6 +780,25 @@ impl Mdio {
             out,
             [dims[0], sy],
         )
+    }
+
+    /// Start fetching the chunks under voxels `lo..hi` (i, j, k), where the dataset is
+    /// remote: a column's chunks all at once rather than one after the other.
+    fn prefetch_box(&self, lo: [usize; 3], hi: [usize; 3]) {
+        if crate::fetch::url_of(&self.data.folder).is_none() || (0..3).any(|a| hi[a] <= lo[a]) {
+            return;
+        }
+        let per = [2, 1, 0].map(|a| self.data.chunks[a] as usize);
+        let span = |a: usize| (lo[a] / per[a])..=((hi[a] - 1) / per[a]);
+        let mut files = Vec::new();
+        for k in span(2) {
+            for j in span(1) {
+                for i in span(0) {
+                    files.push(self.data.chunk_file(&[k as u64, j as u64, i as u64]));
+                }
+            }
+        }
+        crate::fetch::prefetch(files);
     }
 
     /// Bytes the chunk cache may hold at most.

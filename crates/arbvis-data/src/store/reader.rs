@@ -82,8 +82,8 @@ pub const CHUNK_CACHE: usize = 64;
 impl Store {
     /// Open the store at `path`: its description and every array checked.
     pub fn open(path: &Path) -> Result<Store, StoreError> {
-        if !path.is_dir() {
-            let why = if path.exists() {
+        if !crate::fetch::is_folder(path) {
+            let why = if crate::fetch::exists(path) {
                 "not a folder: a store is a folder (make one with `arbvis convert SURVEY STORE`)"
             } else {
                 "no such store: no such file or folder (make one with `arbvis convert SURVEY STORE`)"
@@ -207,6 +207,65 @@ impl Store {
         self.arrays[attr][level].chunk_file(&[c[2] as u64, c[1] as u64, c[0] as u64])
     }
 
+    /// Start fetching ahead what bricks `bricks` (attribute, level, brick) and their
+    /// borders read, when the store is remote (nothing for a local one): the coarsest
+    /// levels first, many requests at once.
+    pub fn prefetch(&self, bricks: &[(usize, usize, [usize; 3])]) {
+        if crate::fetch::url_of(&self.path).is_none() {
+            return;
+        }
+        let mut order: Vec<_> = bricks.to_vec();
+        order.sort_by_key(|b| std::cmp::Reverse(b.1));
+        let mut seen = std::collections::HashSet::new();
+        let mut files = Vec::new();
+        for (attr, level, c) in order {
+            for file in self.brick_files(attr, level, c) {
+                if seen.insert(file.clone()) {
+                    files.push(file);
+                }
+            }
+        }
+        crate::fetch::prefetch(files);
+    }
+
+    /// The chunk files brick `c` of `attr` at `level` reads, its border included: its
+    /// own first (an MDIO variable's chunks under the grown box).
+    fn brick_files(&self, attr: usize, level: usize, c: [usize; 3]) -> Vec<PathBuf> {
+        let b = self.meta.brick;
+        let n = self.meta.level_dims(level);
+        let mut files = vec![self.chunk_file(attr, level, c)];
+        if let Some(m) = self.mdio.as_ref().filter(|_| attr == 0 && level == 0) {
+            // The variable's chunks under voxels c B - 1 ..= (c + 1) B, clamped.
+            let ch = &m.data.chunks;
+            let span = |a: usize| {
+                let lo = (c[a] * b).saturating_sub(1).min(n[a] - 1);
+                let hi = ((c[a] + 1) * b).min(n[a] - 1);
+                let per = ch[2 - a] as usize;
+                (lo / per)..=(hi / per)
+            };
+            for k in span(2) {
+                for j in span(1) {
+                    for i in span(0) {
+                        files.push(m.data.chunk_file(&[k as u64, j as u64, i as u64]));
+                    }
+                }
+            }
+            return files;
+        }
+        let counts = self.meta.brick_counts(level);
+        for dz in 0..3 {
+            for dy in 0..3 {
+                for dx in 0..3 {
+                    let cc = [c[0] + dx, c[1] + dy, c[2] + dz].map(|v| v.wrapping_sub(1));
+                    if (0..3).all(|a| cc[a] < counts[a]) && cc != c {
+                        files.push(self.chunk_file(attr, level, cc));
+                    }
+                }
+            }
+        }
+        files
+    }
+
     /// Chunk `c` (`[i, j, k]` brick indices) of `attr` at `level`: `B³` values, i fastest
     /// (edge chunks padded with 0 beyond the level's voxels).
     pub fn chunk(
@@ -294,7 +353,7 @@ impl Store {
         let first_level = usize::from(self.meta.source_variable.is_some());
         for level in 1..self.meta.levels {
             let group = self.path.join(format!("level_{level}/zarr.json"));
-            if !group.is_file() {
+            if !crate::fetch::exists(&group) {
                 return Some(group);
             }
         }
@@ -302,7 +361,7 @@ impl Store {
             for (level, array) in levels.iter().enumerate().skip(first_level) {
                 // The ranges: one chunk of every brick's pair.
                 let ranges = self.range_arrays[attr][level].chunk_file(&[0, 0, 0, 0]);
-                if !ranges.is_file() {
+                if !crate::fetch::exists(&ranges) {
                     return Some(ranges);
                 }
                 let c = self.meta.brick_counts(level);
@@ -310,7 +369,7 @@ impl Store {
                     for j in 0..c[1] as u64 {
                         for i in 0..c[0] as u64 {
                             let file = array.chunk_file(&[k, j, i]);
-                            if !file.is_file() {
+                            if !crate::fetch::exists(&file) {
                                 return Some(file);
                             }
                         }

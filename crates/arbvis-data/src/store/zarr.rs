@@ -30,9 +30,8 @@ pub const MAX_CHUNK_BYTES: u64 = 1 << 30;
 /// A `zarr.json` read and parsed: bounded, regular files only, JSON errors with their
 /// line and column.
 pub fn read_json(file: &Path) -> Result<Value, StoreError> {
-    let text = crate::input::read_regular(file, MAX_METADATA_BYTES)
-        .and_then(crate::input::utf8)
-        .map_err(|e| StoreError::io(file, e))?;
+    let text =
+        crate::fetch::read_text(file, MAX_METADATA_BYTES).map_err(|e| StoreError::io(file, e))?;
     serde_json::from_str(&text).map_err(|e| {
         StoreError::invalid(
             file,
@@ -473,7 +472,7 @@ pub fn check_group(doc: &Value, file: &Path) -> Result<(), StoreError> {
 /// The array at `folder` (its `zarr.json`), every field checked.
 pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
     let file = folder.join("zarr.json");
-    if !file.exists() && folder.join(".zarray").exists() {
+    if !crate::fetch::exists(&file) && crate::fetch::exists(&folder.join(".zarray")) {
         return v2::open_array(folder);
     }
     let doc = read_json(&file)?;
@@ -753,20 +752,19 @@ impl ArrayMeta {
     /// Chunk `index`'s decoded bytes, exactly one chunk's worth, or `None` where absent.
     fn read_chunk_bytes(&self, index: &[u64]) -> Result<Option<Vec<u8>>, String> {
         let file = self.chunk_file(index);
-        let meta = match std::fs::metadata(&file) {
-            Ok(m) => m,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        let max = self.max_encoded_bytes();
+        let data = match crate::fetch::read_object(&file, max) {
+            Ok(Some(data)) => data,
+            Ok(None) => return Ok(None),
+            Err(crate::fetch::FetchError::TooLarge { bytes, .. }) => {
+                return Err(format!(
+                "the file holds {bytes} bytes; its codecs ({}) can make at most {max} of a chunk",
+                self.codec_names()
+            ))
+            }
             Err(e) => return Err(e.to_string()),
         };
-        let max = self.max_encoded_bytes();
-        if meta.is_file() && meta.len() > max {
-            return Err(format!(
-                "the file holds {} bytes; its codecs ({}) can make at most {max} of a chunk",
-                meta.len(),
-                self.codec_names()
-            ));
-        }
-        let mut data = crate::input::read_regular(&file, max).map_err(|e| e.to_string())?;
+        let mut data = std::sync::Arc::unwrap_or_clone(data);
         let decoded = self.chunk_elements() * self.data_type.size();
         let mut limits = vec![self.serialized_bound()];
         for c in &self.codecs {

@@ -2,14 +2,15 @@
 //! (read through [`crate::points::lasfile::layout`]), the info VLR's octree, the checks
 //! every LAS reader runs, the root hierarchy page and the laszip items.
 
-use std::fs::File;
-use std::io::{BufReader, Read, Seek, SeekFrom};
+use std::io::BufReader;
 use std::path::Path;
 use std::sync::Mutex;
 
+use crate::fetch::{Cursor, File};
+
 use las::Header;
 
-use super::{read_at, Copc, OctreeInfo};
+use super::{Copc, OctreeInfo};
 use crate::le::{f64_at, u64_at};
 use crate::points::copc_hierarchy::Hierarchy;
 use crate::points::guarded;
@@ -38,8 +39,10 @@ impl Opening<'_> {
 impl Copc {
     /// Open `path`, checking its header, VLRs, EVLRs and hierarchy.
     pub fn open(path: &Path) -> Result<Copc, PointsError> {
-        // A FIFO, a device or a folder is refused here, never waited on.
-        let (file, len) = crate::input::open_regular(path).map_err(|e| PointsError::io(path, e))?;
+        // A FIFO, a device or a folder is refused here, never waited on; a URL costs one
+        // request (the first 64 KiB: the header and VLRs).
+        let file = File::open(path).map_err(|e| PointsError::io(path, std::io::Error::other(e)))?;
+        let len = file.len();
         let mut f = Opening { path, file, len };
         let h = f.header()?;
         f.vlrs(&h)?;
@@ -59,14 +62,14 @@ impl Copc {
         // The checks every LAS/LAZ reader runs on the header and VLRs, and the
         // extra-bytes descriptors against the record: what `render` decodes with, so
         // `inspect` refuses what `render` would.
-        crate::points::lasfile::stream::check_las_head(path, &mut f.file, len)?;
+        crate::points::lasfile::stream::check_las_head(path, &mut Cursor::new(&f.file), len)?;
         let info_at = h.header_size as u64 + VLR_HEADER;
         let hierarchy = Hierarchy::open(
             hierarchy,
             (h.point_offset as u64, h.evlr_start),
             h.count_64,
             (root, info_at + 40),
-            &mut |at, buf| read_at(&mut f.file, at, buf),
+            &mut |at, buf| f.file.read_at(at, buf),
         )
         .map_err(|(at, m)| PointsError::format(path, at, m))?;
         let (header, items) = f.las_header(&h)?;
@@ -79,7 +82,7 @@ impl Copc {
             hierarchy: Mutex::new(hierarchy),
             header,
             items,
-            file: Mutex::new(BufReader::new(f.file)),
+            file: f.file,
         })
     }
 }
@@ -90,7 +93,7 @@ impl Opening<'_> {
     fn header(&mut self) -> Result<RawHeader, PointsError> {
         let len = self.len;
         let mut head = vec![0u8; HEADER_14];
-        self.file.read_exact(&mut head).map_err(|_| {
+        self.file.read_at(0, &mut head).map_err(|_| {
             self.bad(
                 0,
                 format!("{len} bytes: shorter than a LAS 1.4 header ({HEADER_14} bytes)"),
@@ -146,8 +149,8 @@ impl Opening<'_> {
         let mut walk = Walk::vlrs(h.header_size as u64, count, point_offset);
         let path = self.path;
         let bad = |offset: u64, m: String| PointsError::format(path, offset, m);
-        let file = &mut self.file;
-        let mut read = |at, buf: &mut [u8]| read_at(file, at, buf);
+        let file = &self.file;
+        let mut read = |at, buf: &mut [u8]| file.read_at(at, buf);
         let mut first = true;
         while let Some(next) = walk.next(&mut read) {
             let vlr = match next {
@@ -179,10 +182,10 @@ impl Opening<'_> {
         }
         let path = self.path;
         let bad = |offset: u64, m: String| PointsError::format(path, offset, m);
-        let file = &mut self.file;
+        let file = &self.file;
         let mut hierarchy = Vec::new();
         let mut walk = Walk::evlrs(start, count, len);
-        let mut read = |at, buf: &mut [u8]| read_at(file, at, buf);
+        let mut read = |at, buf: &mut [u8]| file.read_at(at, buf);
         while let Some(next) = walk.next(&mut read) {
             match next {
                 Ok(v) => {
@@ -213,7 +216,9 @@ impl Opening<'_> {
     fn octree(&mut self, h: &RawHeader) -> Result<(OctreeInfo, (u64, u64)), PointsError> {
         let info_at = h.header_size as u64 + VLR_HEADER;
         let mut info = [0u8; 160];
-        read_at(&mut self.file, info_at, &mut info).map_err(|e| self.io(e))?;
+        self.file
+            .read_at(info_at, &mut info)
+            .map_err(|e| self.io(e))?;
         let f = |at: usize| f64_at(&info, at);
         let octree = OctreeInfo {
             center_x: f(0),
@@ -254,8 +259,7 @@ impl Opening<'_> {
     /// the point format's types, as long as a record.
     fn las_header(&mut self, h: &RawHeader) -> Result<(Header, Vec<laz::LazItem>), PointsError> {
         let header_size = h.header_size as u64;
-        self.file.seek(SeekFrom::Start(0)).map_err(|e| self.io(e))?;
-        let header = guarded(|| Header::new(BufReader::new(&mut self.file)))
+        let header = guarded(|| Header::new(BufReader::new(Cursor::new(&self.file))))
             .map_err(|e| self.bad(0, format!("the LAS header: {e}")))?;
         let laz = guarded(|| header.laz_vlr())
             .map_err(|e| self.bad(header_size, format!("the laszip VLR: {e}")))?;

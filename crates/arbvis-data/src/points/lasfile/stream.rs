@@ -83,7 +83,7 @@ fn copied(b: &[u8], vlrs: &[RawVlr]) -> Vec<CopiedVlr> {
 /// data (at most [`MAX_HEAD`]), what the checks found, and the point data's offset.
 pub(super) fn read_head(
     path: &Path,
-    file: &mut File,
+    file: &mut (impl Read + Seek),
     len: u64,
 ) -> Result<(Vec<u8>, Checked, usize), PointsError> {
     let io = |e| PointsError::io(path, e);
@@ -106,7 +106,11 @@ pub(super) fn read_head(
 /// The checks every LAS/LAZ reader here runs on a file's header and VLRs
 /// ([`check_head`]) and on its extra-bytes descriptors against its records: a COPC file
 /// is opened only when they pass, so `inspect` refuses what `render` refuses.
-pub(crate) fn check_las_head(path: &Path, file: &mut File, len: u64) -> Result<(), PointsError> {
+pub(crate) fn check_las_head(
+    path: &Path,
+    file: &mut (impl Read + Seek),
+    len: u64,
+) -> Result<(), PointsError> {
     let (head, checked, _) = read_head(path, file, len)?;
     let base = super::header::RECORD_LENGTH[checked.info.point_format as usize] as usize;
     super::extra::extra_bytes(

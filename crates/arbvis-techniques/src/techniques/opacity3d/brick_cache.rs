@@ -426,6 +426,24 @@ pub fn pack_brick(store: &Store, packing: &Packing, id: BrickId) -> Result<Vec<u
     Ok(texels)
 }
 
+/// Bricks whose chunks a remote store fetches ahead of the one being read.
+const PREFETCH_BRICKS: usize = 64;
+
+/// Start fetching the chunks of the next bricks in `queue` (a remote store's; the
+/// ones fetched or on their way are passed over).
+fn prefetch_ahead(store: &Store, packing: &Packing, queue: &[BrickId]) {
+    let attrs: Vec<usize> = packing.channels.iter().flatten().map(|p| p.0).collect();
+    let bricks: Vec<(usize, usize, [usize; 3])> = queue
+        .iter()
+        .take(PREFETCH_BRICKS)
+        .flat_map(|id| {
+            let c = id.c.map(|x| x as usize);
+            attrs.iter().map(move |&a| (a, id.level as usize, c))
+        })
+        .collect();
+    store.prefetch(&bricks);
+}
+
 fn loader(
     store: Arc<Store>,
     packing: Packing,
@@ -446,6 +464,7 @@ fn loader(
             // what the older lists still hold.
             queue = list.into_iter().chain(queue.drain(..)).collect();
         }
+        prefetch_ahead(&store, &packing, &queue);
         let id = queue.remove(0);
         let reply = match pack_brick(&store, &packing, id) {
             Ok(t) => Reply::Loaded(id, t),

@@ -169,7 +169,7 @@ impl StoreScene {
         let Some(path) = store_of(params)? else {
             return Ok(None);
         };
-        let store = Arc::new(Store::open(&base.join(&path))?);
+        let store = Arc::new(Store::open(&crate::fetch::resolve(base, &path))?);
         let view = params.store.clone().unwrap_or_default();
         let meta = &store.meta;
         let window = view.window.unwrap_or([[0; 3], meta.dims]);

@@ -59,7 +59,7 @@ pub fn lod(
     let PointSource::Copc(spec) = &p.cloud else {
         bail!("the splats-lod study needs a scene whose cloud is a COPC file");
     };
-    let path = scene.base.join(&spec.path);
+    let path = crate::fetch::resolve(&scene.base, &spec.path);
     let copc = Copc::open(&path).with_context(|| format!("opening {}", path.display()))?;
     progress(&format!(
         "splats-lod: the reference, all {} points of {}",

@@ -1,0 +1,199 @@
+//! The object-storage clients (Apache Arrow's `object_store`): one per bucket or server,
+//! made on first use and kept for the process, on one runtime of their own; the settings
+//! (timeouts, retries, credentials) read from the environment, and their errors in words
+//! that name the URL, the byte range and, where access is refused, the variables to set.
+
+use std::collections::HashMap;
+use std::ops::Range;
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::Duration;
+
+use object_store::aws::AmazonS3Builder;
+use object_store::http::HttpBuilder;
+use object_store::{BackoffConfig, ClientOptions, ObjectStore, RetryConfig};
+
+/// The environment variables arbvis reads for S3, as AWS's own tools read them.
+pub const AWS_VARIABLES: &str = "AWS_ACCESS_KEY_ID and AWS_SECRET_ACCESS_KEY (and AWS_SESSION_TOKEN for temporary credentials; AWS_REGION, AWS_ENDPOINT_URL for an S3-compatible server)";
+
+/// An object named by a URL: its client and its path there.
+#[derive(Clone)]
+pub struct Object {
+    /// The URL as the user gave it (what errors name).
+    pub url: String,
+    /// The bucket's or server's client.
+    pub store: Arc<dyn ObjectStore>,
+    /// The object's path in the bucket or on the server.
+    pub path: object_store::path::Path,
+    /// An S3 object (else HTTP).
+    pub s3: bool,
+}
+
+/// The runtime the clients run on: two threads, whatever the cores (requests wait on the
+/// network, not on a core).
+pub fn runtime() -> &'static tokio::runtime::Runtime {
+    static RUNTIME: OnceLock<tokio::runtime::Runtime> = OnceLock::new();
+    RUNTIME.get_or_init(|| {
+        tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(2)
+            .thread_name("arbvis-fetch")
+            .enable_all()
+            .build()
+            .expect("a tokio runtime (two threads)")
+    })
+}
+
+/// Seconds a request may take before it fails (`ARBVIS_REMOTE_TIMEOUT`, default 30).
+pub fn timeout() -> Duration {
+    let secs = std::env::var("ARBVIS_REMOTE_TIMEOUT")
+        .ok()
+        .and_then(|v| v.parse::<f64>().ok())
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .unwrap_or(30.0);
+    Duration::from_secs_f64(secs)
+}
+
+/// Requests kept in flight at once (`ARBVIS_REMOTE_REQUESTS`, default 16).
+pub fn in_flight() -> usize {
+    std::env::var("ARBVIS_REMOTE_REQUESTS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+        .filter(|v| (1..=256).contains(v))
+        .unwrap_or(16)
+}
+
+fn options() -> ClientOptions {
+    let t = timeout();
+    ClientOptions::new()
+        .with_timeout(t)
+        .with_connect_timeout(t.min(Duration::from_secs(10)))
+        .with_allow_http(true)
+        .with_pool_max_idle_per_host(64)
+}
+
+/// Retries on 429, 5xx and dropped connections: four, backing off from 100 ms up to 2 s,
+/// and none after twice the request timeout.
+fn retry() -> RetryConfig {
+    RetryConfig {
+        backoff: BackoffConfig {
+            init_backoff: Duration::from_millis(100),
+            max_backoff: Duration::from_secs(2),
+            base: 2.0,
+        },
+        max_retries: 4,
+        retry_timeout: 2 * timeout(),
+    }
+}
+
+/// The object at `url` (`s3://bucket/key`, `http://` or `https://`).
+pub fn object(url: &str) -> Result<Object, String> {
+    let (scheme, rest) = url
+        .split_once("://")
+        .ok_or_else(|| "not a URL".to_string())?;
+    let (authority, key) = rest.split_once('/').unwrap_or((rest, ""));
+    if authority.is_empty() || key.is_empty() {
+        return Err(format!(
+            "a URL names a {} and an object in it",
+            if scheme == "s3" { "bucket" } else { "server" }
+        ));
+    }
+    let s3 = match scheme {
+        "s3" => true,
+        "http" | "https" => false,
+        _ => return Err("arbvis reads s3://, http://, https:// and file:// URLs".to_string()),
+    };
+    let root = format!("{scheme}://{authority}");
+    let store = client(&root, s3)?;
+    let path = object_store::path::Path::from_url_path(key)
+        .map_err(|e| format!("not an object's path: {e}"))?;
+    Ok(Object {
+        url: url.to_string(),
+        store,
+        path,
+        s3,
+    })
+}
+
+fn client(root: &str, s3: bool) -> Result<Arc<dyn ObjectStore>, String> {
+    static CLIENTS: OnceLock<Mutex<HashMap<String, Arc<dyn ObjectStore>>>> = OnceLock::new();
+    let mut clients = CLIENTS
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner());
+    if let Some(c) = clients.get(root) {
+        return Ok(c.clone());
+    }
+    // The builders' reqwest clients start on the runtime.
+    let _guard = runtime().enter();
+    let made: Arc<dyn ObjectStore> = if s3 {
+        let bucket = &root["s3://".len()..];
+        let mut b = AmazonS3Builder::from_env()
+            .with_bucket_name(bucket)
+            .with_client_options(options())
+            .with_retry(retry());
+        if std::env::var_os("AWS_REGION").is_none()
+            && std::env::var_os("AWS_DEFAULT_REGION").is_none()
+        {
+            b = b.with_region("us-east-1");
+        }
+        if anonymous() {
+            b = b.with_skip_signature(true);
+        }
+        Arc::new(b.build().map_err(|e| format!("{root}: {e}"))?)
+    } else {
+        Arc::new(
+            HttpBuilder::new()
+                .with_url(root)
+                .with_client_options(options())
+                .with_retry(retry())
+                .build()
+                .map_err(|e| format!("{root}: {e}"))?,
+        )
+    };
+    clients.insert(root.to_string(), made.clone());
+    Ok(made)
+}
+
+/// Reads of public buckets go unsigned: no access key, and no role to assume.
+fn anonymous() -> bool {
+    let set = |k: &str| std::env::var_os(k).is_some_and(|v| !v.is_empty());
+    !set("AWS_ACCESS_KEY_ID")
+        && !set("AWS_WEB_IDENTITY_TOKEN_FILE")
+        && !set("AWS_CONTAINER_CREDENTIALS_RELATIVE_URI")
+        && !set("AWS_CONTAINER_CREDENTIALS_FULL_URI")
+}
+
+/// What a request for `object` (bytes `range`, where one) failed with, in words (the
+/// caller's error names the URL, as it names a file).
+pub fn describe(object: &Object, range: Option<&Range<u64>>, e: &object_store::Error) -> String {
+    let what = match range {
+        Some(r) => format!("bytes {}-{}", r.start, r.end.saturating_sub(1)),
+        None => "GET".to_string(),
+    };
+    use object_store::Error as E;
+    match e {
+        E::NotFound { .. } => format!("{what}: no such object (HTTP 404)"),
+        E::PermissionDenied { .. } | E::Unauthenticated { .. } => {
+            if object.s3 {
+                let creds = if anonymous() {
+                    "no credentials were set, so the request went unsigned (a public bucket's way): set "
+                } else {
+                    "the credentials set may not read it: check "
+                };
+                format!("{what}: access denied (HTTP 401/403); {creds}{AWS_VARIABLES}")
+            } else {
+                format!("{what}: access denied (HTTP 401/403); arbvis sends no credentials over HTTP (an S3 bucket is read as s3://BUCKET/KEY with {AWS_VARIABLES})")
+            }
+        }
+        E::Precondition { .. } => format!(
+            "{what}: the object changed while it was read (its ETag is not the one it had when it was opened); open it again"
+        ),
+        other => {
+            let text = other.to_string();
+            if text.contains("non-partial response") || text.contains("Range request not supported") {
+                format!("{what}: the server ignored the Range request (it answered 200 with the whole object); arbvis reads a part of an object only from servers that honour Range")
+            } else {
+                format!("{what}: {text}")
+            }
+        }
+    }
+}

@@ -1,0 +1,458 @@
+//! Where data lies: a local path, or a URL (`s3://bucket/key`, `http://`, `https://`;
+//! `file://` is the local path it names). A store or a COPC cloud named by a URL is read
+//! through [`object_store`] (Apache Arrow's S3 and HTTP clients: request signing, retries
+//! with backoff on 429, 5xx and dropped connections, timeouts), with
+//! - [`read_object`]: whole objects (a zarr store's metadata and chunks), an absent one
+//!   (404) being `None`, as an absent file is;
+//! - [`prefetch`]: objects fetched ahead, many at a time, for a view's bricks;
+//! - [`File`]: a file read by byte ranges (COPC), its nodes fetched ahead and merged;
+//! - [`cache`]: the disk cache shared by every process of the user.
+//!
+//! A URL travels in a `Path` (`Path::new("s3://b/store").join("zarr.json")` is the URL of
+//! the store's `zarr.json`), so every error that names a file names the URL, and the
+//! readers above tell the two apart only here. Request counts are kept ([`stats`]) for
+//! the tests, `--stats` and the viewer's status line.
+
+pub mod cache;
+pub mod client;
+pub mod ranged;
+mod whole;
+
+use std::collections::HashMap;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use std::sync::{Mutex, OnceLock};
+
+/// The cache key of a whole object (no range).
+const WHOLE: Range<u64> = 0..u64::MAX;
+
+/// Why an object could not be read.
+#[derive(Debug, Clone)]
+pub enum FetchError {
+    /// It holds more than the reader may read.
+    TooLarge {
+        /// Its size.
+        bytes: u64,
+        /// The most the reader takes.
+        max: u64,
+    },
+    /// Anything else, in words naming the file or URL.
+    Failed(String),
+}
+
+impl std::fmt::Display for FetchError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            FetchError::TooLarge { bytes, max } => {
+                write!(f, "it holds {bytes} bytes, more than the {max} read")
+            }
+            FetchError::Failed(m) => f.write_str(m),
+        }
+    }
+}
+
+/// The remote URL `path` holds, if it holds one (`file://` URLs are local paths).
+pub fn url_of(path: &Path) -> Option<&str> {
+    let s = path.to_str()?;
+    ["s3://", "http://", "https://"]
+        .iter()
+        .any(|p| s.starts_with(p))
+        .then_some(s)
+}
+
+/// Whether `name` (as a scene or the command line gives it) is a URL, `file://` included.
+pub fn is_url(name: &str) -> bool {
+    ["s3://", "http://", "https://", "file://"]
+        .iter()
+        .any(|p| name.starts_with(p))
+}
+
+/// `name` as a path: a `file://` URL as its local path (percent-escapes decoded), any
+/// other name unchanged.
+pub fn local_or_url(name: &Path) -> PathBuf {
+    match name.to_str().and_then(|s| s.strip_prefix("file://")) {
+        Some(rest) => {
+            // file:///abs/path and file://localhost/abs/path.
+            let rest = rest.strip_prefix("localhost").unwrap_or(rest);
+            PathBuf::from(percent_decode(rest))
+        }
+        None => name.to_path_buf(),
+    }
+}
+
+/// `name` relative to `base` (a scene's folder): a URL or an absolute path as it is.
+pub fn resolve(base: &Path, name: &Path) -> PathBuf {
+    let name = local_or_url(name);
+    if url_of(&name).is_some() {
+        name
+    } else {
+        base.join(name)
+    }
+}
+
+fn percent_decode(s: &str) -> String {
+    let b = s.as_bytes();
+    let mut out = Vec::with_capacity(b.len());
+    let mut i = 0;
+    while i < b.len() {
+        let hex = |c: u8| (c as char).to_digit(16);
+        if b[i] == b'%' && i + 2 < b.len() {
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(b[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// The most bytes a prefetched object may hold (a store's largest chunk).
+fn zarr_max() -> u64 {
+    crate::store::zarr::MAX_CHUNK_BYTES * 2
+}
+
+/// The object or file at `path`, at most `max` bytes; `None` where it is absent (a
+/// missing file, a 404). A local one must be a regular file.
+pub fn read_object(path: &Path, max: u64) -> Result<Option<std::sync::Arc<Vec<u8>>>, FetchError> {
+    if let Some(url) = url_of(path) {
+        let found = whole::read(url, max)?;
+        if let Some(b) = &found {
+            if b.len() as u64 > max {
+                return Err(FetchError::TooLarge {
+                    bytes: b.len() as u64,
+                    max,
+                });
+            }
+        }
+        return Ok(found);
+    }
+    let meta = match std::fs::metadata(path) {
+        Ok(m) => m,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(FetchError::Failed(e.to_string())),
+    };
+    if meta.is_file() && meta.len() > max {
+        return Err(FetchError::TooLarge {
+            bytes: meta.len(),
+            max,
+        });
+    }
+    crate::input::read_regular(path, max)
+        .map(|b| Some(std::sync::Arc::new(b)))
+        .map_err(|e| FetchError::Failed(e.to_string()))
+}
+
+/// The object or file at `path` as text, at most `max` bytes; an absent one is an error.
+pub fn read_text(path: &Path, max: u64) -> Result<String, String> {
+    if url_of(path).is_none() {
+        return crate::input::read_regular(path, max)
+            .and_then(crate::input::utf8)
+            .map_err(|e| e.to_string());
+    }
+    match read_object(path, max) {
+        Ok(Some(b)) => String::from_utf8(b.to_vec())
+            .map_err(|e| format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())),
+        Ok(None) => Err("no such object (HTTP 404)".into()),
+        Err(FetchError::Failed(m)) => Err(m),
+        Err(e) => Err(e.to_string()),
+    }
+}
+
+/// Whether something lies at `path`: for a URL, a small object is fetched (metadata
+/// read next anyway) and a large one asked for with a HEAD.
+pub fn exists(path: &Path) -> bool {
+    let Some(url) = url_of(path) else {
+        return std::fs::symlink_metadata(path).is_ok();
+    };
+    let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+    let metadata = name == "zarr.json" || name.starts_with(".z");
+    if metadata {
+        return matches!(
+            read_object(path, crate::store::zarr::MAX_METADATA_BYTES),
+            Ok(Some(_))
+        );
+    }
+    let Ok(object) = client::object(url) else {
+        return false;
+    };
+    let _busy = count::request();
+    client::runtime()
+        .block_on(object_store::ObjectStoreExt::head(
+            &*object.store,
+            &object.path,
+        ))
+        .is_ok()
+}
+
+/// Whether `path` is a folder (for a URL: a zarr group or array, v3 or v2, lies there).
+pub fn is_folder(path: &Path) -> bool {
+    if url_of(path).is_none() {
+        return path.is_dir();
+    }
+    ["zarr.json", ".zgroup", ".zarray"]
+        .iter()
+        .any(|m| exists(&path.join(m)))
+}
+
+/// Start fetching the objects at `paths` ahead, many at once, in this order (local
+/// files are passed over).
+pub fn prefetch(paths: impl IntoIterator<Item = PathBuf>) {
+    let urls: Vec<String> = paths
+        .into_iter()
+        .filter_map(|p| url_of(&p).map(str::to_string))
+        .collect();
+    if !urls.is_empty() {
+        whole::prefetch(urls);
+    }
+}
+
+/// A file read by byte ranges: local, or remote.
+pub enum File {
+    /// A local file.
+    Local(Mutex<std::fs::File>, u64),
+    /// A remote object.
+    Remote(ranged::RemoteFile),
+}
+
+impl File {
+    /// Open `path` (a URL: one request for its first block).
+    pub fn open(path: &Path) -> Result<File, String> {
+        if let Some(url) = url_of(path) {
+            return ranged::RemoteFile::open(url).map(File::Remote);
+        }
+        let (f, len) = crate::input::open_regular(path).map_err(|e| e.to_string())?;
+        Ok(File::Local(Mutex::new(f), len))
+    }
+
+    /// Its length in bytes.
+    pub fn len(&self) -> u64 {
+        match self {
+            File::Local(_, len) => *len,
+            File::Remote(r) => r.size,
+        }
+    }
+
+    /// Whether it is empty.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Fill `buf` from byte `at`.
+    pub fn read_at(&self, at: u64, buf: &mut [u8]) -> std::io::Result<()> {
+        match self {
+            File::Local(f, _) => {
+                use std::os::unix::fs::FileExt;
+                let f = f.lock().unwrap_or_else(|e| e.into_inner());
+                f.read_exact_at(buf, at)
+            }
+            File::Remote(r) => r.read_at(at, buf).map_err(std::io::Error::other),
+        }
+    }
+
+    /// Fetch `ranges` ahead (a remote file; nothing for a local one).
+    pub fn prefetch(&self, ranges: &[Range<u64>]) -> Result<(), String> {
+        match self {
+            File::Local(..) => Ok(()),
+            File::Remote(r) => r.prefetch(ranges),
+        }
+    }
+
+    /// The remote object's ETag (a local file has none).
+    pub fn etag(&self) -> Option<&str> {
+        match self {
+            File::Local(..) => None,
+            File::Remote(r) => r.etag(),
+        }
+    }
+}
+
+/// A reader of a [`File`] from its start (for readers that want `Read + Seek`).
+pub struct Cursor<'f> {
+    file: &'f File,
+    at: u64,
+}
+
+impl<'f> Cursor<'f> {
+    /// At the start of `file`.
+    pub fn new(file: &'f File) -> Cursor<'f> {
+        Cursor { file, at: 0 }
+    }
+}
+
+impl std::io::Read for Cursor<'_> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = (self.file.len().saturating_sub(self.at)).min(buf.len() as u64) as usize;
+        self.file.read_at(self.at, &mut buf[..n])?;
+        self.at += n as u64;
+        Ok(n)
+    }
+}
+
+impl std::io::Seek for Cursor<'_> {
+    fn seek(&mut self, to: std::io::SeekFrom) -> std::io::Result<u64> {
+        use std::io::SeekFrom;
+        let at = match to {
+            SeekFrom::Start(a) => Some(a),
+            SeekFrom::End(d) => self.file.len().checked_add_signed(d),
+            SeekFrom::Current(d) => self.at.checked_add_signed(d),
+        };
+        self.at = at.ok_or_else(|| std::io::Error::other("a seek before the start"))?;
+        Ok(self.at)
+    }
+}
+
+/// The ETag this process has seen for the object at `path` (None for a local file).
+pub fn version(path: &Path) -> Option<String> {
+    url_of(path).and_then(known_etag)
+}
+
+/// ETags and sizes of the remote objects this process has read: an object seen with
+/// another ETag since is an object that changed while it was read.
+fn known() -> std::sync::MutexGuard<'static, HashMap<String, (String, u64)>> {
+    static KNOWN: OnceLock<Mutex<HashMap<String, (String, u64)>>> = OnceLock::new();
+    KNOWN
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+}
+
+fn known_etag(url: &str) -> Option<String> {
+    known().get(url).map(|(e, _)| e.clone())
+}
+
+fn learn_etag(url: &str, etag: &str, size: u64) -> Result<(), FetchError> {
+    let mut k = known();
+    match k.get(url) {
+        Some((e, s)) if e != etag || *s != size => Err(FetchError::Failed(format!(
+            "the object changed while it was read (ETag {e}, {s} bytes when first read; now ETag {etag}, {size} bytes); open it again"
+        ))),
+        Some(_) => Ok(()),
+        None => {
+            k.insert(url.to_string(), (etag.to_string(), size));
+            Ok(())
+        }
+    }
+}
+
+pub use count::{stats, status, Stats};
+
+/// One line on stderr of what this process fetched, if it fetched anything.
+pub fn print_stats() {
+    let s = stats();
+    if s.requests > 0 || s.from_disk > 0 {
+        eprintln!(
+            "fetched: {} request{}, {:.2} MB; {:.2} MB from the disk cache ({})",
+            s.requests,
+            if s.requests == 1 { "" } else { "s" },
+            s.bytes as f64 / 1e6,
+            s.from_disk as f64 / 1e6,
+            cache::global().map_or("off".into(), |c| c.dir().display().to_string())
+        );
+    }
+}
+
+/// Request counts.
+pub mod count {
+    use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
+
+    static REQUESTS: AtomicU64 = AtomicU64::new(0);
+    static BYTES: AtomicU64 = AtomicU64::new(0);
+    static FROM_DISK: AtomicU64 = AtomicU64::new(0);
+    static IN_FLIGHT: AtomicU64 = AtomicU64::new(0);
+
+    /// What this process has fetched.
+    #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+    pub struct Stats {
+        /// Requests sent (GET and HEAD, retries not counted).
+        pub requests: u64,
+        /// Body bytes received.
+        pub bytes: u64,
+        /// Bytes served by the disk cache.
+        pub from_disk: u64,
+        /// Requests in flight now.
+        pub in_flight: u64,
+    }
+
+    /// The counts so far.
+    pub fn stats() -> Stats {
+        Stats {
+            requests: REQUESTS.load(Relaxed),
+            bytes: BYTES.load(Relaxed),
+            from_disk: FROM_DISK.load(Relaxed),
+            in_flight: IN_FLIGHT.load(Relaxed),
+        }
+    }
+
+    /// What is loading, for a status line: `None` while nothing is in flight.
+    pub fn status() -> Option<String> {
+        let s = stats();
+        (s.in_flight > 0).then(|| {
+            format!(
+                "fetching: {} request{} in flight, {:.1} MB fetched",
+                s.in_flight,
+                if s.in_flight == 1 { "" } else { "s" },
+                s.bytes as f64 / 1e6
+            )
+        })
+    }
+
+    /// A request under way, until dropped.
+    pub struct Busy;
+
+    impl Drop for Busy {
+        fn drop(&mut self) {
+            IN_FLIGHT.fetch_sub(1, Relaxed);
+        }
+    }
+
+    pub(super) fn request() -> Busy {
+        REQUESTS.fetch_add(1, Relaxed);
+        IN_FLIGHT.fetch_add(1, Relaxed);
+        Busy
+    }
+
+    pub(super) fn fetched(n: usize) {
+        BYTES.fetch_add(n as u64, Relaxed);
+    }
+
+    pub(super) fn from_disk(n: usize) {
+        FROM_DISK.fetch_add(n as u64, Relaxed);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_sorted_into_urls_and_paths() {
+        assert_eq!(url_of(Path::new("s3://b/k")), Some("s3://b/k"));
+        assert_eq!(
+            url_of(&Path::new("https://h:8/a").join("zarr.json")),
+            Some("https://h:8/a/zarr.json")
+        );
+        assert_eq!(url_of(Path::new("data/x.copc.laz")), None);
+        assert_eq!(url_of(Path::new("file:///tmp/x")), None);
+        assert_eq!(
+            local_or_url(Path::new("file:///tmp/a%20b")),
+            Path::new("/tmp/a b")
+        );
+        assert_eq!(
+            local_or_url(Path::new("file://localhost/t")),
+            Path::new("/t")
+        );
+        assert_eq!(
+            resolve(Path::new("scenes"), Path::new("s3://b/k")),
+            Path::new("s3://b/k")
+        );
+        assert_eq!(
+            resolve(Path::new("scenes"), Path::new("a")),
+            Path::new("scenes/a")
+        );
+        assert_eq!(percent_decode("%4"), "%4");
+        assert_eq!(percent_decode("%41%zz"), "A%zz");
+    }
+}

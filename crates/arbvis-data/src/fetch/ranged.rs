@@ -1,0 +1,314 @@
+//! A remote file read a range at a time (a COPC cloud): small reads (headers, VLRs,
+//! hierarchy pages) in aligned 64 KiB blocks, so the header and VLRs cost one request;
+//! a view's nodes fetched ahead together ([`RemoteFile::prefetch`]), ranges closer than
+//! 32 KiB merged into one request, many requests in flight. Every request after the
+//! first carries the ETag the file had when it was opened (`If-Match`), and every answer's
+//! ETag and size are checked against it: a file that changes while it is read is an
+//! error naming it, never a cloud of two versions. Ranges are kept in memory (up to
+//! 256 MiB) and on disk ([`super::cache`]), keyed by the ETag.
+
+use std::collections::BTreeMap;
+use std::ops::Range;
+use std::sync::{Arc, Mutex};
+
+use futures::StreamExt;
+use object_store::{GetOptions, GetRange};
+
+use super::client::{self, Object};
+use super::count;
+
+/// Small reads are rounded out to blocks of this size.
+pub const BLOCK: u64 = 64 << 10;
+
+/// Requested ranges closer than this are fetched as one.
+pub const MERGE_GAP: u64 = 32 << 10;
+
+/// A merged request is not grown past this.
+const MERGE_MAX: u64 = 16 << 20;
+
+const MEMORY_BYTES: u64 = 256 << 20;
+
+/// A fetched range and its bytes.
+type Span = (Range<u64>, Arc<Vec<u8>>);
+
+/// An open remote file.
+pub struct RemoteFile {
+    object: Object,
+    /// Its size.
+    pub size: u64,
+    /// Its ETag when opened (None where the server gives none: then nothing is cached).
+    etag: Option<String>,
+    /// Ranges held, by start: (end, bytes).
+    held: Mutex<Held>,
+}
+
+#[derive(Default)]
+struct Held {
+    ranges: BTreeMap<u64, (u64, Arc<Vec<u8>>)>,
+    bytes: u64,
+}
+
+impl Held {
+    fn find(&self, r: &Range<u64>) -> Option<Vec<u8>> {
+        let (start, (end, data)) = self.ranges.range(..=r.start).next_back()?;
+        (*end >= r.end).then(|| data[(r.start - start) as usize..(r.end - start) as usize].to_vec())
+    }
+    fn keep(&mut self, start: u64, data: Arc<Vec<u8>>) {
+        let end = start + data.len() as u64;
+        if self.ranges.get(&start).is_some_and(|(e, _)| *e >= end) {
+            return;
+        }
+        self.bytes += data.len() as u64;
+        if let Some((_, old)) = self.ranges.insert(start, (end, data)) {
+            self.bytes -= old.len() as u64;
+        }
+        // Past the budget: drop the ranges furthest into the file (the coarse levels and
+        // the header come first in a COPC file's reads).
+        while self.bytes > MEMORY_BYTES {
+            let Some((_, (_, d))) = self.ranges.pop_last() else {
+                break;
+            };
+            self.bytes -= d.len() as u64;
+        }
+    }
+}
+
+impl RemoteFile {
+    /// Open `url`: one request for its first block (or none, when the block on disk is
+    /// still the object's: then one `If-None-Match` request answered 304).
+    pub fn open(url: &str) -> Result<RemoteFile, String> {
+        let object = client::object(url)?;
+        let first = 0..BLOCK;
+        let disk = super::cache::global().and_then(|c| c.get(url, &first));
+        let options = GetOptions {
+            range: Some(GetRange::Bounded(first.clone())),
+            if_none_match: disk.as_ref().map(|e| e.etag.clone()),
+            ..Default::default()
+        };
+        let _busy = count::request();
+        let got = client::runtime().block_on(object.store.get_opts(&object.path, options));
+        let (size, etag, bytes) = match got {
+            Err(object_store::Error::NotModified { .. }) if disk.is_some() => {
+                let e = disk.expect("checked");
+                count::from_disk(e.bytes.len());
+                (e.size, Some(e.etag), e.bytes)
+            }
+            Err(e) => return Err(client::describe(&object, Some(&first), &e)),
+            Ok(got) => {
+                let size = got.meta.size;
+                let etag = got.meta.e_tag.clone();
+                let range = got.range.clone();
+                let bytes = client::runtime()
+                    .block_on(got.bytes())
+                    .map_err(|e| client::describe(&object, Some(&first), &e))?;
+                check_length(&range, bytes.len())?;
+                count::fetched(bytes.len());
+                let bytes = bytes.to_vec();
+                if let (Some(c), Some(t)) = (super::cache::global(), &etag) {
+                    c.put(url, &first, t, size, &bytes);
+                }
+                (size, etag, bytes)
+            }
+        };
+        if let Some(t) = &etag {
+            super::learn_etag(url, t, size).map_err(|e| e.to_string())?;
+        }
+        let file = RemoteFile {
+            object,
+            size,
+            etag,
+            held: Mutex::new(Held::default()),
+        };
+        file.held().keep(0, Arc::new(bytes));
+        Ok(file)
+    }
+
+    /// The ETag the file had when opened.
+    pub fn etag(&self) -> Option<&str> {
+        self.etag.as_deref()
+    }
+
+    fn held(&self) -> std::sync::MutexGuard<'_, Held> {
+        self.held.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Fill `buf` from byte `at`.
+    pub fn read_at(&self, at: u64, buf: &mut [u8]) -> Result<(), String> {
+        let want = at..at + buf.len() as u64;
+        if want.end > self.size {
+            return Err(format!(
+                "bytes {}-{}: past the end of its {} bytes",
+                want.start,
+                want.end.saturating_sub(1),
+                self.size
+            ));
+        }
+        if let Some(data) = self.held().find(&want) {
+            buf.copy_from_slice(&data);
+            return Ok(());
+        }
+        let fetch = if want.end - want.start <= BLOCK {
+            (want.start / BLOCK * BLOCK)..(want.end.div_ceil(BLOCK) * BLOCK).min(self.size)
+        } else {
+            want.clone()
+        };
+        self.prefetch(std::slice::from_ref(&fetch))?;
+        let data = self.held().find(&want).ok_or_else(|| {
+            format!(
+                "bytes {}-{}: not held after their fetch (the memory budget of remote ranges is too small)",
+                want.start,
+                want.end - 1
+            )
+        })?;
+        buf.copy_from_slice(&data);
+        Ok(())
+    }
+
+    /// Fetch `ranges` ahead (from the disk cache where it holds them, else merged where
+    /// close, many at once), so that reading them waits for nothing; the first error is
+    /// returned, naming its range.
+    pub fn prefetch(&self, ranges: &[Range<u64>]) -> Result<(), String> {
+        let mut wanted: Vec<Range<u64>> = {
+            let held = self.held();
+            ranges
+                .iter()
+                .filter(|r| r.start < r.end && r.end <= self.size && held.find(r).is_none())
+                .cloned()
+                .collect()
+        };
+        // From disk first.
+        if let (Some(c), Some(etag)) = (super::cache::global(), &self.etag) {
+            wanted.retain(|r| match c.get(&self.object.url, r) {
+                Some(e) if &e.etag == etag && e.bytes.len() as u64 == r.end - r.start => {
+                    count::from_disk(e.bytes.len());
+                    self.held().keep(r.start, Arc::new(e.bytes));
+                    false
+                }
+                _ => true,
+            });
+        }
+        if wanted.is_empty() {
+            return Ok(());
+        }
+        let merged = merge(&wanted);
+        let limit = client::in_flight();
+        let fetched: Vec<Result<Span, String>> = client::runtime().block_on(async {
+            futures::stream::iter(merged)
+                .map(|(span, _)| async move {
+                    let data = self.range(span.clone()).await?;
+                    Ok((span, data))
+                })
+                .buffer_unordered(limit)
+                .collect()
+                .await
+        });
+        let mut spans = Vec::new();
+        for f in fetched {
+            spans.push(f?);
+        }
+        // Each requested range kept (and cached) on its own: the next view asks for the
+        // same nodes, merged otherwise.
+        for r in &wanted {
+            let Some((span, data)) = spans
+                .iter()
+                .find(|(s, _)| s.start <= r.start && r.end <= s.end)
+            else {
+                continue;
+            };
+            let part =
+                data[(r.start - span.start) as usize..(r.end - span.start) as usize].to_vec();
+            if let (Some(c), Some(etag)) = (super::cache::global(), &self.etag) {
+                c.put(&self.object.url, r, etag, self.size, &part);
+            }
+            self.held().keep(r.start, Arc::new(part));
+        }
+        Ok(())
+    }
+
+    /// One range GET, pinned to the ETag the file was opened with.
+    async fn range(&self, r: Range<u64>) -> Result<Arc<Vec<u8>>, String> {
+        let options = GetOptions {
+            range: Some(GetRange::Bounded(r.clone())),
+            if_match: self.etag.clone(),
+            ..Default::default()
+        };
+        let describe = |e: &object_store::Error| client::describe(&self.object, Some(&r), e);
+        let _busy = count::request();
+        let got = self
+            .object
+            .store
+            .get_opts(&self.object.path, options)
+            .await
+            .map_err(|e| describe(&e))?;
+        if got.meta.size != self.size || (self.etag.is_some() && got.meta.e_tag != self.etag) {
+            return Err(format!(
+                "bytes {}-{}: the object changed while it was read (it had {} bytes and ETag {}; now {} bytes and ETag {}); open it again",
+                r.start,
+                r.end - 1,
+                self.size,
+                self.etag.as_deref().unwrap_or("none"),
+                got.meta.size,
+                got.meta.e_tag.as_deref().unwrap_or("none"),
+            ));
+        }
+        let range = got.range.clone();
+        let bytes = got.bytes().await.map_err(|e| describe(&e))?;
+        check_length(&range, bytes.len())?;
+        count::fetched(bytes.len());
+        Ok(Arc::new(bytes.to_vec()))
+    }
+}
+
+/// The body must hold the range the server said it sends.
+fn check_length(range: &Range<u64>, got: usize) -> Result<(), String> {
+    let want = range.end - range.start;
+    if got as u64 != want {
+        return Err(format!(
+            "bytes {}-{}: the body held {got} bytes, not the range's {want}",
+            range.start,
+            range.end.saturating_sub(1)
+        ));
+    }
+    Ok(())
+}
+
+/// `ranges` sorted and merged where closer than [`MERGE_GAP`] (up to [`MERGE_MAX`] a
+/// request): each merged span with how many ranges it serves.
+pub fn merge(ranges: &[Range<u64>]) -> Vec<(Range<u64>, usize)> {
+    let mut sorted = ranges.to_vec();
+    sorted.sort_by_key(|r| r.start);
+    let mut out: Vec<(Range<u64>, usize)> = Vec::new();
+    for r in sorted {
+        match out.last_mut() {
+            Some((span, n))
+                if r.start <= span.end + MERGE_GAP
+                    && r.end.max(span.end) - span.start <= MERGE_MAX =>
+            {
+                span.end = span.end.max(r.end);
+                *n += 1;
+            }
+            _ => out.push((r, 1)),
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn close_ranges_merge_far_ones_do_not() {
+        let m = merge(&[1000..2000, 0..100, 2000..3000, 10_000_000..10_000_010]);
+        assert_eq!(m, vec![(0..3000, 3), (10_000_000..10_000_010, 1)]);
+        // A gap of exactly MERGE_GAP merges; one byte more does not.
+        assert_eq!(merge(&[0..10, 10 + MERGE_GAP..20 + MERGE_GAP]).len(), 1);
+        assert_eq!(merge(&[0..10, 11 + MERGE_GAP..20 + MERGE_GAP]).len(), 2);
+        // A span stops growing at MERGE_MAX.
+        let many: Vec<_> = (0..40u64).map(|i| i << 20..(i << 20) + 1000).collect();
+        assert!(merge(&many)
+            .iter()
+            .all(|(s, _)| s.end - s.start <= MERGE_MAX));
+        assert_eq!(merge(&many).iter().map(|(_, n)| n).sum::<usize>(), 40);
+    }
+}
