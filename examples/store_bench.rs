@@ -12,6 +12,9 @@
 //!   count and fidelity, interleaved; a picture of the survey.
 //!   `precise`: the one-pass ray caster through the page table (the demo then ray casts
 //!   too, without jitter, as the page table's ray caster does).
+//! - `first STORE WxH`: open to first picture (the viewer's path: streaming, the coarsest
+//!   level standing in until finer bricks arrive) and on to the full-quality picture, with
+//!   what a remote store (`STORE` a URL) fetched by each: `benches/remote/run.sh`.
 //! - `error STORE N`: on a window of N³ voxels at the survey's centre, the f64 reference
 //!   integral of the full-resolution data against each LOD policy (RMSE and max, RGB),
 //!   faithful and precise.
@@ -40,7 +43,8 @@ fn main() -> Result<()> {
         Some("view") if args.len() == 3 => view(&args[1], &args[2], false),
         Some("view") if args.len() == 4 && args[3] == "precise" => view(&args[1], &args[2], true),
         Some("error") if args.len() == 3 => error(&args[1], args[2].parse()?),
-        _ => bail!("usage: store_bench generate OUT.sgy NS NX NI | view STORE WxH [precise] | error STORE N"),
+        Some("first") if args.len() == 3 => first(&args[1], &args[2]),
+        _ => bail!("usage: store_bench generate OUT.sgy NS NX NI | view STORE WxH [precise] | error STORE N | first STORE WxH"),
     }
 }
 
@@ -230,6 +234,53 @@ fn turned(scene: &Scene, degrees: f64) -> arbvis::camera::Camera {
     let q = glam::DQuat::from_rotation_y(degrees.to_radians()) * c.quat();
     c.rotation = q.to_array();
     c
+}
+
+fn first(store: &str, size: &str) -> Result<()> {
+    let size = parse_size(size)?;
+    let h = Headless::new(Backend::Egl)?;
+    let gpu = h.gpu();
+    let scene = store_scene(store, size, "gpu_memory = \"512M\"")?;
+    let target = Target::create(gpu, size[0], size[1], scene.target_format(), false)?;
+    let frame = Frame {
+        camera: scene.camera,
+        width: size[0],
+        height: size[1],
+    };
+    let t0 = Instant::now();
+    let mut r = arbvis::render::build(gpu, &scene, scene.programs.resolve(gpu))?;
+    r.set_streaming(true);
+    let mut first = None;
+    for frames in 1.. {
+        target.clear(gpu, scene.clear_colour())?;
+        r.draw(gpu, Surface::Target(&target), &frame)?;
+        gpu.finish();
+        let status = r.status().unwrap_or_default();
+        let f = arbvis::fetch::stats();
+        if first.is_none() && !status.contains("; 0 drawn") {
+            first = Some(());
+            println!(
+                "first picture: {:.3} s, {frames} frames; {status}; fetched {} requests, {} bytes",
+                t0.elapsed().as_secs_f64(),
+                f.requests,
+                f.bytes
+            );
+        }
+        if first.is_some() && !status.contains("loading") {
+            println!(
+                "full picture: {:.3} s, {frames} frames; {status}; fetched {} requests, {} bytes",
+                t0.elapsed().as_secs_f64(),
+                f.requests,
+                f.bytes
+            );
+            break;
+        }
+        if t0.elapsed().as_secs() > 600 {
+            bail!("no full picture in 10 minutes: {status}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    }
+    Ok(())
 }
 
 fn view(store: &str, size: &str, precise: bool) -> Result<()> {

@@ -32,6 +32,7 @@ from ._arbvis import (  # noqa: F401
     diff_image,
     info,
     inspect,
+    fetch_stats,
     read_png,
     write_png,
 )
@@ -50,6 +51,7 @@ __all__ = [
     "diff_image",
     "info",
     "inspect",
+    "fetch_stats",
     "read_png",
     "write_png",
     "__version__",

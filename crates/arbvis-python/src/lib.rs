@@ -49,6 +49,7 @@ fn _arbvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(tools::inspect, m)?)?;
     m.add_function(wrap_pyfunction!(tools::convert, m)?)?;
+    m.add_function(wrap_pyfunction!(tools::fetch_stats, m)?)?;
     m.add_function(wrap_pyfunction!(images::read_png, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_png, m)?)?;
     m.add_function(wrap_pyfunction!(images::compare, m)?)?;

@@ -46,6 +46,22 @@ pub fn inspect(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyDict>> {
     Ok(out)
 }
 
+/// What this process has fetched from remote stores and clouds (`s3://`, `http(s)://`):
+/// `requests` sent, `bytes` received, `from_disk` (bytes the disk cache served),
+/// `in_flight` (requests under way now) and `loading` (a status line while any are in
+/// flight, else None).
+#[pyfunction]
+pub fn fetch_stats(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let s = arbvis_data::fetch::stats();
+    let out = PyDict::new(py);
+    out.set_item("requests", s.requests)?;
+    out.set_item("bytes", s.bytes)?;
+    out.set_item("from_disk", s.from_disk)?;
+    out.set_item("in_flight", s.in_flight)?;
+    out.set_item("loading", arbvis_data::fetch::status())?;
+    Ok(out)
+}
+
 /// Convert the survey `src` (SEG-Y, or an MDIO dataset) into the store `dst` (or resume
 /// an interrupted conversion there), as `arbvis convert` does: bricks of `brick` voxels,
 /// the derived `attributes`, `compression` (`lz4`, `zstd`, `zstd:LEVEL`, `none`).

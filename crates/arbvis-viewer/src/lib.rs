@@ -24,7 +24,7 @@
 #[allow(unused_imports)]
 use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, vocab};
 #[allow(unused_imports)]
-use arbvis_data::{mesh, points, store, surface, volume};
+use arbvis_data::{fetch, mesh, points, store, surface, volume};
 use arbvis_gl as gl;
 #[allow(unused_imports)]
 use arbvis_techniques::{

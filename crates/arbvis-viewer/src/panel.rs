@@ -287,6 +287,13 @@ fn controls(
         // The renderer's own lines (a COPC cut, its node cache), recorded for scripts.
         w.status_text(ui, "Renderer", &state.volume_info);
     }
+    // A remote store's or cloud's requests in flight (the loader threads fetch; the
+    // frames go on): redrawn while they last, so the line follows them.
+    if let Some(loading) = crate::fetch::status() {
+        w.status_text(ui, "Loading", &loading);
+        ui.ctx()
+            .request_repaint_after(std::time::Duration::from_millis(200));
+    }
 }
 
 /// The program kind (ARB where the driver has it) and the fidelity.

@@ -9,14 +9,20 @@
 //! - [`cache`]: the disk cache shared by every process of the user.
 //!
 //! A URL travels in a `Path` (`Path::new("s3://b/store").join("zarr.json")` is the URL of
-//! the store's `zarr.json`), so every error that names a file names the URL, and the
-//! readers above tell the two apart only here. Request counts are kept ([`stats`]) for
-//! the tests, `--stats` and the viewer's status line.
+//! the store's `zarr.json`), so every error that names a file names the URL. The readers
+//! above read through this module alike; they ask [`url_of`] only to fetch ahead, or to
+//! pass over what a URL has not (a listing, a modification time). Request counts are
+//! kept ([`stats`]) for the tests, `--stats` and the viewer's status line.
 
 pub mod cache;
 pub mod client;
+pub mod count;
+mod file;
 pub mod ranged;
 mod whole;
+
+pub use count::{stats, status, Stats};
+pub use file::{Cursor, File};
 
 use std::collections::HashMap;
 use std::ops::Range;
@@ -109,10 +115,15 @@ fn percent_decode(s: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-/// The most bytes a prefetched object may hold (a store's largest chunk).
+/// The most bytes a prefetched object may hold: twice a store's largest decoded chunk (1
+/// GiB, `store::zarr::MAX_CHUNK_BYTES`); the reader then holds it to its own bound.
 fn zarr_max() -> u64 {
-    crate::store::zarr::MAX_CHUNK_BYTES * 2
+    2 << 30
 }
+
+/// The most bytes of an object `exists` fetches whole to answer (a zarr metadata file:
+/// `store::zarr::MAX_METADATA_BYTES`).
+const METADATA_MAX: u64 = 16 << 20;
 
 /// The object or file at `path`, at most `max` bytes; `None` where it is absent (a
 /// missing file, a 404). A local one must be a regular file.
@@ -170,10 +181,7 @@ pub fn exists(path: &Path) -> bool {
     let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
     let metadata = name == "zarr.json" || name.starts_with(".z");
     if metadata {
-        return matches!(
-            read_object(path, crate::store::zarr::MAX_METADATA_BYTES),
-            Ok(Some(_))
-        );
+        return matches!(read_object(path, METADATA_MAX), Ok(Some(_)));
     }
     let Ok(object) = client::object(url) else {
         return false;
@@ -200,107 +208,22 @@ pub fn is_folder(path: &Path) -> bool {
 /// Start fetching the objects at `paths` ahead, many at once, in this order (local
 /// files are passed over).
 pub fn prefetch(paths: impl IntoIterator<Item = PathBuf>) {
-    let urls: Vec<String> = paths
+    prefetch_in_stages(vec![paths.into_iter().collect()]);
+}
+
+/// [`prefetch`] a stage at a time: a stage's objects start once the stage before is in.
+pub fn prefetch_in_stages(stages: Vec<Vec<PathBuf>>) {
+    let stages: Vec<Vec<String>> = stages
         .into_iter()
-        .filter_map(|p| url_of(&p).map(str::to_string))
+        .map(|s| {
+            s.iter()
+                .filter_map(|p| url_of(p).map(str::to_string))
+                .collect()
+        })
+        .filter(|s: &Vec<String>| !s.is_empty())
         .collect();
-    if !urls.is_empty() {
-        whole::prefetch(urls);
-    }
-}
-
-/// A file read by byte ranges: local, or remote.
-pub enum File {
-    /// A local file.
-    Local(Mutex<std::fs::File>, u64),
-    /// A remote object.
-    Remote(ranged::RemoteFile),
-}
-
-impl File {
-    /// Open `path` (a URL: one request for its first block).
-    pub fn open(path: &Path) -> Result<File, String> {
-        if let Some(url) = url_of(path) {
-            return ranged::RemoteFile::open(url).map(File::Remote);
-        }
-        let (f, len) = crate::input::open_regular(path).map_err(|e| e.to_string())?;
-        Ok(File::Local(Mutex::new(f), len))
-    }
-
-    /// Its length in bytes.
-    pub fn len(&self) -> u64 {
-        match self {
-            File::Local(_, len) => *len,
-            File::Remote(r) => r.size,
-        }
-    }
-
-    /// Whether it is empty.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Fill `buf` from byte `at`.
-    pub fn read_at(&self, at: u64, buf: &mut [u8]) -> std::io::Result<()> {
-        match self {
-            File::Local(f, _) => {
-                use std::os::unix::fs::FileExt;
-                let f = f.lock().unwrap_or_else(|e| e.into_inner());
-                f.read_exact_at(buf, at)
-            }
-            File::Remote(r) => r.read_at(at, buf).map_err(std::io::Error::other),
-        }
-    }
-
-    /// Fetch `ranges` ahead (a remote file; nothing for a local one).
-    pub fn prefetch(&self, ranges: &[Range<u64>]) -> Result<(), String> {
-        match self {
-            File::Local(..) => Ok(()),
-            File::Remote(r) => r.prefetch(ranges),
-        }
-    }
-
-    /// The remote object's ETag (a local file has none).
-    pub fn etag(&self) -> Option<&str> {
-        match self {
-            File::Local(..) => None,
-            File::Remote(r) => r.etag(),
-        }
-    }
-}
-
-/// A reader of a [`File`] from its start (for readers that want `Read + Seek`).
-pub struct Cursor<'f> {
-    file: &'f File,
-    at: u64,
-}
-
-impl<'f> Cursor<'f> {
-    /// At the start of `file`.
-    pub fn new(file: &'f File) -> Cursor<'f> {
-        Cursor { file, at: 0 }
-    }
-}
-
-impl std::io::Read for Cursor<'_> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        let n = (self.file.len().saturating_sub(self.at)).min(buf.len() as u64) as usize;
-        self.file.read_at(self.at, &mut buf[..n])?;
-        self.at += n as u64;
-        Ok(n)
-    }
-}
-
-impl std::io::Seek for Cursor<'_> {
-    fn seek(&mut self, to: std::io::SeekFrom) -> std::io::Result<u64> {
-        use std::io::SeekFrom;
-        let at = match to {
-            SeekFrom::Start(a) => Some(a),
-            SeekFrom::End(d) => self.file.len().checked_add_signed(d),
-            SeekFrom::Current(d) => self.at.checked_add_signed(d),
-        };
-        self.at = at.ok_or_else(|| std::io::Error::other("a seek before the start"))?;
-        Ok(self.at)
+    if !stages.is_empty() {
+        whole::prefetch(stages);
     }
 }
 
@@ -337,8 +260,6 @@ fn learn_etag(url: &str, etag: &str, size: u64) -> Result<(), FetchError> {
     }
 }
 
-pub use count::{stats, status, Stats};
-
 /// One line on stderr of what this process fetched, if it fetched anything.
 pub fn print_stats() {
     let s = stats();
@@ -351,75 +272,6 @@ pub fn print_stats() {
             s.from_disk as f64 / 1e6,
             cache::global().map_or("off".into(), |c| c.dir().display().to_string())
         );
-    }
-}
-
-/// Request counts.
-pub mod count {
-    use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
-
-    static REQUESTS: AtomicU64 = AtomicU64::new(0);
-    static BYTES: AtomicU64 = AtomicU64::new(0);
-    static FROM_DISK: AtomicU64 = AtomicU64::new(0);
-    static IN_FLIGHT: AtomicU64 = AtomicU64::new(0);
-
-    /// What this process has fetched.
-    #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-    pub struct Stats {
-        /// Requests sent (GET and HEAD, retries not counted).
-        pub requests: u64,
-        /// Body bytes received.
-        pub bytes: u64,
-        /// Bytes served by the disk cache.
-        pub from_disk: u64,
-        /// Requests in flight now.
-        pub in_flight: u64,
-    }
-
-    /// The counts so far.
-    pub fn stats() -> Stats {
-        Stats {
-            requests: REQUESTS.load(Relaxed),
-            bytes: BYTES.load(Relaxed),
-            from_disk: FROM_DISK.load(Relaxed),
-            in_flight: IN_FLIGHT.load(Relaxed),
-        }
-    }
-
-    /// What is loading, for a status line: `None` while nothing is in flight.
-    pub fn status() -> Option<String> {
-        let s = stats();
-        (s.in_flight > 0).then(|| {
-            format!(
-                "fetching: {} request{} in flight, {:.1} MB fetched",
-                s.in_flight,
-                if s.in_flight == 1 { "" } else { "s" },
-                s.bytes as f64 / 1e6
-            )
-        })
-    }
-
-    /// A request under way, until dropped.
-    pub struct Busy;
-
-    impl Drop for Busy {
-        fn drop(&mut self) {
-            IN_FLIGHT.fetch_sub(1, Relaxed);
-        }
-    }
-
-    pub(super) fn request() -> Busy {
-        REQUESTS.fetch_add(1, Relaxed);
-        IN_FLIGHT.fetch_add(1, Relaxed);
-        Busy
-    }
-
-    pub(super) fn fetched(n: usize) {
-        BYTES.fetch_add(n as u64, Relaxed);
-    }
-
-    pub(super) fn from_disk(n: usize) {
-        FROM_DISK.fetch_add(n as u64, Relaxed);
     }
 }
 

@@ -94,17 +94,25 @@ pub fn read(url: &str, max: u64) -> Outcome {
     outcome
 }
 
-/// Start fetching `urls` (in this order, many at a time) without waiting.
-pub fn prefetch(urls: Vec<String>) {
-    let mut started = Vec::new();
+/// Start fetching `stages` without waiting: each stage's objects many at a time, in
+/// order, and a stage only once the one before it is in (the coarse levels of a view
+/// before the finer ones).
+pub fn prefetch(stages: Vec<Vec<String>>) {
+    let mut started: Vec<Vec<String>> = Vec::new();
     {
         let mut m = memory();
-        for url in urls {
-            if m.objects.contains_key(&url) || m.pending.contains_key(&url) {
-                continue;
+        for stage in stages {
+            let mut urls = Vec::new();
+            for url in stage {
+                if m.objects.contains_key(&url) || m.pending.contains_key(&url) {
+                    continue;
+                }
+                m.pending.insert(url.clone(), Arc::new(Slot::default()));
+                urls.push(url);
             }
-            m.pending.insert(url.clone(), Arc::new(Slot::default()));
-            started.push(url);
+            if !urls.is_empty() {
+                started.push(urls);
+            }
         }
     }
     if started.is_empty() {
@@ -112,18 +120,29 @@ pub fn prefetch(urls: Vec<String>) {
     }
     let limit = client::in_flight();
     client::runtime().spawn(async move {
-        futures::stream::iter(started)
-            .map(|url| async move {
-                let outcome = match client::object(&url) {
-                    Ok(object) => fetch(object, super::zarr_max()).await,
-                    Err(e) => Err(FetchError::Failed(e)),
-                };
-                finish(&url, &outcome);
-            })
-            .buffered(limit)
-            .for_each(|_| async {})
-            .await;
+        for stage in started {
+            futures::stream::iter(stage)
+                .map(|url| async move {
+                    // One queue for every prefetch, first come first served: the bricks
+                    // a loader reads next go before those it reads later.
+                    let _permit = permits().acquire().await;
+                    let outcome = match client::object(&url) {
+                        Ok(object) => fetch(object, super::zarr_max()).await,
+                        Err(e) => Err(FetchError::Failed(e)),
+                    };
+                    finish(&url, &outcome);
+                })
+                .buffered(limit)
+                .for_each(|_| async {})
+                .await;
+        }
     });
+}
+
+/// The prefetches' requests in flight, at most [`client::in_flight`] of them together.
+fn permits() -> &'static tokio::sync::Semaphore {
+    static PERMITS: OnceLock<tokio::sync::Semaphore> = OnceLock::new();
+    PERMITS.get_or_init(|| tokio::sync::Semaphore::new(client::in_flight()))
 }
 
 /// Hand `outcome` to whoever waits for `url`, and keep it.

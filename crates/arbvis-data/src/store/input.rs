@@ -64,6 +64,7 @@ impl Input {
         raw: Option<&RawSpec>,
         segy_keys: crate::volume::segy::KeyBytes,
     ) -> Result<Input, StoreError> {
+        let path = &crate::fetch::local_or_url(path);
         if crate::fetch::is_folder(path) && raw.is_none() {
             let Some(flavour) = super::mdio::flavour(path)? else {
                 if !crate::fetch::exists(&path.join("zarr.json")) {

@@ -82,6 +82,7 @@ pub const CHUNK_CACHE: usize = 64;
 impl Store {
     /// Open the store at `path`: its description and every array checked.
     pub fn open(path: &Path) -> Result<Store, StoreError> {
+        let path = &crate::fetch::local_or_url(path);
         if !crate::fetch::is_folder(path) {
             let why = if crate::fetch::exists(path) {
                 "not a folder: a store is a folder (make one with `arbvis convert SURVEY STORE`)"
@@ -208,8 +209,9 @@ impl Store {
     }
 
     /// Start fetching ahead what bricks `bricks` (attribute, level, brick) and their
-    /// borders read, when the store is remote (nothing for a local one): the coarsest
-    /// levels first, many requests at once.
+    /// borders read, when the store is remote (nothing for a local one): a level at a
+    /// time, the coarsest first (a first picture's bricks do not share the link with the
+    /// finer ones), many requests at once.
     pub fn prefetch(&self, bricks: &[(usize, usize, [usize; 3])]) {
         if crate::fetch::url_of(&self.path).is_none() {
             return;
@@ -217,15 +219,21 @@ impl Store {
         let mut order: Vec<_> = bricks.to_vec();
         order.sort_by_key(|b| std::cmp::Reverse(b.1));
         let mut seen = std::collections::HashSet::new();
-        let mut files = Vec::new();
-        for (attr, level, c) in order {
-            for file in self.brick_files(attr, level, c) {
+        let mut stages: Vec<Vec<PathBuf>> = Vec::new();
+        let mut level = usize::MAX;
+        for (attr, l, c) in order {
+            if l != level {
+                stages.push(Vec::new());
+                level = l;
+            }
+            let stage = stages.last_mut().expect("a stage per level");
+            for file in self.brick_files(attr, l, c) {
                 if seen.insert(file.clone()) {
-                    files.push(file);
+                    stage.push(file);
                 }
             }
         }
-        crate::fetch::prefetch(files);
+        crate::fetch::prefetch_in_stages(stages);
     }
 
     /// The chunk files brick `c` of `attr` at `level` reads, its border included: its
