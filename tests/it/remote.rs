@@ -302,7 +302,8 @@ fn inspect_with_fault(
 /// survived; a stalled server, a refusal (403), a server ignoring `Range`, a short body
 /// and a file that changes while it is read are errors naming the URL (and the byte
 /// range or the variables to set), within seconds. No fault leaves a wrong entry in the
-/// cache: a clean inspect afterwards says what the first one said.
+/// cache: a clean inspect afterwards says what the first one said. A node's range that
+/// fails is an error naming the node.
 #[test]
 fn faults_are_retried_or_named_never_waited_on() {
     let dir = temp_dir("remote-faults");
@@ -349,6 +350,25 @@ fn faults_are_retried_or_named_never_waited_on() {
     }
     let after = inspect_with_fault(&server, &cache, "none", 0, 0).0;
     assert_eq!(after.stdout, clean.stdout);
+    // A node whose range is refused, once the header and hierarchy are read: the error
+    // names the node and the URL.
+    server.control("_fault?mode=status:403&count=0&skip=2");
+    let scene = copc_scene(&dir, "remote.toml", &url);
+    let out = arbvis(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            dir.join("x.png").to_str().unwrap(),
+        ],
+        &dir.join("cache-nodes"),
+        &[],
+    );
+    let e = stderr(&out);
+    assert!(!out.status.success(), "a refused node drew a picture");
+    for s in [url.as_str(), "node [", "points,", "403"] {
+        assert!(e.contains(s), "{s:?} unsaid: {e}");
+    }
 }
 
 /// A store's chunk absent on the server (404) is what an absent file is: here a chunk
