@@ -69,28 +69,12 @@ fn store_fixture(name: &str) -> PathBuf {
     dir
 }
 
-/// A 3D-opacity scene of the store `store` (a path or URL) at 64².
+/// The store tests' scene (amplitude and envelope) of the store `store` (a path or URL)
+/// at 64², written to `dir/name`.
 fn store_scene(dir: &Path, name: &str, store: &str) -> PathBuf {
-    let text = format!(
-        r#"size = [64, 64]
-background = [0.0, 0.0, 0.0, 1.0]
-[camera]
-rotation = [0.2241, -0.3696, 0.0747, 0.8986]
-[technique.opacity3d]
-slices = 60
-[technique.opacity3d.primary]
-volume = {{ store = "{store}" }}
-attribute = "amplitude"
-table = {{ builtin = "seismic", alpha = [[0.0, 0.6], [0.4, 0.0], [0.6, 0.0], [1.0, 0.6]] }}
-[technique.opacity3d.secondary]
-volume = {{ store = "{store}" }}
-attribute = "envelope"
-table = {{ builtin = "viridis", alpha = [[0.0, 0.0], [0.5, 0.05], [1.0, 0.4]] }}
-coefficients = [0.8, 0.8, 0.8, 0.8]
-"#
-    );
+    let volume = format!("{{ store = \"{store}\" }}");
     let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
+    std::fs::write(&path, crate::store::store_scene_text(&volume, "", 64)).unwrap();
     path
 }
 

@@ -322,7 +322,14 @@ fn an_interrupted_conversion_resumes_to_the_same_store() {
 
 /// A store scene: amplitude (seismic table, transparent mid-range) and envelope.
 fn store_scene(dir: &Path, volume: &str, extra: &str, size: u32) -> Scene {
-    let text = format!(
+    let mut scene = Scene::parse(&store_scene_text(volume, extra, size), "test").unwrap();
+    scene.base = dir.to_path_buf();
+    scene
+}
+
+/// [`store_scene`]'s text: both attributes from `volume` (`{ store = "..." }`, ...).
+pub(crate) fn store_scene_text(volume: &str, extra: &str, size: u32) -> String {
+    format!(
         r#"size = [{size}, {size}]
 background = [0.0, 0.0, 0.0, 1.0]
 [camera]
@@ -339,10 +346,7 @@ attribute = "envelope"
 table = {{ builtin = "viridis", alpha = [[0.0, 0.0], [0.5, 0.05], [1.0, 0.4]] }}
 coefficients = [0.8, 0.8, 0.8, 0.8]
 {extra}"#
-    );
-    let mut scene = Scene::parse(&text, "test").unwrap();
-    scene.base = dir.to_path_buf();
-    scene
+    )
 }
 
 /// A converted survey and the same values as a raw file, for bricked-against-whole tests.
