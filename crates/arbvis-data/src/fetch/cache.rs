@@ -258,16 +258,14 @@ mod tests {
         let data = std::fs::read(&file).unwrap();
         std::fs::write(&file, &data[..10]).unwrap();
         assert!(cache.get(url, &(0..5)).is_none());
-        // Over the limit: the oldest entries go first, down to 80 % of it.
+        // Over the limit: the oldest entries go first, down to 80 % of it. Filled through
+        // a handle with room for all, then evicted by another on the same folder with a
+        // limit of 10,000 bytes (as a second process would).
+        let roomy = DiskCache::new(dir.clone(), 1 << 30);
         for i in 0..12u64 {
-            cache.put(
-                url,
-                &(i * 1000..(i + 1) * 1000),
-                "e",
-                1 << 20,
-                &[i as u8; 1000],
-            );
-            let f = dir.join(name(url, &(i * 1000..(i + 1) * 1000)));
+            let r = i * 1000..(i + 1) * 1000;
+            roomy.put(url, &r, "e", 1 << 20, &[i as u8; 1000]);
+            let f = dir.join(name(url, &r));
             let t = SystemTime::UNIX_EPOCH + std::time::Duration::from_secs(1_000_000 + i);
             std::fs::File::options()
                 .write(true)
@@ -276,11 +274,13 @@ mod tests {
                 .set_modified(t)
                 .unwrap();
         }
-        cache.evict();
-        assert!(cache.bytes() <= 8_000, "{} bytes left", cache.bytes());
-        assert!(cache.get(url, &(0..1000)).is_none(), "the oldest went");
+        assert!(roomy.bytes() > 12_000);
+        let small = DiskCache::new(dir.clone(), 10_000);
+        small.evict();
+        assert!(small.bytes() <= 8_000, "{} bytes left", small.bytes());
+        assert!(small.get(url, &(0..1000)).is_none(), "the oldest went");
         assert!(
-            cache.get(url, &(11_000..12_000)).is_some(),
+            small.get(url, &(11_000..12_000)).is_some(),
             "the newest stayed"
         );
         std::fs::remove_dir_all(&dir).unwrap();

@@ -226,6 +226,17 @@ impl PointSource {
         base: &Path,
         view: Option<&copc_lod::View>,
     ) -> Result<(PointCloud, Option<copc_lod::Loaded>), PointsError> {
+        if let Some(url) = self.path().filter(|p| crate::fetch::url_of(p).is_some()) {
+            if !matches!(self, PointSource::Copc(_)) {
+                return Err(PointsError::io(
+                    url,
+                    std::io::Error::other(format!(
+                        "a {} cloud is read from local disk; from a URL arbvis reads COPC (`cloud = {{ copc = {{ path = \"...\" }} }}`)",
+                        self.kind()
+                    )),
+                ));
+            }
+        }
         let cloud = match self {
             PointSource::Dat(spec) => dat::read(&base.join(&spec.path), &spec.columns)?,
             PointSource::Las(p) => lasfile::read(&base.join(p))?.cloud,

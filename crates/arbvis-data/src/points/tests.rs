@@ -519,3 +519,23 @@ fn cloud_estimates_count_every_array() {
     let las = footprint(20_000_000, 4, true, false);
     assert!(las > 1_400_000_000 && las < 1_600_000_000, "{las}");
 }
+
+#[test]
+fn a_remote_cloud_that_is_not_copc_is_refused_by_name() {
+    // No request is sent: the kind decides.
+    for source in [
+        PointSource::Las("https://example.org/a.laz".into()),
+        PointSource::Ply("s3://bucket/a.ply".into()),
+    ] {
+        let e = source
+            .load(Path::new("."))
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(e.contains("from a URL arbvis reads COPC"), "{e}");
+        assert!(
+            e.contains("example.org/a.laz") || e.contains("s3://bucket/a.ply"),
+            "{e}"
+        );
+    }
+}
