@@ -5,7 +5,7 @@
 #
 # In DIR: a survey store (default 1000 samples x 1100 inlines x 1200 crosslines of float32,
 # a 5.3 GB SEG-Y made by benches/store/make_segy.py, converted with amplitude alone: a
-# store of about 5.6 GB) and a COPC cloud (default 200 M points from
+# store of 5.5 GB) and a COPC cloud (default 200 M points from
 # benches/points/outcrop.py, as benches/points/copc.sh makes it; reused from DIR when
 # there). Both are served by the tests' Range server (tests/servers/range_server.py)
 # behind this bench's link (proxy.py: 25 ms each way, 50 MB/s), and drawn from local disk
@@ -14,9 +14,9 @@
 #     coarsest level standing in, then on to the full picture; what was fetched by each);
 #   - the cloud by `arbvis render` (its first picture is its whole cut);
 # then over the link again on the cache the first run filled (a second process: 304s
-# only; what it reads from the cache is what the picture reads). Release build
-# (cargo build --release --no-default-features --bin arbvis --example store_bench first). Everything it prints goes to
-# DIR/remote-bench.log too.
+# only; what it reads from the cache is what the picture reads). Release build first:
+#   cargo build --release --no-default-features --bin arbvis --example store_bench
+# Everything it prints goes to DIR/remote-bench.log too.
 set -euo pipefail
 dir=${1:?usage: run.sh DIR [SAMPLES INLINES CROSSLINES] [POINTS]}
 ns=${2:-1000}; ni=${3:-1100}; nx=${4:-1200}; points=${5:-200000000}
