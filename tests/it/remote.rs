@@ -107,6 +107,16 @@ fn copc_fixture(dir: &Path) {
     assert!(out.status.success(), "{}", stderr(&out));
 }
 
+/// A test folder `name` holding [`copc_fixture`]'s cloud, the HTTP server on it, and the
+/// folder's cache path.
+fn copc_served(name: &str) -> (PathBuf, Server, PathBuf) {
+    let dir = temp_dir(name);
+    copc_fixture(&dir);
+    let server = Server::http(&dir);
+    let cache = dir.join("cache");
+    (dir, server, cache)
+}
+
 /// Bytes of every file under `dir`.
 fn bytes_under(dir: &Path) -> u64 {
     let mut total = 0;
@@ -177,10 +187,7 @@ fn a_store_over_http_renders_as_the_local_one_and_then_from_the_cache() {
 /// twice what the picture reads; a second process with the same cache fetches no bytes.
 #[test]
 fn a_copc_cloud_over_http_renders_as_the_local_one_in_few_requests() {
-    let dir = temp_dir("remote-copc-http");
-    copc_fixture(&dir);
-    let server = Server::http(&dir);
-    let cache = dir.join("cache");
+    let (dir, server, cache) = copc_served("remote-copc-http");
     let local = copc_scene(&dir, "local.toml", "c.copc.laz");
     let remote = copc_scene(&dir, "remote.toml", &server.url("c.copc.laz"));
     let (want, _) = render(&local, &dir.join("local.png"), &cache, &[]);
@@ -290,10 +297,7 @@ fn inspect_with_fault(
 /// fails is an error naming the node.
 #[test]
 fn faults_are_retried_or_named_never_waited_on() {
-    let dir = temp_dir("remote-faults");
-    copc_fixture(&dir);
-    let server = Server::http(&dir);
-    let cache = dir.join("cache");
+    let (dir, server, cache) = copc_served("remote-faults");
     let clean = inspect_with_fault(&server, &cache, "none", 0, 0).0;
     assert!(clean.status.success(), "{}", stderr(&clean));
     for (mode, count) in [
