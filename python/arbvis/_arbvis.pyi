@@ -90,6 +90,7 @@ def convert(
     attributes: List[str] = ["envelope"],
     compression: str = "lz4",
     progress: Optional[Callable[[int, int], Optional[bool]]] = None,
+    node_points: int = 100_000,
 ) -> Dict[str, Any]: ...
 
 _Image = Union[npt.NDArray[np.uint8], npt.NDArray[np.float32]]

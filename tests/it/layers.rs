@@ -40,7 +40,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("the catalog of techniques", &["catalog"]),
     (
         "scenes and rendering",
-        &["scene", "render", "annotate", "inspect", "info"],
+        &["scene", "session", "render", "annotate", "inspect", "info"],
     ),
     ("studies", &["study", "techniques::*::study"]),
     ("the viewer", &["viewer"]),
@@ -382,7 +382,7 @@ const CRATES: [(&str, Option<&str>); 6] = [
 
 /// The top-level modules of the crates below that a crate's root names for its files
 /// (`crate::scene` in the viewer is arbvis-techniques' `scene`).
-const NAMED_FROM_BELOW: [&str; 25] = [
+const NAMED_FROM_BELOW: [&str; 26] = [
     "budget",
     "camera",
     "colortable",
@@ -406,6 +406,7 @@ const NAMED_FROM_BELOW: [&str; 25] = [
     "programs",
     "render",
     "scene",
+    "session",
     "study",
     "techniques",
 ];

@@ -39,6 +39,7 @@ mod programs;
 mod quad;
 mod remote;
 mod segy_keys;
+mod session;
 mod splats;
 mod splats_edl;
 mod splats_tiles;

@@ -96,7 +96,7 @@ fn copc_scene(dir: &Path, name: &str, copc: &str) -> PathBuf {
 
 /// A COPC cloud of many nodes (autzen_trim.laz, 110,000 points, written by `arbvis
 /// convert` with nodes of at most 2,000 points: 43 nodes, 941 KiB) as `dir/c.copc.laz`.
-fn copc_fixture(dir: &Path) {
+pub(crate) fn copc_fixture(dir: &Path) {
     let out = Command::new(env!("CARGO_BIN_EXE_arbvis"))
         .arg("convert")
         .arg(data_file("points/autzen_trim.laz"))

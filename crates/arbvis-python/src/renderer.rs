@@ -1,4 +1,4 @@
-//! `arbvis.Renderer`: a scene kept ready to draw ([`arbvis_techniques::render::Session`]:
+//! `arbvis.Renderer`: a scene kept ready to draw ([`arbvis_techniques::session::Offscreen`]:
 //! GL context, prepared data, programs, target) on a render thread of its own. A GL
 //! context belongs to one thread, and the Python thread that calls may change; so each
 //! renderer owns the thread its context lives on, and a call hands it the scene and waits
@@ -18,8 +18,8 @@ use arbvis_data::volume::Limits;
 use arbvis_gl::Backend;
 use arbvis_techniques::catalog;
 use arbvis_techniques::error::RenderResult;
-use arbvis_techniques::render::Session;
 use arbvis_techniques::scene::Scene;
+use arbvis_techniques::session::Offscreen;
 use arbvis_techniques::techniques::ReferenceView;
 
 use crate::errors;
@@ -53,7 +53,7 @@ struct Ready {
 /// The render thread: make the session, say so, then draw what is asked until the
 /// renderer is dropped.
 fn serve(scene: Scene, backend: Backend, ready: Sender<RenderResult<Ready>>, jobs: Receiver<Job>) {
-    let mut session = match Session::new(&scene, backend) {
+    let mut session = match Offscreen::new(&scene, backend) {
         Ok(s) => s,
         Err(e) => {
             let _ = ready.send(Err(e));

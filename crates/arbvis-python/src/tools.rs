@@ -69,8 +69,11 @@ pub fn fetch_stats(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
 /// threads, holding the GIL while it runs); a false return stops the conversion with
 /// `arbvis.Cancelled`, and Ctrl-C or an exception the callback raises stops it with that
 /// exception (running it again resumes either way). A dict of what was done.
+/// A `dst` whose name ends in `.copc.laz` writes the point cloud `src` (LAS, LAZ, PLY) as
+/// COPC instead, in nodes of about `node_points` points, as `arbvis convert` does.
 #[pyfunction]
-#[pyo3(signature = (src, dst, brick = 64, attributes = vec!["envelope".to_string()], compression = "lz4", progress = None))]
+#[pyo3(signature = (src, dst, brick = 64, attributes = vec!["envelope".to_string()], compression = "lz4", progress = None, node_points = 100_000))]
+#[allow(clippy::too_many_arguments)]
 pub fn convert<'py>(
     py: Python<'py>,
     src: PathBuf,
@@ -79,7 +82,11 @@ pub fn convert<'py>(
     attributes: Vec<String>,
     compression: &str,
     progress: Option<Py<PyAny>>,
+    node_points: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
+    if dst.to_string_lossy().to_lowercase().ends_with(".copc.laz") {
+        return convert_to_copc(py, &src, &dst, node_points);
+    }
     let mut derived = Vec::new();
     for name in &attributes {
         match by_name(name) {
@@ -134,5 +141,29 @@ pub fn convert<'py>(
     out.set_item("seconds", report.seconds)?;
     out.set_item("dims", report.meta.dims.to_vec())?;
     out.set_item("levels", report.meta.levels)?;
+    Ok(out)
+}
+
+/// `convert(cloud, "x.copc.laz")`: the cloud written as COPC; a dict of what was written.
+fn convert_to_copc<'py>(
+    py: Python<'py>,
+    src: &std::path::Path,
+    dst: &std::path::Path,
+    node_points: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    use arbvis_data::points::copc_write::{write_copc, CopcWriteOptions};
+    let options = CopcWriteOptions {
+        node_points: node_points.max(1),
+        ..Default::default()
+    };
+    let report = py
+        .detach(|| write_copc(src, dst, &options))
+        .map_err(|e| InputError::new_err(e.to_string()))?;
+    let out = PyDict::new(py);
+    out.set_item("copc", dst.display().to_string())?;
+    out.set_item("points", report.points)?;
+    out.set_item("nodes", report.nodes)?;
+    out.set_item("levels", report.depth + 1)?;
+    out.set_item("bytes", report.bytes)?;
     Ok(out)
 }

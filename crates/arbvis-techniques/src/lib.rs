@@ -2,7 +2,8 @@
 //! multi-resolution clip textures and point-based geological sections — each with its CPU
 //! preparation, GL renderer and f64 CPU reference ([`techniques`]); the program texts
 //! ([`programs`]); the one list of them ([`catalog`]); what can go wrong ([`error`]);
-//! scenes ([`scene`]), offscreen rendering ([`render`], [`annotate`]), `inspect` and
+//! scenes ([`scene`]), the one interactive session below every front end ([`session`]),
+//! offscreen rendering ([`render`], [`annotate`]), `inspect` and
 //! `info`, and the studies ([`study`]).
 
 #![deny(unsafe_code)]
@@ -22,5 +23,6 @@ pub mod inspect;
 pub mod programs;
 pub mod render;
 pub mod scene;
+pub mod session;
 pub mod study;
 pub mod techniques;

@@ -3,10 +3,11 @@
 use crate::error::RenderResult;
 use std::time::{Duration, Instant};
 
-use crate::gl::{Backend, Caps, Headless, ProgramKind, Resource, Surface, Target};
+use crate::gl::{Backend, Caps, Headless, ProgramKind, Resource};
 use crate::image::Image;
 use crate::scene::Scene;
-use crate::techniques::{Frame, Renderer};
+use crate::session::{Mode, Session};
+use crate::techniques::Renderer;
 
 /// One rendered scene and what made it.
 pub struct Rendered {
@@ -67,30 +68,20 @@ pub fn render(scene: &Scene, backend: Backend) -> RenderResult<Rendered> {
     render_on(&headless, scene)
 }
 
-/// Render `scene` with an existing context.
+/// Render `scene` with an existing context, through a [`Session`] as every front end
+/// draws: the renderer built, then one complete frame (every datum the view needs).
 pub fn render_on(headless: &Headless, scene: &Scene) -> RenderResult<Rendered> {
     let gpu = headless.gpu();
     let kind = scene.programs.resolve(gpu);
-    let [width, height] = scene.size;
-    crate::budget::check_estimates(
-        &format!("this {} scene", scene.technique.name()),
-        &scene.memory_estimate(true),
-    )?;
     let t0 = Instant::now();
-    let mut renderer = build(gpu, scene, kind)?;
-    let target = Target::create(
-        gpu,
-        width,
-        height,
-        scene.target_format(),
-        renderer.needs_depth(),
-    )?;
+    let mut session = Session::build(gpu, scene, kind, true)?;
     gpu.finish();
     let build_time = t0.elapsed();
     let t1 = Instant::now();
-    draw_frame(gpu, &mut *renderer, &target, scene)?;
+    session.frame(gpu, scene, Mode::Complete)?;
     let draw_time = t1.elapsed();
-    let image = read_frame(gpu, &*renderer, &target, scene)?;
+    let image = session.read(gpu, scene)?;
+    let renderer = session.renderer();
     Ok(Rendered {
         image,
         program_kind: renderer.program_kind(),
@@ -101,124 +92,6 @@ pub fn render_on(headless: &Headless, scene: &Scene) -> RenderResult<Rendered> {
         draw_time,
         status: renderer.status(),
     })
-}
-
-/// A scene kept ready to draw frame after frame (the Python `Renderer`): its context,
-/// renderer and target. A changed camera, size, background or technique parameter costs
-/// a frame (the renderer takes new parameters through [`Renderer::update`]); another
-/// technique, fidelity, program choice, target format or data folder a new renderer.
-pub struct Session {
-    headless: Headless,
-    scene: Scene,
-    renderer: Box<dyn Renderer>,
-    target: Target,
-}
-
-impl Session {
-    /// A context on `backend` and `scene`'s renderer.
-    pub fn new(scene: &Scene, backend: Backend) -> RenderResult<Session> {
-        let headless = Headless::new(backend)?;
-        let (renderer, target) = Session::build(&headless, scene)?;
-        Ok(Session {
-            headless,
-            scene: scene.clone(),
-            renderer,
-            target,
-        })
-    }
-
-    fn build(headless: &Headless, scene: &Scene) -> RenderResult<(Box<dyn Renderer>, Target)> {
-        let gpu = headless.gpu();
-        crate::budget::check_estimates(
-            &format!("this {} scene", scene.technique.name()),
-            &scene.memory_estimate(true),
-        )?;
-        let renderer = build(gpu, scene, scene.programs.resolve(gpu))?;
-        let [width, height] = scene.size;
-        let format = scene.target_format();
-        let target = Target::create(gpu, width, height, format, renderer.needs_depth())?;
-        Ok((renderer, target))
-    }
-
-    /// Draw `scene` (what changed since the last frame applied first), as the target
-    /// holds it: top row first, alpha is coverage.
-    pub fn render(&mut self, scene: &Scene) -> RenderResult<Image> {
-        let old = &self.scene;
-        let same_renderer = old.technique.name() == scene.technique.name()
-            && old.fidelity == scene.fidelity
-            && old.programs == scene.programs
-            && old.target_format() == scene.target_format()
-            && old.base == scene.base;
-        if !same_renderer {
-            (self.renderer, self.target) = Session::build(&self.headless, scene)?;
-        } else {
-            let gpu = self.headless.gpu();
-            if old.technique != scene.technique {
-                self.renderer.update(gpu, scene.technique.params())?;
-            }
-            if old.size != scene.size {
-                let [width, height] = scene.size;
-                let depth = self.renderer.needs_depth();
-                self.target = Target::create(gpu, width, height, scene.target_format(), depth)?;
-            }
-        }
-        self.scene = scene.clone();
-        let gpu = self.headless.gpu();
-        draw_frame(gpu, &mut *self.renderer, &self.target, scene)?;
-        read_frame(gpu, &*self.renderer, &self.target, scene)
-    }
-
-    /// The program kind the renderer draws with.
-    pub fn program_kind(&self) -> ProgramKind {
-        self.renderer.program_kind()
-    }
-
-    /// The backend drawing.
-    pub fn backend(&self) -> Backend {
-        self.headless.backend()
-    }
-
-    /// The driver.
-    pub fn caps(&self) -> &Caps {
-        self.headless.gpu().caps()
-    }
-}
-
-/// One frame of `scene` by `renderer` on `target`: cleared, drawn and finished.
-fn draw_frame(
-    gpu: &crate::gl::Gpu,
-    renderer: &mut dyn Renderer,
-    target: &Target,
-    scene: &Scene,
-) -> RenderResult<()> {
-    target.clear(gpu, scene.clear_colour())?;
-    let frame = Frame {
-        camera: scene.camera,
-        width: scene.size[0],
-        height: scene.size[1],
-    };
-    renderer.draw(gpu, Surface::Target(target), &frame)?;
-    arbvis_gl::gl_check!(gpu)?;
-    gpu.finish();
-    Ok(())
-}
-
-/// The frame on `target` read back, with the legends and axes `scene` asks for drawn in.
-fn read_frame(
-    gpu: &crate::gl::Gpu,
-    renderer: &dyn Renderer,
-    target: &Target,
-    scene: &Scene,
-) -> RenderResult<Image> {
-    let mut image = target.read(gpu)?;
-    let show = crate::annotate::Show {
-        legend: scene.legend,
-        axes: scene.axes,
-    };
-    if show.legend || show.axes {
-        crate::annotate::draw(&mut image, &scene.camera, &renderer.annotations(), show)?;
-    }
-    Ok(image)
 }
 
 /// What `arbvis render` prints after writing `output`: the line that says so, and with

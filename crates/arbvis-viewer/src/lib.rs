@@ -7,8 +7,9 @@
 //! The event loop waits ([`ControlFlow::Wait`]): a frame is drawn only for input, a
 //! repaint egui asks for (animations, with their delay), a volume picture still being drawn
 //! in parts, the refinement once the user is still, or a script step. An idle viewer draws
-//! nothing. The volume is kept in an offscreen picture ([`volume_view`]) and redrawn only
-//! when the camera, parameters, size or background change; the UI is redrawn over it.
+//! nothing. The picture is kept by the session every front end shares
+//! ([`arbvis_techniques::session`]) and redrawn only when the camera, parameters, size or
+//! background change; the UI is redrawn over it.
 //!
 //! # Framing and size
 //! The 3D view is what is left of the window beside the panels; the scene's `size` follows
@@ -46,15 +47,14 @@ pub mod overlay;
 pub mod panel;
 pub mod remembered;
 pub mod runner;
+mod running;
 pub mod screenshot;
 pub mod script;
-mod session;
 pub mod splats;
 pub mod store_sections;
 pub mod summary;
 pub mod transfer;
 pub mod units;
-pub mod volume_view;
 pub mod widgets;
 
 use std::time::{Duration, Instant};
@@ -66,10 +66,10 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy}
 use winit::window::WindowId;
 
 use runner::{ScriptRunner, ScriptStep};
-use session::Running;
+use running::Running;
 
 pub use options::ViewerOptions;
-pub use session::fit_zoom;
+pub use running::fit_zoom;
 
 /// Wakes the event loop.
 #[derive(Debug, Clone, Copy)]

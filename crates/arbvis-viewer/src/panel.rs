@@ -14,7 +14,6 @@ use super::layout::{self, overlay_font};
 use super::legend;
 use super::lut3d;
 use super::overlay::{self, Ink, Projector, SECTION_COLOURS};
-use super::volume_view::InteractiveQuality;
 use super::widgets::Widgets;
 use crate::camera::Projection;
 use crate::gl::{Caps, ProgramKind};
@@ -23,6 +22,7 @@ use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::splats::SplatsScene;
 use crate::vocab::Fidelity;
 use crate::volume::axes::section_axes;
+use arbvis_techniques::session::InteractiveQuality;
 
 /// What the user asked for this frame.
 #[derive(Debug, Clone, PartialEq)]

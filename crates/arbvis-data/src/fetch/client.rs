@@ -12,6 +12,8 @@ use object_store::aws::AmazonS3Builder;
 use object_store::http::HttpBuilder;
 use object_store::{BackoffConfig, ClientOptions, ObjectStore, RetryConfig};
 
+use super::FetchError;
+
 /// The environment variables arbvis reads for S3, as AWS's own tools read them.
 pub const AWS_VARIABLES: &str = "AWS_ACCESS_KEY_ID and AWS_SECRET_ACCESS_KEY (and AWS_SESSION_TOKEN for temporary credentials; AWS_REGION, AWS_ENDPOINT_URL for an S3-compatible server)";
 
@@ -85,26 +87,30 @@ fn retry() -> RetryConfig {
 }
 
 /// The object at `url` (`s3://bucket/key`, `http://` or `https://`).
-pub fn object(url: &str) -> Result<Object, String> {
+pub fn object(url: &str) -> Result<Object, FetchError> {
+    let fail = |m: String| FetchError::at(url, None, m);
     let (scheme, rest) = url
         .split_once("://")
-        .ok_or_else(|| "not a URL".to_string())?;
+        .ok_or_else(|| fail("not a URL".to_string()))?;
     let (authority, key) = rest.split_once('/').unwrap_or((rest, ""));
     if authority.is_empty() || key.is_empty() {
-        return Err(format!(
+        return Err(fail(format!(
             "a URL names a {} and an object in it",
             if scheme == "s3" { "bucket" } else { "server" }
-        ));
+        )));
     }
     let s3 = match scheme {
         "s3" => true,
         "http" | "https" => false,
-        _ => return Err("arbvis reads s3://, http://, https:// and file:// URLs".to_string()),
+        _ => {
+            let m = "arbvis reads s3://, http://, https:// and file:// URLs";
+            return Err(fail(m.to_string()));
+        }
     };
     let root = format!("{scheme}://{authority}");
-    let store = client(&root, s3)?;
+    let store = client(&root, s3).map_err(fail)?;
     let path = object_store::path::Path::from_url_path(key)
-        .map_err(|e| format!("not an object's path: {e}"))?;
+        .map_err(|e| fail(format!("not an object's path: {e}")))?;
     Ok(Object {
         url: url.to_string(),
         store,
@@ -160,6 +166,11 @@ fn anonymous() -> bool {
         && !set("AWS_WEB_IDENTITY_TOKEN_FILE")
         && !set("AWS_CONTAINER_CREDENTIALS_RELATIVE_URI")
         && !set("AWS_CONTAINER_CREDENTIALS_FULL_URI")
+}
+
+/// [`describe`] as the error of the request for `range` of `object`.
+pub fn failure(object: &Object, range: Option<&Range<u64>>, e: &object_store::Error) -> FetchError {
+    FetchError::at(&object.url, range, describe(object, range, e))
 }
 
 /// What a request for `object` (bytes `range`, where one) failed with, in words (the

@@ -5,7 +5,7 @@ use std::ops::Range;
 use std::path::Path;
 use std::sync::Mutex;
 
-use super::{local_or_url, ranged, url_of};
+use super::{local_or_url, ranged, url_of, FetchError};
 
 /// A file read by byte ranges: local, or remote.
 pub enum File {
@@ -17,12 +17,13 @@ pub enum File {
 
 impl File {
     /// Open `path` (a URL: one request for its first block).
-    pub fn open(path: &Path) -> Result<File, String> {
+    pub fn open(path: &Path) -> Result<File, FetchError> {
         let path = &local_or_url(path);
         if let Some(url) = url_of(path) {
             return ranged::RemoteFile::open(url).map(File::Remote);
         }
-        let (f, len) = crate::input::open_regular(path).map_err(|e| e.to_string())?;
+        let (f, len) =
+            crate::input::open_regular(path).map_err(|e| FetchError::failed(e.to_string()))?;
         Ok(File::Local(Mutex::new(f), len))
     }
 
@@ -52,7 +53,7 @@ impl File {
     }
 
     /// Fetch `ranges` ahead (a remote file; nothing for a local one).
-    pub fn prefetch(&self, ranges: &[Range<u64>]) -> Result<(), String> {
+    pub fn prefetch(&self, ranges: &[Range<u64>]) -> Result<(), FetchError> {
         match self {
             File::Local(..) => Ok(()),
             File::Remote(r) => r.prefetch(ranges),

@@ -32,27 +32,62 @@ use std::sync::{Mutex, OnceLock};
 /// The cache key of a whole object (no range).
 const WHOLE: Range<u64> = 0..u64::MAX;
 
-/// Why an object could not be read.
-#[derive(Debug, Clone)]
+/// Why an object could not be read: its URL and byte range where a request failed, and
+/// the message (which names them for a reader of the error line).
+#[derive(Debug, Clone, thiserror::Error)]
 pub enum FetchError {
     /// It holds more than the reader may read.
+    #[error("it holds {bytes} bytes, more than the {max} read")]
     TooLarge {
         /// Its size.
         bytes: u64,
         /// The most the reader takes.
         max: u64,
     },
-    /// Anything else, in words naming the file or URL.
-    Failed(String),
+    /// It could not be read.
+    #[error("{message}")]
+    Failed {
+        /// The URL asked for (`None`: a local file, or no request was made).
+        url: Option<String>,
+        /// The bytes asked for (`None`: the whole object).
+        range: Option<Range<u64>>,
+        /// What went wrong, in words.
+        message: String,
+    },
 }
 
-impl std::fmt::Display for FetchError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+impl FetchError {
+    /// A failure of no particular request (a local file, a URL that is not one).
+    pub fn failed(message: impl Into<String>) -> FetchError {
+        FetchError::Failed {
+            url: None,
+            range: None,
+            message: message.into(),
+        }
+    }
+
+    /// A failure of the request for `range` (`None`: the whole object) of `url`.
+    pub fn at(url: &str, range: Option<&Range<u64>>, message: impl Into<String>) -> FetchError {
+        FetchError::Failed {
+            url: Some(url.to_string()),
+            range: range.cloned(),
+            message: message.into(),
+        }
+    }
+
+    /// The URL whose request failed, where one did.
+    pub fn url(&self) -> Option<&str> {
         match self {
-            FetchError::TooLarge { bytes, max } => {
-                write!(f, "it holds {bytes} bytes, more than the {max} read")
-            }
-            FetchError::Failed(m) => f.write_str(m),
+            FetchError::Failed { url, .. } => url.as_deref(),
+            FetchError::TooLarge { .. } => None,
+        }
+    }
+
+    /// The byte range whose request failed, where one did.
+    pub fn range(&self) -> Option<&Range<u64>> {
+        match self {
+            FetchError::Failed { range, .. } => range.as_ref(),
+            FetchError::TooLarge { .. } => None,
         }
     }
 }
@@ -143,7 +178,7 @@ pub fn read_object(path: &Path, max: u64) -> Result<Option<std::sync::Arc<Vec<u8
     let meta = match std::fs::metadata(path) {
         Ok(m) => m,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
-        Err(e) => return Err(FetchError::Failed(e.to_string())),
+        Err(e) => return Err(FetchError::failed(e.to_string())),
     };
     if meta.is_file() && meta.len() > max {
         return Err(FetchError::TooLarge {
@@ -153,22 +188,23 @@ pub fn read_object(path: &Path, max: u64) -> Result<Option<std::sync::Arc<Vec<u8
     }
     crate::input::read_regular(path, max)
         .map(|b| Some(std::sync::Arc::new(b)))
-        .map_err(|e| FetchError::Failed(e.to_string()))
+        .map_err(|e| FetchError::failed(e.to_string()))
 }
 
 /// The object or file at `path` as text, at most `max` bytes; an absent one is an error.
-pub fn read_text(path: &Path, max: u64) -> Result<String, String> {
+pub fn read_text(path: &Path, max: u64) -> Result<String, FetchError> {
     if url_of(path).is_none() {
         return crate::input::read_regular(path, max)
             .and_then(crate::input::utf8)
-            .map_err(|e| e.to_string());
+            .map_err(|e| FetchError::failed(e.to_string()));
     }
-    match read_object(path, max) {
-        Ok(Some(b)) => String::from_utf8(b.to_vec())
-            .map_err(|e| format!("not UTF-8 text (byte {})", e.utf8_error().valid_up_to())),
-        Ok(None) => Err("no such object (HTTP 404)".into()),
-        Err(FetchError::Failed(m)) => Err(m),
-        Err(e) => Err(e.to_string()),
+    let url = url_of(path).unwrap_or_default();
+    match read_object(path, max)? {
+        Some(b) => String::from_utf8(b.to_vec()).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            FetchError::at(url, None, format!("not UTF-8 text (byte {at})"))
+        }),
+        None => Err(FetchError::at(url, None, "no such object (HTTP 404)")),
     }
 }
 
@@ -249,7 +285,7 @@ fn known_etag(url: &str) -> Option<String> {
 fn learn_etag(url: &str, etag: &str, size: u64) -> Result<(), FetchError> {
     let mut k = known();
     match k.get(url) {
-        Some((e, s)) if e != etag || *s != size => Err(FetchError::Failed(format!(
+        Some((e, s)) if e != etag || *s != size => Err(FetchError::at(url, None, format!(
             "the object changed while it was read (ETag {e}, {s} bytes when first read; now ETag {etag}, {size} bytes); open it again"
         ))),
         Some(_) => Ok(()),

@@ -16,6 +16,7 @@ use object_store::{GetOptions, GetRange};
 
 use super::client::{self, Object};
 use super::count;
+use super::FetchError;
 
 /// Small reads are rounded out to blocks of this size.
 pub const BLOCK: u64 = 64 << 10;
@@ -76,7 +77,7 @@ impl Held {
 impl RemoteFile {
     /// Open `url`: one request for its first block (or none, when the block on disk is
     /// still the object's: then one `If-None-Match` request answered 304).
-    pub fn open(url: &str) -> Result<RemoteFile, String> {
+    pub fn open(url: &str) -> Result<RemoteFile, FetchError> {
         let object = client::object(url)?;
         let first = 0..BLOCK;
         let disk = super::cache::global().and_then(|c| c.get(url, &first));
@@ -93,15 +94,15 @@ impl RemoteFile {
                 count::from_disk(e.bytes.len());
                 (e.size, Some(e.etag), e.bytes)
             }
-            Err(e) => return Err(client::describe(&object, Some(&first), &e)),
+            Err(e) => return Err(client::failure(&object, Some(&first), &e)),
             Ok(got) => {
                 let size = got.meta.size;
                 let etag = got.meta.e_tag.clone();
                 let range = got.range.clone();
                 let bytes = client::runtime()
                     .block_on(got.bytes())
-                    .map_err(|e| client::describe(&object, Some(&first), &e))?;
-                check_length(&range, bytes.len())?;
+                    .map_err(|e| client::failure(&object, Some(&first), &e))?;
+                check_length(url, &range, bytes.len())?;
                 count::fetched(bytes.len());
                 let bytes = bytes.to_vec();
                 if let (Some(c), Some(t)) = (super::cache::global(), &etag) {
@@ -111,7 +112,7 @@ impl RemoteFile {
             }
         };
         if let Some(t) = &etag {
-            super::learn_etag(url, t, size).map_err(|e| e.to_string())?;
+            super::learn_etag(url, t, size)?;
         }
         let file = RemoteFile {
             object,
@@ -133,15 +134,15 @@ impl RemoteFile {
     }
 
     /// Fill `buf` from byte `at`.
-    pub fn read_at(&self, at: u64, buf: &mut [u8]) -> Result<(), String> {
+    pub fn read_at(&self, at: u64, buf: &mut [u8]) -> Result<(), FetchError> {
         let want = at..at + buf.len() as u64;
         if want.end > self.size {
-            return Err(format!(
-                "bytes {}-{}: past the end of its {} bytes",
-                want.start,
-                want.end.saturating_sub(1),
+            let (first, last) = (want.start, want.end.saturating_sub(1));
+            let m = format!(
+                "bytes {first}-{last}: past the end of its {} bytes",
                 self.size
-            ));
+            );
+            return Err(FetchError::at(&self.object.url, Some(&want), m));
         }
         if let Some(data) = self.held().find(&want) {
             buf.copy_from_slice(&data);
@@ -154,11 +155,12 @@ impl RemoteFile {
         };
         self.prefetch(std::slice::from_ref(&fetch))?;
         let data = self.held().find(&want).ok_or_else(|| {
-            format!(
+            let m = format!(
                 "bytes {}-{}: not held after their fetch (the memory budget of remote ranges is too small)",
                 want.start,
                 want.end - 1
-            )
+            );
+            FetchError::at(&self.object.url, Some(&want), m)
         })?;
         buf.copy_from_slice(&data);
         Ok(())
@@ -167,7 +169,7 @@ impl RemoteFile {
     /// Fetch `ranges` ahead (from the disk cache where it holds them, else merged where
     /// close, many at once), so that reading them waits for nothing; the first error is
     /// returned, naming its range.
-    pub fn prefetch(&self, ranges: &[Range<u64>]) -> Result<(), String> {
+    pub fn prefetch(&self, ranges: &[Range<u64>]) -> Result<(), FetchError> {
         let mut wanted: Vec<Range<u64>> = {
             let held = self.held();
             ranges
@@ -192,7 +194,7 @@ impl RemoteFile {
         }
         let merged = merge(&wanted);
         let limit = client::in_flight();
-        let fetched: Vec<Result<Span, String>> = client::runtime().block_on(async {
+        let fetched: Vec<Result<Span, FetchError>> = client::runtime().block_on(async {
             futures::stream::iter(merged)
                 .map(|(span, _)| async move {
                     let data = self.range(span.clone()).await?;
@@ -226,13 +228,13 @@ impl RemoteFile {
     }
 
     /// One range GET, pinned to the ETag the file was opened with.
-    async fn range(&self, r: Range<u64>) -> Result<Arc<Vec<u8>>, String> {
+    async fn range(&self, r: Range<u64>) -> Result<Arc<Vec<u8>>, FetchError> {
         let options = GetOptions {
             range: Some(GetRange::Bounded(r.clone())),
             if_match: self.etag.clone(),
             ..Default::default()
         };
-        let describe = |e: &object_store::Error| client::describe(&self.object, Some(&r), e);
+        let describe = |e: &object_store::Error| client::failure(&self.object, Some(&r), e);
         let _busy = count::request();
         let got = self
             .object
@@ -241,7 +243,7 @@ impl RemoteFile {
             .await
             .map_err(|e| describe(&e))?;
         if got.meta.size != self.size || (self.etag.is_some() && got.meta.e_tag != self.etag) {
-            return Err(format!(
+            return Err(FetchError::at(&self.object.url, Some(&r), format!(
                 "bytes {}-{}: the object changed while it was read (it had {} bytes and ETag {}; now {} bytes and ETag {}); open it again",
                 r.start,
                 r.end - 1,
@@ -249,25 +251,23 @@ impl RemoteFile {
                 self.etag.as_deref().unwrap_or("none"),
                 got.meta.size,
                 got.meta.e_tag.as_deref().unwrap_or("none"),
-            ));
+            )));
         }
         let range = got.range.clone();
         let bytes = got.bytes().await.map_err(|e| describe(&e))?;
-        check_length(&range, bytes.len())?;
+        check_length(&self.object.url, &range, bytes.len())?;
         count::fetched(bytes.len());
         Ok(Arc::new(bytes.to_vec()))
     }
 }
 
 /// The body must hold the range the server said it sends.
-fn check_length(range: &Range<u64>, got: usize) -> Result<(), String> {
+fn check_length(url: &str, range: &Range<u64>, got: usize) -> Result<(), FetchError> {
     let want = range.end - range.start;
     if got as u64 != want {
-        return Err(format!(
-            "bytes {}-{}: the body held {got} bytes, not the range's {want}",
-            range.start,
-            range.end.saturating_sub(1)
-        ));
+        let (first, last) = (range.start, range.end.saturating_sub(1));
+        let m = format!("bytes {first}-{last}: the body held {got} bytes, not the range's {want}");
+        return Err(FetchError::at(url, Some(range), m));
     }
     Ok(())
 }

@@ -88,7 +88,7 @@ pub fn read(url: &str, max: u64) -> Outcome {
     }
     let outcome = match client::object(url) {
         Ok(object) => client::runtime().block_on(fetch(object, max)),
-        Err(e) => Err(FetchError::Failed(e)),
+        Err(e) => Err(e),
     };
     finish(url, &outcome);
     outcome
@@ -128,7 +128,7 @@ pub fn prefetch(stages: Vec<Vec<String>>) {
                     let _permit = permits().acquire().await;
                     let outcome = match client::object(&url) {
                         Ok(object) => fetch(object, super::zarr_max()).await,
-                        Err(e) => Err(FetchError::Failed(e)),
+                        Err(e) => Err(e),
                     };
                     finish(&url, &outcome);
                 })
@@ -184,7 +184,7 @@ async fn fetch(object: Object, max: u64) -> Outcome {
             return Ok(Some(Arc::new(entry.bytes)));
         }
         Err(object_store::Error::NotFound { .. }) => return Ok(None),
-        Err(e) => return Err(FetchError::Failed(client::describe(&object, None, &e))),
+        Err(e) => return Err(client::failure(&object, None, &e)),
     };
     let size = got.meta.size;
     if size > max {
@@ -194,20 +194,23 @@ async fn fetch(object: Object, max: u64) -> Outcome {
     let mut body = got.into_stream();
     let mut bytes = Vec::with_capacity(size as usize);
     while let Some(part) = body.next().await {
-        let part = part.map_err(|e| FetchError::Failed(client::describe(&object, None, &e)))?;
+        let part = part.map_err(|e| client::failure(&object, None, &e))?;
         if (bytes.len() + part.len()) as u64 > size {
-            return Err(FetchError::Failed(format!(
-                "the server sent more than the {size} bytes it announced"
-            )));
+            return Err(FetchError::at(
+                &object.url,
+                None,
+                format!("the server sent more than the {size} bytes it announced"),
+            ));
         }
         bytes.extend_from_slice(&part);
         count::fetched(part.len());
     }
     if (bytes.len() as u64) < size {
-        return Err(FetchError::Failed(format!(
-            "the body ended after {} of its {size} bytes",
-            bytes.len()
-        )));
+        return Err(FetchError::at(
+            &object.url,
+            None,
+            format!("the body ended after {} of its {size} bytes", bytes.len()),
+        ));
     }
     if let Some(etag) = &etag {
         super::learn_etag(&object.url, etag, size)?;

@@ -19,14 +19,16 @@ use super::options::ViewerOptions;
 use super::panel::{self, PanelOutput, PanelState, UiAction};
 use super::screenshot;
 use super::script::MeasureMode;
-use super::volume_view::{Key, Pending, VolumeView, SETTLE};
 use crate::camera::{Arcball, Camera, Projection};
 use crate::gl::window::GlWindow;
 use crate::gl::{self, ProgramKind, Surface};
 use crate::png_io;
 use crate::scene::Scene;
 use crate::techniques::opacity3d::Opacity3dScene;
-use crate::techniques::{Frame, Renderer};
+use arbvis_techniques::session::{Mode, Pending, Session};
+
+/// How long after the last edit the view counts as still.
+pub const SETTLE: std::time::Duration = std::time::Duration::from_millis(250);
 
 /// Margin kept around the volume's bounding sphere when framing.
 const FRAME_MARGIN: f64 = 0.9;
@@ -48,8 +50,8 @@ pub fn fit_zoom(camera: &Camera, half: DVec3) -> f64 {
 
 // Fields drop in order: GL objects and egui's before the window's context.
 pub(super) struct Running {
-    renderer: Box<dyn Renderer>,
-    volume: VolumeView,
+    /// The renderer and its kept picture (the session every front end shares).
+    session: Session,
     data: ViewData,
     pub egui: EguiGlow,
     scene: Scene,
@@ -58,7 +60,6 @@ pub(super) struct Running {
     last_frame: Instant,
     last_edit: Option<Instant>,
     dragging: bool,
-    generation: u64,
     /// The number the next screenshot's name is looked for from.
     screenshots: u32,
     view_px: [i32; 4],
@@ -152,8 +153,7 @@ impl Running {
             }
         }
         Ok(Running {
-            renderer,
-            volume: VolumeView::default(),
+            session: Session::new(renderer, &scene, false),
             data,
             egui,
             scene,
@@ -162,7 +162,6 @@ impl Running {
             last_frame: Instant::now(),
             last_edit: None,
             dragging: false,
-            generation: 0,
             screenshots: 1,
             view_px: [0, 0, 1, 1],
             shown_px: [0, 0, 1, 1],
@@ -224,7 +223,7 @@ impl Running {
         let screenshot = self.take_actions(&out.actions, options);
 
         // Read each frame (a copy): the clip's cost after any rebuild above.
-        self.panel.clip.stats = self.renderer.clip_stats();
+        self.panel.clip.stats = self.session.renderer().clip_stats();
         let win = self.place_view(&out);
 
         if out.edited || out.input.scroll != 0.0 || out.input.drag_end {
@@ -236,38 +235,28 @@ impl Running {
         // A screenshot shows the full-quality picture, drawn now if need be.
         let interacting =
             !screenshot && (self.dragging || settling || measure == Some(MeasureMode::Interactive));
-        let key = Key::of(&self.scene, self.scene.size, self.generation);
+        let mode = if screenshot || measure == Some(MeasureMode::Full) {
+            Mode::Now
+        } else if interacting {
+            Mode::Interacting
+        } else {
+            Mode::Still
+        };
         let gpu = self.window.gpu();
-        // A store's bricks keep arriving: draw the full picture again until none is due.
-        let streaming = self.renderer.pending();
-        if streaming && !interacting {
-            self.volume.refine();
-        }
-        // Still: a COPC cloud loads the nodes this view needs on a thread, drawing the
-        // cut it has until they arrive.
-        if !interacting
-            && self
-                .renderer
-                .settle(gpu, &self.scene.camera, self.scene.size)?
-        {
-            self.volume.refine();
-        }
-        let pending = self.volume.update(
-            gpu,
-            self.renderer.as_mut(),
-            &self.scene.technique,
-            &key,
-            interacting,
-            self.panel.quality,
-            screenshot || measure == Some(MeasureMode::Full),
-        )?;
+        // A store's bricks keep arriving: frames go on until none is due.
+        let streaming = self.session.renderer().pending();
+        self.session.quality = self.panel.quality;
+        let pending = self.session.frame(gpu, &self.scene, mode)?;
+        let p = self.session.picture();
         self.panel.volume_info = format!(
-            "picture: {:.0} ms full ({} part{}), {:.0} ms interactive{}",
-            self.volume.full_ms,
-            self.volume.parts,
-            if self.volume.parts == 1 { "" } else { "s" },
-            self.volume.interactive_ms,
-            self.renderer
+            "picture: {:.0} ms full ({} part{}), {:.0} ms interactive at 1/{:.1} of each side{}",
+            p.full_ms,
+            p.parts,
+            if p.parts == 1 { "" } else { "s" },
+            p.interactive_ms,
+            p.scale,
+            self.session
+                .renderer()
                 .status()
                 .map_or(String::new(), |s| format!("\n{s}"))
         );
@@ -278,7 +267,9 @@ impl Running {
             [0.1, 0.1, 0.1, 1.0],
         )?;
         gl::clear(gpu, Surface::Window(self.shown_px), self.scene.background)?;
-        self.volume.show(gpu, self.view_px)?;
+        if let Some(shown) = self.session.shown() {
+            shown.blit_to_window(gpu, self.view_px)?;
+        }
         // The view before egui paints over it, to tell its marks from the picture's.
         let bare = match screenshot && self.panel.overlay {
             true => Some(gl::read_window(gpu, self.shown_px)?),
@@ -286,7 +277,7 @@ impl Running {
         };
         self.egui.paint(self.window.window());
         if screenshot {
-            self.screenshot(options, &key, bare);
+            self.screenshot(options, bare);
         }
         if std::mem::take(&mut self.window_shot) {
             self.save_window(options);
@@ -345,12 +336,8 @@ impl Running {
             match action {
                 UiAction::SetPrograms(kind) => self.set_programs(*kind),
                 UiAction::ParamsChanged => {
-                    match self
-                        .renderer
-                        .update(self.window.gpu(), self.scene.technique.params())
-                    {
-                        Ok(()) => self.generation += 1,
-                        Err(e) => self.fail_action(format!("error: {e}")),
+                    if let Err(e) = self.session.params_changed(self.window.gpu(), &self.scene) {
+                        self.fail_action(format!("error: {e}"));
                     }
                 }
                 UiAction::Screenshot => screenshot = true,
@@ -426,9 +413,8 @@ impl Running {
     fn set_programs(&mut self, kind: ProgramKind) {
         match data::build(self.window.gpu(), &self.scene, kind, &mut self.data) {
             Ok(r) => {
-                self.renderer = r;
-                self.generation += 1;
-                let drawn = self.renderer.program_kind();
+                self.session.replace_renderer(r);
+                let drawn = self.session.renderer().program_kind();
                 self.panel.kind = Some(drawn);
                 self.scene.programs = match kind {
                     ProgramKind::Arb => crate::gl::ProgramChoice::Arb,
@@ -448,43 +434,12 @@ impl Running {
         }
     }
 
-    /// The view as a picture: the full-quality volume picture (opaque), or, for a
-    /// transparent scene, the frame drawn again on transparent black (straight colour,
-    /// coverage alpha), exactly as `arbvis render` writes it.
-    fn picture(&mut self, key: &Key) -> anyhow::Result<crate::image::Image> {
-        let gpu = self.window.gpu();
-        if !self.scene.transparent {
-            if let Some(t) = self.volume.full_picture(key) {
-                return Ok(self.scene.picture(&t.read(gpu)?));
-            }
-        }
-        let [w, h] = self.scene.size;
-        let target = gl::Target::create(
-            gpu,
-            w,
-            h,
-            self.scene.target_format(),
-            self.renderer.needs_depth(),
-        )?;
-        target.clear(gpu, self.scene.clear_colour())?;
-        let frame = Frame {
-            camera: self.scene.camera,
-            width: w,
-            height: h,
-        };
-        self.renderer.draw(gpu, Surface::Target(&target), &frame)?;
-        Ok(self.scene.picture(&target.read(gpu)?))
-    }
-
     /// Write the view as the next free `arbvis-screenshot-NNN.png`: the picture, with
     /// what egui drew over it when `bare` (the view before egui painted) is given.
-    fn screenshot(
-        &mut self,
-        options: &ViewerOptions,
-        key: &Key,
-        bare: Option<crate::image::Image>,
-    ) {
-        let result = self.picture(key).and_then(|picture| {
+    fn screenshot(&mut self, options: &ViewerOptions, bare: Option<crate::image::Image>) {
+        let gpu = self.window.gpu();
+        let picture = self.session.file_picture(gpu, &self.scene);
+        let result = picture.map_err(anyhow::Error::from).and_then(|picture| {
             let image = match bare {
                 Some(bare) => {
                     let painted = gl::read_window(self.window.gpu(), self.shown_px)?;
@@ -511,7 +466,7 @@ impl Running {
                 ("arbvis:scene", self.scene.to_toml()),
                 (
                     "arbvis:programs",
-                    self.renderer.program_kind().name().to_string(),
+                    self.session.renderer().program_kind().name().to_string(),
                 ),
                 (
                     "arbvis:renderer",

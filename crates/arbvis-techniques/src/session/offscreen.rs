@@ -1,0 +1,54 @@
+//! The session with a headless context of its own: what `arbvis.Renderer` and
+//! `arbvis.dask` keep between frames.
+
+use crate::error::RenderResult;
+use crate::gl::{Backend, Caps, Headless, ProgramKind};
+use crate::image::Image;
+use crate::scene::Scene;
+
+use super::{Mode, Session};
+
+/// A scene kept ready to draw frame after frame: its context and [`Session`]. A changed
+/// camera, size, background or technique parameter costs a frame; another technique,
+/// fidelity, program choice, target format or data folder a new renderer. Each picture is
+/// the one a fresh offscreen render of the scene draws: a new view of streamed data (a
+/// COPC cloud's cut, a store's bricks) is loaded before it is drawn.
+// Fields drop in order: the session's GL objects before the context.
+pub struct Offscreen {
+    session: Session,
+    headless: Headless,
+}
+
+impl Offscreen {
+    /// A context on `backend` and `scene`'s renderer.
+    pub fn new(scene: &Scene, backend: Backend) -> RenderResult<Offscreen> {
+        let headless = Headless::new(backend)?;
+        let gpu = headless.gpu();
+        let session = Session::build(gpu, scene, scene.programs.resolve(gpu), true)?;
+        Ok(Offscreen { session, headless })
+    }
+
+    /// Draw `scene` (what changed since the last frame applied first), as the target
+    /// holds it: top row first, alpha is coverage.
+    pub fn render(&mut self, scene: &Scene) -> RenderResult<Image> {
+        let gpu = self.headless.gpu();
+        self.session.apply(gpu, scene)?;
+        self.session.frame(gpu, scene, Mode::Complete)?;
+        self.session.read(gpu, scene)
+    }
+
+    /// The program kind the renderer draws with.
+    pub fn program_kind(&self) -> ProgramKind {
+        self.session.renderer().program_kind()
+    }
+
+    /// The backend drawing.
+    pub fn backend(&self) -> Backend {
+        self.headless.backend()
+    }
+
+    /// The driver.
+    pub fn caps(&self) -> &Caps {
+        self.headless.gpu().caps()
+    }
+}

@@ -1,0 +1,142 @@
+//! The one interactive session below every front end (`arbvis::session`): a session
+//! turned through views draws each as a fresh render of it does, with streamed data (a
+//! COPC cloud's cut, a store's bricks) following the camera; a reduced frame keeps to the
+//! frame budget.
+
+use std::path::Path;
+
+use arbvis::camera::Camera;
+use arbvis::gl::Backend;
+use arbvis::image::Image;
+use arbvis::scene::Scene;
+use arbvis::session::{FrameBudget, Mode, Offscreen, Pending, Session};
+use glam::DQuat;
+
+use crate::common::{headless, temp_dir};
+
+/// `count` rotations around the vertical axis, seen from 35 degrees above (as
+/// `arbvis.dask.orbit`).
+fn orbit(count: usize) -> Vec<[f64; 4]> {
+    let tilt = DQuat::from_rotation_x(35f64.to_radians());
+    (0..count)
+        .map(|k| {
+            let turn = DQuat::from_rotation_y(std::f64::consts::TAU * k as f64 / count as f64);
+            (tilt * turn).to_array()
+        })
+        .collect()
+}
+
+/// The autzen COPC cloud (43 nodes of at most 2,000 points) at a budget of 20,000 points,
+/// close enough (perspective, zoom 4) that the views want other cuts (2 to 5 nodes: `arbvis
+/// render --stats` of three of them).
+fn copc_scene(dir: &Path) -> Scene {
+    crate::remote::copc_fixture(dir);
+    let text = format!(
+        r#"size = [160, 120]
+[camera]
+projection = "perspective"
+zoom = 4.0
+[technique.splats]
+cloud = {{ copc = {{ path = "{}", points = 20000 }} }}
+colour = "rgb"
+point_size = 3.0
+"#,
+        dir.join("c.copc.laz").display()
+    );
+    Scene::parse(&text, "test").unwrap()
+}
+
+/// Pictures of `scene` turned through an orbit by one session, each beside a fresh
+/// render of the same view.
+fn turned_and_fresh(mut scene: Scene) -> Vec<(Image, Image)> {
+    let mut session = Offscreen::new(&scene, Backend::Egl).unwrap();
+    orbit(5)
+        .into_iter()
+        .map(|rotation| {
+            scene.camera.rotation = rotation;
+            let turned = session.render(&scene).unwrap();
+            (turned, fresh_render(&scene))
+        })
+        .collect()
+}
+
+/// A fresh render of `scene` on a thread of its own (a GL context is current on one
+/// thread: the session's stays current on this one).
+fn fresh_render(scene: &Scene) -> Image {
+    let scene = scene.clone();
+    std::thread::spawn(move || arbvis::render::render(&scene, Backend::Egl).unwrap().image)
+        .join()
+        .unwrap()
+}
+
+/// Exact: the same cut, the same bricks, the same sort and programs draw the same bytes.
+fn assert_each_view_equal(pairs: &[(Image, Image)], what: &str) {
+    for (k, (turned, fresh)) in pairs.iter().enumerate() {
+        assert!(
+            turned.data == fresh.data,
+            "{what}: view {k} differs from a fresh render"
+        );
+    }
+    // The views differ, so the check above is not of one picture five times.
+    assert!(
+        pairs[0].0.data != pairs[2].0.data,
+        "{what}: the orbit drew one picture"
+    );
+}
+
+#[test]
+fn a_copc_cloud_turned_by_one_session_draws_each_view_as_a_fresh_render() {
+    let dir = temp_dir("session-copc");
+    let pairs = turned_and_fresh(copc_scene(&dir));
+    assert_each_view_equal(&pairs, "COPC");
+}
+
+#[test]
+fn a_store_turned_by_one_session_draws_each_view_as_a_fresh_render() {
+    let (dir, _) = crate::store::fixture("session-store", [37, 29, 45], 16);
+    let volume = format!("{{ store = \"{}\" }}", dir.join("s.zarr").display());
+    let text = crate::store::store_scene_text(&volume, "", 48);
+    let pairs = turned_and_fresh(Scene::parse(&text, "test").unwrap());
+    assert_each_view_equal(&pairs, "store");
+}
+
+/// While interacting, a frame over the budget is drawn smaller the next time, and a
+/// still frame is the full picture, equal to the offscreen render.
+#[test]
+fn interactive_frames_shrink_to_the_budget_and_a_still_frame_is_the_full_picture() {
+    let h = headless(Backend::Egl);
+    let gpu = h.gpu();
+    let mut scene = Scene::demo("v3o2-sum").unwrap();
+    scene.size = [96, 80];
+    let kind = scene.programs.resolve(gpu);
+    let mut session = Session::build(gpu, &scene, kind, true).unwrap();
+    // A budget no frame can meet: the scale doubles each frame up to a tenth of a side.
+    session.set_budget(FrameBudget {
+        interactive: std::time::Duration::from_nanos(1),
+        ..FrameBudget::default()
+    });
+    let mut scales = Vec::new();
+    for k in 0..5 {
+        scene.camera = Camera {
+            zoom: 1.0 + 0.01 * k as f64,
+            ..scene.camera
+        };
+        let pending = session.frame(gpu, &scene, Mode::Interacting).unwrap();
+        assert_eq!(pending, Pending::Refine);
+        scales.push(session.picture().scale);
+    }
+    assert_eq!(scales, [4.0, 8.0, 10.0, 10.0, 10.0]);
+    let shown = session.shown().unwrap();
+    // The last interactive picture was drawn at a tenth of each side (9.6 rounds to 10).
+    assert_eq!([shown.width(), shown.height()], [10, 8]);
+    assert_eq!(
+        session.frame(gpu, &scene, Mode::Now).unwrap(),
+        Pending::Done
+    );
+    let image = session.read(gpu, &scene).unwrap();
+    let fresh = fresh_render(&scene);
+    assert!(
+        image.data == fresh.data,
+        "the still picture differs from a render"
+    );
+}
