@@ -1,6 +1,9 @@
 //! Request counts: what this process has fetched, for the tests, `--stats` and the
 //! viewer's status line.
 
+// Without `remote` no request is counted.
+#![cfg_attr(not(feature = "remote"), allow(dead_code))]
+
 use std::sync::atomic::{AtomicU64, Ordering::Relaxed};
 
 static REQUESTS: AtomicU64 = AtomicU64::new(0);

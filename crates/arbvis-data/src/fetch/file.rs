@@ -31,7 +31,7 @@ impl File {
     pub fn len(&self) -> u64 {
         match self {
             File::Local(_, len) => *len,
-            File::Remote(r) => r.size,
+            File::Remote(r) => r.size(),
         }
     }
 

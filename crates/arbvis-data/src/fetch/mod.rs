@@ -14,12 +14,22 @@
 //! pass over what a URL has not (a listing, a modification time). Request counts are
 //! kept ([`stats`]) for the tests, `--stats` and the viewer's status line.
 
+// Without `remote`, the request-side helpers below serve no caller.
+#![cfg_attr(not(feature = "remote"), allow(dead_code))]
+
 pub mod cache;
+#[cfg(feature = "remote")]
 pub mod client;
 pub mod count;
 mod file;
+#[cfg(not(feature = "remote"))]
+mod offline;
+#[cfg(feature = "remote")]
 pub mod ranged;
+#[cfg(feature = "remote")]
 mod whole;
+#[cfg(not(feature = "remote"))]
+use offline::{ranged, whole};
 
 pub use count::{stats, status, Stats};
 pub use file::{Cursor, File};
@@ -219,16 +229,7 @@ pub fn exists(path: &Path) -> bool {
     if metadata {
         return matches!(read_object(path, METADATA_MAX), Ok(Some(_)));
     }
-    let Ok(object) = client::object(url) else {
-        return false;
-    };
-    let _busy = count::request();
-    client::runtime()
-        .block_on(object_store::ObjectStoreExt::head(
-            &*object.store,
-            &object.path,
-        ))
-        .is_ok()
+    whole::head(url)
 }
 
 /// Whether `path` is a folder (for a URL: a zarr group or array, v3 or v2, lies there).
@@ -342,5 +343,26 @@ mod tests {
         );
         assert_eq!(percent_decode("%4"), "%4");
         assert_eq!(percent_decode("%41%zz"), "A%zz");
+    }
+}
+
+#[cfg(all(test, feature = "remote"))]
+mod error_tests {
+    use super::*;
+
+    #[test]
+    fn a_failed_fetch_is_an_error_with_its_url_and_range_as_fields() {
+        let e = client::object("s3://bucket-only").err().expect("no object named");
+        assert_eq!(e.url(), Some("s3://bucket-only"));
+        assert_eq!(e.range(), None);
+        assert!(e.to_string().contains("names a bucket and an object"), "{e}");
+        let e = read_text(Path::new("ftp://h/o"), 10);
+        // Not a URL arbvis fetches: read as a local path that is not there.
+        assert!(e.is_err_and(|e| e.url().is_none()));
+        let e = FetchError::at("http://h/o", Some(&(3..9)), "bytes 3-8: reset");
+        assert_eq!((e.url(), e.range()), (Some("http://h/o"), Some(&(3..9))));
+        // A std::error::Error, as every other layer's error is.
+        let boxed: Box<dyn std::error::Error + Send + Sync> = Box::new(e);
+        assert_eq!(boxed.to_string(), "bytes 3-8: reset");
     }
 }

@@ -124,6 +124,11 @@ impl RemoteFile {
         Ok(file)
     }
 
+    /// Its size in bytes.
+    pub fn size(&self) -> u64 {
+        self.size
+    }
+
     /// The ETag the file had when opened.
     pub fn etag(&self) -> Option<&str> {
         self.etag.as_deref()

@@ -94,6 +94,20 @@ pub fn read(url: &str, max: u64) -> Outcome {
     outcome
 }
 
+/// Whether the object at `url` is there (a HEAD request).
+pub fn head(url: &str) -> bool {
+    let Ok(object) = client::object(url) else {
+        return false;
+    };
+    let _busy = count::request();
+    client::runtime()
+        .block_on(object_store::ObjectStoreExt::head(
+            &*object.store,
+            &object.path,
+        ))
+        .is_ok()
+}
+
 /// Start fetching `stages` without waiting: each stage's objects many at a time, in
 /// order, and a stage only once the one before it is in (the coarse levels of a view
 /// before the finer ones).

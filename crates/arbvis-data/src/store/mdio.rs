@@ -87,7 +87,7 @@ fn read_whole(array: &ArrayMeta) -> Result<Vec<f64>, StoreError> {
             };
             let values = array
                 .read_chunk_f64(&index)
-                .map_err(|e| StoreError::invalid(&array.chunk_file(&index), e))?;
+                .map_err(|e| StoreError::invalid(&array.chunk_file(&index), e.to_string()))?;
             let Some(values) = values else { continue };
             for y in 0..cr.min(rows - a * cr) {
                 for x in 0..cc.min(cols - b * cc) {
@@ -684,14 +684,11 @@ impl Mdio {
             *t = *tick;
             return Ok(v.clone());
         }
-        let values = match self
-            .data
-            .read_chunk(index)
-            .map_err(|message| ChunkFailure {
-                index: *index,
-                path: self.data.chunk_file(index),
-                message,
-            })? {
+        let values = match self.data.read_chunk(index).map_err(|e| ChunkFailure {
+            index: *index,
+            path: self.data.chunk_file(index),
+            message: e.to_string(),
+        })? {
             Some(v) => v,
             None => vec![self.data.fill_value as f32; self.data.chunk_elements()],
         };

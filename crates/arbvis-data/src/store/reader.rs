@@ -317,7 +317,7 @@ impl Store {
             }
         }
         let array = &self.arrays[attr][level];
-        let values = match array.read_chunk(&index).map_err(fail)? {
+        let values = match array.read_chunk(&index).map_err(|e| fail(e.to_string()))? {
             Some(values) => values,
             None => {
                 self.absent_chunk_is_fill(attr, level, c).map_err(fail)?;
@@ -416,7 +416,7 @@ impl Store {
         let file = array.chunk_file(&[0, 0, 0, 0]);
         let values = array
             .read_chunk(&[0, 0, 0, 0])
-            .map_err(|e| StoreError::invalid(&file, e))?
+            .map_err(|e| StoreError::invalid(&file, e.to_string()))?
             .ok_or_else(|| StoreError::invalid(&file, "the brick ranges are missing"))?;
         let table: Vec<[f32; 2]> = values.chunks_exact(2).map(|p| [p[0], p[1]]).collect();
         let table = Arc::new(table);

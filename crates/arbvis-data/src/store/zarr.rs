@@ -19,6 +19,62 @@ use std::path::{Path, PathBuf};
 use serde_json::{Map, Value};
 
 use super::StoreError;
+use crate::fetch::FetchError;
+
+/// Why a chunk's bytes could not be decoded: the codec that refused them and its words.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{message}")]
+pub struct CodecError {
+    /// The codec (`zstd`, `gzip`, `crc32c`, `blosc`, `zfpy`).
+    pub codec: &'static str,
+    /// What is wrong, in words that name the codec.
+    pub message: String,
+}
+
+impl CodecError {
+    /// `codec`'s refusal, in `message`.
+    pub fn new(codec: &'static str, message: impl Into<String>) -> CodecError {
+        CodecError {
+            codec,
+            message: message.into(),
+        }
+    }
+}
+
+/// Why a chunk could not be read (the caller names its file, array and index).
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum ChunkError {
+    /// Its file or object could not be read.
+    #[error(transparent)]
+    Fetch(#[from] FetchError),
+    /// Its file holds more than its codecs can make of a chunk.
+    #[error(
+        "the file holds {bytes} bytes; its codecs ({codecs}) can make at most {max} of a chunk"
+    )]
+    TooLarge {
+        /// The file's size.
+        bytes: u64,
+        /// The most its codecs can make.
+        max: u64,
+        /// The codecs, in words.
+        codecs: String,
+    },
+    /// A codec refused its bytes.
+    #[error("cannot be decoded: {0}")]
+    Codec(#[from] CodecError),
+    /// It decoded to another size than a chunk's.
+    #[error("decodes to {got} bytes, not the {want} of a {chunks:?} chunk of {data_type}")]
+    Size {
+        /// Bytes decoded.
+        got: usize,
+        /// Bytes of a chunk.
+        want: usize,
+        /// The chunk's shape.
+        chunks: Vec<u64>,
+        /// The element type's name.
+        data_type: &'static str,
+    },
+}
 
 /// Largest `zarr.json` read (arbvis writes a few KiB; MDIO's statistics and histograms
 /// stay far below this).
@@ -168,27 +224,28 @@ impl Codec {
     }
 
     /// Undo this codec on `data`, which must decode to at most `limit` bytes.
-    fn decode(&self, data: Vec<u8>, limit: u64) -> Result<Vec<u8>, String> {
+    fn decode(&self, data: Vec<u8>, limit: u64) -> Result<Vec<u8>, CodecError> {
+        let fail = |m: String| CodecError::new(self.name(), m);
         match self {
             Codec::Blosc(config) => blosc_decode(config, data, limit),
             Codec::Zstd => {
                 if let Ok(Some(declared)) = zstd::zstd_safe::get_frame_content_size(&data) {
                     if declared > limit {
-                        return Err(format!(
+                        return Err(fail(format!(
                             "its zstd frame declares {declared} bytes, more than the {limit} it may hold"
-                        ));
+                        )));
                     }
                 }
                 let mut decoder = zstd::stream::read::Decoder::with_buffer(data.as_slice())
-                    .map_err(|e| format!("zstd: {e}"))?;
+                    .map_err(|e| fail(format!("zstd: {e}")))?;
                 // The window a frame may ask for: no more than the chunk needs (2^10 at least).
                 let log = (64 - limit.max(1024).leading_zeros()).min(31);
                 decoder
                     .window_log_max(log)
-                    .map_err(|e| format!("zstd: {e}"))?;
+                    .map_err(|e| fail(format!("zstd: {e}")))?;
                 bounded_read(decoder, limit, "zstd").map_err(|e| {
-                    if e.contains("too much memory") {
-                        format!("its zstd frame asks for a window larger than a chunk of {limit} bytes needs")
+                    if e.message.contains("too much memory") {
+                        fail(format!("its zstd frame asks for a window larger than a chunk of {limit} bytes needs"))
                     } else {
                         e
                     }
@@ -201,15 +258,15 @@ impl Codec {
             ),
             Codec::Crc32c => {
                 if data.len() < 4 {
-                    return Err("crc32c: shorter than its 4-byte checksum".into());
+                    return Err(fail("crc32c: shorter than its 4-byte checksum".into()));
                 }
                 let (body, sum) = data.split_at(data.len() - 4);
                 let want = u32::from_le_bytes([sum[0], sum[1], sum[2], sum[3]]);
                 let got = crc32c::crc32c(body);
                 if got != want {
-                    return Err(format!(
+                    return Err(fail(format!(
                         "crc32c checksum {got:#010x}, the chunk says {want:#010x}: the chunk is damaged"
-                    ));
+                    )));
                 }
                 Ok(body.to_vec())
             }
@@ -217,39 +274,44 @@ impl Codec {
     }
 }
 
+/// An error of the blosc codec.
+fn blosc_error(message: String) -> CodecError {
+    CodecError::new("blosc", message)
+}
+
 /// The `zarrs` blosc codec of an array's configuration.
-fn blosc_codec(config: &Value) -> Result<zarrs::array::codec::BloscCodec, String> {
+fn blosc_codec(config: &Value) -> Result<zarrs::array::codec::BloscCodec, CodecError> {
     let configuration: zarrs::metadata_ext::codec::blosc::BloscCodecConfiguration =
         serde_json::from_value(config.clone())
-            .map_err(|e| format!("configuration {config}: {e}"))?;
+            .map_err(|e| blosc_error(format!("configuration {config}: {e}")))?;
     zarrs::array::codec::BloscCodec::new_with_configuration(&configuration)
-        .map_err(|e| format!("configuration {config}: {e}"))
+        .map_err(|e| blosc_error(format!("configuration {config}: {e}")))
 }
 
 /// A blosc 1 buffer decoded, its 16-byte header checked first: what it declares to hold
 /// (at most `limit`), its block size (within that), and its compressed length (the
 /// buffer's own), so that the decoder never allocates more than the chunk may hold.
-fn blosc_decode(config: &Value, data: Vec<u8>, limit: u64) -> Result<Vec<u8>, String> {
+fn blosc_decode(config: &Value, data: Vec<u8>, limit: u64) -> Result<Vec<u8>, CodecError> {
     use zarrs::array::BytesToBytesCodecTraits;
     if data.len() < 16 {
-        return Err(format!(
+        return Err(blosc_error(format!(
             "blosc: {} bytes, shorter than its 16-byte header",
             data.len()
-        ));
+        )));
     }
     let word =
         |at: usize| u32::from_le_bytes([data[at], data[at + 1], data[at + 2], data[at + 3]]) as u64;
     let (nbytes, blocksize, cbytes) = (word(4), word(8), word(12));
     if nbytes > limit {
-        return Err(format!(
+        return Err(blosc_error(format!(
             "its blosc header declares {nbytes} bytes, more than the {limit} it may hold"
-        ));
+        )));
     }
     if blocksize == 0 || blocksize > nbytes.max(1) || cbytes != data.len() as u64 {
-        return Err(format!(
+        return Err(blosc_error(format!(
             "its blosc header (block size {blocksize}, {cbytes} compressed bytes) does not fit its {nbytes} bytes in a buffer of {}",
             data.len()
-        ));
+        )));
     }
     let decoded = blosc_codec(config)?
         .decode(
@@ -257,24 +319,25 @@ fn blosc_decode(config: &Value, data: Vec<u8>, limit: u64) -> Result<Vec<u8>, St
             &zarrs::array::BytesRepresentation::BoundedSize(limit),
             &zarrs::array::CodecOptions::default(),
         )
-        .map_err(|e| format!("blosc: {e}"))?;
+        .map_err(|e| blosc_error(format!("blosc: {e}")))?;
     Ok(decoded.into_owned())
 }
 
 /// Read all of `reader` into a buffer, failing at the first byte past `limit`.
-fn bounded_read(reader: impl Read, limit: u64, codec: &str) -> Result<Vec<u8>, String> {
+fn bounded_read(reader: impl Read, limit: u64, codec: &'static str) -> Result<Vec<u8>, CodecError> {
+    let fail = |m: String| CodecError::new(codec, m);
     let mut out = Vec::new();
     let cap = usize::try_from(limit.min(MAX_CHUNK_BYTES)).unwrap_or(0);
     out.try_reserve(cap)
-        .map_err(|_| format!("cannot allocate {limit} bytes to decode it"))?;
+        .map_err(|_| fail(format!("cannot allocate {limit} bytes to decode it")))?;
     reader
         .take(limit.saturating_add(1))
         .read_to_end(&mut out)
-        .map_err(|e| format!("{codec}: {e}"))?;
+        .map_err(|e| fail(format!("{codec}: {e}")))?;
     if out.len() as u64 > limit {
-        return Err(format!(
+        return Err(fail(format!(
             "{codec} inflates it past the {limit} bytes a chunk of this array holds"
-        ));
+        )));
     }
     Ok(out)
 }
@@ -625,12 +688,12 @@ fn codecs(
             ("crc32c", true) => after.push(Codec::Crc32c),
             ("blosc", true) => {
                 let config = config.cloned().unwrap_or(Value::Null);
-                blosc_codec(&config).map_err(|e| refuse(&e))?;
+                blosc_codec(&config).map_err(|e| refuse(&e.message))?;
                 after.push(Codec::Blosc(config));
             }
             ("numcodecs.zfpy", false) => {
                 let config = config.cloned().unwrap_or(Value::Null);
-                zfp = Some(zfp::Zfp::new(&config, data_type).map_err(|e| refuse(&e))?);
+                zfp = Some(zfp::Zfp::new(&config, data_type).map_err(|e| refuse(&e.message))?);
                 big_endian = Some(false);
             }
             ("numcodecs.zfpy", true) => {
@@ -718,7 +781,7 @@ impl ArrayMeta {
     /// Chunk `index` decoded to f32 values (the last axis fastest), or `None` where its
     /// file is absent (zarr's "all fill value"). Errors say what is wrong, without the
     /// file's name (the caller names it).
-    pub fn read_chunk(&self, index: &[u64]) -> Result<Option<Vec<f32>>, String> {
+    pub fn read_chunk(&self, index: &[u64]) -> Result<Option<Vec<f32>>, ChunkError> {
         let Some(data) = self.read_chunk_bytes(index)? else {
             return Ok(None);
         };
@@ -737,7 +800,7 @@ impl ArrayMeta {
     }
 
     /// [`ArrayMeta::read_chunk`] in f64 (coordinates that need it).
-    pub fn read_chunk_f64(&self, index: &[u64]) -> Result<Option<Vec<f64>>, String> {
+    pub fn read_chunk_f64(&self, index: &[u64]) -> Result<Option<Vec<f64>>, ChunkError> {
         Ok(self
             .read_chunk_bytes(index)?
             .map(|data| self.values(&data).collect()))
@@ -750,19 +813,17 @@ impl ArrayMeta {
     }
 
     /// Chunk `index`'s decoded bytes, exactly one chunk's worth, or `None` where absent.
-    fn read_chunk_bytes(&self, index: &[u64]) -> Result<Option<Vec<u8>>, String> {
+    fn read_chunk_bytes(&self, index: &[u64]) -> Result<Option<Vec<u8>>, ChunkError> {
         let file = self.chunk_file(index);
         let max = self.max_encoded_bytes();
         let data = match crate::fetch::read_object(&file, max) {
             Ok(Some(data)) => data,
             Ok(None) => return Ok(None),
-            Err(crate::fetch::FetchError::TooLarge { bytes, .. }) => {
-                return Err(format!(
-                "the file holds {bytes} bytes; its codecs ({}) can make at most {max} of a chunk",
-                self.codec_names()
-            ))
+            Err(FetchError::TooLarge { bytes, .. }) => {
+                let codecs = self.codec_names();
+                return Err(ChunkError::TooLarge { bytes, max, codecs });
             }
-            Err(e) => return Err(e.to_string()),
+            Err(e) => return Err(e.into()),
         };
         let mut data = std::sync::Arc::unwrap_or_clone(data);
         let decoded = self.chunk_elements() * self.data_type.size();
@@ -772,22 +833,18 @@ impl ArrayMeta {
             limits.push(c.bound(last));
         }
         for (k, codec) in self.codecs.iter().enumerate().rev() {
-            data = codec
-                .decode(data, limits[k])
-                .map_err(|e| format!("cannot be decoded: {e}"))?;
+            data = codec.decode(data, limits[k])?;
         }
         if let Some(z) = &self.zfp {
-            data = z
-                .decode(&data, &self.chunks, self.data_type)
-                .map_err(|e| format!("cannot be decoded: {e}"))?;
+            data = z.decode(&data, &self.chunks, self.data_type)?;
         }
         if data.len() != decoded {
-            return Err(format!(
-                "decodes to {} bytes, not the {decoded} of a {:?} chunk of {}",
-                data.len(),
-                self.chunks,
-                self.data_type.name()
-            ));
+            return Err(ChunkError::Size {
+                got: data.len(),
+                want: decoded,
+                chunks: self.chunks.clone(),
+                data_type: self.data_type.name(),
+            });
         }
         Ok(Some(data))
     }

@@ -105,8 +105,8 @@ fn reads_what_zarrs_writes_with_each_codec() {
         assert!(a.fill_value.is_nan(), "{name}");
         assert_eq!(read_all(&a), values, "{name}");
         assert_eq!(
-            a.read_chunk(&[5, 0, 0]),
-            Ok(None),
+            a.read_chunk(&[5, 0, 0]).ok(),
+            Some(None),
             "an absent chunk is the fill value"
         );
         std::fs::remove_dir_all(&dir).unwrap();
@@ -133,7 +133,7 @@ fn a_blosc_header_declaring_more_than_the_chunk_is_refused_before_decoding() {
     let mut bytes = std::fs::read(&file).unwrap();
     bytes[4..8].copy_from_slice(&u32::MAX.to_le_bytes());
     std::fs::write(&file, &bytes).unwrap();
-    let e = a.read_chunk(&[0, 0, 0]).unwrap_err();
+    let e = a.read_chunk(&[0, 0, 0]).unwrap_err().to_string();
     assert!(
         e.contains("its blosc header declares 4294967295 bytes"),
         "{e}"
@@ -141,7 +141,7 @@ fn a_blosc_header_declaring_more_than_the_chunk_is_refused_before_decoding() {
     bytes[4..8].copy_from_slice(&256u32.to_le_bytes());
     bytes[12..16].copy_from_slice(&7u32.to_le_bytes());
     std::fs::write(&file, &bytes).unwrap();
-    let e = a.read_chunk(&[0, 0, 0]).unwrap_err();
+    let e = a.read_chunk(&[0, 0, 0]).unwrap_err().to_string();
     assert!(e.contains("does not fit"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -152,7 +152,7 @@ fn read_hostile_chunk(name: &str, bytes: &[u8]) -> String {
     write_array(&dir, vec![Arc::new(ZstdCodec::new(1, false))]);
     let a = open_array(&dir.join("a")).unwrap();
     std::fs::write(a.chunk_file(&[0, 0, 0]), bytes).unwrap();
-    let e = a.read_chunk(&[0, 0, 0]).unwrap_err();
+    let e = a.read_chunk(&[0, 0, 0]).unwrap_err().to_string();
     std::fs::remove_dir_all(&dir).unwrap();
     e
 }
@@ -212,7 +212,7 @@ fn a_fifo_as_a_chunk_is_refused_at_once() {
         .status()
         .unwrap();
     assert!(status.success());
-    let e = a.read_chunk(&[0, 0, 0]).unwrap_err();
+    let e = a.read_chunk(&[0, 0, 0]).unwrap_err().to_string();
     assert!(e.contains("FIFO"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -149,7 +149,7 @@ fn compressor(c: &Value, t: DataType, file: &Path) -> Result<Codec, StoreError> 
                 "typesize": t.size(),
                 "blocksize": c.get("blocksize").cloned().unwrap_or(json!(0)),
             });
-            super::blosc_codec(&config).map_err(refuse)?;
+            super::blosc_codec(&config).map_err(|e| refuse(e.message))?;
             Ok(Codec::Blosc(config))
         }
         Some("zstd") => Ok(Codec::Zstd),

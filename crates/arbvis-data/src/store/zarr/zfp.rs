@@ -15,7 +15,12 @@
 
 use serde_json::Value;
 
-use super::DataType;
+use super::{CodecError, DataType};
+
+/// An error of the zfpy codec.
+fn zfp_error(message: impl Into<String>) -> CodecError {
+    CodecError::new("zfpy", message)
+}
 
 /// zfp's most bits per block in its short modes but fixed rate (`ZFP_MAX_BITS`).
 const MAX_BITS: u64 = 16658;
@@ -36,30 +41,30 @@ pub struct Zfp {
 impl Zfp {
     /// Read a configuration (v3's `configuration`, or v2's compressor object) for an
     /// array of `data_type`.
-    pub fn new(config: &Value, data_type: DataType) -> Result<Zfp, String> {
+    pub fn new(config: &Value, data_type: DataType) -> Result<Zfp, CodecError> {
         let mut config = config.clone();
         if let Some(map) = config.as_object_mut() {
             map.remove("id");
             map.remove("compression_kwargs");
         }
         let mode = config.get("mode").and_then(Value::as_i64).ok_or_else(|| {
-            format!(
+            zfp_error(format!(
                 "configuration {config}: no `mode` (2 rate, 3 precision, 4 accuracy, 5 reversible)"
-            )
+            ))
         })?;
         if !(2..=5).contains(&mode) {
-            return Err(format!(
+            return Err(zfp_error(format!(
                 "mode {mode}: numcodecs' zfpy modes are 2 (fixed rate), 3 (fixed precision), 4 (fixed accuracy) and 5 (reversible)"
-            ));
+            )));
         }
         if !matches!(
             data_type,
             DataType::Float32 | DataType::Float64 | DataType::Int32 | DataType::Int64
         ) {
-            return Err(format!(
+            return Err(zfp_error(format!(
                 "zfpy on {}: zfp compresses float32, float64, int32 and int64",
                 data_type.name()
-            ));
+            )));
         }
         let zfp = Zfp { config, mode };
         zfp.check_configuration()?;
@@ -90,21 +95,21 @@ impl Zfp {
     }
 
     #[cfg(feature = "zfp")]
-    fn codec(&self) -> Result<zarrs::array::codec::ZfpyCodec, String> {
+    fn codec(&self) -> Result<zarrs::array::codec::ZfpyCodec, CodecError> {
         let configuration: zarrs::metadata_ext::codec::zfpy::ZfpyCodecConfiguration =
             serde_json::from_value(self.config.clone())
-                .map_err(|e| format!("zfpy configuration {}: {e}", self.config))?;
+                .map_err(|e| zfp_error(format!("zfpy configuration {}: {e}", self.config)))?;
         zarrs::array::codec::ZfpyCodec::new_with_configuration(&configuration)
-            .map_err(|e| format!("zfpy configuration {}: {e}", self.config))
+            .map_err(|e| zfp_error(format!("zfpy configuration {}: {e}", self.config)))
     }
 
     #[cfg(feature = "zfp")]
-    fn check_configuration(&self) -> Result<(), String> {
+    fn check_configuration(&self) -> Result<(), CodecError> {
         self.codec().map(|_| ())
     }
 
     #[cfg(not(feature = "zfp"))]
-    fn check_configuration(&self) -> Result<(), String> {
+    fn check_configuration(&self) -> Result<(), CodecError> {
         Ok(())
     }
 
@@ -115,7 +120,7 @@ impl Zfp {
         data: &[u8],
         shape: &[u64],
         data_type: DataType,
-    ) -> Result<Vec<u8>, String> {
+    ) -> Result<Vec<u8>, CodecError> {
         let header = Header::read(data)?;
         let want_type = match data_type {
             DataType::Int32 => 1,
@@ -125,7 +130,7 @@ impl Zfp {
         };
         let sizes: Vec<u64> = shape.iter().rev().copied().collect();
         if header.scalar != want_type || header.sizes != sizes {
-            return Err(format!(
+            return Err(zfp_error(format!(
                 "its zfp header describes {} values of type {} ({}), not the chunk's {:?} of {}",
                 header
                     .sizes
@@ -139,7 +144,7 @@ impl Zfp {
                     .unwrap_or(&"?"),
                 shape,
                 data_type.name()
-            ));
+            )));
         }
         let blocks: u64 = shape.iter().map(|n| n.div_ceil(4)).product();
         let most = (header.bits + blocks.saturating_mul(header.max_bits)).div_ceil(8) + 16;
@@ -153,20 +158,20 @@ impl Zfp {
         most: u64,
         shape: &[u64],
         data_type: DataType,
-    ) -> Result<Vec<u8>, String> {
+    ) -> Result<Vec<u8>, CodecError> {
         use std::num::NonZeroU64;
         use zarrs::array::ArrayToBytesCodecTraits;
         let mut padded = Vec::new();
         let len = usize::try_from(most.max(data.len() as u64))
-            .map_err(|_| "its zfp stream is too large".to_string())?;
+            .map_err(|_| zfp_error("its zfp stream is too large"))?;
         padded
             .try_reserve_exact(len)
-            .map_err(|_| format!("cannot allocate {len} bytes to decode it"))?;
+            .map_err(|_| zfp_error(format!("cannot allocate {len} bytes to decode it")))?;
         padded.extend_from_slice(data);
         padded.resize(len, 0);
         let shape: Vec<NonZeroU64> = shape
             .iter()
-            .map(|&n| NonZeroU64::new(n).ok_or("a chunk side of 0"))
+            .map(|&n| NonZeroU64::new(n).ok_or_else(|| zfp_error("a chunk side of 0")))
             .collect::<Result<_, _>>()?;
         let (zarrs_type, fill) = match data_type {
             DataType::Int32 => (
@@ -195,14 +200,22 @@ impl Zfp {
                 &zarrs::array::FillValue::new(fill),
                 &zarrs::array::CodecOptions::default(),
             )
-            .map_err(|e| format!("zfp: {e}"))?;
-        let bytes = decoded.into_fixed().map_err(|e| format!("zfp: {e}"))?;
+            .map_err(|e| zfp_error(format!("zfp: {e}")))?;
+        let bytes = decoded
+            .into_fixed()
+            .map_err(|e| zfp_error(format!("zfp: {e}")))?;
         Ok(bytes.into_owned())
     }
 
     #[cfg(not(feature = "zfp"))]
-    fn decode_padded(&self, _: &[u8], _: u64, _: &[u64], _: DataType) -> Result<Vec<u8>, String> {
-        Err("this arbvis was built without its `zfp` feature (a default feature; it needs cmake and libclang to build), so it cannot decode ZFP chunks".into())
+    fn decode_padded(
+        &self,
+        _: &[u8],
+        _: u64,
+        _: &[u64],
+        _: DataType,
+    ) -> Result<Vec<u8>, CodecError> {
+        Err(zfp_error("this arbvis was built without its `zfp` feature (a default feature; it needs cmake and libclang to build), so it cannot decode ZFP chunks"))
     }
 }
 
@@ -234,14 +247,14 @@ fn bits(data: &[u8], at: u64, n: u32) -> Option<u64> {
 impl Header {
     /// The full header zfpy writes: 32 bits of magic (`zfp` and the codec version), 52 of
     /// the field (type, axes, sizes), 12 or 64 of the mode.
-    fn read(data: &[u8]) -> Result<Header, String> {
-        let short = || format!("{} bytes: shorter than a zfp header", data.len());
+    fn read(data: &[u8]) -> Result<Header, CodecError> {
+        let short = || zfp_error(format!("{} bytes: shorter than a zfp header", data.len()));
         let magic = bits(data, 0, 32).ok_or_else(short)?;
         if magic & 0xff_ffff != u64::from_le_bytes(*b"zfp\0\0\0\0\0") || magic >> 24 != CODEC {
-            return Err(format!(
+            return Err(zfp_error(format!(
                 "no zfp header (expected the magic `zfp` and codec {CODEC}, found bytes {:02x?})",
                 &data[..4.min(data.len())]
-            ));
+            )));
         }
         let meta = bits(data, 32, 52).ok_or_else(short)?;
         let scalar = (meta & 3) + 1;
@@ -331,7 +344,10 @@ mod tests {
                 DataType::Float32,
             )
             .unwrap_err();
-        assert!(e.contains("4 x 4 x 8") && e.contains("[4, 4, 4]"), "{e}");
+        assert!(
+            e.message.contains("4 x 4 x 8") && e.message.contains("[4, 4, 4]"),
+            "{e}"
+        );
         let e = r
             .decode(
                 &header(4, &[4, 4, 4], 2048 + 128),
@@ -339,14 +355,16 @@ mod tests {
                 DataType::Float32,
             )
             .unwrap_err();
-        assert!(e.contains("type 4 (double)"), "{e}");
+        assert!(e.message.contains("type 4 (double)"), "{e}");
         assert!(r
             .decode(b"zfq\x05abcdefghijkl", &[4], DataType::Float32)
             .unwrap_err()
+            .message
             .contains("no zfp header"));
         assert!(r
             .decode(b"zf", &[4], DataType::Float32)
             .unwrap_err()
+            .message
             .contains("shorter"));
         assert!(Zfp::new(&serde_json::json!({"mode": 1}), DataType::Float32).is_err());
         assert!(Zfp::new(&serde_json::json!({"mode": 5}), DataType::UInt8).is_err());
