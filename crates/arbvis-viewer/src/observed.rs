@@ -35,4 +35,6 @@ pub struct Observed<'a> {
     pub action_error: Option<String>,
     /// The interactive quality's name.
     pub quality: &'static str,
+    /// The divisor of each side the next interactive picture is drawn at.
+    pub scale: f64,
 }

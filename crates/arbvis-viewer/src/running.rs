@@ -193,6 +193,7 @@ impl Running {
             overlay: &self.panel.overlay_items,
             action_error: self.action_error.take(),
             quality: self.panel.quality.name(),
+            scale: self.session.picture().scale,
         }
     }
 

@@ -165,7 +165,8 @@ pub struct Picture {
     pub interactive_ms: f64,
     /// Parts the last full-quality picture was drawn in.
     pub parts: usize,
-    /// The divisor of each side the last reduced picture was drawn at.
+    /// The divisor of each side the next reduced picture is drawn at (under the budget:
+    /// the last one's, adapted to its time).
     pub scale: f64,
     /// The budget the frames are held to.
     pub budget: FrameBudget,

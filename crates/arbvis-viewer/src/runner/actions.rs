@@ -310,7 +310,7 @@ impl ScriptRunner {
         }
         let ms = now.duration_since(t0).as_secs_f64() * 1e3 / n as f64;
         println!(
-            "measure {}: {n} frames, {ms:.1} ms per frame ({:.2} fps), view {}x{}, window {}x{}, interactive quality {} (script line {})",
+            "measure {}: {n} frames, {ms:.1} ms per frame ({:.2} fps), view {}x{}, window {}x{}, interactive quality {} (scale 1/{:.1}) (script line {})",
             mode.name(),
             1e3 / ms.max(1e-9),
             o.view_px[0],
@@ -318,6 +318,7 @@ impl ScriptRunner {
             o.window[0],
             o.window[1],
             o.quality,
+            o.scale,
             step.line
         );
         Outcome::Done
