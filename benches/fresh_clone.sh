@@ -25,7 +25,7 @@ s=$(date +%s)
 cargo test --workspace --no-run -q > "$d.rebuild.log" 2>&1; rc=$?
 e=$(date +%s); echo "rebuild after touching splats/renderer.rs: rc=$rc $((e-s)) s"
 s=$(date +%s)
-cargo test -q --test it splats > "$d.splats.log" 2>&1; rc=$?
-e=$(date +%s); echo "then the splats tests (cargo test --test it splats): rc=$rc $((e-s)) s"
+cargo test -q --workspace --test it splats > "$d.splats.log" 2>&1; rc=$?
+e=$(date +%s); echo "then the splats tests (cargo test --workspace --test it splats): rc=$rc $((e-s)) s"
 grep -E "^test result" "$d.splats.log"
 uptime

@@ -13,3 +13,24 @@ ROOT = Path(__file__).resolve().parents[2]
 def root():
     """The repository's root."""
     return ROOT
+
+
+@pytest.fixture
+def f3_store_scene(tmp_path):
+    """The F3 crop converted to a store of 16³ bricks in `tmp_path`, and a 48 x 40 scene of
+    its amplitude in the seismic table (the store's fixed range)."""
+    import arbvis
+
+    store = tmp_path / "f3.zarr"
+    arbvis.convert(ROOT / "data/seismic/f3.sgy", store, brick=16)
+    return arbvis.Scene.from_toml(
+        f"""
+size = [48, 40]
+[technique.opacity3d]
+slices = 64
+[technique.opacity3d.primary]
+volume = {{ store = "{store}" }}
+quantize = {{ range = [-6000.0, 6000.0] }}
+table = {{ builtin = "seismic" }}
+"""
+    )

@@ -11,20 +11,8 @@ import arbvis.dask
 distributed = pytest.importorskip("dask.distributed")
 
 
-def test_an_orbit_of_a_store_on_two_workers_equals_one_process(root, tmp_path):
-    store = tmp_path / "f3.zarr"
-    arbvis.convert(root / "data/seismic/f3.sgy", store, brick=16)
-    scene = arbvis.Scene.from_toml(
-        f"""
-size = [48, 40]
-[technique.opacity3d]
-slices = 64
-[technique.opacity3d.primary]
-volume = {{ store = "{store}" }}
-quantize = {{ range = [-6000.0, 6000.0] }}
-table = {{ builtin = "seismic" }}
-"""
-    )
+def test_an_orbit_of_a_store_on_two_workers_equals_one_process(f3_store_scene, tmp_path):
+    scene = f3_store_scene
     views = arbvis.dask.orbit(6)
     with distributed.LocalCluster(
         n_workers=2,

@@ -167,15 +167,15 @@ def test_a_technique_without_a_reference_says_none():
         assert r.reference() is None
 
 
-def test_a_turned_copc_cloud_and_store_equal_a_fresh_renderers_views(root, tmp_path):
+def test_a_turned_copc_cloud_and_store_equal_a_fresh_renderers_views(
+    root, tmp_path, f3_store_scene
+):
     # One renderer turned through an orbit draws each view as a renderer made for that
     # view does: a COPC cloud's cut and a store's bricks follow the camera (a renderer
     # that kept its first cut differed by up to 0.84 on 44 % of the pixels).
     copc = tmp_path / "autzen.copc.laz"
     written = arbvis.convert(root / "data/points/autzen_trim.laz", copc, node_points=2000)
     assert written["nodes"] > 10 and written["levels"] > 2, written
-    store = tmp_path / "f3.zarr"
-    arbvis.convert(root / "data/seismic/f3.sgy", store, brick=16)
     cloud = arbvis.Scene.from_toml(
         f"""
 size = [160, 120]
@@ -188,18 +188,7 @@ colour = "rgb"
 point_size = 3.0
 """
     )
-    survey = arbvis.Scene.from_toml(
-        f"""
-size = [48, 40]
-[technique.opacity3d]
-slices = 48
-[technique.opacity3d.primary]
-volume = {{ store = "{store}" }}
-quantize = {{ range = [-6000.0, 6000.0] }}
-table = {{ builtin = "seismic" }}
-"""
-    )
-    for scene in (cloud, survey):
+    for scene in (cloud, f3_store_scene):
         pictures = []
         with arbvis.Renderer(scene) as turned:
             for rotation in arbvis.dask.orbit(5, elevation_deg=35.0):
@@ -211,3 +200,23 @@ table = {{ builtin = "seismic" }}
                 assert np.array_equal(picture, expected), rotation
                 pictures.append(picture)
         assert not np.array_equal(pictures[0], pictures[2])
+
+
+def test_interactive_frames_shrink_within_the_budget_and_a_full_render_follows():
+    scene = arbvis.Scene.demo("v3o2-sum")
+    scene.size = (120, 90)
+    with arbvis.Renderer(scene) as r:
+        assert r.budget_ms == 66.0
+        with pytest.raises(ValueError):
+            r.budget_ms = 0.0
+        # A budget no frame meets: each frame's scale doubles, to a tenth of each side.
+        r.budget_ms = 1e-6
+        shapes = []
+        for k in range(5):
+            scene.zoom = 1.0 + 0.01 * k
+            shapes.append(r.render(interactive=True).shape)
+        # 1/2, 1/4, 1/8, then 1/10 of 120 x 90 (sides rounded).
+        assert shapes == [(45, 60, 4), (23, 30, 4), (11, 15, 4), (9, 12, 4), (9, 12, 4)]
+        full = r.render()
+        with arbvis.Renderer(scene) as fresh:
+            assert np.array_equal(full, fresh.render())

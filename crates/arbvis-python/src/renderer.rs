@@ -19,7 +19,7 @@ use arbvis_gl::Backend;
 use arbvis_techniques::catalog;
 use arbvis_techniques::error::RenderResult;
 use arbvis_techniques::scene::Scene;
-use arbvis_techniques::session::Offscreen;
+use arbvis_techniques::session::{FrameBudget, Offscreen};
 use arbvis_techniques::techniques::ReferenceView;
 
 use crate::errors;
@@ -38,8 +38,11 @@ pub fn backend_named(name: &str) -> PyResult<Backend> {
 
 /// What the render thread is asked.
 enum Job {
-    /// Draw the scene; the picture (composited as a PNG shows it) back.
-    Render(Box<Scene>, Sender<RenderResult<Image>>),
+    /// Draw the scene (whole, or as an interactive frame within the budget); the picture
+    /// (composited as a PNG shows it) back.
+    Render(Box<Scene>, bool, Sender<RenderResult<Image>>),
+    /// Keep interactive frames to this many milliseconds.
+    Budget(f64),
 }
 
 /// What the render thread says once its context and renderer are made.
@@ -68,9 +71,19 @@ fn serve(scene: Scene, backend: Backend, ready: Sender<RenderResult<Ready>>, job
     }));
     while let Ok(job) = jobs.recv() {
         match job {
-            Job::Render(scene, reply) => {
-                let picture = session.render(&scene).map(|frame| scene.picture(&frame));
-                let _ = reply.send(picture);
+            Job::Render(scene, interactive, reply) => {
+                let frame = match interactive {
+                    true => session.render_interactive(&scene),
+                    false => session.render(&scene),
+                };
+                let _ = reply.send(frame.map(|frame| scene.picture(&frame)));
+            }
+            Job::Budget(ms) => {
+                let interactive = std::time::Duration::from_secs_f64(ms / 1e3);
+                session.set_budget(FrameBudget {
+                    interactive,
+                    ..session.budget()
+                });
             }
         }
     }
@@ -92,6 +105,7 @@ pub struct PyRenderer {
     max_3d_texture_size: i32,
     backend: &'static str,
     renderer: String,
+    budget_ms: f64,
 }
 
 #[pymethods]
@@ -121,18 +135,22 @@ impl PyRenderer {
             max_3d_texture_size: made.max_3d_texture_size,
             backend: made.backend,
             renderer: made.renderer,
+            budget_ms: FrameBudget::default().interactive.as_secs_f64() * 1e3,
         })
     }
 
     /// Draw the scene (or `scene`, which becomes the renderer's) as it is now: an
     /// `(height, width, 4)` numpy array, top row first, as a PNG of it would show it;
     /// `uint8` for an 8-bit target (faithful), `float32` for a float one (precise), handed
-    /// to numpy without a copy.
-    #[pyo3(signature = (scene = None))]
+    /// to numpy without a copy. `interactive=True` draws a frame as while the user drags:
+    /// within `budget_ms`, at a scale the last frames' times chose (down to a tenth of each
+    /// side: a smaller array), without waiting for streamed data.
+    #[pyo3(signature = (scene = None, interactive = false))]
     fn render<'py>(
         &mut self,
         py: Python<'py>,
         scene: Option<Py<PyScene>>,
+        interactive: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         if let Some(s) = scene {
             self.scene = s;
@@ -143,7 +161,7 @@ impl PyRenderer {
             .as_ref()
             .ok_or_else(|| PyRuntimeError::new_err("the renderer is closed"))?;
         let (reply, picture) = channel();
-        jobs.send(Job::Render(Box::new(scene), reply))
+        jobs.send(Job::Render(Box::new(scene), interactive, reply))
             .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?;
         let image = py
             .detach(move || picture.recv())
@@ -173,6 +191,29 @@ impl PyRenderer {
             })
             .map_err(errors::from_render)?;
         Ok(image.map(|i| to_array(py, i)))
+    }
+
+    /// Milliseconds an interactive frame may take (default 66: 15 frames per second).
+    #[getter]
+    fn budget_ms(&self) -> f64 {
+        self.budget_ms
+    }
+
+    #[setter]
+    fn set_budget_ms(&mut self, ms: f64) -> PyResult<()> {
+        if !(ms.is_finite() && ms > 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "budget_ms {ms}: a positive number of milliseconds"
+            )));
+        }
+        let jobs = self
+            .jobs
+            .as_ref()
+            .ok_or_else(|| PyRuntimeError::new_err("the renderer is closed"))?;
+        jobs.send(Job::Budget(ms))
+            .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?;
+        self.budget_ms = ms;
+        Ok(())
     }
 
     /// The scene this renderer draws.

@@ -9,6 +9,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
+use arbvis_data::store::compression::UnknownCompression;
 use arbvis_data::store::convert::{convert as convert_store, ConvertOptions, Watch};
 use arbvis_data::store::StoreError;
 use arbvis_data::volume::attributes::{by_name, Attribute};
@@ -98,7 +99,9 @@ pub fn convert<'py>(
             Some(a) => derived.push(a),
         }
     }
-    let compression = compression.parse().map_err(PyValueError::new_err)?;
+    let compression = compression
+        .parse()
+        .map_err(|e: UnknownCompression| PyValueError::new_err(e.to_string()))?;
     // What the callback raised (on a conversion thread), raised here afterwards.
     let raised: Arc<Mutex<Option<PyErr>>> = Arc::default();
     let watch = progress.map(|callback| {

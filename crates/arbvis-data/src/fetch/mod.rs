@@ -28,8 +28,9 @@ mod offline;
 pub mod ranged;
 #[cfg(feature = "remote")]
 mod whole;
+// Without `remote`, the same two names stand for the refusals.
 #[cfg(not(feature = "remote"))]
-use offline::{ranged, whole};
+pub(crate) use offline::{ranged, whole};
 
 pub use count::{stats, status, Stats};
 pub use file::{Cursor, File};
@@ -352,10 +353,15 @@ mod error_tests {
 
     #[test]
     fn a_failed_fetch_is_an_error_with_its_url_and_range_as_fields() {
-        let e = client::object("s3://bucket-only").err().expect("no object named");
+        let e = client::object("s3://bucket-only")
+            .err()
+            .expect("no object named");
         assert_eq!(e.url(), Some("s3://bucket-only"));
         assert_eq!(e.range(), None);
-        assert!(e.to_string().contains("names a bucket and an object"), "{e}");
+        assert!(
+            e.to_string().contains("names a bucket and an object"),
+            "{e}"
+        );
         let e = read_text(Path::new("ftp://h/o"), 10);
         // Not a URL arbvis fetches: read as a local path that is not there.
         assert!(e.is_err_and(|e| e.url().is_none()));

@@ -56,19 +56,23 @@ impl fmt::Display for Compression {
     }
 }
 
+/// A compression's name that is not one ([`Compression::from_str`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("'{0}': expected lz4, zstd, zstd:LEVEL (1-22) or none")]
+pub struct UnknownCompression(pub String);
+
 impl FromStr for Compression {
-    type Err = String;
+    type Err = UnknownCompression;
 
     /// `lz4`, `zstd` (level 1), `zstd:LEVEL` (1-22) or `none`.
-    fn from_str(s: &str) -> Result<Self, String> {
-        let wanted = "expected lz4, zstd, zstd:LEVEL (1-22) or none";
+    fn from_str(s: &str) -> Result<Self, UnknownCompression> {
         match s {
             "none" => Ok(Compression::None),
             "lz4" => Ok(Compression::Lz4),
             "zstd" => Ok(Compression::Zstd(1)),
             _ => match s.strip_prefix("zstd:").map(str::parse::<i32>) {
                 Some(Ok(level)) if (1..=22).contains(&level) => Ok(Compression::Zstd(level)),
-                _ => Err(format!("'{s}': {wanted}")),
+                _ => Err(UnknownCompression(s.to_string())),
             },
         }
     }
@@ -90,7 +94,7 @@ mod tests {
         }
         assert_eq!("zstd".parse::<Compression>(), Ok(Compression::Zstd(1)));
         for bad in ["zstd:0", "zstd:23", "zstd:x", "gzip", "", "LZ4"] {
-            let e = bad.parse::<Compression>().unwrap_err();
+            let e = bad.parse::<Compression>().unwrap_err().to_string();
             assert!(e.contains("expected lz4"), "{bad}: {e}");
         }
     }

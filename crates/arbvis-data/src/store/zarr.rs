@@ -502,16 +502,19 @@ const GROUP_FIELDS: &[&str] = &[
 /// A field of a zarr v3 metadata document that is not one of `known`: the spec (2.1,
 /// "extension definitions") says an implementation must fail to open a node with one,
 /// unless the field is an object whose `must_understand` is `false`.
-fn unknown_fields(doc: &Value, known: &[&str]) -> Result<(), String> {
+fn unknown_fields(file: &Path, doc: &Value, known: &[&str]) -> Result<(), StoreError> {
     let Some(fields) = doc.as_object() else {
-        return Err("the metadata is not a JSON object".into());
+        return Err(StoreError::invalid(
+            file,
+            "the metadata is not a JSON object",
+        ));
     };
     for (name, value) in fields {
         let optional = value.get("must_understand").and_then(Value::as_bool) == Some(false);
         if !known.contains(&name.as_str()) && !optional {
-            return Err(format!(
+            return Err(StoreError::invalid(file, format!(
                 "field `{name}` is not one arbvis knows, and it does not say `\"must_understand\": false`: the zarr v3 spec has a reader refuse such a node"
-            ));
+            )));
         }
     }
     Ok(())
@@ -529,7 +532,7 @@ pub fn check_group(doc: &Value, file: &Path) -> Result<(), StoreError> {
             ),
         ));
     }
-    unknown_fields(doc, GROUP_FIELDS).map_err(|m| StoreError::invalid(file, m))
+    unknown_fields(file, doc, GROUP_FIELDS)
 }
 
 /// The array at `folder` (its `zarr.json`), every field checked.
@@ -549,7 +552,7 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
     if doc.get("node_type").and_then(Value::as_str) != Some("array") {
         return Err(invalid("`node_type` is not \"array\"".into()));
     }
-    unknown_fields(&doc, ARRAY_FIELDS).map_err(invalid)?;
+    unknown_fields(&file, &doc, ARRAY_FIELDS)?;
     let shape = sizes(field(&doc, "shape", &file)?, "shape", &file, 0)?;
     let type_name = field(&doc, "data_type", &file)?;
     let data_type = type_name

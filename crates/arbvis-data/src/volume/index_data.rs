@@ -20,11 +20,28 @@ pub struct SlotGrid {
     pub side: usize,
 }
 
+/// Slots that no texture of the GL's largest size holds ([`SlotGrid::arrange`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "{count} slots of {side}³ texels do not fit a texture of at most {max_size}³ texels (at most {cap} slots per side, {} in all)",
+    cap.saturating_pow(3)
+)]
+pub struct SlotsDoNotFit {
+    /// Slots asked for.
+    pub count: usize,
+    /// Texels per side of a slot.
+    pub side: usize,
+    /// Texels per side of the largest texture.
+    pub max_size: usize,
+    /// Slots per side that fit.
+    pub cap: usize,
+}
+
 impl SlotGrid {
     /// The near-cubic arrangement of `count` slots of side `side` within `max_size`
     /// texels per axis: the largest count of slots per axis as small as possible
     /// (`ceil(cbrt(count))`), then the fewest slots in all. An error says why it does not fit.
-    pub fn arrange(count: usize, side: usize, max_size: usize) -> Result<SlotGrid, String> {
+    pub fn arrange(count: usize, side: usize, max_size: usize) -> Result<SlotGrid, SlotsDoNotFit> {
         if count == 0 {
             return Ok(SlotGrid {
                 slots: [0; 3],
@@ -40,10 +57,12 @@ impl SlotGrid {
             m -= 1;
         }
         if m > cap {
-            return Err(format!(
-                "{count} slots of {side}³ texels do not fit a texture of at most {max_size}³ texels (at most {cap} slots per side, {} in all)",
-                cap.saturating_pow(3)
-            ));
+            return Err(SlotsDoNotFit {
+                count,
+                side,
+                max_size,
+                cap,
+            });
         }
         let mut best = [m, m, m];
         for sx in 1..=m {
@@ -120,7 +139,7 @@ mod tests {
         assert!(g.iter().product::<usize>() < 2600 + 14 * 14, "{g:?}");
         // 204 slots of 10 texels per side fit 2048; 204³ + 1 slots do not.
         assert_eq!(arrange(204usize.pow(3), 10).unwrap(), [204; 3]);
-        let e = arrange(204usize.pow(3) + 1, 10).unwrap_err();
+        let e = arrange(204usize.pow(3) + 1, 10).unwrap_err().to_string();
         assert!(e.contains("do not fit") && e.contains("2048"), "{e}");
         assert!(arrange(1, 3000).is_err());
     }

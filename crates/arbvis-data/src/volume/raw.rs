@@ -40,7 +40,7 @@ impl RawSpec {
     /// Check what the scene says: positive dims whose byte size fits 64 bits, positive
     /// finite spacing.
     pub fn validate(&self) -> Result<(), FieldError> {
-        self.byte_size().map_err(|m| FieldError::new("", m))?;
+        self.byte_size()?;
         if self.spacing.iter().any(|v| !v.is_finite() || *v <= 0.0) {
             return Err(FieldError::new(
                 "",
@@ -51,7 +51,7 @@ impl RawSpec {
     }
 
     /// Bytes the file must hold: `offset + ni*nj*nk*bytes`, with checked arithmetic.
-    fn byte_size(&self) -> Result<u64, String> {
+    fn byte_size(&self) -> Result<u64, FieldError> {
         let samples = self
             .dims
             .iter()
@@ -61,12 +61,13 @@ impl RawSpec {
             .and_then(|n| n.checked_mul(self.sample.bytes() as u64))
             .and_then(|n| n.checked_add(self.offset))
             .ok_or_else(|| {
-                format!(
+                let message = format!(
                     "dims {:?} of {} after an offset of {} bytes: the dims must be positive and the size must fit 64 bits",
                     self.dims,
                     self.sample.name(),
                     self.offset
-                )
+                );
+                FieldError::new("", message)
             })
     }
 }
@@ -77,7 +78,7 @@ pub fn read(base: &Path, spec: &RawSpec, limits: &super::Limits) -> Result<Volum
     let path = base.join(&spec.path);
     let need = spec
         .byte_size()
-        .map_err(|e| VolumeError::Invalid(format!("{}: {e}", path.display())))?;
+        .map_err(|e| VolumeError::Invalid(format!("{}: {}", path.display(), e.message)))?;
     limits.check(spec.dims, &path.display().to_string())?;
     let (_, len) = crate::input::open_regular(&path).map_err(|e| VolumeError::io(&path, e))?;
     if len != need {

@@ -6,7 +6,7 @@ use crate::gl::{Backend, Caps, Headless, ProgramKind};
 use crate::image::Image;
 use crate::scene::Scene;
 
-use super::{Mode, Session};
+use super::{FrameBudget, Mode, Session};
 
 /// A scene kept ready to draw frame after frame: its context and [`Session`]. A changed
 /// camera, size, background or technique parameter costs a frame; another technique,
@@ -35,6 +35,30 @@ impl Offscreen {
         self.session.apply(gpu, scene)?;
         self.session.frame(gpu, scene, Mode::Complete)?;
         self.session.read(gpu, scene)
+    }
+
+    /// Draw `scene` as a frame while the user interacts (a notebook's drag): reduced to
+    /// keep within the frame budget ([`Offscreen::set_budget`]), at the scale the last
+    /// frames' times chose (from the whole picture down to a tenth of each side), without
+    /// waiting for streamed data; the picture as the target holds it, at that scale.
+    pub fn render_interactive(&mut self, scene: &Scene) -> RenderResult<Image> {
+        let gpu = self.headless.gpu();
+        self.session.apply(gpu, scene)?;
+        self.session.frame(gpu, scene, Mode::Interacting)?;
+        let shown = self.session.shown().ok_or_else(|| {
+            crate::gl::GlError::Invalid("the session drew no interactive picture".into())
+        })?;
+        Ok(shown.read(gpu)?)
+    }
+
+    /// The frame budget interactive frames keep to.
+    pub fn budget(&self) -> FrameBudget {
+        self.session.budget()
+    }
+
+    /// Keep interactive frames to `budget`.
+    pub fn set_budget(&mut self, budget: FrameBudget) {
+        self.session.set_budget(budget);
     }
 
     /// The program kind the renderer draws with.
