@@ -315,7 +315,16 @@ impl Picture {
         let frame = key.frame(1.0);
         let budget = self.budget.parts;
         if self.building.as_ref().is_none_or(|b| b.picture.key != *key) {
-            let old = self.building.take().map(|b| b.picture);
+            // A picture drawn whole now reuses the shown one's target (nothing is shown
+            // meanwhile); one drawn in parts leaves it on screen until done.
+            let old = match sync {
+                true => self
+                    .building
+                    .take()
+                    .map(|b| b.picture)
+                    .or(self.shown.take()),
+                false => self.building.take().map(|b| b.picture),
+            };
             let target = fresh_target(gpu, old, &frame, key.format, renderer.needs_depth())?;
             target.clear(gpu, key.background)?;
             // Parts of about a frame's part time each, from the last full picture's time.

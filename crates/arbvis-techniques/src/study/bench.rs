@@ -21,10 +21,11 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::gl::{Gpu, Headless, ProgramKind, Surface, Target};
+use crate::gl::{Gpu, Headless, ProgramKind};
 use crate::image::Image;
 use crate::progress::{Bar, Unit};
 use crate::scene::Scene;
+use crate::session::{Mode, Session};
 use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::reference::reference_clipped;
@@ -388,8 +389,8 @@ fn slot_key(scene: &Scene, kind: ProgramKind) -> (Fidelity, bool, ProgramKind, T
 
 struct Slot {
     key: (Fidelity, bool, ProgramKind, TargetFormat),
-    renderer: Box<dyn Renderer>,
-    target: Target,
+    /// The renderer and its picture, drawn as every front end draws.
+    session: Session,
 }
 
 /// Run the bench; `progress` hears a line per setting and round.
@@ -439,13 +440,13 @@ pub fn run(
                 setting.name
             ));
             let slot = slot_for(gpu, &mut slots, &setting.scene, prepared.as_ref(), [w, h])?;
-            let (first, times) = time_frames(gpu, slot, &setting.scene, frame, options)?;
-            let entry = results[i].get_or_insert_with(|| {
-                new_measured(setting, &setting.scene, slot.renderer.program_kind(), first)
-            });
+            let (first, times, picture) = time_frames(gpu, slot, &setting.scene, frame, options)?;
+            let kind = slot.session.renderer().program_kind();
+            let entry = results[i]
+                .get_or_insert_with(|| new_measured(setting, &setting.scene, kind, first));
             if round == 0 {
                 if let Some(rgb) = &reference_rgb {
-                    let (max, rmse) = rgb_error(&slot.target.read(gpu)?, rgb);
+                    let (max, rmse) = rgb_error(&picture, rgb);
                     entry.rmse = Some(rmse);
                     entry.max_abs = Some(max);
                 }
@@ -545,7 +546,7 @@ fn slot_for<'a>(
     let kind = s.programs.resolve(gpu);
     let key = slot_key(s, kind);
     if let Some(n) = slots.iter().position(|x| x.key == key) {
-        slots[n].renderer.update(gpu, s.technique.params())?;
+        slots[n].session.params_changed(gpu, s)?;
         return Ok(&mut slots[n]);
     }
     let renderer: Box<dyn Renderer> = match (s.technique.get::<Opacity3dScene>(), prepared) {
@@ -560,47 +561,57 @@ fn slot_for<'a>(
         )?),
         _ => crate::render::build(gpu, s, kind)?,
     };
-    let target = if renderer.needs_depth() {
-        Target::with_depth(gpu, w, h, s.target_format())?
-    } else {
-        Target::new(gpu, w, h, s.target_format())?
+    let sized = Scene {
+        size: [w, h],
+        ..s.clone()
     };
     slots.push(Slot {
         key,
-        renderer,
-        target,
+        session: Session::new(renderer, &sized, true),
     });
     Ok(slots.last_mut().expect("just pushed"))
 }
 
-/// The first frame's time and `options.frames` more (ms) of setting `s` from `frame`:
-/// clear, draw, finish, the camera turned by `options.turn` before each.
+/// The first frame's time and `options.frames` more (ms) of setting `s` from `frame`,
+/// each drawn whole by the slot's session (clear, draw, finish), the camera turned by
+/// `options.turn` before each; and the last frame's picture.
 fn time_frames(
     gpu: &Gpu,
     slot: &mut Slot,
     s: &Scene,
-    mut frame: Frame,
+    frame: Frame,
     options: &BenchOptions,
-) -> Result<(f64, Vec<f64>)> {
+) -> Result<(f64, Vec<f64>, Image)> {
     let turn = glam::DQuat::from_rotation_y(options.turn.to_radians());
-    let mut one = || -> Result<f64> {
+    let mut scene = Scene {
+        size: [frame.width, frame.height],
+        camera: frame.camera,
+        ..s.clone()
+    };
+    let mut one = |scene: &mut Scene| -> Result<f64> {
         if options.turn != 0.0 {
-            frame.camera.rotation = (frame.camera.quat() * turn).to_array();
+            scene.camera.rotation = (scene.camera.quat() * turn).to_array();
         }
+        slot.session.redraw();
         let t0 = Instant::now();
-        slot.target.clear(gpu, s.clear_colour())?;
-        slot.renderer
-            .draw(gpu, Surface::Target(&slot.target), &frame)?;
-        gpu.finish();
+        slot.session.frame(gpu, scene, Mode::Now)?;
         Ok(t0.elapsed().as_secs_f64() * 1e3)
     };
-    let first = one()?;
+    let first = one(&mut scene)?;
     let mut times = Vec::with_capacity(options.frames);
     for _ in 0..options.frames.max(1) {
-        times.push(one()?);
+        times.push(one(&mut scene)?);
     }
     arbvis_gl::gl_check!(gpu)?;
-    Ok((first, times))
+    let picture = slot.session.read(
+        gpu,
+        &Scene {
+            legend: false,
+            axes: false,
+            ..scene
+        },
+    )?;
+    Ok((first, times, picture))
 }
 
 /// A setting's median, fastest and slowest frame from its times.
