@@ -175,9 +175,9 @@ impl TechniqueScene {
 
     /// The technique as the frames drawn while the user interacts draw it, at
     /// 1/`divisor` of the image's resolution ([`Technique::for_interaction`]).
-    pub fn for_interaction(&self, divisor: u32) -> TechniqueScene {
+    pub fn for_interaction(&self, scale: f64) -> TechniqueScene {
         let mut reduced = self.clone();
-        each_technique!(&mut reduced, |mut p| Technique::for_interaction(p, divisor));
+        each_technique!(&mut reduced, |mut p| Technique::for_interaction(p, scale));
         reduced
     }
 

@@ -2,7 +2,7 @@
 //! edited, and what each frame does (UI pass, camera input, actions, volume update,
 //! blit, UI paint).
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::anyhow;
 use egui_glow::EguiGlow;
@@ -25,10 +25,15 @@ use crate::gl::{self, ProgramKind, Surface};
 use crate::png_io;
 use crate::scene::Scene;
 use crate::techniques::opacity3d::Opacity3dScene;
-use arbvis_techniques::session::{Mode, Pending, Session};
+use arbvis_techniques::session::{FrameBudget, Mode, Pending, Session};
+
+/// A whole UI frame while the user drags: VTK's 15 frames per second.
+const FRAME_BUDGET: Duration = Duration::from_millis(66);
+/// The least the picture is given of a frame, however slow the UI.
+const MIN_PICTURE_BUDGET: Duration = Duration::from_millis(10);
 
 /// How long after the last edit the view counts as still.
-pub const SETTLE: std::time::Duration = std::time::Duration::from_millis(250);
+pub const SETTLE: Duration = Duration::from_millis(250);
 
 /// Margin kept around the volume's bounding sphere when framing.
 const FRAME_MARGIN: f64 = 0.9;
@@ -60,6 +65,8 @@ pub(super) struct Running {
     last_frame: Instant,
     last_edit: Option<Instant>,
     dragging: bool,
+    /// Milliseconds of a frame the UI takes (all but the picture), smoothed.
+    ui_ms: f64,
     /// The number the next screenshot's name is looked for from.
     screenshots: u32,
     view_px: [i32; 4],
@@ -162,6 +169,7 @@ impl Running {
             last_frame: Instant::now(),
             last_edit: None,
             dragging: false,
+            ui_ms: 0.0,
             screenshots: 1,
             view_px: [0, 0, 1, 1],
             shown_px: [0, 0, 1, 1],
@@ -247,7 +255,15 @@ impl Running {
         // A store's bricks keep arriving: frames go on until none is due.
         let streaming = self.session.renderer().pending();
         self.session.quality = self.panel.quality;
+        // The picture gets what the frame budget leaves after the UI's own work.
+        let budget = FRAME_BUDGET.saturating_sub(Duration::from_secs_f64(self.ui_ms / 1e3));
+        self.session.set_budget(FrameBudget {
+            interactive: budget.max(MIN_PICTURE_BUDGET),
+            ..self.session.budget()
+        });
+        let before_picture = Instant::now();
         let pending = self.session.frame(gpu, &self.scene, mode)?;
+        let picture_time = before_picture.elapsed();
         let p = self.session.picture();
         self.panel.volume_info = format!(
             "picture: {:.0} ms full ({} part{}), {:.0} ms interactive at 1/{:.1} of each side{}",
@@ -284,6 +300,13 @@ impl Running {
             self.save_window(options);
         }
         self.window.swap_buffers()?;
+        // The UI's share of this frame (all but the picture), smoothed over frames.
+        let ui = now.elapsed().saturating_sub(picture_time).as_secs_f64() * 1e3;
+        self.ui_ms = if self.ui_ms == 0.0 {
+            ui
+        } else {
+            0.8 * self.ui_ms + 0.2 * ui
+        };
         Ok(match pending {
             Pending::Done if streaming => Some(Instant::now()),
             Pending::Done => None,

@@ -282,8 +282,7 @@ impl Picture {
             renderer.needs_depth(),
         )?;
         target.clear(gpu, key.background)?;
-        let divisor = scale.round().max(1.0) as u32;
-        renderer.update(gpu, technique.for_interaction(divisor).params())?;
+        renderer.update(gpu, technique.for_interaction(scale).params())?;
         let drawn = renderer.draw(gpu, Surface::Target(&target), &frame);
         renderer.update(gpu, technique.params())?;
         drawn?;

@@ -197,10 +197,10 @@ pub trait Technique: Any + Sized {
         let _ = (written, camera, fidelity);
     }
     /// Cheaper parameters of the same picture for the frames drawn while the user
-    /// interacts, at 1/`divisor` of the image's resolution (the viewer); by default the
-    /// same parameters.
-    fn for_interaction(&mut self, divisor: u32) {
-        let _ = divisor;
+    /// interacts, into an image of 1/`scale` of each side (the session's frame budget:
+    /// `scale` from 1 to 10); by default the same parameters.
+    fn for_interaction(&mut self, scale: f64) {
+        let _ = scale;
     }
     /// Every program pair its renderers can draw with, both kinds (the
     /// compile-everything test).

@@ -284,10 +284,11 @@ impl crate::techniques::Technique for CellprojScene {
     /// A volume's pre-integrated table a quarter (half quality) or an eighth (quarter)
     /// of each side: 64 to 512 times fewer integrals while a transfer-function drag
     /// rebuilds it every frame (the renderer remakes it only when it draws).
-    fn for_interaction(&mut self, divisor: u32) {
-        if self.mode.volume() && divisor > 1 {
+    fn for_interaction(&mut self, scale: f64) {
+        if self.mode.volume() && scale >= 1.5 {
             let mut spec = self.volume_spec();
-            spec.table_size = spec.table_size.map(|s| (s / (2 * divisor)).max(8).min(s));
+            let cut = |s: u32| ((s as f64 / (2.0 * scale.round())) as u32).max(8).min(s);
+            spec.table_size = spec.table_size.map(cut);
             self.volume = Some(spec);
         }
     }

@@ -225,9 +225,9 @@ impl crate::techniques::Technique for Opacity3dScene {
         Opacity3dScene::unwritten_defaults(self, written, camera)
     }
 
-    /// The slice count divided by `divisor` (at least one).
-    fn for_interaction(&mut self, divisor: u32) {
-        self.slices = (self.slices / divisor as usize).max(1);
+    /// The slice count divided by `scale` (at least one).
+    fn for_interaction(&mut self, scale: f64) {
+        self.slices = ((self.slices as f64 / scale.max(1.0)) as usize).max(1);
     }
 
     fn program_pairs() -> Vec<crate::programs::ProgramPair> {

@@ -88,6 +88,12 @@ impl crate::techniques::Technique for SplatsScene {
         SplatsScene::unwritten_defaults(self, written, fidelity)
     }
 
+    /// Splats a `scale`-th of their size in pixels, so that the smaller picture shows
+    /// what the whole one does (and each covers as few of its pixels).
+    fn for_interaction(&mut self, scale: f64) {
+        self.point_size = (self.point_size / scale.max(1.0)).max(1.0);
+    }
+
     fn program_pairs() -> Vec<crate::programs::ProgramPair> {
         renderer::program_pairs()
     }
