@@ -140,3 +140,51 @@ fn interactive_frames_shrink_to_the_budget_and_a_still_frame_is_the_full_picture
         "the still picture differs from a render"
     );
 }
+
+/// Each technique's cheaper parameters at an image scale: splats keep their size relative
+/// to the picture, 3D opacity draws a scale-th of its slices, a cell-projection volume's
+/// pre-integrated table shrinks; at scale 1 nothing changes.
+#[test]
+fn the_cheaper_parameters_follow_the_scale() {
+    use arbvis::techniques::cellproj::CellprojScene;
+    use arbvis::techniques::opacity3d::Opacity3dScene;
+    use arbvis::techniques::splats::SplatsScene;
+    let splats = Scene::demo("splats-section").unwrap().technique;
+    let size = |t: &arbvis::catalog::TechniqueScene| t.get::<SplatsScene>().unwrap().point_size;
+    for scale in [1.0, 1.4, 2.5, 10.0] {
+        let reduced = splats.for_interaction(scale);
+        // The demo's 9-pixel splats, a scale-th of it (never under a pixel).
+        assert!(
+            (size(&reduced) - (9.0 / scale).max(1.0)).abs() < 1e-12,
+            "{scale}"
+        );
+    }
+    let v3o2 = Scene::demo("v3o2-sum").unwrap().technique;
+    let slices = |t: &arbvis::catalog::TechniqueScene| t.get::<Opacity3dScene>().unwrap().slices;
+    let full = slices(&v3o2);
+    assert_eq!(slices(&v3o2.for_interaction(1.0)), full);
+    assert_eq!(
+        slices(&v3o2.for_interaction(2.5)),
+        (full as f64 / 2.5) as usize
+    );
+    assert_eq!(slices(&v3o2.for_interaction(10.0)), full / 10);
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/data/bracket-volume.toml");
+    let cells = Scene::parse(&std::fs::read_to_string(path).unwrap(), "test")
+        .unwrap()
+        .technique;
+    let params = cells.get::<CellprojScene>().unwrap();
+    let table = |t: &arbvis::catalog::TechniqueScene| {
+        let p = t.get::<CellprojScene>().unwrap();
+        p.volume
+            .as_ref()
+            .map_or(p.volume_spec().table_size, |v| v.table_size)
+    };
+    let whole = params.volume_spec().table_size;
+    assert_eq!(table(&cells.for_interaction(1.0)), whole);
+    // A table an eighth of each side (at least 8) at a quarter, as the viewer's quarter
+    // quality had.
+    assert_eq!(
+        table(&cells.for_interaction(4.0)),
+        whole.map(|s| (s / 8).max(8).min(s))
+    );
+}
