@@ -158,6 +158,9 @@ fn the_cheaper_parameters_follow_the_scale() {
             (size(&reduced) - (9.0 / scale).max(1.0)).abs() < 1e-12,
             "{scale}"
         );
+        // And every floor(scale)-th point.
+        let stride = reduced.get::<SplatsScene>().unwrap().stride;
+        assert_eq!(stride, scale.floor() as usize, "{scale}");
     }
     let v3o2 = Scene::demo("v3o2-sum").unwrap().technique;
     let slices = |t: &arbvis::catalog::TechniqueScene| t.get::<Opacity3dScene>().unwrap().slices;
@@ -187,4 +190,42 @@ fn the_cheaper_parameters_follow_the_scale() {
         table(&cells.for_interaction(4.0)),
         whole.map(|s| (s / 8).max(8).min(s))
     );
+}
+
+/// A stride draws every k-th point of the order; back at 1, the picture is the full one
+/// again (the same view ordered anew, not the strided order kept).
+#[test]
+fn a_stride_thins_the_splats_and_one_restores_them() {
+    use arbvis::techniques::splats::SplatsScene;
+    let h = headless(Backend::Egl);
+    let gpu = h.gpu();
+    let mut scene = Scene::demo("splats-section").unwrap();
+    scene.size = [64, 48];
+    if let Some(s) = scene.technique.get_mut::<SplatsScene>() {
+        if let arbvis::points::PointSource::Section(spec) = &mut s.cloud {
+            spec.points = 20_000;
+        }
+    }
+    let kind = scene.programs.resolve(gpu);
+    let mut session = Session::build(gpu, &scene, kind, true).unwrap();
+    let draw = |scene: &Scene, session: &mut Session| {
+        session.params_changed(gpu, scene).unwrap();
+        session.frame(gpu, scene, Mode::Now).unwrap();
+        session.read(gpu, scene).unwrap()
+    };
+    let full = draw(&scene, &mut session);
+    let mut thin = scene.clone();
+    thin.technique.get_mut::<SplatsScene>().unwrap().stride = 7;
+    let thinned = draw(&thin, &mut session);
+    let again = draw(&scene, &mut session);
+    assert!(full.data != thinned.data, "a stride of 7 drew every point");
+    assert!(
+        full.data == again.data,
+        "stride 1 after 7 is not the full picture"
+    );
+    // A stride that no cloud could use is refused by name.
+    let mut bad = scene.clone();
+    bad.technique.get_mut::<SplatsScene>().unwrap().stride = 0;
+    let e = session.params_changed(gpu, &bad).unwrap_err().to_string();
+    assert!(e.contains("stride"), "{e}");
 }

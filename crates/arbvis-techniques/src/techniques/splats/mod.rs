@@ -89,9 +89,11 @@ impl crate::techniques::Technique for SplatsScene {
     }
 
     /// Splats a `scale`-th of their size in pixels, so that the smaller picture shows
-    /// what the whole one does (and each covers as few of its pixels).
+    /// what the whole one does (and each covers as few of its pixels), and every
+    /// `floor(scale)`-th point drawn: a large cloud's cost is its points, not its pixels.
     fn for_interaction(&mut self, scale: f64) {
         self.point_size = (self.point_size / scale.max(1.0)).max(1.0);
+        self.stride = (scale.floor() as usize).clamp(1, scene::MAX_STRIDE);
     }
 
     fn program_pairs() -> Vec<crate::programs::ProgramPair> {

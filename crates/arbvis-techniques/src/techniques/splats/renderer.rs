@@ -577,12 +577,13 @@ impl SplatsRenderer {
             // The seed's way: the structs sorted with a distance comparator, the whole
             // buffer re-uploaded in that order (hidden points left out).
             let order = seed_order(&mut self.seed_points, view);
-            let order = self.visible(order);
+            let order = self.visible(order.into_iter().step_by(self.params.stride));
             let vertices = self.prepared.vertices(Some(&order), &self.size_scales);
             self.mesh.update(gpu, &vertices)?;
         } else if let Some(cache) = &mut self.cache {
+            let stride = self.params.stride;
             let order: Vec<u32> = cache.order(&self.prepared.positions, view).to_vec();
-            let order = self.visible(order);
+            let order = self.visible(order.into_iter().step_by(stride));
             self.set_indices(gpu, order)?;
         }
         self.last_sort = t0.elapsed();
@@ -818,6 +819,10 @@ impl Renderer for SplatsRenderer {
             || new.sort != p.sort
             || new.draw != p.draw
             || new.tile != p.tile;
+        if new.stride != p.stride {
+            // The same view drawn with more or fewer points: ordered again.
+            self.ordered_for = None;
+        }
         self.params = new.clone();
         if rebuild {
             self.prepared = from_cloud(&self.cloud, new, self.normals.clone())?;

@@ -163,6 +163,10 @@ pub struct SplatsScene {
     /// Tile side in pixels (`draw = "tiles"`).
     #[serde(default = "default_tile")]
     pub tile: u32,
+    /// Every `stride`-th point of the drawing order is drawn as a point (1: all; tiles
+    /// draw all). The frame budget draws fewer while the user drags a large cloud.
+    #[serde(default = "one_point", skip_serializing_if = "is_one_point")]
+    pub stride: usize,
     /// Volume mode's transfer function.
     #[serde(default)]
     pub volume: VolumeSpec,
@@ -176,6 +180,12 @@ fn default_point_size() -> f64 {
 }
 fn one() -> f64 {
     1.0
+}
+fn one_point() -> usize {
+    1
+}
+fn is_one_point(stride: &usize) -> bool {
+    *stride == 1
 }
 fn default_gauss_width() -> f64 {
     0.2
@@ -192,6 +202,9 @@ fn default_tile() -> u32 {
 /// larger tiles slower (measured: docs/benchmarks.md, "Figures behind the splats'
 /// settings").
 pub const DEFAULT_TILE: u32 = 2;
+
+/// Largest stride: a point of every million.
+pub const MAX_STRIDE: usize = 1_000_000;
 
 /// Largest point size asked for (GL clamps to its own range, 255 on llvmpipe).
 pub const MAX_POINT_SIZE: f64 = 4096.0;
@@ -323,6 +336,12 @@ impl SplatsScene {
             return Err(FieldError::new(
                 "gauss_width",
                 format!("{}: must be finite and not negative", self.gauss_width),
+            ));
+        }
+        if !(1..=MAX_STRIDE).contains(&self.stride) {
+            return Err(FieldError::new(
+                "stride",
+                format!("{}: must be 1..={MAX_STRIDE}", self.stride),
             ));
         }
         if !(3..=256).contains(&self.normals_k) {
