@@ -234,12 +234,12 @@ impl CopcFile {
             .par_iter()
             .map(|(_, records)| {
                 let mut c = LayeredPointRecordCompressor::new(Vec::new());
-                c.set_fields_from(&items).map_err(|e| e.to_string())?;
-                c.compress_many(records).map_err(|e| e.to_string())?;
-                c.done().map_err(|e| e.to_string())?;
+                c.set_fields_from(&items)?;
+                c.compress_many(records)?;
+                c.done()?;
                 Ok(std::mem::take(c.get_mut()))
             })
-            .collect::<Result<_, String>>()
+            .collect::<Result<_, laz::LasZipError>>()
             .map_err(|e| PointsError::unsupported(&self.path, format!("compressing: {e}")))?;
         for ((key, records), chunk) in pending.iter().zip(chunks) {
             let points = (records.len() / self.record) as u64;

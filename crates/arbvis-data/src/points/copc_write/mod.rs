@@ -118,8 +118,7 @@ pub fn write_copc(
         bounds = scan_bounds(&mut source)?;
     }
     for attempt in 0..2 {
-        let cube =
-            cube_around(&bounds, &source, grid).map_err(|m| PointsError::format(input, 179, m))?;
+        let cube = cube_around(input, &bounds, &source, grid)?;
         let mut out = file::CopcFile::create(output, &source, &cube)?;
         let bar = crate::progress::Bar::new(
             source.count,
@@ -243,7 +242,12 @@ fn scan_bounds(source: &mut source::Source) -> Result<[[f64; 3]; 2], PointsError
 
 /// The root cube: centred on `bounds`, its side the largest extent, padded by two steps
 /// of the coordinates' scale so that points on the bounds are inside.
-fn cube_around(bounds: &[[f64; 3]; 2], source: &source::Source, grid: u32) -> Result<Cube, String> {
+fn cube_around(
+    input: &Path,
+    bounds: &[[f64; 3]; 2],
+    source: &source::Source,
+    grid: u32,
+) -> Result<Cube, PointsError> {
     let pad = 2.0 * source.scale.iter().fold(0f64, |m, s| m.max(s.abs()));
     let side = (0..3)
         .map(|a| bounds[1][a] - bounds[0][a])
@@ -251,10 +255,13 @@ fn cube_around(bounds: &[[f64; 3]; 2], source: &source::Source, grid: u32) -> Re
         + 2.0 * pad;
     let centre: [f64; 3] = std::array::from_fn(|a| 0.5 * bounds[0][a] + 0.5 * bounds[1][a]);
     if !(side.is_finite() && side > 0.0 && centre.iter().all(|c| c.is_finite())) {
-        return Err(format!(
+        // Byte 179: the LAS header's bounds, where they came from (or the points'
+        // own, scanned, when those were not valid).
+        let m = format!(
             "bounds {:?}..{:?}: too far apart (or not finite) for an octree's cube",
             bounds[0], bounds[1]
-        ));
+        );
+        return Err(PointsError::format(input, 179, m));
     }
     Ok(Cube {
         min: centre.map(|c| c - 0.5 * side),

@@ -98,8 +98,9 @@ impl Source {
         let described = vlrs
             .iter()
             .filter(|v| is_extra(v))
-            .try_fold(0usize, |sum, v| described_bytes(&v.data).map(|n| sum + n))
-            .map_err(|m| PointsError::unsupported(path, m))?;
+            .try_fold(0usize, |sum, v| {
+                described_bytes(path, &v.data).map(|n| sum + n)
+            })?;
         if described > extra {
             return Err(PointsError::unsupported(
                 path,
@@ -303,11 +304,14 @@ fn extra_name(name: &str) -> String {
 }
 
 /// Bytes of the record the Extra Bytes descriptors in `data` (192 bytes each) describe.
-fn described_bytes(data: &[u8]) -> Result<usize, String> {
+fn described_bytes(path: &Path, data: &[u8]) -> Result<usize, PointsError> {
     if !data.len().is_multiple_of(192) {
-        return Err(format!(
-            "the Extra Bytes record holds {} bytes, not a multiple of its 192-byte descriptors",
-            data.len()
+        return Err(PointsError::unsupported(
+            path,
+            format!(
+                "the Extra Bytes record holds {} bytes, not a multiple of its 192-byte descriptors",
+                data.len()
+            ),
         ));
     }
     let size = |t: u8| -> Option<usize> {
@@ -326,8 +330,9 @@ fn described_bytes(data: &[u8]) -> Result<usize, String> {
             t @ 1..=10 => Ok(size(t).unwrap_or(0)),
             t @ 11..=20 => Ok(2 * size(t - 10).unwrap_or(0)),
             t @ 21..=30 => Ok(3 * size(t - 20).unwrap_or(0)),
-            t => Err(format!(
-                "extra bytes descriptor {k}: data type {t} is not LAS 1.4's"
+            t => Err(PointsError::unsupported(
+                path,
+                format!("extra bytes descriptor {k}: data type {t} is not LAS 1.4's"),
             )),
         })
         .sum()
