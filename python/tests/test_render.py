@@ -1,6 +1,7 @@
 """arbvis.Renderer: numpy arrays, frames after edits equal to fresh renderers', goldens,
 errors, two threads."""
 
+import shutil
 import threading
 
 import numpy as np
@@ -173,21 +174,13 @@ def test_a_turned_copc_cloud_and_store_equal_a_fresh_renderers_views(
     # One renderer turned through an orbit draws each view as a renderer made for that
     # view does: a COPC cloud's cut and a store's bricks follow the camera (a renderer
     # that kept its first cut differed by up to 0.84 on 44 % of the pixels).
-    copc = tmp_path / "autzen.copc.laz"
-    written = arbvis.convert(root / "data/points/autzen_trim.laz", copc, node_points=2000)
-    assert written["nodes"] > 10 and written["levels"] > 2, written
-    cloud = arbvis.Scene.from_toml(
-        f"""
-size = [160, 120]
-[camera]
-projection = "perspective"
-zoom = 4.0
-[technique.splats]
-cloud = {{ copc = {{ path = "{copc}", points = 20000 }} }}
-colour = "rgb"
-point_size = 3.0
-"""
+    # The Rust session test's scene (tests/fixtures/session-copc.toml), beside its cloud.
+    written = arbvis.convert(
+        root / "data/points/autzen_trim.laz", tmp_path / "c.copc.laz", node_points=2000
     )
+    assert written["nodes"] > 10 and written["levels"] > 2, written
+    shutil.copy(root / "tests/fixtures/session-copc.toml", tmp_path)
+    cloud = arbvis.Scene.load(tmp_path / "session-copc.toml")
     for scene in (cloud, f3_store_scene):
         pictures = []
         with arbvis.Renderer(scene) as turned:

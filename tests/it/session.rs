@@ -6,7 +6,7 @@
 use std::path::Path;
 
 use arbvis::camera::Camera;
-use arbvis::gl::Backend;
+use arbvis::gl::{Backend, Headless};
 use arbvis::image::Image;
 use arbvis::scene::Scene;
 use arbvis::session::{FrameBudget, Mode, Offscreen, Pending, Session};
@@ -26,24 +26,24 @@ fn orbit(count: usize) -> Vec<[f64; 4]> {
         .collect()
 }
 
-/// The autzen COPC cloud (43 nodes of at most 2,000 points) at a budget of 20,000 points,
-/// close enough (perspective, zoom 4) that the views want other cuts (2 to 5 nodes: `arbvis
-/// render --stats` of three of them).
+/// `tests/fixtures/session-copc.toml` (the autzen cloud close up, at a budget that makes
+/// the views want other cuts) beside its cloud, converted into `dir`.
 fn copc_scene(dir: &Path) -> Scene {
     crate::remote::copc_fixture(dir);
-    let text = format!(
-        r#"size = [160, 120]
-[camera]
-projection = "perspective"
-zoom = 4.0
-[technique.splats]
-cloud = {{ copc = {{ path = "{}", points = 20000 }} }}
-colour = "rgb"
-point_size = 3.0
-"#,
-        dir.join("c.copc.laz").display()
-    );
-    Scene::parse(&text, "test").unwrap()
+    let fixture = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/fixtures/session-copc.toml");
+    let path = dir.join("session-copc.toml");
+    std::fs::copy(fixture, &path).unwrap();
+    Scene::load(&path).unwrap()
+}
+
+/// A session on the demo `name` (edited by `edit`) drawn with the context of `h`.
+fn demo_session(h: &Headless, name: &str, edit: impl FnOnce(&mut Scene)) -> (Scene, Session) {
+    let gpu = h.gpu();
+    let mut scene = Scene::demo(name).unwrap();
+    edit(&mut scene);
+    let kind = scene.programs.resolve(gpu);
+    let session = Session::build(gpu, &scene, kind, true).unwrap();
+    (scene, session)
 }
 
 /// Pictures of `scene` turned through an orbit by one session, each beside a fresh
@@ -106,10 +106,7 @@ fn a_store_turned_by_one_session_draws_each_view_as_a_fresh_render() {
 fn interactive_frames_shrink_to_the_budget_and_a_still_frame_is_the_full_picture() {
     let h = headless(Backend::Egl);
     let gpu = h.gpu();
-    let mut scene = Scene::demo("v3o2-sum").unwrap();
-    scene.size = [96, 80];
-    let kind = scene.programs.resolve(gpu);
-    let mut session = Session::build(gpu, &scene, kind, true).unwrap();
+    let (mut scene, mut session) = demo_session(&h, "v3o2-sum", |s| s.size = [96, 80]);
     // A budget no frame can meet: the scale doubles each frame up to a tenth of a side.
     session.set_budget(FrameBudget {
         interactive: std::time::Duration::from_nanos(1),
@@ -199,15 +196,15 @@ fn a_stride_thins_the_splats_and_one_restores_them() {
     use arbvis::techniques::splats::SplatsScene;
     let h = headless(Backend::Egl);
     let gpu = h.gpu();
-    let mut scene = Scene::demo("splats-section").unwrap();
-    scene.size = [64, 48];
-    if let Some(s) = scene.technique.get_mut::<SplatsScene>() {
-        if let arbvis::points::PointSource::Section(spec) = &mut s.cloud {
-            spec.points = 20_000;
+    // A smaller section than the demo's, for a test's time.
+    let (scene, mut session) = demo_session(&h, "splats-section", |scene| {
+        scene.size = [64, 48];
+        if let Some(s) = scene.technique.get_mut::<SplatsScene>() {
+            if let arbvis::points::PointSource::Section(spec) = &mut s.cloud {
+                spec.points = 20_000;
+            }
         }
-    }
-    let kind = scene.programs.resolve(gpu);
-    let mut session = Session::build(gpu, &scene, kind, true).unwrap();
+    });
     let draw = |scene: &Scene, session: &mut Session| {
         session.params_changed(gpu, scene).unwrap();
         session.frame(gpu, scene, Mode::Now).unwrap();
