@@ -199,12 +199,9 @@ impl From<BenchOptionArgs> for BenchOptions {
 pub struct SceneArgs {
     /// Scene file (TOML).
     scene: Option<PathBuf>,
-    /// A built-in demo instead of a file; `--demo` alone lists them. Demos: quad,
-    /// v3o2-sum, v3o2-product, cellproj-planar, cellproj-spherical,
-    /// cellproj-spherical-precise, splats-section, splats-section-precise, clip-sphere,
-    /// clip-mesh.
+    // A built-in demo instead of a file (the help names the catalog's demos).
     #[arg(long, conflicts_with = "scene", num_args = 0..=1, default_missing_value = "",
-          value_name = "NAME", value_parser = demo_name)]
+          value_name = "NAME", value_parser = demo_name, help = demo_help())]
     pub demo: Option<String>,
     /// Image size, e.g. 512x512.
     #[arg(long, value_parser = parse_size)]
@@ -321,17 +318,24 @@ pub fn parse_dims(s: &str) -> Result<[usize; 3], String> {
 
 /// A demo's name, or "" (`--demo` alone: list them).
 fn demo_name(s: &str) -> Result<String, String> {
-    if s.is_empty() || arbvis::scene::DEMOS.iter().any(|d| d.0 == s) {
+    if s.is_empty() || arbvis::scene::demos().any(|d| d.0 == s) {
         Ok(s.to_string())
     } else {
         Err(format!("no demo named {s:?}; demos: {}", demo_list(", ")))
     }
 }
 
+/// `--demo`'s help: what it does and every demo the catalog registers.
+fn demo_help() -> String {
+    format!(
+        "A built-in demo instead of a file; `--demo` alone lists them. Demos: {}.",
+        demo_list(", ")
+    )
+}
+
 /// The demos' names joined by `separator`.
 pub fn demo_list(separator: &str) -> String {
-    arbvis::scene::DEMOS
-        .iter()
+    arbvis::scene::demos()
         .map(|d| d.0)
         .collect::<Vec<_>>()
         .join(separator)

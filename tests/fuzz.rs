@@ -298,8 +298,7 @@ fn nifti_corpus() -> Vec<Vec<u8>> {
 }
 
 fn scene_corpus() -> Vec<Vec<u8>> {
-    let mut corpus: Vec<Vec<u8>> = arbvis::scene::DEMOS
-        .iter()
+    let mut corpus: Vec<Vec<u8>> = arbvis::scene::demos()
         .map(|(_, t)| t.as_bytes().to_vec())
         .collect();
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/data");

@@ -169,15 +169,15 @@ fn demo_without_a_name_lists_the_demos_as_an_answer() {
         let (stdout, stderr) = text(&out);
         assert!(out.status.success(), "{command} --demo: {stderr}");
         let listed: Vec<&str> = stdout.lines().collect();
-        let demos: Vec<&str> = arbvis::scene::DEMOS.iter().map(|d| d.0).collect();
+        let demos: Vec<&str> = arbvis::scene::demos().map(|d| d.0).collect();
         assert_eq!(
             listed, demos,
             "{command} --demo lists every demo, one a line"
         );
     }
-    // The help names every demo (its list is written by hand beside DEMOS).
+    // The help names every demo (its list is the catalog's).
     let (help, _) = text(&arbvis(&["render", "--help"]));
-    for (name, _) in arbvis::scene::DEMOS {
+    for (name, _) in arbvis::scene::demos() {
         assert!(help.contains(name), "render --help lacks {name}:\n{help}");
     }
     // A render with a demo but no output says what is missing.

@@ -22,7 +22,7 @@ fn params(scene: &Scene) -> QuadScene {
     let arbvis::scene::TechniqueScene::Quad(p) = &scene.technique else {
         panic!("the quad demo is a quad scene")
     };
-    p.clone()
+    (**p).clone()
 }
 
 #[test]
@@ -77,10 +77,11 @@ fn float_target_keeps_values_above_one() {
     // RGBA8 clamps to 1; a float target does not (precise mode relies on it).
     let h = headless(Backend::Egl);
     let mut scene = quad_scene(ProgramChoice::Auto, TargetFormat::Rgba32f, 16);
-    scene.technique = arbvis::scene::TechniqueScene::Quad(QuadScene {
+    scene.technique = QuadScene {
         left: [2.0, 2.0, 2.0, 2.0],
         right: [2.0, 2.0, 2.0, 2.0],
-    });
+    }
+    .into();
     let img = render_on(&h, &scene).unwrap().image;
     assert!(img.pixel(8, 0)[3] > 1.99, "{:?}", img.pixel(8, 0));
     scene.target = Some(TargetFormat::Rgba8);

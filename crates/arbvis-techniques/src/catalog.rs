@@ -1,13 +1,14 @@
-//! Every technique in one list: [`TechniqueScene`] has a variant per technique (its
-//! scene parameters, `[technique.NAME]` in TOML), and each variant's type implements
-//! [`Technique`] once (validation, data paths, memory estimate, defaults, program pairs,
-//! the renderer). What the layers above ask of "the scene's technique" goes through the
-//! methods here, which match the list in one macro; code that needs one technique's
-//! parameters asks for them by type ([`TechniqueScene::get`]).
+//! Every technique in one list: the `techniques!` line of each makes [`TechniqueScene`]'s
+//! variant (its scene parameters, `[technique.NAME]` in TOML) and its [`Registration`]
+//! in [`TECHNIQUES`] (name, demos, program pairs), from its type's one [`Technique`]
+//! implementation (validation, data paths, memory estimate, defaults, the renderer).
+//! What the layers above ask of "the scene's technique" goes through the methods here;
+//! code that needs one technique's parameters asks for them by type
+//! ([`TechniqueScene::get`]).
 //!
 //! The catalog sits above the techniques and below the scene: techniques never import it
 //! (their renderers take their own parameters through [`crate::techniques::Params`]), so
-//! adding a technique touches its own folder and this file.
+//! adding a technique is its own folder and one line here.
 
 use crate::error::RenderResult;
 use std::any::Any;
@@ -28,103 +29,239 @@ use crate::techniques::{Params, ReferenceView, Renderer, Technique};
 use crate::vocab::{Fidelity, FieldError};
 use crate::volume::Limits;
 
-/// Which technique and its parameters; in TOML a `[technique.NAME]` table.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "kebab-case", deny_unknown_fields)]
-pub enum TechniqueScene {
-    /// The full-screen quad demo.
-    Quad(QuadScene),
-    /// v3o2's 3D opacity (boxed: it is much larger than the other variants).
-    Opacity3d(Box<Opacity3dScene>),
-    /// Isosurfaces of tetrahedral meshes by cell projection.
-    Cellproj(Box<CellprojScene>),
-    /// Point-based rendering of geological sections as splats.
-    Splats(Box<SplatsScene>),
-}
+/// The one list of techniques: each line is a technique's variant and its parameters'
+/// type, which implements [`Technique`] in its own folder. The enum, its conversions,
+/// the dispatch below and [`TECHNIQUES`] (demos, program pairs, names) are made from it,
+/// so adding a technique is its folder plus one line here.
+macro_rules! techniques {
+    ($($(#[$doc:meta])* $variant:ident($type:ty)),* $(,)?) => {
+        /// Which technique and its parameters; in TOML a `[technique.NAME]` table.
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[serde(rename_all = "kebab-case", deny_unknown_fields)]
+        pub enum TechniqueScene {
+            $($(#[$doc])* $variant(Box<$type>),)*
+        }
 
-macro_rules! from_parameters {
-    ($($variant:ident($type:ty) => $wrap:expr),*) => {$(
-        impl From<$type> for TechniqueScene {
+        $(impl From<$type> for TechniqueScene {
             /// The technique of these parameters.
             fn from(p: $type) -> TechniqueScene {
-                TechniqueScene::$variant($wrap(p))
+                TechniqueScene::$variant(Box::new(p))
+            }
+        })*
+
+        impl TechniqueScene {
+            /// The parameters, as the catalog dispatches on them.
+            fn technique(&self) -> &dyn AnyTechnique {
+                match self {
+                    $(TechniqueScene::$variant(p) => &**p,)*
+                }
+            }
+
+            /// [`TechniqueScene::technique`], to change.
+            fn technique_mut(&mut self) -> &mut dyn AnyTechnique {
+                match self {
+                    $(TechniqueScene::$variant(p) => &mut **p,)*
+                }
             }
         }
-    )*};
+
+        /// Every technique, in the catalog's order: what the lists of demos and program
+        /// pairs (and the viewer's faces, checked against it) derive from.
+        pub const TECHNIQUES: &[Registration] = &[$(Registration::of::<$type>(),)*];
+    };
 }
 
-from_parameters!(
-    Quad(QuadScene) => std::convert::identity,
-    Opacity3d(Opacity3dScene) => Box::new,
-    Cellproj(CellprojScene) => Box::new,
-    Splats(SplatsScene) => Box::new
+techniques!(
+    /// The full-screen quad demo.
+    Quad(QuadScene),
+    /// v3o2's 3D opacity (with its clip).
+    Opacity3d(Opacity3dScene),
+    /// Isosurfaces and volumes of tetrahedral meshes by cell projection.
+    Cellproj(CellprojScene),
+    /// Point-based rendering of geological sections as splats.
+    Splats(SplatsScene),
 );
 
-/// `$body` with `$p` bound to the parameters of whichever technique `$scene` holds (`&T`,
-/// or `&mut T` with `mut`): the one place that lists the variants for the methods below.
-macro_rules! each_technique {
-    ($scene:expr, |$p:ident| $body:expr) => {
-        match $scene {
-            TechniqueScene::Quad($p) => $body,
-            TechniqueScene::Opacity3d(boxed) => {
-                let $p = &**boxed;
-                $body
-            }
-            TechniqueScene::Cellproj(boxed) => {
-                let $p = &**boxed;
-                $body
-            }
-            TechniqueScene::Splats(boxed) => {
-                let $p = &**boxed;
-                $body
-            }
-        }
-    };
-    ($scene:expr, |mut $p:ident| $body:expr) => {
-        match $scene {
-            TechniqueScene::Quad($p) => $body,
-            TechniqueScene::Opacity3d(boxed) => {
-                let $p = &mut **boxed;
-                $body
-            }
-            TechniqueScene::Cellproj(boxed) => {
-                let $p = &mut **boxed;
-                $body
-            }
-            TechniqueScene::Splats(boxed) => {
-                let $p = &mut **boxed;
-                $body
-            }
-        }
-    };
+/// What a technique declares once, read by every list of techniques.
+#[derive(Debug, Clone, Copy)]
+pub struct Registration {
+    /// The name of its scene table, `[technique.NAME]`.
+    pub name: &'static str,
+    /// Its built-in demos: name and scene text.
+    pub demos: &'static [(&'static str, &'static str)],
+    /// Every program pair its renderers can draw with, both kinds.
+    pub program_pairs: fn() -> Vec<ProgramPair>,
 }
 
-/// The technique's name and its [`Technique`] implementation's answer, for a `T` known
-/// only by the trait.
-fn name_of<T: Technique>(_: &T) -> &'static str {
-    T::NAME
+impl Registration {
+    /// Technique `T`'s registration, from its [`Technique`] implementation.
+    pub const fn of<T: Technique>() -> Registration {
+        Registration {
+            name: T::NAME,
+            demos: T::DEMOS,
+            program_pairs: T::program_pairs,
+        }
+    }
+}
+
+/// Every built-in demo (name, scene text), technique by technique.
+pub fn demos() -> impl Iterator<Item = (&'static str, &'static str)> {
+    TECHNIQUES.iter().flat_map(|t| t.demos.iter().copied())
+}
+
+/// [`Technique`] with `T` erased, for the catalog's dispatch (one blanket implementation
+/// below); keys are relative to the scene's root here.
+trait AnyTechnique: Any {
+    fn name(&self) -> &'static str;
+    fn params(&self) -> Params<'_>;
+    fn as_any(&self) -> &dyn Any;
+    fn as_any_mut(&mut self) -> &mut dyn Any;
+    fn validate(&self, fidelity: Fidelity, programs: ProgramChoice) -> Result<(), FieldError>;
+    fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut PathBuf));
+    fn default_camera(&self) -> Option<Camera>;
+    fn unwritten_defaults(
+        &mut self,
+        written: &dyn Fn(&str) -> bool,
+        camera: &mut Camera,
+        fidelity: &mut Fidelity,
+    );
+    fn for_interaction(&mut self, scale: f64);
+    fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate>;
+    fn build(
+        &self,
+        gpu: &Gpu,
+        settings: &Settings<'_>,
+        kind: ProgramKind,
+    ) -> RenderResult<Box<dyn Renderer>>;
+    fn prepare(&self, settings: &Settings<'_>, limits: &Limits) -> RenderResult<PreparedData>;
+    fn renderer(
+        &self,
+        gpu: &Gpu,
+        settings: &Settings<'_>,
+        kind: ProgramKind,
+        prepared: PreparedData,
+    ) -> RenderResult<Box<dyn Renderer>>;
+    fn reference(
+        &self,
+        settings: &Settings<'_>,
+        limits: &Limits,
+        view: &ReferenceView<'_>,
+    ) -> RenderResult<Option<Image>>;
+}
+
+impl<T: Technique> AnyTechnique for T {
+    fn name(&self) -> &'static str {
+        T::NAME
+    }
+
+    fn params(&self) -> Params<'_> {
+        Params::of(self)
+    }
+
+    fn as_any(&self) -> &dyn Any {
+        self
+    }
+
+    fn as_any_mut(&mut self) -> &mut dyn Any {
+        self
+    }
+
+    fn validate(&self, fidelity: Fidelity, programs: ProgramChoice) -> Result<(), FieldError> {
+        Technique::validate(self, fidelity, programs)
+            .map_err(|e| e.within(&format!("technique.{}", T::NAME)))
+    }
+
+    fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut PathBuf)) {
+        let within = format!("technique.{}", T::NAME);
+        let f = &mut |key: &str, path: &mut PathBuf| f(&format!("{within}.{key}"), path);
+        Technique::for_each_data_path(self, f)
+    }
+
+    fn default_camera(&self) -> Option<Camera> {
+        Technique::default_camera(self)
+    }
+
+    fn unwritten_defaults(
+        &mut self,
+        written: &dyn Fn(&str) -> bool,
+        camera: &mut Camera,
+        fidelity: &mut Fidelity,
+    ) {
+        Technique::unwritten_defaults(self, written, camera, fidelity)
+    }
+
+    fn for_interaction(&mut self, scale: f64) {
+        Technique::for_interaction(self, scale)
+    }
+
+    fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
+        Technique::memory_estimate(self, size)
+    }
+
+    fn build(
+        &self,
+        gpu: &Gpu,
+        settings: &Settings<'_>,
+        kind: ProgramKind,
+    ) -> RenderResult<Box<dyn Renderer>> {
+        Technique::build(self, gpu, settings, kind)
+    }
+
+    fn prepare(&self, settings: &Settings<'_>, limits: &Limits) -> RenderResult<PreparedData> {
+        Technique::prepare(self, settings, limits).map(|d| Box::new(d) as PreparedData)
+    }
+
+    /// [`Technique::renderer`] of `prepared`, which must be `T`'s.
+    fn renderer(
+        &self,
+        gpu: &Gpu,
+        settings: &Settings<'_>,
+        kind: ProgramKind,
+        prepared: PreparedData,
+    ) -> RenderResult<Box<dyn Renderer>> {
+        let prepared = prepared.downcast::<T::Prepared>().map_err(|_| {
+            GlError::Invalid(format!(
+                "the {} renderer was given another technique's prepared data",
+                T::NAME
+            ))
+        })?;
+        Technique::renderer(self, gpu, settings, kind, *prepared)
+    }
+
+    fn reference(
+        &self,
+        settings: &Settings<'_>,
+        limits: &Limits,
+        view: &ReferenceView<'_>,
+    ) -> RenderResult<Option<Image>> {
+        Ok(Technique::reference(
+            self,
+            &Technique::prepare(self, settings, limits)?,
+            view,
+        ))
+    }
 }
 
 impl TechniqueScene {
     /// Technique name as written in scenes.
     pub fn name(&self) -> &'static str {
-        each_technique!(self, |p| name_of(p))
+        self.technique().name()
     }
 
     /// The parameters as a renderer's [`Renderer::update`] takes them.
     pub fn params(&self) -> Params<'_> {
-        each_technique!(self, |p| Params::of(p))
+        self.technique().params()
     }
 
     /// The parameters, of whichever technique (for a list of capabilities kept above
     /// the catalog, such as the viewer's faces).
     pub fn parameters(&self) -> &dyn Any {
-        each_technique!(self, |p| p as &dyn Any)
+        self.technique().as_any()
     }
 
     /// [`TechniqueScene::parameters`], to change.
     pub fn parameters_mut(&mut self) -> &mut dyn Any {
-        each_technique!(self, |mut p| p as &mut dyn Any)
+        self.technique_mut().as_any_mut()
     }
 
     /// The parameters as technique `T`'s, where the scene draws `T`.
@@ -140,23 +277,19 @@ impl TechniqueScene {
     /// Check values that parse but cannot render at `fidelity` with `programs`; the
     /// error's key is the dotted key from the scene's root.
     pub fn validate(&self, fidelity: Fidelity, programs: ProgramChoice) -> Result<(), FieldError> {
-        let within = format!("technique.{}", self.name());
-        each_technique!(self, |p| Technique::validate(p, fidelity, programs))
-            .map_err(|e| e.within(&within))
+        self.technique().validate(fidelity, programs)
     }
 
     /// Call `f` on every data file the parameters name, with the dotted key that holds
     /// it (from the scene's root).
     pub fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut PathBuf)) {
-        let within = format!("technique.{}", self.name());
-        let f = &mut |key: &str, path: &mut PathBuf| f(&format!("{within}.{key}"), path);
-        each_technique!(self, |mut p| Technique::for_each_data_path(p, f))
+        self.technique_mut().for_each_data_path(f)
     }
 
     /// The camera a scene without `[camera]` starts from (and the viewer's Reset camera
     /// returns to), where the technique's data asks for another than the default.
     pub fn default_camera(&self) -> Option<Camera> {
-        each_technique!(self, |p| Technique::default_camera(p))
+        self.technique().default_camera()
     }
 
     /// Defaults that depend on the data a scene names, for the keys its text leaves out
@@ -168,23 +301,22 @@ impl TechniqueScene {
         camera: &mut Camera,
         fidelity: &mut Fidelity,
     ) {
-        each_technique!(self, |mut p| Technique::unwritten_defaults(
-            p, written, camera, fidelity
-        ))
+        self.technique_mut()
+            .unwritten_defaults(written, camera, fidelity)
     }
 
-    /// The technique as the frames drawn while the user interacts draw it, at
-    /// 1/`divisor` of the image's resolution ([`Technique::for_interaction`]).
+    /// The technique as the frames drawn while the user interacts draw it, into an image
+    /// of 1/`scale` of each side ([`Technique::for_interaction`]).
     pub fn for_interaction(&self, scale: f64) -> TechniqueScene {
         let mut reduced = self.clone();
-        each_technique!(&mut reduced, |mut p| Technique::for_interaction(p, scale));
+        reduced.technique_mut().for_interaction(scale);
         reduced
     }
 
     /// The large allocations preparing and drawing it at `size` makes that the scene
     /// alone determines (generated data, grids, lists); files are checked by their loaders.
     pub fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
-        each_technique!(self, |p| Technique::memory_estimate(p, size))
+        self.technique().memory_estimate(size)
     }
 }
 
@@ -195,7 +327,7 @@ pub fn build(
     settings: &Settings<'_>,
     kind: ProgramKind,
 ) -> RenderResult<Box<dyn Renderer>> {
-    each_technique!(technique, |p| Technique::build(p, gpu, settings, kind))
+    technique.technique().build(gpu, settings, kind)
 }
 
 /// A technique's prepared data ([`Technique::Prepared`]), boxed, so that a caller that
@@ -211,15 +343,7 @@ pub fn reference(
     limits: &Limits,
     view: &ReferenceView<'_>,
 ) -> RenderResult<Option<Image>> {
-    fn of<T: Technique>(
-        t: &T,
-        settings: &Settings<'_>,
-        limits: &Limits,
-        view: &ReferenceView<'_>,
-    ) -> RenderResult<Option<Image>> {
-        Ok(t.reference(&t.prepare(settings, limits)?, view))
-    }
-    each_technique!(technique, |p| of(p, settings, limits, view))
+    technique.technique().reference(settings, limits, view)
 }
 
 /// Check `technique`'s parameters, then load and prepare its data within `limits`
@@ -229,8 +353,7 @@ pub fn prepare(
     settings: &Settings<'_>,
     limits: &Limits,
 ) -> RenderResult<PreparedData> {
-    each_technique!(technique, |p| Technique::prepare(p, settings, limits)
-        .map(|d| Box::new(d) as PreparedData))
+    technique.technique().prepare(settings, limits)
 }
 
 /// The renderer of what [`prepare`] made for `technique`, with programs of `kind`.
@@ -241,32 +364,16 @@ pub fn renderer(
     kind: ProgramKind,
     prepared: PreparedData,
 ) -> RenderResult<Box<dyn Renderer>> {
-    each_technique!(technique, |p| renderer_of(p, gpu, settings, kind, prepared))
-}
-
-/// [`Technique::renderer`] of `prepared`, which must be `T`'s.
-fn renderer_of<T: Technique>(
-    technique: &T,
-    gpu: &Gpu,
-    settings: &Settings<'_>,
-    kind: ProgramKind,
-    prepared: PreparedData,
-) -> RenderResult<Box<dyn Renderer>> {
-    let prepared = prepared.downcast::<T::Prepared>().map_err(|_| {
-        GlError::Invalid(format!(
-            "the {} renderer was given another technique's prepared data",
-            T::NAME
-        ))
-    })?;
-    technique.renderer(gpu, settings, kind, *prepared)
+    technique
+        .technique()
+        .renderer(gpu, settings, kind, prepared)
 }
 
 /// Every program pair the techniques can draw with, both kinds (the compile-everything
 /// test): each technique lists its own.
 pub fn all_program_pairs() -> Vec<ProgramPair> {
-    let mut pairs = QuadScene::program_pairs();
-    pairs.extend(Opacity3dScene::program_pairs());
-    pairs.extend(CellprojScene::program_pairs());
-    pairs.extend(SplatsScene::program_pairs());
-    pairs
+    TECHNIQUES
+        .iter()
+        .flat_map(|t| (t.program_pairs)())
+        .collect()
 }

@@ -7,7 +7,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::camera::Camera;
-pub use crate::catalog::TechniqueScene;
+pub use crate::catalog::{demos, TechniqueScene};
 use crate::gl::{ProgramChoice, TargetFormat};
 pub use crate::vocab::{Fidelity, FieldError};
 
@@ -126,50 +126,9 @@ pub enum SceneError {
         message: String,
     },
     /// No built-in demo of that name.
-    #[error("no demo named {0:?}; demos: {demos}", demos = DEMOS.iter().map(|d| d.0).collect::<Vec<_>>().join(", "))]
+    #[error("no demo named {0:?}; demos: {demos}", demos = demos().map(|d| d.0).collect::<Vec<_>>().join(", "))]
     UnknownDemo(String),
 }
-
-/// Built-in demos: name and scene text (files under `scenes/demo/`).
-pub const DEMOS: &[(&str, &str)] = &[
-    ("quad", include_str!("../../../scenes/demo/quad.toml")),
-    (
-        "v3o2-sum",
-        include_str!("../../../scenes/demo/v3o2-sum.toml"),
-    ),
-    (
-        "v3o2-product",
-        include_str!("../../../scenes/demo/v3o2-product.toml"),
-    ),
-    (
-        "cellproj-planar",
-        include_str!("../../../scenes/demo/cellproj-planar.toml"),
-    ),
-    (
-        "cellproj-spherical",
-        include_str!("../../../scenes/demo/cellproj-spherical.toml"),
-    ),
-    (
-        "cellproj-spherical-precise",
-        include_str!("../../../scenes/demo/cellproj-spherical-precise.toml"),
-    ),
-    (
-        "splats-section",
-        include_str!("../../../scenes/demo/splats-section.toml"),
-    ),
-    (
-        "splats-section-precise",
-        include_str!("../../../scenes/demo/splats-section-precise.toml"),
-    ),
-    (
-        "clip-sphere",
-        include_str!("../../../scenes/demo/clip-sphere.toml"),
-    ),
-    (
-        "clip-mesh",
-        include_str!("../../../scenes/demo/clip-mesh.toml"),
-    ),
-];
 
 impl Scene {
     /// Parse scene text; `origin` names it in errors.
@@ -236,8 +195,7 @@ impl Scene {
 
     /// A built-in demo scene.
     pub fn demo(name: &str) -> Result<Scene, SceneError> {
-        let (_, text) = DEMOS
-            .iter()
+        let (_, text) = demos()
             .find(|(n, _)| *n == name)
             .ok_or_else(|| SceneError::UnknownDemo(name.to_string()))?;
         Scene::parse(text, &format!("demo:{name}"))
@@ -532,7 +490,7 @@ mod tests {
 
     #[test]
     fn arrays_longer_than_their_field_are_errors() {
-        let (_, base) = DEMOS.iter().find(|(n, _)| *n == "clip-sphere").unwrap();
+        let (_, base) = demos().find(|(n, _)| *n == "clip-sphere").unwrap();
         for (from, to, key) in [
             ("size = [256, 256]", "size = [256, 256, 5]", "size"),
             (
@@ -553,14 +511,14 @@ mod tests {
             assert!(e.starts_with("s.toml:"), "{e}");
         }
         // Every demo and data scene, written back, has nothing longer than it reads.
-        for (name, _) in DEMOS {
+        for (name, _) in demos() {
             Scene::parse(&Scene::demo(name).unwrap().to_toml(), name).unwrap();
         }
     }
 
     #[test]
     fn every_demo_parses() {
-        for (name, _) in DEMOS {
+        for (name, _) in demos() {
             Scene::demo(name).unwrap();
         }
     }

@@ -3,6 +3,23 @@
 //! of the same maths. The seed techniques (`opacity3d`, `cellproj`, `clip`, `splats`)
 //! slot in beside `quad`, the foundation's demo.
 
+/// A built-in demo for [`Technique::DEMOS`]: its name and the text of
+/// `scenes/demo/NAME.toml`.
+macro_rules! demo {
+    ($name:literal) => {
+        (
+            $name,
+            include_str!(concat!(
+                env!("CARGO_MANIFEST_DIR"),
+                "/../../scenes/demo/",
+                $name,
+                ".toml"
+            )),
+        )
+    };
+}
+pub(crate) use demo;
+
 pub mod annotations;
 pub mod cellproj;
 pub mod clip;
@@ -62,10 +79,11 @@ pub trait Renderer {
     fn status(&self) -> Option<String> {
         None
     }
-    /// The clip's last build time and texture memory, for a technique drawn through a
-    /// clip object (3D opacity with `[technique.opacity3d.clip]`); `None` without one.
-    fn clip_stats(&self) -> Option<clip::stats::ClipStats> {
-        None
+    /// Labelled facts about what the renderer built, for the viewer's panel (3D
+    /// opacity's clip: its last build time and texture memory, labelled
+    /// [`clip::stats::LABEL`]); none by default.
+    fn facts(&self) -> Vec<(&'static str, String)> {
+        Vec::new()
     }
     /// What the picture's legends and axes say (`render --legend --axes`): its colour
     /// tables with their value ranges, keys, and the box's axes in the data's numbers.
@@ -166,6 +184,8 @@ impl<'a> dyn Renderer + 'a {
 pub trait Technique: Any + Sized {
     /// The technique's name as written in scenes.
     const NAME: &'static str;
+    /// Its built-in demos, name and scene text ([`demo!`] reads one from `scenes/demo/`).
+    const DEMOS: &'static [(&'static str, &'static str)];
     /// Check values that parse but cannot render, in a scene drawn at `fidelity` with
     /// `programs`; the error's key is relative to `[technique.NAME]`.
     fn validate(&self, fidelity: Fidelity, programs: ProgramChoice) -> Result<(), FieldError>;

@@ -36,6 +36,7 @@ pub struct QuadScene {
 
 impl Technique for QuadScene {
     const NAME: &'static str = "quad";
+    const DEMOS: &'static [(&'static str, &'static str)] = &[crate::techniques::demo!("quad")];
 
     fn validate(
         &self,

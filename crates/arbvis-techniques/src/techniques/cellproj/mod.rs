@@ -266,6 +266,11 @@ pub struct CellprojScene {
 
 impl crate::techniques::Technique for CellprojScene {
     const NAME: &'static str = "cellproj";
+    const DEMOS: &'static [(&'static str, &'static str)] = &[
+        crate::techniques::demo!("cellproj-planar"),
+        crate::techniques::demo!("cellproj-spherical"),
+        crate::techniques::demo!("cellproj-spherical-precise"),
+    ];
 
     fn validate(&self, _: Fidelity, _: ProgramChoice) -> Result<(), FieldError> {
         CellprojScene::validate(self)

@@ -187,6 +187,12 @@ pub struct Opacity3dScene {
 
 impl crate::techniques::Technique for Opacity3dScene {
     const NAME: &'static str = "opacity3d";
+    const DEMOS: &'static [(&'static str, &'static str)] = &[
+        crate::techniques::demo!("v3o2-sum"),
+        crate::techniques::demo!("v3o2-product"),
+        crate::techniques::demo!("clip-sphere"),
+        crate::techniques::demo!("clip-mesh"),
+    ];
 
     fn validate(&self, _: Fidelity, _: ProgramChoice) -> Result<(), FieldError> {
         Opacity3dScene::validate(self)

@@ -58,6 +58,10 @@ pub use scene::SplatsScene;
 /// renderer (`renderer.rs`).
 impl crate::techniques::Technique for SplatsScene {
     const NAME: &'static str = "splats";
+    const DEMOS: &'static [(&'static str, &'static str)] = &[
+        crate::techniques::demo!("splats-section"),
+        crate::techniques::demo!("splats-section-precise"),
+    ];
 
     fn validate(
         &self,
