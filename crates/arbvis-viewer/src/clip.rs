@@ -3,7 +3,7 @@
 //! torus-mesh), its position, size and rotation (Euler degrees; the normal for a
 //! half-space), `invert`, the block side `B` and INDEX-DATA on or off, and what the clip
 //! cost when last built (time, texture bytes, compression ratio), from
-//! [`crate::techniques::Renderer::clip_stats`].
+//! [`crate::techniques::Renderer::facts`].
 //!
 //! Decisions: clipping switched on restores the clip last switched off, else adds a
 //! sphere of radius 0.5 at the centre. A shape the editor cannot edit (a file mesh, a
@@ -16,7 +16,6 @@
 //! "Clipping").
 
 use super::widgets::Widgets;
-use crate::techniques::clip::stats::ClipStats;
 use crate::techniques::clip::{ClipSpec, ShapeSpec};
 use crate::techniques::opacity3d::Opacity3dScene;
 
@@ -37,8 +36,8 @@ pub struct ClipEditor {
     disabled: Option<ClipSpec>,
     /// A shape from the scene the editor cannot edit, kept to be chosen again.
     kept: Option<ShapeSpec>,
-    /// The clip's cost as last built (the viewer copies it from the renderer).
-    pub stats: Option<ClipStats>,
+    /// The clip's cost as last built (the viewer copies it from the renderer's facts).
+    pub stats: Option<String>,
 }
 
 /// The clip added when clipping is switched on: a sphere of radius 0.5 at the centre.
@@ -345,10 +344,10 @@ fn body(
         ));
     }
     let line = match &state.stats {
-        Some(s) => s.line(),
+        Some(s) => s.clone(),
         None => "not built yet".to_string(),
     };
-    w.text(ui, "Clip stats", &line);
+    w.text(ui, crate::techniques::clip::stats::LABEL, &line);
     changed
 }
 

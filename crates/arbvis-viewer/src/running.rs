@@ -232,7 +232,11 @@ impl Running {
         let screenshot = self.take_actions(&out.actions, options);
 
         // Read each frame (a copy): the clip's cost after any rebuild above.
-        self.panel.clip.stats = self.session.renderer().clip_stats();
+        let facts = self.session.renderer().facts();
+        let clip = facts
+            .into_iter()
+            .find(|(l, _)| *l == crate::techniques::clip::stats::LABEL);
+        self.panel.clip.stats = clip.map(|(_, line)| line);
         let win = self.place_view(&out);
 
         if out.edited || out.input.scroll != 0.0 || out.input.drag_end {

@@ -8,6 +8,9 @@ use super::multires::TexelFormat;
 use super::ClipTextures;
 use crate::vocab::Fidelity;
 
+/// The label of [`ClipStats::line`] among a renderer's facts (the viewer's panel).
+pub const LABEL: &str = "Clip stats";
+
 /// A built clip's cost.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClipStats {

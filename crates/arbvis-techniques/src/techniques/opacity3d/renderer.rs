@@ -37,7 +37,6 @@ use crate::gl::{
 use crate::programs;
 
 use crate::techniques::clip::stage as clipping_stage;
-use crate::techniques::clip::stats::ClipStats;
 use crate::techniques::{DrawInParts, Frame, Params, Renderer};
 use crate::vocab::Fidelity;
 use crate::volume::quantize::NoData;
@@ -776,8 +775,11 @@ impl Renderer for Opacity3dRenderer {
         self.program.kind()
     }
 
-    fn clip_stats(&self) -> Option<ClipStats> {
-        self.clip.as_ref().map(|c| c.stats)
+    fn facts(&self) -> Vec<(&'static str, String)> {
+        let clip = self.clip.as_ref();
+        clip.map(|c| (crate::techniques::clip::stats::LABEL, c.stats.line()))
+            .into_iter()
+            .collect()
     }
 
     fn in_parts(&mut self) -> Option<&mut dyn DrawInParts> {
