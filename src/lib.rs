@@ -14,7 +14,7 @@
 
 #![deny(unsafe_code)]
 
-pub use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, vocab};
+pub use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, secrets, vocab};
 pub use arbvis_data::{fetch, mesh, points, store, surface, volume};
 pub use arbvis_gl as gl;
 pub use arbvis_gl::{gl_check, gl_check_alloc, gl_debug_check};

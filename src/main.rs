@@ -156,7 +156,9 @@ fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("arbvis: error: {e:#}");
+            // A URL's password or signature never reaches the terminal or a log.
+            let message = arbvis::secrets::redact(&format!("{e:#}"));
+            eprintln!("arbvis: error: {message}");
             ExitCode::FAILURE
         }
     }

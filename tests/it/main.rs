@@ -38,6 +38,7 @@ mod pictures;
 mod programs;
 mod quad;
 mod remote;
+mod remote_secrets;
 mod segy_keys;
 mod session;
 mod splats;

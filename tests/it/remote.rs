@@ -15,7 +15,7 @@ use crate::common::serve::Server;
 use crate::common::{data_file, temp_dir};
 
 /// `arbvis ARGS` with the cache in `cache` and `env` set.
-fn arbvis(args: &[&str], cache: &Path, env: &[(&str, &str)]) -> Output {
+pub(crate) fn arbvis(args: &[&str], cache: &Path, env: &[(&str, &str)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_arbvis"));
     c.args(args)
         .env("ARBVIS_CACHE_DIR", cache)
@@ -27,7 +27,7 @@ fn arbvis(args: &[&str], cache: &Path, env: &[(&str, &str)]) -> Output {
     c.output().unwrap()
 }
 
-fn stderr(o: &Output) -> String {
+pub(crate) fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
@@ -79,7 +79,7 @@ fn store_scene(dir: &Path, name: &str, store: &str) -> PathBuf {
 }
 
 /// The autzen scene's splats on the COPC cloud `copc` (a path or URL) at 96 x 72.
-fn copc_scene(dir: &Path, name: &str, copc: &str) -> PathBuf {
+pub(crate) fn copc_scene(dir: &Path, name: &str, copc: &str) -> PathBuf {
     let text = std::fs::read_to_string(
         Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/data/autzen.toml"),
     )
@@ -109,7 +109,7 @@ pub(crate) fn copc_fixture(dir: &Path) {
 
 /// A test folder `name` holding [`copc_fixture`]'s cloud, the HTTP server on it, and the
 /// folder's cache path.
-fn copc_served(name: &str) -> (PathBuf, Server, PathBuf) {
+pub(crate) fn copc_served(name: &str) -> (PathBuf, Server, PathBuf) {
     let dir = temp_dir(name);
     copc_fixture(&dir);
     let server = Server::http(&dir);

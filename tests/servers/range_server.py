@@ -16,7 +16,13 @@ closes (the test ends) or it is killed. Control, by GET:
                         Content-Length to match, and the Content-Range of the whole range)
         truncate        a Range answer that closes the connection halfway through its body
         change          the file as though rewritten: another ETag (If-Match fails: 412)
-    /_stats             {"requests": N, "bytes": N, "ranges": N} since the start or /_reset
+        redirect:PORT   answer 307 to the same path on 127.0.0.1:PORT (another origin)
+        huge            a Range answer that declares a 2 GiB body (Content-Length
+                        2147483648, the Content-Range of the range asked) and sends the
+                        range's bytes, then zeros until the client stops reading
+    /_stats             {"requests": N, "bytes": N, "ranges": N, "tokens": N,
+                        "authorized": N} since the start or /_reset (tokens: requests
+                        that carried x-amz-security-token; authorized: Authorization)
     /_reset             zero the counts and clear the fault
 
 A file's ETag is its size and modification time (as nginx makes it), so a file rewritten
@@ -34,7 +40,9 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 
 ROOT = os.path.abspath(sys.argv[1])
 LOCK = threading.Lock()
-STATE = {"requests": 0, "bytes": 0, "ranges": 0, "fault": None, "count": 0, "skip": 0}
+STATE = {"requests": 0, "bytes": 0, "ranges": 0, "tokens": 0, "authorized": 0, "fault": None,
+         "count": 0, "skip": 0}
+COUNTS = ("requests", "bytes", "ranges", "tokens", "authorized")
 
 
 def take_fault():
@@ -73,8 +81,8 @@ class Handler(BaseHTTPRequestHandler):
                 STATE["count"] = int(q.get("count", ["0"])[0])
                 STATE["skip"] = int(q.get("skip", ["0"])[0])
             elif url.path == "/_reset":
-                STATE.update(requests=0, bytes=0, ranges=0, fault=None, count=0, skip=0)
-            body = json.dumps({k: STATE[k] for k in ("requests", "bytes", "ranges")}).encode()
+                STATE.update({k: 0 for k in COUNTS}, fault=None, count=0, skip=0)
+            body = json.dumps({k: STATE[k] for k in COUNTS}).encode()
         self.send_response(200)
         self.send_header("Content-Type", "application/json")
         self.send_header("Content-Length", str(len(body)))
@@ -91,7 +99,16 @@ class Handler(BaseHTTPRequestHandler):
         url = urllib.parse.urlparse(self.path)
         if url.path.startswith("/_"):
             return self.control(url)
+        with LOCK:
+            STATE["tokens"] += int("x-amz-security-token" in self.headers)
+            STATE["authorized"] += int("Authorization" in self.headers)
         fault = take_fault()
+        if fault and fault.startswith("redirect:"):
+            self.send_response(307)
+            self.send_header("Location", "http://127.0.0.1:%s%s" % (fault.split(":")[1], self.path))
+            self.send_header("Content-Length", "0")
+            self.end_headers()
+            return
         if fault == "reset":
             self.close_connection = True
             self.connection.shutdown(2)
@@ -154,9 +171,19 @@ class Handler(BaseHTTPRequestHandler):
         self.send_header("Accept-Ranges", "bytes")
         if partial:
             self.send_header("Content-Range", "bytes %d-%d/%d" % (start, end - 1, size))
-        self.send_header("Content-Length", str(len(sent)))
+        huge = partial and fault == "huge"
+        self.send_header("Content-Length", str(2**31 if huge else len(sent)))
         self.end_headers()
         if head:
+            return
+        if huge:
+            try:
+                self.wfile.write(sent)
+                for _ in range(2**31 // 65536):
+                    self.wfile.write(bytes(65536))
+            except (BrokenPipeError, ConnectionResetError):
+                pass
+            self.close_connection = True
             return
         if partial and fault == "truncate":
             sent = sent[: len(sent) // 2]

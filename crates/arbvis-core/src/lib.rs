@@ -13,4 +13,5 @@ pub mod image;
 pub mod input;
 pub mod png_io;
 pub mod progress;
+pub mod secrets;
 pub mod vocab;

@@ -80,6 +80,8 @@ pub const MAX_TEXT_BYTES: usize = 256 * 1024;
 
 /// One text chunk: iTXt (UTF-8, so paths in any script survive), compressed when long.
 fn text_chunk(key: &str, value: &str) -> png::text_metadata::ITXtChunk {
+    // A scene naming a URL with a password or a signature embeds it hidden.
+    let value = &crate::secrets::redact(value);
     let value = if value.len() > MAX_TEXT_BYTES {
         let mut cut = MAX_TEXT_BYTES;
         while !value.is_char_boundary(cut) {

@@ -6,6 +6,7 @@
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
 
+use arbvis_core::secrets::redact;
 use arbvis_gl::GlError;
 use arbvis_techniques::error::RenderError as RustRenderError;
 use arbvis_techniques::scene::SceneError as RustSceneError;
@@ -94,7 +95,7 @@ impl<'a> At<'a> {
 
 /// A `SceneError` saying `message`, with its position as attributes.
 pub fn scene_error(message: String, at: At<'_>) -> PyErr {
-    let err = SceneError::new_err(message);
+    let err = SceneError::new_err(redact(&message));
     Python::attach(|py| {
         let value = err.value(py);
         let _ = value.setattr("path", at.path);
@@ -105,9 +106,14 @@ pub fn scene_error(message: String, at: At<'_>) -> PyErr {
     err
 }
 
+/// An `InputError` saying `e`, any URL's secrets hidden.
+pub fn input_error(e: impl std::fmt::Display) -> PyErr {
+    InputError::new_err(redact(&e.to_string()))
+}
+
 /// A scene's error from the Rust side.
 pub fn from_scene(e: RustSceneError) -> PyErr {
-    let message = e.to_string();
+    let message = redact(&e.to_string());
     match &e {
         RustSceneError::Io { path, .. } => InputError::new_err(format!("{message} ({path})")),
         RustSceneError::Parse {
@@ -126,13 +132,13 @@ pub fn from_scene(e: RustSceneError) -> PyErr {
 
 /// A GL error.
 pub fn from_gl(e: GlError) -> PyErr {
-    GLError::new_err(e.to_string())
+    GLError::new_err(redact(&e.to_string()))
 }
 
 /// A render error: the data layers' as `InputError`, the GL's as `GLError`, parameters as
 /// `SceneError` (the key relative to the technique's table), the rest as `RenderError`.
 pub fn from_render(e: RustRenderError) -> PyErr {
-    let message = e.to_string();
+    let message = redact(&e.to_string());
     match e {
         RustRenderError::Gl(e) => from_gl(e),
         RustRenderError::Volume(_)

@@ -15,8 +15,6 @@ use arbvis_core::image::Image;
 use arbvis_core::png_io;
 use arbvis_core::vocab::TargetFormat;
 
-use crate::errors::InputError;
-
 /// An `(height, width, 4)` array (uint8, or float32 in 0..1) as an image.
 fn image_of(array: &Bound<'_, PyAny>) -> PyResult<Image> {
     let (format, data, shape) = if let Ok(a) = array.extract::<PyReadonlyArray3<'_, u8>>() {
@@ -65,7 +63,7 @@ fn levels(image: Image) -> Image {
 /// Read a PNG as an `(height, width, 4)` uint8 array.
 #[pyfunction]
 pub fn read_png(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
-    let (image, _) = png_io::read_png(&path).map_err(|e| InputError::new_err(e.to_string()))?;
+    let (image, _) = png_io::read_png(&path).map_err(crate::errors::input_error)?;
     Ok(to_u8_array(py, &image))
 }
 
@@ -74,7 +72,7 @@ pub fn read_png(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
 #[pyfunction]
 pub fn write_png(path: PathBuf, array: &Bound<'_, PyAny>) -> PyResult<()> {
     let image = levels(image_of(array)?);
-    png_io::write_png(&path, &image, &[]).map_err(|e| InputError::new_err(e.to_string()))
+    png_io::write_png(&path, &image, &[]).map_err(crate::errors::input_error)
 }
 
 /// How `actual` differs from `expected`, on 8-bit levels (what a PNG holds): a dict of

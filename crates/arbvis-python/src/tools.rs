@@ -15,7 +15,7 @@ use arbvis_data::store::StoreError;
 use arbvis_data::volume::attributes::{by_name, Attribute};
 use arbvis_techniques::inspect::inspect as inspect_file;
 
-use crate::errors::{Cancelled, InputError};
+use crate::errors::Cancelled;
 
 /// What `arbvis inspect PATH` says of a file or store, as a dict: `path`, each
 /// `name: value` line's value under its name (a name said twice: a list), and the whole
@@ -24,9 +24,12 @@ use crate::errors::{Cancelled, InputError};
 pub fn inspect(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyDict>> {
     let text = py
         .detach(|| inspect_file(&path))
-        .map_err(|e| InputError::new_err(e.to_string()))?;
+        .map_err(crate::errors::input_error)?;
     let out = PyDict::new(py);
-    out.set_item("path", path.display().to_string())?;
+    out.set_item(
+        "path",
+        arbvis_core::secrets::redact(&path.display().to_string()),
+    )?;
     for line in text.lines() {
         let Some((name, value)) = line.split_once(": ") else {
             continue;
@@ -133,8 +136,8 @@ pub fn convert<'py>(
         return Err(e);
     }
     let report = report.map_err(|e| match e {
-        StoreError::Interrupted(m) => Cancelled::new_err(m),
-        e => InputError::new_err(e.to_string()),
+        StoreError::Interrupted(m) => Cancelled::new_err(arbvis_core::secrets::redact(&m)),
+        e => crate::errors::input_error(e),
     })?;
     let out = PyDict::new(py);
     out.set_item("store", dst.display().to_string())?;
@@ -161,7 +164,7 @@ fn convert_to_copc<'py>(
     };
     let report = py
         .detach(|| write_copc(src, dst, &options))
-        .map_err(|e| InputError::new_err(e.to_string()))?;
+        .map_err(crate::errors::input_error)?;
     let out = PyDict::new(py);
     out.set_item("copc", dst.display().to_string())?;
     out.set_item("points", report.points)?;

@@ -116,11 +116,16 @@ pub fn inspect(path: &Path) -> Result<String, InspectError> {
 }
 
 /// [`inspect`] with a SEG-Y file's inline and crossline bytes named (each one not named
-/// is detected).
+/// is detected); a URL's password or signature is hidden in what it says.
 pub fn inspect_with(
     path: &Path,
     segy_keys: crate::volume::segy::KeyBytes,
 ) -> Result<String, InspectError> {
+    describe(path, segy_keys).map(|text| arbvis_core::secrets::redact(&text))
+}
+
+/// What [`inspect_with`] says, secrets and all.
+fn describe(path: &Path, segy_keys: crate::volume::segy::KeyBytes) -> Result<String, InspectError> {
     let io = |error| InspectError::Io {
         path: path.display().to_string(),
         error,

@@ -6,6 +6,12 @@
 //! entry is written to a file of its own and renamed into place, so a reader sees a whole
 //! entry or none, and a file removed by another process's eviction is a miss.
 //!
+//! An entry's header holds the URL with its secrets hidden (a password, a signature:
+//! [`arbvis_core::secrets`]), and the bytes' length and CRC-32C: a damaged entry (a
+//! flipped bit, a cut) is a miss, fetched again. Only regular files are read, and no
+//! more of them than the range's bytes and a header (a symlink to `/dev/zero` or a FIFO
+//! planted in the folder is a miss, not a hang or a flood).
+//!
 //! Settings: `ARBVIS_CACHE_DIR` (default `$XDG_CACHE_HOME/arbvis/remote`, else
 //! `~/.cache/arbvis/remote`), `ARBVIS_CACHE_BYTES` (default 2 GiB; 0 turns the cache off).
 
@@ -18,7 +24,10 @@ use std::sync::OnceLock;
 use std::time::SystemTime;
 
 /// First line of every entry (a format change renames it, and old entries are misses).
-const MAGIC: &str = "arbvis fetch cache 1";
+const MAGIC: &str = "arbvis fetch cache 2";
+
+/// Longest header read: the magic, a URL of up to 8 KiB and the numbers.
+const MAX_HEADER: u64 = 8192 + 256;
 
 /// Default size limit: 2 GiB.
 pub const DEFAULT_BYTES: u64 = 2 << 30;
@@ -100,7 +109,7 @@ impl DiskCache {
     /// The entry of `url`'s bytes `range`, if one is cached (and marked as used now).
     pub fn get(&self, url: &str, range: &Range<u64>) -> Option<Entry> {
         let file = self.dir.join(name(url, range));
-        let data = std::fs::read(&file).ok()?;
+        let data = read_entry(&file, range)?;
         let entry = parse(&data, url, range)?;
         if let Ok(f) = std::fs::File::options().write(true).open(&file) {
             let _ = f.set_modified(SystemTime::now());
@@ -132,7 +141,9 @@ impl DiskCache {
         (etag, size): (&str, u64),
         bytes: &[u8],
     ) -> std::io::Result<()> {
-        if etag.contains('\n') || url.contains('\n') {
+        // The name keys the whole URL; the header holds it with its secrets hidden.
+        let shown = arbvis_core::secrets::redact(url);
+        if etag.contains('\n') || shown.contains('\n') || shown.len() as u64 > MAX_HEADER - 256 {
             return Err(std::io::Error::other("a newline in a cache key"));
         }
         std::fs::create_dir_all(&self.dir)?;
@@ -145,8 +156,11 @@ impl DiskCache {
         ));
         let mut f = std::fs::File::create(&tmp)?;
         let head = format!(
-            "{MAGIC}\n{url}\n{} {}\n{etag}\n{size}\n",
-            range.start, range.end
+            "{MAGIC}\n{shown}\n{} {}\n{etag}\n{size}\n{} {:08x}\n",
+            range.start,
+            range.end,
+            bytes.len(),
+            crc32c::crc32c(bytes)
         );
         let done = f
             .write_all(head.as_bytes())
@@ -210,7 +224,22 @@ impl DiskCache {
     }
 }
 
-/// An entry's file, if it is whole and of (`url`, `range`).
+/// The bytes of the entry file `file` of `range`, if it is a regular file (not followed
+/// through a link) of no more than the range's bytes and a header.
+fn read_entry(file: &Path, range: &Range<u64>) -> Option<Vec<u8>> {
+    use std::io::Read;
+    let meta = std::fs::symlink_metadata(file).ok()?;
+    let most = (range.end - range.start).saturating_add(MAX_HEADER);
+    if !meta.is_file() || meta.len() > most {
+        return None;
+    }
+    let mut data = Vec::with_capacity(meta.len() as usize);
+    let f = std::fs::File::open(file).ok()?;
+    f.take(most.saturating_add(1)).read_to_end(&mut data).ok()?;
+    Some(data)
+}
+
+/// An entry's file, if it is whole, undamaged and of (`url`, `range`).
 fn parse(data: &[u8], url: &str, range: &Range<u64>) -> Option<Entry> {
     let mut at = 0;
     let mut line = || {
@@ -219,7 +248,7 @@ fn parse(data: &[u8], url: &str, range: &Range<u64>) -> Option<Entry> {
         at = end + 1;
         Some(text)
     };
-    if line()? != MAGIC || line()? != url {
+    if line()? != MAGIC || line()? != arbvis_core::secrets::redact(url) {
         return None;
     }
     if line()? != format!("{} {}", range.start, range.end) {
@@ -227,10 +256,17 @@ fn parse(data: &[u8], url: &str, range: &Range<u64>) -> Option<Entry> {
     }
     let etag = line()?.to_string();
     let size = line()?.parse().ok()?;
+    let (len, crc) = line()?.split_once(' ')?;
+    let bytes = &data[at..];
+    if len.parse::<usize>().ok()? != bytes.len()
+        || u32::from_str_radix(crc, 16).ok()? != crc32c::crc32c(bytes)
+    {
+        return None;
+    }
     Some(Entry {
         etag,
         size,
-        bytes: data[at..].to_vec(),
+        bytes: bytes.to_vec(),
     })
 }
 
@@ -258,6 +294,37 @@ mod tests {
         let data = std::fs::read(&file).unwrap();
         std::fs::write(&file, &data[..10]).unwrap();
         assert!(cache.get(url, &(0..5)).is_none());
+        // Every bit of the bytes flipped in turn, and the body cut by one: each a miss.
+        for bit in 0..5 * 8 {
+            let mut bad = data.clone();
+            bad[data.len() - 5 + bit / 8] ^= 1 << (bit % 8);
+            std::fs::write(&file, &bad).unwrap();
+            assert!(cache.get(url, &(0..5)).is_none(), "bit {bit}");
+        }
+        std::fs::write(&file, &data[..data.len() - 1]).unwrap();
+        assert!(cache.get(url, &(0..5)).is_none());
+        // Not a regular file: a link to /dev/zero, a FIFO (opening it would block).
+        std::fs::remove_file(&file).unwrap();
+        std::os::unix::fs::symlink("/dev/zero", &file).unwrap();
+        assert!(cache.get(url, &(0..5)).is_none());
+        std::fs::remove_file(&file).unwrap();
+        let made = std::process::Command::new("mkfifo").arg(&file).status();
+        assert!(
+            made.is_ok_and(|s| s.success()),
+            "mkfifo (coreutils) is needed"
+        );
+        assert!(cache.get(url, &(0..5)).is_none());
+        std::fs::remove_file(&file).unwrap();
+        // A password in the URL is not written into the entry, yet the entry is found.
+        let secret = "http://me:hunter2@h/k?X-Amz-Signature=abcd";
+        cache.put(secret, &(0..5), "e", 5, b"bytes");
+        let written = std::fs::read(dir.join(name(secret, &(0..5)))).unwrap();
+        let text = String::from_utf8_lossy(&written);
+        assert!(
+            !text.contains("hunter2") && !text.contains("abcd"),
+            "{text}"
+        );
+        assert_eq!(cache.get(secret, &(0..5)).unwrap().bytes, b"bytes");
         // Over the limit: the oldest entries go first, down to 80 % of it. Filled through
         // a handle with room for all, then evicted by another on the same folder with a
         // limit of 10,000 bytes (as a second process would).

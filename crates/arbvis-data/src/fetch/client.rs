@@ -9,6 +9,7 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Duration;
 
 use object_store::aws::AmazonS3Builder;
+use object_store::client::{HttpClient, HttpConnector};
 use object_store::http::HttpBuilder;
 use object_store::{BackoffConfig, ClientOptions, ObjectStore, RetryConfig};
 
@@ -143,13 +144,24 @@ fn client(root: &str, s3: bool) -> Result<Arc<dyn ObjectStore>, String> {
         }
         if anonymous() {
             b = b.with_skip_signature(true);
+        } else {
+            b = b.with_http_connector(SameHostRedirects);
         }
         Arc::new(b.build().map_err(|e| format!("{root}: {e}"))?)
     } else {
+        // A password in the URL goes to its server as Basic authorization, which
+        // reqwest drops on a redirect to another host.
+        let (plain, auth) = basic_auth(root);
+        let mut options = options();
+        if let Some(value) = auth {
+            let mut headers = reqwest::header::HeaderMap::new();
+            headers.insert(reqwest::header::AUTHORIZATION, value);
+            options = options.with_default_headers(headers);
+        }
         Arc::new(
             HttpBuilder::new()
-                .with_url(root)
-                .with_client_options(options())
+                .with_url(plain)
+                .with_client_options(options)
                 .with_retry(retry())
                 .build()
                 .map_err(|e| format!("{root}: {e}"))?,
@@ -157,6 +169,73 @@ fn client(root: &str, s3: bool) -> Result<Arc<dyn ObjectStore>, String> {
     };
     clients.insert(root.to_string(), made.clone());
     Ok(made)
+}
+
+/// The HTTP client of signed S3 requests: object_store's settings, and a redirect to
+/// another origin (scheme, host, port) not followed. reqwest drops `Authorization` on
+/// such a redirect but not `x-amz-security-token`, so following it would send a session
+/// token to a host it was not meant for; the redirect is an error that says so instead.
+#[derive(Debug)]
+struct SameHostRedirects;
+
+impl HttpConnector for SameHostRedirects {
+    fn connect(&self, _: &ClientOptions) -> object_store::Result<HttpClient> {
+        use reqwest::redirect::{Attempt, Policy};
+        let policy = Policy::custom(|attempt: Attempt<'_>| {
+            let first = &attempt.previous()[0];
+            let next = attempt.url();
+            if attempt.previous().len() > 10 {
+                attempt.error("more than 10 redirects")
+            } else if next.origin() == first.origin() {
+                attempt.follow()
+            } else {
+                attempt.stop()
+            }
+        });
+        let t = timeout();
+        let client = reqwest::Client::builder()
+            .user_agent(concat!("arbvis/", env!("CARGO_PKG_VERSION")))
+            .timeout(t)
+            .connect_timeout(t.min(Duration::from_secs(10)))
+            .pool_max_idle_per_host(64)
+            .no_gzip()
+            .no_brotli()
+            .no_zstd()
+            .no_deflate()
+            .redirect(policy)
+            .build()
+            .map_err(|e| object_store::Error::Generic {
+                store: "S3",
+                source: Box::new(e),
+            })?;
+        Ok(HttpClient::new(client))
+    }
+}
+
+/// `root` (`scheme://authority`) without its user info, and the Basic authorization
+/// that user info says, where it has one.
+fn basic_auth(root: &str) -> (String, Option<reqwest::header::HeaderValue>) {
+    use base64::Engine as _;
+    let Some((scheme, authority)) = root.split_once("://") else {
+        return (root.to_string(), None);
+    };
+    let Some((user_info, host)) = authority.rsplit_once('@') else {
+        return (root.to_string(), None);
+    };
+    let (user, password) = user_info.split_once(':').unwrap_or((user_info, ""));
+    let pair = format!(
+        "{}:{}",
+        super::percent_decode(user),
+        super::percent_decode(password)
+    );
+    let token = base64::engine::general_purpose::STANDARD.encode(pair);
+    let value = reqwest::header::HeaderValue::from_str(&format!("Basic {token}"))
+        .ok()
+        .map(|mut v| {
+            v.set_sensitive(true);
+            v
+        });
+    (format!("{scheme}://{host}"), value)
 }
 
 /// Reads of public buckets go unsigned: no access key, and no role to assume.
@@ -200,11 +279,21 @@ pub fn describe(object: &Object, range: Option<&Range<u64>>, e: &object_store::E
         ),
         other => {
             let text = other.to_string();
-            if text.contains("non-partial response") || text.contains("Range request not supported") {
+            if object.s3 && !anonymous() && is_redirect(&text) {
+                format!("{what}: the server redirected the request to another host, and a signed request's credentials (the session token) are not sent to another host: set AWS_REGION to the bucket's region or AWS_ENDPOINT_URL to the server that holds it")
+            } else if text.contains("non-partial response") || text.contains("Range request not supported") {
                 format!("{what}: the server ignored the Range request (it answered 200 with the whole object); arbvis reads a part of an object only from servers that honour Range")
             } else {
                 format!("{what}: {text}")
             }
         }
     }
+}
+
+/// Whether object_store's error text is a redirect it did not follow (HTTP 3xx).
+fn is_redirect(text: &str) -> bool {
+    ["301", "302", "303", "307", "308"]
+        .iter()
+        .any(|code| text.contains(&format!("status {code}")) || text.contains(&format!("{code} ")))
+        || text.to_ascii_lowercase().contains("redirect")
 }

@@ -77,12 +77,15 @@ impl FetchError {
         }
     }
 
-    /// A failure of the request for `range` (`None`: the whole object) of `url`.
+    /// A failure of the request for `range` (`None`: the whole object) of `url`; the
+    /// URL and the message (which may quote it) keep no password or signature
+    /// ([`arbvis_core::secrets`]).
     pub fn at(url: &str, range: Option<&Range<u64>>, message: impl Into<String>) -> FetchError {
+        use arbvis_core::secrets::redact;
         FetchError::Failed {
-            url: Some(url.to_string()),
+            url: Some(redact(url)),
             range: range.cloned(),
-            message: message.into(),
+            message: redact(&message.into()),
         }
     }
 
@@ -142,6 +145,7 @@ pub fn resolve(base: &Path, name: &Path) -> PathBuf {
     }
 }
 
+/// `s` with its `%XX` escapes decoded (invalid UTF-8 replaced).
 fn percent_decode(s: &str) -> String {
     let b = s.as_bytes();
     let mut out = Vec::with_capacity(b.len());
@@ -375,5 +379,10 @@ mod error_tests {
         // A std::error::Error, as every other layer's error is.
         let boxed: Box<dyn std::error::Error + Send + Sync> = Box::new(e);
         assert_eq!(boxed.to_string(), "bytes 3-8: reset");
+        // A password in the URL, or quoted in the message, stays out of both.
+        let secret = "http://me:hunter2@h/o";
+        let e = FetchError::at(secret, None, format!("GET {secret}: refused"));
+        assert_eq!(e.url(), Some("http://me:***@h/o"));
+        assert!(!e.to_string().contains("hunter2"), "{e}");
     }
 }

@@ -98,13 +98,9 @@ impl RemoteFile {
             Ok(got) => {
                 let size = got.meta.size;
                 let etag = got.meta.e_tag.clone();
-                let range = got.range.clone();
-                let bytes = client::runtime()
-                    .block_on(got.bytes())
-                    .map_err(|e| client::failure(&object, Some(&first), &e))?;
+                let (range, bytes) = client::runtime().block_on(body(&object, &first, got))?;
                 check_length(url, &range, bytes.len())?;
                 count::fetched(bytes.len());
-                let bytes = bytes.to_vec();
                 if let (Some(c), Some(t)) = (super::cache::global(), &etag) {
                     c.put(url, &first, t, size, &bytes);
                 }
@@ -258,12 +254,44 @@ impl RemoteFile {
                 got.meta.e_tag.as_deref().unwrap_or("none"),
             )));
         }
-        let range = got.range.clone();
-        let bytes = got.bytes().await.map_err(|e| describe(&e))?;
+        let (range, bytes) = body(&self.object, &r, got).await?;
         check_length(&self.object.url, &range, bytes.len())?;
         count::fetched(bytes.len());
-        Ok(Arc::new(bytes.to_vec()))
+        Ok(Arc::new(bytes))
     }
+}
+
+/// The body of `got`, the answer to a request for bytes `asked` of `object`, with the
+/// range the server says it holds: read part by part and refused as soon as it holds
+/// more than `asked` (a server declaring a 2 GiB body for a 64 KiB range is never
+/// buffered past the range).
+async fn body(
+    object: &Object,
+    asked: &Range<u64>,
+    got: object_store::GetResult,
+) -> Result<(Range<u64>, Vec<u8>), FetchError> {
+    let range = got.range.clone();
+    let (first, last) = (asked.start, asked.end.saturating_sub(1));
+    let most = asked.end - asked.start;
+    if range.start != asked.start || range.end - range.start > most {
+        let m = format!(
+            "bytes {first}-{last}: the server answered bytes {}-{}, not the range asked for",
+            range.start,
+            range.end.saturating_sub(1)
+        );
+        return Err(FetchError::at(&object.url, Some(asked), m));
+    }
+    let mut bytes = Vec::with_capacity((range.end - range.start) as usize);
+    let mut parts = got.into_stream();
+    while let Some(part) = parts.next().await {
+        let part = part.map_err(|e| client::failure(object, Some(asked), &e))?;
+        if (bytes.len() + part.len()) as u64 > most {
+            let m = format!("bytes {first}-{last}: the body held more than the range's {most} bytes (its declared length is not believed)");
+            return Err(FetchError::at(&object.url, Some(asked), m));
+        }
+        bytes.extend_from_slice(&part);
+    }
+    Ok((range, bytes))
 }
 
 /// The body must hold the range the server said it sends.

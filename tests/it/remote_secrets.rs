@@ -1,0 +1,154 @@
+//! Remote data against hostile servers, round 5: a URL's secrets never leave the process
+//! but in the request to their own host (not in errors, `inspect`, the disk cache or the
+//! PNG's scene text; a session token is not sent on a redirect to another host), and a
+//! body is never buffered past the range asked for, whatever length the server declares.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use super::common::serve::Server;
+use super::remote::{arbvis, copc_scene, copc_served, stderr};
+
+/// Every file's bytes under `dir`, joined (to look for a secret anywhere in them).
+fn all_bytes(dir: &Path) -> Vec<u8> {
+    let mut out = Vec::new();
+    for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            out.extend(all_bytes(&p));
+        } else {
+            out.extend(std::fs::read(&p).unwrap_or_default());
+        }
+    }
+    out
+}
+
+fn holds(bytes: &[u8], secret: &str) -> bool {
+    bytes.windows(secret.len()).any(|w| w == secret.as_bytes())
+}
+
+/// A password in the URL reaches the server (as HTTP basic authentication) and nothing
+/// else: not `inspect`'s text, not an error line, not a cache entry, not the PNG.
+#[test]
+fn a_urls_password_stays_out_of_inspect_errors_the_cache_and_the_png() {
+    let (dir, server, cache) = copc_served("remote-secrets");
+    let secret = "hunter2-secret";
+    let url = format!("http://me:{secret}@127.0.0.1:{}/c.copc.laz", server.port);
+    let out = arbvis(&["inspect", &url], &cache, &[]);
+    let said = String::from_utf8_lossy(&out.stdout).into_owned() + &stderr(&out);
+    assert!(out.status.success(), "{said}");
+    assert!(!said.contains(secret) && said.contains("me:***@"), "{said}");
+    let stats = server.control("_stats");
+    assert!(
+        !stats.contains("\"authorized\": 0"),
+        "no credentials sent: {stats}"
+    );
+    // A refusal: the error names the URL, its password hidden.
+    server.control("_fault?mode=status:403&count=0&skip=0");
+    let out = arbvis(&["inspect", &url], &dir.join("cache-refused"), &[]);
+    let e = stderr(&out);
+    assert!(!out.status.success() && e.contains("403"), "{e}");
+    assert!(!e.contains(secret) && e.contains("me:***@127.0.0.1"), "{e}");
+    server.control("_reset");
+    // A picture: the scene text it embeds names the URL without the password.
+    let scene = copc_scene(&dir, "secret.toml", &url);
+    let png = dir.join("secret.png");
+    let out = arbvis(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        &cache,
+        &[],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (_, text) = arbvis::png_io::read_png(&png).unwrap();
+    let embedded: String = text.iter().map(|(k, v)| format!("{k}: {v}\n")).collect();
+    assert!(embedded.contains("me:***@127.0.0.1"), "{embedded}");
+    assert!(!embedded.contains(secret), "{embedded}");
+    // The cache's entries (the COPC header, hierarchy and nodes) hold no password.
+    let cached = all_bytes(&cache);
+    assert!(cached.len() > 1000, "the cache was used");
+    assert!(!holds(&cached, secret), "a cache entry holds the password");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A signed S3 request redirected (307) to another host is not followed: the session
+/// token reaches only the endpoint it was meant for, and the error says why. The same
+/// endpoint without the redirect reads the cloud (so the token is sent where it should).
+#[test]
+fn a_session_token_is_not_sent_to_the_host_a_redirect_names() {
+    let (dir, _, cache) = copc_served("remote-token");
+    // Path-style S3 requests: /BUCKET/KEY under the endpoint's folder.
+    let bucket = dir.join("bkt");
+    std::fs::create_dir_all(&bucket).unwrap();
+    std::fs::copy(dir.join("c.copc.laz"), bucket.join("c.copc.laz")).unwrap();
+    let (endpoint, elsewhere) = (Server::http(&dir), Server::http(&dir));
+    let aws = |port: u16| {
+        [
+            ("AWS_ENDPOINT_URL", format!("http://127.0.0.1:{port}")),
+            ("AWS_ACCESS_KEY_ID", "AKIDTEST".to_string()),
+            ("AWS_SECRET_ACCESS_KEY", "secretkey".to_string()),
+            ("AWS_SESSION_TOKEN", "the-session-token".to_string()),
+            ("AWS_REGION", "us-east-1".to_string()),
+            ("AWS_ALLOW_HTTP", "true".to_string()),
+        ]
+    };
+    let env = aws(endpoint.port);
+    let env: Vec<(&str, &str)> = env.iter().map(|(k, v)| (*k, v.as_str())).collect();
+    let ok = arbvis(&["inspect", "s3://bkt/c.copc.laz"], &cache, &env);
+    assert!(ok.status.success(), "{}", stderr(&ok));
+    let stats = endpoint.control("_stats");
+    assert!(!stats.contains("\"tokens\": 0"), "no token sent: {stats}");
+    endpoint.control("_reset");
+    endpoint.control(&format!(
+        "_fault?mode=redirect:{}&count=0&skip=0",
+        elsewhere.port
+    ));
+    let out = arbvis(
+        &["inspect", "s3://bkt/c.copc.laz"],
+        &dir.join("cache-2"),
+        &env,
+    );
+    let e = stderr(&out);
+    assert!(!out.status.success(), "a redirected request succeeded");
+    assert!(
+        e.contains("another host") && e.contains("s3://bkt/c.copc.laz"),
+        "{e}"
+    );
+    let stats = elsewhere.control("_stats");
+    assert!(
+        stats.contains("\"tokens\": 0") && stats.contains("\"requests\": 0"),
+        "{stats}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A range answered with `Content-Length: 2147483648` (and 2 GiB of zeros behind the
+/// range's bytes) is refused once the body passes the range: in seconds, under an
+/// address-space limit of 1.5 GiB that buffering the declared body would break.
+#[test]
+fn a_declared_two_gib_body_is_not_buffered() {
+    let (dir, server, cache) = copc_served("remote-huge");
+    server.control("_fault?mode=huge&count=0&skip=0");
+    let t = Instant::now();
+    let out = std::process::Command::new("sh")
+        .arg("-c")
+        .arg("ulimit -v 1572864 && exec \"$0\" inspect \"$1\"")
+        .arg(env!("CARGO_BIN_EXE_arbvis"))
+        .arg(server.url("c.copc.laz"))
+        .env("ARBVIS_CACHE_DIR", &cache)
+        .output()
+        .unwrap();
+    let e = stderr(&out);
+    assert!(!out.status.success(), "a 2 GiB body was taken");
+    assert!(
+        e.contains("more than the range's") && e.contains("c.copc.laz") && e.contains("bytes 0-"),
+        "{e}"
+    );
+    // Loopback moves 2 GiB in about a second; the refusal comes after the first range.
+    assert!(t.elapsed() < Duration::from_secs(30), "{:?}", t.elapsed());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
