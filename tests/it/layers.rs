@@ -27,6 +27,7 @@ const LAYERS: &[(&str, &[&str])] = &[
             "png_io",
             "colortable",
             "progress",
+            "secrets",
         ],
     ),
     (
