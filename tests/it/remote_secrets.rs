@@ -152,3 +152,30 @@ fn a_declared_two_gib_body_is_not_buffered() {
     assert!(t.elapsed() < Duration::from_secs(30), "{:?}", t.elapsed());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A timeout that cannot be read (`0`, `5s`) is refused by name when a URL is opened,
+/// instead of silently meaning 30 s.
+#[test]
+fn an_unreadable_remote_timeout_is_refused_by_name() {
+    let (dir, server, cache) = copc_served("remote-timeout");
+    for bad in ["0", "5s", "-1", "nan"] {
+        let out = arbvis(
+            &["inspect", &server.url("c.copc.laz")],
+            &cache,
+            &[("ARBVIS_REMOTE_TIMEOUT", bad)],
+        );
+        let e = stderr(&out);
+        assert!(!out.status.success(), "{bad}: accepted");
+        assert!(
+            e.contains("ARBVIS_REMOTE_TIMEOUT") && e.contains("expected seconds"),
+            "{bad}: {e}"
+        );
+    }
+    let out = arbvis(
+        &["inspect", &server.url("c.copc.laz")],
+        &cache,
+        &[("ARBVIS_REMOTE_TIMEOUT", "2.5")],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

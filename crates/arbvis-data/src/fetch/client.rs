@@ -45,14 +45,29 @@ pub fn runtime() -> &'static tokio::runtime::Runtime {
     })
 }
 
-/// Seconds a request may take before it fails (`ARBVIS_REMOTE_TIMEOUT`, default 30).
+/// Seconds a request may take before it fails (`ARBVIS_REMOTE_TIMEOUT`, default 30; a
+/// value [`timeout_setting`] refuses is refused when a URL is opened).
 pub fn timeout() -> Duration {
-    let secs = std::env::var("ARBVIS_REMOTE_TIMEOUT")
+    timeout_setting().unwrap_or(Duration::from_secs(30))
+}
+
+/// `ARBVIS_REMOTE_TIMEOUT` read: seconds, a number above 0 (up to a day), 30 when unset or
+/// empty; anything else (`0`, `5s`, `-1`) is an error that says what is expected.
+pub fn timeout_setting() -> Result<Duration, String> {
+    let Some(text) = std::env::var("ARBVIS_REMOTE_TIMEOUT")
         .ok()
-        .and_then(|v| v.parse::<f64>().ok())
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .unwrap_or(30.0);
-    Duration::from_secs_f64(secs)
+        .filter(|v| !v.trim().is_empty())
+    else {
+        return Ok(Duration::from_secs(30));
+    };
+    match text.trim().parse::<f64>() {
+        Ok(secs) if secs.is_finite() && secs > 0.0 && secs <= 86_400.0 => {
+            Ok(Duration::from_secs_f64(secs))
+        }
+        _ => Err(format!(
+            "ARBVIS_REMOTE_TIMEOUT={text:?}: expected seconds, a number above 0 and at most 86400 (e.g. 30 or 2.5), with no unit"
+        )),
+    }
 }
 
 /// Requests kept in flight at once (`ARBVIS_REMOTE_REQUESTS`, default 16).
@@ -108,6 +123,7 @@ pub fn object(url: &str) -> Result<Object, FetchError> {
             return Err(fail(m.to_string()));
         }
     };
+    timeout_setting().map_err(fail)?;
     let root = format!("{scheme}://{authority}");
     let store = client(&root, s3).map_err(fail)?;
     let path = object_store::path::Path::from_url_path(key)
