@@ -5,24 +5,6 @@
 use std::io::Read;
 use std::path::Path;
 
-/// What `inspect` reads, for the message about a file it does not.
-pub const READS: &str = "volumes: SEG-Y (.sgy, .segy), NIfTI-1 (.nii, .nii.gz); tetrahedral meshes: VTK legacy (.vtk), VTK XML (.vtu), gmsh (.msh); point clouds: LAS/LAZ (.las, .laz; COPC .copc.laz described from its octree), PLY (.ply), ReconMS text (.dat); surfaces: OBJ (.obj), STL (.stl); survey stores (a folder, from `arbvis convert`)";
-
-/// The kinds of file `inspect` knows.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Kind {
-    /// SEG-Y rev 0-2.
-    Segy,
-    /// NIfTI-1, plain or gzip.
-    Nifti,
-    /// A tetrahedral mesh (VTK legacy or XML, gmsh).
-    Mesh,
-    /// A point cloud (LAS/LAZ, PLY, `.dat`).
-    Points,
-    /// A closed triangle surface (OBJ, STL).
-    Surface,
-}
-
 /// Errors of `inspect`: the reader's own, or a file no reader takes.
 #[derive(Debug, thiserror::Error)]
 pub enum InspectError {
@@ -50,26 +32,13 @@ pub enum InspectError {
     #[error(transparent)]
     Store(#[from] crate::store::StoreError),
     /// Not a format arbvis reads.
-    #[error("{path}: {what}; arbvis inspect reads {READS}")]
+    #[error("{path}: {what}; arbvis inspect reads {reads}", reads = arbvis_data::sniff::reads())]
     Unknown {
         /// The file.
         path: String,
         /// What the first bytes look like.
         what: String,
     },
-}
-
-/// The reader for a file, from its extension or, failing that, its first bytes
-/// ([`arbvis_data::sniff::format`]).
-pub fn kind(path: &Path, head: &[u8]) -> Option<Kind> {
-    use arbvis_data::sniff::Format;
-    Some(match arbvis_data::sniff::format(path, head)? {
-        Format::Nifti => Kind::Nifti,
-        Format::Segy => Kind::Segy,
-        Format::Mesh => Kind::Mesh,
-        Format::Copc | Format::Las | Format::Ply | Format::Dat => Kind::Points,
-        Format::Surface => Kind::Surface,
-    })
 }
 
 /// What a file's first bytes look like, for a file no reader takes.
@@ -150,11 +119,15 @@ fn describe(path: &Path, segy_keys: crate::volume::segy::KeyBytes) -> Result<Str
     let (file, _) = crate::input::open_regular(path).map_err(io)?;
     let mut head = Vec::new();
     file.take(4096).read_to_end(&mut head).map_err(io)?;
-    match kind(path, &head) {
-        Some(Kind::Nifti | Kind::Segy) => Ok(crate::volume::inspect_with(path, segy_keys)?),
-        Some(Kind::Mesh) => Ok(crate::mesh::inspect(path)?),
-        Some(Kind::Points) => Ok(crate::points::inspect(path)?),
-        Some(Kind::Surface) => {
+    // The reader the registry picks, by the kind of data it yields.
+    use arbvis_data::sniff::{format, reader, DataKind};
+    match format(path, &head).map(|f| reader(f).kind) {
+        Some(DataKind::Survey | DataKind::Volume) => {
+            Ok(crate::volume::inspect_with(path, segy_keys)?)
+        }
+        Some(DataKind::Mesh) => Ok(crate::mesh::inspect(path)?),
+        Some(DataKind::Cloud | DataKind::SeedCloud) => Ok(crate::points::inspect(path)?),
+        Some(DataKind::Surface) => {
             let mesh = crate::surface::read(path)?;
             Ok(format!(
                 "{}\n{}\n",

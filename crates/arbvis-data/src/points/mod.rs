@@ -204,6 +204,26 @@ pub enum PointSource {
 }
 
 impl PointSource {
+    /// The reader of the source's file ([`crate::sniff::READERS`]); `None` for the
+    /// generated section.
+    pub fn reader(&self) -> Option<&'static crate::sniff::Reader> {
+        use crate::sniff::reader;
+        match self {
+            PointSource::Dat(_) => Some(reader(Format::Dat)),
+            PointSource::Las(_) => Some(reader(Format::Las)),
+            PointSource::Ply(_) => Some(reader(Format::Ply)),
+            PointSource::Copc(_) => Some(reader(Format::Copc)),
+            PointSource::Section(_) => None,
+        }
+    }
+
+    /// The kind of data the source yields: its reader's; the generated section is the
+    /// seed's kind of cloud.
+    pub fn data_kind(&self) -> crate::sniff::DataKind {
+        self.reader()
+            .map_or(crate::sniff::DataKind::SeedCloud, |r| r.kind)
+    }
+
     /// A COPC file drawn within `points` (Potree's pixel size: nodes under 150 px left).
     pub fn copc(path: impl Into<PathBuf>, points: u64) -> PointSource {
         PointSource::Copc(copc::CopcSpec {

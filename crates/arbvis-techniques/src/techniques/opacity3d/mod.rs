@@ -431,22 +431,23 @@ impl Opacity3dScene {
         ]
     }
 
-    /// Defaults for a survey (a SEG-Y file as the primary; a store's scene keeps the plain
-    /// defaults, and its percentiles are not computed) where the scene's text leaves the key
-    /// out (`written` tells which dotted keys it writes):
+    /// Defaults for a survey (a primary volume whose reader yields one: SEG-Y, a store, an
+    /// MDIO dataset) where the scene's text leaves the key out (`written` tells which
+    /// dotted keys it writes):
     /// - no `[camera]`: a three-quarter view from above with time running down the
     ///   screen ([`SURVEY_VIEW`]), zoomed so that a box of any proportions stays whole at
     ///   any rotation;
     /// - one attribute and no `combine`: `product`, whose absent attributes read as a
     ///   neutral 1 (the sum program divides the one colour by 3);
-    /// - no `quantize`: the 1st to 99th percentiles, so that a few spikes do not squeeze
-    ///   every other amplitude into the table's middle.
+    /// - no `quantize`, where the survey is read whole (not a store, which quantizes by
+    ///   the ranges it keeps): the 1st to 99th percentiles, so that a few spikes do not
+    ///   squeeze every other amplitude into the table's middle.
     pub fn unwritten_defaults(
         &mut self,
         written: &dyn Fn(&str) -> bool,
         camera: &mut crate::camera::Camera,
     ) {
-        if !matches!(self.primary.volume, VolumeSource::Segy(_)) {
+        if self.primary.volume.data_kind() != arbvis_data::sniff::DataKind::Survey {
             return;
         }
         if !written("camera") {
@@ -455,6 +456,9 @@ impl Opacity3dScene {
         let one = self.secondary.is_none() && self.tertiary.is_none();
         if one && !written("technique.opacity3d.combine") {
             self.combine = Combine::Product;
+        }
+        if matches!(self.primary.volume, VolumeSource::Store(_)) {
+            return;
         }
         let names = ATTRIBUTE_NAMES;
         for (attr, name) in self.attributes_mut().into_iter().zip(names) {
@@ -468,7 +472,8 @@ impl Opacity3dScene {
     /// The camera a survey's scene starts from (and the viewer's Reset camera returns
     /// to); `None` for other volumes, which keep [`crate::camera::Camera::default`].
     pub fn default_camera(&self) -> Option<crate::camera::Camera> {
-        matches!(self.primary.volume, VolumeSource::Segy(_)).then(survey_camera)
+        (self.primary.volume.data_kind() == arbvis_data::sniff::DataKind::Survey)
+            .then(survey_camera)
     }
 
     /// The voxel size drawn: the scene's `spacing`, else the file's with the samples'

@@ -221,8 +221,8 @@ pub const BYTES_PER_POINT: u64 = 450;
 pub const BYTES_PER_TILE: u64 = 16;
 
 impl SplatsScene {
-    /// Defaults for a cloud from a file of the field (LAS, LAZ, COPC, PLY) where the
-    /// scene's text leaves the key out (`written` tells which dotted keys it writes): the
+    /// Defaults for a measured cloud (a reader of kind `Cloud`: LAS, LAZ, COPC, PLY, and
+    /// any point format registered later) where the scene's text leaves the key out (`written` tells which dotted keys it writes): the
     /// seed's faithful shaders draw each splat of such a cloud as a ring, so
     /// - no `fidelity`: precise (the Gaussian falls off from the splat's centre);
     /// - no `edl`, `lighting` or `programs`: eye-dome lighting at 1 (GLSL), Potree's and
@@ -232,10 +232,8 @@ impl SplatsScene {
     ///
     /// The seed's `.dat` sections and the generated one keep the seed's defaults.
     pub fn unwritten_defaults(&mut self, written: &dyn Fn(&str) -> bool, fidelity: &mut Fidelity) {
-        if !matches!(
-            self.cloud,
-            PointSource::Las(_) | PointSource::Copc(_) | PointSource::Ply(_)
-        ) {
+        // Measured clouds' defaults, whatever the format (the seed's own keep its look).
+        if self.cloud.data_kind() != arbvis_data::sniff::DataKind::Cloud {
             return;
         }
         let key = |k: &str| written(&format!("technique.splats.{k}"));
