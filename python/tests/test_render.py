@@ -122,6 +122,65 @@ def test_two_renderers_in_two_threads_draw_what_one_draws_alone():
         assert np.array_equal(a, b)
 
 
+def test_one_renderer_shared_by_threads_editing_and_drawing_never_panics():
+    # One thread edits the scene in a tight loop (each edit holds the scene a moment)
+    # while two others draw through one renderer: every frame is a picture of one of the
+    # scene's states, no call fails, and close() waits for the frames asked before it.
+    scene = quad(size=32)
+    colours = [[1.0, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 1.0]]
+    with arbvis.Renderer(scene) as r:
+        states = []
+        for c in colours:
+            scene["technique.quad.left"] = c
+            states.append(r.render())
+        stop = threading.Event()
+        errors, frames = [], []
+
+        def edit():
+            i = 0
+            while not stop.is_set():
+                scene["technique.quad.left"] = colours[i % 2]
+                i += 1
+
+        def draw():
+            try:
+                for _ in range(15):
+                    frames.append(r.render())
+            except BaseException as e:  # a PanicException is a BaseException
+                errors.append(e)
+
+        editor = threading.Thread(target=edit)
+        drawers = [threading.Thread(target=draw) for _ in range(2)]
+        editor.start()
+        for t in drawers:
+            t.start()
+        for t in drawers:
+            t.join()
+        stop.set()
+        editor.join()
+    assert not errors, errors
+    assert len(frames) == 30
+    for f in frames:
+        assert any(np.array_equal(f, s) for s in states)
+    # Closed while another thread draws: that frame is drawn or refused by name.
+    r = arbvis.Renderer(quad(size=32))
+    outcome = []
+
+    def late():
+        try:
+            for _ in range(20):
+                r.render()
+            outcome.append("drawn")
+        except RuntimeError as e:
+            outcome.append(str(e))
+
+    t = threading.Thread(target=late)
+    t.start()
+    r.close()
+    t.join()
+    assert outcome == ["drawn"] or outcome == ["the renderer is closed"], outcome
+
+
 def test_osmesa_draws_what_egl_draws():
     scene = quad(64)
     with arbvis.Renderer(scene) as egl, arbvis.Renderer(scene, backend="osmesa") as osmesa:

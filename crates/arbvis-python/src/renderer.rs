@@ -5,7 +5,9 @@
 //! for the picture with the GIL released. Renderers in two Python threads draw at once.
 
 use std::sync::mpsc::{channel, Receiver, Sender};
+use std::sync::{Mutex, MutexGuard};
 use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
 
 use numpy::ndarray::Array3;
 use numpy::IntoPyArray;
@@ -95,17 +97,55 @@ fn serve(scene: Scene, backend: Backend, ready: Sender<RenderResult<Ready>>, job
 ///
 /// Threads: the renderer draws on a thread of its own (a GL context belongs to one
 /// thread), and every call waits for it with the GIL released; a renderer may be called
-/// from any Python thread, one call at a time, and renderers in two threads draw at once.
+/// from any Python thread, calls from several threads are drawn one after another, a
+/// scene being edited in another thread is waited for, `close()` waits for the frames
+/// asked before it, and renderers in two Python threads draw at once.
 #[pyclass(name = "Renderer", module = "arbvis")]
 pub struct PyRenderer {
-    scene: Py<PyScene>,
-    jobs: Option<Sender<Job>>,
-    thread: Option<JoinHandle<()>>,
+    scene: Mutex<Py<PyScene>>,
+    jobs: Mutex<Option<Sender<Job>>>,
+    thread: Mutex<Option<JoinHandle<()>>>,
     program_kind: &'static str,
     max_3d_texture_size: i32,
     backend: &'static str,
     renderer: String,
-    budget_ms: f64,
+    budget_ms: Mutex<f64>,
+}
+
+/// `mutex` locked (held only for a field's read or swap, never across a wait; a panic
+/// that poisoned it left the value whole).
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Longest wait for a scene that another thread is changing.
+const SCENE_WAIT: Duration = Duration::from_secs(30);
+
+/// The scene as it is now: a copy taken between edits (another Python thread that is
+/// changing it holds it only for the edit; this waits, with the GIL released, instead of
+/// failing on the borrow).
+fn scene_now(py: Python<'_>, scene: &Py<PyScene>) -> PyResult<Scene> {
+    let start = Instant::now();
+    loop {
+        if let Ok(s) = scene.try_borrow(py) {
+            return Ok(s.scene.clone());
+        }
+        if start.elapsed() > SCENE_WAIT {
+            return Err(PyRuntimeError::new_err(
+                "the scene has been changing in another thread for 30 s; it could not be read",
+            ));
+        }
+        py.detach(|| std::thread::sleep(Duration::from_micros(200)));
+    }
+}
+
+impl PyRenderer {
+    /// The render thread's inbox, unless the renderer is closed.
+    fn jobs(&self) -> PyResult<Sender<Job>> {
+        lock(&self.jobs)
+            .clone()
+            .ok_or_else(|| PyRuntimeError::new_err("the renderer is closed"))
+    }
 }
 
 #[pymethods]
@@ -116,7 +156,7 @@ impl PyRenderer {
     #[pyo3(signature = (scene, backend = "egl"))]
     fn new(py: Python<'_>, scene: Py<PyScene>, backend: &str) -> PyResult<PyRenderer> {
         let backend = backend_named(backend)?;
-        let first = scene.borrow(py).scene.clone();
+        let first = scene_now(py, &scene)?;
         let (jobs, inbox) = channel();
         let (ready_tx, ready) = channel();
         let thread = std::thread::Builder::new()
@@ -128,14 +168,14 @@ impl PyRenderer {
             .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?
             .map_err(errors::from_render)?;
         Ok(PyRenderer {
-            scene,
-            jobs: Some(jobs),
-            thread: Some(thread),
+            scene: Mutex::new(scene),
+            jobs: Mutex::new(Some(jobs)),
+            thread: Mutex::new(Some(thread)),
             program_kind: made.program_kind,
             max_3d_texture_size: made.max_3d_texture_size,
             backend: made.backend,
             renderer: made.renderer,
-            budget_ms: FrameBudget::default().interactive.as_secs_f64() * 1e3,
+            budget_ms: Mutex::new(FrameBudget::default().interactive.as_secs_f64() * 1e3),
         })
     }
 
@@ -147,21 +187,21 @@ impl PyRenderer {
     /// side: a smaller array), without waiting for streamed data.
     #[pyo3(signature = (scene = None, interactive = false))]
     fn render<'py>(
-        &mut self,
+        &self,
         py: Python<'py>,
         scene: Option<Py<PyScene>>,
         interactive: bool,
     ) -> PyResult<Bound<'py, PyAny>> {
         if let Some(s) = scene {
-            self.scene = s;
+            *lock(&self.scene) = s;
         }
-        let scene = self.scene.borrow(py).scene.clone();
-        let jobs = self
-            .jobs
-            .as_ref()
-            .ok_or_else(|| PyRuntimeError::new_err("the renderer is closed"))?;
+        let current = lock(&self.scene).clone_ref(py);
+        let scene = scene_now(py, &current)?;
         let (reply, picture) = channel();
-        jobs.send(Job::Render(Box::new(scene), interactive, reply))
+        // The inbox's copy goes before the wait, so that close() ends the thread once the
+        // frames asked are drawn.
+        self.jobs()?
+            .send(Job::Render(Box::new(scene), interactive, reply))
             .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?;
         let image = py
             .detach(move || picture.recv())
@@ -175,7 +215,8 @@ impl PyRenderer {
     /// precise modes are measured against. None where the technique has none (splats,
     /// isosurfaces alone, a survey store, a clipped 3D opacity scene).
     fn reference<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
-        let scene = self.scene.borrow(py).scene.clone();
+        let current = lock(&self.scene).clone_ref(py);
+        let scene = scene_now(py, &current)?;
         let limits = Limits::for_max_side(self.max_3d_texture_size);
         let image = py
             .detach(|| {
@@ -196,30 +237,27 @@ impl PyRenderer {
     /// Milliseconds an interactive frame may take (default 66: 15 frames per second).
     #[getter]
     fn budget_ms(&self) -> f64 {
-        self.budget_ms
+        *lock(&self.budget_ms)
     }
 
     #[setter]
-    fn set_budget_ms(&mut self, ms: f64) -> PyResult<()> {
+    fn set_budget_ms(&self, ms: f64) -> PyResult<()> {
         if !(ms.is_finite() && ms > 0.0) {
             return Err(PyValueError::new_err(format!(
                 "budget_ms {ms}: a positive number of milliseconds"
             )));
         }
-        let jobs = self
-            .jobs
-            .as_ref()
-            .ok_or_else(|| PyRuntimeError::new_err("the renderer is closed"))?;
-        jobs.send(Job::Budget(ms))
+        self.jobs()?
+            .send(Job::Budget(ms))
             .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?;
-        self.budget_ms = ms;
+        *lock(&self.budget_ms) = ms;
         Ok(())
     }
 
     /// The scene this renderer draws.
     #[getter]
     fn scene(&self, py: Python<'_>) -> Py<PyScene> {
-        self.scene.clone_ref(py)
+        lock(&self.scene).clone_ref(py)
     }
 
     /// The program kind it draws with (`"arb"` or `"glsl"`).
@@ -240,10 +278,12 @@ impl PyRenderer {
         self.renderer.clone()
     }
 
-    /// Free the context, data and thread now (also done when the renderer is collected).
-    fn close(&mut self, py: Python<'_>) {
-        self.jobs = None;
-        if let Some(thread) = self.thread.take() {
+    /// Free the context, data and thread now (also done when the renderer is collected),
+    /// once the frames other threads asked for are drawn; later calls say it is closed.
+    fn close(&self, py: Python<'_>) {
+        *lock(&self.jobs) = None;
+        let thread = lock(&self.thread).take();
+        if let Some(thread) = thread {
             py.detach(|| {
                 let _ = thread.join();
             });
@@ -255,7 +295,7 @@ impl PyRenderer {
     }
 
     fn __exit__(
-        &mut self,
+        &self,
         py: Python<'_>,
         _exc_type: &Bound<'_, PyAny>,
         _exc: &Bound<'_, PyAny>,
@@ -276,8 +316,8 @@ impl Drop for PyRenderer {
     fn drop(&mut self) {
         // The thread ends when its inbox closes; it never takes the GIL, so waiting for it
         // here cannot deadlock.
-        self.jobs = None;
-        if let Some(thread) = self.thread.take() {
+        *lock(&self.jobs) = None;
+        if let Some(thread) = lock(&self.thread).take() {
             let _ = thread.join();
         }
     }
