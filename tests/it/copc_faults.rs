@@ -140,6 +140,66 @@ fn a_format_6_cloud_drawn_in_rgb_says_it_has_no_colours() {
     );
 }
 
+/// Names in `dir` that hold `part` (what a conversion into it left).
+fn left_in(dir: &std::path::Path, part: &str) -> Vec<String> {
+    let mut names: Vec<String> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().to_string())
+        .filter(|n| n.contains(part))
+        .collect();
+    names.sort();
+    names
+}
+
+/// SIGINT in the middle of a conversion: exit 130, and neither the lock file nor a
+/// temporary is left (the output is not made). A lock file left by a process that is gone
+/// (SIGKILL leaves one) is taken over with a note, and the conversion goes on.
+#[test]
+fn an_interrupt_leaves_no_lock_and_a_dead_writers_lock_is_taken_over() {
+    let dir = temp_dir("copc-sigint");
+    let ply = data_file("points/bunny.ply");
+    let lock = dir.join(".cut.copc.laz.arbvis-convert.lock");
+    // Tried until the signal lands while the conversion runs (it takes about a second).
+    let mut interrupted = false;
+    for _ in 0..5 {
+        let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_arbvis"))
+            .current_dir(&dir)
+            .args(["convert", ply.to_str().unwrap(), "cut.copc.laz"])
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .unwrap();
+        let start = std::time::Instant::now();
+        while !lock.exists() && start.elapsed() < std::time::Duration::from_secs(20) {
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        }
+        // (A conversion that ended first makes kill fail: tried again.)
+        let _ = std::process::Command::new("kill")
+            .args(["-INT", &child.id().to_string()])
+            .status();
+        if child.wait().unwrap().code() == Some(130) {
+            interrupted = true;
+            break;
+        }
+        let _ = std::fs::remove_file(dir.join("cut.copc.laz"));
+    }
+    assert!(interrupted, "no conversion was interrupted in 5 tries");
+    assert_eq!(left_in(&dir, "cut"), Vec::<String>::new(), "left behind");
+    // A writer killed outright leaves its lock file with its pid: a pid that is gone.
+    let mut gone = std::process::Command::new("true").spawn().unwrap();
+    let pid = gone.id();
+    gone.wait().unwrap();
+    std::fs::write(&lock, pid.to_string()).unwrap();
+    let out = arbvis(&dir, &["convert", ply.to_str().unwrap(), "cut.copc.laz"]);
+    let e = stderr(&out);
+    assert!(out.status.success(), "{e}");
+    assert!(
+        e.contains(&format!("the lock of pid {pid}")) && e.contains("taken over"),
+        "{e}"
+    );
+    assert_eq!(left_in(&dir, "cut"), vec!["cut.copc.laz".to_string()]);
+}
+
 #[test]
 fn a_second_conversion_into_one_output_is_refused_naming_the_first() {
     let dir = temp_dir("copc-lock");

@@ -183,6 +183,9 @@ pub fn read_png(path: &Path) -> Result<(Image, Vec<(String, String)>), PngError>
 /// interrupted.
 static TEMPORARIES: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 
+/// The lock files of [`WriterLock`]s held, removed with the temporaries on SIGINT/SIGTERM.
+static LOCKS: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
+
 /// The marker in temporary names: `.NAME.arbvis-tmp.PID`.
 /// What marks a temporary file of an atomic write (`.NAME.arbvis-tmp.PID`).
 pub const TMP_MARK: &str = ".arbvis-tmp.";
@@ -318,10 +321,15 @@ fn lock_temporaries() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
     TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Remove the temporaries of writes in progress (called on SIGINT/SIGTERM).
+/// Remove the temporaries of writes in progress and the lock files held (called on
+/// SIGINT/SIGTERM: an interrupted conversion leaves its folder as it found it, but for
+/// what it finished).
 pub fn remove_temporaries() {
     for t in lock_temporaries().drain(..) {
         remove_path(&t);
+    }
+    for lock in LOCKS.lock().unwrap_or_else(|e| e.into_inner()).drain(..) {
+        let _ = std::fs::remove_file(lock);
     }
 }
 
@@ -362,11 +370,14 @@ fn remove_stale(dir: &Path, file_name: &str) {
 pub struct WriterLock {
     file: File,
     path: PathBuf,
+    taken_over: Option<u32>,
 }
 
 impl WriterLock {
     /// Take the lock at `path` (created if absent). `Ok(Err(holder))`: another process
-    /// holds it, `holder` says which (`pid 1234`, or `a process` when it wrote none).
+    /// holds it, `holder` says which (`pid 1234`, or `a process` when it wrote none). A
+    /// lock file left by a process that is gone (killed) is taken over, and
+    /// [`WriterLock::taken_over`] says whose it was.
     pub fn acquire(path: &Path) -> std::io::Result<Result<WriterLock, String>> {
         use std::io::Read;
         let mut file = std::fs::OpenOptions::new()
@@ -389,18 +400,39 @@ impl WriterLock {
             }
             Err(std::fs::TryLockError::Error(e)) => return Err(e),
         }
+        let mut before = String::new();
+        let _ = (&file).take(64).read_to_string(&mut before);
+        let taken_over = before
+            .trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&pid| pid != std::process::id() && !process_alive(pid));
         file.set_len(0)?;
         write!(file, "{}", std::process::id())?;
         file.sync_data()?;
+        LOCKS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .push(path.to_path_buf());
         Ok(Ok(WriterLock {
             file,
             path: path.to_path_buf(),
+            taken_over,
         }))
+    }
+
+    /// The pid of the process, no longer running, whose lock file this lock took over.
+    pub fn taken_over(&self) -> Option<u32> {
+        self.taken_over
     }
 }
 
 impl Drop for WriterLock {
     fn drop(&mut self) {
+        LOCKS
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .retain(|p| p != &self.path);
         let _ = std::fs::remove_file(&self.path);
         let _ = self.file.unlock();
     }

@@ -204,7 +204,15 @@ impl StoreLock {
     pub(crate) fn acquire(store: &Path) -> Result<StoreLock, StoreError> {
         let path = store.join(LOCK_FILE);
         match crate::png_io::WriterLock::acquire(&path).map_err(|e| StoreError::io(&path, e))? {
-            Ok(lock) => Ok(StoreLock { _lock: lock }),
+            Ok(lock) => {
+                if let Some(pid) = lock.taken_over() {
+                    crate::progress::line(&format!(
+                        "note: {}: the lock of pid {pid}, which is no longer running, taken over",
+                        path.display()
+                    ));
+                }
+                Ok(StoreLock { _lock: lock })
+            }
             Err(holder) => Err(StoreError::invalid(
                 store,
                 format!(

@@ -208,7 +208,15 @@ fn lock(output: &Path) -> Result<crate::png_io::WriterLock, PointsError> {
         .to_string_lossy();
     let path = output.with_file_name(format!(".{name}.arbvis-convert.lock"));
     match crate::png_io::WriterLock::acquire(&path).map_err(|e| PointsError::io(&path, e))? {
-        Ok(lock) => Ok(lock),
+        Ok(lock) => {
+            if let Some(pid) = lock.taken_over() {
+                crate::progress::line(&format!(
+                    "note: {}: the lock of pid {pid}, which is no longer running, taken over",
+                    path.display()
+                ));
+            }
+            Ok(lock)
+        }
         Err(holder) => Err(PointsError::unsupported(
             output,
             format!(
