@@ -67,6 +67,25 @@ def test_convert_refuses_an_unknown_attribute(root, tmp_path):
         arbvis.convert(root / "data/seismic/small.sgy", tmp_path / "s.zarr", attributes=["colour"])
 
 
+def test_convert_reads_a_url_as_a_url_and_writes_only_locally(tmp_path, monkeypatch):
+    """A URL handed to convert is fetched (here from a port nothing listens on: the error
+    says so), not looked for as a local path; a URL to write to is refused."""
+    import socket
+
+    monkeypatch.setenv("ARBVIS_REMOTE_TIMEOUT", "1")
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = s.getsockname()[1]
+    url = f"http://127.0.0.1:{port}/survey.zarr"
+    with pytest.raises(arbvis.InputError) as e:
+        arbvis.convert(url, tmp_path / "out.zarr")
+    assert url in str(e.value) and "could not be reached" in str(e.value), e.value
+    assert "looked for" not in str(e.value)
+    with pytest.raises(arbvis.InputError) as e:
+        arbvis.convert(tmp_path / "in.sgy", url)
+    assert "local folder" in str(e.value), e.value
+
+
 def test_a_remote_cloud_is_inspected_and_its_requests_counted(root, tmp_path, monkeypatch):
     """A COPC file over HTTP (the Rust tests' Range server on 127.0.0.1, stopped with the
     test): inspected as the local file is, its requests in fetch_stats."""

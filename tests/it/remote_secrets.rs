@@ -179,3 +179,111 @@ fn an_unreadable_remote_timeout_is_refused_by_name() {
     assert!(out.status.success(), "{}", stderr(&out));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A server that cannot be reached is said to be so, for a store and a COPC cloud, by
+/// `inspect` and by a render: not "no such store".
+#[test]
+fn an_unreachable_server_is_named_as_such() {
+    let dir = super::common::temp_dir("remote-unreachable");
+    // A port that was free a moment ago: nothing listens there.
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port();
+    let cache = dir.join("cache");
+    let env = [("ARBVIS_REMOTE_TIMEOUT", "1")];
+    for name in ["s.zarr", "c.copc.laz"] {
+        let url = format!("http://127.0.0.1:{port}/{name}");
+        let out = arbvis(&["inspect", &url], &cache, &env);
+        let e = stderr(&out);
+        assert!(!out.status.success(), "{name}");
+        assert!(
+            e.contains(&url) && e.contains("could not be reached"),
+            "{e}"
+        );
+        assert!(!e.contains("no such store"), "{e}");
+    }
+    let store = format!("http://127.0.0.1:{port}/s.zarr");
+    let scene = dir.join("s.toml");
+    std::fs::write(
+        &scene,
+        format!("[technique.opacity3d.primary]\nvolume = {{ store = \"{store}\" }}\nattribute = \"amplitude\"\n"),
+    )
+    .unwrap();
+    let png = dir.join("s.png");
+    let out = arbvis(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        &cache,
+        &env,
+    );
+    let e = stderr(&out);
+    assert!(
+        !out.status.success() && e.contains("could not be reached"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A pre-signed (or tokened) URL of a COPC file: its query goes with every request (the
+/// server refuses any request without it), and its secret values appear nowhere arbvis
+/// writes; a query in a store's (folder's) URL is refused by name.
+#[test]
+fn a_pre_signed_urls_query_goes_with_every_request_and_nowhere_else() {
+    let (dir, server, cache) = copc_served("remote-presigned");
+    let query = "X-Amz-Credential=AKID%2F20261207&X-Amz-Signature=0badc0ffee";
+    server.control(&format!(
+        "_fault?mode=need-query:{}&count=0&skip=0",
+        query.replace('%', "%25").replace('&', "%26")
+    ));
+    let url = format!("{}?{query}", server.url("c.copc.laz"));
+    let out = arbvis(&["inspect", &url], &cache, &[]);
+    let said = String::from_utf8_lossy(&out.stdout).into_owned() + &stderr(&out);
+    assert!(out.status.success(), "{said}");
+    assert!(
+        !said.contains("0badc0ffee") && !said.contains("AKID"),
+        "{said}"
+    );
+    // A render: every node's range request carried the query too.
+    let scene = copc_scene(&dir, "signed.toml", &url);
+    let png = dir.join("signed.png");
+    let out = arbvis(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        &cache,
+        &[],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    let stats = server.control("_stats");
+    assert!(!stats.contains("\"requests\": 0"), "{stats}");
+    // Without the query, the same server refuses.
+    let out = arbvis(
+        &["inspect", &server.url("c.copc.laz")],
+        &dir.join("c2"),
+        &[],
+    );
+    assert!(
+        !out.status.success() && stderr(&out).contains("403"),
+        "{}",
+        stderr(&out)
+    );
+    server.control("_reset");
+    let store = format!("{}?token=abc", server.url("s.zarr"));
+    let out = arbvis(&["inspect", &store], &cache, &[]);
+    let e = stderr(&out);
+    assert!(
+        !out.status.success() && e.contains("a query in a folder's URL"),
+        "{e}"
+    );
+    assert!(!e.contains("abc"), "{e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

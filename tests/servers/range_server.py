@@ -17,6 +17,7 @@ closes (the test ends) or it is killed. Control, by GET:
         truncate        a Range answer that closes the connection halfway through its body
         change          the file as though rewritten: another ETag (If-Match fails: 412)
         redirect:PORT   answer 307 to the same path on 127.0.0.1:PORT (another origin)
+        need-query:Q    answer 403 to a request whose query is not Q (a pre-signed URL's)
         huge            a Range answer that declares a 2 GiB body (Content-Length
                         2147483648, the Content-Range of the range asked) and sends the
                         range's bytes, then zeros until the client stops reading
@@ -103,6 +104,11 @@ class Handler(BaseHTTPRequestHandler):
             STATE["tokens"] += int("x-amz-security-token" in self.headers)
             STATE["authorized"] += int("Authorization" in self.headers)
         fault = take_fault()
+        if fault and fault.startswith("need-query:") and url.query != fault.split(":", 1)[1]:
+            self.send_response(403)
+            self.send_header("Content-Length", "0")
+            self.end_headers()
+            return
         if fault and fault.startswith("redirect:"):
             self.send_response(307)
             self.send_header("Location", "http://127.0.0.1:%s%s" % (fault.split(":")[1], self.path))

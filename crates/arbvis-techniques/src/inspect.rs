@@ -31,6 +31,14 @@ pub enum InspectError {
     /// A store's error.
     #[error(transparent)]
     Store(#[from] crate::store::StoreError),
+    /// A URL that could not be asked (unreachable, refused, redirected in a loop).
+    #[error("{path}: {message}")]
+    Remote {
+        /// The URL.
+        path: String,
+        /// Why, with the request that failed.
+        message: String,
+    },
     /// Not a format arbvis reads.
     #[error("{path}: {what}; arbvis inspect reads {reads}", reads = arbvis_data::sniff::reads())]
     Unknown {
@@ -145,10 +153,15 @@ fn describe(path: &Path, segy_keys: crate::volume::segy::KeyBytes) -> Result<Str
 /// `arbvis inspect` of a URL: a store (a zarr group or an MDIO dataset) or a COPC cloud.
 fn inspect_remote(path: &Path) -> Result<String, InspectError> {
     let name = path.to_string_lossy().to_ascii_lowercase();
+    // The object's name, without a pre-signed URL's query.
+    let name = name.split('?').next().unwrap_or("");
     if name.ends_with(".laz") || name.ends_with(".las") {
         return Ok(crate::points::inspect(path)?);
     }
-    if crate::fetch::is_folder(path) {
+    if crate::fetch::probe_folder(path).map_err(|e| InspectError::Remote {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })? {
         return Ok(crate::store::describe::describe(path)?);
     }
     Err(InspectError::Unknown {

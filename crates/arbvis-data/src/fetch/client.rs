@@ -9,7 +9,6 @@ use std::sync::{Arc, Mutex, OnceLock};
 use std::time::Duration;
 
 use object_store::aws::AmazonS3Builder;
-use object_store::client::{HttpClient, HttpConnector};
 use object_store::http::HttpBuilder;
 use object_store::{BackoffConfig, ClientOptions, ObjectStore, RetryConfig};
 
@@ -124,8 +123,22 @@ pub fn object(url: &str) -> Result<Object, FetchError> {
         }
     };
     timeout_setting().map_err(fail)?;
+    // A query (a pre-signed URL's signature, a token) goes with every request for the
+    // object, not into its key.
+    let (key, query) = match key.split_once('?') {
+        Some((_, q)) if q.contains('/') => {
+            let m = "a query in a folder's URL: a store is read object by object, and a query (a token, a signature) is kept only for one object's URL (a COPC file)";
+            return Err(fail(m.to_string()));
+        }
+        Some((_, _)) if s3 => {
+            let m = "an s3:// URL takes no query: its requests are signed with the AWS variables (a pre-signed URL is an https:// URL)";
+            return Err(fail(m.to_string()));
+        }
+        Some((k, q)) => (k, Some(q)),
+        None => (key, None),
+    };
     let root = format!("{scheme}://{authority}");
-    let store = client(&root, s3).map_err(fail)?;
+    let store = client(&root, s3, query).map_err(fail)?;
     let path = object_store::path::Path::from_url_path(key)
         .map_err(|e| fail(format!("not an object's path: {e}")))?;
     Ok(Object {
@@ -136,13 +149,14 @@ pub fn object(url: &str) -> Result<Object, FetchError> {
     })
 }
 
-fn client(root: &str, s3: bool) -> Result<Arc<dyn ObjectStore>, String> {
+fn client(root: &str, s3: bool, query: Option<&str>) -> Result<Arc<dyn ObjectStore>, String> {
     static CLIENTS: OnceLock<Mutex<HashMap<String, Arc<dyn ObjectStore>>>> = OnceLock::new();
     let mut clients = CLIENTS
         .get_or_init(Default::default)
         .lock()
         .unwrap_or_else(|e| e.into_inner());
-    if let Some(c) = clients.get(root) {
+    let id = format!("{root}?{}", query.unwrap_or(""));
+    if let Some(c) = clients.get(&id) {
         return Ok(c.clone());
     }
     // The builders' reqwest clients start on the runtime.
@@ -161,7 +175,7 @@ fn client(root: &str, s3: bool) -> Result<Arc<dyn ObjectStore>, String> {
         if anonymous() {
             b = b.with_skip_signature(true);
         } else {
-            b = b.with_http_connector(SameHostRedirects);
+            b = b.with_http_connector(super::connect::SameHostRedirects(timeout()));
         }
         Arc::new(b.build().map_err(|e| format!("{root}: {e}"))?)
     } else {
@@ -174,58 +188,20 @@ fn client(root: &str, s3: bool) -> Result<Arc<dyn ObjectStore>, String> {
             headers.insert(reqwest::header::AUTHORIZATION, value);
             options = options.with_default_headers(headers);
         }
+        let mut b = HttpBuilder::new();
+        if let Some(query) = query {
+            b = b.with_http_connector(super::connect::WithQuery(query.to_string(), timeout()));
+        }
         Arc::new(
-            HttpBuilder::new()
-                .with_url(plain)
+            b.with_url(plain)
                 .with_client_options(options)
                 .with_retry(retry())
                 .build()
                 .map_err(|e| format!("{root}: {e}"))?,
         )
     };
-    clients.insert(root.to_string(), made.clone());
+    clients.insert(id, made.clone());
     Ok(made)
-}
-
-/// The HTTP client of signed S3 requests: object_store's settings, and a redirect to
-/// another origin (scheme, host, port) not followed. reqwest drops `Authorization` on
-/// such a redirect but not `x-amz-security-token`, so following it would send a session
-/// token to a host it was not meant for; the redirect is an error that says so instead.
-#[derive(Debug)]
-struct SameHostRedirects;
-
-impl HttpConnector for SameHostRedirects {
-    fn connect(&self, _: &ClientOptions) -> object_store::Result<HttpClient> {
-        use reqwest::redirect::{Attempt, Policy};
-        let policy = Policy::custom(|attempt: Attempt<'_>| {
-            let first = &attempt.previous()[0];
-            let next = attempt.url();
-            if attempt.previous().len() > 10 {
-                attempt.error("more than 10 redirects")
-            } else if next.origin() == first.origin() {
-                attempt.follow()
-            } else {
-                attempt.stop()
-            }
-        });
-        let t = timeout();
-        let client = reqwest::Client::builder()
-            .user_agent(concat!("arbvis/", env!("CARGO_PKG_VERSION")))
-            .timeout(t)
-            .connect_timeout(t.min(Duration::from_secs(10)))
-            .pool_max_idle_per_host(64)
-            .no_gzip()
-            .no_brotli()
-            .no_zstd()
-            .no_deflate()
-            .redirect(policy)
-            .build()
-            .map_err(|e| object_store::Error::Generic {
-                store: "S3",
-                source: Box::new(e),
-            })?;
-        Ok(HttpClient::new(client))
-    }
 }
 
 /// `root` (`scheme://authority`) without its user info, and the Basic authorization
@@ -297,6 +273,10 @@ pub fn describe(object: &Object, range: Option<&Range<u64>>, e: &object_store::E
             let text = other.to_string();
             if object.s3 && !anonymous() && is_redirect(&text) {
                 format!("{what}: the server redirected the request to another host, and a signed request's credentials (the session token) are not sent to another host: set AWS_REGION to the bucket's region or AWS_ENDPOINT_URL to the server that holds it")
+            } else if text.contains("error sending request") || text.contains("Connection refused") {
+                let retried = text.contains("after ") && text.contains(" retries");
+                let tries = if retried { ", tried again with backoff" } else { "" };
+                format!("{what}: the server could not be reached (no connection to it{tries}); check the host, the port and the network")
             } else if text.contains("non-partial response") || text.contains("Range request not supported") {
                 format!("{what}: the server ignored the Range request (it answered 200 with the whole object); arbvis reads a part of an object only from servers that honour Range")
             } else {

@@ -20,6 +20,8 @@
 pub mod cache;
 #[cfg(feature = "remote")]
 pub mod client;
+#[cfg(feature = "remote")]
+mod connect;
 pub mod count;
 mod file;
 #[cfg(not(feature = "remote"))]
@@ -240,6 +242,21 @@ pub fn exists(path: &Path) -> bool {
         return matches!(read_object(path, METADATA_MAX), Ok(Some(_)));
     }
     whole::head(url)
+}
+
+/// Whether `path` is a folder (for a URL: a zarr group or array, v3 or v2, lies there),
+/// or why a URL could not be asked (the server could not be reached, refused, redirected
+/// in a loop): a store that cannot be reached is not "no such store".
+pub fn probe_folder(path: &Path) -> Result<bool, FetchError> {
+    if url_of(path).is_none() || !cfg!(feature = "remote") {
+        return Ok(is_folder(path));
+    }
+    for marker in ["zarr.json", ".zgroup", ".zarray"] {
+        if read_object(&path.join(marker), METADATA_MAX)?.is_some() {
+            return Ok(true);
+        }
+    }
+    Ok(false)
 }
 
 /// Whether `path` is a folder (for a URL: a zarr group or array, v3 or v2, lies there).

@@ -193,6 +193,14 @@ pub fn convert(
     store: &Path,
     o: &ConvertOptions,
 ) -> Result<ConvertReport, StoreError> {
+    // A URL as every front end hands it (a Python str, a CLI argument): read as a URL.
+    let input = &crate::fetch::local_or_url(input);
+    if crate::fetch::url_of(store).is_some() {
+        return Err(StoreError::invalid(
+            store,
+            "convert writes a store to a local folder (copy it to object storage with the bucket's own tools: aws s3 sync, rclone)",
+        ));
+    }
     let threads = rayon::current_num_threads().max(1);
     let on = |workers: usize| match rayon::ThreadPoolBuilder::new().num_threads(workers).build() {
         Ok(pool) => pool.install(|| convert_on_workers(input, store, o)),

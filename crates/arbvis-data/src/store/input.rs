@@ -65,7 +65,9 @@ impl Input {
         segy_keys: crate::volume::segy::KeyBytes,
     ) -> Result<Input, StoreError> {
         let path = &crate::fetch::local_or_url(path);
-        if crate::fetch::is_folder(path) && raw.is_none() {
+        let folder = crate::fetch::probe_folder(path)
+            .map_err(|e| StoreError::invalid(path, e.to_string()))?;
+        if folder && raw.is_none() {
             let Some(flavour) = super::mdio::flavour(path)? else {
                 if !crate::fetch::exists(&path.join("zarr.json")) {
                     return Err(StoreError::invalid(path, super::check::not_v3(path)));

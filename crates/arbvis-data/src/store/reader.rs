@@ -83,7 +83,9 @@ impl Store {
     /// Open the store at `path`: its description and every array checked.
     pub fn open(path: &Path) -> Result<Store, StoreError> {
         let path = &crate::fetch::local_or_url(path);
-        if !crate::fetch::is_folder(path) {
+        let folder = crate::fetch::probe_folder(path)
+            .map_err(|e| StoreError::invalid(path, e.to_string()))?;
+        if !folder {
             let why = if crate::fetch::exists(path) {
                 "not a folder: a store is a folder (make one with `arbvis convert SURVEY STORE`)"
             } else {
