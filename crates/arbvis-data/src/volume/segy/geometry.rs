@@ -83,9 +83,8 @@ fn cdp(header: &[u8], big: bool) -> Option<[f64; 2]> {
 
 /// The geometry of a grid of `nj` crosslines by `nk` inlines sampled every `interval_us`;
 /// `header(k, j)` is the header of the trace at inline index `k`, crossline index `j`
-/// (`None` where no trace is). The steps come from the three corners (0, 0), (0, nj - 1)
-/// and (nk - 1, 0) where all three hold a trace, else (an irregular survey's missing
-/// corner) from a plane fitted through the live traces at `spread` ([`fit_steps`]).
+/// (`None` where no trace is); the trace steps from their CDP coordinates
+/// ([`trace_steps`], the live traces at `spread` where a corner is missing).
 pub(crate) fn geometry(
     interval_us: u32,
     nj: usize,
@@ -96,7 +95,27 @@ pub(crate) fn geometry(
 ) -> Geometry {
     let sample = interval_us as f64 / 1000.0 * VELOCITY_M_S / 2000.0;
     let sample = if sample > 0.0 { sample } else { 1.0 };
-    let mut at = |k, j| header(k, j).and_then(|h| cdp(&h, big));
+    let at = |k, j| header(k, j).and_then(|h| cdp(&h, big));
+    let ([crossline, inline], bins) = trace_steps(nj, nk, spread, at);
+    Geometry {
+        spacing: [sample, crossline, inline],
+        bins,
+    }
+}
+
+/// The trace steps `[crossline, inline]` in map units of a grid of `nj` crosslines by
+/// `nk` inlines whose trace at inline index `k`, crossline index `j` lies at `at(k, j)`
+/// (`None`: no trace, or no coordinates): from the three corners (0, 0), (0, nj - 1) and
+/// (nk - 1, 0) where all three hold a trace, else (an irregular survey's missing corner)
+/// from a plane fitted through the traces at `spread` ([`fit_steps`]); one measured step
+/// stands for the other where the grid has a single line that way, else
+/// [`ASSUMED_BIN_M`]. What SEG-Y files and MDIO datasets are both measured by.
+pub(crate) fn trace_steps(
+    nj: usize,
+    nk: usize,
+    spread: &[(usize, usize)],
+    mut at: impl FnMut(usize, usize) -> Option<[f64; 2]>,
+) -> ([f64; 2], BinsFrom) {
     let step = |a: Option<[f64; 2]>, b: Option<[f64; 2]>, n: usize| -> Option<f64> {
         let (a, b) = (a?, b?);
         let d = ((b[0] - a[0]).powi(2) + (b[1] - a[1]).powi(2)).sqrt() / (n - 1) as f64;
@@ -119,15 +138,11 @@ pub(crate) fn geometry(
         fit_steps(&points)
     };
     // One measured step stands for the other where the grid has a single line that way.
-    let (crossline, inline, bins) = match (crossline, inline) {
-        (Some(x), Some(i)) => (x, i, BinsFrom::Coordinates),
-        (Some(x), None) if nk == 1 => (x, x, BinsFrom::Coordinates),
-        (None, Some(i)) if nj == 1 => (i, i, BinsFrom::Coordinates),
-        _ => (ASSUMED_BIN_M, ASSUMED_BIN_M, BinsFrom::Assumed),
-    };
-    Geometry {
-        spacing: [sample, crossline, inline],
-        bins,
+    match (crossline, inline) {
+        (Some(x), Some(i)) => ([x, i], BinsFrom::Coordinates),
+        (Some(x), None) if nk == 1 => ([x, x], BinsFrom::Coordinates),
+        (None, Some(i)) if nj == 1 => ([i, i], BinsFrom::Coordinates),
+        _ => ([ASSUMED_BIN_M, ASSUMED_BIN_M], BinsFrom::Assumed),
     }
 }
 
