@@ -287,3 +287,40 @@ fn a_pre_signed_urls_query_goes_with_every_request_and_nowhere_else() {
     assert!(!e.contains("abc"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A server that sends weak ETags (nginx for what it may compress) is read (the ETag is
+/// compared on each answer instead of sent in If-Match, which a weak one never matches);
+/// a stalled server is given up on within twice the timeout, retries included.
+#[test]
+fn weak_etags_are_read_and_a_stall_ends_within_twice_the_timeout() {
+    let (dir, server, cache) = copc_served("remote-weak");
+    server.control("_fault?mode=weak-etag&count=0&skip=0");
+    let scene = copc_scene(&dir, "weak.toml", &server.url("c.copc.laz"));
+    let png = dir.join("weak.png");
+    let out = arbvis(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        &cache,
+        &[],
+    );
+    assert!(out.status.success(), "{}", stderr(&out));
+    server.control("_reset");
+    // Every request stalls (60 s): at a 2 s timeout, the first one ends by 4 s.
+    server.control("_fault?mode=stall&count=0&skip=0");
+    let t = Instant::now();
+    let out = arbvis(
+        &["inspect", &server.url("c.copc.laz")],
+        &dir.join("cache-stall"),
+        &[("ARBVIS_REMOTE_TIMEOUT", "2")],
+    );
+    let took = t.elapsed();
+    let e = stderr(&out);
+    assert!(!out.status.success(), "{e}");
+    // 4 s, and what starting the process and its runtime takes on a loaded machine.
+    assert!(took < Duration::from_secs(8), "{took:?}: {e}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -18,6 +18,8 @@ closes (the test ends) or it is killed. Control, by GET:
         change          the file as though rewritten: another ETag (If-Match fails: 412)
         redirect:PORT   answer 307 to the same path on 127.0.0.1:PORT (another origin)
         need-query:Q    answer 403 to a request whose query is not Q (a pre-signed URL's)
+        weak-etag       a weak ETag (W/"..."), which no If-Match matches (412), as nginx
+                        sends for content it may compress
         huge            a Range answer that declares a 2 GiB body (Content-Length
                         2147483648, the Content-Range of the range asked) and sends the
                         range's bytes, then zeros until the client stops reading
@@ -138,13 +140,16 @@ class Handler(BaseHTTPRequestHandler):
         etag = '"%x-%x"' % (st.st_mtime_ns, size)
         if fault == "change":
             etag = '"changed-%x"' % size
+        if fault == "weak-etag":
+            etag = "W/" + etag
         if self.headers.get("If-None-Match") == etag:
             self.send_response(304)
             self.send_header("ETag", etag)
             self.end_headers()
             return
         match = self.headers.get("If-Match")
-        if match is not None and match != etag:
+        # Strong comparison: a weak ETag on either side never matches.
+        if match is not None and (match != etag or etag.startswith("W/")):
             self.send_response(412)
             self.send_header("Content-Length", "0")
             self.end_headers()

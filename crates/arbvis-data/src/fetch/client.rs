@@ -69,6 +69,37 @@ pub fn timeout_setting() -> Result<Duration, String> {
     }
 }
 
+/// The most one request may take, retries and body included: twice the request
+/// timeout, as the documentation promises (object_store's own retry budget could let a
+/// stalled request run four times as long).
+pub fn request_deadline() -> Duration {
+    2 * timeout()
+}
+
+/// `request` (for `range` of `url`, `None`: the whole object) within
+/// [`request_deadline`], else an error saying how long it waited.
+pub async fn within<T>(
+    url: &str,
+    range: Option<&Range<u64>>,
+    request: impl std::future::Future<Output = Result<T, FetchError>>,
+) -> Result<T, FetchError> {
+    let deadline = request_deadline();
+    match tokio::time::timeout(deadline, request).await {
+        Ok(done) => done,
+        Err(_) => {
+            let what = match range {
+                Some(r) => format!("bytes {}-{}", r.start, r.end.saturating_sub(1)),
+                None => "GET".to_string(),
+            };
+            let m = format!(
+                "{what}: no answer within {:.1} s (twice ARBVIS_REMOTE_TIMEOUT, retries included)",
+                deadline.as_secs_f64()
+            );
+            Err(FetchError::at(url, range, m))
+        }
+    }
+}
+
 /// Requests kept in flight at once (`ARBVIS_REMOTE_REQUESTS`, default 16).
 pub fn in_flight() -> usize {
     std::env::var("ARBVIS_REMOTE_REQUESTS")

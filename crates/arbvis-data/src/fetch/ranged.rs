@@ -87,18 +87,26 @@ impl RemoteFile {
             ..Default::default()
         };
         let _busy = count::request();
-        let got = client::runtime().block_on(object.store.get_opts(&object.path, options));
-        let (size, etag, bytes) = match got {
-            Err(object_store::Error::NotModified { .. }) if disk.is_some() => {
-                let e = disk.expect("checked");
+        // The answer (None: the block on disk still holds), within the request deadline.
+        let asked = async {
+            match object.store.get_opts(&object.path, options).await {
+                Err(object_store::Error::NotModified { .. }) if disk.is_some() => Ok(None),
+                Err(e) => Err(client::failure(&object, Some(&first), &e)),
+                Ok(got) => {
+                    let (size, etag) = (got.meta.size, got.meta.e_tag.clone());
+                    let (range, bytes) = body(&object, &first, got).await?;
+                    Ok(Some((size, etag, range, bytes)))
+                }
+            }
+        };
+        let answer = client::runtime().block_on(client::within(url, Some(&first), asked))?;
+        let (size, etag, bytes) = match answer {
+            None => {
+                let e = disk.expect("a 304 answers only a request with the block on disk");
                 count::from_disk(e.bytes.len());
                 (e.size, Some(e.etag), e.bytes)
             }
-            Err(e) => return Err(client::failure(&object, Some(&first), &e)),
-            Ok(got) => {
-                let size = got.meta.size;
-                let etag = got.meta.e_tag.clone();
-                let (range, bytes) = client::runtime().block_on(body(&object, &first, got))?;
+            Some((size, etag, range, bytes)) => {
                 check_length(url, &range, bytes.len())?;
                 count::fetched(bytes.len());
                 if let (Some(c), Some(t)) = (super::cache::global(), &etag) {
@@ -228,11 +236,19 @@ impl RemoteFile {
         Ok(())
     }
 
-    /// One range GET, pinned to the ETag the file was opened with.
+    /// One range GET, pinned to the ETag the file was opened with, within the request
+    /// deadline.
     async fn range(&self, r: Range<u64>) -> Result<Arc<Vec<u8>>, FetchError> {
+        client::within(&self.object.url, Some(&r), self.range_unbounded(r.clone())).await
+    }
+
+    /// [`RemoteFile::range`] with no deadline of its own.
+    async fn range_unbounded(&self, r: Range<u64>) -> Result<Arc<Vec<u8>>, FetchError> {
         let options = GetOptions {
             range: Some(GetRange::Bounded(r.clone())),
-            if_match: self.etag.clone(),
+            // A weak ETag (`W/"..."`) never matches an If-Match (RFC 9110 compares strongly):
+            // the answer's ETag is compared below instead.
+            if_match: self.etag.clone().filter(|e| !e.starts_with("W/")),
             ..Default::default()
         };
         let describe = |e: &object_store::Error| client::failure(&self.object, Some(&r), e);

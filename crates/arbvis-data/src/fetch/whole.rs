@@ -174,8 +174,15 @@ fn finish(url: &str, outcome: &Outcome) {
     }
 }
 
-/// One GET of the whole object (conditional on the ETag of the bytes on disk, if any).
+/// One GET of the whole object (conditional on the ETag of the bytes on disk, if any),
+/// within the request deadline.
 async fn fetch(object: Object, max: u64) -> Outcome {
+    let url = object.url.clone();
+    client::within(&url, None, fetch_unbounded(object, max)).await
+}
+
+/// [`fetch`] with no deadline of its own.
+async fn fetch_unbounded(object: Object, max: u64) -> Outcome {
     let disk = super::cache::global().and_then(|c| c.get(&object.url, &WHOLE));
     let known = super::known_etag(&object.url);
     if let (Some(entry), Some(etag)) = (&disk, &known) {
