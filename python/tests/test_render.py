@@ -1,6 +1,7 @@
 """arbvis.Renderer: numpy arrays, frames after edits equal to fresh renderers', goldens,
 errors, two threads."""
 
+import copy
 import shutil
 import threading
 
@@ -179,6 +180,38 @@ def test_one_renderer_shared_by_threads_editing_and_drawing_never_panics():
     r.close()
     t.join()
     assert outcome == ["drawn"] or outcome == ["the renderer is closed"], outcome
+
+
+def test_ten_renderers_in_ten_threads_each_draw_the_single_picture():
+    # Under load: ten renderers of one scene at once in one process, each turned through
+    # the same three views; every frame equals the one renderer's frame of that view.
+    scene = arbvis.Scene.demo("v3o2-sum")
+    scene.size = (48, 40)
+    views = [(0.0, 0.0, 0.0, 1.0), (0.0, 0.6, 0.0, 0.8), (0.5, 0.5, -0.5, 0.5)]
+
+    def frames(s):
+        with arbvis.Renderer(s) as r:
+            out = []
+            for q in views:
+                s.rotation = q
+                out.append(r.render())
+            return out
+
+    alone = frames(copy.copy(scene))
+    results = [None] * 10
+
+    def work(i):
+        results[i] = frames(copy.copy(scene))
+
+    threads = [threading.Thread(target=work, args=(i,)) for i in range(10)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for i, got in enumerate(results):
+        assert got is not None, f"renderer {i} drew nothing"
+        for v, (a, b) in enumerate(zip(alone, got)):
+            assert np.array_equal(a, b), f"renderer {i}, view {v}"
 
 
 def test_osmesa_draws_what_egl_draws():
