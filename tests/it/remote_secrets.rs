@@ -3,7 +3,7 @@
 //! PNG's scene text; a session token is not sent on a redirect to another host), and a
 //! body is never buffered past the range asked for, whatever length the server declares.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use super::common::serve::Server;
@@ -25,6 +25,25 @@ fn all_bytes(dir: &Path) -> Vec<u8> {
 
 fn holds(bytes: &[u8], secret: &str) -> bool {
     bytes.windows(secret.len()).any(|w| w == secret.as_bytes())
+}
+
+/// Render the autzen splats scene on the COPC cloud at `url` to `DIR/NAME.png`: the
+/// process's output and the picture's path.
+fn render_cloud(
+    dir: &Path,
+    name: &str,
+    url: &str,
+    cache: &Path,
+) -> (std::process::Output, PathBuf) {
+    let scene = copc_scene(dir, &format!("{name}.toml"), url);
+    let png = dir.join(format!("{name}.png"));
+    let args = [
+        "render",
+        scene.to_str().unwrap(),
+        "-o",
+        png.to_str().unwrap(),
+    ];
+    (arbvis(&args, cache, &[]), png)
 }
 
 /// A password in the URL reaches the server (as HTTP basic authentication) and nothing
@@ -51,18 +70,7 @@ fn a_urls_password_stays_out_of_inspect_errors_the_cache_and_the_png() {
     assert!(!e.contains(secret) && e.contains("me:***@127.0.0.1"), "{e}");
     server.control("_reset");
     // A picture: the scene text it embeds names the URL without the password.
-    let scene = copc_scene(&dir, "secret.toml", &url);
-    let png = dir.join("secret.png");
-    let out = arbvis(
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            png.to_str().unwrap(),
-        ],
-        &cache,
-        &[],
-    );
+    let (out, png) = render_cloud(&dir, "secret", &url, &cache);
     assert!(out.status.success(), "{}", stderr(&out));
     let (_, text) = arbvis::png_io::read_png(&png).unwrap();
     let embedded: String = text.iter().map(|(k, v)| format!("{k}: {v}\n")).collect();
@@ -250,18 +258,7 @@ fn a_pre_signed_urls_query_goes_with_every_request_and_nowhere_else() {
         "{said}"
     );
     // A render: every node's range request carried the query too.
-    let scene = copc_scene(&dir, "signed.toml", &url);
-    let png = dir.join("signed.png");
-    let out = arbvis(
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            png.to_str().unwrap(),
-        ],
-        &cache,
-        &[],
-    );
+    let (out, _) = render_cloud(&dir, "signed", &url, &cache);
     assert!(out.status.success(), "{}", stderr(&out));
     let stats = server.control("_stats");
     assert!(!stats.contains("\"requests\": 0"), "{stats}");
@@ -295,18 +292,7 @@ fn a_pre_signed_urls_query_goes_with_every_request_and_nowhere_else() {
 fn weak_etags_are_read_and_a_stall_ends_within_twice_the_timeout() {
     let (dir, server, cache) = copc_served("remote-weak");
     server.control("_fault?mode=weak-etag&count=0&skip=0");
-    let scene = copc_scene(&dir, "weak.toml", &server.url("c.copc.laz"));
-    let png = dir.join("weak.png");
-    let out = arbvis(
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "-o",
-            png.to_str().unwrap(),
-        ],
-        &cache,
-        &[],
-    );
+    let (out, _) = render_cloud(&dir, "weak", &server.url("c.copc.laz"), &cache);
     assert!(out.status.success(), "{}", stderr(&out));
     server.control("_reset");
     // Every request stalls (60 s): at a 2 s timeout, the first one ends by 4 s.
