@@ -22,9 +22,9 @@ pub struct StudyArgs {
     /// to plot and tabulate instead of sweeping.
     #[arg(long, num_args = 1..)]
     pub from: Vec<PathBuf>,
-    /// The technique whose trade to sweep.
-    #[arg(long, value_enum, ignore_case = true, default_value_t = StudyTechnique::Opacity3d)]
-    pub technique: StudyTechnique,
+    // The study to run (help: the registered studies).
+    #[arg(long, value_parser = study_name, default_value = "opacity3d", help = study_help())]
+    pub technique: String,
     /// Cell projection: grid points per side of the generated meshes (17: the seed's
     /// 24,576 tetrahedra; 56: about a million).
     #[arg(long, value_delimiter = ',', default_values_t = [17, 25, 33, 45, 56])]
@@ -62,27 +62,43 @@ pub struct StudyArgs {
     pub out: PathBuf,
 }
 
-/// Techniques with a trade study.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-pub enum StudyTechnique {
-    /// v3o2's 3D opacity: slice counts, targets, opacity correction, program kinds.
-    Opacity3d,
-    /// Cell projection: mesh sizes, exit per vertex / per fragment, faithful / precise,
-    /// mesh / view order, isovalue-edit latency.
-    Cellproj,
-    /// Cell projection's volume: faithful (both sorts, table sizes) and precise, still
-    /// and turning, ortho and perspective, against the f64 reference, on the `--grids`
-    /// meshes and any `--scenes` (e.g. scenes/data/bracket-volume.toml).
-    CellprojVolume,
-    /// Volume clipping: clip grid sizes, shapes and block sizes (bytes, ratio, build
-    /// time), and frame times with no clip, the single texture and INDEX-DATA.
-    Clip,
-    /// Splats: every sort method at each cloud size, and frame times per sort choice
-    /// while the camera turns.
-    Splats,
-    /// Splats of a COPC cloud (`--scenes SCENE`): each of `--budgets`' pictures against
-    /// every point's, and the frame time turning.
-    SplatsLod,
+/// A study's runner: what `arbvis study --technique NAME` runs.
+type Runner = fn(StudyArgs) -> Result<()>;
+
+/// The runner of each study the catalog registers ([`arbvis::catalog::studies`]; a test
+/// checks the two name the same studies): the command line holds the studies' arguments.
+const RUNNERS: &[(&str, Runner)] = &[
+    ("opacity3d", |a| opacity3d_study(&a)),
+    ("clip", clip_study),
+    ("cellproj", cellproj_study),
+    ("cellproj-volume", |a| cellproj_volume_study(&a)),
+    ("splats", splats_study),
+    ("splats-lod", |a| splats_lod_study(&a)),
+];
+
+/// A registered study's name, in any case (`--technique`).
+fn study_name(s: &str) -> Result<String, String> {
+    let name = s.to_ascii_lowercase();
+    if arbvis::catalog::studies().any(|(n, _)| n == name) {
+        Ok(name)
+    } else {
+        let names: Vec<&str> = arbvis::catalog::studies().map(|(n, _)| n).collect();
+        Err(format!(
+            "no study named {s:?}; studies: {}",
+            names.join(", ")
+        ))
+    }
+}
+
+/// `--technique`'s help: every registered study and what it sweeps.
+fn study_help() -> String {
+    let lines: Vec<String> = arbvis::catalog::studies()
+        .map(|(name, about)| format!("- {name}: {about}"))
+        .collect();
+    format!(
+        "The study to run (the techniques register them):\n{}",
+        lines.join("\n")
+    )
 }
 
 /// The sizes a bench or study sweeps.
@@ -129,13 +145,13 @@ pub fn study(a: StudyArgs) -> Result<()> {
         println!("wrote {}", a.out.join("study.md").display());
         return Ok(());
     }
-    match a.technique {
-        StudyTechnique::Opacity3d => opacity3d_study(&a),
-        StudyTechnique::Cellproj => cellproj_study(a),
-        StudyTechnique::CellprojVolume => cellproj_volume_study(&a),
-        StudyTechnique::Clip => clip_study(a),
-        StudyTechnique::Splats => splats_study(a),
-        StudyTechnique::SplatsLod => splats_lod_study(&a),
+    let runner = RUNNERS
+        .iter()
+        .find(|(name, _)| *name == a.technique)
+        .map(|(_, run)| *run);
+    match runner {
+        Some(run) => run(a),
+        None => bail!("study {:?} is registered but has no runner", a.technique),
     }
 }
 
@@ -395,4 +411,16 @@ fn write_study<const N: usize>(out: &Path, files: [(&str, String); N]) -> Result
         println!("wrote {}", path.display());
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn every_registered_study_has_a_runner_and_every_runner_a_registration() {
+        let mut registered: Vec<&str> = arbvis::catalog::studies().map(|(n, _)| n).collect();
+        let mut run: Vec<&str> = super::RUNNERS.iter().map(|(n, _)| *n).collect();
+        registered.sort();
+        run.sort();
+        assert_eq!(registered, run);
+    }
 }

@@ -628,7 +628,7 @@ fn study_help_describes_every_technique_and_how_to_make_run_json() {
     let help = arbvis(&["study", "--help"]);
     let (stdout, _) = text(&help);
     assert!(help.status.success());
-    // The techniques as clap lists them ("- NAME: ..." under --technique's values):
+    // The studies the catalog registers ("- NAME: ..." under --technique):
     // each has its own paragraph, with what it writes.
     let values = stdout
         .split_once("--technique <TECHNIQUE>")

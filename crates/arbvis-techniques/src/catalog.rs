@@ -91,6 +91,8 @@ pub struct Registration {
     pub demos: &'static [(&'static str, &'static str)],
     /// Every program pair its renderers can draw with, both kinds.
     pub program_pairs: fn() -> Vec<ProgramPair>,
+    /// Its `arbvis study` sweeps: name and what each sweeps.
+    pub studies: &'static [(&'static str, &'static str)],
 }
 
 impl Registration {
@@ -100,6 +102,7 @@ impl Registration {
             name: T::NAME,
             demos: T::DEMOS,
             program_pairs: T::program_pairs,
+            studies: T::STUDIES,
         }
     }
 }
@@ -107,6 +110,11 @@ impl Registration {
 /// Every built-in demo (name, scene text), technique by technique.
 pub fn demos() -> impl Iterator<Item = (&'static str, &'static str)> {
     TECHNIQUES.iter().flat_map(|t| t.demos.iter().copied())
+}
+
+/// Every `arbvis study` sweep (name, what it sweeps), technique by technique.
+pub fn studies() -> impl Iterator<Item = (&'static str, &'static str)> {
+    TECHNIQUES.iter().flat_map(|t| t.studies.iter().copied())
 }
 
 /// [`Technique`] with `T` erased, for the catalog's dispatch (one blanket implementation

@@ -186,6 +186,9 @@ pub trait Technique: Any + Sized {
     const NAME: &'static str;
     /// Its built-in demos, name and scene text ([`demo!`] reads one from `scenes/demo/`).
     const DEMOS: &'static [(&'static str, &'static str)];
+    /// Its `arbvis study` sweeps: the name `--technique` takes and what it sweeps (the
+    /// runner is the command line's, which alone holds their arguments).
+    const STUDIES: &'static [(&'static str, &'static str)] = &[];
     /// Check values that parse but cannot render, in a scene drawn at `fidelity` with
     /// `programs`; the error's key is relative to `[technique.NAME]`.
     fn validate(&self, fidelity: Fidelity, programs: ProgramChoice) -> Result<(), FieldError>;

@@ -266,6 +266,16 @@ pub struct CellprojScene {
 
 impl crate::techniques::Technique for CellprojScene {
     const NAME: &'static str = "cellproj";
+    const STUDIES: &'static [(&'static str, &'static str)] = &[
+        (
+            "cellproj",
+            "cell projection: mesh sizes, exit per vertex / per fragment, faithful / precise, mesh / view order, isovalue-edit latency",
+        ),
+        (
+            "cellproj-volume",
+            "cell projection's volume: faithful (both sorts, table sizes) and precise, still and turning, ortho and perspective, against the f64 reference, on the --grids meshes and any --scenes (e.g. scenes/data/bracket-volume.toml)",
+        ),
+    ];
     const DEMOS: &'static [(&'static str, &'static str)] = &[
         crate::techniques::demo!("cellproj-planar"),
         crate::techniques::demo!("cellproj-spherical"),

@@ -187,6 +187,16 @@ pub struct Opacity3dScene {
 
 impl crate::techniques::Technique for Opacity3dScene {
     const NAME: &'static str = "opacity3d";
+    const STUDIES: &'static [(&'static str, &'static str)] = &[
+        (
+            "opacity3d",
+            "v3o2's 3D opacity: slice counts, targets, opacity correction, program kinds",
+        ),
+        (
+            "clip",
+            "volume clipping: clip grid sizes, shapes and block sizes (bytes, ratio, build time), and frame times with no clip, the single texture and INDEX-DATA",
+        ),
+    ];
     const DEMOS: &'static [(&'static str, &'static str)] = &[
         crate::techniques::demo!("v3o2-sum"),
         crate::techniques::demo!("v3o2-product"),

@@ -58,6 +58,16 @@ pub use scene::SplatsScene;
 /// renderer (`renderer.rs`).
 impl crate::techniques::Technique for SplatsScene {
     const NAME: &'static str = "splats";
+    const STUDIES: &'static [(&'static str, &'static str)] = &[
+        (
+            "splats",
+            "splats: every sort method at each cloud size, and frame times per sort choice while the camera turns",
+        ),
+        (
+            "splats-lod",
+            "splats of a COPC cloud (--scenes SCENE): each of --budgets' pictures against every point's, and the frame time turning",
+        ),
+    ];
     const DEMOS: &'static [(&'static str, &'static str)] = &[
         crate::techniques::demo!("splats-section"),
         crate::techniques::demo!("splats-section-precise"),
