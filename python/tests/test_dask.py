@@ -36,3 +36,50 @@ def test_an_orbit_of_a_store_on_two_workers_equals_one_process(f3_store_scene, t
             assert np.array_equal(r.render(), image)
     for png, image in zip(pngs, images):
         assert np.array_equal(arbvis._arbvis.read_png(png), image)
+
+
+def test_four_workers_on_a_remote_store_with_one_shared_cache_equal_one_process(
+    f3_store_scene, tmp_path, monkeypatch, root
+):
+    """Under load: the same store over HTTP (the tests' Range server on 127.0.0.1), four
+    worker processes sharing one disk cache: every view equals the single-process render
+    of the local store, and the shared cache holds whole entries only."""
+    import subprocess
+    import sys
+
+    cache = tmp_path / "cache"
+    # Worker processes start from this environment: one cache folder for all four.
+    monkeypatch.setenv("ARBVIS_CACHE_DIR", str(cache))
+    server = subprocess.Popen(
+        [sys.executable, str(root / "tests/servers/range_server.py"), str(tmp_path)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+    )
+    try:
+        port = int(server.stdout.readline())
+        local = f3_store_scene
+        remote = arbvis.Scene.from_toml(
+            local.to_toml().replace(str(tmp_path / "f3.zarr"), f"http://127.0.0.1:{port}/f3.zarr")
+        )
+        assert "http://" in remote.to_toml()
+        views = arbvis.dask.orbit(8)
+        with distributed.LocalCluster(
+            n_workers=4,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+        ) as cluster, distributed.Client(cluster) as client:
+            images = arbvis.dask.render_views(client, remote, views)
+    finally:
+        server.stdin.close()
+        server.kill()
+        server.wait()
+    with arbvis.Renderer(local) as r:
+        for rotation, image in zip(views, images):
+            local.rotation = rotation
+            assert np.array_equal(r.render(), image)
+    entries = [p for p in cache.rglob("*") if p.is_file()]
+    assert entries, "the workers shared the cache"
+    assert not [p for p in entries if p.name.startswith(".tmp-")], "a temporary was left"
