@@ -103,6 +103,32 @@ impl Camera {
     }
 }
 
+/// A view: the camera's view-projection over the data's frame, its projection's y scale
+/// (`P[1][1]`), and the image size (what a renderer is first built for, and what a COPC
+/// cloud's nodes are chosen for).
+#[derive(Debug, Clone, Copy)]
+pub struct View {
+    /// Clip from frame coordinates.
+    pub view_projection: DMat4,
+    /// The projection matrix's `[1][1]`: pixels per unit at clip w = 1, over half the
+    /// height.
+    pub projection_y: f64,
+    /// Image width and height in pixels.
+    pub size: [u32; 2],
+}
+
+impl View {
+    /// The view of `camera` on an image of `size` pixels.
+    pub fn of(camera: &Camera, size: [u32; 2]) -> View {
+        let aspect = size[0].max(1) as f64 / size[1].max(1) as f64;
+        View {
+            view_projection: camera.view_projection(aspect),
+            projection_y: camera.projection_matrix(aspect).y_axis.y,
+            size,
+        }
+    }
+}
+
 /// `glOrtho`'s matrix (right-handed eye space, depth to [-1, 1]).
 pub fn orthographic_gl(l: f64, r: f64, b: f64, t: f64, n: f64, f: f64) -> DMat4 {
     DMat4::from_cols_array(&[

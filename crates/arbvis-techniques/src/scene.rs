@@ -307,7 +307,7 @@ impl Scene {
             programs: self.programs,
             base: &self.base,
             projection: self.camera.projection,
-            view: crate::points::copc_lod::View::of(&self.camera, self.size),
+            view: crate::camera::View::of(&self.camera, self.size),
         }
     }
 

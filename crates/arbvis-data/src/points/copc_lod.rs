@@ -16,30 +16,9 @@ use glam::{DMat4, DVec3, DVec4};
 
 use super::copc::{Copc, Node};
 
-/// A view: the camera's view-projection over the cloud's frame ([-1, 1]³ around the
-/// header's bounds), its projection's y scale (`P[1][1]`), and the image size.
-#[derive(Debug, Clone, Copy)]
-pub struct View {
-    /// Clip from frame coordinates.
-    pub view_projection: DMat4,
-    /// The projection matrix's `[1][1]`: pixels per unit at clip w = 1, over half the
-    /// height.
-    pub projection_y: f64,
-    /// Image width and height in pixels.
-    pub size: [u32; 2],
-}
-
-impl View {
-    /// The view of `camera` on an image of `size` pixels.
-    pub fn of(camera: &crate::camera::Camera, size: [u32; 2]) -> View {
-        let aspect = size[0].max(1) as f64 / size[1].max(1) as f64;
-        View {
-            view_projection: camera.view_projection(aspect),
-            projection_y: camera.projection_matrix(aspect).y_axis.y,
-            size,
-        }
-    }
-}
+/// A view of the cloud's frame ([-1, 1]³ around the header's bounds): the camera's
+/// [`crate::camera::View`].
+pub use crate::camera::View;
 
 /// What a COPC cloud's load says: its cut in a line, and the spacing of the deepest level
 /// drawn in the cloud's frame (what a splat must cover for the picture to have no gaps).

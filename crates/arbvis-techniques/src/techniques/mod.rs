@@ -288,8 +288,9 @@ pub struct Settings<'a> {
     pub base: &'a Path,
     /// The camera's projection when the renderer is built.
     pub projection: Projection,
-    /// The first view (camera and image size): what a COPC cloud's nodes are chosen for.
-    pub view: crate::points::copc_lod::View,
+    /// The first view (camera and image size), for data that is cut to the view (a COPC
+    /// cloud's nodes).
+    pub view: crate::camera::View,
 }
 
 /// Some technique's parameters; a renderer takes its own with [`Params::get`].
