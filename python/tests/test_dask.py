@@ -11,16 +11,21 @@ import arbvis.dask
 distributed = pytest.importorskip("dask.distributed")
 
 
-def test_an_orbit_of_a_store_on_two_workers_equals_one_process(f3_store_scene, tmp_path):
-    scene = f3_store_scene
-    views = arbvis.dask.orbit(6)
-    with distributed.LocalCluster(
-        n_workers=2,
+def local_cluster(workers):
+    """A LocalCluster of `workers` single-threaded worker processes on loopback."""
+    return distributed.LocalCluster(
+        n_workers=workers,
         threads_per_worker=1,
         processes=True,
         host="127.0.0.1",
         dashboard_address=None,
-    ) as cluster, distributed.Client(cluster) as client:
+    )
+
+
+def test_an_orbit_of_a_store_on_two_workers_equals_one_process(f3_store_scene, tmp_path):
+    scene = f3_store_scene
+    views = arbvis.dask.orbit(6)
+    with local_cluster(2) as cluster, distributed.Client(cluster) as client:
         images = arbvis.dask.render_views(client, scene, views)
         pngs = arbvis.dask.render_views(client, scene, views[:2], out_dir=str(tmp_path / "views"))
         # Every worker that rendered keeps one renderer (the scene's), not one per task.
@@ -39,43 +44,23 @@ def test_an_orbit_of_a_store_on_two_workers_equals_one_process(f3_store_scene, t
 
 
 def test_four_workers_on_a_remote_store_with_one_shared_cache_equal_one_process(
-    f3_store_scene, tmp_path, monkeypatch, root
+    f3_store_scene, tmp_path, monkeypatch, range_server
 ):
     """Under load: the same store over HTTP (the tests' Range server on 127.0.0.1), four
     worker processes sharing one disk cache: every view equals the single-process render
     of the local store, and the shared cache holds whole entries only."""
-    import subprocess
-    import sys
-
     cache = tmp_path / "cache"
     # Worker processes start from this environment: one cache folder for all four.
     monkeypatch.setenv("ARBVIS_CACHE_DIR", str(cache))
-    server = subprocess.Popen(
-        [sys.executable, str(root / "tests/servers/range_server.py"), str(tmp_path)],
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
+    port = range_server(tmp_path)
+    local = f3_store_scene
+    remote = arbvis.Scene.from_toml(
+        local.to_toml().replace(str(tmp_path / "f3.zarr"), f"http://127.0.0.1:{port}/f3.zarr")
     )
-    try:
-        port = int(server.stdout.readline())
-        local = f3_store_scene
-        remote = arbvis.Scene.from_toml(
-            local.to_toml().replace(str(tmp_path / "f3.zarr"), f"http://127.0.0.1:{port}/f3.zarr")
-        )
-        assert "http://" in remote.to_toml()
-        views = arbvis.dask.orbit(8)
-        with distributed.LocalCluster(
-            n_workers=4,
-            threads_per_worker=1,
-            processes=True,
-            host="127.0.0.1",
-            dashboard_address=None,
-        ) as cluster, distributed.Client(cluster) as client:
-            images = arbvis.dask.render_views(client, remote, views)
-    finally:
-        server.stdin.close()
-        server.kill()
-        server.wait()
+    assert "http://" in remote.to_toml()
+    views = arbvis.dask.orbit(8)
+    with local_cluster(4) as cluster, distributed.Client(cluster) as client:
+        images = arbvis.dask.render_views(client, remote, views)
     with arbvis.Renderer(local) as r:
         for rotation, image in zip(views, images):
             local.rotation = rotation

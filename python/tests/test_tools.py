@@ -86,34 +86,22 @@ def test_convert_reads_a_url_as_a_url_and_writes_only_locally(tmp_path, monkeypa
     assert "local folder" in str(e.value), e.value
 
 
-def test_a_remote_cloud_is_inspected_and_its_requests_counted(root, tmp_path, monkeypatch):
+def test_a_remote_cloud_is_inspected_and_its_requests_counted(
+    root, tmp_path, monkeypatch, range_server
+):
     """A COPC file over HTTP (the Rust tests' Range server on 127.0.0.1, stopped with the
     test): inspected as the local file is, its requests in fetch_stats."""
-    import subprocess
-    import sys
-
     monkeypatch.setenv("ARBVIS_CACHE_DIR", str(tmp_path / "cache"))
-    server = subprocess.Popen(
-        [sys.executable, str(root / "tests/servers/range_server.py"), str(root / "data/points")],
-        stdin=subprocess.PIPE,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
-    )
-    try:
-        port = int(server.stdout.readline())
-        before = arbvis.fetch_stats()["requests"]
-        url = f"http://127.0.0.1:{port}/simple.copc.laz"
-        remote = arbvis.inspect(url)
-        local = arbvis.inspect(root / "data/points/simple.copc.laz")
-        assert remote["text"].split("\n", 1)[1] == local["text"].split("\n", 1)[1]
-        stats = arbvis.fetch_stats()
-        # The 33 KB file in one request: its first 64 KiB block is all of it.
-        assert stats["requests"] - before == 1
-        assert stats["in_flight"] == 0 and stats["loading"] is None
-        with pytest.raises(arbvis.InputError) as e:
-            arbvis.inspect(f"http://127.0.0.1:{port}/none.copc.laz")
-        assert "none.copc.laz" in str(e.value) and "404" in str(e.value)
-    finally:
-        server.stdin.close()
-        server.kill()
-        server.wait()
+    port = range_server(root / "data/points")
+    before = arbvis.fetch_stats()["requests"]
+    url = f"http://127.0.0.1:{port}/simple.copc.laz"
+    remote = arbvis.inspect(url)
+    local = arbvis.inspect(root / "data/points/simple.copc.laz")
+    assert remote["text"].split("\n", 1)[1] == local["text"].split("\n", 1)[1]
+    stats = arbvis.fetch_stats()
+    # The 33 KB file in one request: its first 64 KiB block is all of it.
+    assert stats["requests"] - before == 1
+    assert stats["in_flight"] == 0 and stats["loading"] is None
+    with pytest.raises(arbvis.InputError) as e:
+        arbvis.inspect(f"http://127.0.0.1:{port}/none.copc.laz")
+    assert "none.copc.laz" in str(e.value) and "404" in str(e.value)

@@ -135,12 +135,6 @@ trait AnyTechnique: Any {
     );
     fn for_interaction(&mut self, scale: f64);
     fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate>;
-    fn build(
-        &self,
-        gpu: &Gpu,
-        settings: &Settings<'_>,
-        kind: ProgramKind,
-    ) -> RenderResult<Box<dyn Renderer>>;
     fn prepare(&self, settings: &Settings<'_>, limits: &Limits) -> RenderResult<PreparedData>;
     fn renderer(
         &self,
@@ -204,15 +198,6 @@ impl<T: Technique> AnyTechnique for T {
 
     fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
         Technique::memory_estimate(self, size)
-    }
-
-    fn build(
-        &self,
-        gpu: &Gpu,
-        settings: &Settings<'_>,
-        kind: ProgramKind,
-    ) -> RenderResult<Box<dyn Renderer>> {
-        Technique::build(self, gpu, settings, kind)
     }
 
     fn prepare(&self, settings: &Settings<'_>, limits: &Limits) -> RenderResult<PreparedData> {
@@ -335,7 +320,11 @@ pub fn build(
     settings: &Settings<'_>,
     kind: ProgramKind,
 ) -> RenderResult<Box<dyn Renderer>> {
-    technique.technique().build(gpu, settings, kind)
+    // Prepared within the GL's largest 3D texture; nothing else is created.
+    let limits = Limits::for_max_side(gpu.caps().max_3d_texture_size);
+    let technique = technique.technique();
+    let prepared = technique.prepare(settings, &limits)?;
+    technique.renderer(gpu, settings, kind, prepared)
 }
 
 /// A technique's prepared data ([`Technique::Prepared`]), boxed, so that a caller that

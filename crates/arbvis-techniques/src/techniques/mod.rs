@@ -250,18 +250,6 @@ pub trait Technique: Any + Sized {
         let _ = (prepared, view);
         None
     }
-    /// Prepare (within the GL's largest 3D texture), then make the renderer; nothing else
-    /// is created.
-    fn build(
-        &self,
-        gpu: &Gpu,
-        settings: &Settings<'_>,
-        kind: ProgramKind,
-    ) -> RenderResult<Box<dyn Renderer>> {
-        let limits = Limits::for_max_side(gpu.caps().max_3d_texture_size);
-        let prepared = self.prepare(settings, &limits)?;
-        self.renderer(gpu, settings, kind, prepared)
-    }
 }
 
 /// What a reference picture is computed for ([`Technique::reference`]).
