@@ -370,8 +370,8 @@ struct Graph {
 
 /// The workspace's crates as one module tree: each crate's folder of sources and the
 /// module its root stands for (`None`: its modules sit at the top, as `arbvis` names them).
-/// A crate's `lib.rs` other than a module's own only declares its modules and names the
-/// crates below (Cargo.toml keeps the crates' order), so it is not read.
+/// A crate's `lib.rs` other than a module's own only declares its modules (Cargo.toml keeps
+/// the crates' order), so it is not read.
 const CRATES: [(&str, Option<&str>); 6] = [
     ("src", None),
     ("crates/arbvis-core/src", None),
@@ -381,39 +381,9 @@ const CRATES: [(&str, Option<&str>); 6] = [
     ("crates/arbvis-viewer/src", Some("viewer")),
 ];
 
-/// The top-level modules of the crates below that a crate's root names for its files
-/// (`crate::scene` in the viewer is arbvis-techniques' `scene`).
-const NAMED_FROM_BELOW: [&str; 26] = [
-    "budget",
-    "camera",
-    "colortable",
-    "image",
-    "input",
-    "png_io",
-    "progress",
-    "vocab",
-    "gl",
-    "fetch",
-    "mesh",
-    "points",
-    "store",
-    "surface",
-    "volume",
-    "annotate",
-    "catalog",
-    "error",
-    "info",
-    "inspect",
-    "programs",
-    "render",
-    "scene",
-    "session",
-    "study",
-    "techniques",
-];
-
 /// A file's text with its paths written as in one crate: `crate::` inside a crate that is a
-/// module (`gl`, `viewer`) gains that module, and the crates below are named as `crate::`.
+/// module (`gl`, `viewer`) gains that module, and the crates below (each named where it is
+/// used, never re-exported as a crate's own module) are named as `crate::`.
 fn as_one_crate(text: &str, own: Option<&str>) -> String {
     let mut text = text.to_string();
     if let Some(own) = own {
@@ -422,14 +392,8 @@ fn as_one_crate(text: &str, own: Option<&str>) -> String {
         while let Some(at) = rest.find("crate::") {
             out.push_str(&rest[..at + "crate::".len()]);
             rest = &rest[at + "crate::".len()..];
-            let word: String = rest
-                .chars()
-                .take_while(|c| c.is_alphanumeric() || *c == '_')
-                .collect();
-            if !NAMED_FROM_BELOW.contains(&word.as_str()) {
-                out.push_str(own);
-                out.push_str("::");
-            }
+            out.push_str(own);
+            out.push_str("::");
         }
         out.push_str(rest);
         text = out;
@@ -657,4 +621,24 @@ fn the_reader_sees_the_imports_it_must() {
         layer_of(&m("techniques::splats::sort")),
         layer_of(&m("techniques"))
     );
+}
+
+/// No crate below the command line names a lower crate's module as its own
+/// (`use arbvis_core::{budget, ...}` in its root made `crate::budget` another crate's
+/// module, which neither a reader nor this graph could tell): each file names the crate.
+#[test]
+fn crates_name_the_crates_below_where_they_use_them() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    for (folder, _) in &CRATES[1..] {
+        let lib = root.join(folder).join("lib.rs");
+        let text = std::fs::read_to_string(&lib).unwrap();
+        let aliases: Vec<&str> = text
+            .lines()
+            .filter(|l| {
+                let l = l.trim_start_matches("pub ");
+                l.starts_with("use arbvis_") && (l.contains("::{") || l.contains(" as "))
+            })
+            .collect();
+        assert!(aliases.is_empty(), "{}: {aliases:?}", lib.display());
+    }
 }

@@ -128,6 +128,13 @@ pub enum OverBudget {
     },
 }
 
+/// The message, for the readers that place it at a position in their file.
+impl From<OverBudget> for String {
+    fn from(e: OverBudget) -> String {
+        e.to_string()
+    }
+}
+
 const NOT_SET: u8 = 0;
 static CHOSEN_BYTES: AtomicU64 = AtomicU64::new(0);
 static CHOSEN_SOURCE: AtomicU8 = AtomicU8::new(NOT_SET);

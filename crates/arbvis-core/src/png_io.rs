@@ -373,12 +373,31 @@ pub struct WriterLock {
     taken_over: Option<u32>,
 }
 
+/// The process holding a [`WriterLock`]: `pid 1234`, or `a process` when its lock file
+/// names none.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LockHolder {
+    /// The process whose id the lock file holds.
+    Pid(u32),
+    /// A process that wrote no id (yet).
+    Unnamed,
+}
+
+impl std::fmt::Display for LockHolder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LockHolder::Pid(pid) => write!(f, "pid {pid}"),
+            LockHolder::Unnamed => write!(f, "a process"),
+        }
+    }
+}
+
 impl WriterLock {
     /// Take the lock at `path` (created if absent). `Ok(Err(holder))`: another process
     /// holds it, `holder` says which (`pid 1234`, or `a process` when it wrote none). A
     /// lock file left by a process that is gone (killed) is taken over, and
     /// [`WriterLock::taken_over`] says whose it was.
-    pub fn acquire(path: &Path) -> std::io::Result<Result<WriterLock, String>> {
+    pub fn acquire(path: &Path) -> std::io::Result<Result<WriterLock, LockHolder>> {
         use std::io::Read;
         let mut file = std::fs::OpenOptions::new()
             .read(true)
@@ -392,10 +411,9 @@ impl WriterLock {
                 let mut holder = String::new();
                 let _ = (&file).take(64).read_to_string(&mut holder);
                 let holder = holder.trim();
-                return Ok(Err(if holder.is_empty() {
-                    "a process".to_string()
-                } else {
-                    format!("pid {holder}")
+                return Ok(Err(match holder.trim().parse::<u32>() {
+                    Ok(pid) => LockHolder::Pid(pid),
+                    Err(_) => LockHolder::Unnamed,
                 }));
             }
             Err(std::fs::TryLockError::Error(e)) => return Err(e),

@@ -10,9 +10,7 @@
 #[cfg(test)]
 extern crate self as arbvis;
 
-// The ground floor, named as the crate root names it (`crate::budget`, ...).
-#[allow(unused_imports)]
-use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, vocab};
+// The ground floor, named as the crate root names it (`arbvis_core::budget`, ...).
 
 pub mod fetch;
 pub mod le;

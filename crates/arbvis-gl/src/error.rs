@@ -44,16 +44,16 @@ pub enum GlError {
     },
     /// The GL could not allocate memory for an object (`GL_OUT_OF_MEMORY`).
     #[error("the GL ran out of memory (GL_OUT_OF_MEMORY) creating {what}, {}; try a smaller \
-             size, fewer slices or points, or a coarser grid", crate::budget::format_bytes(*.bytes))]
+             size, fewer slices or points, or a coarser grid", arbvis_core::budget::format_bytes(*.bytes))]
     OutOfMemory {
         /// What was being created.
         what: String,
         /// Its size in bytes.
         bytes: u64,
     },
-    /// What was asked for is over the memory budget ([`crate::budget`]).
+    /// What was asked for is over the memory budget ([`arbvis_core::budget`]).
     #[error(transparent)]
-    Budget(#[from] crate::budget::OverBudget),
+    Budget(#[from] arbvis_core::budget::OverBudget),
     /// A program failed to compile or link.
     #[error(transparent)]
     Compile(#[from] CompileError),

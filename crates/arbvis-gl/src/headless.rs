@@ -107,26 +107,24 @@ impl Headless {
         Err(err(reasons.join("; ")))
     }
 
-    fn egl_on(device: &Device) -> Result<Headless, String> {
+    fn egl_on(device: &Device) -> Result<Headless, DeviceRefusal> {
         // SAFETY: the device comes from query_devices and outlives this call.
-        let display = unsafe { Display::with_device(device, None) }.map_err(|e| e.to_string())?;
+        let display = unsafe { Display::with_device(device, None) }?;
         let template = ConfigTemplateBuilder::new()
             .with_surface_type(ConfigSurfaceTypes::PBUFFER)
             .with_api(Api::OPENGL)
             .build();
         // SAFETY: the template is valid for this display.
-        let config = unsafe { display.find_configs(template) }
-            .map_err(|e| e.to_string())?
+        let config = unsafe { display.find_configs(template) }?
             .next()
-            .ok_or("no PBUFFER-capable OpenGL config")?;
-        let mut last = String::new();
+            .ok_or(DeviceRefusal::NoConfig)?;
+        let mut last = None;
         for attrs in compatibility_attributes(None) {
             // SAFETY: config belongs to display; no window handle.
             match unsafe { display.create_context(&config, &attrs) } {
                 Ok(ctx) => {
-                    let ctx = ctx.make_current_surfaceless().map_err(|e| e.to_string())?;
-                    let gpu = Gpu::from_loader(|s| display.get_proc_address(s))
-                        .map_err(|e| e.to_string())?;
+                    let ctx = ctx.make_current_surfaceless()?;
+                    let gpu = Gpu::from_loader(|s| display.get_proc_address(s))?;
                     return Ok(Headless {
                         gpu,
                         backend: Backend::Egl,
@@ -136,10 +134,10 @@ impl Headless {
                         },
                     });
                 }
-                Err(e) => last = e.to_string(),
+                Err(e) => last = Some(e),
             }
         }
-        Err(format!("no compatibility-profile context: {last}"))
+        Err(DeviceRefusal::NoContext(last))
     }
 
     fn osmesa() -> GlResult<Headless> {
@@ -155,6 +153,23 @@ impl Headless {
             _context: HeadlessContext::Osmesa { _context: ctx },
         })
     }
+}
+
+/// Why one EGL device gave no context.
+#[derive(Debug, thiserror::Error)]
+enum DeviceRefusal {
+    /// EGL refused a call.
+    #[error("{0}")]
+    Egl(#[from] glutin::error::Error),
+    /// The device has no configuration for offscreen OpenGL.
+    #[error("no PBUFFER-capable OpenGL config")]
+    NoConfig,
+    /// No compatibility-profile context of any version (the last refusal).
+    #[error("no compatibility-profile context: {}", .0.as_ref().map_or(String::new(), |e| e.to_string()))]
+    NoContext(Option<glutin::error::Error>),
+    /// The context's GL lacks what arbvis needs.
+    #[error("{0}")]
+    Gl(#[from] GlError),
 }
 
 /// Context attributes to try, best first: compatibility profile 4.5, then 3.0, then any

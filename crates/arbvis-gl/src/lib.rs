@@ -5,8 +5,7 @@
 //! owned textures, meshes and render targets (each freed on Drop), a state guard, and
 //! error checking that names the Rust file and line of the failed call.
 
-// The ground floor, named as the crate root names it (`crate::budget`, ...).
-use arbvis_core::{budget, image, vocab};
+// The ground floor, named as the crate root names it (`arbvis_core::budget`, ...).
 
 mod arb;
 mod draw;

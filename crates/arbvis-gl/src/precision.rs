@@ -29,7 +29,7 @@ use super::mesh::Mesh;
 use super::program::{Program, ProgramKind, ProgramText};
 use super::target::{Surface, Target};
 use super::texture::{Extent, Filter, TexelData, TexelFormat, Texture};
-use crate::vocab::TargetFormat;
+use arbvis_core::vocab::TargetFormat;
 
 /// The largest filter error taken as f32 interpolation: an f32 lerp between 0 and 1 is
 /// within 6e-8; 8-bit weights are off by up to 2e-3 (1.8e-3 measured), 13-bit ones by up

@@ -11,8 +11,8 @@ use super::error::{GlError, GlResult};
 use super::gpu::Gpu;
 use super::state::StateGuard;
 use super::texture::{TexelFormat, Texture};
-use crate::image::Image;
-pub use crate::vocab::TargetFormat;
+use arbvis_core::image::Image;
+pub use arbvis_core::vocab::TargetFormat;
 
 /// The texel format of a target's colour texture.
 pub(crate) fn texel_format(format: TargetFormat) -> TexelFormat {

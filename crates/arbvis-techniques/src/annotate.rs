@@ -19,10 +19,10 @@
 use crate::error::AnnotateError;
 use glam::{DVec2, DVec3, DVec4};
 
-use crate::camera::Camera;
-use crate::image::Image;
 use crate::techniques::annotations::{Annotations, Legend};
-use crate::volume::axes::Axis;
+use arbvis_core::camera::Camera;
+use arbvis_core::image::Image;
+use arbvis_data::volume::axes::Axis;
 
 /// Which annotations to draw.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
@@ -132,7 +132,7 @@ pub fn brief(v: f64) -> String {
     if v.fract() == 0.0 && v.abs() < 1e9 {
         format!("{}", v as i64)
     } else {
-        crate::vocab::significant(v)
+        arbvis_core::vocab::significant(v)
     }
 }
 

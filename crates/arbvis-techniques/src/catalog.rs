@@ -16,9 +16,6 @@ use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
 
-use crate::camera::Camera;
-use crate::gl::{GlError, Gpu, ProgramChoice, ProgramKind};
-use crate::image::Image;
 use crate::programs::ProgramPair;
 use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::Opacity3dScene;
@@ -26,8 +23,11 @@ use crate::techniques::quad::QuadScene;
 use crate::techniques::splats::SplatsScene;
 pub use crate::techniques::Settings;
 use crate::techniques::{Params, ReferenceView, Renderer, Technique};
-use crate::vocab::{Fidelity, FieldError};
-use crate::volume::Limits;
+use arbvis_core::camera::Camera;
+use arbvis_core::image::Image;
+use arbvis_core::vocab::{Fidelity, FieldError};
+use arbvis_data::volume::Limits;
+use arbvis_gl::{GlError, Gpu, ProgramChoice, ProgramKind};
 
 /// The one list of techniques: each line is a technique's variant and its parameters'
 /// type, which implements [`Technique`] in its own folder. The enum, its conversions,
@@ -134,7 +134,7 @@ trait AnyTechnique: Any {
         fidelity: &mut Fidelity,
     );
     fn for_interaction(&mut self, scale: f64);
-    fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate>;
+    fn memory_estimate(&self, size: [u32; 2]) -> Vec<arbvis_core::budget::Estimate>;
     fn prepare(&self, settings: &Settings<'_>, limits: &Limits) -> RenderResult<PreparedData>;
     fn renderer(
         &self,
@@ -196,7 +196,7 @@ impl<T: Technique> AnyTechnique for T {
         Technique::for_interaction(self, scale)
     }
 
-    fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
+    fn memory_estimate(&self, size: [u32; 2]) -> Vec<arbvis_core::budget::Estimate> {
         Technique::memory_estimate(self, size)
     }
 
@@ -308,7 +308,7 @@ impl TechniqueScene {
 
     /// The large allocations preparing and drawing it at `size` makes that the scene
     /// alone determines (generated data, grids, lists); files are checked by their loaders.
-    pub fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
+    pub fn memory_estimate(&self, size: [u32; 2]) -> Vec<arbvis_core::budget::Estimate> {
         self.technique().memory_estimate(size)
     }
 }

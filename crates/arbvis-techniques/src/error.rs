@@ -2,16 +2,16 @@
 //! data layer's, kept as their own types (`#[from]`) so that a caller can still ask which
 //! file and position failed, and each prints the message its layer wrote.
 
-use crate::budget::{OverBudget, SizeError};
-use crate::colortable::TableError;
-use crate::gl::GlError;
-use crate::mesh::MeshError;
-use crate::points::PointsError;
-use crate::store::StoreError;
-use crate::surface::SurfaceError;
 use crate::techniques::clip::error::{ClipError, ComposeError};
-use crate::vocab::FieldError;
-use crate::volume::VolumeError;
+use arbvis_core::budget::{OverBudget, SizeError};
+use arbvis_core::colortable::TableError;
+use arbvis_core::vocab::FieldError;
+use arbvis_data::mesh::MeshError;
+use arbvis_data::points::PointsError;
+use arbvis_data::store::StoreError;
+use arbvis_data::surface::SurfaceError;
+use arbvis_data::volume::VolumeError;
+use arbvis_gl::GlError;
 
 /// An error preparing data for a renderer, making one or drawing with it.
 #[derive(Debug, thiserror::Error)]
@@ -148,7 +148,7 @@ pub type AnnotationDrawing = plotters::drawing::DrawingAreaErrorKind<
 /// Rows of `row` texels a 2D texture needs to hold `texels` (at least one), within the
 /// driver's largest 2D texture, or [`RenderError::TooManyRows`] naming `label`.
 pub fn texture_rows(
-    gpu: &crate::gl::Gpu,
+    gpu: &arbvis_gl::Gpu,
     label: &str,
     texels: usize,
     row: usize,

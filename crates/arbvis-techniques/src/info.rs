@@ -1,9 +1,9 @@
 //! `arbvis info`: what the driver is and what it can do for ARB programs.
 
-use crate::gl::{Backend, Caps, EXACT_FILTER, EXACT_INTERPOLATION};
+use arbvis_gl::{Backend, Caps, EXACT_FILTER, EXACT_INTERPOLATION};
 
 /// How the texture units interpolate, from the largest error of a linear fetch
-/// ([`crate::gl::Gpu::linear_filter_error`]).
+/// ([`arbvis_gl::Gpu::linear_filter_error`]).
 pub fn filtering(filter_error: f32) -> String {
     if filter_error <= EXACT_FILTER {
         format!("f32 (largest error {filter_error:.1e})")
@@ -17,7 +17,7 @@ pub fn filtering(filter_error: f32) -> String {
 }
 
 /// How attributes interpolate, from the largest distance (pixels) between an interpolated
-/// coordinate and the pixel centre's ([`crate::gl::Gpu::interpolation_error`]).
+/// coordinate and the pixel centre's ([`arbvis_gl::Gpu::interpolation_error`]).
 pub fn interpolation(error: f32) -> String {
     if error <= EXACT_INTERPOLATION {
         format!("from the true vertices (largest error {error:.1e} pixel)")

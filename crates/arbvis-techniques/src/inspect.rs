@@ -18,19 +18,19 @@ pub enum InspectError {
     },
     /// A volume reader's error.
     #[error(transparent)]
-    Volume(#[from] crate::volume::VolumeError),
+    Volume(#[from] arbvis_data::volume::VolumeError),
     /// A mesh reader's error.
     #[error(transparent)]
-    Mesh(#[from] crate::mesh::MeshError),
+    Mesh(#[from] arbvis_data::mesh::MeshError),
     /// A point-cloud reader's error.
     #[error(transparent)]
-    Points(#[from] crate::points::PointsError),
+    Points(#[from] arbvis_data::points::PointsError),
     /// A surface reader's error.
     #[error(transparent)]
-    Surface(#[from] crate::surface::SurfaceError),
+    Surface(#[from] arbvis_data::surface::SurfaceError),
     /// A store's error.
     #[error(transparent)]
-    Store(#[from] crate::store::StoreError),
+    Store(#[from] arbvis_data::store::StoreError),
     /// A URL that could not be asked (unreachable, refused, redirected in a loop).
     #[error("{path}: {message}")]
     Remote {
@@ -78,7 +78,7 @@ pub fn looks_like(head: &[u8]) -> String {
             .to_string();
         return format!(
             "it looks like text starting with {:?}",
-            crate::input::shorten(&first, 40)
+            arbvis_core::input::shorten(&first, 40)
         );
     }
     format!(
@@ -89,58 +89,61 @@ pub fn looks_like(head: &[u8]) -> String {
 
 /// `arbvis inspect`.
 pub fn inspect(path: &Path) -> Result<String, InspectError> {
-    inspect_with(path, crate::volume::segy::KeyBytes::default())
+    inspect_with(path, arbvis_data::volume::segy::KeyBytes::default())
 }
 
 /// [`inspect`] with a SEG-Y file's inline and crossline bytes named (each one not named
 /// is detected); a URL's password or signature is hidden in what it says.
 pub fn inspect_with(
     path: &Path,
-    segy_keys: crate::volume::segy::KeyBytes,
+    segy_keys: arbvis_data::volume::segy::KeyBytes,
 ) -> Result<String, InspectError> {
     describe(path, segy_keys).map(|text| arbvis_core::secrets::redact(&text))
 }
 
 /// What [`inspect_with`] says, secrets and all.
-fn describe(path: &Path, segy_keys: crate::volume::segy::KeyBytes) -> Result<String, InspectError> {
+fn describe(
+    path: &Path,
+    segy_keys: arbvis_data::volume::segy::KeyBytes,
+) -> Result<String, InspectError> {
     let io = |error| InspectError::Io {
         path: path.display().to_string(),
         error,
     };
-    let path = &crate::fetch::local_or_url(path);
-    if crate::fetch::url_of(path).is_some() {
+    let path = &arbvis_data::fetch::local_or_url(path);
+    if arbvis_data::fetch::url_of(path).is_some() {
         return inspect_remote(path);
     }
     if path.is_dir() {
         // A zarr v3 root, or a zarr v2 one (an MDIO dataset, v0 or v1, written with it).
         if std::fs::symlink_metadata(path.join("zarr.json")).is_ok()
             || path.join(".zgroup").is_file()
-            || crate::store::mdio::is_mdio_v0(path)
+            || arbvis_data::store::mdio::is_mdio_v0(path)
         {
-            return Ok(crate::store::describe::describe(path)?);
+            return Ok(arbvis_data::store::describe::describe(path)?);
         }
         return Err(InspectError::Unknown {
             path: path.display().to_string(),
             what: "a folder without zarr.json or .zgroup (not a store or an MDIO dataset)".into(),
         });
     }
-    let (file, _) = crate::input::open_regular(path).map_err(io)?;
+    let (file, _) = arbvis_core::input::open_regular(path).map_err(io)?;
     let mut head = Vec::new();
     file.take(4096).read_to_end(&mut head).map_err(io)?;
     // The reader the registry picks, by the kind of data it yields.
     use arbvis_data::sniff::{format, reader, DataKind};
     match format(path, &head).map(|f| reader(f).kind) {
         Some(DataKind::Survey | DataKind::Volume) => {
-            Ok(crate::volume::inspect_with(path, segy_keys)?)
+            Ok(arbvis_data::volume::inspect_with(path, segy_keys)?)
         }
-        Some(DataKind::Mesh) => Ok(crate::mesh::inspect(path)?),
-        Some(DataKind::Cloud | DataKind::SeedCloud) => Ok(crate::points::inspect(path)?),
+        Some(DataKind::Mesh) => Ok(arbvis_data::mesh::inspect(path)?),
+        Some(DataKind::Cloud | DataKind::SeedCloud) => Ok(arbvis_data::points::inspect(path)?),
         Some(DataKind::Surface) => {
-            let mesh = crate::surface::read(path)?;
+            let mesh = arbvis_data::surface::read(path)?;
             Ok(format!(
                 "{}\n{}\n",
                 path.display(),
-                crate::surface::describe(&mesh)
+                arbvis_data::surface::describe(&mesh)
             ))
         }
         None => Err(InspectError::Unknown {
@@ -156,13 +159,13 @@ fn inspect_remote(path: &Path) -> Result<String, InspectError> {
     // The object's name, without a pre-signed URL's query.
     let name = name.split('?').next().unwrap_or("");
     if name.ends_with(".laz") || name.ends_with(".las") {
-        return Ok(crate::points::inspect(path)?);
+        return Ok(arbvis_data::points::inspect(path)?);
     }
-    if crate::fetch::probe_folder(path).map_err(|e| InspectError::Remote {
+    if arbvis_data::fetch::probe_folder(path).map_err(|e| InspectError::Remote {
         path: path.display().to_string(),
         message: e.to_string(),
     })? {
-        return Ok(crate::store::describe::describe(path)?);
+        return Ok(arbvis_data::store::describe::describe(path)?);
     }
     Err(InspectError::Unknown {
         path: path.display().to_string(),

@@ -8,13 +8,6 @@
 
 #![deny(unsafe_code)]
 
-// The layers below, named as this crate's files name them (`crate::volume`, `crate::gl`, ...).
-#[allow(unused_imports)]
-use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, vocab};
-#[allow(unused_imports)]
-use arbvis_data::{fetch, mesh, points, store, surface, volume};
-use arbvis_gl as gl;
-
 pub mod annotate;
 pub mod catalog;
 pub mod error;

@@ -1,6 +1,6 @@
 //! The program texts of `programs/`, embedded, and the pairs each technique draws with.
 
-use crate::gl::{ProgramKind, ProgramText};
+use arbvis_gl::{ProgramKind, ProgramText};
 
 macro_rules! program {
     ($path:literal) => {

@@ -3,11 +3,11 @@
 use crate::error::RenderResult;
 use std::time::{Duration, Instant};
 
-use crate::gl::{Backend, Caps, Headless, ProgramKind, Resource};
-use crate::image::Image;
 use crate::scene::Scene;
 use crate::session::{Mode, Session};
 use crate::techniques::Renderer;
+use arbvis_core::image::Image;
+use arbvis_gl::{Backend, Caps, Headless, ProgramKind, Resource};
 
 /// One rendered scene and what made it.
 pub struct Rendered {
@@ -55,7 +55,7 @@ impl Rendered {
 
 /// Build the renderer `scene` names, with programs of `kind`; nothing else is created.
 pub fn build(
-    gpu: &crate::gl::Gpu,
+    gpu: &arbvis_gl::Gpu,
     scene: &Scene,
     kind: ProgramKind,
 ) -> RenderResult<Box<dyn Renderer>> {

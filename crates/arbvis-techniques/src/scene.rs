@@ -6,10 +6,10 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::camera::Camera;
 pub use crate::catalog::{demos, TechniqueScene};
-use crate::gl::{ProgramChoice, TargetFormat};
-pub use crate::vocab::{Fidelity, FieldError};
+use arbvis_core::camera::Camera;
+pub use arbvis_core::vocab::{Fidelity, FieldError};
+use arbvis_gl::{ProgramChoice, TargetFormat};
 
 /// A whole scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -45,7 +45,7 @@ pub struct Scene {
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub axes: bool,
     /// The memory budget this scene asks for (`"16G"`, `"75%"`): taken where neither
-    /// `--memory-budget` nor `ARBVIS_MEMORY_BUDGET` sets one ([`crate::budget`]).
+    /// `--memory-budget` nor `ARBVIS_MEMORY_BUDGET` sets one ([`arbvis_core::budget`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub memory_budget: Option<String>,
     /// How to get the scene's data where it is not in the clone (a download or a
@@ -163,21 +163,19 @@ impl Scene {
                 line,
                 column,
                 key: e.key,
-                message: crate::input::shorten(&e.message, MESSAGE_CHARS),
+                message: arbvis_core::input::shorten(&e.message, MESSAGE_CHARS),
             }
         })?;
         Ok(scene)
     }
 
     /// Read and parse a scene file (a regular file of at most
-    /// [`crate::input::MAX_SCENE_BYTES`], UTF-8).
+    /// [`arbvis_core::input::MAX_SCENE_BYTES`], UTF-8).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text =
-            crate::input::read_text(path, crate::input::MAX_SCENE_BYTES).map_err(|error| {
-                SceneError::Io {
-                    path: path.display().to_string(),
-                    error,
-                }
+        let text = arbvis_core::input::read_text(path, arbvis_core::input::MAX_SCENE_BYTES)
+            .map_err(|error| SceneError::Io {
+                path: path.display().to_string(),
+                error,
             })?;
         let mut scene = Scene::parse(&text, &path.display().to_string())?;
         scene.base = path.parent().map(Path::to_path_buf).unwrap_or_default();
@@ -188,7 +186,7 @@ impl Scene {
     /// what the command line does before it renders, views or benches a scene.
     pub fn load_checked(path: &Path) -> Result<Scene, SceneError> {
         let scene = Scene::load(path)?;
-        let text = crate::input::read_text(path, crate::input::MAX_SCENE_BYTES).ok();
+        let text = arbvis_core::input::read_text(path, arbvis_core::input::MAX_SCENE_BYTES).ok();
         scene.check_data_files(&path.display().to_string(), text.as_deref())?;
         Ok(scene)
     }
@@ -221,8 +219,8 @@ impl Scene {
             files.push(DataFile {
                 key: key.to_string(),
                 written: p.clone(),
-                resolved: match crate::fetch::resolve(&base, p) {
-                    url if crate::fetch::url_of(&url).is_some() => url,
+                resolved: match arbvis_data::fetch::resolve(&base, p) {
+                    url if arbvis_data::fetch::url_of(&url).is_some() => url,
                     local => std::path::absolute(&local).unwrap_or(local),
                 },
             })
@@ -238,7 +236,7 @@ impl Scene {
         let missing = self
             .data_files()
             .into_iter()
-            .find(|f| crate::fetch::url_of(&f.resolved).is_none() && !f.resolved.exists());
+            .find(|f| arbvis_data::fetch::url_of(&f.resolved).is_none() && !f.resolved.exists());
         let Some(missing) = missing else {
             return Ok(());
         };
@@ -266,7 +264,7 @@ impl Scene {
     pub fn with_absolute_paths(&self) -> Scene {
         let mut scene = self.clone();
         let base = std::path::absolute(&self.base).unwrap_or_else(|_| self.base.clone());
-        scene.for_each_data_path(&mut |_, p| *p = crate::fetch::resolve(&base, p));
+        scene.for_each_data_path(&mut |_, p| *p = arbvis_data::fetch::resolve(&base, p));
         scene.base = base;
         scene
     }
@@ -283,7 +281,7 @@ impl Scene {
 
     /// A frame as the scene's pictures show it: opaque, or straight colour with
     /// coverage alpha when `transparent`.
-    pub fn picture(&self, frame: &crate::image::Image) -> crate::image::Image {
+    pub fn picture(&self, frame: &arbvis_core::image::Image) -> arbvis_core::image::Image {
         if self.transparent {
             frame.unpremultiplied()
         } else {
@@ -295,7 +293,7 @@ impl Scene {
     pub fn memory_budget_bytes(&self) -> Result<Option<u64>, FieldError> {
         self.memory_budget
             .as_deref()
-            .map(crate::budget::parse)
+            .map(arbvis_core::budget::parse)
             .transpose()
             .map_err(|m| FieldError::new("memory_budget", m.to_string()))
     }
@@ -307,15 +305,15 @@ impl Scene {
             programs: self.programs,
             base: &self.base,
             projection: self.camera.projection,
-            view: crate::camera::View::of(&self.camera, self.size),
+            view: arbvis_core::camera::View::of(&self.camera, self.size),
         }
     }
 
     /// The large allocations rendering this scene makes that the scene alone determines:
     /// the target, with `read_back` the frame read back and written (f32 RGBA, a flipped
     /// copy, the picture, the PNG's rows), and the technique's generated data.
-    pub fn memory_estimate(&self, read_back: bool) -> Vec<crate::budget::Estimate> {
-        use crate::budget::Estimate;
+    pub fn memory_estimate(&self, read_back: bool) -> Vec<arbvis_core::budget::Estimate> {
+        use arbvis_core::budget::Estimate;
         let [w, h] = self.size;
         let pixels = w as u64 * h as u64;
         let format = self.target_format();
@@ -441,7 +439,7 @@ fn parse_message(text: &str, start: usize, message: &str) -> String {
         && word.chars().next().is_some_and(|c| c.is_ascii_alphabetic())
         && !matches!(word.as_str(), "true" | "false" | "inf" | "nan")
         && text[..start].trim_end().ends_with('=');
-    let message = crate::input::shorten(message.trim(), MESSAGE_CHARS);
+    let message = arbvis_core::input::shorten(message.trim(), MESSAGE_CHARS);
     if bare {
         format!("{message} (a word must be quoted: \"{word}\")")
     } else {

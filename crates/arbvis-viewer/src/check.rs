@@ -36,10 +36,15 @@ fn rect(r: Rect) -> String {
     )
 }
 
+/// What does not fit in the window: a message for the script line that checked.
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct Misfit(pub String);
+
 impl LayoutCheck {
     /// One frame of the check: `Ok(true)` once done (the lines printed), `Ok(false)` to
     /// go on next frame, `Err` naming what does not fit.
-    pub fn step(&mut self, o: &mut Observed<'_>) -> Result<bool, String> {
+    pub fn step(&mut self, o: &mut Observed<'_>) -> Result<bool, Misfit> {
         let ppp = o.pixels_per_point.max(1e-3);
         let window = Rect::from_min_max(
             Pos2::ZERO,
@@ -66,9 +71,9 @@ impl LayoutCheck {
             ));
             if let (Some([sw, sh]), Some([x, y, w, h])) = (o.screen, o.outer) {
                 if x < 0 || y < 0 || x + w > sw as i32 || y + h > sh as i32 {
-                    return Err(format!(
+                    return Err(Misfit(format!(
                         "the window ({x}, {y}, {w} x {h} pixels with its frame) is not inside the {sw}x{sh} screen"
-                    ));
+                    )));
                 }
             }
         }
@@ -98,17 +103,17 @@ impl LayoutCheck {
                     return Ok(false);
                 }
                 Some((false, seen)) => {
-                    return Err(format!(
+                    return Err(Misfit(format!(
                     "{label:?} at {} is not whole inside the window ({}): its visible part is {}",
                     rect(seen.rect),
                     rect(window),
                     rect(seen.visible)
-                ))
+                )))
                 }
                 None => {
-                    return Err(format!(
+                    return Err(Misfit(format!(
                         "{label:?} is no longer drawn (closed or hidden since the check began)"
-                    ))
+                    )))
                 }
             }
         }
@@ -121,14 +126,17 @@ impl LayoutCheck {
                 if overflows { "overflows" } else { "fits" }
             ));
             if overflows && *floating {
-                return Err(format!(
+                return Err(Misfit(format!(
                     "the {name} overflows ({content:.0} points in {shown:.0}) behind a floating scroll bar, hidden until hovered"
-                ));
+                )));
             }
         }
         let problems = overlay_problems(o.view, o.shown, o.overlay);
         if let Some(p) = problems.first() {
-            return Err(format!("overlay: {p} ({} problems)", problems.len()));
+            return Err(Misfit(format!(
+                "overlay: {p} ({} problems)",
+                problems.len()
+            )));
         }
         for (name, r) in o.overlay {
             self.lines

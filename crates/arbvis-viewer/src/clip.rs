@@ -3,7 +3,7 @@
 //! torus-mesh), its position, size and rotation (Euler degrees; the normal for a
 //! half-space), `invert`, the block side `B` and INDEX-DATA on or off, and what the clip
 //! cost when last built (time, texture bytes, compression ratio), from
-//! [`crate::techniques::Renderer::facts`].
+//! [`arbvis_techniques::techniques::Renderer::facts`].
 //!
 //! Decisions: clipping switched on restores the clip last switched off, else adds a
 //! sphere of radius 0.5 at the centre. A shape the editor cannot edit (a file mesh, a
@@ -15,9 +15,9 @@
 //! dragged number rebuilds once per frame it changes; measured: docs/benchmarks.md,
 //! "Clipping").
 
-use super::widgets::Widgets;
-use crate::techniques::clip::{ClipSpec, ShapeSpec};
-use crate::techniques::opacity3d::Opacity3dScene;
+use super::widgets::{SetOutcome, Widgets};
+use arbvis_techniques::techniques::clip::{ClipSpec, ShapeSpec};
+use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
 
 /// Block sides offered for `B`.
 pub const BLOCKS: [usize; 4] = [4, 8, 16, 32];
@@ -221,7 +221,9 @@ fn shape_editor(ui: &mut egui::Ui, w: &mut Widgets, shape: &mut ShapeSpec) -> bo
             if triple(ui, w, "Clip normal", "normal", normal, -1.0..=1.0, 0.01) {
                 if normal.iter().all(|c| *c == 0.0) {
                     *normal = before;
-                    w.set_outcome(Err("the clip normal must not be zero".into()));
+                    w.set_outcome(SetOutcome::Refused(
+                        "the clip normal must not be zero".into(),
+                    ));
                 } else {
                     changed = true;
                 }
@@ -347,7 +349,7 @@ fn body(
         Some(s) => s.clone(),
         None => "not built yet".to_string(),
     };
-    w.text(ui, crate::techniques::clip::stats::LABEL, &line);
+    w.text(ui, arbvis_techniques::techniques::clip::stats::LABEL, &line);
     changed
 }
 

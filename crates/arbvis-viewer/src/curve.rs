@@ -15,7 +15,7 @@
 use egui::{Color32, Pos2, Rect, Sense, Stroke, Ui, Vec2};
 
 use super::widgets::Widgets;
-use crate::colortable::ColorTable;
+use arbvis_core::colortable::ColorTable;
 
 /// Points closer than this (points) to the pointer are picked.
 const PICK: f32 = 8.0;

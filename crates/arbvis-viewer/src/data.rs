@@ -15,18 +15,18 @@ use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
 
 use super::store_sections::{MapPositions, SectionKey, StoreSections};
 use super::summary::{cloud_units, data_box, CloudSummary, DataBox, MeshSummary};
-use crate::catalog;
-use crate::colortable::{ColorTable, TableSpec};
-use crate::error::RenderResult;
-use crate::gl::{Gpu, ProgramKind};
-use crate::scene::Scene;
-use crate::techniques::cellproj::prepare::Prepared as PreparedMesh;
-use crate::techniques::opacity3d::prepare::{prepare, Prepared};
-use crate::techniques::opacity3d::Opacity3dScene;
-use crate::techniques::splats::prepare::PreparedCloud;
-use crate::techniques::splats::SplatsScene;
-use crate::techniques::Renderer;
-use crate::volume::axes::{self, section_axes, section_voxels, Axis};
+use arbvis_core::colortable::{ColorTable, TableSpec};
+use arbvis_data::volume::axes::{self, section_axes, section_voxels, Axis};
+use arbvis_gl::{Gpu, ProgramKind};
+use arbvis_techniques::catalog;
+use arbvis_techniques::error::RenderResult;
+use arbvis_techniques::scene::Scene;
+use arbvis_techniques::techniques::cellproj::prepare::Prepared as PreparedMesh;
+use arbvis_techniques::techniques::opacity3d::prepare::{prepare, Prepared};
+use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
+use arbvis_techniques::techniques::splats::prepare::PreparedCloud;
+use arbvis_techniques::techniques::splats::SplatsScene;
+use arbvis_techniques::techniques::Renderer;
 
 /// The 3D-opacity data behind the panels.
 pub struct Volume3d {
@@ -84,7 +84,7 @@ impl SectionGrid {
     /// section at `index` along `axis` points at: the voxel's numbers on the three axes,
     /// inline first, and the trace's map position where the data has one.
     pub fn point(&self, axis: usize, index: usize, across: f32, down: f32) -> String {
-        let (u, w) = crate::volume::axes::section_axes(axis);
+        let (u, w) = arbvis_data::volume::axes::section_axes(axis);
         let at = |f: f32, n: usize| ((f.max(0.0) * n as f32) as usize).min(n.saturating_sub(1));
         let mut v = [0usize; 3];
         v[axis] = index.min(self.dims[axis].saturating_sub(1));
@@ -115,7 +115,7 @@ pub fn build(
     }
     data.volume = None;
     let settings = scene.settings();
-    let limits = crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size);
+    let limits = arbvis_data::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size);
     let prepared = catalog::prepare(&scene.technique, &settings, &limits)?;
     data.summarize(scene, prepared.as_ref());
     catalog::renderer(&scene.technique, gpu, &settings, kind, prepared)
@@ -158,13 +158,13 @@ fn build_volume(
     data: &mut ViewData,
 ) -> RenderResult<Box<dyn Renderer>> {
     // A survey store is streamed: frames draw what is resident and refine.
-    if crate::techniques::opacity3d::bricked::store_of(params)
+    if arbvis_techniques::techniques::opacity3d::bricked::store_of(params)
         .ok()
         .flatten()
         .is_some()
     {
         data.volume = None;
-        let mut r = crate::render::build(gpu, scene, kind)?;
+        let mut r = arbvis_techniques::render::build(gpu, scene, kind)?;
         r.set_streaming(true);
         data.store = StoreSections::open(params, &scene.base)?;
         data.store_levels = [None, None, None];
@@ -176,7 +176,7 @@ fn build_volume(
         Some(volume) => volume,
         None => {
             params.validate()?;
-            let limits = crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size);
+            let limits = arbvis_data::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size);
             let prepared = prepare(params, &scene.base, &limits)?;
             let axes = axes::describe(&params.primary.volume, &scene.base, prepared.dims);
             let histograms = std::array::from_fn(|a| {

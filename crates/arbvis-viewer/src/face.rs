@@ -13,13 +13,13 @@ use super::data::ViewData;
 use super::legend::{self, Legend};
 use super::transfer::TransferState;
 use super::widgets::Widgets;
-use crate::catalog::TechniqueScene;
-use crate::scene::Scene;
-use crate::techniques::cellproj::CellprojScene;
-use crate::techniques::opacity3d::Opacity3dScene;
-use crate::techniques::quad::QuadScene;
-use crate::techniques::splats::SplatsScene;
-use crate::vocab::Fidelity;
+use arbvis_core::vocab::Fidelity;
+use arbvis_techniques::catalog::TechniqueScene;
+use arbvis_techniques::scene::Scene;
+use arbvis_techniques::techniques::cellproj::CellprojScene;
+use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
+use arbvis_techniques::techniques::quad::QuadScene;
+use arbvis_techniques::techniques::splats::SplatsScene;
 
 /// What an editor may read and keep besides the parameters it edits.
 pub struct EditContext<'a> {
@@ -151,7 +151,7 @@ type FaceLookup = (
 );
 
 /// Every technique's face: the viewer's one list, checked against the catalog's
-/// [`crate::catalog::TECHNIQUES`] by a test (egui lives only up here).
+/// [`arbvis_techniques::catalog::TECHNIQUES`] by a test (egui lives only up here).
 const FACES: &[FaceLookup] = &[
     (face_of::<QuadScene>, face_of_mut::<QuadScene>),
     (face_of::<Opacity3dScene>, face_of_mut::<Opacity3dScene>),
@@ -192,7 +192,7 @@ mod tests {
 
     #[test]
     fn every_registered_technique_has_a_face_found_both_ways() {
-        for technique in crate::catalog::TECHNIQUES {
+        for technique in arbvis_techniques::catalog::TECHNIQUES {
             // A technique without a demo could not be checked here.
             assert!(
                 !technique.demos.is_empty(),
@@ -206,6 +206,6 @@ mod tests {
                 assert!(face_mut(&mut scene.technique).is_some(), "{name}");
             }
         }
-        assert_eq!(FACES.len(), crate::catalog::TECHNIQUES.len());
+        assert_eq!(FACES.len(), arbvis_techniques::catalog::TECHNIQUES.len());
     }
 }

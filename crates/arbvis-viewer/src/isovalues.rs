@@ -3,7 +3,9 @@
 //! Each edit rewrites only the isosurface table (and the active list) on the next frame.
 
 use super::widgets::Widgets;
-use crate::techniques::cellproj::{CellprojScene, Exit, Isovalue, IsovalueUnits, MAX_ISOVALUES};
+use arbvis_techniques::techniques::cellproj::{
+    CellprojScene, Exit, Isovalue, IsovalueUnits, MAX_ISOVALUES,
+};
 
 /// Draw the editor; true when something changed. `range` is the scalar's range in its
 /// own units (the values are dragged within it, or within 0..1 where the scene writes

@@ -18,16 +18,18 @@ use egui::{Color32, Painter, Pos2, Rect, Stroke, TextureId, Vec2};
 use super::data::ViewData;
 use super::lut3d;
 use super::overlay::{paint_texts, Ink, Measure, Text};
-use crate::points::section::{facies_colour, FACIES_TABLE, PALETTE};
-use crate::points::UNDEFINED_FACIES;
-use crate::scene::Scene;
-use crate::techniques::cellproj::CellprojScene;
-use crate::techniques::cellproj::IsovalueUnits;
-use crate::techniques::opacity3d::Opacity3dScene;
-pub use crate::techniques::splats::prepare::class_name;
-use crate::techniques::splats::prepare::{class_colour, COLOR_A, COLOR_B, LAYERS_IN_PALETTE};
-use crate::techniques::splats::scene::ColourMode;
-use crate::techniques::splats::SplatsScene;
+use arbvis_data::points::section::{facies_colour, FACIES_TABLE, PALETTE};
+use arbvis_data::points::UNDEFINED_FACIES;
+use arbvis_techniques::scene::Scene;
+use arbvis_techniques::techniques::cellproj::CellprojScene;
+use arbvis_techniques::techniques::cellproj::IsovalueUnits;
+use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
+pub use arbvis_techniques::techniques::splats::prepare::class_name;
+use arbvis_techniques::techniques::splats::prepare::{
+    class_colour, COLOR_A, COLOR_B, LAYERS_IN_PALETTE,
+};
+use arbvis_techniques::techniques::splats::scene::ColourMode;
+use arbvis_techniques::techniques::splats::SplatsScene;
 
 /// Padding around and between legends (points).
 pub const PAD: f32 = 8.0;

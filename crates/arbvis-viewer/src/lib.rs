@@ -21,17 +21,6 @@
 
 #![deny(unsafe_code)]
 
-// The layers below, named as the viewer's files name them (`crate::scene`, `crate::gl`, ...).
-#[allow(unused_imports)]
-use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, vocab};
-#[allow(unused_imports)]
-use arbvis_data::{fetch, mesh, points, store, surface, volume};
-use arbvis_gl as gl;
-#[allow(unused_imports)]
-use arbvis_techniques::{
-    annotate, catalog, error, info, inspect, programs, render, scene, study, techniques,
-};
-
 pub mod check;
 pub mod clip;
 pub mod curve;

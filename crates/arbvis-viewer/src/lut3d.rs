@@ -14,10 +14,10 @@ use egui::{Color32, RichText, Vec2};
 use super::curve;
 use super::data::ViewData;
 use super::widgets::Widgets;
-use crate::colortable::BUILTINS;
-use crate::scene::Scene;
-use crate::techniques::opacity3d::Opacity3dScene;
-use crate::techniques::opacity3d::{Combine, MAX_SLICES};
+use arbvis_core::colortable::BUILTINS;
+use arbvis_techniques::scene::Scene;
+use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
+use arbvis_techniques::techniques::opacity3d::{Combine, MAX_SLICES};
 
 /// Width of the editor's panel in points: the grid and curves fit without clipping.
 pub const WIDTH: f32 = 430.0;
@@ -53,7 +53,7 @@ pub fn editor(
     let mut edit = Lut3dEdit::default();
     let ctx = ui.ctx().clone();
     // Tables first (they borrow the scene immutably).
-    let tables: [Option<(crate::colortable::ColorTable, egui::TextureId)>; 3] =
+    let tables: [Option<(arbvis_core::colortable::ColorTable, egui::TextureId)>; 3] =
         std::array::from_fn(|a| data.table(&ctx, scene, a).map(|(t, x)| (t.clone(), x.id())));
     let Some(o) = scene.technique.get_mut::<Opacity3dScene>() else {
         return edit;
@@ -175,7 +175,7 @@ pub fn editor(
 fn table_and_lock(
     ui: &mut egui::Ui,
     role: &str,
-    attr: &mut crate::techniques::opacity3d::AttributeScene,
+    attr: &mut arbvis_techniques::techniques::opacity3d::AttributeScene,
     lock: &mut bool,
     widgets: &mut Widgets,
 ) -> bool {

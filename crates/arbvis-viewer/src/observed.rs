@@ -5,7 +5,7 @@
 use egui::Rect;
 
 use super::widgets::Widgets;
-use crate::camera::Camera;
+use arbvis_core::camera::Camera;
 
 /// What the runner sees of the viewer between frames.
 pub struct Observed<'a> {

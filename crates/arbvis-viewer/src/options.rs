@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use super::script::Script;
-use crate::scene::Scene;
+use arbvis_techniques::scene::Scene;
 
 /// What `arbvis view` was asked to show.
 pub struct ViewerOptions {

@@ -27,8 +27,8 @@ use egui::{Align2, Color32, Painter, Pos2, Rect, Stroke, Vec2};
 use glam::{DVec3, DVec4};
 
 use super::layout::overlay_font;
-use crate::camera::Camera;
-use crate::volume::axes::Axis;
+use arbvis_core::camera::Camera;
+use arbvis_data::volume::axes::Axis;
 
 /// Colours of the inline, crossline and time-slice section outlines, by fixed axis
 /// (0 time slice, 1 crossline, 2 inline).
@@ -319,7 +319,7 @@ pub fn layout_box(
     }
     for (a, index) in sections.iter().enumerate() {
         let Some(index) = *index else { continue };
-        let (u, w) = crate::volume::axes::section_axes(a);
+        let (u, w) = arbvis_data::volume::axes::section_axes(a);
         let quad = [
             (-1.0, -1.0),
             (1.0, -1.0),

@@ -15,14 +15,14 @@ use super::legend;
 use super::lut3d;
 use super::overlay::{self, Ink, Projector, SECTION_COLOURS};
 use super::widgets::Widgets;
-use crate::camera::Projection;
-use crate::gl::{Caps, ProgramKind};
-use crate::scene::Scene;
-use crate::techniques::opacity3d::Opacity3dScene;
-use crate::techniques::splats::SplatsScene;
-use crate::vocab::Fidelity;
-use crate::volume::axes::section_axes;
+use arbvis_core::camera::Projection;
+use arbvis_core::vocab::Fidelity;
+use arbvis_data::volume::axes::section_axes;
+use arbvis_gl::{Caps, ProgramKind};
+use arbvis_techniques::scene::Scene;
 use arbvis_techniques::session::InteractiveQuality;
+use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
+use arbvis_techniques::techniques::splats::SplatsScene;
 
 /// What the user asked for this frame.
 #[derive(Debug, Clone, PartialEq)]
@@ -289,7 +289,7 @@ fn controls(
     }
     // A remote store's or cloud's requests in flight (the loader threads fetch; the
     // frames go on): redrawn while they last, so the line follows them.
-    if let Some(loading) = crate::fetch::status() {
+    if let Some(loading) = arbvis_data::fetch::status() {
         w.status_text(ui, "Loading", &loading);
         ui.ctx()
             .request_repaint_after(std::time::Duration::from_millis(200));
@@ -328,7 +328,7 @@ fn programs_and_fidelity(
                 // Tiles are precise only: faithful draws the seed's points.
                 if let Some(sp) = scene.technique.get_mut::<SplatsScene>() {
                     if f == Fidelity::Faithful {
-                        sp.draw = crate::techniques::splats::scene::DrawChoice::Points;
+                        sp.draw = arbvis_techniques::techniques::splats::scene::DrawChoice::Points;
                     }
                 }
                 actions.push(UiAction::SetFidelity);

@@ -26,7 +26,7 @@ pub fn folder() -> Option<PathBuf> {
 /// The window size remembered in `folder`, if any usable one is.
 pub fn load(folder: &Path) -> Option<Vec2> {
     let path = folder.join("window.toml");
-    let text = crate::input::read_text(&path, 4096).ok()?;
+    let text = arbvis_core::input::read_text(&path, 4096).ok()?;
     match parse(&text) {
         Ok(size) => Some(size),
         Err(e) => {
@@ -39,21 +39,33 @@ pub fn load(folder: &Path) -> Option<Vec2> {
     }
 }
 
-fn parse(text: &str) -> Result<Vec2, String> {
-    let table: toml::Table = text
-        .parse()
-        .map_err(|e: toml::de::Error| e.message().to_string())?;
+/// Why `window.toml` holds no usable size.
+#[derive(Debug, thiserror::Error)]
+enum Unusable {
+    /// Not TOML.
+    #[error("{}", .0.message())]
+    Toml(#[from] toml::de::Error),
+    /// No `size` of two values.
+    #[error("expected size = [width, height]")]
+    NoSize,
+    /// A side that is not a number in [`SIDES`].
+    #[error("each side a number of points in {SIDES:?}")]
+    Side,
+}
+
+fn parse(text: &str) -> Result<Vec2, Unusable> {
+    let table: toml::Table = text.parse()?;
     let size = table
         .get("size")
         .and_then(|v| v.as_array())
         .filter(|a| a.len() == 2)
-        .ok_or("expected size = [width, height]")?;
+        .ok_or(Unusable::NoSize)?;
     let side = |v: &toml::Value| {
         v.as_float()
             .or_else(|| v.as_integer().map(|i| i as f64))
             .map(|f| f as f32)
             .filter(|f| SIDES.contains(f))
-            .ok_or(format!("each side a number of points in {SIDES:?}"))
+            .ok_or(Unusable::Side)
     };
     Ok(Vec2::new(side(&size[0])?, side(&size[1])?))
 }
@@ -66,7 +78,7 @@ pub fn save(folder: &Path, size: Vec2) -> std::io::Result<()> {
         size.x.round(),
         size.y.round()
     );
-    crate::png_io::write_atomic(&folder.join("window.toml"), text.as_bytes())
+    arbvis_core::png_io::write_atomic(&folder.join("window.toml"), text.as_bytes())
 }
 
 #[cfg(test)]

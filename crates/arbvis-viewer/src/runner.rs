@@ -10,7 +10,7 @@ use egui::{Event, Modifiers, PointerButton, Pos2};
 use super::check::LayoutCheck;
 pub use super::observed::Observed;
 use super::script::{Action, MeasureMode, Script, Step};
-use crate::camera::Camera;
+use arbvis_core::camera::Camera;
 
 /// Frames a step may wait for its widget to appear or take effect.
 const PATIENCE: u32 = 30;
@@ -168,7 +168,7 @@ impl ScriptRunner {
                 let check = self.layout.get_or_insert_with(LayoutCheck::default);
                 match check.step(o) {
                     Ok(finished) => Outcome::done_if(finished),
-                    Err(e) => return Err(self.error(&step, e)),
+                    Err(e) => return Err(self.error(&step, e.to_string())),
                 }
             }
             Action::WindowShot => {

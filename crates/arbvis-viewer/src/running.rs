@@ -19,13 +19,13 @@ use super::options::ViewerOptions;
 use super::panel::{self, PanelOutput, PanelState, UiAction};
 use super::screenshot;
 use super::script::MeasureMode;
-use crate::camera::{Arcball, Camera, Projection};
-use crate::gl::window::GlWindow;
-use crate::gl::{self, ProgramKind, Surface};
-use crate::png_io;
-use crate::scene::Scene;
-use crate::techniques::opacity3d::Opacity3dScene;
+use arbvis_core::camera::{Arcball, Camera, Projection};
+use arbvis_core::png_io;
+use arbvis_gl::window::GlWindow;
+use arbvis_gl::{self, ProgramKind, Surface};
+use arbvis_techniques::scene::Scene;
 use arbvis_techniques::session::{FrameBudget, Mode, Pending, Session};
+use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
 
 /// A whole UI frame while the user drags: VTK's 15 frames per second.
 const FRAME_BUDGET: Duration = Duration::from_millis(66);
@@ -235,7 +235,7 @@ impl Running {
         let facts = self.session.renderer().facts();
         let clip = facts
             .into_iter()
-            .find(|(l, _)| *l == crate::techniques::clip::stats::LABEL);
+            .find(|(l, _)| *l == arbvis_techniques::techniques::clip::stats::LABEL);
         self.panel.clip.stats = clip.map(|(_, line)| line);
         let win = self.place_view(&out);
 
@@ -282,18 +282,18 @@ impl Running {
                 .map_or(String::new(), |s| format!("\n{s}"))
         );
 
-        gl::clear(
+        arbvis_gl::clear(
             gpu,
             Surface::Window([0, 0, win.width as i32, win.height as i32]),
             [0.1, 0.1, 0.1, 1.0],
         )?;
-        gl::clear(gpu, Surface::Window(self.shown_px), self.scene.background)?;
+        arbvis_gl::clear(gpu, Surface::Window(self.shown_px), self.scene.background)?;
         if let Some(shown) = self.session.shown() {
             shown.blit_to_window(gpu, self.view_px)?;
         }
         // The view before egui paints over it, to tell its marks from the picture's.
         let bare = match screenshot && self.panel.overlay {
-            true => Some(gl::read_window(gpu, self.shown_px)?),
+            true => Some(arbvis_gl::read_window(gpu, self.shown_px)?),
             false => None,
         };
         self.egui.paint(self.window.window());
@@ -421,7 +421,7 @@ impl Running {
     fn save_window(&mut self, options: &ViewerOptions) {
         let win = self.window.window().inner_size();
         let rect = [0, 0, win.width as i32, win.height as i32];
-        let result = gl::read_window(self.window.gpu(), rect)
+        let result = arbvis_gl::read_window(self.window.gpu(), rect)
             .map_err(anyhow::Error::from)
             .and_then(|image| {
                 let bytes = png_io::encode_png("window", &image, &[])?;
@@ -445,8 +445,8 @@ impl Running {
                 let drawn = self.session.renderer().program_kind();
                 self.panel.kind = Some(drawn);
                 self.scene.programs = match kind {
-                    ProgramKind::Arb => crate::gl::ProgramChoice::Arb,
-                    ProgramKind::Glsl => crate::gl::ProgramChoice::Glsl,
+                    ProgramKind::Arb => arbvis_gl::ProgramChoice::Arb,
+                    ProgramKind::Glsl => arbvis_gl::ProgramChoice::Glsl,
                 };
                 self.panel.status = if drawn == kind {
                     format!("programs: {}", kind.name())
@@ -464,13 +464,13 @@ impl Running {
 
     /// Write the view as the next free `arbvis-screenshot-NNN.png`: the picture, with
     /// what egui drew over it when `bare` (the view before egui painted) is given.
-    fn screenshot(&mut self, options: &ViewerOptions, bare: Option<crate::image::Image>) {
+    fn screenshot(&mut self, options: &ViewerOptions, bare: Option<arbvis_core::image::Image>) {
         let gpu = self.window.gpu();
         let picture = self.session.file_picture(gpu, &self.scene);
         let result = picture.map_err(anyhow::Error::from).and_then(|picture| {
             let image = match bare {
                 Some(bare) => {
-                    let painted = gl::read_window(self.window.gpu(), self.shown_px)?;
+                    let painted = arbvis_gl::read_window(self.window.gpu(), self.shown_px)?;
                     let [vx, vy, _, vh] = self.view_px;
                     let [sx, sy, _, sh] = self.shown_px;
                     let at = [
@@ -552,7 +552,7 @@ impl Running {
 fn save_tables(
     scene: &mut Scene,
     dir: &std::path::Path,
-) -> Result<Vec<String>, crate::colortable::TableError> {
+) -> Result<Vec<String>, arbvis_core::colortable::TableError> {
     let base = scene.base.clone();
     let Some(o) = scene.technique.get_mut::<Opacity3dScene>() else {
         return Ok(Vec::new());

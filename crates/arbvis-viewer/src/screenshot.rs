@@ -4,7 +4,7 @@
 //! - **Names.** `arbvis-screenshot-NNN.png`, the first number from 001 on whose name is
 //!   free in the folder (earlier sessions' pictures are never replaced); the file is
 //!   written whole and then linked to its name, which fails if the name was taken
-//!   meanwhile ([`crate::png_io::write_new`]), so two viewers writing into one folder at
+//!   meanwhile ([`arbvis_core::png_io::write_new`]), so two viewers writing into one folder at
 //!   once take different names.
 //! - **Content.** The 3D picture exactly as rendered (the full-quality picture, float
 //!   precision kept in precise mode, or the transparent render), and, when the box, axes
@@ -17,8 +17,8 @@
 use std::io;
 use std::path::{Path, PathBuf};
 
-use crate::image::Image;
-use crate::png_io;
+use arbvis_core::image::Image;
+use arbvis_core::png_io;
 
 /// The names' common start.
 pub const PREFIX: &str = "arbvis-screenshot-";
@@ -93,7 +93,7 @@ pub fn compose(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::vocab::TargetFormat;
+    use arbvis_core::vocab::TargetFormat;
 
     #[test]
     fn names_are_never_reused() {

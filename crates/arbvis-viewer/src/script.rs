@@ -180,12 +180,10 @@ const WORDS: &str = "wait, click, click-at, right-click-at, double-click-at, dra
 impl Script {
     /// Read a script file.
     pub fn load(path: &Path) -> Result<Script, ScriptError> {
-        let text =
-            crate::input::read_text(path, crate::input::MAX_SMALL_TEXT_BYTES).map_err(|e| {
-                ScriptError::File {
-                    path: path.display().to_string(),
-                    error: e,
-                }
+        let text = arbvis_core::input::read_text(path, arbvis_core::input::MAX_SMALL_TEXT_BYTES)
+            .map_err(|e| ScriptError::File {
+                path: path.display().to_string(),
+                error: e,
             })?;
         Script::parse(&text, &path.display().to_string())
     }
@@ -205,7 +203,7 @@ impl Script {
             })?;
             steps.push(Step {
                 line: i + 1,
-                text: crate::input::shorten(line, 80),
+                text: arbvis_core::input::shorten(line, 80),
                 action,
             });
         }
@@ -227,7 +225,7 @@ fn label_and_numbers(
     let bad = || {
         format!(
             "{word} takes {usage}, got {:?}",
-            crate::input::shorten(rest, 60)
+            arbvis_core::input::shorten(rest, 60)
         )
     };
     if words.len() < n + 1 {
@@ -260,7 +258,7 @@ fn numbers<const N: usize>(word: &str, rest: &str, usage: &str) -> Result<[f32; 
     v.and_then(|v| <[f32; N]>::try_from(v).ok()).ok_or_else(|| {
         format!(
             "{word} takes {usage}, got {:?}",
-            crate::input::shorten(rest, 60)
+            arbvis_core::input::shorten(rest, 60)
         )
     })
 }
@@ -377,7 +375,7 @@ fn parse_action(line: &str) -> Result<Action, String> {
         other => {
             return Err(format!(
                 "unknown action {:?} ({WORDS})",
-                crate::input::shorten(other, 40)
+                arbvis_core::input::shorten(other, 40)
             ))
         }
     })

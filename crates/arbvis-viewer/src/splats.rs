@@ -7,10 +7,12 @@
 use super::legend::class_name;
 use super::summary::CloudSummary;
 use super::widgets::Widgets;
-use crate::points::PointSource;
-use crate::techniques::splats::scene::{ColourMode, DrawChoice, Kernel, Mode, SortChoice};
-use crate::techniques::splats::SplatsScene;
-use crate::vocab::Fidelity;
+use arbvis_core::vocab::Fidelity;
+use arbvis_data::points::PointSource;
+use arbvis_techniques::techniques::splats::scene::{
+    ColourMode, DrawChoice, Kernel, Mode, SortChoice,
+};
+use arbvis_techniques::techniques::splats::SplatsScene;
 
 /// Layer ids with a toggle (the seed's sections have layers 0..7).
 pub const LAYERS: i32 = 8;

@@ -15,12 +15,12 @@ use std::sync::Arc;
 
 use glam::DVec3;
 
-use crate::error::{RenderError, RenderResult};
-use crate::store::{Store, StoreError};
-use crate::techniques::opacity3d::bricked::StoreScene;
-use crate::techniques::opacity3d::Opacity3dScene;
-use crate::volume::axes::{Axis, Numbers};
-use crate::volume::quantize::quantize_value;
+use arbvis_data::store::{Store, StoreError};
+use arbvis_data::volume::axes::{Axis, Numbers};
+use arbvis_data::volume::quantize::quantize_value;
+use arbvis_techniques::error::{RenderError, RenderResult};
+use arbvis_techniques::techniques::opacity3d::bricked::StoreScene;
+use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
 
 /// Map positions (`cdp_x`, `cdp_y`) of a survey's traces, and where the shown window
 /// starts in it.
@@ -130,7 +130,7 @@ impl StoreSections {
     }
 
     /// The sections read since the last call: key and its quantized levels (across
-    /// fastest, as [`crate::volume::axes::section_axes`] orders them), or the error.
+    /// fastest, as [`arbvis_data::volume::axes::section_axes`] orders them), or the error.
     pub fn arrived(&mut self) -> Vec<Reply> {
         self.replies.try_iter().collect()
     }
@@ -158,7 +158,7 @@ pub fn section_levels(
 ) -> Result<Vec<u8>, StoreError> {
     let v = store.window(attr, region[0], region[1])?;
     // The window is one voxel thick along `axis`: its voxel 0 there.
-    let (_, voxels) = crate::volume::axes::section_voxels(v.dims, axis, 0);
+    let (_, voxels) = arbvis_data::volume::axes::section_voxels(v.dims, axis, 0);
     let out = voxels
         .map(|[i, j, k]| quantize_value(v.values[v.index(i, j, k)], low, high))
         .collect();
@@ -187,7 +187,10 @@ fn read_sections(store: &Store, requests: Receiver<Request>, replies: Sender<Rep
 /// The axes of a store's window: the sample axis as the store numbers it (SEG-Y time in
 /// ms, an MDIO dataset's time or depth), crossline and inline numbers from the source's
 /// first and step; plain indices where it gave none.
-pub fn store_axes(meta: &crate::store::meta::StoreMeta, window: [[usize; 3]; 2]) -> [Axis; 3] {
+pub fn store_axes(
+    meta: &arbvis_data::store::meta::StoreMeta,
+    window: [[usize; 3]; 2],
+) -> [Axis; 3] {
     let len = |a: usize| window[1][a].saturating_sub(window[0][a]);
     let numbered = |name: &str, a: usize, start: f64, step: f64| Axis {
         name: name.to_string(),

@@ -12,8 +12,8 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::units::{las_units, Units};
-use crate::points::{PointCloud, PointSource, FACIES, FAULT, LAYER};
-use crate::volume::axes::{span, Axis};
+use arbvis_data::points::{PointCloud, PointSource, FACIES, FAULT, LAYER};
+use arbvis_data::volume::axes::{span, Axis};
 
 /// Most distinct ids a key lists (beyond, it says how many more there are).
 pub const MAX_IDS: usize = 64;
@@ -139,7 +139,7 @@ pub struct MeshSummary {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::points::section::{generate, SectionSpec};
+    use arbvis_data::points::section::{generate, SectionSpec};
 
     #[test]
     fn a_section_has_metres_and_its_ids() {

@@ -18,11 +18,11 @@ use egui::{TextureHandle, TextureOptions, Vec2};
 
 use super::curve;
 use super::widgets::Widgets;
-use crate::colortable::ColorTable;
-use crate::techniques::cellproj::transfer::{
+use arbvis_core::colortable::ColorTable;
+use arbvis_techniques::techniques::cellproj::transfer::{
     Precise, Sort, Transfer, VolumeSpec, MAX_GRID, MAX_POINTS,
 };
-use crate::techniques::cellproj::{CellprojScene, Mode};
+use arbvis_techniques::techniques::cellproj::{CellprojScene, Mode};
 
 /// Largest side of the pre-integrated table offered (256² x 256 = 2^24 texels, the most
 /// a scene may ask for).

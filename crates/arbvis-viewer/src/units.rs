@@ -32,7 +32,7 @@ pub struct Units {
 
 /// The units a LAS/LAZ file at `path` states (none when unreadable or unstated).
 pub fn las_units(path: &Path) -> Units {
-    let Ok((file, _)) = crate::input::open_regular(path) else {
+    let Ok((file, _)) = arbvis_core::input::open_regular(path) else {
         return Units::default();
     };
     let mut bytes = Vec::new();
@@ -205,7 +205,7 @@ mod tests {
 
     #[test]
     fn autzen_is_in_feet() {
-        let path = crate::input::data_file("points/autzen_trim.laz");
+        let path = arbvis_core::input::data_file("points/autzen_trim.laz");
         assert_eq!(las_units(&path).horizontal.as_deref(), Some("ft"));
     }
 }

@@ -31,7 +31,26 @@ pub struct SetRequest {
     /// The value as written.
     pub value: String,
     /// `None` until the widget took it; then applied or why not.
-    pub outcome: Option<Result<(), String>>,
+    pub outcome: Option<SetOutcome>,
+}
+
+/// What a widget did with a script's value.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SetOutcome {
+    /// It took the value.
+    Applied,
+    /// It refused it, saying why.
+    Refused(String),
+}
+
+impl SetOutcome {
+    /// Applied where `result` is `Ok`, else refused with the error's message.
+    pub fn of<T, E: std::fmt::Display>(result: &Result<T, E>) -> SetOutcome {
+        match result {
+            Ok(_) => SetOutcome::Applied,
+            Err(e) => SetOutcome::Refused(e.to_string()),
+        }
+    }
 }
 
 /// The registry, rebuilt every frame.
@@ -158,7 +177,7 @@ impl Widgets {
     }
 
     /// Record what became of the pending `set`.
-    pub fn set_outcome(&mut self, outcome: Result<(), String>) {
+    pub fn set_outcome(&mut self, outcome: SetOutcome) {
         if let Some(s) = &mut self.set {
             s.outcome = Some(outcome);
         }
@@ -228,7 +247,7 @@ impl Widgets {
             Err(_) => Err(format!("{label} takes a number, got {text:?}")),
         };
         let value = outcome.as_ref().ok().map(|&v| N::from_f64(v));
-        self.set_outcome(outcome.map(|_| ()));
+        self.set_outcome(SetOutcome::of(&outcome));
         if value.is_some() {
             self.hit(label);
         }
@@ -250,7 +269,7 @@ impl Widgets {
                 set = true;
                 self.hit(label);
             }
-            self.set_outcome(outcome.map(|_| ()));
+            self.set_outcome(SetOutcome::of(&outcome));
         }
         let r = ui.checkbox(value, text);
         self.add(ui, label, &r) || set
@@ -286,7 +305,7 @@ impl Widgets {
                         .join(", ")
                 )),
             };
-            self.set_outcome(outcome);
+            self.set_outcome(SetOutcome::of(&outcome));
         }
         let current = options
             .iter()

@@ -52,7 +52,7 @@ pub fn timeout() -> Duration {
 
 /// `ARBVIS_REMOTE_TIMEOUT` read: seconds, a number above 0 (up to a day), 30 when unset or
 /// empty; anything else (`0`, `5s`, `-1`) is an error that says what is expected.
-pub fn timeout_setting() -> Result<Duration, String> {
+pub fn timeout_setting() -> Result<Duration, SettingError> {
     let Some(text) = std::env::var("ARBVIS_REMOTE_TIMEOUT")
         .ok()
         .filter(|v| !v.trim().is_empty())
@@ -63,10 +63,24 @@ pub fn timeout_setting() -> Result<Duration, String> {
         Ok(secs) if secs.is_finite() && secs > 0.0 && secs <= 86_400.0 => {
             Ok(Duration::from_secs_f64(secs))
         }
-        _ => Err(format!(
-            "ARBVIS_REMOTE_TIMEOUT={text:?}: expected seconds, a number above 0 and at most 86400 (e.g. 30 or 2.5), with no unit"
-        )),
+        _ => Err(SettingError {
+            variable: "ARBVIS_REMOTE_TIMEOUT",
+            value: text,
+            expected: "seconds, a number above 0 and at most 86400 (e.g. 30 or 2.5), with no unit",
+        }),
     }
+}
+
+/// An environment variable whose value cannot be read.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{variable}={value:?}: expected {expected}")]
+pub struct SettingError {
+    /// The variable.
+    pub variable: &'static str,
+    /// Its value.
+    pub value: String,
+    /// What it takes.
+    pub expected: &'static str,
 }
 
 /// The most one request may take, retries and body included: twice the request
@@ -153,7 +167,7 @@ pub fn object(url: &str) -> Result<Object, FetchError> {
             return Err(fail(m.to_string()));
         }
     };
-    timeout_setting().map_err(fail)?;
+    timeout_setting().map_err(|e| fail(e.to_string()))?;
     // A query (a pre-signed URL's signature, a token) goes with every request for the
     // object, not into its key.
     let (key, query) = match key.split_once('?') {
@@ -169,7 +183,7 @@ pub fn object(url: &str) -> Result<Object, FetchError> {
         None => (key, None),
     };
     let root = format!("{scheme}://{authority}");
-    let store = client(&root, s3, query).map_err(fail)?;
+    let store = client(&root, s3, query).map_err(|e| fail(format!("{root}: {e}")))?;
     let path = object_store::path::Path::from_url_path(key)
         .map_err(|e| fail(format!("not an object's path: {e}")))?;
     Ok(Object {
@@ -180,7 +194,11 @@ pub fn object(url: &str) -> Result<Object, FetchError> {
     })
 }
 
-fn client(root: &str, s3: bool, query: Option<&str>) -> Result<Arc<dyn ObjectStore>, String> {
+fn client(
+    root: &str,
+    s3: bool,
+    query: Option<&str>,
+) -> Result<Arc<dyn ObjectStore>, object_store::Error> {
     static CLIENTS: OnceLock<Mutex<HashMap<String, Arc<dyn ObjectStore>>>> = OnceLock::new();
     let mut clients = CLIENTS
         .get_or_init(Default::default)
@@ -208,7 +226,7 @@ fn client(root: &str, s3: bool, query: Option<&str>) -> Result<Arc<dyn ObjectSto
         } else {
             b = b.with_http_connector(super::connect::SameHostRedirects(timeout()));
         }
-        Arc::new(b.build().map_err(|e| format!("{root}: {e}"))?)
+        Arc::new(b.build()?)
     } else {
         // A password in the URL goes to its server as Basic authorization, which
         // reqwest drops on a redirect to another host.
@@ -227,8 +245,7 @@ fn client(root: &str, s3: bool, query: Option<&str>) -> Result<Arc<dyn ObjectSto
             b.with_url(plain)
                 .with_client_options(options)
                 .with_retry(retry())
-                .build()
-                .map_err(|e| format!("{root}: {e}"))?,
+                .build()?,
         )
     };
     clients.insert(id, made.clone());

@@ -22,8 +22,8 @@ impl File {
         if let Some(url) = url_of(path) {
             return ranged::RemoteFile::open(url).map(File::Remote);
         }
-        let (f, len) =
-            crate::input::open_regular(path).map_err(|e| FetchError::failed(e.to_string()))?;
+        let (f, len) = arbvis_core::input::open_regular(path)
+            .map_err(|e| FetchError::failed(e.to_string()))?;
         Ok(File::Local(Mutex::new(f), len))
     }
 

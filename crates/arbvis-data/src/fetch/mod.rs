@@ -203,7 +203,7 @@ pub fn read_object(path: &Path, max: u64) -> Result<Option<std::sync::Arc<Vec<u8
             max,
         });
     }
-    crate::input::read_regular(path, max)
+    arbvis_core::input::read_regular(path, max)
         .map(|b| Some(std::sync::Arc::new(b)))
         .map_err(|e| FetchError::failed(e.to_string()))
 }
@@ -211,8 +211,8 @@ pub fn read_object(path: &Path, max: u64) -> Result<Option<std::sync::Arc<Vec<u8
 /// The object or file at `path` as text, at most `max` bytes; an absent one is an error.
 pub fn read_text(path: &Path, max: u64) -> Result<String, FetchError> {
     if url_of(path).is_none() {
-        return crate::input::read_regular(path, max)
-            .and_then(crate::input::utf8)
+        return arbvis_core::input::read_regular(path, max)
+            .and_then(arbvis_core::input::utf8)
             .map_err(|e| FetchError::failed(e.to_string()));
     }
     let url = url_of(path).unwrap_or_default();

@@ -452,10 +452,10 @@ impl RawCells {
             "making the tetrahedra of {} cells (at most {most})",
             self.len()
         );
-        let budget_err = |e: crate::budget::OverBudget| err(0, e.to_string());
+        let budget_err = |e: arbvis_core::budget::OverBudget| err(0, e.to_string());
         let mut out = Converted {
-            tets: crate::budget::vec_for(most, &what).map_err(budget_err)?,
-            source_cell: crate::budget::vec_for(most, &what).map_err(budget_err)?,
+            tets: arbvis_core::budget::vec_for(most, &what).map_err(budget_err)?,
+            source_cell: arbvis_core::budget::vec_for(most, &what).map_err(budget_err)?,
             ..Converted::default()
         };
         let mut names: Vec<(&'static str, usize)> = Vec::new();

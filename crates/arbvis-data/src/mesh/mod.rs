@@ -16,7 +16,7 @@
 //! - The format is chosen from the content, not the extension: `# vtk DataFile` starts a
 //!   legacy file, `<VTKFile` (after an optional XML declaration) an XML file, and
 //!   `$MeshFormat` a gmsh file.
-//! - Files are read whole through [`crate::input`], at most [`MAX_MESH_BYTES`].
+//! - Files are read whole through [`arbvis_core::input`], at most [`MAX_MESH_BYTES`].
 //! - Sections may come in any order the format allows (gmsh data before `$Nodes`, VTK
 //!   `POINT_DATA` before `POINTS`); what refers to another section is checked against it
 //!   once both are read, with the file and the position of the one that disagrees, and
@@ -24,7 +24,7 @@
 //!   count (it never indexes past one). A section a file may hold once (`POINTS`) is
 //!   refused the second time.
 //! - Memory: every allocation whose size comes from the file is checked against the
-//!   memory budget ([`crate::budget`]) before it is made, and made fallibly; compressed
+//!   memory budget ([`arbvis_core::budget`]) before it is made, and made fallibly; compressed
 //!   `.vtu` arrays are checked against what the piece declares, and the total against
 //!   the budget, before anything is inflated. A refusal names the file, the place that
 //!   declared the size, the estimate, the budget and how to raise it.
@@ -48,7 +48,7 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
-use crate::budget;
+use arbvis_core::budget;
 
 /// Largest mesh file read (1 GiB).
 pub const MAX_MESH_BYTES: u64 = 1 << 30;
@@ -225,7 +225,7 @@ impl MeshSource {
 /// Read a mesh file (format from its content).
 pub fn read(path: &Path) -> Result<Mesh, MeshError> {
     let bytes =
-        crate::input::read_regular(path, MAX_MESH_BYTES).map_err(|source| MeshError::Io {
+        arbvis_core::input::read_regular(path, MAX_MESH_BYTES).map_err(|source| MeshError::Io {
             path: path.to_path_buf(),
             source,
         })?;

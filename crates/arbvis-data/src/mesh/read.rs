@@ -195,15 +195,15 @@ pub fn binary_error(name: &Path, at: usize, message: impl Into<String>) -> MeshE
 pub fn quote(token: &[u8]) -> String {
     format!(
         "\"{}\"",
-        crate::input::shorten(&String::from_utf8_lossy(token), 40)
+        arbvis_core::input::shorten(&String::from_utf8_lossy(token), 40)
     )
 }
 
 /// An empty vector with room for `n` items, checked against the memory budget and
 /// reserved fallibly: the error (the estimate, the budget and how to raise it, or the
 /// system's refusal) is a message the caller places at a position, never an abort.
-pub fn vec_for<T>(n: usize, what: &str) -> Result<Vec<T>, String> {
-    crate::budget::vec_for(n, &format!("{n} {what}")).map_err(|e| e.to_string())
+pub fn vec_for<T>(n: usize, what: &str) -> Result<Vec<T>, arbvis_core::budget::OverBudget> {
+    arbvis_core::budget::vec_for(n, &format!("{n} {what}"))
 }
 
 /// A cursor over a file's bytes.

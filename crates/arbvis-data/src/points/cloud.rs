@@ -159,11 +159,34 @@ pub struct CloudParts {
     pub normals: Option<Vec<[f32; 3]>>,
 }
 
+/// Why [`CloudParts`] cannot make a cloud.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PartsError {
+    /// A column whose length is not the number of points.
+    #[error("{what} has {len} values for {points} points")]
+    Length {
+        /// The column ("attribute NAME", "the colour", "the normal").
+        what: String,
+        /// Its length.
+        len: usize,
+        /// The number of points.
+        points: usize,
+    },
+    /// A position with a NaN or infinite coordinate.
+    #[error("point {point} has a non-finite coordinate {position:?}")]
+    NonFinite {
+        /// The point's index.
+        point: usize,
+        /// Its position.
+        position: [f64; 3],
+    },
+}
+
 impl PointCloud {
     /// Rescale `parts` (origin at the bounding-box centre, scale half the largest
     /// extent) and compute every attribute's statistics. Errors name the first
     /// non-finite position or a column of the wrong length.
-    pub fn from_parts(parts: CloudParts) -> Result<PointCloud, String> {
+    pub fn from_parts(parts: CloudParts) -> Result<PointCloud, PartsError> {
         PointCloud::from_parts_framed(parts, None)
     }
 
@@ -173,33 +196,37 @@ impl PointCloud {
     pub fn from_parts_framed(
         parts: CloudParts,
         frame: Option<&[[f64; 3]; 2]>,
-    ) -> Result<PointCloud, String> {
+    ) -> Result<PointCloud, PartsError> {
         let n = parts.positions.len();
-        let check = |what: &str, len: usize| {
+        let check = |what: String, len: usize| {
             if len == n {
                 Ok(())
             } else {
-                Err(format!("{what} has {len} values for {n} points"))
+                Err(PartsError::Length {
+                    what,
+                    len,
+                    points: n,
+                })
             }
         };
         for (name, values) in &parts.attributes {
-            check(&format!("attribute {name}"), values.len())?;
+            check(format!("attribute {name}"), values.len())?;
         }
         if let Some(rgb) = &parts.rgb {
-            check("the colour", rgb.len())?;
+            check("the colour".into(), rgb.len())?;
         }
         if let Some(normals) = &parts.normals {
-            check("the normal", normals.len())?;
+            check("the normal".into(), normals.len())?;
         }
         if let Some(i) = parts
             .positions
             .iter()
             .position(|p| p.iter().any(|c| !c.is_finite()))
         {
-            return Err(format!(
-                "point {i} has a non-finite coordinate {:?}",
-                parts.positions[i]
-            ));
+            return Err(PartsError::NonFinite {
+                point: i,
+                position: parts.positions[i],
+            });
         }
         let bounds = bounds(&parts.positions);
         let frame = *frame.unwrap_or(&bounds);
@@ -364,11 +391,11 @@ fn local(v: f64, origin: f64, scale: f64) -> f32 {
 /// attribute, u16 colours, f32 normals), the f32 positions made from them, and the copy
 /// of each attribute that its median is selected in (all made in parallel). Loaders add
 /// what they hold besides (their input, decoding buffers) and check the sum against
-/// [`crate::budget`] before reading the points.
+/// [`arbvis_core::budget`] before reading the points.
 pub fn footprint(points: u64, attributes: usize, rgb: bool, normals: bool) -> u64 {
     let per_point =
         24 + 12 + 8 * attributes as u64 + if rgb { 6 } else { 0 } + if normals { 12 } else { 0 };
-    crate::budget::times(points, per_point)
+    arbvis_core::budget::times(points, per_point)
 }
 
 /// Decimals that show a step of `step` (0 to 12).

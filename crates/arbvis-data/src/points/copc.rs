@@ -177,7 +177,7 @@ impl Copc {
     /// scales: `las::PointData`).
     pub fn read_node(&self, node: &Node) -> Result<PointData, PointsError> {
         let record = self.format.1 as u64;
-        crate::budget::check(
+        arbvis_core::budget::check(
             format!("node {:?} of {}", node.key, self.path.display()),
             node.points.saturating_mul(record).saturating_mul(2),
         )
@@ -234,7 +234,7 @@ impl Copc {
             d.decompress_many(&mut out)?;
             Ok(())
         })
-        .map_err(what)?;
+        .map_err(|e| what(e.to_string()))?;
         PointDataBuilder::new()
             .for_header(&self.header)
             .build_from_bytes(out)

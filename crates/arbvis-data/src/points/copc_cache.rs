@@ -57,7 +57,7 @@ fn cache() -> std::sync::MutexGuard<'static, Cache> {
 
 /// The cache's budget in bytes.
 pub fn budget() -> u64 {
-    (crate::budget::current().bytes / 8).min(1 << 30)
+    (arbvis_core::budget::current().bytes / 8).min(1 << 30)
 }
 
 /// Node `key` of `file`, if it is held (it becomes the most recently used).

@@ -17,8 +17,8 @@ use glam::{DMat4, DVec3, DVec4};
 use super::copc::{Copc, Node};
 
 /// A view of the cloud's frame ([-1, 1]³ around the header's bounds): the camera's
-/// [`crate::camera::View`].
-pub use crate::camera::View;
+/// [`arbvis_core::camera::View`].
+pub use arbvis_core::camera::View;
 
 /// What a COPC cloud's load says: its cut in a line, and the spacing of the deepest level
 /// drawn in the cloud's frame (what a splat must cover for the picture to have no gaps).
@@ -99,7 +99,7 @@ impl Cut {
             } else {
                 String::new()
             },
-            crate::budget::format_bytes(bytes),
+            arbvis_core::budget::format_bytes(bytes),
             self.culled,
             self.too_small,
             self.over_budget
@@ -108,7 +108,7 @@ impl Cut {
 }
 
 /// A queued node (its index) and its projected radius.
-type Ranked = crate::vocab::Ranked<usize>;
+type Ranked = arbvis_core::vocab::Ranked<usize>;
 
 /// Each point's spacing (file units) in a cloud loaded from `cut` (its nodes' points in
 /// order, `positions` in file coordinates): the spacing of the deepest level drawn in its

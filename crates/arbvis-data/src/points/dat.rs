@@ -108,26 +108,26 @@ struct Layout {
 }
 
 impl DatColumns {
-    fn layout(&self) -> Result<Layout, String> {
+    fn layout(&self) -> Result<Layout, PointsError> {
         if self.count < 3 || self.count > MAX_COUNT {
-            return Err(format!(
+            return Err(PointsError::Invalid(format!(
                 ".dat columns: count = {} must be between 3 and {MAX_COUNT}",
                 self.count
-            ));
+            )));
         }
         let mut slots = vec![Slot::Unused; self.count];
         let mut names = Vec::new();
-        let mut place = |what: String, column: usize, slot: Slot| -> Result<(), String> {
+        let mut place = |what: String, column: usize, slot: Slot| {
             if column == 0 || column > self.count {
-                return Err(format!(
+                return Err(PointsError::Invalid(format!(
                     ".dat columns: {what} = {column} is not a column of 1..{}",
                     self.count
-                ));
+                )));
             }
             if slots[column - 1] != Slot::Unused {
-                return Err(format!(
+                return Err(PointsError::Invalid(format!(
                     ".dat columns: column {column} is mapped twice ({what} and another)"
-                ));
+                )));
             }
             slots[column - 1] = slot;
             Ok(())
@@ -175,15 +175,16 @@ pub fn read(path: &Path, columns: &DatColumns) -> Result<PointCloud, PointsError
 
 /// Parse `.dat` text named `name` with `columns`.
 pub fn parse(name: &Path, bytes: &[u8], columns: &DatColumns) -> Result<PointCloud, PointsError> {
-    let layout = columns
-        .layout()
-        .map_err(|m| PointsError::Invalid(format!("{}: {m}", name.display())))?;
+    let layout = columns.layout().map_err(|e| match e {
+        PointsError::Invalid(m) => PointsError::Invalid(format!("{}: {m}", name.display())),
+        other => other,
+    })?;
     let chunks = split_lines(bytes, chunk_size(bytes.len()));
     let lines: usize = chunks.par_iter().map(|c| count_lines(c)).sum();
     // Every line may be a point: the chunks' columns and the joined ones are held
     // together, then the cloud is made from the joined ones.
     let attributes = layout.names.len() as u64;
-    let estimate = crate::budget::times(lines as u64, 2 * (24 + 4 * attributes))
+    let estimate = arbvis_core::budget::times(lines as u64, 2 * (24 + 4 * attributes))
         .max(super::footprint(
             lines as u64,
             layout.names.len(),
@@ -191,7 +192,7 @@ pub fn parse(name: &Path, bytes: &[u8], columns: &DatColumns) -> Result<PointClo
             false,
         ))
         .saturating_add(bytes.len() as u64);
-    crate::budget::check(format!("the points of {lines} lines"), estimate).map_err(|e| {
+    arbvis_core::budget::check(format!("the points of {lines} lines"), estimate).map_err(|e| {
         PointsError::text(
             name,
             1,
@@ -385,7 +386,7 @@ fn parse_line(line: &[u8], layout: &Layout, chunk: &mut Chunk) -> Result<(), (us
                     format!(
                         "{}: expected a number, found \"{}\"",
                         what(),
-                        crate::input::shorten(&String::from_utf8_lossy(token), 40)
+                        arbvis_core::input::shorten(&String::from_utf8_lossy(token), 40)
                     ),
                 )
             })?;
@@ -407,7 +408,7 @@ fn parse_line(line: &[u8], layout: &Layout, chunk: &mut Chunk) -> Result<(), (us
                         format!(
                             "{}: expected an integer id, found \"{}\"",
                             what(),
-                            crate::input::shorten(&String::from_utf8_lossy(token), 40)
+                            arbvis_core::input::shorten(&String::from_utf8_lossy(token), 40)
                         ),
                     ));
                 }
@@ -462,7 +463,7 @@ fn describe_column(index: usize, slot: Slot, layout: &Layout) -> String {
 /// [`PointCloud::original`] with as many decimals as the f32 positions resolve
 /// (`scale * 2^-24`), attributes by name, `0` in columns that map nothing or whose
 /// attribute the cloud lacks. For tests and benchmarks of the reader.
-pub fn write(cloud: &PointCloud, columns: &DatColumns) -> Result<String, String> {
+pub fn write(cloud: &PointCloud, columns: &DatColumns) -> Result<String, PointsError> {
     use std::fmt::Write;
     let layout = columns.layout()?;
     let sources: Vec<Option<&Values>> = layout

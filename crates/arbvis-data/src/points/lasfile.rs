@@ -22,7 +22,7 @@
 //!
 //! Memory and time: the header's count, times what each point costs once loaded
 //! ([`super::footprint`] and an f64 per extra-bytes value), plus the file and one batch of
-//! records, is checked against [`crate::budget`] before anything is decoded; the columns
+//! records, is checked against [`arbvis_core::budget`] before anything is decoded; the columns
 //! are then reserved once. A LAZ file may declare at most 1,000,000 points plus 1 per byte
 //! of compressed data, each extra-bytes attribute counting a third of a point (see
 //! `check::laz_bound`): LAZ decodes about 2.5 million points a second here and a stream
@@ -54,8 +54,8 @@ use header::RECORD_LENGTH;
 
 use super::guarded;
 use super::progress::Progress;
-use super::{read_file, CloudParts, PointCloud, PointsError, Values};
-use crate::budget::{vec_for, OverBudget};
+use super::{read_file, CloudParts, PartsError, PointCloud, PointsError, Values};
+use arbvis_core::budget::{vec_for, OverBudget};
 
 /// Points decoded per batch, at most.
 const BATCH: u64 = 65_536;
@@ -107,19 +107,19 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
     // per extra-bytes value and GPS time, one batch of records) and the file itself.
     let batch = batch_points(record);
     let f64_columns = extras.len() + usize::from(has_gps);
-    let extra_values = crate::budget::times(count, 8 * f64_columns as u64);
+    let extra_values = arbvis_core::budget::times(count, 8 * f64_columns as u64);
     let estimate = super::footprint(count, 4 + f64_columns, has_rgb, false)
         .saturating_add(extra_values)
         .saturating_add(bytes.len() as u64)
         .saturating_add(batch * record as u64);
-    let over = |e: crate::budget::OverBudget| {
+    let over = |e: arbvis_core::budget::OverBudget| {
         PointsError::format(
             name,
             checked.count_at as u64,
             format!("the header declares {count} points: {e}"),
         )
     };
-    crate::budget::check(
+    arbvis_core::budget::check(
         format!("reading {count} points of {record} bytes"),
         estimate,
     )
@@ -153,7 +153,8 @@ pub(crate) fn parse_owned(name: &Path, bytes: Vec<u8>) -> Result<LasCloud, Point
         progress.inc(n);
     }
     drop(progress);
-    let cloud = cloud_of(cols, &extras, has_rgb, (None, None)).map_err(decode_error)?;
+    let cloud =
+        cloud_of(cols, &extras, has_rgb, (None, None)).map_err(|e| decode_error(e.to_string()))?;
     Ok(LasCloud { cloud, info })
 }
 
@@ -165,7 +166,7 @@ fn cloud_of(
     extras: &[Extra],
     has_rgb: bool,
     (gps_reference, frame): (Option<f64>, Option<&[[f64; 3]; 2]>),
-) -> Result<PointCloud, String> {
+) -> Result<PointCloud, PartsError> {
     let mut attributes = vec![
         ("intensity".to_string(), Values::Int(cols.intensity)),
         (
@@ -231,7 +232,7 @@ pub(super) fn copc_cloud(
         extra_bytes(path, &head, &checked.vlrs, base, copc.format.1 as usize)?
     };
     let over = |e: OverBudget| PointsError::format(copc.path(), 247, e.to_string());
-    crate::budget::check(
+    arbvis_core::budget::check(
         format!("{count} points of {}", copc.path().display()),
         super::footprint(count, 5 + extras.len(), has_rgb, false),
     )
@@ -272,9 +273,9 @@ pub(super) fn copc_cloud(
     // file's bounds: the same for every cut.
     let reference = Some(copc.info.gps_range[0]).filter(|t| t.is_finite());
     let frame = (reference, Some(&copc.bounds));
-    let cloud = cloud_of(cols, &extras, has_rgb, frame).map_err(|message| PointsError::Decode {
+    let cloud = cloud_of(cols, &extras, has_rgb, frame).map_err(|e| PointsError::Decode {
         path: copc.path().to_path_buf(),
-        message,
+        message: e.to_string(),
     })?;
     Ok((cloud, cached.into_inner()))
 }

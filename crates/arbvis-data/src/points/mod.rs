@@ -57,7 +57,7 @@ use serde::{Deserialize, Serialize};
 
 pub use cloud::footprint;
 pub(crate) use cloud::{decimals_for, fixed};
-pub use cloud::{Attribute, CloudParts, PointCloud, Stats, Values};
+pub use cloud::{Attribute, CloudParts, PartsError, PointCloud, Stats, Values};
 
 /// Largest point file read (the whole file is read into memory).
 pub const MAX_FILE_BYTES: u64 = 8 << 30;
@@ -177,11 +177,11 @@ impl PointsError {
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, PointsError> {
     if let Ok(meta) = std::fs::metadata(path) {
         if meta.is_file() {
-            crate::budget::check("reading the file", meta.len())
+            arbvis_core::budget::check("reading the file", meta.len())
                 .map_err(|e| PointsError::unsupported(path, e.to_string()))?;
         }
     }
-    crate::input::read_regular(path, MAX_FILE_BYTES).map_err(|e| PointsError::io(path, e))
+    arbvis_core::input::read_regular(path, MAX_FILE_BYTES).map_err(|e| PointsError::io(path, e))
 }
 
 /// Where a cloud comes from, as written in a scene:
@@ -334,7 +334,8 @@ pub fn inspect(path: &Path) -> Result<String, PointsError> {
     let remote = crate::fetch::url_of(path).is_some();
     let mut head = Vec::new();
     if !remote {
-        let (file, _) = crate::input::open_regular(path).map_err(|e| PointsError::io(path, e))?;
+        let (file, _) =
+            arbvis_core::input::open_regular(path).map_err(|e| PointsError::io(path, e))?;
         std::io::Read::read_to_end(&mut std::io::Read::take(file, 512), &mut head)
             .map_err(|e| PointsError::io(path, e))?;
     }
@@ -373,24 +374,34 @@ pub fn inspect(path: &Path) -> Result<String, PointsError> {
     Ok(format!("{}\n{format}{}", path.display(), cloud.describe()))
 }
 
-/// Run a `las`/`laz` call, turning a panic into an error message. `laz` asserts on
+/// What the `las`/`laz` decoder reported: its own error, or a panic caught on corrupt data.
+#[derive(Debug, thiserror::Error)]
+pub enum DecoderError {
+    /// An error the decoder returned.
+    #[error("{0}")]
+    Las(#[from] las::Error),
+    /// A panic inside the decoder, with the start of its message.
+    #[error("the decoder failed on corrupt data ({0})")]
+    Panicked(String),
+}
+
+/// Run a `las`/`laz` call, turning a panic into an error. `laz` asserts on
 /// some corrupt compressed streams (e.g. `assert!(sym < (1 << 16))` in its arithmetic
 /// decoder) where it could return an error; the checks above cannot foresee what an
 /// arithmetic-coded stream decodes to, so this is the last guard: the decoder that
 /// panicked is dropped with the error, never reused.
-pub(crate) fn guarded<T>(f: impl FnOnce() -> las::Result<T>) -> Result<T, String> {
+pub(crate) fn guarded<T>(f: impl FnOnce() -> las::Result<T>) -> Result<T, DecoderError> {
     match std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)) {
-        Ok(result) => result.map_err(|e| e.to_string()),
+        Ok(result) => result.map_err(DecoderError::Las),
         Err(panic) => {
             let what = panic
                 .downcast_ref::<&str>()
                 .map(|s| s.to_string())
                 .or_else(|| panic.downcast_ref::<String>().cloned())
                 .unwrap_or_default();
-            Err(format!(
-                "the decoder failed on corrupt data ({})",
-                crate::input::shorten(&what, 80)
-            ))
+            Err(DecoderError::Panicked(arbvis_core::input::shorten(
+                &what, 80,
+            )))
         }
     }
 }

@@ -43,7 +43,7 @@ impl PlyCloud {
             elements.join(", ")
         );
         for c in &self.comments {
-            s += &format!("comment: {}\n", crate::input::shorten(c, 100));
+            s += &format!("comment: {}\n", arbvis_core::input::shorten(c, 100));
         }
         s
     }
@@ -123,14 +123,14 @@ pub fn cloud(name: &Path, ply: &Ply) -> Result<PointCloud, PointsError> {
     // The cloud is built while the PLY's f64 columns are held: both count. (Every other
     // scalar property becomes an attribute; colours and normals take no more than that.)
     let held: u64 = ply.elements.iter().fold(0, |sum, e| {
-        sum.saturating_add(crate::budget::times(
+        sum.saturating_add(arbvis_core::budget::times(
             e.count as u64,
             8 * e.properties.len() as u64,
         ))
     });
     let estimate =
         super::footprint(n as u64, vertex.properties.len(), false, false).saturating_add(held);
-    crate::budget::check(format!("the cloud of {n} vertices"), estimate).map_err(|e| {
+    arbvis_core::budget::check(format!("the cloud of {n} vertices"), estimate).map_err(|e| {
         at(
             vertex.declared,
             format!("the vertex element declares {n} rows: {e}"),

@@ -1,14 +1,14 @@
-//! A progress bar for big clouds: [`crate::progress`]'s bar, drawn only when the work has
+//! A progress bar for big clouds: [`arbvis_core::progress`]'s bar, drawn only when the work has
 //! at least [`MIN_POINTS`] points (and bars are drawn at all: stderr a terminal, not CI).
 
-use crate::progress::{Bar, Unit};
+use arbvis_core::progress::{Bar, Unit};
 
 /// Smallest number of points for which a bar is shown.
 pub const MIN_POINTS: u64 = 1_000_000;
 
-/// True when bars can be drawn at all (see [`crate::progress::enabled`]).
+/// True when bars can be drawn at all (see [`arbvis_core::progress::enabled`]).
 pub fn enabled() -> bool {
-    crate::progress::enabled()
+    arbvis_core::progress::enabled()
 }
 
 /// A bar that may not be shown; cleared when dropped.

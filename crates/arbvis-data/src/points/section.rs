@@ -395,9 +395,9 @@ pub fn generate(spec: &SectionSpec) -> Result<PointCloud, PointsError> {
     }
     // The samples and the columns made from them are held together, then the cloud.
     let each = std::mem::size_of::<Sample>() as u64;
-    let estimate =
-        crate::budget::times(n as u64, 2 * each).max(super::footprint(n as u64, 6, false, false));
-    crate::budget::check(format!("the section of {n} points"), estimate)
+    let estimate = arbvis_core::budget::times(n as u64, 2 * each)
+        .max(super::footprint(n as u64, 6, false, false));
+    arbvis_core::budget::check(format!("the section of {n} points"), estimate)
         .map_err(|e| PointsError::Invalid(format!("section: points = {n}: {e}")))?;
     let model = Model::new(spec.seed);
     let progress = Progress::new(n as u64, "generating the section");

@@ -2,8 +2,8 @@
 //! `inspect`, the scene syntax and a seeded mutation test of every parser.
 
 use super::*;
-use crate::input::data_file;
 use crate::points::section::SplitMix64;
+use arbvis_core::input::data_file;
 
 fn temp_dir(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("arbvis-points-{name}-{}", std::process::id()));
@@ -92,14 +92,23 @@ fn degenerate_clouds() {
         ..Default::default()
     })
     .unwrap_err();
-    assert!(e.contains("point 1 has a non-finite coordinate"), "{e}");
+    assert!(matches!(e, PartsError::NonFinite { point: 1, .. }), "{e}");
+    assert!(
+        e.to_string()
+            .contains("point 1 has a non-finite coordinate"),
+        "{e}"
+    );
     let e = PointCloud::from_parts(CloudParts {
         positions: vec![[0.0; 3]],
         attributes: vec![("a".into(), Values::Int(vec![1, 2]))],
         ..Default::default()
     })
     .unwrap_err();
-    assert!(e.contains("attribute a has 2 values for 1 points"), "{e}");
+    assert!(
+        e.to_string()
+            .contains("attribute a has 2 values for 1 points"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -343,7 +343,7 @@ impl Plan {
                 Input::Mdio(m, _) => m.cache_bytes(),
                 _ => 0,
             };
-        crate::budget::check(
+        arbvis_core::budget::check(
             format!(
                 "converting {} ({} samples per trace, {b}³ bricks, {} attributes, {workers} workers)",
                 input.display(),
@@ -541,9 +541,9 @@ fn check_disk(store: &Path, meta: &StoreMeta, skip: usize, say: bool) -> Result<
     let free = nix::sys::statvfs::statvfs(store)
         .ok()
         .map(|s| s.blocks_available().saturating_mul(s.fragment_size()));
-    let size = crate::budget::format_bytes;
+    let size = arbvis_core::budget::format_bytes;
     if say {
-        crate::progress::line(&format!(
+        arbvis_core::progress::line(&format!(
             "{}: writes up to {} (before compression){}",
             store.display(),
             size(need),
@@ -587,7 +587,7 @@ fn mdio_root_attributes(
                     "its levels and ranges were added already: the dataset opens as a store as it is",
                 ));
             };
-            crate::progress::line(&format!(
+            arbvis_core::progress::line(&format!(
                 "{}: the levels added earlier are damaged ({damage}): adding them again",
                 store.display()
             ));

@@ -85,7 +85,7 @@ impl Input {
             spec.validate()
                 .map_err(|e| VolumeError::Invalid(format!("{}: {}", path.display(), e.message)))?;
             let (file, flen) =
-                crate::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
+                arbvis_core::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
             let need = spec.dims.iter().map(|&d| d as u64).product::<u64>()
                 * spec.sample.bytes() as u64
                 + spec.offset;
@@ -123,12 +123,12 @@ impl Input {
                 .map(|(a, b)| (a.to_string(), b.to_string()))
                 .collect();
             let (file, flen) =
-                crate::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
+                arbvis_core::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
             let mut magic = [0u8; 2];
             let gzip = file.read_exact_at(&mut magic, 0).is_ok() && magic == [0x1f, 0x8b];
             if gzip {
                 let bytes = header.count().saturating_mul(4);
-                crate::budget::check(
+                arbvis_core::budget::check(
                     format!(
                         "{} (gzip NIfTI is read whole; decompress it to convert in columns)",
                         path.display()

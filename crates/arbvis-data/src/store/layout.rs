@@ -94,7 +94,7 @@ pub fn write_json(
     std::fs::create_dir_all(&folder).map_err(|e| StoreError::io(&folder, e))?;
     let file = folder.join("zarr.json");
     let json = serde_json::to_vec_pretty(metadata).map_err(|e| StoreError::io(&file, e))?;
-    crate::png_io::write_atomic(&file, &json).map_err(|e| StoreError::io(&file, e))
+    arbvis_core::png_io::write_atomic(&file, &json).map_err(|e| StoreError::io(&file, e))
 }
 
 /// A group at `node` with `attributes`.

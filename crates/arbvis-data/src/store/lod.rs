@@ -256,7 +256,7 @@ pub struct Selection {
     pub missing: usize,
 }
 
-type Node = crate::vocab::Ranked<BrickId>;
+type Node = arbvis_core::vocab::Ranked<BrickId>;
 
 /// The wanted cut for `view` at `pixels` per voxel, at most `max_bricks` bricks; `visible`
 /// says whether a brick can show anything (ranges against the tables).

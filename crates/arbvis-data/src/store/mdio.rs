@@ -70,7 +70,7 @@ fn read_whole(array: &ArrayMeta) -> Result<Vec<f64>, StoreError> {
         .ok_or_else(|| {
             StoreError::invalid(&file, format!("shape {:?}: too many values", array.shape))
         })?;
-    let mut out = crate::budget::vec_for::<f64>(n as usize, "an MDIO coordinate or mask")
+    let mut out = arbvis_core::budget::vec_for::<f64>(n as usize, "an MDIO coordinate or mask")
         .map_err(|e| StoreError::Budget(e.to_string()))?;
     out.resize(n as usize, array.fill_value);
     let (cr, cc) = match array.chunks[..] {

@@ -114,8 +114,8 @@ fn log_bound(meta: &StoreMeta) -> u64 {
 
 /// The columns a log lists, without checking them (for `inspect`).
 pub(crate) fn logged_columns(path: &Path, meta: &StoreMeta) -> Result<usize, StoreError> {
-    let text =
-        crate::input::read_regular(path, log_bound(meta)).map_err(|e| StoreError::io(path, e))?;
+    let text = arbvis_core::input::read_regular(path, log_bound(meta))
+        .map_err(|e| StoreError::io(path, e))?;
     Ok(text
         .split(|&b| b == b'\n')
         .skip(1)
@@ -131,8 +131,8 @@ pub(crate) fn read_log(
     job: &Job,
     meta: &StoreMeta,
 ) -> Result<HashMap<[usize; 3], Unit>, StoreError> {
-    let text =
-        crate::input::read_regular(path, log_bound(meta)).map_err(|e| StoreError::io(path, e))?;
+    let text = arbvis_core::input::read_regular(path, log_bound(meta))
+        .map_err(|e| StoreError::io(path, e))?;
     let text = String::from_utf8_lossy(&text);
     let mut lines = text.split_terminator('\n');
     let first = lines.next().unwrap_or_default();
@@ -190,23 +190,23 @@ pub(crate) fn read_log(
 /// Create the log with the job's line, whole or not at all.
 pub(crate) fn start_log(path: &Path, job: &Job) -> Result<(), StoreError> {
     let line = serde_json::to_string(job).map_err(|e| StoreError::io(path, e))?;
-    crate::png_io::write_atomic(path, format!("{line}\n").as_bytes())
+    arbvis_core::png_io::write_atomic(path, format!("{line}\n").as_bytes())
         .map_err(|e| StoreError::io(path, e))
 }
 
 /// The exclusive right to write a store, held until dropped (then the lock file goes).
 pub(crate) struct StoreLock {
-    _lock: crate::png_io::WriterLock,
+    _lock: arbvis_core::png_io::WriterLock,
 }
 
 impl StoreLock {
     /// Take the store's lock, or say which process holds it.
     pub(crate) fn acquire(store: &Path) -> Result<StoreLock, StoreError> {
         let path = store.join(LOCK_FILE);
-        match crate::png_io::WriterLock::acquire(&path).map_err(|e| StoreError::io(&path, e))? {
+        match arbvis_core::png_io::WriterLock::acquire(&path).map_err(|e| StoreError::io(&path, e))? {
             Ok(lock) => {
                 if let Some(pid) = lock.taken_over() {
-                    crate::progress::line(&format!(
+                    arbvis_core::progress::line(&format!(
                         "note: {}: the lock of pid {pid}, which is no longer running, taken over",
                         path.display()
                     ));
@@ -231,7 +231,7 @@ pub(crate) fn holds_nothing(store: &Path) -> Result<bool, StoreError> {
         let entry = entry.map_err(|e| StoreError::io(store, e))?;
         let name = entry.file_name();
         let name = name.to_string_lossy();
-        if name != LOCK_FILE && !name.contains(crate::png_io::TMP_MARK) {
+        if name != LOCK_FILE && !name.contains(arbvis_core::png_io::TMP_MARK) {
             return Ok(false);
         }
     }

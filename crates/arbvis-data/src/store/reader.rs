@@ -441,7 +441,7 @@ impl Store {
         let n = self.meta.level_dims(level);
         let b = self.meta.brick;
         let count = size.iter().product::<usize>();
-        let mut out = crate::budget::vec_for::<f32>(count, "a region of a store")
+        let mut out = arbvis_core::budget::vec_for::<f32>(count, "a region of a store")
             .map_err(|e| StoreError::Budget(e.to_string()))?;
         out.resize(count, 0.0);
         let clamp = |v: i64, a: usize| v.clamp(0, n[a] as i64 - 1) as usize;

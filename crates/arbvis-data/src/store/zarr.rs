@@ -1,5 +1,5 @@
 //! Reading zarr v3 arrays as the bounded input every other file is: metadata and chunks
-//! are opened through [`crate::input`]'s regular-file check (a FIFO, a device or a link to
+//! are opened through [`arbvis_core::input`]'s regular-file check (a FIFO, a device or a link to
 //! `/dev/zero` is refused with its true cause, never waited on), every number in a
 //! `zarr.json` is checked before it sizes anything, a chunk file longer than its codecs
 //! can produce is refused before it is read, and a chunk is decoded into a buffer of its
@@ -559,7 +559,7 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
         .as_str()
         .and_then(DataType::parse)
         .ok_or_else(|| {
-            let shown = crate::input::shorten(&type_name.to_string(), 60);
+            let shown = arbvis_core::input::shorten(&type_name.to_string(), 60);
             invalid(format!(
                 "`data_type` {shown}: arbvis reads bool, (u)int8-64 and float16-64"
             ))

@@ -221,7 +221,7 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
             path: name.to_path_buf(),
             message: format!(
                 "unknown surface extension {:?}: expected .obj, .stl or .ply",
-                crate::input::shorten(&ext, 20)
+                arbvis_core::input::shorten(&ext, 20)
             ),
         }),
     }
@@ -265,9 +265,9 @@ fn parse_ply(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
     // The vertices and the fans' triangles, made while the PLY's columns are held (those
     // were checked as they were read).
     let corners = faces.values().len() as u64;
-    let estimate =
-        crate::budget::times(x.len() as u64, 24).saturating_add(crate::budget::times(corners, 12));
-    crate::budget::check(
+    let estimate = arbvis_core::budget::times(x.len() as u64, 24)
+        .saturating_add(arbvis_core::budget::times(corners, 12));
+    arbvis_core::budget::check(
         format!("the surface of {} vertices and {corners} corners", x.len()),
         estimate,
     )
@@ -294,11 +294,12 @@ fn parse_ply(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
 
 /// Read a surface file (regular files of at most [`MAX_SURFACE_BYTES`]).
 pub fn read(path: &Path) -> Result<TriangleMesh, SurfaceError> {
-    let bytes =
-        crate::input::read_regular(path, MAX_SURFACE_BYTES).map_err(|error| SurfaceError::Io {
+    let bytes = arbvis_core::input::read_regular(path, MAX_SURFACE_BYTES).map_err(|error| {
+        SurfaceError::Io {
             path: path.to_path_buf(),
             error,
-        })?;
+        }
+    })?;
     parse(path, &bytes)
 }
 
@@ -417,7 +418,7 @@ mod tests {
 
     #[test]
     fn the_bunny_is_a_ply_surface() {
-        let path = crate::input::data_file("points/bunny.ply");
+        let path = arbvis_core::input::data_file("points/bunny.ply");
         let m = read(&path).unwrap();
         assert_eq!((m.vertices.len(), m.triangles.len()), (35_947, 69_451));
     }

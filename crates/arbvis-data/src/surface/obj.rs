@@ -27,7 +27,7 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
     if let Some((position, message)) = locate(text, &mut counts) {
         return Err(SurfaceError::format(name, position, message));
     }
-    crate::budget::check(
+    arbvis_core::budget::check(
         format!(
             "reading {} vertices and {} faces of {} corners",
             counts.vertices, counts.faces, counts.corners
@@ -71,7 +71,10 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
             return Err(SurfaceError::format(
                 name,
                 Position::Line { line, column: 1 },
-                format!("{e} in {:?}", crate::input::shorten(source_line.trim(), 60)),
+                format!(
+                    "{e} in {:?}",
+                    arbvis_core::input::shorten(source_line.trim(), 60)
+                ),
             ));
         }
     };
@@ -170,7 +173,7 @@ impl Counts {
     /// welding (about 110 bytes a corner) and the triangles (12 each, fewer than the
     /// corners).
     fn bytes(&self, len: usize) -> u64 {
-        let times = crate::budget::times;
+        let times = arbvis_core::budget::times;
         (2 * len as u64)
             .saturating_add(times(self.vertices, 24))
             .saturating_add(times(self.faces, 140))
@@ -226,7 +229,7 @@ fn locate(text: &str, counts: &mut Counts) -> Option<(Position, String)> {
                             },
                             format!(
                                 "vertex {vertex_count} has the coordinate {:?}: must be finite",
-                                crate::input::shorten(word, 30)
+                                arbvis_core::input::shorten(word, 30)
                             ),
                         ));
                     }
@@ -256,7 +259,7 @@ fn locate(text: &str, counts: &mut Counts) -> Option<(Position, String)> {
                             },
                             format!(
                                 "face corner {:?}: expected a vertex index",
-                                crate::input::shorten(word, 30)
+                                arbvis_core::input::shorten(word, 30)
                             ),
                         ));
                     };
@@ -269,7 +272,7 @@ fn locate(text: &str, counts: &mut Counts) -> Option<(Position, String)> {
                             },
                             format!(
                                 "face corner {:?} refers to vertex {resolved}, but only {vertex_count} vertices are defined before it (1-based)",
-                                crate::input::shorten(word, 30)
+                                arbvis_core::input::shorten(word, 30)
                             ),
                         ));
                     }
@@ -290,7 +293,7 @@ mod tests {
         Path::new("t.obj")
     }
 
-    use crate::input::data_file;
+    use arbvis_core::input::data_file;
 
     #[test]
     fn quads_pentagons_and_negative_indices() {

@@ -74,9 +74,9 @@ fn binary(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
         ));
     }
     let count = count as usize; // at most len / 50
-    crate::budget::check(
+    arbvis_core::budget::check(
         format!("reading {count} triangles"),
-        crate::budget::times(3 * count as u64, CORNER_BYTES),
+        arbvis_core::budget::times(3 * count as u64, CORNER_BYTES),
     )
     .map_err(|e| SurfaceError::format(name, Position::Byte(80), e.to_string()))?;
     let mut corners: Vec<[f64; 3]> = Vec::new();
@@ -203,9 +203,9 @@ fn ascii(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
     let text = super::utf8(name, bytes)?;
     // Each corner takes at least `vertex 0 0 0` (14 bytes): the budget holds for the
     // corners the text can hold.
-    crate::budget::check(
+    arbvis_core::budget::check(
         "reading the ASCII STL's vertices",
-        crate::budget::times(text.len() as u64 / 14 + 1, CORNER_BYTES + 4),
+        arbvis_core::budget::times(text.len() as u64 / 14 + 1, CORNER_BYTES + 4),
     )
     .map_err(|e| {
         SurfaceError::format(name, Position::Line { line: 1, column: 1 }, e.to_string())
@@ -268,7 +268,7 @@ impl<'a> Ascii<'a> {
                 format!(
                     "expected `{}`, found {:?}",
                     kw,
-                    crate::input::shorten(w.text, 40)
+                    arbvis_core::input::shorten(w.text, 40)
                 ),
             )),
             None => Err(self.at_end(format!("the file ends where `{kw}` was expected"))),
@@ -287,7 +287,7 @@ impl<'a> Ascii<'a> {
                 &w,
                 format!(
                     "expected {what} (a number), found {:?}",
-                    crate::input::shorten(w.text, 40)
+                    arbvis_core::input::shorten(w.text, 40)
                 ),
             )),
         }
@@ -303,7 +303,7 @@ impl<'a> Ascii<'a> {
                     &w,
                     format!(
                         "expected `solid`, found {:?}",
-                        crate::input::shorten(w.text, 40)
+                        arbvis_core::input::shorten(w.text, 40)
                     ),
                 ))
             }
@@ -323,7 +323,7 @@ impl<'a> Ascii<'a> {
                     &w,
                     format!(
                         "expected `facet` or `endsolid`, found {:?}",
-                        crate::input::shorten(w.text, 40)
+                        arbvis_core::input::shorten(w.text, 40)
                     ),
                 ));
             }
@@ -355,7 +355,7 @@ impl<'a> Ascii<'a> {
                     &w,
                     format!(
                         "expected `vertex` or `endloop`, found {:?}",
-                        crate::input::shorten(w.text, 40)
+                        arbvis_core::input::shorten(w.text, 40)
                     ),
                 ));
             }
@@ -564,7 +564,7 @@ mod tests {
 
     #[test]
     fn the_real_binary_stl() {
-        let p = crate::input::data_file("surfaces/42400-IDGH.stl");
+        let p = arbvis_core::input::data_file("surfaces/42400-IDGH.stl");
         let m = crate::surface::read(&p).unwrap();
         assert_eq!(m.triangles.len(), 11_036);
         let r = inspect(&m);

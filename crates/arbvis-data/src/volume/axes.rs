@@ -340,7 +340,7 @@ mod tests {
 
     #[test]
     fn segy_axes_from_f3() {
-        let path = crate::input::data_file("seismic/f3.sgy");
+        let path = arbvis_core::input::data_file("seismic/f3.sgy");
         let source = VolumeSource::Segy(segy::SegySource::new(path));
         let a = describe(&source, Path::new("."), [75, 18, 23]);
         assert_eq!(a[0].name, "time (ms)");

@@ -368,9 +368,9 @@ impl Limits {
         if let Some(n) = voxels {
             // The samples as f32 (the loaders' output); derived attributes and textures are
             // estimated by the technique that makes them.
-            crate::budget::check(
+            arbvis_core::budget::check(
                 format!("{what}: {n} samples of {dims:?} as f32"),
-                crate::budget::times(n, 4),
+                arbvis_core::budget::times(n, 4),
             )
             .map_err(|e| VolumeError::Invalid(e.to_string()))?;
         }
@@ -429,7 +429,7 @@ impl VolumeSource {
     }
 
     /// Check the scene values that can be checked without reading files.
-    pub fn validate(&self) -> Result<(), crate::vocab::FieldError> {
+    pub fn validate(&self) -> Result<(), arbvis_core::vocab::FieldError> {
         match self {
             VolumeSource::Synthetic(spec) => spec.validate().map_err(|e| e.within("synthetic")),
             VolumeSource::Raw(spec) => spec.validate().map_err(|e| e.within("raw")),
@@ -504,7 +504,7 @@ pub fn inspect_with(path: &Path, keys: segy::KeyBytes) -> Result<String, VolumeE
             return Ok(format!(
                 "{}\n{facts}dimensions (i, j, k): {i} x {j} x {k}\nstatistics: not computed for a file over {} (they read every sample; `arbvis convert` computes them into a store, which `arbvis inspect STORE` shows)\n",
                 path.display(),
-                crate::budget::format_bytes(INSPECT_WHOLE_MAX)
+                arbvis_core::budget::format_bytes(INSPECT_WHOLE_MAX)
             ));
         }
         Err(e) if len > INSPECT_WHOLE_MAX => return Err(e),
@@ -562,5 +562,5 @@ fn describe_with(v: &Volume, stats: Stats) -> String {
 
 /// Read a whole regular file of at most `max_bytes`, naming it in the error.
 pub(crate) fn read_file(path: &Path, max_bytes: u64) -> Result<Vec<u8>, VolumeError> {
-    crate::input::read_regular(path, max_bytes).map_err(|e| VolumeError::io(path, e))
+    arbvis_core::input::read_regular(path, max_bytes).map_err(|e| VolumeError::io(path, e))
 }

@@ -371,7 +371,7 @@ fn read_from(
 }
 
 fn open(path: &Path) -> Result<(Box<dyn Read>, bool), VolumeError> {
-    let (file, _) = crate::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
+    let (file, _) = arbvis_core::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
     let mut reader = BufReader::new(file);
     let mut magic = [0u8; 2];
     let n = read_full(&mut reader, &mut magic).map_err(|e| VolumeError::io(path, e))?;

@@ -2,7 +2,7 @@
 //! byte offset. The file must hold exactly `offset + ni*nj*nk*bytes` bytes (a size that
 //! does not match is an error, because it usually means wrong dimensions or type).
 
-use crate::vocab::FieldError;
+use arbvis_core::vocab::FieldError;
 use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
@@ -80,7 +80,8 @@ pub fn read(base: &Path, spec: &RawSpec, limits: &super::Limits) -> Result<Volum
         .byte_size()
         .map_err(|e| VolumeError::Invalid(format!("{}: {}", path.display(), e.message)))?;
     limits.check(spec.dims, &path.display().to_string())?;
-    let (_, len) = crate::input::open_regular(&path).map_err(|e| VolumeError::io(&path, e))?;
+    let (_, len) =
+        arbvis_core::input::open_regular(&path).map_err(|e| VolumeError::io(&path, e))?;
     if len != need {
         return Err(VolumeError::format(
             &path,

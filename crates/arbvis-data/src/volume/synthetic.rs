@@ -3,7 +3,7 @@
 //! convolved with a Ricker wavelet, plus a little noise. Deterministic for a seed.
 //! Axes as in SEG-Y: sample (i, time), crossline (j), inline (k).
 
-use crate::vocab::FieldError;
+use arbvis_core::vocab::FieldError;
 use serde::{Deserialize, Serialize};
 
 use super::{Volume, VolumeError};

@@ -20,9 +20,9 @@ pub use picture::{FrameBudget, InteractiveQuality, Key, Pending, Picture};
 use std::time::Duration;
 
 use crate::error::RenderResult;
-use crate::gl::{Gpu, ProgramKind, Target};
 use crate::scene::Scene;
 use crate::techniques::Renderer;
+use arbvis_gl::{Gpu, ProgramKind, Target};
 
 /// How a frame is wanted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -223,10 +223,10 @@ impl Session {
     /// The full-quality picture of `scene` read back as the target holds it (top row
     /// first, alpha the coverage), with the legends and axes the scene asks for; after a
     /// [`Mode::Now`] or [`Mode::Complete`] frame.
-    pub fn read(&self, gpu: &Gpu, scene: &Scene) -> RenderResult<crate::image::Image> {
+    pub fn read(&self, gpu: &Gpu, scene: &Scene) -> RenderResult<arbvis_core::image::Image> {
         let target = self
             .full_picture(scene)
-            .ok_or_else(|| crate::gl::GlError::Invalid("the session drew no picture".into()))?;
+            .ok_or_else(|| arbvis_gl::GlError::Invalid("the session drew no picture".into()))?;
         let mut image = target.read(gpu)?;
         let show = crate::annotate::Show {
             legend: scene.legend,
@@ -245,7 +245,11 @@ impl Session {
     /// scene's straight colour with coverage alpha): the kept picture where it was cleared
     /// as a file is, else drawn now onto a target of its own (a window's session keeps
     /// its pictures on the background).
-    pub fn file_picture(&mut self, gpu: &Gpu, scene: &Scene) -> RenderResult<crate::image::Image> {
+    pub fn file_picture(
+        &mut self,
+        gpu: &Gpu,
+        scene: &Scene,
+    ) -> RenderResult<arbvis_core::image::Image> {
         if self.as_files || !scene.transparent {
             self.frame(gpu, scene, Mode::Now)?;
             let target = self.full_picture(scene);
@@ -263,14 +267,14 @@ impl Session {
             height: h,
         };
         self.renderer
-            .draw(gpu, crate::gl::Surface::Target(&target), &frame)?;
+            .draw(gpu, arbvis_gl::Surface::Target(&target), &frame)?;
         Ok(scene.picture(&target.read(gpu)?))
     }
 }
 
 /// Build the renderer `scene` names, with programs of `kind`, within the memory budget.
 fn build_renderer(gpu: &Gpu, scene: &Scene, kind: ProgramKind) -> RenderResult<Box<dyn Renderer>> {
-    crate::budget::check_estimates(
+    arbvis_core::budget::check_estimates(
         &format!("this {} scene", scene.technique.name()),
         &scene.memory_estimate(true),
     )?;

@@ -2,9 +2,9 @@
 //! `arbvis.dask` keep between frames.
 
 use crate::error::RenderResult;
-use crate::gl::{Backend, Caps, Headless, ProgramKind};
-use crate::image::Image;
 use crate::scene::Scene;
+use arbvis_core::image::Image;
+use arbvis_gl::{Backend, Caps, Headless, ProgramKind};
 
 use super::{FrameBudget, Mode, Session};
 
@@ -46,7 +46,7 @@ impl Offscreen {
         self.session.apply(gpu, scene)?;
         self.session.frame(gpu, scene, Mode::Interacting)?;
         let shown = self.session.shown().ok_or_else(|| {
-            crate::gl::GlError::Invalid("the session drew no interactive picture".into())
+            arbvis_gl::GlError::Invalid("the session drew no interactive picture".into())
         })?;
         Ok(shown.read(gpu)?)
     }

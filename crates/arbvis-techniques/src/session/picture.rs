@@ -18,12 +18,12 @@
 
 use std::time::{Duration, Instant};
 
-use crate::camera::Camera;
 use crate::error::RenderResult;
-use crate::gl::{Gpu, Surface, Target};
 use crate::scene::{Scene, TechniqueScene};
 use crate::techniques::{Frame, Renderer};
-use crate::vocab::TargetFormat;
+use arbvis_core::camera::Camera;
+use arbvis_core::vocab::TargetFormat;
+use arbvis_gl::{Gpu, Surface, Target};
 
 /// The most each side of a reduced picture is divided by (VTK's largest image sample
 /// distance is 10 too).

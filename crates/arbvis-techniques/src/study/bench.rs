@@ -21,9 +21,6 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use serde::{Deserialize, Serialize};
 
-use crate::gl::{Gpu, Headless, ProgramKind};
-use crate::image::Image;
-use crate::progress::{Bar, Unit};
 use crate::scene::Scene;
 use crate::session::{Mode, Session};
 use crate::techniques::cellproj::CellprojScene;
@@ -33,8 +30,11 @@ use crate::techniques::opacity3d::renderer::{path, preintegrated, resolve_kind, 
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::opacity3d::{Opacity3dRenderer, Raycast};
 use crate::techniques::{Frame, Renderer};
-use crate::vocab::Fidelity;
-use crate::vocab::TargetFormat;
+use arbvis_core::image::Image;
+use arbvis_core::progress::{Bar, Unit};
+use arbvis_core::vocab::Fidelity;
+use arbvis_core::vocab::TargetFormat;
+use arbvis_gl::{Gpu, Headless, ProgramKind};
 
 /// What to measure (`arbvis bench`'s options; the command line's `BenchArgs` gives their help).
 #[derive(Debug, Clone)]
@@ -137,7 +137,7 @@ impl View {
 
     /// `scene` seen this way.
     pub fn apply(self, scene: &Scene) -> Scene {
-        use crate::camera::{Camera, Projection};
+        use arbvis_core::camera::{Camera, Projection};
         let rotated = [0.326506, -0.092296, -0.701057, 0.627211];
         let mut s = scene.clone();
         match self {
@@ -523,7 +523,7 @@ fn prepare_volume(
     let prepared = prepare(
         p,
         &scene.base,
-        &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
+        &arbvis_data::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
     )
     .map_err(anyhow::Error::msg)?;
     progress(&format!(
@@ -772,8 +772,8 @@ fn reference_rgb(
     if let Some(dir) = &options.export {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         let raw: Vec<u8> = rgb.iter().flat_map(|v| v.to_le_bytes()).collect();
-        crate::png_io::write_atomic(&dir.join("reference.f32"), &raw)?;
-        crate::png_io::write_atomic(
+        arbvis_core::png_io::write_atomic(&dir.join("reference.f32"), &raw)?;
+        arbvis_core::png_io::write_atomic(
             &dir.join("reference.toml"),
             toml::to_string(&key)?.as_bytes(),
         )?;
@@ -782,13 +782,16 @@ fn reference_rgb(
 }
 
 fn read_cached(dir: &Path, key: &ReferenceKey, bytes: u64) -> Option<Vec<f32>> {
-    let text =
-        crate::input::read_text(&dir.join("reference.toml"), crate::input::MAX_SCENE_BYTES).ok()?;
+    let text = arbvis_core::input::read_text(
+        &dir.join("reference.toml"),
+        arbvis_core::input::MAX_SCENE_BYTES,
+    )
+    .ok()?;
     let stored: ReferenceKey = toml::from_str(&text).ok()?;
     if &stored != key {
         return None;
     }
-    let raw = crate::input::read_regular(&dir.join("reference.f32"), bytes).ok()?;
+    let raw = arbvis_core::input::read_regular(&dir.join("reference.f32"), bytes).ok()?;
     (raw.len() as u64 == bytes).then(|| {
         raw.chunks_exact(4)
             .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))

@@ -13,10 +13,6 @@ use std::time::Instant;
 use anyhow::Result;
 
 use super::measured::Measured;
-use crate::gl::{
-    self, Blend, DrawCall, Extent, Headless, Mesh, Program, ProgramKind, Surface, TexelData,
-    TexelFormat, Texture,
-};
 use crate::programs::{self, with_transform};
 use crate::scene::Scene;
 use crate::techniques::opacity3d::prepare::Prepared;
@@ -26,7 +22,11 @@ use crate::techniques::opacity3d::renderer::model_view_projection;
 use crate::techniques::opacity3d::slicing::slice_box;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::Frame;
-use crate::vocab::TargetFormat;
+use arbvis_core::vocab::TargetFormat;
+use arbvis_gl::{
+    self, Blend, DrawCall, Extent, Headless, Mesh, Program, ProgramKind, Surface, TexelData,
+    TexelFormat, Texture,
+};
 
 /// One probe: a name, its tags, which volume it reads, its target and blend.
 struct Probe {
@@ -137,7 +137,7 @@ pub fn run(
         programs_of.push(program);
     }
     let targets =
-        [TargetFormat::Rgba8, TargetFormat::Rgba32f].map(|f| gl::Target::new(gpu, w, h, f));
+        [TargetFormat::Rgba8, TargetFormat::Rgba32f].map(|f| arbvis_gl::Target::new(gpu, w, h, f));
     let [t8, t32] = targets;
     let (t8, t32) = (t8?, t32?);
     let mut out: Vec<Measured> = Vec::new();
@@ -153,7 +153,7 @@ pub fn run(
             let one = || -> Result<f64> {
                 let t0 = Instant::now();
                 target.clear(gpu, scene.clear_colour())?;
-                gl::draw(
+                arbvis_gl::draw(
                     gpu,
                     Surface::Target(target),
                     &DrawCall {

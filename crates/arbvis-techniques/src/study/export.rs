@@ -12,12 +12,12 @@ use anyhow::{Context, Result};
 use glam::DVec3;
 use serde::Serialize;
 
-use crate::camera::Projection;
 use crate::scene::Scene;
 use crate::techniques::opacity3d::prepare::Prepared;
 use crate::techniques::opacity3d::renderer::coefficients;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::opacity3d::ATTRIBUTE_NAMES;
+use arbvis_core::camera::Projection;
 
 #[derive(Serialize)]
 struct CameraJson {
@@ -103,8 +103,8 @@ pub fn write(dir: &Path, scene: &Scene, prepared: &Prepared, oversample: f64) ->
         let levels: Vec<u8> = (0..voxels).map(|v| prepared.byte(v, a)).collect();
         let levels_file = format!("levels_{name}.u8");
         let table_file = format!("table_{name}.u8");
-        crate::png_io::write_atomic(&dir.join(&levels_file), &levels)?;
-        crate::png_io::write_atomic(&dir.join(&table_file), &table.texels())?;
+        arbvis_core::png_io::write_atomic(&dir.join(&levels_file), &levels)?;
+        arbvis_core::png_io::write_atomic(&dir.join(&table_file), &table.texels())?;
         attributes.push(AttributeJson {
             name,
             levels: levels_file,
@@ -127,7 +127,7 @@ pub fn write(dir: &Path, scene: &Scene, prepared: &Prepared, oversample: f64) ->
         oversample,
     };
     let text = serde_json::to_string_pretty(&json)?;
-    crate::png_io::write_atomic(&dir.join("scene.json"), text.as_bytes())?;
+    arbvis_core::png_io::write_atomic(&dir.join("scene.json"), text.as_bytes())?;
     Ok(())
 }
 
@@ -178,10 +178,10 @@ pub fn write_cellproj(
         .flat_map(|v| v.to_le_bytes())
         .collect();
     let rgb: Vec<u8> = reference_rgb.iter().flat_map(|v| v.to_le_bytes()).collect();
-    crate::png_io::write_atomic(&dir.join("points.f64"), &points)?;
-    crate::png_io::write_atomic(&dir.join("tets.u32"), &tets)?;
-    crate::png_io::write_atomic(&dir.join("scalars.f64"), &scalars)?;
-    crate::png_io::write_atomic(&dir.join("reference.f32"), &rgb)?;
+    arbvis_core::png_io::write_atomic(&dir.join("points.f64"), &points)?;
+    arbvis_core::png_io::write_atomic(&dir.join("tets.u32"), &tets)?;
+    arbvis_core::png_io::write_atomic(&dir.join("scalars.f64"), &scalars)?;
+    arbvis_core::png_io::write_atomic(&dir.join("reference.f32"), &rgb)?;
     let json = MeshJson {
         points: prepared.points.len(),
         tets: prepared.tets.len(),
@@ -201,7 +201,7 @@ pub fn write_cellproj(
         reference: "reference.f32",
     };
     let text = serde_json::to_string_pretty(&json)?;
-    crate::png_io::write_atomic(&dir.join("scene.json"), text.as_bytes())?;
+    arbvis_core::png_io::write_atomic(&dir.join("scene.json"), text.as_bytes())?;
     Ok(())
 }
 

@@ -3,8 +3,8 @@
 
 use serde::Serialize;
 
-use crate::gl::ProgramKind;
-use crate::vocab::TargetFormat;
+use arbvis_core::vocab::TargetFormat;
+use arbvis_gl::ProgramKind;
 
 /// One setting measured.
 #[derive(Debug, Clone, Serialize)]

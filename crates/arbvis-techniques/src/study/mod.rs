@@ -20,18 +20,18 @@ use crate::error::RenderResult;
 use std::path::Path;
 use std::time::Instant;
 
-use crate::gl::{Headless, ProgramKind, Surface, Target};
-use crate::image::Image;
-use crate::progress::{Bar, Unit};
 use crate::scene::Scene;
 use crate::techniques::opacity3d::prepare::{prepare, Prepared};
 use crate::techniques::opacity3d::reference::reference;
 use crate::techniques::opacity3d::{Opacity3dRenderer, Opacity3dScene};
 use crate::techniques::{Frame, Renderer};
-use crate::vocab::Fidelity;
-use crate::vocab::TargetFormat;
-use crate::volume::synthetic::SyntheticSpec;
-use crate::volume::VolumeSource;
+use arbvis_core::image::Image;
+use arbvis_core::progress::{Bar, Unit};
+use arbvis_core::vocab::Fidelity;
+use arbvis_core::vocab::TargetFormat;
+use arbvis_data::volume::synthetic::SyntheticSpec;
+use arbvis_data::volume::VolumeSource;
+use arbvis_gl::{Headless, ProgramKind, Surface, Target};
 
 /// What to sweep.
 #[derive(Debug, Clone)]
@@ -192,7 +192,7 @@ pub fn run(
     let prepared = prepare(
         params(&base_scene),
         &base_scene.base,
-        &crate::volume::Limits::for_max_side(headless.gpu().caps().max_3d_texture_size),
+        &arbvis_data::volume::Limits::for_max_side(headless.gpu().caps().max_3d_texture_size),
     )
     .map_err(anyhow::Error::msg)?;
     progress(&format!(

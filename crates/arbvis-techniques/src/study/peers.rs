@@ -102,7 +102,7 @@ fn series(run: &Run) -> BTreeMap<String, Vec<Point>> {
 }
 
 fn read_run(path: &Path) -> Result<Run> {
-    let text = crate::input::read_text(path, 64 << 20)
+    let text = arbvis_core::input::read_text(path, 64 << 20)
         .with_context(|| format!("reading {}", path.display()))?;
     serde_json::from_str(&text)
         .map_err(|e| anyhow::anyhow!("{}:{}:{}: {e}", path.display(), e.line(), e.column()))
@@ -241,8 +241,8 @@ pub fn study(runs: &[PathBuf], out: &Path) -> Result<String> {
         };
         super::plot_lines(&lines, &out.join(format!("{name}.png")), &chart, &[])?;
     }
-    crate::png_io::write_atomic(&out.join("study.csv"), csv.as_bytes())?;
-    crate::png_io::write_atomic(&out.join("study.md"), md.as_bytes())?;
+    arbvis_core::png_io::write_atomic(&out.join("study.csv"), csv.as_bytes())?;
+    arbvis_core::png_io::write_atomic(&out.join("study.md"), md.as_bytes())?;
     Ok(md)
 }
 

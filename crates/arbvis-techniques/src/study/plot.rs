@@ -5,8 +5,8 @@
 
 use std::path::Path;
 
-use crate::image::Image;
-use crate::vocab::TargetFormat;
+use arbvis_core::image::Image;
+use arbvis_core::vocab::TargetFormat;
 
 /// Titles of a plot.
 #[derive(Debug, Clone, Copy)]
@@ -154,7 +154,7 @@ fn save_plot(buffer: &[u8], w: u32, h: u32, path: &Path) -> anyhow::Result<()> {
         format: TargetFormat::Rgba8,
         data,
     };
-    crate::png_io::write_png(path, &image, &[("Software", "arbvis study".into())])?;
+    arbvis_core::png_io::write_png(path, &image, &[("Software", "arbvis study".into())])?;
     Ok(())
 }
 
@@ -184,7 +184,7 @@ mod tests {
             ("b".to_string(), vec![(5.0, f64::NAN)]),
         ];
         plot_lines(&lines, &png, &chart(), &[(41.0, "no clip".into())]).unwrap();
-        let (image, _) = crate::png_io::read_png(&png).unwrap();
+        let (image, _) = arbvis_core::png_io::read_png(&png).unwrap();
         assert_eq!((image.width, image.height), (1100, 700));
         // The first series is drawn in the palette's first colour: its line (three
         // segments, each tens of pixels long) and the legend's sample, well over 100

@@ -3,7 +3,7 @@
 //! isovalues or classes as keys, and the box's three axes in the data's own numbers. The
 //! viewer draws its own; `crate::annotate` draws these into offscreen pictures.
 
-use crate::volume::axes::Axis;
+use arbvis_data::volume::axes::Axis;
 
 /// One legend.
 #[derive(Debug, Clone, PartialEq)]

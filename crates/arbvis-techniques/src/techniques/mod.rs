@@ -29,17 +29,17 @@ pub mod rays;
 pub mod splats;
 
 use crate::error::RenderResult;
-use crate::gl::GlResult;
+use arbvis_gl::GlResult;
 use std::any::Any;
 use std::path::{Path, PathBuf};
 
-use crate::budget::Estimate;
-use crate::camera::{Camera, Projection};
-use crate::gl::{GlError, Gpu, ProgramChoice, ProgramKind, Surface};
-use crate::image::Image;
 use crate::programs::ProgramPair;
-use crate::vocab::{Fidelity, FieldError};
-use crate::volume::Limits;
+use arbvis_core::budget::Estimate;
+use arbvis_core::camera::{Camera, Projection};
+use arbvis_core::image::Image;
+use arbvis_core::vocab::{Fidelity, FieldError};
+use arbvis_data::volume::Limits;
+use arbvis_gl::{GlError, Gpu, ProgramChoice, ProgramKind, Surface};
 
 /// What changes from frame to frame.
 #[derive(Debug, Clone, Copy)]
@@ -278,7 +278,7 @@ pub struct Settings<'a> {
     pub projection: Projection,
     /// The first view (camera and image size), for data that is cut to the view (a COPC
     /// cloud's nodes).
-    pub view: crate::camera::View,
+    pub view: arbvis_core::camera::View,
 }
 
 /// Some technique's parameters; a renderer takes its own with [`Params::get`].

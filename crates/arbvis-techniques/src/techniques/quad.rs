@@ -10,14 +10,14 @@
 //! and outputs `(c.rgb * v, c.a)`. [`reference`] computes the same at pixel centres in f64.
 
 use crate::error::RenderResult;
-use crate::gl::GlResult;
+use arbvis_gl::GlResult;
 use glam::{DMat4, DVec3};
 use serde::{Deserialize, Serialize};
 
 use super::{Frame, Params, Renderer, Settings, Technique};
-use crate::gl::{self, DrawCall, GlError, Gpu, Mesh, Program, ProgramKind, Surface};
-use crate::image::Image;
 use crate::programs;
+use arbvis_core::image::Image;
+use arbvis_gl::{self, DrawCall, GlError, Gpu, Mesh, Program, ProgramKind, Surface};
 
 /// The program local of the left edge's colour (`program.local[0]`).
 pub const LEFT_LOCAL: usize = 0;
@@ -40,9 +40,9 @@ impl Technique for QuadScene {
 
     fn validate(
         &self,
-        _: crate::vocab::Fidelity,
-        _: gl::ProgramChoice,
-    ) -> Result<(), crate::vocab::FieldError> {
+        _: arbvis_core::vocab::Fidelity,
+        _: arbvis_gl::ProgramChoice,
+    ) -> Result<(), arbvis_core::vocab::FieldError> {
         Ok(())
     }
 
@@ -52,7 +52,7 @@ impl Technique for QuadScene {
 
     type Prepared = ();
 
-    fn prepare(&self, _: &Settings<'_>, _: &crate::volume::Limits) -> RenderResult<()> {
+    fn prepare(&self, _: &Settings<'_>, _: &arbvis_data::volume::Limits) -> RenderResult<()> {
         Ok(())
     }
 
@@ -61,9 +61,14 @@ impl Technique for QuadScene {
         &self,
         _: &(),
         view: &crate::techniques::ReferenceView<'_>,
-    ) -> Option<crate::image::Image> {
+    ) -> Option<arbvis_core::image::Image> {
         let [w, h] = view.size;
-        Some(reference_image(self, w, h, gl::TargetFormat::Rgba32f))
+        Some(reference_image(
+            self,
+            w,
+            h,
+            arbvis_gl::TargetFormat::Rgba32f,
+        ))
     }
 
     fn renderer(
@@ -86,7 +91,7 @@ impl Default for QuadScene {
     }
 }
 
-pub use crate::gl::quad_vertices;
+pub use arbvis_gl::quad_vertices;
 
 /// A mesh of [`quad_vertices`] (attributes 4 + 4), labelled `label`: the full-screen
 /// passes' quad.
@@ -135,7 +140,7 @@ impl QuadRenderer {
 impl Renderer for QuadRenderer {
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
         self.program.set_transform(gpu, transform(frame))?;
-        Ok(gl::draw(
+        Ok(arbvis_gl::draw(
             gpu,
             surface,
             &DrawCall::new(&self.program, &self.mesh),
@@ -182,9 +187,9 @@ pub fn reference_image(
     params: &QuadScene,
     width: u32,
     height: u32,
-    format: gl::TargetFormat,
+    format: arbvis_gl::TargetFormat,
 ) -> Image {
-    let clamp = format == gl::TargetFormat::Rgba8;
+    let clamp = format == arbvis_gl::TargetFormat::Rgba8;
     Image::from_f64_pixels(
         width,
         height,

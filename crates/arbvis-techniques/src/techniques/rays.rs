@@ -2,16 +2,16 @@
 //! the near plane to the far plane of the camera's projection (so orthographic and
 //! perspective views are handled alike), traced in parallel rows. A large reference is
 //! announced with its estimated time before it starts (timed on 1 pixel in 256), and
-//! shows a progress bar ([`crate::progress`]), or plain lines where no bar is drawn,
+//! shows a progress bar ([`arbvis_core::progress`]), or plain lines where no bar is drawn,
 //! when it runs longer than a couple of seconds.
 
 use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 
-use crate::camera::Camera;
-use crate::image::Image;
-use crate::progress::{Bar, Lines, Unit};
-use crate::vocab::TargetFormat;
+use arbvis_core::camera::Camera;
+use arbvis_core::image::Image;
+use arbvis_core::progress::{Bar, Lines, Unit};
+use arbvis_core::vocab::TargetFormat;
 
 /// A pixel's ray in object space: origin on the near plane, direction toward the far
 /// plane (not normalized: the parameter runs 0..1 from near to far).
@@ -122,7 +122,7 @@ fn announce_cost(size: [u32; 2], trace: &(impl Fn(u32, u32) + Sync)) {
         .sum();
     let estimate = t0.elapsed().as_secs_f64() * pixels as f64 / samples.max(1) as f64;
     if estimate > ANNOUNCE_ABOVE_S {
-        crate::progress::line(&format!(
+        arbvis_core::progress::line(&format!(
             "f64 reference at {width}x{height}: about {estimate:.0} s on this machine (timed on 1 pixel in {}); its progress follows",
             STRIDE * STRIDE
         ));

@@ -1,7 +1,7 @@
 use super::*;
-use crate::camera::Projection;
 use crate::fit_zoom;
-use crate::volume::axes::{span, Numbers};
+use arbvis_core::camera::Projection;
+use arbvis_data::volume::axes::{span, Numbers};
 
 /// Text as a font of this size measures it, about: 0.55 em per character, 1.25 em tall.
 fn measure(t: &str, size: f32) -> Vec2 {

@@ -8,7 +8,7 @@ use egui::{Event, Modifiers, PointerButton};
 
 use super::{press, Observed, Outcome, ScriptRunner, ScriptStep, PATIENCE};
 use crate::script::{ClickKind, MeasureMode, Step};
-use crate::widgets::SetRequest;
+use crate::widgets::{SetOutcome, SetRequest};
 
 impl ScriptRunner {
     /// `click`, `click-at`, `right-click-at`, `double-click-at`: press and release on the
@@ -180,12 +180,12 @@ impl ScriptRunner {
             return Ok(Outcome::Pending);
         }
         match o.widgets.set.as_ref().and_then(|s| s.outcome.clone()) {
-            Some(Ok(())) => {
+            Some(SetOutcome::Applied) => {
                 o.widgets.set = None;
                 o.widgets.focus = None;
                 Ok(Outcome::Done)
             }
-            Some(Err(e)) => Err(self.error(step, e)),
+            Some(SetOutcome::Refused(e)) => Err(self.error(step, e)),
             None if self.frames_in_step > PATIENCE => Err(self.error(
                 step,
                 format!(

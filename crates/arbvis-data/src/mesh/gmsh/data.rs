@@ -4,9 +4,9 @@
 use std::collections::{HashMap, HashSet};
 
 use super::reader::{Reader, TagMap};
-use crate::budget;
 use crate::mesh::read::vec_for;
 use crate::mesh::{DataArray, MeshError, ReadArray};
+use arbvis_core::budget;
 
 /// A `$NodeData` / `$ElementData` section as read. Its entries name nodes and elements
 /// by tag; they are matched at the end of the file, when every `$Nodes` and `$Elements`

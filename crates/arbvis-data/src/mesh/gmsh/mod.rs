@@ -31,7 +31,7 @@ use self::reader::{Reader, TagMap};
 use super::cells::{gmsh_kind, RawCells};
 use super::read::{quote, vec_for, Cursor};
 use super::{Mesh, MeshError, MeshInfo};
-use crate::budget;
+use arbvis_core::budget;
 
 #[derive(Default)]
 struct State {

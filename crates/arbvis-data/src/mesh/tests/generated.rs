@@ -108,7 +108,7 @@ fn mesh_sources_from_toml() {
     assert_eq!(s.mesh.load(Path::new(".")).unwrap().tets.len(), 24_576);
     let s: S = toml::from_str("mesh = { file = \"tets/post.vtk\" }").unwrap();
     assert_eq!(s.mesh.path(), Some(Path::new("tets/post.vtk")));
-    let data = crate::input::data_file("tets/post.vtk");
+    let data = arbvis_core::input::data_file("tets/post.vtk");
     let m = s
         .mesh
         .load(data.parent().unwrap().parent().unwrap())

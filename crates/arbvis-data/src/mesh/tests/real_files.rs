@@ -3,9 +3,9 @@
 
 use std::collections::HashMap;
 
-use crate::input::data_file;
 use crate::mesh::quality::{signed_volume, Quality};
 use crate::mesh::{inspect, read, Mesh};
+use arbvis_core::input::data_file;
 
 fn load(name: &str) -> Mesh {
     read(&data_file(&format!("tets/{name}"))).unwrap_or_else(|e| panic!("{e}"))

@@ -5,10 +5,10 @@
 //! refused here), and only then the connectivity, the points and the data arrays.
 
 use super::desc::{ArrayDesc, File, Format, Section};
-use crate::budget;
 use crate::mesh::cells::{vtk_kind, Kind as CellKind, RawCells, Shape};
 use crate::mesh::read::{line_column, text_error, vec_for};
 use crate::mesh::{DataArray, Mesh, MeshError, MeshInfo, ReadArray};
+use arbvis_core::budget;
 
 /// Bytes one value of `d` needs once decoded: its stored width (the bytes inflated or
 /// copied) and the f64 or i64 it becomes.
@@ -179,7 +179,7 @@ impl<'f, 'a> Piece<'f, 'a> {
             prev = o;
         }
         let types = f.ints(types_d, Some(nc_usize), &self.cells_need)?;
-        let mut kinds = vec_for(nc_usize, "cell types").map_err(|m| self.err(self.at, m))?;
+        let mut kinds = vec_for(nc_usize, "cell types").map_err(|m| self.err(self.at, m.into()))?;
         for (i, &t) in types.iter().enumerate() {
             kinds.push(vtk_kind(t).map_err(|m| self.err(types_d.at, format!("cell {i}: {m}")))?);
         }
@@ -244,7 +244,7 @@ impl<'f, 'a> Piece<'f, 'a> {
             kinds,
             ..RawCells::default()
         };
-        let mk = |m: String| self.err(self.at, m);
+        let mk = |m: arbvis_core::budget::OverBudget| self.err(self.at, m.into());
         cells.offsets = vec_for(self.nc_usize + 1, "cell offsets").map_err(mk)?;
         cells.at = vec_for(self.nc_usize, "cell positions").map_err(mk)?;
         cells.nodes = vec_for(conn.len(), "cell nodes").map_err(mk)?;

@@ -102,7 +102,7 @@ impl File<'_> {
             return self.ascii(d, n, need, ascii);
         }
         let data = self.binary(d, n, t, need)?;
-        let mut out = vec_for(n, "values").map_err(|m| self.err(d, m))?;
+        let mut out = vec_for(n, "values").map_err(|m| self.err(d, m.into()))?;
         decode(&data, &mut out);
         Ok(out)
     }
@@ -484,7 +484,7 @@ impl File<'_> {
                 )));
             }
         }
-        let mut out = vec_for(want, "bytes").map_err(|m| self.err(d, m))?;
+        let mut out = vec_for(want, "bytes").map_err(|m| self.err(d, m.into()))?;
         let mut pos = 0usize;
         for (i, &c) in table[3..].iter().enumerate() {
             let u = size(i);

@@ -47,7 +47,7 @@ impl Copc {
         let h = f.header()?;
         f.vlrs(&h)?;
         let (hierarchy, evlrs_end) = f.evlrs(&h)?;
-        crate::budget::check(
+        arbvis_core::budget::check(
             format!("the hierarchy and other EVLRs of {}", path.display()),
             (evlrs_end - h.evlr_start).saturating_mul(3),
         )

@@ -21,8 +21,8 @@ const PENDING: usize = 64 << 20;
 /// A COPC file being written to a temporary beside its name.
 pub(super) struct CopcFile {
     path: PathBuf,
-    temporary: crate::png_io::Temporary,
-    spill: crate::png_io::Temporary,
+    temporary: arbvis_core::png_io::Temporary,
+    spill: arbvis_core::png_io::Temporary,
     file: BufWriter<File>,
     at: u64,
     header: Vec<u8>,
@@ -71,8 +71,8 @@ impl CopcFile {
         cube: &Cube,
     ) -> Result<CopcFile, PointsError> {
         let io = |e| PointsError::io(path, e);
-        let temporary = crate::png_io::Temporary::beside(path, "").map_err(io)?;
-        let spill = crate::png_io::Temporary::beside(path, ".spill").map_err(io)?;
+        let temporary = arbvis_core::png_io::Temporary::beside(path, "").map_err(io)?;
+        let spill = arbvis_core::png_io::Temporary::beside(path, ".spill").map_err(io)?;
         std::fs::create_dir(spill.path()).map_err(io)?;
         let file = File::create(temporary.path()).map_err(io)?;
         let extra = source.record - super::records::BASE[source.format as usize];

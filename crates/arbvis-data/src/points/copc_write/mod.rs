@@ -92,10 +92,10 @@ pub fn write_copc(
     let each = 2 * source.record as u64 + 24 + 8 + 8;
     // At most 8 Mi points at once (about 1 GB with format 7): the whole conversion stays
     // under 2 GB of memory for any size of cloud.
-    let memory_points = options
-        .memory_points
-        .unwrap_or_else(|| (crate::budget::current().bytes / 4 / each).clamp(1 << 16, 1 << 23));
-    crate::budget::check(
+    let memory_points = options.memory_points.unwrap_or_else(|| {
+        (arbvis_core::budget::current().bytes / 4 / each).clamp(1 << 16, 1 << 23)
+    });
+    arbvis_core::budget::check(
         format!(
             "building {memory_points} points of {} in memory",
             input.display()
@@ -120,10 +120,10 @@ pub fn write_copc(
     for attempt in 0..2 {
         let cube = cube_around(input, &bounds, &source, grid)?;
         let mut out = file::CopcFile::create(output, &source, &cube)?;
-        let bar = crate::progress::Bar::new(
+        let bar = arbvis_core::progress::Bar::new(
             source.count,
             &format!("writing {}", output.display()),
-            crate::progress::Unit::Points,
+            arbvis_core::progress::Unit::Points,
         );
         let spill = out.spill_dir().to_path_buf();
         let count = source.count;
@@ -175,7 +175,7 @@ pub fn write_copc(
                 if !(outside || differ) {
                     return Err(e);
                 }
-                crate::progress::line(&format!(
+                arbvis_core::progress::line(&format!(
                     "{}: the points' bounds are not the header's; building the octree again around the points' own",
                     input.display()
                 ));
@@ -201,16 +201,16 @@ pub fn write_copc(
 
 /// The lock on `output` (`.NAME.arbvis-convert.lock` beside it), or the error naming the
 /// process that holds it.
-fn lock(output: &Path) -> Result<crate::png_io::WriterLock, PointsError> {
+fn lock(output: &Path) -> Result<arbvis_core::png_io::WriterLock, PointsError> {
     let name = output
         .file_name()
         .ok_or_else(|| PointsError::unsupported(output, "not a file path"))?
         .to_string_lossy();
     let path = output.with_file_name(format!(".{name}.arbvis-convert.lock"));
-    match crate::png_io::WriterLock::acquire(&path).map_err(|e| PointsError::io(&path, e))? {
+    match arbvis_core::png_io::WriterLock::acquire(&path).map_err(|e| PointsError::io(&path, e))? {
         Ok(lock) => {
             if let Some(pid) = lock.taken_over() {
-                crate::progress::line(&format!(
+                arbvis_core::progress::line(&format!(
                     "note: {}: the lock of pid {pid}, which is no longer running, taken over",
                     path.display()
                 ));

@@ -51,7 +51,7 @@ impl Source {
     /// Open `path` as LAS/LAZ (by content or extension), PLY or `.dat`.
     pub(super) fn open(path: &Path) -> Result<Source, PointsError> {
         let io = |e| PointsError::io(path, e);
-        let (file, _) = crate::input::open_regular(path).map_err(io)?;
+        let (file, _) = arbvis_core::input::open_regular(path).map_err(io)?;
         let mut head = Vec::new();
         std::io::Read::read_to_end(&mut std::io::Read::take(file, 16), &mut head).map_err(io)?;
         match FileKind::detect(path, &head) {

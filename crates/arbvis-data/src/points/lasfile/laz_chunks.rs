@@ -57,7 +57,7 @@ fn decode_chunk(
     bytes: &[u8],
     chunk: Chunk,
     out: &mut [u8],
-) -> Result<(), String> {
+) -> Result<(), crate::points::DecoderError> {
     let source = Cursor::new(&bytes[chunk.start..chunk.end]);
     let layered = vlr.items().first().is_some_and(|i| i.version() >= 3);
     let run = |d: &mut dyn RecordDecompressor<Cursor<&[u8]>>, out: &mut [u8]| -> las::Result<()> {
@@ -103,8 +103,9 @@ impl Decoded {
                     .enumerate()
                     .map(|(k, &chunk)| {
                         let n = chunk.points as usize * record;
-                        let mut out = crate::budget::vec_for::<u8>(n, "a LAZ chunk's records")
-                            .map_err(|e| PointsError::unsupported(&path, e.to_string()))?;
+                        let mut out =
+                            arbvis_core::budget::vec_for::<u8>(n, "a LAZ chunk's records")
+                                .map_err(|e| PointsError::unsupported(&path, e.to_string()))?;
                         out.resize(n, 0);
                         decode_chunk(&vlr, &bytes, chunk, &mut out).map_err(|m| {
                             PointsError::format(

@@ -127,7 +127,7 @@ impl Records {
     /// Open `path` and check it.
     pub(crate) fn open(path: &Path) -> Result<Records, PointsError> {
         let io = |e| PointsError::io(path, e);
-        let (mut file, len) = crate::input::open_regular(path).map_err(io)?;
+        let (mut file, len) = arbvis_core::input::open_regular(path).map_err(io)?;
         let mut head = vec![0u8; len.min(375) as usize];
         file.read_exact(&mut head).map_err(io)?;
         let compressed = head.len() > 104 && head[104] & 0x80 != 0;

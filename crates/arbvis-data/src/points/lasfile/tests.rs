@@ -417,7 +417,7 @@ fn every_truncation_fails_cleanly() {
 
 #[test]
 fn autzen_laz() {
-    let path = crate::input::data_file("points/autzen_trim.laz");
+    let path = arbvis_core::input::data_file("points/autzen_trim.laz");
     let t = std::time::Instant::now();
     let c = read(&path).unwrap();
     eprintln!(

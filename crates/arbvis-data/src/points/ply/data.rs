@@ -66,7 +66,7 @@ pub(super) fn read_binary(
 /// the bytes left, the estimate against the budget).
 fn columns(name: &Path, e: &DeclaredElement) -> Result<Vec<Property>, PointsError> {
     let (line, column) = e.at;
-    let fail = |error: crate::budget::OverBudget| {
+    let fail = |error: arbvis_core::budget::OverBudget| {
         PointsError::text(
             name,
             line,
@@ -81,11 +81,12 @@ fn columns(name: &Path, e: &DeclaredElement) -> Result<Vec<Property>, PointsErro
             let data = match d.count {
                 None => PropertyData::Scalar {
                     ty: d.ty,
-                    values: crate::budget::vec_for(e.count, &what).map_err(fail)?,
+                    values: arbvis_core::budget::vec_for(e.count, &what).map_err(fail)?,
                 },
                 Some(count) => {
                     let mut offsets =
-                        crate::budget::vec_for(e.count.saturating_add(1), &what).map_err(fail)?;
+                        arbvis_core::budget::vec_for(e.count.saturating_add(1), &what)
+                            .map_err(fail)?;
                     offsets.push(0);
                     PropertyData::List {
                         count,
@@ -217,7 +218,7 @@ fn reserve_items(
     e: &DeclaredElement,
 ) -> Result<(), PointsError> {
     let what = format!("the list items of element {}", e.name);
-    crate::budget::reserve(values, n as usize, &what).map_err(|error| {
+    arbvis_core::budget::reserve(values, n as usize, &what).map_err(|error| {
         let message = format!("element {}: {error}", e.name);
         match at {
             Position::Byte(b) => PointsError::format(name, b, message),
@@ -408,7 +409,7 @@ impl Where<'_> {
 /// A token as a value of `ty`, or what is wrong with it.
 fn ascii_value(token: &[u8], ty: ScalarType) -> Result<f64, String> {
     let text = std::str::from_utf8(token).unwrap_or("");
-    let shown = || crate::input::shorten(&String::from_utf8_lossy(token), 40);
+    let shown = || arbvis_core::input::shorten(&String::from_utf8_lossy(token), 40);
     let v = text
         .parse::<f64>()
         .map_err(|_| format!("expected a number, found \"{}\"", shown()))?;

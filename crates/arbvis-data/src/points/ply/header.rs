@@ -80,7 +80,7 @@ pub(super) fn parse(name: &Path, bytes: &[u8]) -> Result<Header, PointsError> {
                     1,
                     format!(
                         "expected format, comment, obj_info, element, property or end_header, found \"{}\"",
-                        crate::input::shorten(other, 40)
+                        arbvis_core::input::shorten(other, 40)
                     ),
                 ))
             }
@@ -160,7 +160,7 @@ impl<'a> Line<'a> {
                 1,
                 format!(
                     "not a PLY file: expected \"ply\" on the first line, found \"{}\"",
-                    crate::input::shorten(self.line, 40)
+                    arbvis_core::input::shorten(self.line, 40)
                 ),
             ));
         }
@@ -178,7 +178,7 @@ impl<'a> Line<'a> {
                     self.col(1),
                     format!(
                         "expected ascii, binary_little_endian or binary_big_endian, found \"{}\"",
-                        crate::input::shorten(other, 40)
+                        arbvis_core::input::shorten(other, 40)
                     ),
                 ))
             }
@@ -188,7 +188,7 @@ impl<'a> Line<'a> {
                 self.col(2),
                 format!(
                     "expected format version 1.0, found \"{}\"",
-                    crate::input::shorten(self.word(2), 40)
+                    arbvis_core::input::shorten(self.word(2), 40)
                 ),
             ));
         }
@@ -204,7 +204,7 @@ impl<'a> Line<'a> {
                 col(2),
                 format!(
                     "expected the element's row count, found \"{}\"",
-                    crate::input::shorten(word(2), 40)
+                    arbvis_core::input::shorten(word(2), 40)
                 ),
             )
         })?;
@@ -230,7 +230,7 @@ impl<'a> Line<'a> {
                 self.col(i),
                 format!(
                     "expected a PLY type (char, uchar, short, ushort, int, uint, float, double or int8 .. float64), found \"{}\"",
-                    crate::input::shorten(self.word(i), 40)
+                    arbvis_core::input::shorten(self.word(i), 40)
                 ),
             )
         })

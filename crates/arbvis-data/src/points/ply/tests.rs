@@ -371,7 +371,7 @@ fn every_truncation_fails_cleanly() {
 
 #[test]
 fn bunny_faces_through_the_public_api() {
-    let path = crate::input::data_file("points/bunny.ply");
+    let path = arbvis_core::input::data_file("points/bunny.ply");
     let ply = read(&path).unwrap();
     assert_eq!(ply.encoding, Encoding::Ascii);
     assert_eq!(ply.comments, vec!["zipper output", "modified by flipply"]);

@@ -52,7 +52,7 @@ pub fn open_array(folder: &Path) -> Result<ArrayMeta, StoreError> {
     let (data_type, big_endian) = numpy_type(type_name).ok_or_else(|| {
         let what = match doc.get("dtype") {
             Some(Value::Array(_)) => "a structured type".to_string(),
-            other => crate::input::shorten(&other.unwrap_or(&Value::Null).to_string(), 60),
+            other => arbvis_core::input::shorten(&other.unwrap_or(&Value::Null).to_string(), 60),
         };
         invalid(format!(
             "`dtype` {what}: arbvis reads bool, (u)int8-64 and float16-64"

@@ -140,7 +140,7 @@ pub(super) fn grid(
     let dims = [l.samples, crosslines.count, inlines.count];
     options.limits.check(dims, &path.display().to_string())?;
     let mut values =
-        crate::budget::vec_for::<f32>(l.samples * trace_grid.positions(), "a SEG-Y volume")
+        arbvis_core::budget::vec_for::<f32>(l.samples * trace_grid.positions(), "a SEG-Y volume")
             .map_err(|e| VolumeError::Invalid(format!("{}: {e}", path.display())))?;
     values.resize(l.samples * trace_grid.positions(), f32::NAN);
     let width = l.format.bytes();

@@ -7,7 +7,7 @@
 //! otherwise the first of [`LAYOUTS`] whose numbers look like a grid in the file's first
 //! traces is taken, and rev 1's bytes where none does.
 
-use crate::vocab::FieldError;
+use arbvis_core::vocab::FieldError;
 use std::collections::HashSet;
 use std::path::Path;
 

@@ -45,9 +45,9 @@ fn gcd(a: i64, b: i64) -> i64 {
 impl Lines {
     /// The lines `numbers` (the distinct numbers of the traces, any order) span; `axis`
     /// ("inline", "crossline") names them in the error.
-    pub fn of(numbers: &BTreeSet<i32>, axis: &str) -> Result<Lines, String> {
+    pub fn of(numbers: &BTreeSet<i32>, axis: &str) -> Result<Lines, GridError> {
         let (Some(&first), Some(&last)) = (numbers.first(), numbers.last()) else {
-            return Err(format!("no {axis} numbers"));
+            return Err(GridError::Lines(format!("no {axis} numbers")));
         };
         let step = numbers
             .iter()
@@ -57,11 +57,11 @@ impl Lines {
         let present = numbers.len();
         if count > MAX_SPARSITY * present + SPARSE_SLACK {
             let shown: Vec<String> = numbers.iter().take(8).map(i32::to_string).collect();
-            return Err(format!(
+            return Err(GridError::Lines(format!(
                 "the {present} {axis} numbers ({}{}) have no common step above {step}: a grid from {first} to {last} in steps of {step} would hold {count} {axis}s for the {present} that have traces (at most {MAX_SPARSITY}x + {SPARSE_SLACK} is gridded); if these are not {axis} numbers, name the bytes that hold them",
                 shown.join(", "),
                 if present > 8 { ", ..." } else { "" },
-            ));
+            )));
         }
         Ok(Lines {
             first,
@@ -198,10 +198,8 @@ impl TraceGrid {
                 at: (w[0].0, w[0].1),
             }));
         }
-        let inlines =
-            Lines::of(&keys.iter().map(|k| k.0).collect(), "inline").map_err(GridError::Lines)?;
-        let crosslines = Lines::of(&keys.iter().map(|k| k.1).collect(), "crossline")
-            .map_err(GridError::Lines)?;
+        let inlines = Lines::of(&keys.iter().map(|k| k.0).collect(), "inline")?;
+        let crosslines = Lines::of(&keys.iter().map(|k| k.1).collect(), "crossline")?;
         let nj = crosslines.count;
         let mut cells = vec![TraceGrid::DEAD; inlines.count * nj];
         for &(il, xl, t) in &keys {
@@ -328,7 +326,9 @@ mod tests {
     fn a_stray_number_is_refused_not_gridded_into_millions_of_lines() {
         let mut v: Vec<i32> = (0..100).map(|q| 1000 + 2 * q).collect();
         v.push(5_000_001);
-        let e = Lines::of(&set(&v), "inline").unwrap_err();
+        let Err(GridError::Lines(e)) = Lines::of(&set(&v), "inline") else {
+            panic!("a stray number is refused as no survey's lines");
+        };
         assert!(e.contains("the 101 inline numbers (1000, 1002,"), "{e}");
         assert!(
             e.contains("in steps of 1 would hold 4999002 inlines"),

@@ -56,7 +56,8 @@ impl SegyStream {
 
     /// [`SegyStream::open`] with the inline and crossline bytes `named` (else detected).
     pub fn open_with(path: &Path, named: KeyBytes) -> Result<SegyStream, VolumeError> {
-        let (file, len) = crate::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
+        let (file, len) =
+            arbvis_core::input::open_regular(path).map_err(|e| VolumeError::io(path, e))?;
         let read_prefix = |n: u64| -> Result<Vec<u8>, VolumeError> {
             let n = n.min(len) as usize;
             let mut b = vec![0u8; n];
@@ -233,7 +234,7 @@ impl SegyStream {
     /// Grid from every trace header (any order, any outline).
     fn map_every_trace(&mut self) -> Result<(), VolumeError> {
         let traces = self.layout.traces;
-        crate::budget::check("the trace map of a SEG-Y file", traces as u64 * 16)
+        arbvis_core::budget::check("the trace map of a SEG-Y file", traces as u64 * 16)
             .map_err(|e| VolumeError::Invalid(format!("{}: {e}", self.path.display())))?;
         let mut keys = Vec::with_capacity(traces);
         for t in 0..traces {

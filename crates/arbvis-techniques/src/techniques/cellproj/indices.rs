@@ -5,8 +5,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::prepare::{Prepared, Viewer, FACES, FACING_MARGIN};
-use crate::camera::Projection;
 use crate::techniques::Frame;
+use arbvis_core::camera::Projection;
 
 /// Per face of a tetrahedron with corners `p`: the cosine between its outward normal
 /// and the direction from `viewer` (below 0: it faces the viewer; NaN: no area).
@@ -97,7 +97,7 @@ pub fn viewer(frame: &Frame) -> Viewer {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::mesh::Mesh;
+    use arbvis_data::mesh::Mesh;
 
     /// `count` random tetrahedra (positively oriented, some slivers) in the unit box.
     pub(crate) fn random_cells(count: usize, seed: u64) -> Prepared {

@@ -9,7 +9,7 @@
 //! `(sf, sb)`: the colour of the first isovalue crossed between the two.
 //!
 //! # How it works
-//! 1. [`prepare`] (CPU, no GL): the mesh (generated or read by [`crate::mesh`]) is
+//! 1. [`prepare`] (CPU, no GL): the mesh (generated or read by [`arbvis_data::mesh`]) is
 //!    moved into the object box (centred, longest side [-1, 1], in f64 before anything
 //!    becomes f32, so coordinates far from the origin keep their precision); each
 //!    tetrahedron gives four faces of three vertices with what the seed's vertex program
@@ -94,11 +94,11 @@ pub mod volume_reference;
 
 use serde::{Deserialize, Serialize};
 
-use crate::camera::Projection;
-use crate::gl::ProgramChoice;
-use crate::mesh::scalars::ScalarSpec;
-use crate::mesh::MeshSource;
-use crate::vocab::{significant, Fidelity, FieldError};
+use arbvis_core::camera::Projection;
+use arbvis_core::vocab::{significant, Fidelity, FieldError};
+use arbvis_data::mesh::scalars::ScalarSpec;
+use arbvis_data::mesh::MeshSource;
+use arbvis_gl::ProgramChoice;
 
 pub use renderer::CellprojRenderer;
 
@@ -261,7 +261,7 @@ pub struct CellprojScene {
     /// (`hardware`) or where the pixel's own ray meets the face (`shader`; `auto`: where
     /// the rasterizer interpolates from snapped vertices).
     #[serde(default)]
-    pub interpolation: crate::vocab::Interpolation,
+    pub interpolation: arbvis_core::vocab::Interpolation,
 }
 
 impl crate::techniques::Technique for CellprojScene {
@@ -292,7 +292,7 @@ impl crate::techniques::Technique for CellprojScene {
         }
     }
 
-    fn memory_estimate(&self, _: [u32; 2]) -> Vec<crate::budget::Estimate> {
+    fn memory_estimate(&self, _: [u32; 2]) -> Vec<arbvis_core::budget::Estimate> {
         CellprojScene::memory_estimate(self)
     }
 
@@ -317,7 +317,7 @@ impl crate::techniques::Technique for CellprojScene {
     fn prepare(
         &self,
         settings: &crate::techniques::Settings<'_>,
-        _: &crate::volume::Limits,
+        _: &arbvis_data::volume::Limits,
     ) -> crate::error::RenderResult<prepare::Prepared> {
         CellprojScene::validate(self)?;
         prepare::prepare(self, settings.base)
@@ -330,7 +330,7 @@ impl crate::techniques::Technique for CellprojScene {
         &self,
         prepared: &prepare::Prepared,
         view: &crate::techniques::ReferenceView<'_>,
-    ) -> Option<crate::image::Image> {
+    ) -> Option<arbvis_core::image::Image> {
         if self.mode == Mode::Isosurfaces {
             return None;
         }
@@ -351,9 +351,9 @@ impl crate::techniques::Technique for CellprojScene {
 
     fn renderer(
         &self,
-        gpu: &crate::gl::Gpu,
+        gpu: &arbvis_gl::Gpu,
         settings: &crate::techniques::Settings<'_>,
-        kind: crate::gl::ProgramKind,
+        kind: arbvis_gl::ProgramKind,
         prepared: prepare::Prepared,
     ) -> crate::error::RenderResult<Box<dyn crate::techniques::Renderer>> {
         Ok(Box::new(CellprojRenderer::upload(
@@ -376,20 +376,20 @@ pub const BYTES_PER_TET: u64 = 2000;
 impl CellprojScene {
     /// The large allocations this scene makes that the scene alone determines (a generated
     /// grid); mesh files are held to the budget by their loaders once their headers are read.
-    pub fn memory_estimate(&self) -> Vec<crate::budget::Estimate> {
+    pub fn memory_estimate(&self) -> Vec<arbvis_core::budget::Estimate> {
         match &self.mesh {
-            crate::mesh::MeshSource::Grid(g) => {
+            arbvis_data::mesh::MeshSource::Grid(g) => {
                 let tets = g
                     .points
                     .iter()
                     .fold(6u64, |a, &n| a.saturating_mul(n.saturating_sub(1) as u64));
-                vec![crate::budget::Estimate::of(
+                vec![arbvis_core::budget::Estimate::of(
                     format!("the generated grid's {tets} tetrahedra"),
                     tets,
                     BYTES_PER_TET,
                 )]
             }
-            crate::mesh::MeshSource::File(_) => Vec::new(),
+            arbvis_data::mesh::MeshSource::File(_) => Vec::new(),
         }
     }
 }

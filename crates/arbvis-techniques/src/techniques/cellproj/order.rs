@@ -245,7 +245,7 @@ pub fn boundary_is_convex(prepared: &Prepared, neighbours: &[[u32; 4]]) -> bool 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::grid::{generate, Field, GridSpec};
+    use arbvis_data::mesh::grid::{generate, Field, GridSpec};
 
     fn grid(n: usize) -> Prepared {
         let mesh = generate(&GridSpec {
@@ -253,7 +253,7 @@ mod tests {
             field: Field::Spherical,
         })
         .unwrap();
-        let s = crate::mesh::scalars::ScalarSpec::default()
+        let s = arbvis_data::mesh::scalars::ScalarSpec::default()
             .evaluate(&mesh)
             .unwrap();
         super::super::prepare::from_mesh(&mesh, &s.values, s.name, s.range).unwrap()

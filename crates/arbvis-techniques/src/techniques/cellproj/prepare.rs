@@ -8,8 +8,8 @@ use rayon::prelude::*;
 
 use super::{first_crossed, CellprojScene, Isovalue};
 use crate::error::RenderResult;
-use crate::mesh::quality::{self, Quality};
-use crate::mesh::{Mesh, MeshError};
+use arbvis_data::mesh::quality::{self, Quality};
+use arbvis_data::mesh::{Mesh, MeshError};
 
 /// Floats per face vertex: position 3, scalar 1, opposite vertex 3, three normals 3
 /// each, gradient 3 (generic attributes 0..6, in this order).
@@ -81,7 +81,7 @@ pub struct Prepared {
 }
 
 /// Most layers cell projection draws: the mean number of tetrahedra a line through the
-/// mesh's box crosses ([`Quality::depth`](crate::mesh::quality::Quality), counted over
+/// mesh's box crosses ([`Quality::depth`](arbvis_data::mesh::quality::Quality), counted over
 /// the tetrahedra that are drawn). Every layer is a face rasterized at a pixel, so this
 /// bounds the rasterizer's work at about this many fragments per pixel: near this depth
 /// a frame of thin plates stacked across a whole mesh is already far from interactive
@@ -200,13 +200,13 @@ pub fn from_mesh(
         ))
         .into());
     }
-    crate::budget::check(
+    arbvis_core::budget::check(
         format!(
             "{}: the cell-projection vertex data of {} tetrahedra",
             mesh.info.source,
             tets.len()
         ),
-        crate::budget::times(tets.len() as u64, VERTEX_BYTES_PER_TET),
+        arbvis_core::budget::times(tets.len() as u64, VERTEX_BYTES_PER_TET),
     )?;
     if tets.is_empty() {
         return Err(MeshError::Invalid(format!(
@@ -520,7 +520,7 @@ pub fn iso_list(isovalues: &[Isovalue]) -> Vec<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::grid::{generate, Field, GridSpec};
+    use arbvis_data::mesh::grid::{generate, Field, GridSpec};
 
     #[test]
     fn faces_are_outward_and_counter_clockwise() {
@@ -547,7 +547,7 @@ mod tests {
     #[test]
     fn corners_carry_their_cell_planes_and_gradient() {
         let (p, g) = skewed_cell();
-        let mesh = crate::mesh::Mesh {
+        let mesh = arbvis_data::mesh::Mesh {
             points: p.iter().map(|q| q.to_array()).collect(),
             tets: vec![[0, 1, 2, 3]],
             ..Default::default()
@@ -600,7 +600,7 @@ mod tests {
             field: Field::Spherical,
         })
         .unwrap();
-        let s = crate::mesh::scalars::ScalarSpec::default()
+        let s = arbvis_data::mesh::scalars::ScalarSpec::default()
             .evaluate(&mesh)
             .unwrap();
         let p = from_mesh(&mesh, &s.values, s.name, s.range).unwrap();
@@ -620,7 +620,7 @@ mod tests {
         // corners would collapse (f32 spacing at 1e6 is 0.0625); re-centred in f64 they
         // keep their shape.
         let o = 1.0e6;
-        let mesh = crate::mesh::Mesh {
+        let mesh = arbvis_data::mesh::Mesh {
             points: vec![
                 [o, o, o],
                 [o + 0.001, o, o],

@@ -13,8 +13,8 @@ use glam::{DMat4, DVec3, DVec4};
 
 use super::prepare::{gradient, normal, Prepared, FACES};
 use super::{first_crossed, Isovalue, REFERENCE_SLACK};
-use crate::camera::Camera;
 use crate::techniques::rays::trace_rays;
+use arbvis_core::camera::Camera;
 
 /// What a pixel's ray finds.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -245,7 +245,7 @@ pub fn silhouette_pixels(
     let inverse = camera.view().inverse();
     let eye = inverse.transform_point3(DVec3::ZERO);
     let view_dir = inverse.transform_vector3(DVec3::NEG_Z);
-    let perspective = camera.projection == crate::camera::Projection::Perspective;
+    let perspective = camera.projection == arbvis_core::camera::Projection::Perspective;
     // Each boundary edge with the facings of the boundary faces around it.
     let mut edges: HashMap<(u32, u32), (bool, bool)> = HashMap::new();
     for (count, v) in faces.values() {
@@ -336,7 +336,7 @@ impl Agreement {
 /// Classify every pixel of `image` (RGBA, top row first) as the nearest isovalue colour
 /// or the background, and compare with `hits`.
 pub fn agreement(
-    image: &crate::image::Image,
+    image: &arbvis_core::image::Image,
     depth: Option<&[f32]>,
     hits: &[Option<Hit>],
     sorted: &[Isovalue],

@@ -4,21 +4,21 @@
 //! depth test. Changing isovalues or colours rewrites only the table.
 
 use crate::error::RenderResult;
-use crate::gl::GlResult;
+use arbvis_gl::GlResult;
 use std::path::Path;
 
 use super::prepare::{iso_list, iso_table, prepare, Prepared, Viewer, VERTEX_COMPONENTS};
 use super::{CellprojScene, Depth, Order};
-use crate::camera::Projection;
-use crate::gl::{
+use crate::programs::{self, ProgramPair};
+use crate::techniques::cellproj::locals;
+use arbvis_core::camera::Projection;
+use arbvis_gl::{
     self, DrawCall, Extent, Filter, GlError, Gpu, Mesh, Program, ProgramKind, ProgramText, Surface,
     TexelData, TexelFormat, Texture,
 };
-use crate::programs::{self, ProgramPair};
-use crate::techniques::cellproj::locals;
 
 use crate::techniques::{Frame, Params, Renderer};
-use crate::vocab::{Fidelity, Interpolation};
+use arbvis_core::vocab::{Fidelity, Interpolation};
 
 /// Texture unit of the table (faithful) or isovalue list (precise).
 pub const TABLE_UNIT: u32 = 0;
@@ -372,7 +372,7 @@ impl Renderer for CellprojRenderer {
                 .iter()
                 .map(|i| {
                     let value = lo + i.value * (hi - lo);
-                    (rgb8(i.color), crate::vocab::significant(value))
+                    (rgb8(i.color), arbvis_core::vocab::significant(value))
                 })
                 .collect();
             legends.push(Legend::Keys {
@@ -381,8 +381,9 @@ impl Renderer for CellprojRenderer {
             });
         }
         let [lo, hi] = self.prepared.bounds;
-        let axes =
-            std::array::from_fn(|a| crate::volume::axes::span(["x", "y", "z"][a], lo[a], hi[a]));
+        let axes = std::array::from_fn(|a| {
+            arbvis_data::volume::axes::span(["x", "y", "z"][a], lo[a], hi[a])
+        });
         Annotations {
             legends,
             axes: Some((self.prepared.half.to_array(), axes)),
@@ -447,7 +448,7 @@ impl Renderer for CellprojRenderer {
         }
         self.build_view(gpu, frame)?;
         let program = &self.program.as_ref().expect("compiled above").3;
-        gl::draw(
+        arbvis_gl::draw(
             gpu,
             surface,
             &DrawCall {

@@ -14,18 +14,18 @@ use crate::study::median;
 use crate::techniques::Params;
 use std::time::Instant;
 
-use crate::camera::{Camera, Projection};
-use crate::gl::{Headless, ProgramKind, Surface, Target};
-use crate::mesh::grid::{generate, Field, GridSpec};
-use crate::mesh::scalars::ScalarSpec;
 use crate::techniques::{Frame, Renderer};
-use crate::vocab::Fidelity;
-use crate::vocab::TargetFormat;
+use arbvis_core::camera::{Camera, Projection};
+use arbvis_core::vocab::Fidelity;
+use arbvis_core::vocab::TargetFormat;
+use arbvis_data::mesh::grid::{generate, Field, GridSpec};
+use arbvis_data::mesh::scalars::ScalarSpec;
+use arbvis_gl::{Headless, ProgramKind, Surface, Target};
 
 use super::prepare::{from_mesh, Prepared};
 use super::reference::{agreement, reference, silhouette_pixels, Hit};
 use super::{CellprojRenderer, CellprojScene, Exit, Isovalue, IsovalueUnits};
-use crate::progress::{Bar, Unit};
+use arbvis_core::progress::{Bar, Unit};
 
 /// What to sweep.
 #[derive(Debug, Clone)]
@@ -82,7 +82,7 @@ pub fn seed_isovalues() -> Vec<Isovalue> {
 
 fn scene_for(points: usize, exit: Exit, active_only: bool) -> CellprojScene {
     CellprojScene {
-        mesh: crate::mesh::MeshSource::Grid(GridSpec {
+        mesh: arbvis_data::mesh::MeshSource::Grid(GridSpec {
             points: [points; 3],
             field: Field::Spherical,
         }),
@@ -121,7 +121,7 @@ fn measure(
     kind: ProgramKind,
     camera: Camera,
     options: &Options,
-) -> RenderResult<(f64, f64, crate::image::Image, Vec<f32>)> {
+) -> RenderResult<(f64, f64, arbvis_core::image::Image, Vec<f32>)> {
     let gpu = headless.gpu();
     let [w, h] = options.size;
     let target = Target::with_depth(gpu, w, h, TargetFormat::Rgba8)?;

@@ -28,8 +28,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-use crate::colortable::{TableError, TableSpec};
-use crate::vocab::FieldError;
+use arbvis_core::colortable::{TableError, TableSpec};
+use arbvis_core::vocab::FieldError;
 
 /// `[technique.cellproj.volume]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -507,7 +507,7 @@ mod tests {
     /// point, on random functions with zero runs, repeated positions and steps.
     #[test]
     fn clear_on_agrees_with_the_attenuation_everywhere() {
-        let mut rng = crate::points::section::SplitMix64::new(27);
+        let mut rng = arbvis_data::points::section::SplitMix64::new(27);
         let mut checked = [0usize; 2];
         for _ in 0..300 {
             let mut s: Vec<f64> = (0..2 + (rng.next_f64() * 7.0) as usize)

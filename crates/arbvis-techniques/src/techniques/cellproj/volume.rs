@@ -37,7 +37,7 @@
 //! sum so far (two more RGBA32F targets, ping-pong), so no entry is ever dropped.
 
 use crate::error::RenderResult;
-use crate::gl::GlResult;
+use arbvis_gl::GlResult;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -48,15 +48,15 @@ use super::preint;
 use super::prepare::{Prepared, Viewer, CORNER_COMPONENTS, VERTEX_COMPONENTS};
 use super::transfer::{Sort, Transfer, VolumeSpec};
 use super::Exit;
-use crate::camera::Projection;
-use crate::gl::{
-    self, Blend, DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, TexelData,
-    TexelFormat, Texture,
-};
 use crate::programs::{self, ProgramPair};
 use crate::techniques::cellproj::locals;
 use crate::techniques::Frame;
-use crate::vocab::Fidelity;
+use arbvis_core::camera::Projection;
+use arbvis_core::vocab::Fidelity;
+use arbvis_gl::{
+    self, Blend, DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, TexelData,
+    TexelFormat, Texture,
+};
 
 mod grid;
 mod walk;
@@ -616,7 +616,7 @@ impl VolumeRenderer {
             false => &f.faces,
         };
         let mesh = mesh.as_ref().expect("made above");
-        Ok(gl::draw(
+        Ok(arbvis_gl::draw(
             gpu,
             surface,
             &DrawCall {

@@ -12,10 +12,10 @@ use super::prepare::{gradient, Prepared};
 use super::reference::{tet_interval, Bvh};
 use super::transfer::{over, Rgba, Transfer};
 use super::{first_crossed, Isovalue, REFERENCE_SLACK};
-use crate::camera::Camera;
-use crate::image::Image;
 use crate::techniques::rays::trace_pixels;
-use crate::vocab::TargetFormat;
+use arbvis_core::camera::Camera;
+use arbvis_core::image::Image;
+use arbvis_core::vocab::TargetFormat;
 
 /// The segments of one ray, `(t_in, t_out, tet)` with `t` in [0, 1] from near to far,
 /// sorted by entry.
@@ -133,7 +133,7 @@ pub fn score(image: &Image, reference: &Image, mask: &[bool]) -> ((f64, f64), (f
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::Mesh;
+    use arbvis_data::mesh::Mesh;
 
     #[test]
     fn one_tetrahedron_matches_the_analytic_integral() {

@@ -6,10 +6,10 @@
 pub enum ClipError {
     /// A clip mesh could not be read.
     #[error(transparent)]
-    Surface(#[from] crate::surface::SurfaceError),
+    Surface(#[from] arbvis_data::surface::SurfaceError),
     /// A mask volume could not be read.
     #[error(transparent)]
-    Volume(#[from] crate::volume::VolumeError),
+    Volume(#[from] arbvis_data::volume::VolumeError),
     /// Parameters out of range, or a texture that cannot be built.
     #[error("{0}")]
     Invalid(String),

@@ -24,7 +24,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::grid::ClipGrid;
-use crate::volume::Volume;
+use arbvis_data::volume::Volume;
 
 const NONE: u32 = u32::MAX;
 

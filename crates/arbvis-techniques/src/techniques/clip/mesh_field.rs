@@ -47,7 +47,7 @@ use rayon::prelude::*;
 use super::error::ClipError;
 use super::fast_winding::{solid_angle, WindingTree};
 use super::grid::ClipGrid;
-use crate::surface::{Position, SurfaceError, TriangleMesh};
+use arbvis_data::surface::{Position, SurfaceError, TriangleMesh};
 
 /// Largest coordinate of a placed clip mesh (the grid spans at most [-1, 1]³: 1e15 is
 /// as far as infinity for it, and keeps every product the field forms, up to seventh
@@ -122,9 +122,9 @@ impl MeshShape {
             ClipError::Surface(SurfaceError::format(name, position, message))
         };
         let triangles = mesh.triangles.len() as u64;
-        crate::budget::check(
+        arbvis_core::budget::check(
             format!("placing a clip mesh of {triangles} triangles"),
-            crate::budget::times(triangles, TRIANGLE_BYTES),
+            arbvis_core::budget::times(triangles, TRIANGLE_BYTES),
         )
         .map_err(|e| fail(Position::Item("triangle", 0), e.to_string()))?;
         for (i, p) in mesh.vertices.iter().enumerate() {

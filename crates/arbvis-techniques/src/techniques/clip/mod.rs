@@ -7,7 +7,7 @@
 //!
 //! # How it works
 //! 1. [`ClipSpec`] (scene, checked by [`scene`]) → [`shape::Shape`]: analytic shapes,
-//!    CSG, triangle meshes ([`mesh_field`], from [`crate::surface`] or generated in
+//!    CSG, triangle meshes ([`mesh_field`], from [`arbvis_data::surface`] or generated in
 //!    code) and voxel masks ([`mask_field`]), in the volume's object space (the box `[-half, half]`, longest side `[-1, 1]`).
 //! 2. [`texture::ClipTexture::build`]: the clip distance of every voxel centre, mapped to
 //!    `clamp(0.5 + 0.5 d / diag, 0, 1)` (boundary at 0.5, clamped beyond one voxel
@@ -72,7 +72,7 @@ use std::path::{Path, PathBuf};
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use crate::volume::VolumeSource;
+use arbvis_data::volume::VolumeSource;
 pub use error::ClipError;
 use multires::MultiRes;
 use shape::{rotation_from_degrees, Shape};
@@ -221,8 +221,8 @@ impl ClipSpec {
     /// the volume's): the distance field and, with `multires`, the INDEX texture. DATA
     /// depends on how many blocks meet the boundary: its builder checks the budget once it
     /// has counted them.
-    pub fn memory_estimate(&self, dims: [usize; 3]) -> Vec<crate::budget::Estimate> {
-        use crate::budget::Estimate;
+    pub fn memory_estimate(&self, dims: [usize; 3]) -> Vec<arbvis_core::budget::Estimate> {
+        use arbvis_core::budget::Estimate;
         let grid = self.resolution.unwrap_or(dims);
         let voxels = grid.iter().fold(1u64, |a, &d| a.saturating_mul(d as u64));
         let mut out = vec![Estimate::of(
@@ -307,7 +307,7 @@ impl ShapeSpec {
                 rotation,
             } => {
                 let file = base.join(path);
-                let mesh = crate::surface::read(&file)?;
+                let mesh = arbvis_data::surface::read(&file)?;
                 Shape::Mesh(Box::new(mesh_field::MeshShape::placed(
                     &file,
                     &mesh,
@@ -332,7 +332,7 @@ impl ShapeSpec {
                 )))
             }
             ShapeSpec::Mask { volume, threshold } => {
-                let volume = volume.load(base, &crate::volume::Limits::default())?;
+                let volume = volume.load(base, &arbvis_data::volume::Limits::default())?;
                 Shape::Mask(Box::new(mask_field::MaskShape::new(
                     &volume, *threshold, half,
                 )))
@@ -373,7 +373,7 @@ impl ClipSpec {
     }
 
     /// Build everything for a volume of `volume_dims` and half-extents `half` (see
-    /// [`crate::volume::Volume::half_extent`]); the DATA texture stays within
+    /// [`arbvis_data::volume::Volume::half_extent`]); the DATA texture stays within
     /// `max_3d_texture_size` texels per side.
     pub fn build(
         &self,

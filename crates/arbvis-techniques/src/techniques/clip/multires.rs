@@ -54,7 +54,7 @@ use rayon::prelude::*;
 
 use super::error::ClipError;
 use super::texture::{trilinear, ClipTexture};
-use crate::volume::index_data::{self, SlotGrid};
+use arbvis_data::volume::index_data::{self, SlotGrid};
 
 /// Largest DATA texture built (texels; 2 GiB of f32).
 pub const MAX_DATA_TEXELS: usize = 1 << 29;
@@ -206,7 +206,7 @@ impl MultiRes {
         })?;
         // DATA as f32 here, and its 8-bit or float texture: checked once the boundary
         // blocks are counted (the scene's estimate could not know how many there are).
-        let mut data: Vec<f32> = crate::budget::vec_for(
+        let mut data: Vec<f32> = arbvis_core::budget::vec_for(
             texels,
             &format!(
                 "the DATA texture of {slots} boundary blocks of {side}³ ({data_dims:?} texels)"

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use super::texture::MAX_CLIP_VOXELS;
 use super::{ClipSpec, ShapeSpec, MAX_DEPTH};
-use crate::surface::{SurfaceError, TriangleMesh};
-use crate::vocab::FieldError;
+use arbvis_core::vocab::FieldError;
+use arbvis_data::surface::{SurfaceError, TriangleMesh};
 
 /// Largest block side accepted (one block of 512³ is already the largest clip grid).
 pub const MAX_BLOCK: usize = 512;
@@ -247,7 +247,7 @@ mod tests {
     #[test]
     fn the_generated_torus_is_closed_and_holds_its_tube() {
         let mesh = torus(0.6, 0.25, [24, 12]).unwrap();
-        assert!(crate::surface::inspect(&mesh).is_closed());
+        assert!(arbvis_data::surface::inspect(&mesh).is_closed());
         let shape = MeshShape::new(&mesh, DVec3::ZERO, DVec3::ONE, DQuat::IDENTITY);
         assert!(shape.inside(DVec3::new(0.6, 0.0, 0.0)));
         assert!(shape.inside(DVec3::new(0.0, -0.7, 0.1)));

@@ -21,16 +21,16 @@
 //! era's LUMINANCE8), precise ones 32-bit float.
 
 use crate::error::RenderResult;
-use crate::gl::GlResult;
 use crate::techniques::clip::error::ComposeError;
+use arbvis_gl::GlResult;
 use glam::DVec3;
 
 use super::multires::{IndexEncoding, MultiRes};
 use super::texture::ClipTexture;
 use super::ClipTextures;
-use crate::gl::{Extent, Filter, Gpu, Program, TexelData, TexelFormat, Texture};
 use crate::programs;
-use crate::vocab::Fidelity;
+use arbvis_core::vocab::Fidelity;
+use arbvis_gl::{Extent, Filter, Gpu, Program, TexelData, TexelFormat, Texture};
 
 /// The ARB clip prologue of `lookup` (`programs/clip/*.arbfp`, units 7/8 and locals
 /// 10-13 written there), reading the host program's volume coordinate `coord`.
@@ -261,7 +261,7 @@ pub fn compose_glsl_at(
         .find('{')
         .map(|o| main + o + 1)
         .ok_or_else(|| ComposeError::NoBody(signature.to_string()))?;
-    let locals = format!("uniform vec4 program_local[{}];", crate::gl::MAX_LOCALS);
+    let locals = format!("uniform vec4 program_local[{}];", arbvis_gl::MAX_LOCALS);
     let mut head = text[..main].to_string();
     match head.find("uniform vec4 program_local[") {
         Some(at) => {

@@ -6,7 +6,7 @@
 
 use super::multires::TexelFormat;
 use super::ClipTextures;
-use crate::vocab::Fidelity;
+use arbvis_core::vocab::Fidelity;
 
 /// The label of [`ClipStats::line`] among a renderer's facts (the viewer's panel).
 pub const LABEL: &str = "Clip stats";

@@ -28,16 +28,16 @@ use super::multires::{MultiRes, TexelFormat};
 use super::shape::Shape;
 use super::texture::{ClipGrid, ClipTexture};
 use super::{ClipError, ClipSpec, ShapeSpec};
-use crate::gl::{Headless, Surface, Target};
-use crate::progress::{Bar, Unit};
 use crate::scene::Scene;
 use crate::techniques::opacity3d::prepare::prepare;
 use crate::techniques::opacity3d::reference::reference_clipped;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::Frame;
 use crate::techniques::Params;
-use crate::volume::Limits;
-use crate::volume::VolumeSource;
+use arbvis_core::progress::{Bar, Unit};
+use arbvis_data::volume::Limits;
+use arbvis_data::volume::VolumeSource;
+use arbvis_gl::{Headless, Surface, Target};
 
 /// What to sweep.
 #[derive(Debug, Clone)]

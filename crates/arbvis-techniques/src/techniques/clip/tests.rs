@@ -9,7 +9,7 @@ use super::multires::{BlockClass, IndexEncoding, MultiRes, TexelFormat};
 use super::shape::{rotation_from_degrees, Shape};
 use super::texture::{ClipGrid, ClipTexture};
 use super::{ClipError, ClipSpec, ShapeSpec};
-use crate::surface::TriangleMesh;
+use arbvis_data::surface::TriangleMesh;
 
 /// A small deterministic generator (xorshift64*), uniform in [0, 1).
 struct Rng(u64);
@@ -409,7 +409,7 @@ fn an_open_mesh_is_decided_by_the_winding_number() {
     assert_eq!(wrong, 0);
 }
 
-use crate::input::data_file;
+use arbvis_core::input::data_file;
 
 /// Place `mesh` to fill about 80 % of `[-half, half]`.
 fn fit(mesh: &TriangleMesh, half: [f64; 3]) -> MeshShape {
@@ -427,7 +427,7 @@ fn fit(mesh: &TriangleMesh, half: [f64; 3]) -> MeshShape {
 #[test]
 fn cow_signs_match_the_winding_number() {
     let path = data_file("surfaces/cow.obj");
-    let cow = crate::surface::read(&path).unwrap();
+    let cow = arbvis_data::surface::read(&path).unwrap();
     let dims = [40, 26, 18];
     let grid = ClipGrid::new(dims, half(dims)).unwrap();
     let mesh = fit(&cow, half(dims));
@@ -460,7 +460,7 @@ fn cow_signs_match_the_winding_number() {
 #[test]
 fn the_real_stl_is_closed_and_signed() {
     let path = data_file("surfaces/42400-IDGH.stl");
-    let part = crate::surface::read(&path).unwrap();
+    let part = arbvis_data::surface::read(&path).unwrap();
     let dims = [32, 32, 32];
     let grid = ClipGrid::new(dims, half(dims)).unwrap();
     let mesh = fit(&part, half(dims));
@@ -487,7 +487,7 @@ fn mask_fields_follow_the_voxels() {
             }
         }
     }
-    let volume = crate::volume::Volume::new(dims, [1.0; 3], values).unwrap();
+    let volume = arbvis_data::volume::Volume::new(dims, [1.0; 3], values).unwrap();
     let mask = super::mask_field::MaskShape::new(&volume, 25.0, half(dims));
     let grid = ClipGrid::new(dims, half(dims)).unwrap();
     let field = mask.field(&grid);

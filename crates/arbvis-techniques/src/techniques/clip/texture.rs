@@ -8,7 +8,7 @@
 //! 1 at least one diagonal inside. A fragment is kept when the filtered value is >= 0.5.
 //!
 //! The grid spans the volume's object-space box `[-half, half]` (longest side `[-1, 1]`,
-//! [`crate::volume::Volume::half_extent`]); voxel `(i, j, k)`'s centre is at
+//! [`arbvis_data::volume::Volume::half_extent`]); voxel `(i, j, k)`'s centre is at
 //! `-half + (i + 0.5, j + 0.5, k + 0.5) * h` with `h = 2 half / dims`, i.e. at texture
 //! coordinate `(i + 0.5) / ni` (GL's texel centres). [`ClipTexture::sample_single`] is
 //! the CPU emulation of a GL_LINEAR, CLAMP_TO_EDGE lookup.

@@ -5,7 +5,7 @@
 //! # How it works
 //! - The renderer asks for the bricks its view wants, most urgent first
 //!   ([`BrickCache::request`]); the loader thread works through the newest list, reads each
-//!   brick of each attribute with its one-voxel border ([`crate::store::Store::brick`]), quantizes
+//!   brick of each attribute with its one-voxel border ([`arbvis_data::store::Store::brick`]), quantizes
 //!   and packs it ([`Packing`]) and sends the texels back.
 //! - Each frame the renderer takes what has arrived ([`BrickCache::receive`], at most a
 //!   few bricks a frame, so an upload never stalls a frame) and uploads it into a free
@@ -18,7 +18,7 @@
 //! Two layouts of the slots: one texture per brick ([`BrickCache::new`], what the faithful
 //! brick-by-brick renderer binds, one brick a draw, as 2004's bricked renderers did), or
 //! one atlas texture of slots ([`BrickCache::atlas`], the INDEX-DATA layout of
-//! [`crate::volume::index_data`], which the precise one-pass ray caster reads through its
+//! [`arbvis_data::volume::index_data`], which the precise one-pass ray caster reads through its
 //! page table).
 //!
 //! The renderers see only resident bricks: [`BrickCache::texture`] or
@@ -31,12 +31,12 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use crate::gl::{Extent, Filter, Gpu, TexelData, TexelFormat, Texture};
-use crate::store::lod::BrickId;
-use crate::store::reader::Store;
-use crate::store::StoreError;
-use crate::volume::index_data::SlotGrid;
-use crate::volume::quantize::{quantize_level, NoData};
+use arbvis_data::store::lod::BrickId;
+use arbvis_data::store::reader::Store;
+use arbvis_data::store::StoreError;
+use arbvis_data::volume::index_data::SlotGrid;
+use arbvis_data::volume::quantize::{quantize_level, NoData};
+use arbvis_gl::{Extent, Filter, Gpu, TexelData, TexelFormat, Texture};
 
 /// How a brick's attributes become texels: per texture channel (R, G, B), the store's
 /// attribute and its quantization range (v3o2: G primary, B secondary, R tertiary).

@@ -7,8 +7,8 @@
 //! union of its children's ranges, so that leaving out a brick that looks transparent
 //! never leaves out a visible brick under it.
 
-use crate::store::{Store, StoreError};
-use crate::volume::quantize::{quantize_level, NoData};
+use arbvis_data::store::{Store, StoreError};
+use arbvis_data::volume::quantize::{quantize_level, NoData};
 
 /// Per brick of one level (x fastest), per attribute, the lowest and highest quantized
 /// level it may hold.

@@ -3,7 +3,7 @@
 //! store through the GPU brick cache ([`crate::techniques::opacity3d::brick_cache`]), never loading the survey.
 //!
 //! # How it works
-//! 1. Each frame [`crate::store::lod`] picks the bricks of the view (screen-space error,
+//! 1. Each frame [`arbvis_data::store::lod`] picks the bricks of the view (screen-space error,
 //!    the GPU budget, bricks the tables make transparent left out) and the back-to-front
 //!    order of what is resident.
 //! 2. Each brick is drawn with the **verbatim** `!!ARBfp1.0` program (sum or product) on
@@ -56,17 +56,17 @@ use super::renderer::model_view_projection;
 use super::slicing::{polygon, EDGES};
 use super::textures::{neutral_for, table_texture};
 use super::{coefficients, Combine, Opacity3dScene, ATTRIBUTE_NAMES};
-use crate::camera::Projection;
-use crate::gl::{
-    self, Blend, DrawCall, GlError, Gpu, Mesh, Program, ProgramKind, Surface, Texture,
-};
-use crate::store::lod::{self, BrickId, Pyramid, View};
-use crate::store::Store;
 use crate::techniques::opacity3d::brick_cache::{BrickCache, Packing};
 use crate::techniques::{Frame, Params, Renderer, Streaming};
-use crate::vocab::{Fidelity, FieldError};
-use crate::volume::quantize::{NoData, Quantization};
-use crate::volume::VolumeSource;
+use arbvis_core::camera::Projection;
+use arbvis_core::vocab::{Fidelity, FieldError};
+use arbvis_data::store::lod::{self, BrickId, Pyramid, View};
+use arbvis_data::store::Store;
+use arbvis_data::volume::quantize::{NoData, Quantization};
+use arbvis_data::volume::VolumeSource;
+use arbvis_gl::{
+    self, Blend, DrawCall, GlError, Gpu, Mesh, Program, ProgramKind, Surface, Texture,
+};
 
 /// `[technique.opacity3d.store]`: how a store is streamed.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -99,7 +99,7 @@ impl Default for StoreView {
 impl StoreView {
     /// Check the values; errors name the key under `store`.
     pub fn validate(&self) -> Result<(), FieldError> {
-        crate::budget::parse(&self.gpu_memory)
+        arbvis_core::budget::parse(&self.gpu_memory)
             .map_err(|e| FieldError::new("gpu_memory", e.to_string()))?;
         if !(self.pixels.is_finite() && self.pixels > 0.0 && self.pixels <= 1e6) {
             return Err(FieldError::new(
@@ -169,7 +169,7 @@ impl StoreScene {
         let Some(path) = store_of(params)? else {
             return Ok(None);
         };
-        let store = Arc::new(Store::open(&crate::fetch::resolve(base, &path))?);
+        let store = Arc::new(Store::open(&arbvis_data::fetch::resolve(base, &path))?);
         let view = params.store.clone().unwrap_or_default();
         let meta = &store.meta;
         let window = view.window.unwrap_or([[0; 3], meta.dims]);
@@ -306,7 +306,7 @@ impl BrickedRenderer {
         }
         let budget = match gpu_memory {
             Some(b) => b,
-            None => crate::budget::parse(&view.gpu_memory)?,
+            None => arbvis_core::budget::parse(&view.gpu_memory)?,
         };
         let cache = match fidelity {
             Fidelity::Faithful => BrickCache::new(
@@ -566,7 +566,7 @@ impl BrickedRenderer {
                 }
             }
             let Some(mesh) = &self.mesh else { break };
-            gl::draw(
+            arbvis_gl::draw(
                 gpu,
                 surface,
                 &DrawCall {

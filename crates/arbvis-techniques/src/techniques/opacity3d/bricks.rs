@@ -145,7 +145,7 @@ impl Bricks {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::colortable::ColorTable;
+    use arbvis_core::colortable::ColorTable;
     use glam::DVec3;
 
     fn prepared(dims: [usize; 3], levels: Vec<u8>) -> Prepared {
@@ -160,7 +160,7 @@ mod tests {
             packed: super::super::prepare::pack([Some(&levels), None, None], n),
             tables: [Some(table), None, None],
             ranges: [Some((0.0, 255.0)), None, None],
-            no_data: [crate::volume::quantize::NoData::Absent; 3],
+            no_data: [arbvis_data::volume::quantize::NoData::Absent; 3],
         }
     }
 

@@ -3,12 +3,12 @@
 //! made again exactly when its key differs. No GL; the renderer's `update` acts on it.
 
 use super::{Combine, Interpolation, Opacity3dScene};
-use crate::colortable::TableSpec;
-use crate::gl::Filter;
 use crate::techniques::clip::ClipSpec;
-use crate::volume::attributes::Attribute;
-use crate::volume::quantize::Quantization;
-use crate::volume::VolumeSource;
+use arbvis_core::colortable::TableSpec;
+use arbvis_data::volume::attributes::Attribute;
+use arbvis_data::volume::quantize::Quantization;
+use arbvis_data::volume::VolumeSource;
+use arbvis_gl::Filter;
 
 /// What each attribute's data are read and quantized from.
 type AttributeData = Option<(VolumeSource, Attribute, Quantization)>;
@@ -89,7 +89,7 @@ impl Changes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::colortable::TableSpec;
+    use arbvis_core::colortable::TableSpec;
 
     fn scene() -> Opacity3dScene {
         let text = r#"

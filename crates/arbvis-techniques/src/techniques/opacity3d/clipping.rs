@@ -31,7 +31,6 @@ use std::time::Instant;
 
 use super::prepare::Prepared;
 use super::Path3d;
-use crate::gl::{Gpu, ProgramKind, ProgramText};
 use crate::programs::ProgramPair;
 use crate::techniques::clip::multires::IndexEncoding;
 use crate::techniques::clip::stage::{
@@ -40,7 +39,8 @@ use crate::techniques::clip::stage::{
 };
 use crate::techniques::clip::stats::ClipStats;
 use crate::techniques::clip::{ClipSpec, ClipTextures};
-use crate::vocab::Fidelity;
+use arbvis_core::vocab::Fidelity;
+use arbvis_gl::{Gpu, ProgramKind, ProgramText};
 
 /// Where 3D opacity's programs read the sample's volume coordinate.
 pub const ARB_COORD: &str = "fragment.texcoord[0]";

@@ -13,10 +13,10 @@ use glam::DVec3;
 use super::prepare::Prepared;
 use super::reference::{exact_rgba, over, sample, Filtering, ViewSlices};
 use super::Opacity3dScene;
-use crate::camera::Camera;
-use crate::image::Image;
 use crate::techniques::rays::{box_interval, trace_pixels};
-use crate::vocab::TargetFormat;
+use arbvis_core::camera::Camera;
+use arbvis_core::image::Image;
+use arbvis_core::vocab::TargetFormat;
 
 /// Length of ray a precise slicing sample at `p` stands for, on a ray of unit direction
 /// `dir` whose samples lie `2 half_step` apart: half a step each side, or, where the
@@ -46,7 +46,7 @@ pub fn emulate_precise(
 ) -> Image {
     let half = prepared.half;
     let reference = prepared.reference_spacing();
-    let corrected = super::renderer::corrected(params, crate::vocab::Fidelity::Precise);
+    let corrected = super::renderer::corrected(params, arbvis_core::vocab::Fidelity::Precise);
     let slices = ViewSlices::new(half, camera, params.slices);
     trace_pixels(camera, size, TargetFormat::Rgba32f, |origin, dir| {
         let mut dst = background;

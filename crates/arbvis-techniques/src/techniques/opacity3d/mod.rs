@@ -69,14 +69,14 @@ pub mod textures;
 
 use serde::{Deserialize, Serialize};
 
-use crate::colortable::TableSpec;
-use crate::gl::{Filter, ProgramChoice};
 use crate::techniques::clip::ClipSpec;
-pub use crate::vocab::Interpolation;
-use crate::vocab::{Fidelity, FieldError};
-use crate::volume::attributes::Attribute;
-use crate::volume::quantize::Quantization;
-use crate::volume::VolumeSource;
+use arbvis_core::colortable::TableSpec;
+pub use arbvis_core::vocab::Interpolation;
+use arbvis_core::vocab::{Fidelity, FieldError};
+use arbvis_data::volume::attributes::Attribute;
+use arbvis_data::volume::quantize::Quantization;
+use arbvis_data::volume::VolumeSource;
+use arbvis_gl::{Filter, ProgramChoice};
 
 pub use renderer::Opacity3dRenderer;
 
@@ -122,8 +122,8 @@ pub const SURVEY_VIEW: [f64; 4] = [0.326506, -0.092296, -0.701057, 0.627211];
 
 /// A three-quarter view of a survey ([`SURVEY_VIEW`]), zoomed so that a box of any
 /// proportions stays whole at any rotation.
-fn survey_camera() -> crate::camera::Camera {
-    crate::camera::Camera {
+fn survey_camera() -> arbvis_core::camera::Camera {
+    arbvis_core::camera::Camera {
         rotation: SURVEY_VIEW,
         // The prepared box's longest half side is 1, so its bounding sphere's radius is at
         // most sqrt(3); with the viewer's 10 % framing margin.
@@ -224,18 +224,18 @@ impl crate::techniques::Technique for Opacity3dScene {
         }
     }
 
-    fn memory_estimate(&self, _: [u32; 2]) -> Vec<crate::budget::Estimate> {
+    fn memory_estimate(&self, _: [u32; 2]) -> Vec<arbvis_core::budget::Estimate> {
         Opacity3dScene::memory_estimate(self)
     }
 
-    fn default_camera(&self) -> Option<crate::camera::Camera> {
+    fn default_camera(&self) -> Option<arbvis_core::camera::Camera> {
         Opacity3dScene::default_camera(self)
     }
 
     fn unwritten_defaults(
         &mut self,
         written: &dyn Fn(&str) -> bool,
-        camera: &mut crate::camera::Camera,
+        camera: &mut arbvis_core::camera::Camera,
         _: &mut Fidelity,
     ) {
         Opacity3dScene::unwritten_defaults(self, written, camera)
@@ -256,7 +256,7 @@ impl crate::techniques::Technique for Opacity3dScene {
     fn prepare(
         &self,
         settings: &crate::techniques::Settings<'_>,
-        limits: &crate::volume::Limits,
+        limits: &arbvis_data::volume::Limits,
     ) -> crate::error::RenderResult<Option<prepare::Prepared>> {
         if bricked::store_of(self)?.is_some() {
             return Ok(None);
@@ -273,7 +273,7 @@ impl crate::techniques::Technique for Opacity3dScene {
         &self,
         prepared: &Option<prepare::Prepared>,
         view: &crate::techniques::ReferenceView<'_>,
-    ) -> Option<crate::image::Image> {
+    ) -> Option<arbvis_core::image::Image> {
         let prepared = prepared.as_ref().filter(|_| self.clip.is_none())?;
         Some(reference::reference(
             prepared,
@@ -287,16 +287,16 @@ impl crate::techniques::Technique for Opacity3dScene {
 
     fn renderer(
         &self,
-        gpu: &crate::gl::Gpu,
+        gpu: &arbvis_gl::Gpu,
         settings: &crate::techniques::Settings<'_>,
-        kind: crate::gl::ProgramKind,
+        kind: arbvis_gl::ProgramKind,
         prepared: Option<prepare::Prepared>,
     ) -> crate::error::RenderResult<Box<dyn crate::techniques::Renderer>> {
         let fidelity = settings.fidelity;
         let Some(prepared) = prepared else {
             let kind = if fidelity == Fidelity::Precise && settings.programs == ProgramChoice::Auto
             {
-                crate::gl::ProgramKind::Glsl
+                arbvis_gl::ProgramKind::Glsl
             } else {
                 kind
             };
@@ -333,13 +333,13 @@ impl Opacity3dScene {
     /// The large allocations this scene makes that the scene alone determines (generated
     /// volumes, the clip's grid); volume files are held to the budget by their loaders
     /// once their headers are read.
-    pub fn memory_estimate(&self) -> Vec<crate::budget::Estimate> {
+    pub fn memory_estimate(&self) -> Vec<arbvis_core::budget::Estimate> {
         let mut out = Vec::new();
         let mut grid = None;
         for (name, attribute) in ATTRIBUTE_NAMES.iter().zip(self.attributes()) {
             let Some(a) = attribute else { continue };
             if let Some(voxels) = a.volume.declared_voxels() {
-                out.push(crate::budget::Estimate::of(
+                out.push(arbvis_core::budget::Estimate::of(
                     format!("the {name} attribute's generated volume of {voxels} voxels"),
                     voxels,
                     BYTES_PER_VOXEL,
@@ -455,7 +455,7 @@ impl Opacity3dScene {
     pub fn unwritten_defaults(
         &mut self,
         written: &dyn Fn(&str) -> bool,
-        camera: &mut crate::camera::Camera,
+        camera: &mut arbvis_core::camera::Camera,
     ) {
         if self.primary.volume.data_kind() != arbvis_data::sniff::DataKind::Survey {
             return;
@@ -480,8 +480,8 @@ impl Opacity3dScene {
     }
 
     /// The camera a survey's scene starts from (and the viewer's Reset camera returns
-    /// to); `None` for other volumes, which keep [`crate::camera::Camera::default`].
-    pub fn default_camera(&self) -> Option<crate::camera::Camera> {
+    /// to); `None` for other volumes, which keep [`arbvis_core::camera::Camera::default`].
+    pub fn default_camera(&self) -> Option<arbvis_core::camera::Camera> {
         (self.primary.volume.data_kind() == arbvis_data::sniff::DataKind::Survey)
             .then(survey_camera)
     }

@@ -1,6 +1,6 @@
 //! Precise 3D opacity of a store in one pass: the ray caster (`raycast.frag`, tag `paged`)
 //! walks the survey's bricks through a page table, as seed 002's INDEX-DATA clip texture
-//! does (the shared layout and offset are [`crate::volume::index_data`]).
+//! does (the shared layout and offset are [`arbvis_data::volume::index_data`]).
 //!
 //! # How it works
 //! 1. The brick cache keeps its resident bricks in one atlas texture of `(B+2)³` slots
@@ -32,20 +32,20 @@
 //! the nearest resident ancestors standing in.
 
 use crate::error::RenderResult;
-use crate::gl::GlResult;
+use arbvis_gl::GlResult;
 use glam::DVec3;
 
 use super::locals;
 use super::programs::{raycast_pair, InShader, Variant};
 use super::proxy::{eye, far_faces, toward_viewer};
 use super::{corrected, Combine, Opacity3dScene};
-use crate::camera::Projection;
-use crate::gl::{
+use crate::techniques::Frame;
+use arbvis_core::camera::Projection;
+use arbvis_data::store::lod::{BrickId, Pyramid};
+use arbvis_data::volume::index_data::{self, SlotGrid};
+use arbvis_gl::{
     self, Blend, DrawCall, Gpu, Mesh, Program, Surface, TexelData, TexelFormat, Texture,
 };
-use crate::store::lod::{BrickId, Pyramid};
-use crate::techniques::Frame;
-use crate::volume::index_data::{self, SlotGrid};
 
 /// Unit of the page table (the clip's INDEX unit; a store scene has no clip).
 pub const PAGE_UNIT: u32 = 7;
@@ -146,7 +146,8 @@ impl PagedPass {
     pub fn new(gpu: &Gpu, params: &Opacity3dScene) -> RenderResult<PagedPass> {
         let present = params.attributes().map(|a| a.is_some());
         let projection = Projection::Orthographic;
-        let filter = super::renderer::shader_filter(gpu, params, crate::vocab::Fidelity::Precise)?;
+        let filter =
+            super::renderer::shader_filter(gpu, params, arbvis_core::vocab::Fidelity::Precise)?;
         Ok(PagedPass {
             program: program(gpu, params.combine, present, projection, filter)?,
             projection,
@@ -161,7 +162,8 @@ impl PagedPass {
     /// The program, rebuilt when the combination changed.
     pub fn program_for(&mut self, gpu: &Gpu, params: &Opacity3dScene) -> RenderResult<&Program> {
         let present = params.attributes().map(|a| a.is_some());
-        let filter = super::renderer::shader_filter(gpu, params, crate::vocab::Fidelity::Precise)?;
+        let filter =
+            super::renderer::shader_filter(gpu, params, arbvis_core::vocab::Fidelity::Precise)?;
         if params.combine != self.combine || present != self.present || filter != self.filter {
             self.combine = params.combine;
             self.present = present;
@@ -212,9 +214,9 @@ impl PagedPass {
                 let t = Texture::new(
                     gpu,
                     "store page table",
-                    gl::Extent::D3(w, h, d),
+                    arbvis_gl::Extent::D3(w, h, d),
                     TexelFormat::Rgba32f,
-                    gl::Filter::Nearest,
+                    arbvis_gl::Filter::Nearest,
                     data,
                 )?;
                 self.table = Some((t, table.dims));
@@ -231,7 +233,7 @@ impl PagedPass {
             .unwrap_or(0);
         let reference = 2.0 * half[longest] / window[longest];
         let r = params.raycast.unwrap_or_default();
-        let (scale, offset) = if corrected(params, crate::vocab::Fidelity::Precise) {
+        let (scale, offset) = if corrected(params, arbvis_core::vocab::Fidelity::Precise) {
             (1.0 / reference, 0.0)
         } else {
             (0.0, 1.0)
@@ -281,7 +283,7 @@ impl PagedPass {
         let mut textures: Vec<(u32, &Texture)> =
             vec![(super::renderer::VOLUME_UNIT, atlas.0), (PAGE_UNIT, page)];
         textures.extend_from_slice(tables);
-        Ok(gl::draw(
+        Ok(arbvis_gl::draw(
             gpu,
             surface,
             &DrawCall {

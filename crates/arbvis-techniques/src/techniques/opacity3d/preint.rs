@@ -25,8 +25,8 @@ use rayon::prelude::*;
 
 use super::reference::{lookup, Addressing, Filtering};
 use super::Combine;
-use crate::colortable::ColorTable;
-use crate::gl::Filter;
+use arbvis_core::colortable::ColorTable;
+use arbvis_gl::Filter;
 
 /// Entries per side of the table (one per level).
 pub const SIZE: usize = 256;

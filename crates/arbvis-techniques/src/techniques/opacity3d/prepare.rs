@@ -7,12 +7,12 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::{AttributeScene, Opacity3dScene};
-use crate::colortable::ColorTable;
 use crate::error::{RenderError, RenderResult};
-use crate::vocab::FieldError;
-use crate::volume::attributes::derive;
-use crate::volume::quantize::{quantize_level, quantize_value, range, NoData, Quantization};
-use crate::volume::{Limits, Volume, VolumeError, VolumeSource};
+use arbvis_core::colortable::ColorTable;
+use arbvis_core::vocab::FieldError;
+use arbvis_data::volume::attributes::derive;
+use arbvis_data::volume::quantize::{quantize_level, quantize_value, range, NoData, Quantization};
+use arbvis_data::volume::{Limits, Volume, VolumeError, VolumeSource};
 
 /// Everything the renderer uploads, and the CPU references read.
 #[derive(Debug, Clone, PartialEq)]
@@ -170,14 +170,14 @@ pub fn from_volumes(
 }
 
 /// The table's alpha from the distribution of `volume`'s levels over its quantization
-/// range ([`crate::colortable::alpha_from_histogram`]); NaN samples (no data) are left out.
+/// range ([`arbvis_core::colortable::alpha_from_histogram`]); NaN samples (no data) are left out.
 fn alpha_from_data(volume: &Volume, how: Quantization) -> Result<[u8; 256], VolumeError> {
     let (low, high) = range(volume, how)?;
     let mut counts = [0u64; 256];
     for &v in volume.values.iter().filter(|v| !v.is_nan()) {
         counts[quantize_value(v, low, high) as usize] += 1;
     }
-    Ok(crate::colortable::alpha_from_histogram(&counts))
+    Ok(arbvis_core::colortable::alpha_from_histogram(&counts))
 }
 
 /// Prepare a scene: load each distinct source once (its size checked against `limits`

@@ -22,9 +22,9 @@
 use std::borrow::Cow;
 
 use super::{Combine, Interpolation, Opacity3dScene};
-use crate::camera::Projection;
-use crate::gl::{Filter, ProgramKind, ProgramText};
 use crate::programs::{self, with_transform, ProgramPair};
+use arbvis_core::camera::Projection;
+use arbvis_gl::{Filter, ProgramKind, ProgramText};
 
 /// What a precise program is specialized to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -55,9 +55,9 @@ pub struct Variant {
 
 /// What a precise program computes itself instead of the hardware: linear reads of its
 /// filtered textures (`texelFetch` and f32 `mix`, `programs/common/sampling.glsl`) where
-/// the texture units keep coarse weights ([`crate::gl::Gpu::filters_exactly`]), and its
+/// the texture units keep coarse weights ([`arbvis_gl::Gpu::filters_exactly`]), and its
 /// slices' sample points from each pixel's centre where the rasterizer interpolates from
-/// snapped vertices ([`crate::gl::Gpu::interpolates_exactly`]).
+/// snapped vertices ([`arbvis_gl::Gpu::interpolates_exactly`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct InShader {
     /// The attribute volume (or a store's brick atlas).

@@ -7,8 +7,8 @@ use glam::DVec3;
 
 use super::slicing::slice_box;
 use super::Path3d;
-use crate::gl::{GlResult, Gpu, Mesh};
 use crate::techniques::Frame;
+use arbvis_gl::{GlResult, Gpu, Mesh};
 
 /// The view a slice mesh was made for: the direction toward the viewer (its bits) and the
 /// slice count.

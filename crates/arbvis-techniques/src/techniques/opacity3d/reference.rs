@@ -30,12 +30,12 @@ use glam::DVec3;
 
 use super::prepare::Prepared;
 use super::{coefficients, Combine, Opacity3dScene};
-use crate::camera::Camera;
-use crate::colortable::ColorTable;
-use crate::gl::Filter;
-use crate::image::Image;
 use crate::techniques::rays::{box_interval, trace_pixels};
-use crate::vocab::TargetFormat;
+use arbvis_core::camera::Camera;
+use arbvis_core::colortable::ColorTable;
+use arbvis_core::image::Image;
+use arbvis_core::vocab::TargetFormat;
+use arbvis_gl::Filter;
 
 /// How a table is addressed with a value `v` in [0, 1].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

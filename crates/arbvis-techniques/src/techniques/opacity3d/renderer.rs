@@ -29,17 +29,17 @@ use super::textures::{neutral_for, table_texture, uses_neighbours, volume_textur
 use super::Interpolation;
 pub use super::{coefficients, corrected, path, preintegrated, Path3d};
 use super::{Combine, Opacity3dScene};
-use crate::camera::Projection;
-use crate::gl::{
+use crate::programs;
+use arbvis_core::camera::Projection;
+use arbvis_gl::{
     self, Blend, DrawCall, Extent, Filter, GlError, Gpu, Program, ProgramChoice, ProgramKind,
     Surface, TexelData, TexelFormat, Texture,
 };
-use crate::programs;
 
 use crate::techniques::clip::stage as clipping_stage;
 use crate::techniques::{DrawInParts, Frame, Params, Renderer};
-use crate::vocab::Fidelity;
-use crate::volume::quantize::NoData;
+use arbvis_core::vocab::Fidelity;
+use arbvis_data::volume::quantize::NoData;
 
 /// Texture unit of the packed volume and of the three tables (unit 1 is v3o2's
 /// lighting, unused here).
@@ -244,7 +244,7 @@ impl Opacity3dRenderer {
         let prepared = prepare(
             params,
             base,
-            &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
+            &arbvis_data::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
         )?;
         Opacity3dRenderer::from_prepared(gpu, kind, fidelity, params, base, prepared, projection)
     }
@@ -636,7 +636,7 @@ impl Opacity3dRenderer {
             return Ok(());
         };
         let raycast = self.path() == Path3d::Raycast;
-        Ok(gl::draw(
+        Ok(arbvis_gl::draw(
             gpu,
             surface,
             &DrawCall {
@@ -674,7 +674,8 @@ impl Renderer for Opacity3dRenderer {
                 })
             })
             .collect();
-        let axes = crate::volume::axes::describe(&self.params.primary.volume, &self.base, p.dims);
+        let axes =
+            arbvis_data::volume::axes::describe(&self.params.primary.volume, &self.base, p.dims);
         Annotations {
             legends,
             axes: Some((p.half.to_array(), axes)),
@@ -694,7 +695,7 @@ impl Renderer for Opacity3dRenderer {
             let prepared = prepare(
                 new,
                 &self.base,
-                &crate::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
+                &arbvis_data::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size),
             )?;
             *self = Opacity3dRenderer::from_prepared(
                 gpu,

@@ -6,9 +6,9 @@
 use super::prepare::Prepared;
 use super::programs::InShader;
 use super::{path, Opacity3dScene, Path3d};
-use crate::colortable::ColorTable;
-use crate::gl::{Extent, Filter, GlResult, Gpu, TexelData, TexelFormat, Texture};
-use crate::vocab::Fidelity;
+use arbvis_core::colortable::ColorTable;
+use arbvis_core::vocab::Fidelity;
+use arbvis_gl::{Extent, Filter, GlResult, Gpu, TexelData, TexelFormat, Texture};
 
 /// Texel formats of the packed volume and the tables: 8-bit when faithful (filtering in
 /// 8-bit arithmetic, as the original hardware); when precise the same 8-bit values as
@@ -74,7 +74,7 @@ pub fn volume_texture(
     let extent = Extent::D3(ni as u32, nj as u32, nk as u32);
     if neighbours {
         let bytes = (ni * nj * nk) as u64 * 8;
-        crate::budget::check(
+        arbvis_core::budget::check(
             "the ray caster's neighbour texture (8 bytes a voxel)",
             bytes,
         )?;

@@ -11,11 +11,11 @@ use crate::error::RenderResult;
 use glam::{DMat4, DVec4};
 
 use super::locals;
-use crate::gl::{
+use crate::programs;
+use arbvis_gl::{
     self, Blend, DrawCall, Gpu, Mesh, Primitive, Program, ProgramKind, Surface, Target,
     TargetFormat,
 };
-use crate::programs;
 
 /// Pixels from a pixel to the neighbours it is compared with (Boucheny's 1.4, rounded
 /// per direction).
@@ -96,7 +96,7 @@ impl EdlPass {
             locals::VERTEX_SIZES,
             [view.size_range[0], view.size_range[1], 0.0, 0.0],
         )?;
-        gl::draw(
+        arbvis_gl::draw(
             gpu,
             Surface::Target(&self.depth),
             &DrawCall {
@@ -116,7 +116,7 @@ impl EdlPass {
             locals::SURFACE_ORIGIN,
             [origin[0], origin[1], 0.0, 0.0],
         )?;
-        Ok(gl::draw(
+        Ok(arbvis_gl::draw(
             gpu,
             surface,
             &DrawCall {

@@ -75,9 +75,9 @@ impl crate::techniques::Technique for SplatsScene {
 
     fn validate(
         &self,
-        fidelity: crate::vocab::Fidelity,
-        programs: crate::gl::ProgramChoice,
-    ) -> Result<(), crate::vocab::FieldError> {
+        fidelity: arbvis_core::vocab::Fidelity,
+        programs: arbvis_gl::ProgramChoice,
+    ) -> Result<(), arbvis_core::vocab::FieldError> {
         SplatsScene::validate(self)?;
         self.draw_allowed(fidelity, programs)
     }
@@ -89,15 +89,15 @@ impl crate::techniques::Technique for SplatsScene {
         }
     }
 
-    fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
+    fn memory_estimate(&self, size: [u32; 2]) -> Vec<arbvis_core::budget::Estimate> {
         SplatsScene::memory_estimate(self, size)
     }
 
     fn unwritten_defaults(
         &mut self,
         written: &dyn Fn(&str) -> bool,
-        _: &mut crate::camera::Camera,
-        fidelity: &mut crate::vocab::Fidelity,
+        _: &mut arbvis_core::camera::Camera,
+        fidelity: &mut arbvis_core::vocab::Fidelity,
     ) {
         SplatsScene::unwritten_defaults(self, written, fidelity)
     }
@@ -120,7 +120,7 @@ impl crate::techniques::Technique for SplatsScene {
     fn prepare(
         &self,
         settings: &crate::techniques::Settings<'_>,
-        _: &crate::volume::Limits,
+        _: &arbvis_data::volume::Limits,
     ) -> crate::error::RenderResult<prepare::PreparedCloud> {
         SplatsScene::validate(self)?;
         prepare::prepare_for(self, settings.base, Some(&settings.view))
@@ -128,9 +128,9 @@ impl crate::techniques::Technique for SplatsScene {
 
     fn renderer(
         &self,
-        gpu: &crate::gl::Gpu,
+        gpu: &arbvis_gl::Gpu,
         settings: &crate::techniques::Settings<'_>,
-        kind: crate::gl::ProgramKind,
+        kind: arbvis_gl::ProgramKind,
         prepared: prepare::PreparedCloud,
     ) -> crate::error::RenderResult<Box<dyn crate::techniques::Renderer>> {
         Ok(Box::new(SplatsRenderer::upload(

@@ -29,7 +29,7 @@
 //!   [`orient_toward`] flips a normal whose dot product with the direction to the eye
 //!   is negative, as the seed fixed its inverted normals.
 //! - **Parallel** over the points of a layer (rayon), with a progress bar on a terminal
-//!   for [`crate::points::progress::MIN_POINTS`] points or more.
+//!   for [`arbvis_data::points::progress::MIN_POINTS`] points or more.
 
 use std::collections::BTreeMap;
 use std::num::NonZeroUsize;
@@ -38,8 +38,8 @@ use glam::DVec3;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
-use crate::points::progress::Progress;
-use crate::points::{PointCloud, Values, LAYER};
+use arbvis_data::points::progress::Progress;
+use arbvis_data::points::{PointCloud, Values, LAYER};
 
 /// The default neighbourhood size.
 pub const DEFAULT_K: usize = 16;

@@ -30,13 +30,13 @@ use glam::{DMat4, DVec4};
 
 use super::locals;
 use super::reference::OitWeight;
-use crate::camera::{Camera, Projection};
-use crate::gl::{
-    self, Blend, DrawCall, Gpu, Mesh, Primitive, Program, ProgramKind, Surface, Target,
-};
 use crate::programs;
 use crate::techniques::quad::quad_mesh;
-use crate::vocab::TargetFormat;
+use arbvis_core::camera::{Camera, Projection};
+use arbvis_core::vocab::TargetFormat;
+use arbvis_gl::{
+    self, Blend, DrawCall, Gpu, Mesh, Primitive, Program, ProgramKind, Surface, Target,
+};
 
 /// The weight the GPU programs compute (eq. 7), for comparisons with the reference.
 pub const OIT_WEIGHT: OitWeight = OitWeight::Eq7;
@@ -100,11 +100,11 @@ impl OitPass {
             ..DrawCall::new(program, mesh)
         };
         program.set_local(gpu, locals::OIT_ACCUMULATE, [1.0, 0.0, 0.0, 0.0])?;
-        let drawn = gl::draw(gpu, Surface::Target(&self.accum), &splats(Blend::Add));
+        let drawn = arbvis_gl::draw(gpu, Surface::Target(&self.accum), &splats(Blend::Add));
         program.set_local(gpu, locals::OIT_ACCUMULATE, [0.0; 4])?;
         drawn?;
-        gl::draw(gpu, Surface::Target(&self.reveal), &splats(Blend::Reveal))?;
-        Ok(gl::draw(
+        arbvis_gl::draw(gpu, Surface::Target(&self.reveal), &splats(Blend::Reveal))?;
+        Ok(arbvis_gl::draw(
             gpu,
             surface,
             &DrawCall {

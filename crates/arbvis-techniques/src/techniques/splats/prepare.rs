@@ -9,10 +9,10 @@ use glam::DVec3;
 use super::normals::{estimate_cloud, DEFAULT_K};
 use super::scene::{ColourMode, Kernel, Mode, SplatsScene};
 use crate::error::RenderResult;
-use crate::points::section::{facies_colour, PALETTE};
-use crate::points::{PointCloud, FACIES, FAULT, LAYER, UNDEFINED_FACIES};
-use crate::vocab::Fidelity;
-use crate::vocab::FieldError;
+use arbvis_core::vocab::Fidelity;
+use arbvis_core::vocab::FieldError;
+use arbvis_data::points::section::{facies_colour, PALETTE};
+use arbvis_data::points::{PointCloud, FACIES, FAULT, LAYER, UNDEFINED_FACIES};
 
 /// Floats per vertex: position 3, colour 3, property value 1, normal 3, size scale 1 (a
 /// COPC point's spacing over the deepest drawn level's; the precise programs multiply the
@@ -27,7 +27,7 @@ pub const COLOR_A: [f64; 3] = [0.05, 0.10, 0.45];
 /// See [`COLOR_A`].
 pub const COLOR_B: [f64; 3] = [1.0, 0.85, 0.25];
 
-/// Layer colours: the first 8 of [`crate::points::section::PALETTE`] (layer ids 0..7 in
+/// Layer colours: the first 8 of [`arbvis_data::points::section::PALETTE`] (layer ids 0..7 in
 /// the seed's sections; ids wrap around beyond).
 pub const LAYERS_IN_PALETTE: i32 = 8;
 
@@ -61,14 +61,14 @@ pub fn prepare(scene: &SplatsScene, base: &Path) -> RenderResult<(PointCloud, Pr
 pub type PreparedCloud = (
     PointCloud,
     Prepared,
-    Option<crate::points::copc_lod::Loaded>,
+    Option<arbvis_data::points::copc_lod::Loaded>,
 );
 
 /// [`prepare`], a COPC cloud's nodes chosen for `view`; with what a COPC cut holds.
 pub fn prepare_for(
     scene: &SplatsScene,
     base: &Path,
-    view: Option<&crate::points::copc_lod::View>,
+    view: Option<&arbvis_data::points::copc_lod::View>,
 ) -> RenderResult<PreparedCloud> {
     let (cloud, note) = scene.cloud.load_for(base, view)?;
     if let Some(warning) = missing_colour(scene, &cloud) {
@@ -100,30 +100,30 @@ pub fn missing_colour(scene: &SplatsScene, cloud: &PointCloud) -> Option<String>
     ))
 }
 
-/// [`prepare_for`] in stages (a COPC cloud: [`crate::points::copc_load`]'s; any other
+/// [`prepare_for`] in stages (a COPC cloud: [`arbvis_data::points::copc_load`]'s; any other
 /// cloud in one): `each` gets each stage prepared and whether it is the whole cut, and
 /// returns false to stop.
 pub fn prepare_in_stages(
     scene: &SplatsScene,
     base: &Path,
-    view: &crate::points::copc_lod::View,
-    stages: crate::points::copc_load::Stages,
+    view: &arbvis_data::points::copc_lod::View,
+    stages: arbvis_data::points::copc_load::Stages,
     mut each: impl FnMut(
         (
             PointCloud,
             Prepared,
-            Option<crate::points::copc_lod::Loaded>,
+            Option<arbvis_data::points::copc_lod::Loaded>,
         ),
         bool,
     ) -> bool,
 ) -> RenderResult<()> {
-    let crate::points::PointSource::Copc(spec) = &scene.cloud else {
+    let arbvis_data::points::PointSource::Copc(spec) = &scene.cloud else {
         each(prepare_for(scene, base, Some(view))?, true);
         return Ok(());
     };
     let mut failed = None;
     let mut warned = false;
-    crate::points::copc_load::load_in_stages(
+    arbvis_data::points::copc_load::load_in_stages(
         spec,
         base,
         Some(view),
@@ -179,8 +179,8 @@ pub fn from_cloud(
     let faults = cloud.ints(FAULT);
     let values: Vec<f32> = match cloud.attribute(&scene.property) {
         Some(a) => match &a.values {
-            crate::points::Values::Float(v) => v.clone(),
-            crate::points::Values::Int(v) => v.iter().map(|&x| x as f32).collect(),
+            arbvis_data::points::Values::Float(v) => v.clone(),
+            arbvis_data::points::Values::Int(v) => v.iter().map(|&x| x as f32).collect(),
         },
         None if scene.colour == ColourMode::Property || scene.mode == Mode::Volume => {
             let names: Vec<&str> = cloud.attributes.iter().map(|a| a.name.as_str()).collect();
@@ -446,7 +446,7 @@ pub fn rgba_of(
 /// pixels, so the distance cancels in perspective), or the scene's own when larger.
 pub fn point_size_for_spacing(
     scene: &SplatsScene,
-    view: &crate::points::copc_lod::View,
+    view: &arbvis_data::points::copc_lod::View,
     spacing: f64,
 ) -> f64 {
     let covering =
@@ -483,8 +483,8 @@ pub fn class_name(code: i32) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::points::section::{generate, SectionSpec};
-    use crate::points::PointSource;
+    use arbvis_data::points::section::{generate, SectionSpec};
+    use arbvis_data::points::PointSource;
 
     fn scene() -> SplatsScene {
         toml::from_str::<SplatsScene>("cloud = { section = { points = 2000, seed = 5 } }").unwrap()
@@ -563,7 +563,7 @@ mod tests {
     /// `hide_classes` hides the points of those LAS classes and no others.
     #[test]
     fn hidden_classes_are_not_drawn() {
-        use crate::points::{CloudParts, Values};
+        use arbvis_data::points::{CloudParts, Values};
         let classes: Vec<i32> = (0..50).map(|i| [1, 2, 5, 7, 2][i % 5]).collect();
         let cloud = PointCloud::from_parts(CloudParts {
             positions: (0..50)
@@ -590,7 +590,7 @@ mod tests {
     /// of the positions: 1e-5 of the range).
     #[test]
     fn elevation_follows_each_points_height() {
-        use crate::points::CloudParts;
+        use arbvis_data::points::CloudParts;
         // Uneven heights far from the origin (a lidar tile's), x and y unrelated to z.
         let z: Vec<f64> = (0..40)
             .map(|i| 312.5 + ((i * 37) % 23) as f64 * 1.7)

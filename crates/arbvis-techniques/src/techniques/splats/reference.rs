@@ -84,9 +84,9 @@ use glam::{DMat4, DVec3, DVec4};
 use rayon::prelude::*;
 
 use super::sort::{keys_order, View};
-use crate::camera::{Camera, Projection};
-use crate::image::Image;
-use crate::vocab::TargetFormat;
+use arbvis_core::camera::{Camera, Projection};
+use arbvis_core::image::Image;
+use arbvis_core::vocab::TargetFormat;
 
 /// How a splat's alpha falls off with `n_dist` (0 at the centre, 1 on the rim).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -330,10 +330,10 @@ fn rasterize<T: Send>(
     let [width, height] = size;
     let band = 16usize;
     // A bar (bands of rows done, time left) when a reference runs past a couple of seconds.
-    let bar = crate::progress::Bar::delayed(
+    let bar = arbvis_core::progress::Bar::delayed(
         height.div_ceil(band as u32) as u64,
         "f64 splat reference (bands of 16 rows)",
-        crate::progress::Unit::Rows,
+        arbvis_core::progress::Unit::Rows,
         std::time::Duration::from_secs(2),
     );
     pixels

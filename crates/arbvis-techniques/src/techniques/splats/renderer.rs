@@ -18,7 +18,7 @@
 //! Gaussian of width 0.35 by up to 0.2.
 
 use crate::error::RenderResult;
-use crate::gl::GlResult;
+use arbvis_gl::GlResult;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -38,14 +38,14 @@ use super::tiles::{
     place_splats, point_colours, spatial_order, Binner, SpatialPoints, TooManyEntries,
     DEFAULT_MAX_ENTRIES,
 };
-use crate::camera::{Camera, Projection};
-use crate::gl::{self, Blend, DrawCall, Gpu, Mesh, Primitive, Program, ProgramKind, Surface};
-use crate::points::copc_lod::View as CloudView;
-use crate::points::PointCloud;
 use crate::programs::{self, ProgramPair};
+use arbvis_core::camera::{Camera, Projection};
+use arbvis_data::points::copc_lod::View as CloudView;
+use arbvis_data::points::PointCloud;
+use arbvis_gl::{self, Blend, DrawCall, Gpu, Mesh, Primitive, Program, ProgramKind, Surface};
 
 use crate::techniques::{Frame, Params, Renderer, Streaming};
-use crate::vocab::Fidelity;
+use arbvis_core::vocab::Fidelity;
 
 mod loading;
 use loading::{not_refined, Arrival, Loading, Prepared3};
@@ -108,7 +108,7 @@ pub struct SplatsRenderer {
     /// The cut of the view the camera stopped at, being loaded, and how it is handed
     /// over.
     loading: Option<Loading>,
-    stages: crate::points::copc_load::Stages,
+    stages: arbvis_data::points::copc_load::Stages,
     /// Eye-dome lighting's depth target and programs, made at the first frame's size.
     edl: Option<EdlPass>,
     /// A COPC cut's points' sizes over the scene's (precise tiles and points; empty: all 1).
@@ -259,7 +259,7 @@ impl SplatsRenderer {
 
     /// How a COPC cut loaded when the camera stops is handed over (the viewer's stages
     /// by default).
-    pub fn set_stages(&mut self, stages: crate::points::copc_load::Stages) {
+    pub fn set_stages(&mut self, stages: arbvis_data::points::copc_load::Stages) {
         self.stages = stages;
     }
 
@@ -287,7 +287,7 @@ impl SplatsRenderer {
         base: &Path,
         (cloud, prepared, (nodes, size_scales)): (PointCloud, Prepared, CutParts),
     ) -> RenderResult<SplatsRenderer> {
-        params.draw_allowed(fidelity, crate::gl::ProgramChoice::Auto)?;
+        params.draw_allowed(fidelity, arbvis_gl::ProgramChoice::Auto)?;
         let pair = program_pair(fidelity, kind);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         let mesh = Mesh::new(
@@ -321,7 +321,7 @@ impl SplatsRenderer {
             scene_point_size: params.point_size,
             spacing: None,
             loading: None,
-            stages: crate::points::copc_load::Stages::viewer(),
+            stages: arbvis_data::points::copc_load::Stages::viewer(),
             edl: None,
             size_scales,
             nodes,
@@ -391,7 +391,7 @@ impl SplatsRenderer {
                 return oit.draw(gpu, &self.program, &self.mesh, surface);
             }
         }
-        Ok(gl::draw(
+        Ok(arbvis_gl::draw(
             gpu,
             surface,
             &DrawCall {
@@ -748,8 +748,9 @@ impl Renderer for SplatsRenderer {
         };
         // The box the cloud is framed by, in the file's coordinates.
         let half = std::array::from_fn(|a| ((hi[a] - lo[a]) / (2.0 * c.scale)).max(1e-9));
-        let axes =
-            std::array::from_fn(|a| crate::volume::axes::span(["x", "y", "z"][a], lo[a], hi[a]));
+        let axes = std::array::from_fn(|a| {
+            arbvis_data::volume::axes::span(["x", "y", "z"][a], lo[a], hi[a])
+        });
         Annotations {
             legends: legend.into_iter().collect(),
             axes: Some((half, axes)),
@@ -783,7 +784,7 @@ impl Renderer for SplatsRenderer {
     fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> RenderResult<()> {
         let asked = params.get::<SplatsScene>()?;
         asked.validate()?;
-        asked.draw_allowed(self.fidelity, crate::gl::ProgramChoice::Auto)?;
+        asked.draw_allowed(self.fidelity, arbvis_gl::ProgramChoice::Auto)?;
         // A COPC cut keeps its splats sized from its spacing over the scene's size.
         let mut sized = asked.clone();
         if let (Some(v), Some(spacing)) = (&self.view, self.spacing) {
@@ -956,7 +957,7 @@ pub fn program_pairs() -> Vec<ProgramPair> {
 /// Precise programs (tiles and points) scale each point by its size scale; faithful
 /// ones draw one size.
 fn cut_text(
-    l: &crate::points::copc_lod::Loaded,
+    l: &arbvis_data::points::copc_lod::Loaded,
     sized: &SplatsScene,
     scene_size: f64,
     fidelity: Fidelity,

@@ -3,9 +3,9 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::gl::ProgramChoice;
-use crate::points::PointSource;
-use crate::vocab::{Fidelity, FieldError};
+use arbvis_core::vocab::{Fidelity, FieldError};
+use arbvis_data::points::PointSource;
+use arbvis_gl::ProgramChoice;
 
 /// What colours a point.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
@@ -173,7 +173,7 @@ pub struct SplatsScene {
 }
 
 fn porosity() -> String {
-    crate::points::POROSITY.into()
+    arbvis_data::points::POROSITY.into()
 }
 fn default_point_size() -> f64 {
     10.0
@@ -254,8 +254,8 @@ impl SplatsScene {
     /// The large allocations this scene makes that the scene alone determines (a
     /// generated section, the tile lists of an image of `size`); cloud files are held to
     /// the budget by their loaders once their headers are read.
-    pub fn memory_estimate(&self, size: [u32; 2]) -> Vec<crate::budget::Estimate> {
-        use crate::budget::Estimate;
+    pub fn memory_estimate(&self, size: [u32; 2]) -> Vec<arbvis_core::budget::Estimate> {
+        use arbvis_core::budget::Estimate;
         let mut out = Vec::new();
         if let PointSource::Section(spec) = &self.cloud {
             out.push(Estimate::of(

@@ -59,15 +59,17 @@
 //!
 //! Orders are u32 indices, as a GL index buffer holds: slices of more than `u32::MAX`
 //! points have no such order and get an empty one (point readers stop at
-//! [`crate::points::MAX_POINTS`], far below).
+//! [`arbvis_data::points::MAX_POINTS`], far below).
 
 use std::time::{Duration, Instant};
 
 use glam::DVec3;
 use rayon::prelude::*;
 
-use crate::camera::{Camera, Projection};
-use crate::points::{PointCloud, Values, AMPLITUDE, FACIES, FAULT, JOINT_DIP, LAYER, POROSITY};
+use arbvis_core::camera::{Camera, Projection};
+use arbvis_data::points::{
+    PointCloud, Values, AMPLITUDE, FACIES, FAULT, JOINT_DIP, LAYER, POROSITY,
+};
 
 mod radix;
 pub use radix::{radix_order_into, RadixScratch, RADIX_BITS};
@@ -232,7 +234,7 @@ impl SeedPoint {
     }
 
     /// Structs of a cloud with the seed's attributes (missing ones zero; facies colours
-    /// from [`crate::points::section::facies_colour`]; the cloud's normals if it has them).
+    /// from [`arbvis_data::points::section::facies_colour`]; the cloud's normals if it has them).
     pub fn from_cloud(cloud: &PointCloud) -> Vec<SeedPoint> {
         let mut points = SeedPoint::from_positions(&cloud.positions);
         let int = |name: &str, i: usize| cloud.ints(name).and_then(|v| v.get(i).copied());
@@ -243,7 +245,7 @@ impl SeedPoint {
         };
         for (i, p) in points.iter_mut().enumerate() {
             if let Some(f) = int(FACIES, i) {
-                p.colour = crate::points::section::facies_colour(f).map(|c| c as f32 / 255.0);
+                p.colour = arbvis_data::points::section::facies_colour(f).map(|c| c as f32 / 255.0);
             }
             p.layer = int(LAYER, i).unwrap_or(0);
             p.fault = int(FAULT, i).unwrap_or(-1);

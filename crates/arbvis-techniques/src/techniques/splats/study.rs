@@ -20,15 +20,15 @@ use std::time::Instant;
 use super::prepare::prepare;
 use super::scene::{DrawChoice, SortChoice};
 use super::sort::time_methods;
-use crate::camera::{Camera, Projection};
-use crate::gl::{Headless, Surface, Target};
-use crate::points::section::{generate, SectionSpec};
-use crate::points::{PointCloud, PointSource};
-use crate::progress::{Bar, Unit};
 use crate::scene::Scene;
 use crate::techniques::splats::SplatsScene;
 use crate::techniques::{self, Frame};
-use crate::vocab::Fidelity;
+use arbvis_core::camera::{Camera, Projection};
+use arbvis_core::progress::{Bar, Unit};
+use arbvis_core::vocab::Fidelity;
+use arbvis_data::points::section::{generate, SectionSpec};
+use arbvis_data::points::{PointCloud, PointSource};
+use arbvis_gl::{Headless, Surface, Target};
 
 /// What to sweep.
 #[derive(Debug, Clone)]
@@ -119,11 +119,11 @@ pub fn sorts(options: &Options, mut progress: impl FnMut(&str)) -> anyhow::Resul
 /// per-layer normals (k = 16), each timed once.
 fn accuracy(cloud: &PointCloud, camera: &Camera, size: [u32; 2]) -> Vec<(String, f64)> {
     use super::reference::{self, Footprint, SplatParams, SplatScene};
-    let facies = cloud.ints(crate::points::FACIES).unwrap_or(&[]);
+    let facies = cloud.ints(arbvis_data::points::FACIES).unwrap_or(&[]);
     let rgba: Vec<[f64; 4]> = (0..cloud.len())
         .map(|i| {
             let f = facies.get(i).copied().unwrap_or(0);
-            let c = crate::points::section::facies_colour(f).map(|c| c as f64 / 255.0);
+            let c = arbvis_data::points::section::facies_colour(f).map(|c| c as f64 / 255.0);
             [c[0], c[1], c[2], 0.6]
         })
         .collect();
@@ -301,7 +301,7 @@ fn reference_of(
     camera: &Camera,
     size: [u32; 2],
     background: [f64; 4],
-) -> crate::image::Image {
+) -> arbvis_core::image::Image {
     use super::reference::{composite, eye_position, view_direction, SplatParams, SplatScene};
     let rgba = super::prepare::point_rgba(
         prepared,

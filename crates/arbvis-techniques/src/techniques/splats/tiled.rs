@@ -9,11 +9,11 @@ use glam::DMat4;
 
 use super::locals;
 use super::tiles::TileLists;
-use crate::gl::{
+use crate::programs;
+use arbvis_gl::{
     self, Blend, DrawCall, Extent, GlError, Gpu, Mesh, Program, ProgramKind, Surface, TexelData,
     TexelFormat, Texture,
 };
-use crate::programs;
 
 /// Texels per row of the array textures (`ROW` in `tiles.frag`).
 pub const ROW: usize = 4096;
@@ -187,7 +187,7 @@ impl TilePass {
             locals::SURFACE_ORIGIN,
             [origin[0] as f64, origin[1] as f64, 0.0, 0.0],
         )?;
-        Ok(gl::draw(
+        Ok(arbvis_gl::draw(
             gpu,
             surface,
             &DrawCall {

@@ -59,8 +59,8 @@ use super::prepare::{rgba_of, Prepared};
 use super::reference::SplatParams;
 use super::scene::SplatsScene;
 use super::sort::View;
-use crate::camera::Camera;
-use crate::vocab::Fidelity;
+use arbvis_core::camera::Camera;
+use arbvis_core::vocab::Fidelity;
 
 /// Pixels a splat's listed square is widened by on each side (f32 rounding of window
 /// positions is far below it; the program's exact test decides).

@@ -9,12 +9,12 @@
 use crate::error::RenderResult;
 use std::time::Instant;
 
-use crate::camera::{Camera, Projection};
-use crate::gl::{Headless, ProgramKind, Surface, Target};
-use crate::progress::{Bar, Unit};
 use crate::study::median;
 use crate::techniques::{Frame, Renderer};
-use crate::vocab::{Fidelity, TargetFormat};
+use arbvis_core::camera::{Camera, Projection};
+use arbvis_core::progress::{Bar, Unit};
+use arbvis_core::vocab::{Fidelity, TargetFormat};
+use arbvis_gl::{Headless, ProgramKind, Surface, Target};
 
 use super::super::prepare::Prepared;
 use super::super::reference::silhouette_pixels;

@@ -7,21 +7,21 @@
 //! boundary to within a grid spacing) and the table's.
 
 use crate::error::RenderResult;
-use crate::gl::GlResult;
+use arbvis_gl::GlResult;
 use glam::{DMat3, DVec3};
 use rayon::prelude::*;
 
 use super::super::preint;
 use super::super::prepare::Prepared;
 use super::super::transfer::{Build, Transfer, VolumeSpec};
-use crate::gl::{
-    self, Blend, DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, TexelData,
-    TexelFormat, Texture,
-};
 use crate::programs::{self, ProgramPair};
 use crate::techniques::cellproj::locals;
 use crate::techniques::quad::quad_mesh;
 use crate::techniques::Frame;
+use arbvis_gl::{
+    self, Blend, DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, TexelData,
+    TexelFormat, Texture,
+};
 
 /// The mesh's scalar on a regular grid.
 #[derive(Debug, Clone)]
@@ -177,9 +177,9 @@ impl GridCaster {
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         program.set_transform(gpu, glam::DMat4::IDENTITY)?;
         let ([nx, ny, nz], _) = layout(prepared.half, spec.grid);
-        crate::budget::check(
+        arbvis_core::budget::check(
             format!("precise grid's {nx} x {ny} x {nz} points"),
-            crate::budget::times((nx * ny * nz) as u64, POINT_BYTES),
+            arbvis_core::budget::times((nx * ny * nz) as u64, POINT_BYTES),
         )?;
         let resampled = resample(prepared, spec.grid);
         let [nx, ny, nz] = resampled.dims.map(|n| n as u32);
@@ -255,7 +255,7 @@ impl GridCaster {
             locals::GRID_TABLE,
             [sides[0], sides[1], spec.termination, 0.0],
         )?;
-        Ok(gl::draw(
+        Ok(arbvis_gl::draw(
             gpu,
             surface,
             &DrawCall {

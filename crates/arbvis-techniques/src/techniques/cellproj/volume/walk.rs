@@ -3,7 +3,7 @@
 //! pixel's ray through the tetrahedra and integrate it exactly.
 
 use crate::error::{texture_rows, RenderResult};
-use crate::gl::GlResult;
+use arbvis_gl::GlResult;
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -12,15 +12,15 @@ use super::super::order::BOUNDARY;
 use super::super::prepare::{gradient, normal, Prepared, FACES};
 use super::super::transfer::{Transfer, VolumeSpec};
 use super::super::Isovalue;
-use crate::camera::Projection;
-use crate::gl::ProgramText;
-use crate::gl::{
-    self, Blend, DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, Target,
-    TargetFormat, TexelData, TexelFormat, Texture,
-};
 use crate::programs::{self, ProgramPair};
 use crate::techniques::cellproj::locals;
 use crate::techniques::Frame;
+use arbvis_core::camera::Projection;
+use arbvis_gl::ProgramText;
+use arbvis_gl::{
+    self, Blend, DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, Target,
+    TargetFormat, TexelData, TexelFormat, Texture,
+};
 
 /// `volume_integral.glsl` joined before the main of `fragment` (after its `#version`).
 pub fn with_integral(fragment: &ProgramText) -> ProgramText {
@@ -327,11 +327,11 @@ impl Precise {
             // boundary's single layer), no count is needed.
             let target = Surface::Target(&p.layers[k]);
             if p.cap.is_none() {
-                if gl::draw_counted(gpu, target, &call)? == 0 {
+                if arbvis_gl::draw_counted(gpu, target, &call)? == 0 {
                     break;
                 }
             } else {
-                gl::draw(gpu, target, &call)?;
+                arbvis_gl::draw(gpu, target, &call)?;
             }
             n += 1;
             p.peeled += 1;
@@ -450,7 +450,7 @@ impl Precise {
                 }
             }
             if last {
-                return Ok(gl::draw(
+                return Ok(arbvis_gl::draw(
                     gpu,
                     surface,
                     &DrawCall {
@@ -461,7 +461,7 @@ impl Precise {
                 )?);
             }
             p.sums[sum_out].clear(gpu, [0.0; 4])?;
-            gl::draw(
+            arbvis_gl::draw(
                 gpu,
                 Surface::Target(&p.sums[sum_out]),
                 &DrawCall {

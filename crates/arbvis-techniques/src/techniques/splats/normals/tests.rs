@@ -1,6 +1,6 @@
 use super::*;
-use crate::points::section::SplitMix64;
-use crate::points::CloudParts;
+use arbvis_data::points::section::SplitMix64;
+use arbvis_data::points::CloudParts;
 
 /// Angle in degrees between two axes (sign ignored).
 fn axis_angle(a: DVec3, b: DVec3) -> f64 {
@@ -306,9 +306,9 @@ fn orientation_faces_the_eye() {
 #[test]
 fn bunny_normals_follow_its_surface() {
     // The Stanford bunny's vertices, against the area-weighted normals of its faces.
-    let path = crate::input::data_file("points/bunny.ply");
-    let ply = crate::points::ply::read(&path).unwrap();
-    let cloud = crate::points::plycloud::cloud(&path, &ply).unwrap();
+    let path = arbvis_core::input::data_file("points/bunny.ply");
+    let ply = arbvis_data::points::ply::read(&path).unwrap();
+    let cloud = arbvis_data::points::plycloud::cloud(&path, &ply).unwrap();
     assert_eq!(cloud.len(), 35_947);
     let faces = ply.element("face").and_then(|f| f.face_indices()).unwrap();
     let mut truth = vec![DVec3::ZERO; cloud.len()];

@@ -1,6 +1,6 @@
 use super::*;
-use crate::points::section::SplitMix64;
 use crate::techniques::splats::sort::{keys_order, View};
+use arbvis_data::points::section::SplitMix64;
 
 const BG: [f64; 4] = [0.0, 0.0, 0.1, 1.0];
 

@@ -1,5 +1,5 @@
 //! A COPC cut loaded for the view the camera stopped at: on a thread, in stages
-//! ([`crate::points::copc_load`]), which the renderer takes one a frame; a loading dropped
+//! ([`arbvis_data::points::copc_load`]), which the renderer takes one a frame; a loading dropped
 //! (the camera moved on) stops its thread before the next batch.
 
 use std::path::PathBuf;
@@ -8,10 +8,10 @@ use std::sync::mpsc::{Receiver, TryRecvError};
 use std::sync::Arc;
 
 use crate::error::{RenderError, RenderResult};
-use crate::points::copc_load::Stages;
-use crate::points::copc_lod::View as CloudView;
 use crate::techniques::splats::prepare::prepare_in_stages;
 use crate::techniques::splats::scene::SplatsScene;
+use arbvis_data::points::copc_load::Stages;
+use arbvis_data::points::copc_lod::View as CloudView;
 
 /// What [`prepare_for`](crate::techniques::splats::prepare::prepare_for) makes.
 pub(super) type Prepared3 = crate::techniques::splats::prepare::PreparedCloud;

@@ -1,6 +1,6 @@
 use super::*;
-use crate::points::section::SplitMix64;
-use crate::points::CloudParts;
+use arbvis_data::points::section::SplitMix64;
+use arbvis_data::points::CloudParts;
 
 fn random_cloud(n: usize, seed: u64) -> Vec<[f32; 3]> {
     let mut r = SplitMix64::new(seed);
@@ -318,8 +318,8 @@ fn time_methods_reports_every_row() {
 #[test]
 fn lidar_tile_orders_agree() {
     // 110,000 lidar returns quantized to centimetres: plenty of exact ties.
-    let path = crate::input::data_file("points/autzen_trim.laz");
-    let cloud = crate::points::lasfile::read(&path).unwrap().cloud;
+    let path = arbvis_core::input::data_file("points/autzen_trim.laz");
+    let cloud = arbvis_data::points::lasfile::read(&path).unwrap().cloud;
     assert_eq!(cloud.len(), 110_000);
     let positions = &cloud.positions;
     for view in [

@@ -8,13 +8,13 @@
 
 use anyhow::{bail, Context, Result};
 
-use crate::gl::Headless;
-use crate::points::copc::Copc;
-use crate::points::copc_lod::{select, View};
-use crate::points::PointSource;
 use crate::scene::Scene;
 use crate::study::bench::{self, BenchOptions};
 use crate::techniques::splats::SplatsScene;
+use arbvis_data::points::copc::Copc;
+use arbvis_data::points::copc_lod::{select, View};
+use arbvis_data::points::PointSource;
+use arbvis_gl::Headless;
 
 /// One budget measured.
 #[derive(Debug, Clone, PartialEq)]
@@ -59,7 +59,7 @@ pub fn lod(
     let PointSource::Copc(spec) = &p.cloud else {
         bail!("the splats-lod study needs a scene whose cloud is a COPC file");
     };
-    let path = crate::fetch::resolve(&scene.base, &spec.path);
+    let path = arbvis_data::fetch::resolve(&scene.base, &spec.path);
     let copc = Copc::open(&path).with_context(|| format!("opening {}", path.display()))?;
     progress(&format!(
         "splats-lod: the reference, all {} points of {}",

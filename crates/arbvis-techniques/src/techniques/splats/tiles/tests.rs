@@ -1,10 +1,10 @@
 use super::*;
-use crate::camera::Projection;
-use crate::image::Image;
-use crate::points::section::SplitMix64;
 use crate::techniques::splats::reference::{composite, exact_order, Footprint, SplatScene};
 use crate::techniques::splats::sort::View;
-use crate::vocab::TargetFormat;
+use arbvis_core::camera::Projection;
+use arbvis_core::image::Image;
+use arbvis_core::vocab::TargetFormat;
+use arbvis_data::points::section::SplitMix64;
 
 /// Odd sizes: tiles do not divide them.
 const SIZE: [u32; 2] = [37, 23];
