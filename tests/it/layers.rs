@@ -37,6 +37,7 @@ const LAYERS: &[(&str, &[&str])] = &[
         ],
     ),
     ("program texts", &["programs"]),
+    ("what panels show of prepared data", &["summary"]),
     ("techniques", &["techniques", "error"]),
     ("the catalog of techniques", &["catalog"]),
     (

@@ -12,11 +12,12 @@
 
 use crate::error::RenderResult;
 use std::any::Any;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
 use crate::programs::ProgramPair;
+use crate::summary::Summary;
 use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::quad::QuadScene;
@@ -149,6 +150,7 @@ trait AnyTechnique: Any {
         limits: &Limits,
         view: &ReferenceView<'_>,
     ) -> RenderResult<Option<Image>>;
+    fn summary(&self, prepared: &dyn Any, base: &Path) -> Option<Summary>;
 }
 
 impl<T: Technique> AnyTechnique for T {
@@ -232,6 +234,11 @@ impl<T: Technique> AnyTechnique for T {
             &Technique::prepare(self, settings, limits)?,
             view,
         ))
+    }
+
+    /// [`Technique::summary`] of `prepared` (none where it is another technique's).
+    fn summary(&self, prepared: &dyn Any, base: &Path) -> Option<Summary> {
+        Technique::summary(self, prepared.downcast_ref::<T::Prepared>()?, base)
     }
 }
 
@@ -351,6 +358,16 @@ pub fn prepare(
     limits: &Limits,
 ) -> RenderResult<PreparedData> {
     technique.technique().prepare(settings, limits)
+}
+
+/// What the panels show of what [`prepare`] made for `technique` (data files relative to
+/// `base`), where the technique tells ([`Technique::summary`]).
+pub fn summary(
+    technique: &TechniqueScene,
+    prepared: &PreparedData,
+    base: &Path,
+) -> Option<Summary> {
+    technique.technique().summary(prepared.as_ref(), base)
 }
 
 /// The renderer of what [`prepare`] made for `technique`, with programs of `kind`.

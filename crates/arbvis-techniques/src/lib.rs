@@ -18,4 +18,5 @@ pub mod render;
 pub mod scene;
 pub mod session;
 pub mod study;
+pub mod summary;
 pub mod techniques;

@@ -14,18 +14,15 @@
 use egui::{Color32, ColorImage, TextureHandle, TextureOptions};
 
 use super::store_sections::{MapPositions, SectionKey, StoreSections};
-use super::summary::{cloud_units, data_box, CloudSummary, DataBox, MeshSummary};
 use arbvis_core::colortable::{ColorTable, TableSpec};
 use arbvis_data::volume::axes::{self, section_axes, section_voxels, Axis};
 use arbvis_gl::{Gpu, ProgramKind};
 use arbvis_techniques::catalog;
 use arbvis_techniques::error::RenderResult;
 use arbvis_techniques::scene::Scene;
-use arbvis_techniques::techniques::cellproj::prepare::Prepared as PreparedMesh;
+use arbvis_techniques::summary::{CloudSummary, DataBox, MeshSummary, Summary};
 use arbvis_techniques::techniques::opacity3d::prepare::{prepare, Prepared};
 use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
-use arbvis_techniques::techniques::splats::prepare::PreparedCloud;
-use arbvis_techniques::techniques::splats::SplatsScene;
 use arbvis_techniques::techniques::Renderer;
 
 /// The 3D-opacity data behind the panels.
@@ -117,35 +114,12 @@ pub fn build(
     let settings = scene.settings();
     let limits = arbvis_data::volume::Limits::for_max_side(gpu.caps().max_3d_texture_size);
     let prepared = catalog::prepare(&scene.technique, &settings, &limits)?;
-    data.summarize(scene, prepared.as_ref());
+    (data.cloud, data.mesh) = match catalog::summary(&scene.technique, &prepared, &scene.base) {
+        Some(Summary::Cloud(cloud)) => (Some(cloud), None),
+        Some(Summary::Mesh(mesh)) => (None, Some(mesh)),
+        None => (None, None),
+    };
     catalog::renderer(&scene.technique, gpu, &settings, kind, prepared)
-}
-
-impl ViewData {
-    /// What the panels show of a technique's prepared data: a cloud's box, units and
-    /// attributes; a mesh's box in its file's coordinates and its scalar's histogram.
-    fn summarize(&mut self, scene: &Scene, prepared: &dyn std::any::Any) {
-        if let (Some((cloud, _, _)), Some(params)) = (
-            prepared.downcast_ref::<PreparedCloud>(),
-            scene.technique.get::<SplatsScene>(),
-        ) {
-            self.cloud = Some(CloudSummary::of(
-                cloud,
-                &cloud_units(&params.cloud, &scene.base),
-            ));
-        }
-        if let Some(mesh) = prepared.downcast_ref::<PreparedMesh>() {
-            let [lo, hi] = mesh.bounds;
-            let longest = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
-            let scale = if longest > 0.0 { 2.0 / longest } else { 1.0 };
-            self.mesh = Some(MeshSummary {
-                data_box: data_box(lo, hi, scale, &Default::default()),
-                scalar: mesh.scalar_name.clone(),
-                range: mesh.scalar_range,
-                histogram: super::transfer::histogram(&mesh.scalars, mesh.scalar_range),
-            });
-        }
-    }
 }
 
 /// 3D opacity's renderer: a survey store streamed, else the volume prepared once and kept,

@@ -41,9 +41,7 @@ pub mod screenshot;
 pub mod script;
 pub mod splats;
 pub mod store_sections;
-pub mod summary;
 pub mod transfer;
-pub mod units;
 pub mod widgets;
 
 use std::time::{Duration, Instant};

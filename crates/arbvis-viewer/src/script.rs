@@ -214,20 +214,55 @@ impl Script {
     }
 }
 
+/// Arguments an action word cannot take.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum ArgError {
+    /// Not the words and numbers the action takes.
+    #[error("{word} takes {usage}, got {got:?}")]
+    Usage {
+        /// The action word.
+        word: String,
+        /// What it takes.
+        usage: String,
+        /// What followed it (shortened).
+        got: String,
+    },
+    /// A point in a widget outside it.
+    #[error("{word}: FX and FY are fractions of the widget, 0..=1; got {} {}", .at[0], .at[1])]
+    Fractions {
+        /// The action word.
+        word: String,
+        /// The fractions given.
+        at: [f32; 2],
+    },
+}
+
+/// The message, for the line that holds the action.
+impl From<ArgError> for String {
+    fn from(e: ArgError) -> String {
+        e.to_string()
+    }
+}
+
+impl ArgError {
+    fn usage(word: &str, usage: &str, rest: &str) -> ArgError {
+        ArgError::Usage {
+            word: word.to_string(),
+            usage: usage.to_string(),
+            got: arbvis_core::input::shorten(rest, 60),
+        }
+    }
+}
+
 /// Split `rest` into a label and its last `n` words parsed as finite numbers.
 fn label_and_numbers(
     word: &str,
     rest: &str,
     n: usize,
     usage: &str,
-) -> Result<(String, Vec<f32>), String> {
+) -> Result<(String, Vec<f32>), ArgError> {
     let words: Vec<&str> = rest.split_whitespace().collect();
-    let bad = || {
-        format!(
-            "{word} takes {usage}, got {:?}",
-            arbvis_core::input::shorten(rest, 60)
-        )
-    };
+    let bad = || ArgError::usage(word, usage, rest);
     if words.len() < n + 1 {
         return Err(bad());
     }
@@ -240,27 +275,23 @@ fn label_and_numbers(
     Ok((label.join(" "), numbers))
 }
 
-fn fractions(word: &str, f: &[f32]) -> Result<(f32, f32), String> {
+fn fractions(word: &str, f: &[f32]) -> Result<(f32, f32), ArgError> {
     if f.iter().any(|v| !(0.0..=1.0).contains(v)) {
-        return Err(format!(
-            "{word}: FX and FY are fractions of the widget, 0..=1; got {} {}",
-            f[0], f[1]
-        ));
+        return Err(ArgError::Fractions {
+            word: word.to_string(),
+            at: [f[0], f[1]],
+        });
     }
     Ok((f[0], f[1]))
 }
 
-fn numbers<const N: usize>(word: &str, rest: &str, usage: &str) -> Result<[f32; N], String> {
+fn numbers<const N: usize>(word: &str, rest: &str, usage: &str) -> Result<[f32; N], ArgError> {
     let v: Option<Vec<f32>> = rest
         .split_whitespace()
         .map(|s| s.parse::<f32>().ok().filter(|v| v.is_finite()))
         .collect();
-    v.and_then(|v| <[f32; N]>::try_from(v).ok()).ok_or_else(|| {
-        format!(
-            "{word} takes {usage}, got {:?}",
-            arbvis_core::input::shorten(rest, 60)
-        )
-    })
+    v.and_then(|v| <[f32; N]>::try_from(v).ok())
+        .ok_or_else(|| ArgError::usage(word, usage, rest))
 }
 
 fn parse_action(line: &str) -> Result<Action, String> {

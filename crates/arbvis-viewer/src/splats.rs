@@ -5,10 +5,10 @@
 //! function. The frame, sort and tile-list times show in the panel's status line.
 
 use super::legend::class_name;
-use super::summary::CloudSummary;
 use super::widgets::Widgets;
 use arbvis_core::vocab::Fidelity;
 use arbvis_data::points::PointSource;
+use arbvis_techniques::summary::CloudSummary;
 use arbvis_techniques::techniques::splats::scene::{
     ColourMode, DrawChoice, Kernel, Mode, SortChoice,
 };

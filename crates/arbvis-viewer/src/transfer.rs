@@ -103,22 +103,6 @@ pub fn points_from_curve(
     curve.iter().map(fresh).collect()
 }
 
-/// The histogram of normalized scalars `(v - lo) / (hi - lo)` in 256 bins (values
-/// outside the range in the end bins).
-pub fn histogram(values: &[f64], range: [f64; 2]) -> Vec<u32> {
-    let mut h = vec![0u32; 256];
-    let span = range[1] - range[0];
-    for &v in values.iter().filter(|v| v.is_finite()) {
-        let t = if span > 0.0 {
-            (v - range[0]) / span
-        } else {
-            0.0
-        };
-        h[(t * 255.0).round().clamp(0.0, 255.0) as usize] += 1;
-    }
-    h
-}
-
 /// Draw the editor; true when the scene changed. `counts` is the scalar's histogram.
 pub fn editor(
     ui: &mut egui::Ui,
@@ -304,14 +288,6 @@ mod tests {
         // From a table (no points) to three: each from the function.
         let made = points_from_curve(&[], &[[0.0, 0.0], [0.5, 0.75], [1.0, 1.0]], red);
         assert_eq!(made[1], [0.5, 1.0, 0.0, 0.0, 0.75]);
-    }
-
-    #[test]
-    fn histogram_bins_normalized_values() {
-        // Range 10..20: 10 -> bin 0, 15 -> 127.5 rounds to 128, 25 (beyond) -> 255.
-        let h = histogram(&[10.0, 15.0, 15.0, 25.0, f64::NAN], [10.0, 20.0]);
-        assert_eq!((h[0], h[128], h[255]), (1, 2, 1));
-        assert_eq!(h.iter().sum::<u32>(), 4);
     }
 
     #[test]

@@ -34,6 +34,7 @@ use std::any::Any;
 use std::path::{Path, PathBuf};
 
 use crate::programs::ProgramPair;
+use crate::summary::Summary;
 use arbvis_core::budget::Estimate;
 use arbvis_core::camera::{Camera, Projection};
 use arbvis_core::image::Image;
@@ -248,6 +249,13 @@ pub trait Technique: Any + Sized {
     /// yardstick its precise mode is measured against. None by default.
     fn reference(&self, prepared: &Self::Prepared, view: &ReferenceView<'_>) -> Option<Image> {
         let _ = (prepared, view);
+        None
+    }
+    /// What a front end's panels and overlays show of `prepared` (data files relative to
+    /// `base`): its box in the file's coordinates, a cloud's key, a mesh's scalar. None by
+    /// default.
+    fn summary(&self, prepared: &Self::Prepared, base: &Path) -> Option<Summary> {
+        let _ = (prepared, base);
         None
     }
 }

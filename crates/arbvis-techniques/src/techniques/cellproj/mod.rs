@@ -314,6 +314,25 @@ impl crate::techniques::Technique for CellprojScene {
 
     type Prepared = prepare::Prepared;
 
+    /// The mesh's box in its file's coordinates (no units: mesh formats name none), its
+    /// scalar, and the scalar's histogram over its range.
+    fn summary(
+        &self,
+        mesh: &prepare::Prepared,
+        _: &std::path::Path,
+    ) -> Option<crate::summary::Summary> {
+        use crate::summary::{data_box, histogram, MeshSummary, Summary};
+        let [lo, hi] = mesh.bounds;
+        let longest = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+        let scale = if longest > 0.0 { 2.0 / longest } else { 1.0 };
+        Some(Summary::Mesh(MeshSummary {
+            data_box: data_box(lo, hi, scale, &Default::default()),
+            scalar: mesh.scalar_name.clone(),
+            range: mesh.scalar_range,
+            histogram: histogram(&mesh.scalars, mesh.scalar_range),
+        }))
+    }
+
     fn prepare(
         &self,
         settings: &crate::techniques::Settings<'_>,

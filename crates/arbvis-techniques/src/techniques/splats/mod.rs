@@ -116,6 +116,18 @@ impl crate::techniques::Technique for SplatsScene {
 
     type Prepared = prepare::PreparedCloud;
 
+    /// The cloud's box in its file's coordinates and units, and its key's ids and ranges.
+    fn summary(
+        &self,
+        (cloud, _, _): &prepare::PreparedCloud,
+        base: &std::path::Path,
+    ) -> Option<crate::summary::Summary> {
+        let units = crate::summary::cloud_units(&self.cloud, base);
+        Some(crate::summary::Summary::Cloud(
+            crate::summary::CloudSummary::of(cloud, &units),
+        ))
+    }
+
     /// The cloud loaded (a COPC cloud's nodes chosen for the first view) and prepared.
     fn prepare(
         &self,

@@ -1,9 +1,10 @@
-//! What the overlays know of a mesh or a cloud, taken once when the viewer prepares it:
+//! What the panels and overlays know of a mesh or a cloud, told by its technique
+//! ([`Summary`], [`crate::techniques::Technique::summary`]) once it is prepared:
 //! the box in object space with its axes in the file's coordinates and units, and, for a
 //! cloud, the ids (facies, layers, classes) and attribute ranges its key shows.
 //!
 //! Units: the generated section is in metres (its module says so); a LAS/LAZ file's
-//! come from its projection records ([`super::units`]); `.dat` text, PLY files and
+//! come from its projection records ([`units`]); `.dat` text, PLY files and
 //! meshes say nothing of units, so their axes are plain `x`, `y`, `z`.
 
 use std::collections::BTreeSet;
@@ -11,9 +12,11 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use super::units::{las_units, Units};
+pub mod units;
+
 use arbvis_data::points::{PointCloud, PointSource, FACIES, FAULT, LAYER};
 use arbvis_data::volume::axes::{span, Axis};
+use units::{las_units, Units};
 
 /// Most distinct ids a key lists (beyond, it says how many more there are).
 pub const MAX_IDS: usize = 64;
@@ -123,6 +126,16 @@ impl CloudSummary {
     }
 }
 
+/// What a technique tells its front end's panels of its prepared data
+/// ([`crate::techniques::Technique::summary`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Summary {
+    /// A cloud's box, ids and ranges (splats).
+    Cloud(CloudSummary),
+    /// A mesh's box and scalar (cell projection).
+    Mesh(MeshSummary),
+}
+
 /// What a mesh's key and box need.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshSummary {
@@ -134,6 +147,22 @@ pub struct MeshSummary {
     pub range: [f64; 2],
     /// The normalized scalar's histogram, 256 bins (the transfer-function editor's).
     pub histogram: Vec<u32>,
+}
+
+/// The histogram of normalized scalars `(v - lo) / (hi - lo)` in 256 bins (values
+/// outside the range in the end bins).
+pub fn histogram(values: &[f64], range: [f64; 2]) -> Vec<u32> {
+    let mut h = vec![0u32; 256];
+    let span = range[1] - range[0];
+    for &v in values.iter().filter(|v| v.is_finite()) {
+        let t = if span > 0.0 {
+            (v - range[0]) / span
+        } else {
+            0.0
+        };
+        h[(t * 255.0).round().clamp(0.0, 255.0) as usize] += 1;
+    }
+    h
 }
 
 #[cfg(test)]
@@ -189,5 +218,13 @@ mod tests {
         let (ids, more) = distinct(Some(&many));
         assert_eq!((ids.len(), ids[0], more), (MAX_IDS, 0, 100 - MAX_IDS));
         assert_eq!(distinct(None), (vec![], 0));
+    }
+
+    #[test]
+    fn histogram_bins_normalized_values() {
+        // Range 10..20: 10 -> bin 0, 15 -> 127.5 rounds to 128, 25 (beyond) -> 255.
+        let h = histogram(&[10.0, 15.0, 15.0, 25.0, f64::NAN], [10.0, 20.0]);
+        assert_eq!((h[0], h[128], h[255]), (1, 2, 1));
+        assert_eq!(h.iter().sum::<u32>(), 4);
     }
 }
