@@ -3,6 +3,7 @@
 //! file that cannot be read or used: its message names the file and the position),
 //! `GLError` (the GL refused) and `RenderError` (anything else while drawing).
 
+use arbvis_techniques::techniques::opacity3d::error::Opacity3dError;
 use pyo3::exceptions::PyException;
 use pyo3::prelude::*;
 
@@ -147,9 +148,14 @@ pub fn from_render(e: RustRenderError) -> PyErr {
         | RustRenderError::Store(_)
         | RustRenderError::Surface(_)
         | RustRenderError::Table(_)
-        | RustRenderError::AttributeTable { .. }
-        | RustRenderError::Attribute { .. }
         | RustRenderError::Brick(_) => InputError::new_err(message),
+        RustRenderError::Technique { source, .. }
+            if source
+                .downcast_ref::<Opacity3dError>()
+                .is_some_and(Opacity3dError::is_input) =>
+        {
+            InputError::new_err(message)
+        }
         RustRenderError::Parameters(field) => scene_error(message, At::key(Some(&field.key))),
         _ => RenderError::new_err(message),
     }

@@ -2,7 +2,6 @@
 //! data layer's, kept as their own types (`#[from]`) so that a caller can still ask which
 //! file and position failed, and each prints the message its layer wrote.
 
-use crate::techniques::clip::error::{ClipError, ComposeError};
 use arbvis_core::budget::{OverBudget, SizeError};
 use arbvis_core::colortable::TableError;
 use arbvis_core::vocab::FieldError;
@@ -34,9 +33,6 @@ pub enum RenderError {
     /// A surface could not be read.
     #[error(transparent)]
     Surface(#[from] SurfaceError),
-    /// A clip could not be prepared.
-    #[error("clip: {0}")]
-    Clip(#[from] ClipError),
     /// A brick of a survey store failed to load on the loader thread (shared: the
     /// cache keeps it to answer every frame that asks for the brick).
     #[error(transparent)]
@@ -54,27 +50,6 @@ pub enum RenderError {
     /// table).
     #[error(transparent)]
     Parameters(#[from] FieldError),
-    /// The precise ray caster needs more bricks resident at once than the GPU budget
-    /// holds.
-    #[error(
-        "the precise ray caster draws in one pass and needs its {bricks} bricks resident at \
-         once, more than the {capacity} the GPU budget holds: raise --gpu-memory (or \
-         store.gpu_memory), or draw a coarser level"
-    )]
-    GpuBudget {
-        /// Bricks the view needs.
-        bricks: usize,
-        /// Bricks the budget holds.
-        capacity: usize,
-    },
-    /// The clip could not be composed into a program's text.
-    #[error("clip composition of {program}: {source}")]
-    Compose {
-        /// The program.
-        program: String,
-        /// Why.
-        source: ComposeError,
-    },
     /// A worker thread could not be started.
     #[error("cannot start a thread: {0}")]
     Thread(std::io::Error),
@@ -98,35 +73,19 @@ pub enum RenderError {
         /// GL_MAX_TEXTURE_SIZE.
         max: usize,
     },
+    /// A technique's own error (3D opacity's attribute data and tables, its clip, its ray
+    /// caster's bricks): the type is the technique's (`source` downcasts to it), the
+    /// message its own.
+    #[error("{source}")]
+    Technique {
+        /// The technique's name, as scenes write it.
+        technique: &'static str,
+        /// Its error.
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
     /// The legends and axes could not be drawn.
     #[error("drawing the legends and axes: {0}")]
     Annotate(#[from] AnnotateError),
-    /// One attribute's colour table (3D opacity's `primary`, ...).
-    #[error("{attribute} table: {source}")]
-    AttributeTable {
-        /// The attribute.
-        attribute: &'static str,
-        /// What failed.
-        source: TableError,
-    },
-    /// One attribute's data (3D opacity's `primary`, `secondary`, `tertiary`).
-    #[error("{attribute}: {source}")]
-    Attribute {
-        /// The attribute.
-        attribute: &'static str,
-        /// What failed.
-        source: Box<RenderError>,
-    },
-}
-
-impl RenderError {
-    /// `self`, said of 3D opacity's attribute `attribute`.
-    pub fn of_attribute(self, attribute: &'static str) -> RenderError {
-        RenderError::Attribute {
-            attribute,
-            source: Box::new(self),
-        }
-    }
 }
 
 /// Drawing the legends and axes onto a picture failed ([`crate::annotate`]).

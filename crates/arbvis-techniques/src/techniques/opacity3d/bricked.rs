@@ -40,7 +40,7 @@
 //! draws what is resident (stand-ins for what is not), asks for the rest, and refines over
 //! the next frames.
 
-use crate::error::{RenderError, RenderResult};
+use crate::error::RenderResult;
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -193,9 +193,9 @@ impl StoreScene {
         let mut attributes = [None; 3];
         for (a, attr) in params.attributes().iter().enumerate() {
             let Some(attr) = attr else { continue };
-            let index = store
-                .attribute_index(attr.attribute.name())
-                .map_err(|e| RenderError::from(e).of_attribute(ATTRIBUTE_NAMES[a]))?;
+            let index = store.attribute_index(attr.attribute.name()).map_err(|e| {
+                super::error::Opacity3dError::of_attribute(e.into(), ATTRIBUTE_NAMES[a])
+            })?;
             let am = &meta.attributes[index];
             let (low, high) = match attr.quantize {
                 Quantization::MinMax => (am.min.unwrap_or(0.0), am.max.unwrap_or(0.0)),
@@ -620,10 +620,11 @@ impl BrickedRenderer {
         } else {
             let wanted = self.wanted(view, capacity);
             if wanted.len() > capacity {
-                return Err(RenderError::GpuBudget {
+                return Err(super::error::Opacity3dError::GpuBudget {
                     bricks: wanted.len(),
                     capacity,
-                });
+                }
+                .into());
             }
             self.cache.ensure(gpu, &wanted)?;
             if let Some(e) = wanted.iter().find_map(|&id| self.cache.error(id)) {

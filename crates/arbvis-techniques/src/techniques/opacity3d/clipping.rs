@@ -24,7 +24,7 @@
 //! the seed found, INDEX-DATA is slower than the single texture (two dependent fetches);
 //! on the ray caster, whose samples all pay the lookup, the two cost alike.
 
-use crate::error::{RenderError, RenderResult};
+use crate::error::RenderResult;
 use std::borrow::Cow;
 use std::path::Path;
 use std::time::Instant;
@@ -109,10 +109,12 @@ pub fn compose(
             "if (clip_value(tc) < 0.5) return vec4(0.0);",
         ),
     }
-    .map_err(|source| RenderError::Compose {
-        program: pair.fragment.name.to_string(),
-        source,
-    })?;
+    .map_err(
+        |source| crate::techniques::opacity3d::error::Opacity3dError::Compose {
+            program: pair.fragment.name.to_string(),
+            source,
+        },
+    )?;
     Ok(ProgramPair {
         fragment: ProgramText {
             name: Cow::Owned(format!("{} + clip {:?}", pair.fragment.name, stage.lookup)),

@@ -55,6 +55,7 @@ pub mod bricked;
 pub mod bricks;
 pub mod changes;
 pub mod clipping;
+pub mod error;
 pub mod locals;
 pub mod mirror;
 pub mod paged;

@@ -7,7 +7,7 @@ use std::path::Path;
 use glam::DVec3;
 
 use super::{AttributeScene, Opacity3dScene};
-use crate::error::{RenderError, RenderResult};
+use crate::error::RenderResult;
 use arbvis_core::colortable::ColorTable;
 use arbvis_core::vocab::FieldError;
 use arbvis_data::volume::attributes::derive;
@@ -142,8 +142,8 @@ pub fn from_volumes(
             ))
             .into());
         }
-        let (low, high) =
-            range(volume, how).map_err(|e| RenderError::from(e).of_attribute(names[a]))?;
+        let (low, high) = range(volume, how)
+            .map_err(|e| super::error::Opacity3dError::of_attribute(e.into(), names[a]))?;
         let alpha: Vec<u8> = table.entries.iter().map(|e| e[3]).collect();
         no_data[a] = NoData::choose(volume.values.iter().any(|v| v.is_nan()), &alpha);
         if no_data[a] == NoData::Reserved {
@@ -208,14 +208,12 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> RenderRe
         let mut volume = derive(&loaded[index].1, *attribute);
         volume.spacing = scene.spacing_for(volume.spacing);
         derived[a] = Some(volume);
-        tables[a] = Some(
-            table
-                .build(base)
-                .map_err(|source| RenderError::AttributeTable {
-                    attribute: names[a],
-                    source,
-                })?,
-        );
+        tables[a] = Some(table.build(base).map_err(|source| {
+            super::error::Opacity3dError::AttributeTable {
+                attribute: names[a],
+                source,
+            }
+        })?);
     }
     // Alpha from each attribute's own distribution, where its table asks for it.
     let attrs = scene.attributes();
@@ -226,7 +224,7 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> RenderRe
         let survey = matches!(attr.volume, VolumeSource::Segy(_));
         if attr.table.wants_alpha_from_data(survey) {
             let alpha = alpha_from_data(volume, attr.quantize)
-                .map_err(|e| RenderError::from(e).of_attribute(names[a]))?;
+                .map_err(|e| super::error::Opacity3dError::of_attribute(e.into(), names[a]))?;
             for (entry, alpha) in table.entries.iter_mut().zip(alpha) {
                 entry[3] = alpha;
             }
