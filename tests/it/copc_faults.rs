@@ -74,6 +74,12 @@ fn inspect_and_render_refuse_the_same_files_and_never_wait_on_a_fifo() {
     let at = b.windows(9).position(|w| w == b"LASF_Spec").unwrap() - 2 + 54;
     b[at + 2] = 10;
     cases.push(("extra.copc.laz", b, "extra bytes descriptor"));
+    // The first descriptor "undocumented" (type 0) of 200 bytes, its size in `options`:
+    // past the records' extra bytes as any other type's would be (issue 54 item 2).
+    let mut b = good.clone();
+    b[at + 2] = 0;
+    b[at + 3] = 200;
+    cases.push(("undocumented.copc.laz", b, "extra bytes descriptor"));
     // LAS 1.2 with point format 7 (the version byte only).
     let mut b = good.clone();
     b[104] = 0x80 | 7;

@@ -310,3 +310,61 @@ fn weak_etags_are_read_and_a_stall_ends_within_twice_the_timeout() {
     assert!(took < Duration::from_secs(8), "{took:?}: {e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A store's metadata that cannot be read is never "no such store": a 403 names the
+/// credential variables, a 301 (S3's wrong region) the redirect, a redirect loop the
+/// loop, TLS with a plain HTTP server or a self-signed certificate the TLS failure, a
+/// stall the timeout; each names the URL and ends within seconds.
+#[test]
+fn a_stores_metadata_that_cannot_be_read_says_why_not_that_it_is_absent() {
+    let dir = crate::store::fixture("remote-store-faults", [9, 7, 11], 8).0;
+    let server = Server::http(&dir);
+    let cache = dir.join("cache");
+    let env = [("ARBVIS_REMOTE_TIMEOUT", "1")];
+    let port = server
+        .url("")
+        .trim_end_matches('/')
+        .rsplit(':')
+        .next()
+        .unwrap()
+        .to_string();
+    let cases: [(String, &str, &[&str]); 5] = [
+        ("status:403".into(), "http", &["403", "AWS_ACCESS_KEY_ID"]),
+        ("status:301".into(), "http", &["redirect", "AWS_REGION"]),
+        (
+            format!("redirect:{port}"),
+            "http",
+            &["redirects did not end"],
+        ),
+        ("none".into(), "https", &["TLS"]),
+        ("stall".into(), "http", &["no answer within"]),
+    ];
+    for (mode, scheme, says) in cases {
+        server.control(&format!("_fault?mode={mode}&count=0&skip=0"));
+        let url = server.url("s.zarr").replacen("http", scheme, 1);
+        let t = std::time::Instant::now();
+        let out = arbvis(&["inspect", &url], &cache, &env);
+        let took = t.elapsed();
+        server.control("_reset");
+        let e = stderr(&out);
+        assert!(!out.status.success(), "{mode}: succeeded");
+        assert!(e.contains(&url), "{mode}: the URL unnamed: {e}");
+        assert!(!e.contains("no such store"), "{mode}: {e}");
+        for s in says {
+            assert!(e.contains(s), "{mode}: {s:?} unsaid: {e}");
+        }
+        // The 1 s timeout, retried within twice it; the others at once.
+        assert!(took < Duration::from_secs(20), "{mode}: {took:?}");
+    }
+    // A server whose certificate no one signed: the TLS failure, named.
+    let tls = Server::https_self_signed(&dir);
+    let url = format!("https://127.0.0.1:{}/s.zarr", tls.port);
+    let out = arbvis(&["inspect", &url], &cache, &env);
+    let e = stderr(&out);
+    assert!(!out.status.success(), "a self-signed server was trusted");
+    assert!(
+        e.contains(&url) && e.contains("TLS") && e.to_lowercase().contains("certificate"),
+        "{e}"
+    );
+    assert!(!e.contains("no such store"), "{e}");
+}

@@ -49,6 +49,16 @@ impl Server {
         Server::start(&[script("range_server.py").as_os_str(), folder.as_os_str()])
     }
 
+    /// The tests' server on `folder` over HTTPS with a self-signed certificate
+    /// (`tests/servers/self-signed.pem`, for 127.0.0.1), which no client trusts.
+    pub fn https_self_signed(folder: &Path) -> Server {
+        Server::start(&[
+            script("range_server.py").as_os_str(),
+            folder.as_os_str(),
+            script("self-signed.pem").as_os_str(),
+        ])
+    }
+
     /// moto's S3 server with `bucket` holding `folder`'s files, if moto is installed
     /// (else `None` and the test is skipped, or fails under `ARBVIS_NO_SKIP=1`).
     pub fn s3(bucket: &str, folder: &Path) -> Option<Server> {

@@ -319,7 +319,17 @@ pub fn describe(object: &Object, range: Option<&Range<u64>>, e: &object_store::E
         ),
         other => {
             let text = other.to_string();
-            if object.s3 && !anonymous() && is_redirect(&text) {
+            let chain = causes(other).to_ascii_lowercase();
+            if ["tls", "certificate", "handshake", "invalidcontenttype", "corrupt message"]
+                .iter()
+                .any(|w| chain.contains(w))
+            {
+                format!("{what}: the TLS connection failed (the server's certificate was refused, or it does not speak TLS on that port: {}); check the URL's scheme and port, or the server's certificate", arbvis_core::input::shorten(&last_cause(other), 160))
+            } else if text.contains("error following redirect") || chain.contains("too many redirects") {
+                format!("{what}: the server's redirects did not end (a redirect loop, or more than 10 in a row)")
+            } else if text.contains("redirect without LOCATION") {
+                format!("{what}: the server answered with a redirect (HTTP 301-308) naming no location; from S3 this means the bucket lies in another region: set AWS_REGION to the bucket's region (or AWS_ENDPOINT_URL to the server that holds it)")
+            } else if object.s3 && !anonymous() && is_redirect(&text) {
                 format!("{what}: the server redirected the request to another host, and a signed request's credentials (the session token) are not sent to another host: set AWS_REGION to the bucket's region or AWS_ENDPOINT_URL to the server that holds it")
             } else if text.contains("error sending request") || text.contains("Connection refused") {
                 let retried = text.contains("after ") && text.contains(" retries");
@@ -332,6 +342,30 @@ pub fn describe(object: &Object, range: Option<&Range<u64>>, e: &object_store::E
             }
         }
     }
+}
+
+/// `e` and every error below it, joined (the words that tell a TLS failure from a refused
+/// connection are in the causes, not in object_store's own message).
+fn causes(e: &dyn std::error::Error) -> String {
+    let mut text = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        text.push_str(": ");
+        text.push_str(&s.to_string());
+        source = s.source();
+    }
+    text
+}
+
+/// The deepest cause of `e` (what the TLS library or the socket said).
+fn last_cause(e: &dyn std::error::Error) -> String {
+    let mut last = e.to_string();
+    let mut source = e.source();
+    while let Some(s) = source {
+        last = s.to_string();
+        source = s.source();
+    }
+    last
 }
 
 /// Whether object_store's error text is a redirect it did not follow (HTTP 3xx).
