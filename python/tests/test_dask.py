@@ -22,6 +22,13 @@ def local_cluster(workers):
     )
 
 
+def peak_rss():
+    """This process's peak resident memory in bytes (Linux reports KiB)."""
+    import resource
+
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
 def test_an_orbit_of_a_store_on_two_workers_equals_one_process(f3_store_scene, tmp_path):
     scene = f3_store_scene
     views = arbvis.dask.orbit(6)
@@ -50,8 +57,10 @@ def test_four_workers_on_a_remote_store_with_one_shared_cache_equal_one_process(
     worker processes sharing one disk cache: every view equals the single-process render
     of the local store, and the shared cache holds whole entries only."""
     cache = tmp_path / "cache"
-    # Worker processes start from this environment: one cache folder for all four.
+    # Worker processes start from this environment: one cache folder for all four, and a
+    # memory budget of 256 MiB each.
     monkeypatch.setenv("ARBVIS_CACHE_DIR", str(cache))
+    monkeypatch.setenv("ARBVIS_MEMORY_BUDGET", "256M")
     port = range_server(tmp_path)
     local = f3_store_scene
     remote = arbvis.Scene.from_toml(
@@ -60,7 +69,15 @@ def test_four_workers_on_a_remote_store_with_one_shared_cache_equal_one_process(
     assert "http://" in remote.to_toml()
     views = arbvis.dask.orbit(8)
     with local_cluster(4) as cluster, distributed.Client(cluster) as client:
+        before = client.run(peak_rss)
         images = arbvis.dask.render_views(client, remote, views)
+        after = client.run(peak_rss)
+    # Each worker's peak grew by less than its budget: the budget bounds one allocation,
+    # and a render's allocations together (the GL context, the store's chunk cache, the
+    # picture) stay under it here.
+    grown = {w: after[w] - before[w] for w in after}
+    print("peak RSS growth per worker (MiB):", {w: g >> 20 for w, g in grown.items()})
+    assert max(grown.values()) < 256 << 20, grown
     with arbvis.Renderer(local) as r:
         for rotation, image in zip(views, images):
             local.rotation = rotation
