@@ -8,7 +8,9 @@
 ...     scene["technique.opacity3d.primary.coefficients"] = [0.2, 0.2, 0.2, 0.9]
 ...     again = renderer.render()          # a frame, not a new process
 
-`Scene` reads and edits scenes (dotted keys, validated as scene files are);
+`Scene` reads and edits scenes (dotted keys, validated as scene files are); `Volume`
+hands a survey over from a numpy array or an xarray DataArray, wherever a scene names a
+volume file;
 `Renderer` keeps its GL context, data and programs between frames; `info()` reports the
 driver; `inspect(path)` and `convert(src, dst, progress=...)` are the command line's
 `inspect` and `convert`; `read_png`, `write_png`, `compare` and `diff_image` read, write and compare pictures
@@ -26,6 +28,7 @@ from ._arbvis import (  # noqa: F401
     RenderError,
     Scene,
     SceneError,
+    Volume,
     __version__,
     compare,
     convert,
@@ -46,6 +49,7 @@ __all__ = [
     "Renderer",
     "Scene",
     "SceneError",
+    "Volume",
     "compare",
     "convert",
     "diff_image",

@@ -33,6 +33,19 @@ class Cancelled(ArbvisError):
 
 _Path = Union[str, PathLike]
 
+class Volume:
+    """A survey in memory, indexed [inline, crossline, sample]: a numpy array with
+    `spacing` (inline, crossline, sample) in metres, or an xarray DataArray whose
+    coordinates give it. Stands wherever a scene names a volume file."""
+
+    def __init__(self, data: Any, spacing: Optional[Tuple[float, float, float]] = None) -> None: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def shape(self) -> Tuple[int, int, int]: ...
+    @property
+    def spacing(self) -> Tuple[float, float, float]: ...
+
 class Scene:
     """A scene: the technique and its parameters, size, fidelity, programs, camera."""
 

@@ -75,11 +75,26 @@ def render_view(text, base, rotation, backend="egl", png=None):
     return png
 
 
+def _names_memory(tree):
+    """Whether a scene's tree names a volume in memory (`{"memory": NAME}`) anywhere."""
+    if isinstance(tree, dict):
+        return "memory" in tree or any(_names_memory(v) for v in tree.values())
+    if isinstance(tree, list):
+        return any(_names_memory(v) for v in tree)
+    return False
+
+
 def render_views(client, scene, rotations, backend="egl", out_dir=None):
     """Render ``scene`` turned to each of ``rotations`` on ``client``'s workers: the
     arrays in order, or with ``out_dir`` the PNG files written there
     (``view_0000.png``, ...)."""
     text = scene.to_toml()
+    if _names_memory(scene.to_dict()):
+        raise arbvis.InputError(
+            "render_views: the scene holds an arbvis.Volume, which lives in this process "
+            "only; the workers read files: write the survey to a SEG-Y file or a store "
+            "(arbvis convert) and name it in the scene"
+        )
     base = str(scene.base)
     pngs = [None] * len(rotations)
     if out_dir is not None:

@@ -210,21 +210,25 @@ pub fn reads() -> String {
 
 // Here rather than in `volume` (which the SEG-Y sniffer reads): the sources' readers.
 impl crate::volume::VolumeSource {
-    /// The reader of the source's file or folder ([`READERS`]); `None` for a raw file or
-    /// the generated cube, whose scene says what they are.
+    /// The reader of the source's file or folder ([`READERS`]); `None` for a raw file, the
+    /// generated cube or a volume in memory, whose scene says what they are.
     pub fn reader(&self) -> Option<&'static Reader> {
         use crate::volume::VolumeSource as V;
         match self {
             V::Segy(_) => Some(reader(Format::Segy)),
             V::Nifti(_) => Some(reader(Format::Nifti)),
             V::Store(_) => Some(reader(Format::Store)),
-            V::Raw(_) | V::Synthetic(_) => None,
+            V::Raw(_) | V::Synthetic(_) | V::Memory(_) => None,
         }
     }
 
-    /// The kind of data the source yields: its reader's, else a volume.
+    /// The kind of data the source yields: its reader's; a survey handed over in memory
+    /// (indexed inline, crossline, sample as segyio and mdio give it); else a volume.
     pub fn data_kind(&self) -> DataKind {
-        self.reader().map_or(DataKind::Volume, |r| r.kind)
+        match self {
+            crate::volume::VolumeSource::Memory(_) => DataKind::Survey,
+            _ => self.reader().map_or(DataKind::Volume, |r| r.kind),
+        }
     }
 }
 

@@ -5,12 +5,18 @@
 
 use std::path::PathBuf;
 
+use std::sync::Arc;
+
 use pyo3::exceptions::PyKeyError;
 use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyTuple};
+
+use arbvis_data::volume::Volume;
 
 use arbvis_techniques::scene::Scene;
 
 use crate::errors::{self, At};
+use crate::volume::PyVolume;
 
 /// `json.loads(text)`.
 pub fn json_loads<'py>(py: Python<'py>, text: &str) -> PyResult<Bound<'py, PyAny>> {
@@ -29,6 +35,38 @@ fn json_of(value: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
         .extract()?;
     serde_json::from_str(&text)
         .map_err(|e| errors::scene_error(format!("not a value a scene holds: {e}"), At::key(None)))
+}
+
+/// `value` with every `arbvis.Volume` in it (at any depth of dicts, lists and tuples)
+/// replaced by the table that names it (`{"memory": NAME}`); each such volume is kept in
+/// `kept`, so that the scene holds it as long as the scene lives.
+fn naming_volumes<'py>(
+    value: &Bound<'py, PyAny>,
+    kept: &mut Vec<Arc<Volume>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let py = value.py();
+    if let Ok(v) = value.cast::<PyVolume>() {
+        let v = v.get();
+        kept.push(v.volume.clone());
+        let table = PyDict::new(py);
+        table.set_item("memory", &v.name)?;
+        return Ok(table.into_any());
+    }
+    if let Ok(d) = value.cast::<PyDict>() {
+        let out = PyDict::new(py);
+        for (k, v) in d.iter() {
+            out.set_item(k, naming_volumes(&v, kept)?)?;
+        }
+        return Ok(out.into_any());
+    }
+    if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
+        let items: Vec<Bound<'py, PyAny>> = value
+            .try_iter()?
+            .map(|v| naming_volumes(&v?, kept))
+            .collect::<PyResult<_>>()?;
+        return Ok(PyList::new(py, items)?.into_any());
+    }
+    Ok(value.clone())
 }
 
 /// The scene as a JSON tree.
@@ -107,6 +145,8 @@ fn put(tree: &mut serde_json::Value, key: &str, value: Option<serde_json::Value>
 pub struct PyScene {
     /// The scene.
     pub scene: Scene,
+    /// The volumes in memory it was given (`arbvis.Volume`), held while it lives.
+    pub kept: Vec<Arc<Volume>>,
 }
 
 #[pymethods]
@@ -118,7 +158,10 @@ impl PyScene {
         let scene = py
             .detach(|| Scene::load_checked(&path))
             .map_err(errors::from_scene)?;
-        Ok(PyScene { scene })
+        Ok(PyScene {
+            scene,
+            kept: Vec::new(),
+        })
     }
 
     /// A scene from TOML text; relative data paths are read from `base` (the current
@@ -128,7 +171,10 @@ impl PyScene {
     fn from_toml(text: &str, base: Option<PathBuf>) -> PyResult<PyScene> {
         let mut scene = Scene::parse(text, "scene").map_err(errors::from_scene)?;
         scene.base = base.unwrap_or_default();
-        Ok(PyScene { scene })
+        Ok(PyScene {
+            scene,
+            kept: Vec::new(),
+        })
     }
 
     /// A scene from a dict shaped as the TOML (`{"size": [256, 256], "technique":
@@ -142,16 +188,20 @@ impl PyScene {
                 d.get_type().name()?
             )));
         }
-        let tree = json_of(d)?;
+        let mut kept = Vec::new();
+        let tree = json_of(&naming_volumes(d, &mut kept)?)?;
         let scene = scene_of(&tree, base.unwrap_or_default(), None)?;
-        Ok(PyScene { scene })
+        Ok(PyScene { scene, kept })
     }
 
     /// A built-in demo scene (`arbvis render --demo NAME`).
     #[staticmethod]
     fn demo(name: &str) -> PyResult<PyScene> {
         let scene = Scene::demo(name).map_err(errors::from_scene)?;
-        Ok(PyScene { scene })
+        Ok(PyScene {
+            scene,
+            kept: Vec::new(),
+        })
     }
 
     /// The scene as TOML text (what a scene file holds).
@@ -172,16 +222,18 @@ impl PyScene {
     }
 
     /// Set the value at dotted `key`, validated as a scene file is; `None` removes it
-    /// (its default applies).
+    /// (its default applies). An `arbvis.Volume` stands wherever a volume file is named.
     fn __setitem__(&mut self, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
         let mut tree = tree_of(&self.scene);
+        let mut kept = Vec::new();
         let value = if value.is_none() {
             None
         } else {
-            Some(json_of(value)?)
+            Some(json_of(&naming_volumes(value, &mut kept)?)?)
         };
         put(&mut tree, key, value)?;
         self.scene = scene_of(&tree, self.scene.base.clone(), Some(key))?;
+        self.kept.extend(kept);
         Ok(())
     }
 

@@ -436,11 +436,11 @@ fn assemble(store: &Path, parts: Parts) -> Result<(StoreMeta, Mdio), StoreError>
         );
     }
     let (interval_us, sample_axis) = sample_axis(coordinates[2].as_deref(), &domain, &mut facts);
-    let spacing = survey_spacing(
+    let spacing = crate::volume::segy::geometry::survey_spacing(
         cdp.as_ref(),
         live.as_deref(),
         [nj, nk],
-        sample_axis.as_ref(),
+        sample_axis.as_ref().map(|a| (a.domain.as_str(), a.step)),
     );
     let meta = StoreMeta {
         format: format!("MDIO v{}", api.split('.').next().unwrap_or("1")),
@@ -549,41 +549,6 @@ fn sample_axis(
         step: if d.len() > 1 { d[1] - d[0] } else { 1.0 },
     });
     (interval_us, axis)
-}
-
-/// The survey's proportions `[sample, crossline, inline]` in metres, as a SEG-Y file's are
-/// drawn (`volume::segy::geometry`): a time axis at 2000 m/s two-way (one millisecond as
-/// one metre), a depth axis as it is (else one metre a sample); the trace steps from the
-/// live traces' `cdp_x`/`cdp_y` (`cdp[_][k * nj + j]`) as a SEG-Y's from its CDP
-/// coordinates ([`trace_steps`]), else the 25 m bins a SEG-Y without them is given.
-fn survey_spacing(
-    cdp: Option<&[Vec<f64>; 2]>,
-    live: Option<&[bool]>,
-    [nj, nk]: [usize; 2],
-    axis: Option<&SampleAxis>,
-) -> [f64; 3] {
-    use crate::volume::segy::geometry::{trace_steps, VELOCITY_M_S};
-    let sample = match axis {
-        Some(a) if a.domain == "time" => a.step.abs() * VELOCITY_M_S / 2000.0,
-        Some(a) if a.domain == "depth" => a.step.abs(),
-        _ => 1.0,
-    };
-    let sample = if sample.is_finite() && sample > 0.0 {
-        sample
-    } else {
-        1.0
-    };
-    // A live trace with finite coordinates (one at the map's origin is a dead one's zeros).
-    let at = |k: usize, j: usize| {
-        let t = k * nj + j;
-        let [x, y] = cdp?;
-        let (x, y) = (*x.get(t)?, *y.get(t)?);
-        let live = live.is_none_or(|l| l.get(t) == Some(&true));
-        (live && x.is_finite() && y.is_finite() && (x, y) != (0.0, 0.0)).then_some([x, y])
-    };
-    let spread: Vec<(usize, usize)> = (0..nk).flat_map(|k| (0..nj).map(move |j| (k, j))).collect();
-    let ([crossline, inline], _) = trace_steps(nj, nk, &spread, at);
-    [sample, crossline, inline]
 }
 
 /// A survey of `dims` samples must make no more bricks than arbvis draws.

@@ -251,6 +251,12 @@ pub fn describe(source: &VolumeSource, base: &Path, dims: [usize; 3]) -> [Axis; 
                 _ => plain(),
             }
         }
+        // A survey handed over in memory: its axes by index (sample fastest).
+        VolumeSource::Memory(_) => [
+            indices("sample", dims[0]),
+            indices("crossline", dims[1]),
+            indices("inline", dims[2]),
+        ],
         VolumeSource::Nifti(p) => match nifti_file::read_header(&base.join(p)) {
             Ok(h) if h.dims == dims => {
                 [0, 1, 2].map(|a| linear(["i (mm)", "j (mm)", "k (mm)"][a], dims[a], h.spacing[a]))

@@ -9,6 +9,7 @@
 pub mod attributes;
 pub mod axes;
 pub mod index_data;
+pub mod memory;
 pub mod nifti_file;
 pub mod quantize;
 pub mod raw;
@@ -317,6 +318,8 @@ pub enum VolumeSource {
     /// A bricked multi-resolution store made by `arbvis convert` (3D opacity streams it
     /// brick by brick; it is never loaded whole).
     Store(PathBuf),
+    /// A survey handed over in memory (an `arbvis.Volume`), by its name ([`memory`]).
+    Memory(String),
 }
 
 /// What a volume may hold, checked against the dimensions a file or scene declares
@@ -421,6 +424,7 @@ impl VolumeSource {
             VolumeSource::Nifti(p) => nifti_file::read(&base.join(p), limits),
             VolumeSource::Raw(spec) => raw::read(base, spec, limits),
             VolumeSource::Synthetic(spec) => synthetic::amplitude(spec, limits),
+            VolumeSource::Memory(name) => memory::load(name, limits),
             VolumeSource::Store(p) => Err(VolumeError::Unsupported {
                 path: base.join(p),
                 message: "a store is never loaded whole: only 3D opacity's attribute volumes stream one, brick by brick (give the same store as each attribute's volume of an opacity3d scene)".into(),
@@ -434,7 +438,7 @@ impl VolumeSource {
             VolumeSource::Synthetic(spec) => spec.validate().map_err(|e| e.within("synthetic")),
             VolumeSource::Raw(spec) => spec.validate().map_err(|e| e.within("raw")),
             VolumeSource::Segy(s) => s.keys.validate().map_err(|e| e.within("segy")),
-            VolumeSource::Nifti(_) | VolumeSource::Store(_) => Ok(()),
+            VolumeSource::Nifti(_) | VolumeSource::Store(_) | VolumeSource::Memory(_) => Ok(()),
         }
     }
 
@@ -446,6 +450,7 @@ impl VolumeSource {
             VolumeSource::Raw(_) => "raw",
             VolumeSource::Synthetic(_) => "synthetic",
             VolumeSource::Store(_) => "store",
+            VolumeSource::Memory(_) => "memory",
         }
     }
 
@@ -456,7 +461,7 @@ impl VolumeSource {
             VolumeSource::Nifti(p) => Some(p),
             VolumeSource::Raw(spec) => Some(&mut spec.path),
             VolumeSource::Store(p) => Some(p),
-            VolumeSource::Synthetic(_) => None,
+            VolumeSource::Synthetic(_) | VolumeSource::Memory(_) => None,
         }
     }
 
@@ -467,7 +472,7 @@ impl VolumeSource {
             VolumeSource::Nifti(p) => Some(p),
             VolumeSource::Raw(spec) => Some(&spec.path),
             VolumeSource::Store(p) => Some(p),
-            VolumeSource::Synthetic(_) => None,
+            VolumeSource::Synthetic(_) | VolumeSource::Memory(_) => None,
         }
     }
 }

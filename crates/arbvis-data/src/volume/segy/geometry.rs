@@ -103,6 +103,42 @@ pub(crate) fn geometry(
     }
 }
 
+/// A survey's proportions `[sample, crossline, inline]` in metres, as a SEG-Y file's are
+/// drawn: a sample axis `(domain, step)` in time (ms) at [`VELOCITY_M_S`] two-way (one
+/// millisecond as one metre), one in depth as it is (else one metre a sample); the trace
+/// steps from the live traces' map coordinates (`cdp[0]` x, `cdp[1]` y, at `k * nj + j`
+/// for inline index `k`, crossline index `j`) as a SEG-Y's from its CDP coordinates
+/// ([`trace_steps`]), else [`ASSUMED_BIN_M`] bins. What MDIO datasets and surveys handed
+/// over in memory are measured by.
+pub fn survey_spacing(
+    cdp: Option<&[Vec<f64>; 2]>,
+    live: Option<&[bool]>,
+    [nj, nk]: [usize; 2],
+    axis: Option<(&str, f64)>,
+) -> [f64; 3] {
+    let sample = match axis {
+        Some(("time", step)) => step.abs() * VELOCITY_M_S / 2000.0,
+        Some(("depth", step)) => step.abs(),
+        _ => 1.0,
+    };
+    let sample = if sample.is_finite() && sample > 0.0 {
+        sample
+    } else {
+        1.0
+    };
+    // A live trace with finite coordinates (one at the map's origin is a dead one's zeros).
+    let at = |k: usize, j: usize| {
+        let t = k * nj + j;
+        let [x, y] = cdp?;
+        let (x, y) = (*x.get(t)?, *y.get(t)?);
+        let live = live.is_none_or(|l| l.get(t) == Some(&true));
+        (live && x.is_finite() && y.is_finite() && (x, y) != (0.0, 0.0)).then_some([x, y])
+    };
+    let spread: Vec<(usize, usize)> = (0..nk).flat_map(|k| (0..nj).map(move |j| (k, j))).collect();
+    let ([crossline, inline], _) = trace_steps(nj, nk, &spread, at);
+    [sample, crossline, inline]
+}
+
 /// The trace steps `[crossline, inline]` in map units of a grid of `nj` crosslines by
 /// `nk` inlines whose trace at inline index `k`, crossline index `j` lies at `at(k, j)`
 /// (`None`: no trace, or no coordinates): from the three corners (0, 0), (0, nj - 1) and

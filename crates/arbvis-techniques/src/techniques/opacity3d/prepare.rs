@@ -221,7 +221,7 @@ pub fn prepare(scene: &Opacity3dScene, base: &Path, limits: &Limits) -> RenderRe
         let (Some(attr), Some(volume), Some(table)) = (attr, &derived[a], &mut tables[a]) else {
             continue;
         };
-        let survey = matches!(attr.volume, VolumeSource::Segy(_));
+        let survey = attr.volume.data_kind() == arbvis_data::sniff::DataKind::Survey;
         if attr.table.wants_alpha_from_data(survey) {
             let alpha = alpha_from_data(volume, attr.quantize)
                 .map_err(|e| super::error::Opacity3dError::of_attribute(e.into(), names[a]))?;

@@ -1,0 +1,203 @@
+"""arbvis.Volume: a survey handed over in memory draws as the same survey read from a
+SEG-Y file does. The SEG-Y is written here from a random cube of odd sizes on a rotated
+grid (CDP coordinates with scalar -100, 4 ms samples); the same samples as an xarray
+DataArray with the SEG-Y's coordinates, as numpy arrays of several dtypes and orders, and
+through a scene's TOML all draw the same picture. Bad arrays are refused naming the
+argument; a volume lives as long as a scene holds it."""
+
+import gc
+import math
+import struct
+
+import numpy as np
+import pytest
+
+import arbvis
+import arbvis.dask
+
+# The grid: 25 m between inlines and 12.5 m between crosslines, turned 0.3 rad on the map.
+BINS = (25.0, 12.5)
+ANGLE = 0.3
+DT_MS = 4
+ORIGIN = (612345.0, 6123456.0)
+
+
+def random_cube(shape=(9, 13, 31), seed=7):
+    """A cube [inline, crossline, sample] of noise over a dipping layer: nothing smooth
+    or symmetric for a defect to hide in."""
+    rng = np.random.default_rng(seed)
+    ni, nx, ns = shape
+    k, j, s = np.meshgrid(np.arange(ni), np.arange(nx), np.arange(ns), indexing="ij")
+    layer = np.sin(0.4 * s - 0.3 * k + 0.2 * j)
+    return (layer + 0.6 * rng.standard_normal(shape)).astype(np.float32)
+
+
+def trace_xy(k, j):
+    """The map position of inline index k, crossline index j, in centimetres (as the
+    SEG-Y holds it)."""
+    c, s = math.cos(ANGLE), math.sin(ANGLE)
+    x = ORIGIN[0] + k * BINS[0] * c - j * BINS[1] * s
+    y = ORIGIN[1] + k * BINS[0] * s + j * BINS[1] * c
+    return round(x * 100), round(y * 100)
+
+
+def write_segy(path, cube):
+    """`cube` as a big-endian IEEE-float SEG-Y rev 1: inline at byte 189, crossline at
+    193, CDP x/y at 181/185 with coordinate scalar -100 (centimetres)."""
+    ni, nx, ns = cube.shape
+    binary = bytearray(400)
+    struct.pack_into(">hhh", binary, 16, DT_MS * 1000, 0, ns)  # bytes 3217-3222
+    struct.pack_into(">h", binary, 24, 5)  # 3225: IEEE float
+    struct.pack_into(">hh", binary, 300, 0x0100, 1)  # 3501: rev 1, fixed length
+    parts = [b" " * 3200, bytes(binary)]
+    for k in range(ni):
+        for j in range(nx):
+            h = bytearray(240)
+            struct.pack_into(">h", h, 70, -100)
+            struct.pack_into(">ii", h, 180, *trace_xy(k, j))
+            struct.pack_into(">ii", h, 188, 100 + k, 200 + j)
+            struct.pack_into(">hh", h, 114, ns, DT_MS * 1000)
+            parts += [bytes(h), cube[k, j].astype(">f4").tobytes()]
+    path.write_bytes(b"".join(parts))
+
+
+SCENE = """
+size = [88, 70]
+[camera]
+rotation = [0.31, -0.12, -0.64, 0.69]
+zoom = 1.1
+[technique.opacity3d.primary]
+volume = { segy = "cube.sgy" }
+attribute = "amplitude"
+table = { builtin = "seismic" }
+"""
+
+
+def segy_scene(tmp_path, cube):
+    write_segy(tmp_path / "cube.sgy", cube)
+    return arbvis.Scene.from_toml(SCENE, base=tmp_path)
+
+
+def render(scene):
+    with arbvis.Renderer(scene) as r:
+        return r.render()
+
+
+def with_volume(scene, volume):
+    scene = arbvis.Scene.from_toml(scene.to_toml(), base=scene.base)
+    scene["technique.opacity3d.primary.volume"] = volume
+    return scene
+
+
+def test_an_xarray_survey_draws_as_its_segy(tmp_path):
+    xr = pytest.importorskip("xarray")
+    cube = random_cube()
+    scene = segy_scene(tmp_path, cube)
+    want = render(scene)
+    ni, nx, ns = cube.shape
+    xy = np.array([[trace_xy(k, j) for j in range(nx)] for k in range(ni)]) / 100.0
+    # As mdio names it: dimensions inline, crossline, time; the map coordinates beside.
+    da = xr.DataArray(
+        cube,
+        dims=("inline", "crossline", "time"),
+        coords={
+            "inline": 100 + np.arange(ni),
+            "crossline": 200 + np.arange(nx),
+            "time": DT_MS * np.arange(ns, dtype=np.float64),
+            "cdp_x": (("inline", "crossline"), xy[..., 0]),
+            "cdp_y": (("inline", "crossline"), xy[..., 1]),
+        },
+    )
+    volume = arbvis.Volume(da)
+    # The proportions measured as the SEG-Y's are: 25 m, 12.5 m and 4 ms as 4 m
+    # (the centimetres of the coordinates round the bins by far less than 1e-6 m).
+    assert np.allclose(volume.spacing, (BINS[0], BINS[1], DT_MS), atol=1e-6), volume.spacing
+    assert volume.shape == cube.shape
+    assert np.array_equal(render(with_volume(scene, volume)), want)
+    # The same DataArray in another dimension order, as segysak names it: the same survey.
+    other = da.rename(inline="iline", crossline="xline", time="twt").transpose("twt", "iline", "xline")
+    assert np.array_equal(render(with_volume(scene, arbvis.Volume(other))), want)
+    # A numpy array given the spacing the DataArray measured: the same picture.
+    plain = arbvis.Volume(cube, spacing=volume.spacing)
+    assert np.array_equal(render(with_volume(scene, plain)), want)
+
+
+def test_every_dtype_and_order_of_one_survey_draws_one_picture(tmp_path):
+    cube = np.round(random_cube(shape=(7, 11, 23), seed=3) * 1000).astype(np.int16)
+    spacing = (25.0, 12.5, 4.0)
+    scene = segy_scene(tmp_path, cube.astype(np.float32))
+    want = render(with_volume(scene, arbvis.Volume(cube.astype(np.float32), spacing)))
+    for variant in [
+        cube,
+        np.asfortranarray(cube),
+        cube.astype(np.float64),
+        cube.astype(np.int32),
+        cube[:, ::-1, :][:, ::-1, :],  # a strided view
+    ]:
+        got = render(with_volume(scene, arbvis.Volume(variant, spacing)))
+        assert np.array_equal(got, want), (variant.dtype, variant.flags["C_CONTIGUOUS"])
+
+
+def test_a_bad_array_is_refused_naming_the_argument():
+    cases = [
+        (np.zeros((4, 5), np.float32), None, "a 3D array indexed [inline, crossline, sample]"),
+        (np.zeros((2, 3, 4), np.complex64), None, "samples of float32"),
+        (np.zeros((2, 0, 4), np.float32), None, "holds no samples"),
+        (np.zeros((2, 3, 4), np.float32), (1.0, -1.0, 1.0), "spacing is three positive"),
+        (np.zeros((2, 3, 4), np.float32), (1.0, float("nan"), 1.0), "spacing is three positive"),
+        (np.zeros((2, 3, 4), np.float32), "25", "spacing is three positive"),
+        ([[1, 2], [3, 4]], None, "a 3D array"),
+    ]
+    for data, spacing, says in cases:
+        with pytest.raises(arbvis.InputError) as e:
+            arbvis.Volume(data, spacing)
+        assert str(e.value).startswith("volume: ") and says in str(e.value), str(e.value)
+
+
+def test_a_dataarray_without_survey_dimensions_is_refused_by_name():
+    xr = pytest.importorskip("xarray")
+    da = xr.DataArray(np.zeros((2, 3, 4), np.float32), dims=("a", "b", "c"))
+    with pytest.raises(arbvis.InputError) as e:
+        arbvis.Volume(da)
+    assert "volume: a DataArray with one inline dimension" in str(e.value)
+    assert "('a', 'b', 'c')" in str(e.value)
+
+
+def test_a_volume_lives_while_a_scene_holds_it(tmp_path):
+    cube = random_cube(shape=(5, 6, 9), seed=11)
+    scene = segy_scene(tmp_path, cube)
+    volume = arbvis.Volume(cube, spacing=(25.0, 12.5, 4.0))
+    name = volume.name
+    scene["technique.opacity3d.primary.volume"] = volume
+    assert scene["technique.opacity3d.primary.volume"] == {"memory": name}
+    assert f'memory = "{name}"' in scene.to_toml()
+    want = render(scene)
+    # The Python object gone: the scene still holds the samples.
+    del volume
+    gc.collect()
+    assert np.array_equal(render(scene), want)
+    # Another scene may name it by its TOML while the first holds it ...
+    again = arbvis.Scene.from_toml(scene.to_toml(), base=tmp_path)
+    assert np.array_equal(render(again), want)
+    # ... and once no scene that was given it lives, the name finds nothing.
+    del scene
+    gc.collect()
+    with pytest.raises(arbvis.ArbvisError) as e:
+        render(again)
+    assert "no such volume in this process" in str(e.value)
+    # In a dict too, at any depth.
+    volume = arbvis.Volume(cube, spacing=(25.0, 12.5, 4.0))
+    d = arbvis.Scene.from_toml(SCENE, base=tmp_path).to_dict()
+    d["technique"]["opacity3d"]["primary"]["volume"] = volume
+    from_dict = arbvis.Scene.from_dict(d, base=tmp_path)
+    del volume, d
+    gc.collect()
+    assert np.array_equal(render(from_dict), want)
+
+
+def test_dask_refuses_a_volume_in_memory_before_sending_anything(tmp_path):
+    cube = random_cube(shape=(3, 4, 5))
+    scene = with_volume(segy_scene(tmp_path, cube), arbvis.Volume(cube, (1.0, 1.0, 1.0)))
+    with pytest.raises(arbvis.InputError) as e:
+        arbvis.dask.render_views(None, scene, arbvis.dask.orbit(2))
+    assert "lives in this process only" in str(e.value)
