@@ -9,8 +9,8 @@
 ...     again = renderer.render()          # a frame, not a new process
 
 `Scene` reads and edits scenes (dotted keys, validated as scene files are); `Volume`
-hands a survey over from a numpy array or an xarray DataArray, wherever a scene names a
-volume file;
+and `Cloud` hand a survey (numpy, xarray) or a point cloud (numpy, laspy) over from
+memory, wherever a scene names a volume or cloud file;
 `Renderer` keeps its GL context, data and programs between frames; `info()` reports the
 driver; `inspect(path)` and `convert(src, dst, progress=...)` are the command line's
 `inspect` and `convert`; `read_png`, `write_png`, `compare` and `diff_image` read, write and compare pictures
@@ -22,6 +22,7 @@ adds the `arbvis_image` fixture; `arbvis.dask` renders many views on a Dask clus
 from ._arbvis import (  # noqa: F401
     ArbvisError,
     Cancelled,
+    Cloud,
     GLError,
     InputError,
     Renderer,
@@ -43,6 +44,7 @@ from ._arbvis import (  # noqa: F401
 __all__ = [
     "ArbvisError",
     "Cancelled",
+    "Cloud",
     "GLError",
     "InputError",
     "RenderError",

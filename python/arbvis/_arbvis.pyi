@@ -46,6 +46,20 @@ class Volume:
     @property
     def spacing(self) -> Tuple[float, float, float]: ...
 
+class Cloud:
+    """A point cloud in memory: an (N, 3) array of positions, a dict of N values per
+    attribute, (N, 3) colours; or a laspy.LasData. Stands wherever a scene names a
+    cloud file."""
+
+    def __init__(
+        self, positions: Any, attributes: Optional[Dict[str, Any]] = None, rgb: Any = None
+    ) -> None: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def attributes(self) -> List[str]: ...
+    def __len__(self) -> int: ...
+
 class Scene:
     """A scene: the technique and its parameters, size, fidelity, programs, camera."""
 

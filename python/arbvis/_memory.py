@@ -82,3 +82,71 @@ def volume_parts(data, spacing):
     if spacing is not None:
         spacing = _spacing(spacing)
     return np.ascontiguousarray(array, dtype=np.float32), spacing, cdp, axis
+
+
+#: Integer attribute types kept as integers (as arbvis's LAS reader keeps extra bytes of
+#: these types; 32-bit unsigned and 64-bit ones may not fit, and become floats).
+INTEGRAL = ("int8", "int16", "int32", "uint8", "uint16")
+
+
+def _column(name, values, n):
+    array = np.asarray(values)
+    if array.shape != (n,):
+        raise InputError(f"cloud: attribute {name!r} has shape {array.shape}, not ({n},)")
+    if array.dtype.kind not in "iuf":
+        raise InputError(f"cloud: attribute {name!r} holds {array.dtype}, not numbers")
+    return (str(name), array.dtype.name in INTEGRAL, np.ascontiguousarray(array, dtype=np.float64))
+
+
+def _colours(rgb, n):
+    array = np.asarray(rgb)
+    if array.shape != (n, 3) or array.dtype.name not in ("uint8", "uint16"):
+        raise InputError(
+            f"cloud: rgb is an ({n}, 3) array of uint8 or uint16, got {array.shape} {array.dtype}"
+        )
+    if array.dtype.name == "uint8":
+        array = array.astype(np.uint16) * 257
+    return np.ascontiguousarray(array, dtype=np.uint16)
+
+
+def _from_laspy(las):
+    """A LasData's points as arbvis reads its LAS file: positions scaled, intensity,
+    classification, the returns, GPS time after the earliest point's, extra dimensions,
+    colours."""
+    names = set(las.point_format.dimension_names)
+    positions = np.column_stack([np.asarray(las.x), np.asarray(las.y), np.asarray(las.z)])
+    attributes = {}
+    for name in ("intensity", "classification", "return_number", "number_of_returns"):
+        attributes[name] = np.asarray(las[name]).astype(np.int32)
+    if "gps_time" in names:
+        t = np.asarray(las.gps_time, dtype=np.float64)
+        attributes["gps_time"] = t - t.min() if len(t) else t
+    for name in las.point_format.extra_dimension_names:
+        label = name
+        while label in attributes:
+            label += "_extra"
+        attributes[label] = np.asarray(las[name])
+    rgb = None
+    if {"red", "green", "blue"} <= names:
+        rgb = np.column_stack([np.asarray(las[c]) for c in ("red", "green", "blue")]).astype(np.uint16)
+    return positions, attributes, rgb
+
+
+def cloud_parts(positions, attributes, rgb):
+    """(positions N x 3 float64 in C order, [(name, integral, float64 values)], colours
+    N x 3 uint16 or None) of numpy arrays or a laspy.LasData."""
+    if hasattr(positions, "point_format") and hasattr(positions, "header"):
+        if attributes is not None or rgb is not None:
+            raise InputError("cloud: a LasData brings its own attributes and colours")
+        positions, attributes, rgb = _from_laspy(positions)
+    xyz = np.asarray(positions)
+    if xyz.ndim != 2 or xyz.shape[1] != 3 or xyz.dtype.kind not in "iuf":
+        raise InputError(f"cloud: positions are an (N, 3) array of numbers, got {xyz.shape} {xyz.dtype}")
+    n = xyz.shape[0]
+    if attributes is None:
+        attributes = {}
+    if not isinstance(attributes, dict):
+        raise InputError(f"cloud: attributes are a dict of name to values, got {type(attributes).__name__}")
+    columns = [_column(name, values, n) for name, values in attributes.items()]
+    colours = None if rgb is None else _colours(rgb, n)
+    return np.ascontiguousarray(xyz, dtype=np.float64), columns, colours

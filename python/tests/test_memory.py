@@ -201,3 +201,79 @@ def test_dask_refuses_a_volume_in_memory_before_sending_anything(tmp_path):
     with pytest.raises(arbvis.InputError) as e:
         arbvis.dask.render_views(None, scene, arbvis.dask.orbit(2))
     assert "lives in this process only" in str(e.value)
+
+
+CLOUD_SCENE = """
+size = [90, 70]
+[camera]
+rotation = [0.28, -0.1, -0.05, 0.95]
+[technique.splats]
+cloud = { las = "c.las" }
+point_size = 3.0
+"""
+
+
+def lidar_las(n=3001, seed=5):
+    """A laspy LasData of `n` points of format 3 (GPS time, colours) over a rough surface,
+    with an extra dimension: written to and read back from a LAS file by laspy itself."""
+    laspy = pytest.importorskip("laspy")
+    rng = np.random.default_rng(seed)
+    header = laspy.LasHeader(point_format=3, version="1.2")
+    header.scales = [0.001, 0.001, 0.001]
+    header.offsets = [500000.0, 4000000.0, 100.0]
+    header.add_extra_dim(laspy.ExtraBytesParams(name="moisture", type=np.float32))
+    las = laspy.LasData(header)
+    x = 500000.0 + rng.uniform(0, 80, n)
+    y = 4000000.0 + rng.uniform(0, 50, n)
+    las.x, las.y = x, y
+    las.z = 100.0 + 3 * np.sin(x / 7.0) + rng.normal(0, 0.4, n)
+    las.intensity = rng.integers(0, 65535, n, dtype=np.uint16)
+    las.classification = rng.integers(1, 7, n, dtype=np.uint8)
+    las.gps_time = 3e8 + np.sort(rng.uniform(0, 100, n))
+    las.red, las.green, las.blue = (rng.integers(0, 65535, n, dtype=np.uint16) for _ in range(3))
+    las.moisture = rng.uniform(0, 1, n).astype(np.float32)
+    return las
+
+
+@pytest.mark.parametrize("colour", [None, "rgb", "intensity", "classification"])
+def test_a_laspy_cloud_draws_as_its_las_file(tmp_path, colour):
+    laspy = pytest.importorskip("laspy")
+    lidar_las().write(str(tmp_path / "c.las"))
+    las = laspy.read(str(tmp_path / "c.las"))
+    scene = arbvis.Scene.from_toml(CLOUD_SCENE, base=tmp_path)
+    if colour:
+        scene["technique.splats.colour"] = colour
+    want = render(scene)
+    assert want[..., :3].any(), "the cloud is drawn"
+    cloud = arbvis.Cloud(las)
+    assert len(cloud) == len(las.points)
+    assert cloud.attributes == [
+        "intensity", "classification", "return_number", "number_of_returns", "gps_time", "moisture"
+    ]
+    scene["technique.splats.cloud"] = cloud
+    assert np.array_equal(render(scene), want)
+    # The same points as plain arrays.
+    xyz = np.column_stack([las.x, las.y, las.z])
+    rgb = np.column_stack([las.red, las.green, las.blue])
+    attributes = {
+        "intensity": np.asarray(las.intensity),
+        "classification": np.asarray(las.classification),
+    }
+    scene["technique.splats.cloud"] = arbvis.Cloud(xyz, attributes, rgb)
+    assert np.array_equal(render(scene), want)
+
+
+def test_a_bad_cloud_is_refused_naming_the_argument():
+    xyz = np.zeros((4, 3))
+    cases = [
+        (np.zeros((4, 2)), None, None, "cloud: positions are an (N, 3) array"),
+        (xyz, {"a": np.zeros(3)}, None, "cloud: attribute 'a' has shape (3,), not (4,)"),
+        (xyz, {"a": np.array(["x"] * 4)}, None, "cloud: attribute 'a' holds"),
+        (xyz, [1, 2], None, "cloud: attributes are a dict"),
+        (xyz, None, np.zeros((4, 3), np.float32), "cloud: rgb is an (4, 3) array"),
+        (np.array([[0, 0, 0], [np.nan, 0, 0]]), None, None, "cloud: point 1 has a non-finite coordinate"),
+    ]
+    for positions, attributes, rgb, says in cases:
+        with pytest.raises(arbvis.InputError) as e:
+            arbvis.Cloud(positions, attributes, rgb)
+        assert says in str(e.value), str(e.value)

@@ -33,7 +33,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     (
         "data and GL",
         &[
-            "le", "fetch", "sniff", "volume", "store", "mesh", "points", "surface", "gl",
+            "le", "memory", "fetch", "sniff", "volume", "store", "mesh", "points", "surface", "gl",
         ],
     ),
     ("program texts", &["programs"]),

@@ -1,13 +1,14 @@
 //! arbvis from Python (the `arbvis` package's extension module, `arbvis._arbvis`):
 //! scenes read and edited as Python values ([`scene`]), renderers that keep their GL
 //! context, data and programs between frames and hand back numpy arrays ([`renderer`]),
-//! surveys handed over in memory ([`volume`]), the driver's report ([`info`]), and pictures read, written and compared as the Rust
+//! surveys and clouds handed over in memory ([`volume`], [`cloud`]), the driver's report ([`info`]), and pictures read, written and compared as the Rust
 //! tests compare them ([`images`]). Errors are Python exceptions of arbvis's own types
 //! ([`errors`]). The Python side (`python/arbvis/`) adds the pytest plugin and the Dask
 //! helper.
 
 #![deny(unsafe_code)]
 
+mod cloud;
 mod errors;
 mod images;
 mod renderer;
@@ -48,6 +49,7 @@ fn _arbvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyScene>()?;
     m.add_class::<renderer::PyRenderer>()?;
     m.add_class::<volume::PyVolume>()?;
+    m.add_class::<cloud::PyCloud>()?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(tools::inspect, m)?)?;
     m.add_function(wrap_pyfunction!(tools::convert, m)?)?;

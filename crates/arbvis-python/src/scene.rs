@@ -11,10 +11,9 @@ use pyo3::exceptions::PyKeyError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyTuple};
 
-use arbvis_data::volume::Volume;
-
 use arbvis_techniques::scene::Scene;
 
+use crate::cloud::PyCloud;
 use crate::errors::{self, At};
 use crate::volume::PyVolume;
 
@@ -37,20 +36,31 @@ fn json_of(value: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
         .map_err(|e| errors::scene_error(format!("not a value a scene holds: {e}"), At::key(None)))
 }
 
-/// `value` with every `arbvis.Volume` in it (at any depth of dicts, lists and tuples)
+/// Data handed over in memory that a scene holds.
+pub type Kept = Arc<dyn std::any::Any + Send + Sync>;
+
+/// `value` with every `arbvis.Volume` and `arbvis.Cloud` in it (at any depth of dicts, lists and tuples)
 /// replaced by the table that names it (`{"memory": NAME}`); each such volume is kept in
 /// `kept`, so that the scene holds it as long as the scene lives.
 fn naming_volumes<'py>(
     value: &Bound<'py, PyAny>,
-    kept: &mut Vec<Arc<Volume>>,
+    kept: &mut Vec<Kept>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let py = value.py();
+    let named = |name: &str| -> PyResult<Bound<'py, PyAny>> {
+        let table = PyDict::new(py);
+        table.set_item("memory", name)?;
+        Ok(table.into_any())
+    };
     if let Ok(v) = value.cast::<PyVolume>() {
         let v = v.get();
         kept.push(v.volume.clone());
-        let table = PyDict::new(py);
-        table.set_item("memory", &v.name)?;
-        return Ok(table.into_any());
+        return named(&v.name);
+    }
+    if let Ok(c) = value.cast::<PyCloud>() {
+        let c = c.get();
+        kept.push(c.cloud.clone());
+        return named(&c.name);
     }
     if let Ok(d) = value.cast::<PyDict>() {
         let out = PyDict::new(py);
@@ -145,8 +155,9 @@ fn put(tree: &mut serde_json::Value, key: &str, value: Option<serde_json::Value>
 pub struct PyScene {
     /// The scene.
     pub scene: Scene,
-    /// The volumes in memory it was given (`arbvis.Volume`), held while it lives.
-    pub kept: Vec<Arc<Volume>>,
+    /// The data in memory it was given (`arbvis.Volume`, `arbvis.Cloud`), held while it
+    /// lives.
+    pub kept: Vec<Kept>,
 }
 
 #[pymethods]
@@ -222,7 +233,8 @@ impl PyScene {
     }
 
     /// Set the value at dotted `key`, validated as a scene file is; `None` removes it
-    /// (its default applies). An `arbvis.Volume` stands wherever a volume file is named.
+    /// (its default applies). An `arbvis.Volume` or `arbvis.Cloud` stands wherever a volume
+    /// or cloud file is named.
     fn __setitem__(&mut self, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
         let mut tree = tree_of(&self.scene);
         let mut kept = Vec::new();

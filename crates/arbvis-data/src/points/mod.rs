@@ -45,6 +45,7 @@ pub mod copc_lod;
 pub mod copc_write;
 pub mod dat;
 pub mod lasfile;
+pub mod memory;
 pub mod ply;
 pub mod plycloud;
 pub mod progress;
@@ -201,6 +202,8 @@ pub enum PointSource {
     Copc(copc::CopcSpec),
     /// The generated geological section.
     Section(section::SectionSpec),
+    /// A cloud handed over in memory (an `arbvis.Cloud`), by its name ([`memory`]).
+    Memory(String),
 }
 
 impl PointSource {
@@ -213,15 +216,19 @@ impl PointSource {
             PointSource::Las(_) => Some(reader(Format::Las)),
             PointSource::Ply(_) => Some(reader(Format::Ply)),
             PointSource::Copc(_) => Some(reader(Format::Copc)),
-            PointSource::Section(_) => None,
+            PointSource::Section(_) | PointSource::Memory(_) => None,
         }
     }
 
-    /// The kind of data the source yields: its reader's; the generated section is the
-    /// seed's kind of cloud.
+    /// The kind of data the source yields: its reader's; a cloud from memory is a cloud
+    /// (lidar's defaults, as a LAS file's); the generated section is the seed's kind.
     pub fn data_kind(&self) -> crate::sniff::DataKind {
-        self.reader()
-            .map_or(crate::sniff::DataKind::SeedCloud, |r| r.kind)
+        match self {
+            PointSource::Memory(_) => crate::sniff::DataKind::Cloud,
+            _ => self
+                .reader()
+                .map_or(crate::sniff::DataKind::SeedCloud, |r| r.kind),
+        }
     }
 
     /// A COPC file drawn within `points` (Potree's pixel size: nodes under 150 px left).
@@ -266,6 +273,7 @@ impl PointSource {
                 return Ok((cloud, Some(loaded)));
             }
             PointSource::Section(spec) => section::generate(spec)?,
+            PointSource::Memory(name) => memory::load(name)?,
         };
         Ok((cloud, None))
     }
@@ -276,7 +284,7 @@ impl PointSource {
             PointSource::Dat(spec) => Some(&spec.path),
             PointSource::Copc(spec) => Some(&spec.path),
             PointSource::Las(p) | PointSource::Ply(p) => Some(p),
-            PointSource::Section(_) => None,
+            PointSource::Section(_) | PointSource::Memory(_) => None,
         }
     }
 
@@ -288,6 +296,7 @@ impl PointSource {
             PointSource::Ply(_) => "ply",
             PointSource::Copc(_) => "copc",
             PointSource::Section(_) => "section",
+            PointSource::Memory(_) => "memory",
         }
     }
 
@@ -297,7 +306,7 @@ impl PointSource {
             PointSource::Dat(spec) => Some(&mut spec.path),
             PointSource::Copc(spec) => Some(&mut spec.path),
             PointSource::Las(p) | PointSource::Ply(p) => Some(p),
-            PointSource::Section(_) => None,
+            PointSource::Section(_) | PointSource::Memory(_) => None,
         }
     }
 }

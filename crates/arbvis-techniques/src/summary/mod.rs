@@ -62,7 +62,7 @@ pub fn cloud_units(source: &PointSource, base: &Path) -> Units {
         },
         PointSource::Las(p) => las_units(&base.join(p)),
         PointSource::Copc(spec) => las_units(&base.join(&spec.path)),
-        PointSource::Dat(_) | PointSource::Ply(_) => Units::default(),
+        PointSource::Dat(_) | PointSource::Ply(_) | PointSource::Memory(_) => Units::default(),
     }
 }
 
