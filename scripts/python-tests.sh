@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The Python package's tests: a virtual environment in target/python-venv (numpy, pytest,
-# dask[distributed], xarray and laspy (arbvis.Volume and arbvis.Cloud from their objects) and
+# dask[distributed], xarray, laspy and meshio (arbvis.Volume, Cloud and Mesh from their objects) and
 # maturin from PyPI), the package built from this checkout and
 # installed into it (`pip install .`: a debug build that reuses the workspace's test build
 # in target/), then pytest on python/tests. scripts/test.sh runs it after the Rust tests.
@@ -13,6 +13,6 @@ if [ ! -x "$venv/bin/python" ]; then
   python3 -m venv "$venv"
 fi
 "$venv/bin/python" -m pip install -q --disable-pip-version-check \
-  "maturin>=1.5,<2" numpy pytest "dask[distributed]" xarray laspy
+  "maturin>=1.5,<2" numpy pytest "dask[distributed]" xarray laspy meshio
 "$venv/bin/python" -m pip install -q --disable-pip-version-check --no-build-isolation .
 exec "$venv/bin/python" -m pytest -q -p no:cacheprovider python/tests "$@"

@@ -8,9 +8,9 @@
 ...     scene["technique.opacity3d.primary.coefficients"] = [0.2, 0.2, 0.2, 0.9]
 ...     again = renderer.render()          # a frame, not a new process
 
-`Scene` reads and edits scenes (dotted keys, validated as scene files are); `Volume`
-and `Cloud` hand a survey (numpy, xarray) or a point cloud (numpy, laspy) over from
-memory, wherever a scene names a volume or cloud file;
+`Scene` reads and edits scenes (dotted keys, validated as scene files are); `Volume`,
+`Cloud` and `Mesh` hand a survey (numpy, xarray), a point cloud (numpy, laspy) or an
+unstructured mesh (numpy, meshio) over from memory, wherever a scene names a file;
 `Renderer` keeps its GL context, data and programs between frames; `info()` reports the
 driver; `inspect(path)` and `convert(src, dst, progress=...)` are the command line's
 `inspect` and `convert`; `read_png`, `write_png`, `compare` and `diff_image` read, write and compare pictures
@@ -25,6 +25,7 @@ from ._arbvis import (  # noqa: F401
     Cloud,
     GLError,
     InputError,
+    Mesh,
     Renderer,
     RenderError,
     Scene,
@@ -47,6 +48,7 @@ __all__ = [
     "Cloud",
     "GLError",
     "InputError",
+    "Mesh",
     "RenderError",
     "Renderer",
     "Scene",

@@ -60,6 +60,23 @@ class Cloud:
     def attributes(self) -> List[str]: ...
     def __len__(self) -> int: ...
 
+class Mesh:
+    """An unstructured mesh in memory: (N, 3) points, an (M, 4) array of tetrahedra or a
+    dict of meshio cell names to cells, point_data / cell_data dicts; or a meshio.Mesh.
+    Stands wherever a scene names a mesh file."""
+
+    def __init__(
+        self,
+        points: Any,
+        cells: Any = None,
+        point_data: Optional[Dict[str, Any]] = None,
+        cell_data: Optional[Dict[str, Any]] = None,
+    ) -> None: ...
+    @property
+    def name(self) -> str: ...
+    @property
+    def tetrahedra(self) -> int: ...
+
 class Scene:
     """A scene: the technique and its parameters, size, fidelity, programs, camera."""
 

@@ -150,3 +150,82 @@ def cloud_parts(positions, attributes, rgb):
     columns = [_column(name, values, n) for name, values in attributes.items()]
     colours = None if rgb is None else _colours(rgb, n)
     return np.ascontiguousarray(xyz, dtype=np.float64), columns, colours
+
+
+#: meshio's cell names and their VTK types (surface, line and vertex cells are skipped
+#: as a file's are).
+VTK_TYPES = {
+    "vertex": 1,
+    "line": 3,
+    "triangle": 5,
+    "quad": 9,
+    "tetra": 10,
+    "voxel": 11,
+    "hexahedron": 12,
+    "wedge": 13,
+    "pyramid": 14,
+}
+
+
+def _array(name, values, n, where):
+    a = np.asarray(values)
+    if a.ndim not in (1, 2) or a.shape[0] != n or a.dtype.kind not in "iuf":
+        raise InputError(
+            f"mesh: {where} array {name!r} has shape {a.shape} {a.dtype}, not {n} numbers or rows of numbers"
+        )
+    components = 1 if a.ndim == 1 else a.shape[1]
+    return (str(name), components, np.ascontiguousarray(a, dtype=np.float64).ravel())
+
+
+def _blocks(cells, n_points):
+    if isinstance(cells, dict):
+        items = list(cells.items())
+    elif isinstance(cells, (list, tuple)) and all(
+        isinstance(c, (list, tuple)) and len(c) == 2 and isinstance(c[0], str) for c in cells
+    ) and cells:
+        items = list(cells)  # [(kind, cells), ...], meshio's order
+    else:
+        items = [("tetra", cells)]
+    blocks = []
+    for kind, connectivity in items:
+        if kind not in VTK_TYPES:
+            raise InputError(f"mesh: cells of kind {kind!r}: arbvis takes {', '.join(VTK_TYPES)}")
+        c = np.asarray(connectivity)
+        if c.ndim != 2 or c.dtype.kind not in "iu" or c.shape[0] == 0:
+            raise InputError(f"mesh: {kind} cells are an (M, k) array of point indices, got {c.shape} {c.dtype}")
+        if c.min() < 0 or c.max() >= n_points:
+            raise InputError(
+                f"mesh: {kind} cells name point {int(c.min()) if c.min() < 0 else int(c.max())}; the mesh has {n_points} points"
+            )
+        blocks.append((VTK_TYPES[kind], c.shape[1], np.ascontiguousarray(c, dtype=np.uint32).ravel()))
+    return blocks
+
+
+def mesh_parts(points, cells, point_data, cell_data):
+    """(points N x 3 float64 in C order, [(VTK type, points per cell, indices uint32)],
+    [(name, components, float64 values)] per point, the same per cell) of numpy arrays or
+    a meshio.Mesh (its cell_data: a list per block, joined in block order)."""
+    if hasattr(points, "cells") and hasattr(points, "points") and hasattr(points, "point_data"):
+        mesh = points
+        if cells is not None or point_data is not None or cell_data is not None:
+            raise InputError("mesh: a meshio.Mesh brings its own cells and data")
+        points = mesh.points
+        cells = [(block.type, block.data) for block in mesh.cells]
+        point_data = dict(mesh.point_data)
+        cell_data = {name: np.concatenate([np.asarray(b) for b in blocks]) for name, blocks in mesh.cell_data.items()}
+    xyz = np.asarray(points)
+    if xyz.ndim != 2 or xyz.shape[1] != 3 or xyz.dtype.kind not in "iuf":
+        raise InputError(f"mesh: points are an (N, 3) array of numbers, got {xyz.shape} {xyz.dtype}")
+    if not np.isfinite(xyz).all():
+        bad = int(np.argwhere(~np.isfinite(xyz))[0][0])
+        raise InputError(f"mesh: point {bad} has a non-finite coordinate {xyz[bad].tolist()}")
+    if cells is None:
+        raise InputError("mesh: cells are needed (an (M, 4) array of tetrahedra, or a dict of kind to cells)")
+    blocks = _blocks(cells, xyz.shape[0])
+    n_cells = sum(len(c) // k for _, k, c in blocks)
+    for name, data in (("point_data", point_data), ("cell_data", cell_data)):
+        if data is not None and not isinstance(data, dict):
+            raise InputError(f"mesh: {name} is a dict of name to array, got {type(data).__name__}")
+    points_arrays = [_array(k, v, xyz.shape[0], "point") for k, v in (point_data or {}).items()]
+    cell_arrays = [_array(k, v, n_cells, "cell") for k, v in (cell_data or {}).items()]
+    return np.ascontiguousarray(xyz, dtype=np.float64), blocks, points_arrays, cell_arrays

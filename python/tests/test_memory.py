@@ -277,3 +277,96 @@ def test_a_bad_cloud_is_refused_naming_the_argument():
         with pytest.raises(arbvis.InputError) as e:
             arbvis.Cloud(positions, attributes, rgb)
         assert says in str(e.value), str(e.value)
+
+
+MESH_SCENE = """
+size = [80, 64]
+fidelity = "precise"
+[camera]
+rotation = [0.21, 0.37, 0.1, 0.9]
+[technique.cellproj]
+mesh = { file = "m.vtk" }
+mode = "volume"
+"""
+
+
+def mixed_mesh(seed=9):
+    """Points of a 3 x 2 x 2 block of hexahedra with jittered corners, its first row as
+    hexahedra and the rest split by hand into tetrahedra, and a rough point scalar."""
+    rng = np.random.default_rng(seed)
+    g = np.stack(np.meshgrid(np.arange(4), np.arange(3), np.arange(3), indexing="ij"), -1)
+    points = (g.reshape(-1, 3) + rng.uniform(-0.15, 0.15, (36, 3))).astype(np.float64)
+    index = np.arange(36).reshape(4, 3, 3)
+    hexes, tets = [], []
+    for i in range(3):
+        for j in range(2):
+            for k in range(2):
+                v = [index[i, j, k], index[i + 1, j, k], index[i + 1, j + 1, k], index[i, j + 1, k],
+                     index[i, j, k + 1], index[i + 1, j, k + 1], index[i + 1, j + 1, k + 1], index[i, j + 1, k + 1]]
+                if i == 0:
+                    hexes.append(v)
+                else:
+                    for t in ([0, 1, 3, 4], [1, 2, 3, 6], [1, 4, 5, 6], [3, 4, 6, 7], [1, 3, 4, 6]):
+                        tets.append([v[a] for a in t])
+    scalar = np.sin(points[:, 0] * 1.3) + points[:, 2] * 0.4 + rng.normal(0, 0.1, 36)
+    return points, np.array(tets), np.array(hexes), scalar
+
+
+def write_vtk(path, points, tets, hexes, scalar):
+    """A VTK legacy ASCII unstructured grid: the tetrahedra (10), then the hexahedra (12)."""
+    lines = ["# vtk DataFile Version 3.0", "mixed", "ASCII", "DATASET UNSTRUCTURED_GRID"]
+    lines.append(f"POINTS {len(points)} double")
+    lines += [" ".join(repr(float(c)) for c in p) for p in points]
+    cells = [[4, *t] for t in tets] + [[8, *h] for h in hexes]
+    lines.append(f"CELLS {len(cells)} {sum(len(c) for c in cells)}")
+    lines += [" ".join(str(int(v)) for v in c) for c in cells]
+    lines.append(f"CELL_TYPES {len(cells)}")
+    lines += ["10"] * len(tets) + ["12"] * len(hexes)
+    lines += [f"POINT_DATA {len(points)}", "SCALARS s double 1", "LOOKUP_TABLE default"]
+    lines += [repr(float(v)) for v in scalar]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_a_mesh_from_arrays_and_from_meshio_draws_as_its_file(tmp_path):
+    points, tets, hexes, scalar = mixed_mesh()
+    write_vtk(tmp_path / "m.vtk", points, tets, hexes, scalar)
+    scene = arbvis.Scene.from_toml(MESH_SCENE, base=tmp_path)
+    want = render(scene)
+    assert want[..., :3].any(), "the volume is drawn"
+    mesh = arbvis.Mesh(points, {"tetra": tets, "hexahedron": hexes}, {"s": scalar})
+    # 24 tetrahedra given, 4 hexahedra split in 6 each (as arbvis splits a file's).
+    assert mesh.tetrahedra == len(tets) + 6 * len(hexes)
+    scene["technique.cellproj.mesh"] = mesh
+    assert np.array_equal(render(scene), want)
+    meshio = pytest.importorskip("meshio")
+    m = meshio.Mesh(points, [("tetra", tets), ("hexahedron", hexes)], point_data={"s": scalar})
+    scene["technique.cellproj.mesh"] = arbvis.Mesh(m)
+    assert np.array_equal(render(scene), want)
+    # What meshio writes (VTU), read by arbvis from the file and by meshio into memory.
+    m.write(str(tmp_path / "m.vtu"))
+    scene["technique.cellproj.mesh"] = {"file": "m.vtu"}
+    assert np.array_equal(render(scene), want)
+    scene["technique.cellproj.mesh"] = arbvis.Mesh(meshio.read(str(tmp_path / "m.vtu")))
+    assert np.array_equal(render(scene), want)
+
+
+def test_a_bad_mesh_is_refused_naming_the_argument_and_the_cell():
+    points, tets, hexes, scalar = mixed_mesh()
+    flat = tets.copy()
+    flat[3] = [0, 1, 2, 2]  # a collapsed tetrahedron among good ones: dropped, not an error
+    cases = [
+        ((np.zeros((4, 2)), tets), "mesh: points are an (N, 3) array"),
+        ((points, None), "mesh: cells are needed"),
+        ((points, {"polyhedron": tets}), "mesh: cells of kind 'polyhedron'"),
+        ((points, tets + 100), "mesh: tetra cells name point 135; the mesh has 36 points"),
+        ((points, tets, {"s": scalar[:5]}), "mesh: point array 's' has shape (5,)"),
+        ((points, tets, None, {"c": np.zeros(3)}), "mesh: cell array 'c' has shape (3,)"),
+        ((points, {"triangle": tets[:, :3]}), "mesh: cell 0: no volume cells"),
+        # Rows of the wrong length for their kind: named by the cell's index.
+        ((points, {"tetra": hexes}), "mesh: cell 0: cell 0 is a VTK_TETRA and needs 4 points"),
+    ]
+    for args, says in cases:
+        with pytest.raises(arbvis.InputError) as e:
+            arbvis.Mesh(*args)
+        assert says in str(e.value), str(e.value)
+    assert arbvis.Mesh(points, flat).tetrahedra == len(tets) - 1

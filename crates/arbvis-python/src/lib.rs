@@ -1,7 +1,7 @@
 //! arbvis from Python (the `arbvis` package's extension module, `arbvis._arbvis`):
 //! scenes read and edited as Python values ([`scene`]), renderers that keep their GL
 //! context, data and programs between frames and hand back numpy arrays ([`renderer`]),
-//! surveys and clouds handed over in memory ([`volume`], [`cloud`]), the driver's report ([`info`]), and pictures read, written and compared as the Rust
+//! surveys, clouds and meshes handed over in memory ([`volume`], [`cloud`], [`mesh`]), the driver's report ([`info`]), and pictures read, written and compared as the Rust
 //! tests compare them ([`images`]). Errors are Python exceptions of arbvis's own types
 //! ([`errors`]). The Python side (`python/arbvis/`) adds the pytest plugin and the Dask
 //! helper.
@@ -11,6 +11,7 @@
 mod cloud;
 mod errors;
 mod images;
+mod mesh;
 mod renderer;
 mod scene;
 mod tools;
@@ -50,6 +51,7 @@ fn _arbvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<renderer::PyRenderer>()?;
     m.add_class::<volume::PyVolume>()?;
     m.add_class::<cloud::PyCloud>()?;
+    m.add_class::<mesh::PyMesh>()?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(tools::inspect, m)?)?;
     m.add_function(wrap_pyfunction!(tools::convert, m)?)?;

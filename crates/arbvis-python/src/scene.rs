@@ -15,6 +15,7 @@ use arbvis_techniques::scene::Scene;
 
 use crate::cloud::PyCloud;
 use crate::errors::{self, At};
+use crate::mesh::PyMesh;
 use crate::volume::PyVolume;
 
 /// `json.loads(text)`.
@@ -39,7 +40,7 @@ fn json_of(value: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
 /// Data handed over in memory that a scene holds.
 pub type Kept = Arc<dyn std::any::Any + Send + Sync>;
 
-/// `value` with every `arbvis.Volume` and `arbvis.Cloud` in it (at any depth of dicts, lists and tuples)
+/// `value` with every `arbvis.Volume`, `arbvis.Cloud` and `arbvis.Mesh` in it (at any depth of dicts, lists and tuples)
 /// replaced by the table that names it (`{"memory": NAME}`); each such volume is kept in
 /// `kept`, so that the scene holds it as long as the scene lives.
 fn naming_volumes<'py>(
@@ -61,6 +62,11 @@ fn naming_volumes<'py>(
         let c = c.get();
         kept.push(c.cloud.clone());
         return named(&c.name);
+    }
+    if let Ok(m) = value.cast::<PyMesh>() {
+        let m = m.get();
+        kept.push(m.mesh.clone());
+        return named(&m.name);
     }
     if let Ok(d) = value.cast::<PyDict>() {
         let out = PyDict::new(py);
@@ -155,7 +161,7 @@ fn put(tree: &mut serde_json::Value, key: &str, value: Option<serde_json::Value>
 pub struct PyScene {
     /// The scene.
     pub scene: Scene,
-    /// The data in memory it was given (`arbvis.Volume`, `arbvis.Cloud`), held while it
+    /// The data in memory it was given (`arbvis.Volume`, `Cloud`, `Mesh`), held while it
     /// lives.
     pub kept: Vec<Kept>,
 }
@@ -233,8 +239,8 @@ impl PyScene {
     }
 
     /// Set the value at dotted `key`, validated as a scene file is; `None` removes it
-    /// (its default applies). An `arbvis.Volume` or `arbvis.Cloud` stands wherever a volume
-    /// or cloud file is named.
+    /// (its default applies). An `arbvis.Volume`, `Cloud` or `Mesh` stands wherever a volume,
+    /// cloud or mesh file is named.
     fn __setitem__(&mut self, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
         let mut tree = tree_of(&self.scene);
         let mut kept = Vec::new();

@@ -261,6 +261,8 @@ pub struct RawCells {
     pub token_base: Option<usize>,
     /// Whether those offsets lie in text (line and column are given) or binary data.
     pub text: bool,
+    /// Whether `at` holds cell indices (cells handed over in memory, no file).
+    pub indexed: bool,
 }
 
 /// Tetrahedra built from cells.
@@ -441,7 +443,13 @@ impl RawCells {
             if let Some(base) = self.token_base {
                 at = super::read::nth_token(bytes, base, at);
             }
-            if self.text {
+            if self.indexed {
+                super::MeshError::Format {
+                    path: name.to_path_buf(),
+                    at: super::Position::Cell(at as u64),
+                    message: m,
+                }
+            } else if self.text {
                 super::read::text_error(name, bytes, at, m)
             } else {
                 super::read::binary_error(name, at, m)

@@ -35,6 +35,7 @@ pub mod cells;
 pub mod gmsh;
 pub mod grid;
 pub mod legacy;
+pub mod memory;
 pub mod quality;
 pub mod read;
 pub mod scalars;
@@ -136,6 +137,8 @@ pub enum Position {
     },
     /// In binary data: byte offset from the start of the file.
     Byte(u64),
+    /// The cell of that index (0-based), in cells handed over in memory.
+    Cell(u64),
 }
 
 impl fmt::Display for Position {
@@ -145,6 +148,7 @@ impl fmt::Display for Position {
                 write!(f, "line {line}, column {column} (byte {byte})")
             }
             Position::Byte(b) => write!(f, "at byte {b}"),
+            Position::Cell(c) => write!(f, "cell {c}"),
         }
     }
 }
@@ -194,6 +198,8 @@ pub enum MeshSource {
     File(PathBuf),
     /// A generated grid with an analytic field.
     Grid(grid::GridSpec),
+    /// A mesh handed over in memory (an `arbvis.Mesh`), by its name ([`memory`]).
+    Memory(String),
 }
 
 impl MeshSource {
@@ -202,6 +208,7 @@ impl MeshSource {
         match self {
             MeshSource::File(p) => read(&base.join(p)),
             MeshSource::Grid(spec) => grid::generate(spec),
+            MeshSource::Memory(name) => memory::load(name),
         }
     }
 
@@ -209,7 +216,7 @@ impl MeshSource {
     pub fn path(&self) -> Option<&Path> {
         match self {
             MeshSource::File(p) => Some(p),
-            MeshSource::Grid(_) => None,
+            MeshSource::Grid(_) | MeshSource::Memory(_) => None,
         }
     }
 
@@ -217,7 +224,7 @@ impl MeshSource {
     pub fn path_mut(&mut self) -> Option<&mut PathBuf> {
         match self {
             MeshSource::File(p) => Some(p),
-            MeshSource::Grid(_) => None,
+            MeshSource::Grid(_) | MeshSource::Memory(_) => None,
         }
     }
 }

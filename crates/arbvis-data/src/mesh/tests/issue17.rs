@@ -123,6 +123,7 @@ fn assemble_refuses_arrays_that_do_not_match_and_never_indexes_past_them() {
         at: vec![0, 0],
         token_base: None,
         text: false,
+        indexed: false,
     };
     let array = |values: Vec<f64>, components| ReadArray {
         array: DataArray {

@@ -394,7 +394,8 @@ pub const BYTES_PER_TET: u64 = 2000;
 
 impl CellprojScene {
     /// The large allocations this scene makes that the scene alone determines (a generated
-    /// grid); mesh files are held to the budget by their loaders once their headers are read.
+    /// grid, a mesh in memory); mesh files are held to the budget by their loaders once
+    /// their headers are read.
     pub fn memory_estimate(&self) -> Vec<arbvis_core::budget::Estimate> {
         match &self.mesh {
             arbvis_data::mesh::MeshSource::Grid(g) => {
@@ -408,6 +409,17 @@ impl CellprojScene {
                     BYTES_PER_TET,
                 )]
             }
+            // A mesh in memory: its tetrahedra are known.
+            arbvis_data::mesh::MeshSource::Memory(name) => arbvis_data::mesh::memory::MESHES
+                .get(name)
+                .map(|m| {
+                    vec![arbvis_core::budget::Estimate::of(
+                        format!("the {} tetrahedra of {name}", m.tets.len()),
+                        m.tets.len() as u64,
+                        BYTES_PER_TET,
+                    )]
+                })
+                .unwrap_or_default(),
             arbvis_data::mesh::MeshSource::File(_) => Vec::new(),
         }
     }
