@@ -229,3 +229,11 @@ def mesh_parts(points, cells, point_data, cell_data):
     points_arrays = [_array(k, v, xyz.shape[0], "point") for k, v in (point_data or {}).items()]
     cell_arrays = [_array(k, v, n_cells, "cell") for k, v in (cell_data or {}).items()]
     return np.ascontiguousarray(xyz, dtype=np.float64), blocks, points_arrays, cell_arrays
+
+
+def json_default(value):
+    """numpy's numbers and arrays as the Python numbers and lists a scene holds (json's
+    `default`); anything else is json's TypeError."""
+    if isinstance(value, (np.generic, np.ndarray)):
+        return value.tolist()
+    raise TypeError(f"Object of type {type(value).__name__} is not a value a scene holds")

@@ -97,13 +97,13 @@ class ImageChecker:
                 "run with --arbvis-add-missing-images to write it"
             )
         expected = _arbvis.read_png(str(reference))
-        d = _arbvis.compare(image, expected, tolerance)
-        if d is None:
+        if image.shape != expected.shape:
             self._keep_failed(name, image, None, tolerance)
             raise ImageMismatch(
                 f"{name}: size {image.shape[1]}x{image.shape[0]} differs from the "
                 f"reference's {expected.shape[1]}x{expected.shape[0]}"
             )
+        d = _arbvis.compare(image, expected, tolerance)
         if d["max_abs"] > tolerance + 1e-6:
             kept = self._keep_failed(name, image, expected, tolerance)
             raise ImageMismatch(

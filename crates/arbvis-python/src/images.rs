@@ -71,13 +71,23 @@ pub fn read_png(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
 /// atomically.
 #[pyfunction]
 pub fn write_png(path: PathBuf, array: &Bound<'_, PyAny>) -> PyResult<()> {
+    let png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    if !png {
+        return Err(PyValueError::new_err(format!(
+            "{}: write_png writes PNG files; name it .png",
+            path.display()
+        )));
+    }
     let image = levels(image_of(array)?);
     png_io::write_png(&path, &image, &[]).map_err(crate::errors::input_error)
 }
 
 /// How `actual` differs from `expected`, on 8-bit levels (what a PNG holds): a dict of
 /// `max_abs`, `rmse`, `psnr`, `pixels_over` (pixels with a channel more than `tolerance`
-/// off) and `worst` (x, y); None when the sizes differ.
+/// off) and `worst` (x, y). Pictures of different sizes, and a tolerance that is negative
+/// or not a number, are a `ValueError`.
 #[pyfunction]
 #[pyo3(signature = (actual, expected, tolerance = 1.0 / 255.0))]
 pub fn compare<'py>(
@@ -85,18 +95,26 @@ pub fn compare<'py>(
     actual: &Bound<'py, PyAny>,
     expected: &Bound<'py, PyAny>,
     tolerance: f32,
-) -> PyResult<Option<Bound<'py, PyDict>>> {
+) -> PyResult<Bound<'py, PyDict>> {
+    if !(tolerance.is_finite() && tolerance >= 0.0) {
+        return Err(PyValueError::new_err(format!(
+            "tolerance {tolerance}: a difference of 0 or more (1/255 is one 8-bit level)"
+        )));
+    }
     let (a, e) = (levels(image_of(actual)?), levels(image_of(expected)?));
-    let Some(d) = a.compare(&e, tolerance) else {
-        return Ok(None);
-    };
+    let d = a.compare(&e, tolerance).ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "the pictures' sizes differ: {}x{} and {}x{}",
+            a.width, a.height, e.width, e.height
+        ))
+    })?;
     let out = PyDict::new(py);
     out.set_item("max_abs", d.max_abs)?;
     out.set_item("rmse", d.rmse)?;
     out.set_item("psnr", d.psnr)?;
     out.set_item("pixels_over", d.pixels_over)?;
     out.set_item("worst", d.worst)?;
-    Ok(Some(out))
+    Ok(out)
 }
 
 /// A diff image of `actual` against `expected`: each pixel's largest channel difference

@@ -215,6 +215,8 @@ impl PyRenderer {
     /// precise modes are measured against. None where the technique has none (splats,
     /// isosurfaces alone, a survey store, a clipped 3D opacity scene).
     fn reference<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        // A closed renderer draws nothing more, its reference neither.
+        self.jobs()?;
         let current = lock(&self.scene).clone_ref(py);
         let scene = scene_now(py, &current)?;
         let limits = Limits::for_max_side(self.max_3d_texture_size);

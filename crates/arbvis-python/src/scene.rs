@@ -29,6 +29,12 @@ fn json_of(value: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
     // NaN and infinities are no TOML a scene file could hold: json's ValueError says so.
     let options = pyo3::types::PyDict::new(py);
     options.set_item("allow_nan", false)?;
+    // numpy's numbers and arrays (np.float32(2), np.array([...]), np.int64 sizes) as the
+    // Python numbers and lists they hold.
+    options.set_item(
+        "default",
+        py.import("arbvis._memory")?.getattr("json_default")?,
+    )?;
     let text: String = py
         .import("json")?
         .call_method("dumps", (value,), Some(&options))?
@@ -369,6 +375,27 @@ impl PyScene {
 
     fn __eq__(&self, other: &PyScene) -> bool {
         self.scene == other.scene
+    }
+
+    /// The scene's picture as PNG bytes, what a notebook or a report shows for a scene:
+    /// drawn offscreen (EGL) by a renderer made for this call on a thread of its own.
+    fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyBytes>> {
+        let scene = self.scene.clone();
+        let drawn = py.detach(move || {
+            std::thread::spawn(move || {
+                use arbvis_techniques::session::Offscreen;
+                let mut session = Offscreen::new(&scene, arbvis_gl::Backend::Egl)?;
+                let frame = session.render(&scene)?;
+                Ok::<_, arbvis_techniques::error::RenderError>(scene.picture(&frame))
+            })
+            .join()
+        });
+        let image = drawn
+            .map_err(|_| pyo3::exceptions::PyRuntimeError::new_err("the render thread panicked"))?
+            .map_err(errors::from_render)?;
+        let png =
+            arbvis_core::png_io::encode_png("scene", &image, &[]).map_err(errors::input_error)?;
+        Ok(pyo3::types::PyBytes::new(py, &png))
     }
 
     fn __copy__(&self) -> PyScene {

@@ -172,12 +172,13 @@ impl Scene {
     /// Read and parse a scene file (a regular file of at most
     /// [`arbvis_core::input::MAX_SCENE_BYTES`], UTF-8).
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
-        let text = arbvis_core::input::read_text(path, arbvis_core::input::MAX_SCENE_BYTES)
+        let read = arbvis_core::input::read_text(path, arbvis_core::input::MAX_SCENE_BYTES)
             .map_err(|error| SceneError::Io {
                 path: path.display().to_string(),
                 error,
-            })?;
-        let mut scene = Scene::parse(&text, &path.display().to_string())?;
+            })
+            .and_then(|text| Scene::parse(&text, &path.display().to_string()));
+        let mut scene = read.map_err(|e| data_not_scene(path).unwrap_or(e))?;
         scene.base = path.parent().map(Path::to_path_buf).unwrap_or_default();
         Ok(scene)
     }
@@ -350,9 +351,41 @@ impl Scene {
         if self.background.iter().any(|v| !v.is_finite()) {
             return Err(FieldError::new("background", "must be finite"));
         }
+        let zoom = self.camera.zoom;
+        if !(zoom.is_finite() && zoom > 0.0 && zoom <= 1e6) {
+            return Err(FieldError::new(
+                "camera.zoom",
+                format!("{zoom}: a magnification above 0 and at most 1e6 (1: the data fills the shorter side)"),
+            ));
+        }
+        if self.camera.rotation.iter().any(|v| !v.is_finite()) {
+            return Err(FieldError::new("camera.rotation", "must be finite"));
+        }
         self.memory_budget_bytes()?;
         self.technique.validate(self.fidelity, self.programs)
     }
+}
+
+/// The error for a data file given where a scene was expected (a SEG-Y, a mesh, a cloud:
+/// what the reader registry recognizes), if `path` is one.
+fn data_not_scene(path: &Path) -> Option<SceneError> {
+    use std::io::Read;
+    let mut head = Vec::new();
+    std::fs::File::open(path)
+        .ok()?
+        .take(4096)
+        .read_to_end(&mut head)
+        .ok()?;
+    let format = arbvis_data::sniff::format(path, &head)?;
+    let reads = arbvis_data::sniff::reader(format).reads;
+    Some(SceneError::Parse {
+        path: path.display().to_string(),
+        line: 1,
+        column: 1,
+        message: format!(
+            "this is {reads} data, not a scene (TOML): a scene names it, e.g. `volume = {{ segy = \"...\" }}`, `mesh = {{ file = \"...\" }}` or `cloud = {{ las = \"...\" }}` (docs/scenes.md); `arbvis inspect` describes it"
+        ),
+    })
 }
 
 /// CPU memory per pixel of a frame read back and written: f32 RGBA as read (16 bytes),
@@ -440,6 +473,10 @@ fn parse_message(text: &str, start: usize, message: &str) -> String {
         && !matches!(word.as_str(), "true" | "false" | "inf" | "nan")
         && text[..start].trim_end().ends_with('=');
     let message = arbvis_core::input::shorten(message.trim(), MESSAGE_CHARS);
+    // serde's words for a second table in [technique], which holds one technique.
+    if message.contains("wanted exactly 1 element, more than 1 element") {
+        return "a scene draws one technique: [technique] holds one table ([technique.opacity3d], [technique.cellproj], [technique.splats] or [technique.quad]); draw each dataset in a scene of its own".into();
+    }
     if bare {
         format!("{message} (a word must be quoted: \"{word}\")")
     } else {

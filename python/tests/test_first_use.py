@@ -1,0 +1,79 @@
+"""What a PyVista user reaches for first (issue 56 item 4): numpy numbers anywhere a scene
+takes numbers, a picture in a notebook (`_repr_png_`), and clear refusals where a call
+cannot mean anything (a zoom of 0, pictures of two sizes, a JPEG name for a PNG, a SEG-Y
+given as a scene, two techniques in one scene, a closed renderer's reference)."""
+
+import numpy as np
+import pytest
+
+import arbvis
+
+
+def test_numpy_numbers_and_arrays_stand_for_python_ones():
+    scene = arbvis.Scene.demo("v3o2-sum")
+    scene.zoom = np.float32(1.5)
+    scene.rotation = np.array([0.1, 0.2, 0.0, 0.97])
+    scene.size = np.array([64, 48], dtype=np.int64)
+    scene["technique.opacity3d.primary.coefficients"] = np.array([0.2, 0.3, 0.1, 0.9], np.float32)
+    scene["technique.opacity3d.slices"] = np.int16(40)
+    assert scene.zoom == pytest.approx(1.5)
+    assert scene.size == (64, 48)
+    assert scene["technique.opacity3d.slices"] == 40
+    assert scene["technique.opacity3d.primary.coefficients"] == pytest.approx([0.2, 0.3, 0.1, 0.9])
+    # NaN is no number a scene holds, from numpy either.
+    with pytest.raises(ValueError):
+        scene.zoom = np.float64("nan")
+    with pytest.raises(TypeError):
+        scene.zoom = object()
+
+
+@pytest.mark.parametrize("zoom", [0, -1.0, 1e9])
+def test_a_zoom_that_shows_nothing_is_refused_by_key(zoom):
+    scene = arbvis.Scene.demo("quad")
+    with pytest.raises(arbvis.SceneError) as e:
+        scene.zoom = zoom
+    assert e.value.key == "camera.zoom" and "above 0" in str(e.value)
+    assert scene.zoom == 1.0, "the scene keeps its last good state"
+
+
+def test_a_scene_shows_itself_as_a_png_in_a_notebook(tmp_path):
+    scene = arbvis.Scene.demo("quad")
+    scene.size = (48, 32)
+    png = scene._repr_png_()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    (tmp_path / "scene.png").write_bytes(png)
+    with arbvis.Renderer(scene) as r:
+        want = r.render()
+    assert np.array_equal(arbvis.read_png(str(tmp_path / "scene.png")), want)
+
+
+def test_compare_and_write_png_refuse_what_means_nothing(tmp_path):
+    a = np.zeros((4, 5, 4), np.uint8)
+    with pytest.raises(ValueError, match="sizes differ: 5x4 and 5x3"):
+        arbvis.compare(a, np.zeros((3, 5, 4), np.uint8))
+    for tolerance in (-0.1, float("nan")):
+        with pytest.raises(ValueError, match="tolerance"):
+            arbvis.compare(a, a, tolerance)
+    assert arbvis.compare(a, a, 0.0)["max_abs"] == 0.0
+    with pytest.raises(ValueError, match="name it .png"):
+        arbvis.write_png(str(tmp_path / "x.jpg"), a)
+    assert not (tmp_path / "x.jpg").exists()
+
+
+def test_a_data_file_given_as_a_scene_says_what_it_is(root):
+    with pytest.raises(arbvis.SceneError) as e:
+        arbvis.Scene.load(str(root / "data/seismic/f3.sgy"))
+    assert "SEG-Y" in str(e.value) and "not a scene" in str(e.value)
+
+
+def test_two_techniques_in_one_scene_are_told_apart():
+    with pytest.raises(arbvis.SceneError) as e:
+        arbvis.Scene.from_dict({"technique": {"quad": {}, "splats": {}}})
+    assert "a scene draws one technique" in str(e.value)
+
+
+def test_a_closed_renderer_draws_no_reference():
+    r = arbvis.Renderer(arbvis.Scene.demo("quad"))
+    r.close()
+    with pytest.raises(RuntimeError, match="closed"):
+        r.reference()
