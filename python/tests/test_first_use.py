@@ -77,3 +77,19 @@ def test_a_closed_renderer_draws_no_reference():
     r.close()
     with pytest.raises(RuntimeError, match="closed"):
         r.reference()
+
+
+def test_a_renderer_says_what_its_last_frame_drew(f3_store_scene):
+    with arbvis.Renderer(f3_store_scene) as r:
+        assert r.stats()["frame_ms"] == 0.0, "no frame yet"
+        r.render()
+        stats = r.stats()
+        assert stats["frame_ms"] > 0.0
+        # A store's renderer says which bricks and levels it drew, as --stats prints it.
+        assert stats["status"] and "brick" in stats["status"], stats
+        assert isinstance(stats["facts"], dict)
+    with arbvis.Renderer(arbvis.Scene.demo("quad")) as r:
+        r.render()
+        assert r.stats()["status"] is None and r.stats()["frame_ms"] > 0.0
+    with pytest.raises(RuntimeError, match="closed"):
+        r.stats()

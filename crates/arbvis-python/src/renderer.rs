@@ -21,7 +21,7 @@ use arbvis_gl::Backend;
 use arbvis_techniques::catalog;
 use arbvis_techniques::error::RenderResult;
 use arbvis_techniques::scene::Scene;
-use arbvis_techniques::session::{FrameBudget, Offscreen};
+use arbvis_techniques::session::{FrameBudget, FrameStats, Offscreen};
 use arbvis_techniques::techniques::ReferenceView;
 
 use crate::errors;
@@ -45,6 +45,8 @@ enum Job {
     Render(Box<Scene>, bool, Sender<RenderResult<Image>>),
     /// Keep interactive frames to this many milliseconds.
     Budget(f64),
+    /// What the last frame drew.
+    Stats(Sender<FrameStats>),
 }
 
 /// What the render thread says once its context and renderer are made.
@@ -79,6 +81,9 @@ fn serve(scene: Scene, backend: Backend, ready: Sender<RenderResult<Ready>>, job
                     false => session.render(&scene),
                 };
                 let _ = reply.send(frame.map(|frame| scene.picture(&frame)));
+            }
+            Job::Stats(reply) => {
+                let _ = reply.send(session.stats());
             }
             Job::Budget(ms) => {
                 let interactive = std::time::Duration::from_secs_f64(ms / 1e3);
@@ -234,6 +239,30 @@ impl PyRenderer {
             })
             .map_err(errors::from_render)?;
         Ok(image.map(|i| to_array(py, i)))
+    }
+
+    /// What the last `render()` drew, as `arbvis render --stats` says it: a dict of
+    /// `frame_ms` (the scene's changes applied, the frame drawn and read back), `status`
+    /// (the renderer's line: a store's resident bricks and levels, a cloud's points; or
+    /// None) and `facts` (labelled lines, e.g. a clip's cost). Before a frame, `frame_ms`
+    /// is 0.
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        let (reply, answer) = channel();
+        self.jobs()?
+            .send(Job::Stats(reply))
+            .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?;
+        let stats = py
+            .detach(move || answer.recv())
+            .map_err(|_| PyRuntimeError::new_err("the render thread stopped"))?;
+        let out = pyo3::types::PyDict::new(py);
+        out.set_item("frame_ms", stats.frame.as_secs_f64() * 1e3)?;
+        out.set_item("status", stats.status)?;
+        let facts = pyo3::types::PyDict::new(py);
+        for (label, line) in stats.facts {
+            facts.set_item(label, line)?;
+        }
+        out.set_item("facts", facts)?;
+        Ok(out)
     }
 
     /// Milliseconds an interactive frame may take (default 66: 15 frames per second).

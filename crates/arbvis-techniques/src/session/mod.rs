@@ -14,7 +14,7 @@
 mod offscreen;
 pub mod picture;
 
-pub use offscreen::Offscreen;
+pub use offscreen::{FrameStats, Offscreen};
 pub use picture::{FrameBudget, InteractiveQuality, Key, Pending, Picture};
 
 use std::time::Duration;

@@ -5,6 +5,7 @@ use crate::error::RenderResult;
 use crate::scene::Scene;
 use arbvis_core::image::Image;
 use arbvis_gl::{Backend, Caps, Headless, ProgramKind};
+use std::time::{Duration, Instant};
 
 use super::{FrameBudget, Mode, Session};
 
@@ -17,6 +18,20 @@ use super::{FrameBudget, Mode, Session};
 pub struct Offscreen {
     session: Session,
     headless: Headless,
+    /// How long the last frame took, from the scene's changes to the picture read.
+    last_frame: Duration,
+}
+
+/// What the last frame drew, as `render --stats` says it.
+#[derive(Debug, Clone)]
+pub struct FrameStats {
+    /// Its time: the scene's changes applied, the frame drawn and read back.
+    pub frame: Duration,
+    /// The renderer's line about it (a store's resident bricks and levels, a cloud's
+    /// points), where it has one.
+    pub status: Option<String>,
+    /// The renderer's facts (the viewer's panel lines: a clip's cost, ...).
+    pub facts: Vec<(&'static str, String)>,
 }
 
 impl Offscreen {
@@ -25,16 +40,23 @@ impl Offscreen {
         let headless = Headless::new(backend)?;
         let gpu = headless.gpu();
         let session = Session::build(gpu, scene, scene.programs.resolve(gpu), true)?;
-        Ok(Offscreen { session, headless })
+        Ok(Offscreen {
+            session,
+            headless,
+            last_frame: Duration::ZERO,
+        })
     }
 
     /// Draw `scene` (what changed since the last frame applied first), as the target
     /// holds it: top row first, alpha is coverage.
     pub fn render(&mut self, scene: &Scene) -> RenderResult<Image> {
+        let start = Instant::now();
         let gpu = self.headless.gpu();
         self.session.apply(gpu, scene)?;
         self.session.frame(gpu, scene, Mode::Complete)?;
-        self.session.read(gpu, scene)
+        let image = self.session.read(gpu, scene)?;
+        self.last_frame = start.elapsed();
+        Ok(image)
     }
 
     /// Draw `scene` as a frame while the user interacts (a notebook's drag): reduced to
@@ -42,13 +64,26 @@ impl Offscreen {
     /// frames' times chose (from the whole picture down to a tenth of each side), without
     /// waiting for streamed data; the picture as the target holds it, at that scale.
     pub fn render_interactive(&mut self, scene: &Scene) -> RenderResult<Image> {
+        let start = Instant::now();
         let gpu = self.headless.gpu();
         self.session.apply(gpu, scene)?;
         self.session.frame(gpu, scene, Mode::Interacting)?;
         let shown = self.session.shown().ok_or_else(|| {
             arbvis_gl::GlError::Invalid("the session drew no interactive picture".into())
         })?;
-        Ok(shown.read(gpu)?)
+        let image = shown.read(gpu)?;
+        self.last_frame = start.elapsed();
+        Ok(image)
+    }
+
+    /// What the last frame drew ([`FrameStats`]).
+    pub fn stats(&self) -> FrameStats {
+        let renderer = self.session.renderer();
+        FrameStats {
+            frame: self.last_frame,
+            status: renderer.status(),
+            facts: renderer.facts(),
+        }
     }
 
     /// The frame budget interactive frames keep to.
