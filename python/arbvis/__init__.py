@@ -11,8 +11,8 @@
 `Scene` reads and edits scenes (dotted keys, validated as scene files are); `Volume`,
 `Cloud` and `Mesh` hand a survey (numpy, xarray), a point cloud (numpy, laspy) or an
 unstructured mesh (numpy, meshio) over from memory, wherever a scene names a file;
-`Renderer` keeps its GL context, data and programs between frames; `info()` reports the
-driver; `inspect(path)` and `convert(src, dst, progress=...)` are the command line's
+`Renderer` keeps its GL context, data and programs between frames; `table(colors)` makes a
+colour table of an array or a matplotlib colormap; `info()` reports the driver; `inspect(path)` and `convert(src, dst, progress=...)` are the command line's
 `inspect` and `convert`; `read_png`, `write_png`, `compare` and `diff_image` read, write and compare pictures
 as the Rust tests do. Errors are `ArbvisError` and its subclasses `SceneError`, `InputError`,
 `GLError`, `RenderError`. The pytest plugin (`arbvis.pytest_plugin`, loaded by pytest)
@@ -42,6 +42,8 @@ from ._arbvis import (  # noqa: F401
     write_png,
 )
 
+from .tables import table  # noqa: E402
+
 __all__ = [
     "ArbvisError",
     "Cancelled",
@@ -61,6 +63,7 @@ __all__ = [
     "inspect",
     "fetch_stats",
     "read_png",
+    "table",
     "write_png",
     "__version__",
 ]

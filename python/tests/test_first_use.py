@@ -3,6 +3,8 @@ takes numbers, a picture in a notebook (`_repr_png_`), and clear refusals where 
 cannot mean anything (a zoom of 0, pictures of two sizes, a JPEG name for a PNG, a SEG-Y
 given as a scene, two techniques in one scene, a closed renderer's reference)."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -93,3 +95,51 @@ def test_a_renderer_says_what_its_last_frame_drew(f3_store_scene):
         assert r.stats()["status"] is None and r.stats()["frame_ms"] > 0.0
     with pytest.raises(RuntimeError, match="closed"):
         r.stats()
+
+
+class FakeColormap:
+    """What matplotlib's colormaps are to arbvis.table: called with positions in 0..1,
+    they give RGBA rows."""
+
+    N = 256
+
+    def __call__(self, t):
+        t = np.asarray(t)
+        return np.column_stack([t, 1 - t, 0.5 + 0.5 * np.sin(9 * t), 0.2 + 0.8 * t])
+
+
+def test_a_colour_table_from_an_array_or_a_colormap_draws_as_its_table_file(tmp_path):
+    rng = np.random.default_rng(4)
+    levels = rng.integers(0, 256, (256, 4), dtype=np.uint8)  # a rough table, not a ramp
+    np.savetxt(tmp_path / "rough.table", levels, fmt="%d")
+    scene = arbvis.Scene.demo("v3o2-sum")
+    scene.size = (64, 48)
+    scene.base = str(tmp_path)
+    scene["technique.opacity3d.primary.table"] = {"file": "rough.table"}
+    with arbvis.Renderer(scene) as r:
+        want = r.render()
+        scene["technique.opacity3d.primary.table"] = arbvis.table(levels)
+        assert np.array_equal(r.render(), want)
+        # 256 float colours land on the entries as the file's levels do.
+        scene["technique.opacity3d.primary.table"] = arbvis.table(levels / 255.0)
+        assert np.array_equal(r.render(), want)
+        # A colormap: sampled at 256 positions; three columns are opaque unless an alpha
+        # curve says otherwise.
+        spec = arbvis.table(FakeColormap())
+        assert len(spec["colors"]) == 256 and spec["colors"][255][3] == pytest.approx(1.0)
+        scene["technique.opacity3d.primary.table"] = spec
+        assert not np.array_equal(r.render(), want)
+        three = arbvis.table(levels[:, :3], alpha=[[0.0, 0.0], [1.0, 0.5]])
+        assert three["alpha"] == [[0.0, 0.0], [1.0, 0.5]] and three["colors"][0][3] == 1.0
+    for bad, says in [
+        (np.zeros((1, 3)), "2 <= N <= 4096"),
+        (np.zeros((4, 5)), "(N, 3) or (N, 4)"),
+        (np.full((4, 3), 2.0), "in 0..1"),
+        (np.zeros((4, 3), np.int32), "floats in 0..1 or uint8"),
+    ]:
+        with pytest.raises(arbvis.InputError, match=re.escape(says)):
+            arbvis.table(bad)
+    # Colours given in a scene that make no table: the scene's error, with the key.
+    with pytest.raises(arbvis.SceneError) as e:
+        scene["technique.opacity3d.primary.table"] = {"colors": [[0.0, 0.0, 0.0, 2.0]] * 3}
+    assert e.value.key.endswith("table.colors")

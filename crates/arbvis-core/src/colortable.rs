@@ -23,16 +23,22 @@ pub struct TableSpec {
     /// A built-in name (see [`BUILTINS`]), used when `file` is absent.
     #[serde(default = "default_builtin")]
     pub builtin: String,
-    /// A table file (relative to the scene's folder); wins over `builtin`.
+    /// A table file (relative to the scene's folder); wins over `colors` and `builtin`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub file: Option<PathBuf>,
+    /// The table's colours written out, `[r, g, b, a]` in 0..1 from the lowest value to
+    /// the highest, 2 to [`MAX_COLORS`] of them, spread evenly and interpolated linearly
+    /// to the 256 entries (a matplotlib colormap sampled, an array from Python); wins over
+    /// `builtin`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub colors: Vec<[f64; 4]>,
     /// Alpha as a piecewise-linear curve through `[position 0..1, alpha 0..1]` points,
     /// replacing the table's own alpha.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub alpha: Vec<[f64; 2]>,
     /// Alpha from the data's own distribution ([`alpha_from_histogram`]) instead of the
     /// table's: by default (`None`) for a survey's attribute (SEG-Y) whose scene gives no
-    /// `alpha` and no `file`; `false` keeps the table's own alpha, `true` asks for it on
+    /// `alpha`, no `file` and no `colors`; `false` keeps the table's own alpha, `true` asks for it on
     /// any volume.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub alpha_from_data: Option<bool>,
@@ -48,6 +54,7 @@ impl TableSpec {
         TableSpec {
             builtin: name.into(),
             file: None,
+            colors: Vec::new(),
             alpha: Vec::new(),
             alpha_from_data: None,
         }
@@ -56,14 +63,23 @@ impl TableSpec {
     /// Whether the alpha is made from the data's distribution, for a volume that is (or
     /// is not) a survey.
     pub fn wants_alpha_from_data(&self, survey: bool) -> bool {
-        self.alpha.is_empty() && self.file.is_none() && self.alpha_from_data.unwrap_or(survey)
+        self.alpha.is_empty()
+            && self.file.is_none()
+            && self.colors.is_empty()
+            && self.alpha_from_data.unwrap_or(survey)
     }
 
     /// Check what can be checked without reading files: the built-in name and the alpha
     /// curve. The error names the key (`builtin` or `alpha`).
     pub fn validate(&self) -> Result<(), crate::vocab::FieldError> {
         use crate::vocab::FieldError;
-        if self.file.is_none() && !BUILTINS.contains(&self.builtin.as_str()) {
+        if !self.colors.is_empty() {
+            check_colors(&self.colors).map_err(|m| FieldError::new("colors", m))?;
+        }
+        if self.file.is_none()
+            && self.colors.is_empty()
+            && !BUILTINS.contains(&self.builtin.as_str())
+        {
             return Err(FieldError::new(
                 "builtin",
                 format!(
@@ -83,6 +99,9 @@ impl TableSpec {
     pub fn build(&self, base: &Path) -> Result<ColorTable, TableError> {
         let mut table = match &self.file {
             Some(f) => ColorTable::load(&base.join(f))?,
+            None if !self.colors.is_empty() => {
+                ColorTable::from_colors(&self.colors).map_err(TableError::Colors)?
+            }
             None => ColorTable::builtin(&self.builtin)?,
         };
         if !self.alpha.is_empty() {
@@ -90,6 +109,29 @@ impl TableSpec {
         }
         Ok(table)
     }
+}
+
+/// The most colours a table's `colors` may list.
+pub const MAX_COLORS: usize = 4096;
+
+/// Why `colors` cannot make a table, if they cannot.
+fn check_colors(colors: &[[f64; 4]]) -> Result<(), String> {
+    if !(2..=MAX_COLORS).contains(&colors.len()) {
+        return Err(format!(
+            "{} colours; a table lists 2 to {MAX_COLORS}",
+            colors.len()
+        ));
+    }
+    if let Some(k) = colors
+        .iter()
+        .position(|c| c.iter().any(|v| !(0.0..=1.0).contains(v)))
+    {
+        return Err(format!(
+            "colour {k} is {:?}: r, g, b and a are in 0..1",
+            colors[k]
+        ));
+    }
+    Ok(())
 }
 
 impl Default for TableSpec {
@@ -176,6 +218,9 @@ pub enum TableError {
         /// How many it holds.
         entries: usize,
     },
+    /// Colours written out that cannot make a table.
+    #[error("colors: {0}")]
+    Colors(String),
     /// An alpha curve whose points are outside 0..1 or not ascending.
     #[error("alpha curve {0}: points must be [position, alpha] in 0..1, positions ascending")]
     AlphaCurve(String),
@@ -189,6 +234,25 @@ pub struct ColorTable {
 }
 
 impl ColorTable {
+    /// The table of `colors` (`[r, g, b, a]` in 0..1, 2 to [`MAX_COLORS`]) spread evenly
+    /// over the 256 entries and interpolated linearly between them.
+    pub fn from_colors(colors: &[[f64; 4]]) -> Result<ColorTable, String> {
+        check_colors(colors)?;
+        let last = (colors.len() - 1) as f64;
+        let entries = (0..256)
+            .map(|k| {
+                let t = k as f64 / 255.0 * last;
+                let i = (t.floor() as usize).min(colors.len() - 2);
+                let f = t - i as f64;
+                std::array::from_fn(|c| {
+                    let v = colors[i][c] * (1.0 - f) + colors[i + 1][c] * f;
+                    (v * 255.0).round().clamp(0.0, 255.0) as u8
+                })
+            })
+            .collect();
+        Ok(ColorTable { entries })
+    }
+
     /// A built-in table by name. Alpha: `seismic` is opaque at both extremes and clear in
     /// the middle (`|2t - 1|`); the others ramp from 0 to 1.
     pub fn builtin(name: &str) -> Result<ColorTable, TableError> {
@@ -407,5 +471,56 @@ mod tests {
         assert_eq!(t.entries[255][3], 0);
         assert!(t.set_alpha_curve(&[[0.5, 2.0]]).is_err());
         assert!(t.set_alpha_curve(&[[0.5, 0.0], [0.2, 0.0]]).is_err());
+    }
+
+    #[test]
+    fn colours_written_out_spread_over_the_entries_and_win_over_the_builtin() {
+        // Black to white: entry k is k (t * 255 exactly at every entry).
+        let t = ColorTable::from_colors(&[[0.0, 0.0, 0.0, 0.0], [1.0, 1.0, 1.0, 1.0]]).unwrap();
+        assert!(t
+            .entries
+            .iter()
+            .enumerate()
+            .all(|(k, e)| *e == [k as u8; 4]));
+        // Three uneven colours: the middle entry lands between the last two (127.5 of
+        // 255 is 1.0 of the 2 steps: the second colour); the ends are the ends.
+        let c = [
+            [0.1, 0.9, 0.3, 1.0],
+            [0.7, 0.2, 0.5, 0.25],
+            [1.0, 0.0, 0.0, 0.5],
+        ];
+        let t = ColorTable::from_colors(&c).unwrap();
+        let level = |v: f64| (v * 255.0).round() as u8;
+        assert_eq!(t.entries[0], c[0].map(level));
+        assert_eq!(t.entries[255], c[2].map(level));
+        let mid = 127.0 / 255.0 * 2.0; // entry 127 is 0.996 of the way to the second colour
+        let want: [u8; 4] = std::array::from_fn(|i| level(c[0][i] * (1.0 - mid) + c[1][i] * mid));
+        assert_eq!(t.entries[127], want);
+        for bad in [
+            vec![[0.0; 4]],
+            vec![[0.0; 4]; MAX_COLORS + 1],
+            vec![[0.0; 4], [1.2, 0.0, 0.0, 1.0]],
+            vec![[0.0; 4], [f64::NAN, 0.0, 0.0, 1.0]],
+        ] {
+            assert!(ColorTable::from_colors(&bad).is_err());
+        }
+        let spec = TableSpec {
+            builtin: "no such".into(),
+            colors: c.to_vec(),
+            ..TableSpec::default()
+        };
+        spec.validate().unwrap();
+        assert_eq!(spec.build(Path::new(".")).unwrap(), t);
+        assert!(
+            !spec.wants_alpha_from_data(true),
+            "the colours' own alpha is kept"
+        );
+        let e = TableSpec {
+            colors: vec![[0.0; 4]],
+            ..TableSpec::default()
+        }
+        .validate()
+        .unwrap_err();
+        assert_eq!(e.key, "colors");
     }
 }

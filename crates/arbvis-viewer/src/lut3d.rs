@@ -180,20 +180,23 @@ fn table_and_lock(
     widgets: &mut Widgets,
 ) -> bool {
     let mut changed = false;
-    let mut name = attr
-        .table
-        .file
-        .as_ref()
-        .map(|f| format!("file {}", f.display()))
-        .unwrap_or_else(|| attr.table.builtin.clone());
+    // The table the scene gives: a file, colours written out, or a built-in.
+    let own = match (&attr.table.file, attr.table.colors.len()) {
+        (Some(f), _) => Some(format!("file {}", f.display())),
+        (None, n) if n > 0 => Some(format!("{n} colours")),
+        _ => None,
+    };
+    let mut name = own.clone().unwrap_or_else(|| attr.table.builtin.clone());
     let mut options: Vec<(String, &str)> = BUILTINS.iter().map(|b| (b.to_string(), *b)).collect();
-    let file_name = name.clone();
-    if attr.table.file.is_some() {
-        options.push((file_name.clone(), file_name.as_str()));
+    if let Some(own) = &own {
+        options.push((own.clone(), own.as_str()));
     }
-    if widgets.choice(ui, &format!("{role} table"), &mut name, &options, 90.0) {
+    if widgets.choice(ui, &format!("{role} table"), &mut name, &options, 90.0)
+        && own.as_ref() != Some(&name)
+    {
         attr.table.builtin = name.clone();
         attr.table.file = None;
+        attr.table.colors.clear();
         changed = true;
     }
     if widgets.checkbox(ui, &format!("Lock {role}"), lock, "") && *lock {

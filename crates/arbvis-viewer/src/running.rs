@@ -564,6 +564,7 @@ fn save_tables(
         let path = dir.join(format!("arbvis-table-{role}.table"));
         table.save(&path)?;
         attr.table.file = Some(std::fs::canonicalize(&path).unwrap_or(path.clone()));
+        attr.table.colors.clear();
         attr.table.alpha.clear();
         written.push(path.display().to_string());
     }
