@@ -143,3 +143,40 @@ def test_a_colour_table_from_an_array_or_a_colormap_draws_as_its_table_file(tmp_
     with pytest.raises(arbvis.SceneError) as e:
         scene["technique.opacity3d.primary.table"] = {"colors": [[0.0, 0.0, 0.0, 2.0]] * 3}
     assert e.value.key.endswith("table.colors")
+
+
+def test_the_camera_turns_resets_and_maps_points_to_pixels(root):
+    scene = arbvis.Scene.demo("quad")
+    scene.size = (200, 100)
+    scene.rotation = (0.0, 0.0, 0.0, 1.0)
+    # The centre of the frame is the centre of the picture.
+    assert np.allclose(scene.to_pixels(np.zeros((1, 3))), [[100.0, 50.0]])
+    # Identity: +x is right, +y is up (pixels count down), at zoom 1 the frame's side
+    # fills the shorter side (100 pixels for 2 units).
+    px = scene.to_pixels(np.array([[1.0, 0, 0], [0, 1.0, 0]]))
+    assert np.allclose(px, [[150.0, 50.0], [100.0, 0.0]])
+    # The eye moved right around the data: the point that faced it goes left.
+    scene.azimuth(90)
+    assert scene.to_pixels(np.array([[0, 0, 1.0]]))[0, 0] == pytest.approx(50.0)
+    for _ in range(3):
+        scene.azimuth(90)
+    assert np.allclose(np.abs(scene.rotation), (0, 0, 0, 1), atol=1e-12)
+    # The eye moved up over the data: the point that faced it goes down.
+    scene.elevation(90)
+    assert scene.to_pixels(np.array([[0, 0, 1.0]]))[0, 1] == pytest.approx(100.0)
+    scene.elevation(-90)
+    assert np.allclose(np.abs(scene.rotation), (0, 0, 0, 1), atol=1e-12)
+    # The matrices: clip = projection @ view @ point.
+    m = scene.projection_matrix() @ scene.view_matrix()
+    assert m.shape == (4, 4) and np.allclose(m @ [1, 0, 0, 1], [0.5, 0, 0, 1])
+    with pytest.raises(ValueError):
+        scene.azimuth(float("inf"))
+    # A survey's scene (no [camera] in its file) resets to its three-quarter view.
+    survey = arbvis.Scene.load(str(root / "scenes/data/f3-minimal.toml"))
+    first = (survey.rotation, survey.zoom)
+    assert first[0] != pytest.approx((0.0, 0.0, 0.0, 1.0))
+    survey.azimuth(40)
+    survey.zoom = 3.0
+    assert survey.rotation != pytest.approx(first[0])
+    survey.reset_camera()
+    assert survey.rotation == pytest.approx(first[0]) and survey.zoom == pytest.approx(first[1])

@@ -125,6 +125,12 @@ fn scene_of(tree: &serde_json::Value, base: PathBuf, key: Option<&str>) -> PyRes
     }
 }
 
+/// `m` as a row-major numpy array.
+fn matrix(py: Python<'_>, m: glam::DMat4) -> Bound<'_, numpy::PyArray2<f64>> {
+    let rows: Vec<Vec<f64>> = (0..4).map(|r| m.row(r).to_array().to_vec()).collect();
+    numpy::PyArray2::from_vec2(py, &rows).expect("four rows of four")
+}
+
 /// The value at dotted `key` in `tree`.
 fn at<'t>(tree: &'t serde_json::Value, key: &str) -> Option<&'t serde_json::Value> {
     key.split('.').try_fold(tree, |node, part| node.get(part))
@@ -170,6 +176,21 @@ pub struct PyScene {
     /// The data in memory it was given (`arbvis.Volume`, `Cloud`, `Mesh`), held while it
     /// lives.
     pub kept: Vec<Kept>,
+}
+
+impl PyScene {
+    /// Turn the scene's rotation by `degrees` about `axis` of the screen (eye space).
+    fn turn(&mut self, axis: glam::DVec3, degrees: f64) -> PyResult<()> {
+        if !degrees.is_finite() {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "{degrees} degrees: a finite angle"
+            )));
+        }
+        let turn = glam::DQuat::from_axis_angle(axis, degrees.to_radians());
+        let q = (turn * self.scene.camera.quat()).normalize();
+        self.scene.camera.rotation = q.to_array();
+        Ok(())
+    }
 }
 
 #[pymethods]
@@ -375,6 +396,68 @@ impl PyScene {
 
     fn __eq__(&self, other: &PyScene) -> bool {
         self.scene == other.scene
+    }
+
+    /// Turn the camera `degrees` about the screen's vertical axis (VTK's azimuth: positive
+    /// moves the eye to the right around the data).
+    fn azimuth(&mut self, degrees: f64) -> PyResult<()> {
+        self.turn(glam::DVec3::Y, -degrees)
+    }
+
+    /// Turn the camera `degrees` about the screen's horizontal axis (VTK's elevation:
+    /// positive moves the eye up over the data).
+    fn elevation(&mut self, degrees: f64) -> PyResult<()> {
+        self.turn(glam::DVec3::X, degrees)
+    }
+
+    /// The camera the scene's data gets when its file names none (a survey's
+    /// three-quarter view, ...), else the default one; the projection kept.
+    fn reset_camera(&mut self) {
+        let projection = self.scene.camera.projection;
+        self.scene.camera = self.scene.technique.default_camera().unwrap_or_default();
+        self.scene.camera.projection = projection;
+    }
+
+    /// The camera's view matrix (4 x 4, row-major numpy): the scene's frame (the data in
+    /// [-1, 1] along its longest side) to eye space.
+    fn view_matrix<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
+        matrix(py, self.scene.camera.view())
+    }
+
+    /// The projection matrix (4 x 4, row-major) for the scene's size: eye space to clip
+    /// space, as GL's.
+    fn projection_matrix<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
+        let [w, h] = self.scene.size;
+        matrix(py, self.scene.camera.projection_matrix(w as f64 / h as f64))
+    }
+
+    /// Where points of the scene's frame (an (N, 3) array) fall in the picture: (N, 2)
+    /// pixel positions, x right and y down from the top-left corner, as `render()`'s
+    /// array indexes them (`image[int(y), int(x)]`).
+    fn to_pixels<'py>(
+        &self,
+        py: Python<'py>,
+        points: numpy::PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, numpy::PyArray2<f64>>> {
+        use numpy::PyUntypedArrayMethods;
+        if points.shape().get(1) != Some(&3) {
+            return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                "points are an (N, 3) array, got {:?}",
+                points.shape()
+            )));
+        }
+        let [w, h] = self.scene.size.map(f64::from);
+        let m = self.scene.camera.view_projection(w / h);
+        let xyz = points.as_slice().map_err(errors::input_error)?;
+        let out: Vec<Vec<f64>> = xyz
+            .chunks_exact(3)
+            .map(|p| {
+                let c = m * glam::DVec4::new(p[0], p[1], p[2], 1.0);
+                let (x, y) = (c.x / c.w, c.y / c.w);
+                vec![(x + 1.0) / 2.0 * w, (1.0 - y) / 2.0 * h]
+            })
+            .collect();
+        numpy::PyArray2::from_vec2(py, &out).map_err(errors::input_error)
     }
 
     /// The scene's picture as PNG bytes, what a notebook or a report shows for a scene:
