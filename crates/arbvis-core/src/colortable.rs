@@ -74,7 +74,7 @@ impl TableSpec {
     pub fn validate(&self) -> Result<(), crate::vocab::FieldError> {
         use crate::vocab::FieldError;
         if !self.colors.is_empty() {
-            check_colors(&self.colors).map_err(|m| FieldError::new("colors", m))?;
+            check_colors(&self.colors).map_err(|e| FieldError::new("colors", e.to_string()))?;
         }
         if self.file.is_none()
             && self.colors.is_empty()
@@ -114,22 +114,35 @@ impl TableSpec {
 /// The most colours a table's `colors` may list.
 pub const MAX_COLORS: usize = 4096;
 
+/// Colours written out that cannot make a table.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ColorsError {
+    /// Too few or too many.
+    #[error("{0} colours; a table lists 2 to {MAX_COLORS}")]
+    Count(usize),
+    /// A channel outside 0..1 (or not a number).
+    #[error("colour {index} is {color:?}: r, g, b and a are in 0..1")]
+    Channel {
+        /// Which colour.
+        index: usize,
+        /// Its channels.
+        color: [f64; 4],
+    },
+}
+
 /// Why `colors` cannot make a table, if they cannot.
-fn check_colors(colors: &[[f64; 4]]) -> Result<(), String> {
+fn check_colors(colors: &[[f64; 4]]) -> Result<(), ColorsError> {
     if !(2..=MAX_COLORS).contains(&colors.len()) {
-        return Err(format!(
-            "{} colours; a table lists 2 to {MAX_COLORS}",
-            colors.len()
-        ));
+        return Err(ColorsError::Count(colors.len()));
     }
-    if let Some(k) = colors
+    if let Some(index) = colors
         .iter()
         .position(|c| c.iter().any(|v| !(0.0..=1.0).contains(v)))
     {
-        return Err(format!(
-            "colour {k} is {:?}: r, g, b and a are in 0..1",
-            colors[k]
-        ));
+        return Err(ColorsError::Channel {
+            index,
+            color: colors[index],
+        });
     }
     Ok(())
 }
@@ -220,7 +233,7 @@ pub enum TableError {
     },
     /// Colours written out that cannot make a table.
     #[error("colors: {0}")]
-    Colors(String),
+    Colors(#[from] ColorsError),
     /// An alpha curve whose points are outside 0..1 or not ascending.
     #[error("alpha curve {0}: points must be [position, alpha] in 0..1, positions ascending")]
     AlphaCurve(String),
@@ -236,7 +249,7 @@ pub struct ColorTable {
 impl ColorTable {
     /// The table of `colors` (`[r, g, b, a]` in 0..1, 2 to [`MAX_COLORS`]) spread evenly
     /// over the 256 entries and interpolated linearly between them.
-    pub fn from_colors(colors: &[[f64; 4]]) -> Result<ColorTable, String> {
+    pub fn from_colors(colors: &[[f64; 4]]) -> Result<ColorTable, ColorsError> {
         check_colors(colors)?;
         let last = (colors.len() - 1) as f64;
         let entries = (0..256)

@@ -40,13 +40,33 @@ impl<T> Shelf<T> {
         guard.1.get(name).and_then(Weak::upgrade)
     }
 
-    /// Why `name` finds nothing, for an error.
-    pub fn missing(&self, name: &str) -> String {
-        format!(
-            "memory = {name:?}: no such {} in this process (one handed over from Python lives in the process that made it, while it or a scene holding it is referenced)",
-            self.kind
-        )
+    /// A copy of the item shelved as `name`.
+    pub fn copy(&self, name: &str) -> Result<T, Missing>
+    where
+        T: Clone,
+    {
+        self.get(name)
+            .map(|item| (*item).clone())
+            .ok_or_else(|| self.missing(name))
     }
+
+    /// The error for `name`, which finds nothing.
+    pub fn missing(&self, name: &str) -> Missing {
+        Missing {
+            kind: self.kind,
+            name: name.to_string(),
+        }
+    }
+}
+
+/// A name that finds nothing on its shelf.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("memory = {name:?}: no such {kind} in this process (one handed over from Python lives in the process that made it, while it or a scene holding it is referenced)")]
+pub struct Missing {
+    /// What the shelf holds (`volume`, `cloud`, `mesh`).
+    pub kind: &'static str,
+    /// The name.
+    pub name: String,
 }
 
 #[cfg(test)]
@@ -66,8 +86,11 @@ mod tests {
         let b = Arc::new(vec![4u8]);
         let third = SHELF.register(&b);
         assert!(third != name && third != again && third.starts_with("thing-"));
-        assert!(SHELF
-            .missing(&name)
-            .contains("no such thing in this process"));
+        let e = SHELF.copy(&name).unwrap_err();
+        assert_eq!((e.kind, e.name.as_str()), ("thing", name.as_str()));
+        assert!(
+            e.to_string().contains("no such thing in this process"),
+            "{e}"
+        );
     }
 }

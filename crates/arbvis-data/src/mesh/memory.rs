@@ -85,8 +85,7 @@ pub fn register(mesh: &Arc<Mesh>) -> String {
 
 /// The mesh named `name`, a copy.
 pub fn load(name: &str) -> Result<Mesh, MeshError> {
-    let mesh = MESHES
-        .get(name)
-        .ok_or_else(|| MeshError::Invalid(MESHES.missing(name)))?;
-    Ok((*mesh).clone())
+    MESHES
+        .copy(name)
+        .map_err(|e| MeshError::Invalid(e.to_string()))
 }

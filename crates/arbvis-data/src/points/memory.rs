@@ -16,8 +16,7 @@ pub fn register(cloud: &Arc<PointCloud>) -> String {
 
 /// The cloud named `name`, a copy.
 pub fn load(name: &str) -> Result<PointCloud, PointsError> {
-    let cloud = CLOUDS
-        .get(name)
-        .ok_or_else(|| PointsError::Invalid(CLOUDS.missing(name)))?;
-    Ok((*cloud).clone())
+    CLOUDS
+        .copy(name)
+        .map_err(|e| PointsError::Invalid(e.to_string()))
 }

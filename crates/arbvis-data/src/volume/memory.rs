@@ -18,7 +18,8 @@ pub fn register(volume: &Arc<Volume>) -> String {
 pub fn load(name: &str, limits: &Limits) -> Result<Volume, VolumeError> {
     let volume = VOLUMES
         .get(name)
-        .ok_or_else(|| VolumeError::Invalid(VOLUMES.missing(name)))?;
+        .ok_or_else(|| VolumeError::Invalid(VOLUMES.missing(name).to_string()))?;
+    // The dimensions checked before the copy is made.
     limits.check(volume.dims, &format!("memory = {name:?}"))?;
     Ok((*volume).clone())
 }
