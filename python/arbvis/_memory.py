@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from ._arbvis import InputError
+from ._arbvis import InputError, check_budget
 
 #: The sample types a volume takes (what SEG-Y, MDIO and raw files hold).
 DTYPES = ("float32", "float64", "int8", "int16", "int32", "uint8", "uint16")
@@ -79,6 +79,9 @@ def volume_parts(data, spacing):
         raise InputError(f"volume: samples of {', '.join(DTYPES)}, got {array.dtype}")
     if 0 in array.shape:
         raise InputError(f"volume: shape {array.shape} holds no samples")
+    # The copy (and any conversion before it) checked against the memory budget before it
+    # is made: an array's shape may be declared by strides over a few bytes.
+    check_budget(f"volume: {array.size} samples of {array.shape}", array.size * 8)
     if spacing is not None:
         spacing = _spacing(spacing)
     return np.ascontiguousarray(array, dtype=np.float32), spacing, cdp, axis
@@ -143,6 +146,7 @@ def cloud_parts(positions, attributes, rgb):
     if xyz.ndim != 2 or xyz.shape[1] != 3 or xyz.dtype.kind not in "iuf":
         raise InputError(f"cloud: positions are an (N, 3) array of numbers, got {xyz.shape} {xyz.dtype}")
     n = xyz.shape[0]
+    check_budget(f"cloud: {n} points", n * 64)
     if attributes is None:
         attributes = {}
     if not isinstance(attributes, dict):
@@ -193,6 +197,7 @@ def _blocks(cells, n_points):
         c = np.asarray(connectivity)
         if c.ndim != 2 or c.dtype.kind not in "iu" or c.shape[0] == 0:
             raise InputError(f"mesh: {kind} cells are an (M, k) array of point indices, got {c.shape} {c.dtype}")
+        check_budget(f"mesh: {c.shape[0]} {kind} cells", c.size * 8)
         if c.min() < 0 or c.max() >= n_points:
             raise InputError(
                 f"mesh: {kind} cells name point {int(c.min()) if c.min() < 0 else int(c.max())}; the mesh has {n_points} points"
@@ -216,6 +221,7 @@ def mesh_parts(points, cells, point_data, cell_data):
     xyz = np.asarray(points)
     if xyz.ndim != 2 or xyz.shape[1] != 3 or xyz.dtype.kind not in "iuf":
         raise InputError(f"mesh: points are an (N, 3) array of numbers, got {xyz.shape} {xyz.dtype}")
+    check_budget(f"mesh: {xyz.shape[0]} points", xyz.shape[0] * 48)
     if not np.isfinite(xyz).all():
         bad = int(np.argwhere(~np.isfinite(xyz))[0][0])
         raise InputError(f"mesh: point {bad} has a non-finite coordinate {xyz[bad].tolist()}")

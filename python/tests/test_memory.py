@@ -370,3 +370,35 @@ def test_a_bad_mesh_is_refused_naming_the_argument_and_the_cell():
             arbvis.Mesh(*args)
         assert says in str(e.value), str(e.value)
     assert arbvis.Mesh(points, flat).tetrahedra == len(tets) - 1
+
+
+def test_arrays_whose_strides_declare_huge_shapes_are_refused_before_any_copy():
+    """A few bytes seen through zero strides as trillions of values: refused by the memory
+    budget at once, never copied (numpy would try to allocate them)."""
+    from numpy.lib.stride_tricks import as_strided
+
+    base = np.zeros(4, np.float32)
+    huge = as_strided(base, shape=(1 << 20, 1 << 20, 1 << 12), strides=(0, 0, 0))
+    points = as_strided(np.zeros(3), shape=(1 << 40, 3), strides=(0, 8))
+    cells = as_strided(np.arange(4), shape=(1 << 40, 4), strides=(0, 8))
+    for make in [
+        lambda: arbvis.Volume(huge, spacing=(1.0, 1.0, 1.0)),
+        lambda: arbvis.Cloud(points),
+        lambda: arbvis.Mesh(points[:4], cells),
+        lambda: arbvis.Mesh(points),
+    ]:
+        with pytest.raises(arbvis.InputError, match="memory budget"):
+            make()
+
+
+def test_an_array_changed_after_it_was_handed_over_changes_no_picture(tmp_path):
+    cube = random_cube(shape=(5, 6, 9), seed=2)
+    scene = segy_scene(tmp_path, cube)
+    want = render(with_volume(scene, arbvis.Volume(cube.copy(), (25.0, 12.5, 4.0))))
+    handed = arbvis.Volume(cube, (25.0, 12.5, 4.0))
+    cube[...] = 0.0  # the user's array changed before the volume is read: it holds a copy
+    assert np.array_equal(render(with_volume(scene, handed)), want)
+    # A read-only view is read as any other.
+    view = cube.copy()
+    view.flags.writeable = False
+    arbvis.Volume(view, (1.0, 1.0, 1.0))

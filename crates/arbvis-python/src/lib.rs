@@ -42,6 +42,13 @@ fn info<'py>(py: Python<'py>, backend: &str) -> PyResult<Bound<'py, PyAny>> {
     scene::json_loads(py, &report)
 }
 
+/// Refuse, before it is made, a copy of `bytes` that the memory budget does not hold
+/// (`what` names it): an `InputError` saying the estimate, the budget and how to raise it.
+#[pyfunction]
+fn check_budget(what: &str, bytes: u64) -> PyResult<()> {
+    arbvis_core::budget::check(what, bytes).map_err(errors::input_error)
+}
+
 /// The extension module.
 #[pymodule]
 fn _arbvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -53,6 +60,7 @@ fn _arbvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<cloud::PyCloud>()?;
     m.add_class::<mesh::PyMesh>()?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
+    m.add_function(wrap_pyfunction!(check_budget, m)?)?;
     m.add_function(wrap_pyfunction!(tools::inspect, m)?)?;
     m.add_function(wrap_pyfunction!(tools::convert, m)?)?;
     m.add_function(wrap_pyfunction!(tools::fetch_stats, m)?)?;
