@@ -14,5 +14,7 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 "$venv/bin/python" -m pip install -q --disable-pip-version-check \
   "maturin>=1.5,<2" numpy pytest "dask[distributed]" xarray laspy meshio
-"$venv/bin/python" -m pip install -q --disable-pip-version-check --no-build-isolation .
+# The test profile, not pyproject.toml's release one: the extension reuses `cargo test`'s build.
+MATURIN_PEP517_ARGS="--profile dev" \
+  "$venv/bin/python" -m pip install -q --disable-pip-version-check --no-build-isolation .
 exec "$venv/bin/python" -m pytest -q -p no:cacheprovider python/tests "$@"
