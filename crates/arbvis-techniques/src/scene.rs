@@ -370,6 +370,10 @@ impl Scene {
 /// what the reader registry recognizes), if `path` is one.
 fn data_not_scene(path: &Path) -> Option<SceneError> {
     use std::io::Read;
+    // Only a regular file is opened: a FIFO would block the open (what read_text refused).
+    if !std::fs::metadata(path).ok()?.is_file() {
+        return None;
+    }
     let mut head = Vec::new();
     std::fs::File::open(path)
         .ok()?
