@@ -399,7 +399,7 @@ impl WriterLock {
     /// [`WriterLock::taken_over`] says whose it was.
     pub fn acquire(path: &Path) -> std::io::Result<Result<WriterLock, LockHolder>> {
         use std::io::Read;
-        let mut file = std::fs::OpenOptions::new()
+        let file = std::fs::OpenOptions::new()
             .read(true)
             .write(true)
             .create(true)
@@ -418,25 +418,29 @@ impl WriterLock {
             }
             Err(std::fs::TryLockError::Error(e)) => return Err(e),
         }
-        let mut before = String::new();
-        let _ = (&file).take(64).read_to_string(&mut before);
-        let taken_over = before
-            .trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|&pid| pid != std::process::id() && !process_alive(pid));
-        file.set_len(0)?;
-        write!(file, "{}", std::process::id())?;
-        file.sync_data()?;
+        // Held: from here a signal removes the file (its pid is written after, and fsync
+        // may take milliseconds: a SIGINT in them left the file behind), and so does an
+        // error below, through Drop.
         LOCKS
             .lock()
             .unwrap_or_else(|e| e.into_inner())
             .push(path.to_path_buf());
-        Ok(Ok(WriterLock {
+        let mut lock = WriterLock {
             file,
             path: path.to_path_buf(),
-            taken_over,
-        }))
+            taken_over: None,
+        };
+        let mut before = String::new();
+        let _ = (&lock.file).take(64).read_to_string(&mut before);
+        lock.taken_over = before
+            .trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&pid| pid != std::process::id() && !process_alive(pid));
+        lock.file.set_len(0)?;
+        write!(lock.file, "{}", std::process::id())?;
+        lock.file.sync_data()?;
+        Ok(Ok(lock))
     }
 
     /// The pid of the process, no longer running, whose lock file this lock took over.
