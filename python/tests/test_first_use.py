@@ -180,3 +180,13 @@ def test_the_camera_turns_resets_and_maps_points_to_pixels(root):
     assert survey.rotation != pytest.approx(first[0])
     survey.reset_camera()
     assert survey.rotation == pytest.approx(first[0]) and survey.zoom == pytest.approx(first[1])
+
+
+def test_a_wrong_shaped_value_in_a_whole_scene_names_its_key():
+    # As the setters do (scene[key] = value): the dotted key of the value of the wrong shape.
+    with pytest.raises(arbvis.SceneError) as e:
+        arbvis.Scene.from_dict({"technique": {"quad": {"left": 5}}})
+    assert e.value.key == "technique.quad.left" and "technique.quad.left" in str(e.value)
+    with pytest.raises(arbvis.SceneError) as e:
+        arbvis.Scene.from_toml("[camera]\nrotation = [\n  0.1,\n  \"x\", 0.0, 1.0]\n[technique.quad]\n")
+    assert e.value.key == "camera.rotation" and e.value.line == 4

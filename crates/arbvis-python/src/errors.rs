@@ -118,8 +118,15 @@ pub fn from_scene(e: RustSceneError) -> PyErr {
     match &e {
         RustSceneError::Io { path, .. } => InputError::new_err(format!("{message} ({path})")),
         RustSceneError::Parse {
-            path, line, column, ..
-        } => scene_error(message.clone(), At::line(path, *line, *column, None)),
+            path,
+            line,
+            column,
+            key,
+            ..
+        } => scene_error(
+            message.clone(),
+            At::line(path, *line, *column, key.as_deref()),
+        ),
         RustSceneError::Invalid {
             path,
             line,

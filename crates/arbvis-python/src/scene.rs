@@ -114,7 +114,16 @@ fn scene_of(tree: &serde_json::Value, base: PathBuf, key: Option<&str>) -> PyRes
             Ok(scene)
         }
         // A value of the wrong shape: the parser's message, at the key changed.
-        Err(arbvis_techniques::scene::SceneError::Parse { message, .. }) => Err(bad(message)),
+        Err(arbvis_techniques::scene::SceneError::Parse {
+            message, key: at, ..
+        }) => match (key, at) {
+            // A whole scene given (from_dict): the key the parser found.
+            (None, Some(at)) => Err(errors::scene_error(
+                format!("{at}: {message}"),
+                At::key(Some(&at)),
+            )),
+            _ => Err(bad(message)),
+        },
         Err(arbvis_techniques::scene::SceneError::Invalid {
             key: at, message, ..
         }) => Err(errors::scene_error(

@@ -108,6 +108,8 @@ pub enum SceneError {
         line: usize,
         /// 1-based column.
         column: usize,
+        /// The dotted key whose value is of the wrong shape, where the text spells it out.
+        key: Option<String>,
         /// What was expected.
         message: String,
     },
@@ -140,6 +142,7 @@ impl Scene {
                 path: origin.to_string(),
                 line,
                 column,
+                key: key_at(text, start),
                 message: parse_message(text, start, e.message()),
             }
         })?;
@@ -386,6 +389,7 @@ fn data_not_scene(path: &Path) -> Option<SceneError> {
         path: path.display().to_string(),
         line: 1,
         column: 1,
+        key: None,
         message: format!(
             "this is {reads} data, not a scene (TOML): a scene names it, e.g. `volume = {{ segy = \"...\" }}`, `mesh = {{ file = \"...\" }}` or `cloud = {{ las = \"...\" }}` (docs/scenes.md); `arbvis inspect` describes it"
         ),
@@ -488,6 +492,46 @@ fn parse_message(text: &str, start: usize, message: &str) -> String {
     }
 }
 
+/// The dotted key whose value holds byte `at` of scene `text`: the table header in force
+/// and the key of the line (or of the nearest line above with one, for an array spread over
+/// lines); a header's own name where `at` is on it. What a wrong-shaped value's error names.
+fn key_at(text: &str, at: usize) -> Option<String> {
+    let at = at.min(text.len());
+    let line_start = text[..at].rfind('\n').map_or(0, |p| p + 1);
+    let header = |l: &str| {
+        let l = l.trim();
+        l.starts_with('[')
+            .then(|| l.trim_matches(|c| c == '[' || c == ']').trim().to_string())
+    };
+    let mut lines = text[..line_start].lines().rev();
+    let this = text[line_start..].lines().next().unwrap_or("");
+    if let Some(h) = header(this) {
+        return Some(h);
+    }
+    let mut key = this
+        .split_once('=')
+        .filter(|(k, _)| line_start + k.len() < at)
+        .map(|(k, _)| k.trim().trim_matches('"').to_string());
+    let mut table = None;
+    for l in lines.by_ref() {
+        if let Some(h) = header(l) {
+            table = Some(h);
+            break;
+        }
+        if key.is_none() {
+            key = l
+                .split_once('=')
+                .map(|(k, _)| k.trim().trim_matches('"').to_string());
+        }
+    }
+    match (table, key) {
+        (Some(t), Some(k)) => Some(format!("{t}.{k}")),
+        (None, Some(k)) => Some(k),
+        (Some(t), None) => Some(t),
+        (None, None) => None,
+    }
+}
+
 /// Whether the scene's text writes the dotted `key` (`camera`, `technique.opacity3d.combine`).
 fn is_written(table: &toml::Table, key: &str) -> bool {
     let mut parts = key.split('.');
@@ -560,6 +604,31 @@ mod tests {
         for (name, _) in demos() {
             Scene::demo(name).unwrap();
         }
+    }
+
+    #[test]
+    fn a_wrong_shaped_value_names_its_dotted_key() {
+        let key = |text: &str| match Scene::parse(text, "x.toml") {
+            Err(SceneError::Parse { key, .. }) => key,
+            other => panic!("expected a parse error, got {other:?}"),
+        };
+        assert_eq!(
+            key("[technique.quad]\nleft = 5\n").as_deref(),
+            Some("technique.quad.left")
+        );
+        assert_eq!(
+            key("size = \"big\"\n[technique.quad]\n").as_deref(),
+            Some("size")
+        );
+        assert_eq!(
+            key("[camera]\nrotation = [\n  0.1,\n  \"x\",\n  0.0, 1.0]\n[technique.quad]\n")
+                .as_deref(),
+            Some("camera.rotation")
+        );
+        assert_eq!(
+            key("[technique.opacity3d.primary]\nvolume = { segy = 5 }\n").as_deref(),
+            Some("technique.opacity3d.primary.volume")
+        );
     }
 
     #[test]
