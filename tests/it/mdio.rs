@@ -48,6 +48,36 @@ pub(crate) fn has_mdio() -> bool {
     )
 }
 
+/// The F3 crop ingested by mdio-python with `template` as `NAME.mdio` in a folder of its
+/// own for test `test`: (the folder, the SEG-Y, the dataset); `None` without mdio-python
+/// (the test skipped, or failed under `ARBVIS_NO_SKIP=1`).
+pub(crate) fn f3_ingested(
+    test: &str,
+    name: &str,
+    template: &str,
+) -> Option<(PathBuf, PathBuf, PathBuf)> {
+    if !has_mdio() {
+        return None;
+    }
+    let dir = temp_dir(test);
+    let sgy = data_file("seismic/f3.sgy");
+    let mdio = ingest_as(&dir, &sgy, name, template);
+    Some((dir, sgy, mdio))
+}
+
+/// `src` converted into the store `dst` by the library, quietly, in bricks of `brick`
+/// (`None`: the default).
+pub(crate) fn convert_quietly(src: &Path, dst: &Path, brick: Option<usize>) {
+    let mut o = arbvis::store::convert::ConvertOptions {
+        progress: false,
+        ..Default::default()
+    };
+    if let Some(b) = brick {
+        o.brick = b;
+    }
+    arbvis::store::convert::convert(src, dst, &o).unwrap();
+}
+
 /// `sgy` ingested by mdio-python into `DIR/NAME.mdio`.
 fn ingest(dir: &Path, sgy: &Path, name: &str) -> PathBuf {
     ingest_as(dir, sgy, name, "PostStack3DTime")
@@ -97,12 +127,9 @@ fn level0(store: &Store) -> Vec<f32> {
 
 #[test]
 fn an_mdio_store_from_mdio_python_reads_as_the_segy_does() {
-    if !has_mdio() {
+    let Some((dir, sgy, mdio)) = f3_ingested("mdio-f3", "f3", "PostStack3DTime") else {
         return;
-    }
-    let dir = temp_dir("mdio-f3");
-    let sgy = data_file("seismic/f3.sgy");
-    let mdio = ingest(&dir, &sgy, "f3");
+    };
     let store = Store::open(&mdio).unwrap();
     let cube = segy::read(&sgy, &Default::default()).unwrap().volume;
     assert_eq!(store.meta.dims, cube.dims);
@@ -227,11 +254,7 @@ fn dead_traces_read_as_no_data_and_draw_transparent() {
     }
     // Converted into a store of its own, the dataset keeps its dead traces dead.
     let copy = dir.join("copy.zarr");
-    let o = arbvis::store::convert::ConvertOptions {
-        progress: false,
-        ..Default::default()
-    };
-    arbvis::store::convert::convert(&holes, &copy, &o).unwrap();
+    convert_quietly(&holes, &copy, None);
     let mask = arbvis::store::zarr::open_array(&copy.join("trace_mask")).unwrap();
     let live = mask.read_chunk(&[0, 0]).unwrap().unwrap();
     let dead = (0..23 * 18)
@@ -251,19 +274,11 @@ fn dead_traces_read_as_no_data_and_draw_transparent() {
 /// dataset of the data tree.
 #[test]
 fn an_arbvis_store_opens_in_mdio_python_and_xarray() {
-    if !has_mdio() {
+    let Some((dir, sgy, theirs)) = f3_ingested("mdio-arbvis", "theirs", "PostStack3DTime") else {
         return;
-    }
-    let dir = temp_dir("mdio-arbvis");
-    let sgy = data_file("seismic/f3.sgy");
-    let theirs = ingest(&dir, &sgy, "theirs");
-    let ours = dir.join("ours.zarr");
-    let o = arbvis::store::convert::ConvertOptions {
-        brick: 16,
-        progress: false,
-        ..Default::default()
     };
-    arbvis::store::convert::convert(&sgy, &ours, &o).unwrap();
+    let ours = dir.join("ours.zarr");
+    convert_quietly(&sgy, &ours, Some(16));
     let script = r#"
 import sys, numpy as np, xarray as xr, mdio
 ours, theirs = mdio.open_mdio(sys.argv[1]), mdio.open_mdio(sys.argv[2])
@@ -421,11 +436,7 @@ print("levels", sorted(tree.children))
         .args(["convert", original.to_str().unwrap(), "--brick", "16"])
         .output()
         .unwrap();
-    let e = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        !out.status.success() && e.contains("were added already"),
-        "{e}"
-    );
+    crate::common::refused(&out, "were added already");
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -434,18 +445,11 @@ print("levels", sorted(tree.children))
 /// that leaves the proportions to the data (no `spacing`), level 0 and one fixed range.
 #[test]
 fn one_survey_draws_one_picture_from_its_segy_store_and_mdio_dataset() {
-    if !has_mdio() {
+    let Some((dir, sgy, mdio)) = f3_ingested("mdio-one-picture", "f3", "PostStack3DTime") else {
         return;
-    }
-    let dir = temp_dir("mdio-one-picture");
-    let sgy = data_file("seismic/f3.sgy");
-    let mdio = ingest(&dir, &sgy, "f3");
-    let store = dir.join("f3.zarr");
-    let o = arbvis::store::convert::ConvertOptions {
-        progress: false,
-        ..Default::default()
     };
-    arbvis::store::convert::convert(&sgy, &store, &o).unwrap();
+    let store = dir.join("f3.zarr");
+    convert_quietly(&sgy, &store, None);
     let scene = |volume: String, stored: bool| {
         let level = if stored {
             "[technique.opacity3d.store]\nlevel = 0\n"

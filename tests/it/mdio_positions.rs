@@ -5,20 +5,15 @@
 
 use std::process::Command;
 
-use crate::common::{data_file, temp_dir};
-use crate::mdio::{has_mdio, ingest_as};
-use arbvis::store::convert::{convert, ConvertOptions};
+use crate::mdio::{convert_quietly, f3_ingested};
 use arbvis::store::meta::SampleAxis;
 use arbvis::store::Store;
 
 #[test]
 fn a_depth_dataset_keeps_its_depths_and_map_positions_into_a_store() {
-    if !has_mdio() {
+    let Some((dir, sgy, mdio)) = f3_ingested("mdio-depth", "depth", "PostStack3DDepth") else {
         return;
-    }
-    let dir = temp_dir("mdio-depth");
-    let sgy = data_file("seismic/f3.sgy");
-    let mdio = ingest_as(&dir, &sgy, "depth", "PostStack3DDepth");
+    };
     let dataset = Store::open(&mdio).unwrap();
     // mdio-python numbers the depth axis from the SEG-Y's 4 ms interval as 0, 4, ... m.
     let depth = SampleAxis {
@@ -36,19 +31,14 @@ fn a_depth_dataset_keeps_its_depths_and_map_positions_into_a_store() {
     // The dataset's positions are the SEG-Y's (arbvis's own reader, through a store
     // converted from the SEG-Y): the same numbers to the bit.
     let theirs = dataset.map_coordinates().unwrap().expect("cdp_x, cdp_y");
-    let o = ConvertOptions {
-        brick: 16,
-        progress: false,
-        ..Default::default()
-    };
     let from_segy = dir.join("segy.zarr");
-    convert(&sgy, &from_segy, &o).unwrap();
+    convert_quietly(&sgy, &from_segy, Some(16));
     let ours = Store::open(&from_segy).unwrap().map_coordinates().unwrap();
     assert_eq!(ours.as_ref(), Some(&theirs));
     assert_eq!(theirs[0].len(), 23 * 18);
     // Converted into a store of its own: depth and positions carried, a depth template.
     let copy = dir.join("copy.zarr");
-    convert(&mdio, &copy, &o).unwrap();
+    convert_quietly(&mdio, &copy, Some(16));
     let store = Store::open(&copy).unwrap();
     assert_eq!(store.meta.source.sample_axis(), depth);
     assert_eq!(store.map_coordinates().unwrap().as_ref(), Some(&theirs));

@@ -256,6 +256,16 @@ pub fn python_has(check: &str, missing: &str) -> bool {
     ok
 }
 
+/// The stderr of `out`, a command asserted to have failed saying `says`.
+pub fn refused(out: &std::process::Output, says: &str) -> String {
+    let e = String::from_utf8_lossy(&out.stderr).to_string();
+    assert!(
+        !out.status.success() && e.contains(says),
+        "expected a failure saying {says:?}: {e}"
+    );
+    e
+}
+
 /// Run `command` to success (its standard error in the failure) and return its standard
 /// output.
 pub fn stdout_of(command: &mut std::process::Command) -> String {
