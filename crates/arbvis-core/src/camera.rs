@@ -26,6 +26,45 @@ pub struct Camera {
     pub zoom: f64,
     /// Vertical field of view in degrees (perspective only).
     pub fov_y_deg: f64,
+    /// Where the drawn layer's own frame sits in the scene's (a uniform scale and an
+    /// offset, [`Placement`]): set by a layered scene for each of its layers as it draws
+    /// them, identity for a one-layer scene; never written in a scene.
+    #[serde(skip)]
+    pub placement: Placement,
+}
+
+/// A layer's own frame placed in the scene's: `scene = scale * rotation * own + offset`.
+/// Uniform and rigid, so depth order, angles and proportions are the layer's own.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Placement {
+    /// Scene units per unit of the layer's frame (above 0).
+    pub scale: f64,
+    /// The layer's axes turned into the scene's (a survey's sample axis downwards).
+    pub rotation: DQuat,
+    /// Where the layer's origin lies in the scene's frame.
+    pub offset: DVec3,
+}
+
+impl Default for Placement {
+    fn default() -> Self {
+        Placement {
+            scale: 1.0,
+            rotation: DQuat::IDENTITY,
+            offset: DVec3::ZERO,
+        }
+    }
+}
+
+impl Placement {
+    /// The matrix from the layer's frame to the scene's.
+    pub fn matrix(&self) -> DMat4 {
+        DMat4::from_scale_rotation_translation(DVec3::splat(self.scale), self.rotation, self.offset)
+    }
+
+    /// A point of the scene's frame in the layer's.
+    pub fn to_own(&self, scene: DVec3) -> DVec3 {
+        self.rotation.inverse() * ((scene - self.offset) / self.scale)
+    }
 }
 
 impl Default for Camera {
@@ -35,6 +74,7 @@ impl Default for Camera {
             rotation: [0.0, 0.0, 0.0, 1.0],
             zoom: 1.0,
             fov_y_deg: 30.0,
+            placement: Placement::default(),
         }
     }
 }
@@ -50,15 +90,29 @@ impl Camera {
         }
     }
 
-    /// Model-view matrix: rotate the scene, then (perspective) move it in front of the eye.
+    /// Model-view matrix: place the layer in the scene, rotate the scene, then
+    /// (perspective) move it in front of the eye.
     pub fn view(&self) -> DMat4 {
-        let rotate = DMat4::from_quat(self.quat());
+        let rotate = DMat4::from_quat(self.quat()) * self.placement.matrix();
         match self.projection {
             Projection::Orthographic => rotate,
             Projection::Perspective => {
                 DMat4::from_translation(DVec3::new(0.0, 0.0, -self.eye_distance())) * rotate
             }
         }
+    }
+
+    /// The unit direction toward the viewer in the drawn layer's frame (the slices'
+    /// normal; the opposite of the viewing direction).
+    pub fn toward_viewer(&self) -> DVec3 {
+        self.placement.rotation.inverse() * (self.quat().inverse() * DVec3::Z)
+    }
+
+    /// The eye in the drawn layer's frame (perspective): `R⁻¹ (0, 0, d)` in the scene's,
+    /// taken into the layer's by its placement.
+    pub fn eye(&self) -> DVec3 {
+        let eye = self.quat().inverse() * DVec3::new(0.0, 0.0, self.eye_distance());
+        self.placement.to_own(eye)
     }
 
     /// Distance from the eye to the scene centre in perspective (fits the unit sphere).
@@ -269,6 +323,57 @@ mod tests {
         for z in [-1.0, 1.0] {
             let p = m.project_point3(DVec3::new(0.0, 0.0, z));
             assert!(p.z > -1.0 && p.z < 1.0, "z {z} -> {}", p.z);
+        }
+    }
+}
+
+#[cfg(test)]
+mod placement_tests {
+    use super::*;
+
+    /// A placed layer's eye and viewing direction, taken back to the scene's frame, are
+    /// the unplaced camera's, for odd placements in both projections.
+    #[test]
+    fn a_placed_layer_sees_the_scenes_eye_and_direction() {
+        let placements = [
+            Placement::default(),
+            Placement {
+                scale: 0.37,
+                rotation: DQuat::from_euler(glam::EulerRot::XYZ, 0.7, -0.2, 2.1),
+                offset: DVec3::new(0.21, -0.53, 0.11),
+            },
+            Placement {
+                scale: 3.9,
+                rotation: DQuat::from_rotation_y(-std::f64::consts::FRAC_PI_2),
+                offset: DVec3::new(-1.0, 0.0, 0.4),
+            },
+        ];
+        for projection in [Projection::Perspective, Projection::Orthographic] {
+            let unplaced = Camera {
+                projection,
+                rotation: DQuat::from_euler(glam::EulerRot::YXZ, 1.1, -0.4, 0.3).to_array(),
+                zoom: 1.7,
+                ..Camera::default()
+            };
+            for placement in placements {
+                let placed = Camera {
+                    placement,
+                    ..unplaced
+                };
+                let m = placement.matrix();
+                // f64 arithmetic on values of order 10: 1e-12.
+                let eye = m.transform_point3(placed.eye());
+                assert!((eye - unplaced.eye()).length() < 1e-12, "{placement:?}");
+                let toward = m.transform_vector3(placed.toward_viewer()) / placement.scale;
+                assert!((toward - unplaced.toward_viewer()).length() < 1e-12);
+                let p = DVec3::new(0.3, -0.8, 0.5);
+                let a = placed.view_projection(1.3).project_point3(p);
+                let b = unplaced
+                    .view_projection(1.3)
+                    .project_point3(m.transform_point3(p));
+                assert!((a - b).length() < 1e-12);
+                assert!((placement.to_own(m.transform_point3(p)) - p).length() < 1e-12);
+            }
         }
     }
 }

@@ -117,12 +117,12 @@ impl Proxy {
 
 /// Direction toward the viewer in object space (the slices' normal).
 pub fn toward_viewer(frame: &Frame) -> DVec3 {
-    frame.camera.quat().inverse() * DVec3::Z
+    frame.camera.toward_viewer()
 }
 
 /// The eye in object space (perspective).
 pub fn eye(frame: &Frame) -> DVec3 {
-    toward_viewer(frame) * frame.camera.eye_distance()
+    frame.camera.eye()
 }
 
 /// The box `[-half, half]` as 12 triangles wound clockwise seen from outside, so that

@@ -262,7 +262,7 @@ pub(crate) struct ViewSlices {
 impl ViewSlices {
     /// The slices of `camera`'s view.
     pub(crate) fn new(half: DVec3, camera: &Camera, count: usize) -> ViewSlices {
-        let normal = (camera.quat().inverse() * DVec3::Z).normalize();
+        let normal = camera.toward_viewer().normalize();
         let extent = (half * normal.abs()).element_sum();
         ViewSlices {
             half,

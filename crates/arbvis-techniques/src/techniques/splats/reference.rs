@@ -181,15 +181,14 @@ impl SplatParams {
     }
 }
 
-/// The eye in object space (perspective), `R⁻¹ (0, 0, d)`.
+/// The eye in object space (perspective), [`Camera::eye`].
 pub fn eye_position(camera: &Camera) -> Option<DVec3> {
-    (camera.projection == Projection::Perspective)
-        .then(|| camera.quat().inverse() * DVec3::new(0.0, 0.0, camera.eye_distance()))
+    (camera.projection == Projection::Perspective).then(|| camera.eye())
 }
 
 /// The viewing direction in object space (into the scene), `R⁻¹ (0, 0, -1)`.
 pub fn view_direction(camera: &Camera) -> DVec3 {
-    camera.quat().inverse() * DVec3::NEG_Z
+    -camera.toward_viewer()
 }
 
 /// A splat's size in pixels (see the module doc), unclamped NaN when undefined.

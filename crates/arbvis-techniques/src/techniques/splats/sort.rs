@@ -87,15 +87,13 @@ pub enum View {
 }
 
 impl View {
-    /// The view of `camera`: its eye `R⁻¹ (0, 0, d)` in perspective, its direction
-    /// `R⁻¹ (0, 0, -1)` in orthographic (`R` the camera's rotation, `d` its eye distance).
+    /// The view of `camera` in the cloud's frame: its eye ([`Camera::eye`]) in
+    /// perspective, its direction `R⁻¹ (0, 0, -1)` in orthographic (`R` the camera's
+    /// rotation).
     pub fn of_camera(camera: &Camera) -> View {
-        let inverse = camera.quat().inverse();
         match camera.projection {
-            Projection::Perspective => View::Eye(to_f32(
-                inverse * DVec3::new(0.0, 0.0, camera.eye_distance()),
-            )),
-            Projection::Orthographic => View::Along(to_f32(inverse * DVec3::NEG_Z)),
+            Projection::Perspective => View::Eye(to_f32(camera.eye())),
+            Projection::Orthographic => View::Along(to_f32(-camera.toward_viewer())),
         }
     }
 

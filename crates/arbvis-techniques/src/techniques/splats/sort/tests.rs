@@ -252,27 +252,41 @@ fn signed_zeros_tie() {
 
 #[test]
 fn view_of_camera_matches_the_camera_matrices() {
-    let camera = Camera {
-        projection: Projection::Perspective,
-        rotation: glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 0.4).to_array(),
-        zoom: 1.3,
-        fov_y_deg: 40.0,
+    // Unplaced, and placed as a layer of a scene (an odd scale and offset): the eye and
+    // the direction are the camera's own in the layer's frame.
+    let placed = arbvis_core::camera::Placement {
+        scale: 0.37,
+        rotation: glam::DQuat::from_euler(glam::EulerRot::XYZ, -0.6, 0.2, 1.3),
+        offset: DVec3::new(0.21, -0.53, 0.11),
     };
-    let View::Eye(eye) = View::of_camera(&camera) else {
-        panic!("perspective gives an eye");
-    };
-    let e = DVec3::from_array(eye.map(f64::from));
-    assert!((e.length() - camera.eye_distance()).abs() < 1e-5);
-    assert!(camera.view().transform_point3(e).length() < 1e-5);
-    let ortho = Camera {
-        projection: Projection::Orthographic,
-        ..camera
-    };
-    let View::Along(v) = View::of_camera(&ortho) else {
-        panic!("orthographic gives a direction");
-    };
-    let v = DVec3::from_array(v.map(f64::from));
-    assert!((ortho.view().transform_vector3(v) - DVec3::NEG_Z).length() < 1e-6);
+    for placement in [Default::default(), placed] {
+        let camera = Camera {
+            projection: Projection::Perspective,
+            rotation: glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 0.4).to_array(),
+            zoom: 1.3,
+            fov_y_deg: 40.0,
+            placement,
+        };
+        let View::Eye(eye) = View::of_camera(&camera) else {
+            panic!("perspective gives an eye");
+        };
+        let e = DVec3::from_array(eye.map(f64::from));
+        // f32 eye coordinates of size ~10: 1e-5 relative.
+        assert!(camera.view().transform_point3(e).length() < 1e-4);
+        if placement == Default::default() {
+            assert!((e.length() - camera.eye_distance()).abs() < 1e-5);
+        }
+        let ortho = Camera {
+            projection: Projection::Orthographic,
+            ..camera
+        };
+        let View::Along(v) = View::of_camera(&ortho) else {
+            panic!("orthographic gives a direction");
+        };
+        let v = DVec3::from_array(v.map(f64::from));
+        let seen = ortho.view().transform_vector3(v).normalize();
+        assert!((seen - DVec3::NEG_Z).length() < 1e-6);
+    }
 }
 
 #[test]
