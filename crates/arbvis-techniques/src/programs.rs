@@ -38,6 +38,23 @@ pub const OPACITY3D_SAMPLING_GLSL: ProgramText = program!("common/sampling.glsl"
 /// The probes of `arbvis bench --breakdown` (new, GLSL), a template.
 pub const OPACITY3D_PROBE_FRAG: ProgramText = program!("opacity3d/probe.frag");
 
+/// A surface lit per vertex (faithful): ARB vertex stage.
+pub const SURFACE_GOURAUD_ARBVP: ProgramText = program!("surface/gouraud.arbvp");
+/// ARB fragment stage of [`SURFACE_GOURAUD_ARBVP`] (the interpolated colour).
+pub const SURFACE_GOURAUD_ARBFP: ProgramText = program!("surface/gouraud.arbfp");
+/// GLSL twin of [`SURFACE_GOURAUD_ARBVP`].
+pub const SURFACE_GOURAUD_VERT: ProgramText = program!("surface/gouraud.vert");
+/// GLSL twin of [`SURFACE_GOURAUD_ARBFP`].
+pub const SURFACE_GOURAUD_FRAG: ProgramText = program!("surface/gouraud.frag");
+/// A surface lit per pixel (precise): ARB vertex stage (normal and colour passed on).
+pub const SURFACE_PHONG_ARBVP: ProgramText = program!("surface/phong.arbvp");
+/// ARB fragment stage of [`SURFACE_PHONG_ARBVP`] (the headlight per pixel).
+pub const SURFACE_PHONG_ARBFP: ProgramText = program!("surface/phong.arbfp");
+/// GLSL twin of [`SURFACE_PHONG_ARBVP`].
+pub const SURFACE_PHONG_VERT: ProgramText = program!("surface/phong.vert");
+/// GLSL twin of [`SURFACE_PHONG_ARBFP`].
+pub const SURFACE_PHONG_FRAG: ProgramText = program!("surface/phong.frag");
+
 /// The seed's Cg vertex program (reference text, not compiled).
 pub const CELLPROJ_SEED_VERTEX_CG: ProgramText = program!("cellproj/seed_vertex.cg");
 /// The seed's Cg fragment program (reference text, not compiled).
@@ -188,6 +205,14 @@ pub fn all_texts() -> Vec<ProgramText> {
         OPACITY3D_RAYCAST_FRAG,
         OPACITY3D_SAMPLING_GLSL,
         OPACITY3D_PROBE_FRAG,
+        SURFACE_GOURAUD_ARBVP,
+        SURFACE_GOURAUD_ARBFP,
+        SURFACE_GOURAUD_VERT,
+        SURFACE_GOURAUD_FRAG,
+        SURFACE_PHONG_ARBVP,
+        SURFACE_PHONG_ARBFP,
+        SURFACE_PHONG_VERT,
+        SURFACE_PHONG_FRAG,
         CELLPROJ_SEED_VERTEX_CG,
         CELLPROJ_SEED_FRAGMENT_CG,
         CELLPROJ_PERSPECTIVE_ARBVP,

@@ -27,6 +27,8 @@ pub mod opacity3d;
 pub mod quad;
 pub mod rays;
 pub mod splats;
+pub mod surface;
+pub mod world;
 
 use crate::error::RenderResult;
 use arbvis_gl::GlResult;
@@ -74,6 +76,11 @@ pub trait Renderer {
     fn program_kind(&self) -> ProgramKind;
     /// Whether its surface needs a depth buffer (opaque geometry with a depth test).
     fn needs_depth(&self) -> bool {
+        false
+    }
+    /// Whether it draws opaque geometry with depth only (an opaque surface, an
+    /// isosurface): a layered scene draws those first and tests the others against them.
+    fn opaque(&self) -> bool {
         false
     }
     /// A line for the viewer about the last frame's CPU work (e.g. the sort time).
@@ -256,6 +263,13 @@ pub trait Technique: Any + Sized {
     /// default.
     fn summary(&self, prepared: &Self::Prepared, base: &Path) -> Option<Summary> {
         let _ = (prepared, base);
+        None
+    }
+    /// Where `prepared`'s object frame lies in the world frame a scene's layers share
+    /// ([`world::World`]); none for a technique without a place (the quad), which a
+    /// layered scene refuses.
+    fn world(&self, prepared: &Self::Prepared) -> Option<world::World> {
+        let _ = prepared;
         None
     }
 }

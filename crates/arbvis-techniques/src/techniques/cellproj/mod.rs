@@ -333,6 +333,12 @@ impl crate::techniques::Technique for CellprojScene {
         }))
     }
 
+    /// The mesh in its file's coordinates.
+    fn world(&self, mesh: &prepare::Prepared) -> Option<crate::techniques::world::World> {
+        let [lo, hi] = mesh.bounds;
+        Some(crate::techniques::world::World::of_box(lo, hi))
+    }
+
     fn prepare(
         &self,
         settings: &crate::techniques::Settings<'_>,

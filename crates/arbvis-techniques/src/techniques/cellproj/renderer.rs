@@ -529,6 +529,11 @@ impl Renderer for CellprojRenderer {
         true
     }
 
+    /// Isosurfaces are opaque; a volume is not.
+    fn opaque(&self) -> bool {
+        self.volume.is_none()
+    }
+
     fn status(&self) -> Option<String> {
         let v = self.volume.as_ref()?;
         let t = v.times();

@@ -266,6 +266,21 @@ impl crate::techniques::Technique for Opacity3dScene {
         prepare::prepare(self, settings.base, limits).map(Some)
     }
 
+    /// A survey hangs from the origin with its samples downwards; other volumes keep
+    /// their grid's axes, first voxel at the origin. None for a store (drawn brick by
+    /// brick, not yet placed in a layered scene).
+    fn world(
+        &self,
+        prepared: &Option<prepare::Prepared>,
+    ) -> Option<crate::techniques::world::World> {
+        use crate::techniques::world::World;
+        let p = prepared.as_ref()?;
+        if self.primary.volume.data_kind() == arbvis_data::sniff::DataKind::Survey {
+            return Some(World::of_survey(p.size, p.half));
+        }
+        Some(World::of_box([0.0; 3], p.size.to_array()))
+    }
+
     /// A survey store is drawn brick by brick ([`bricked::BrickedRenderer`]; precise
     /// with a GLSL ray caster, which `auto` then takes); other volumes whole.
     /// The f64 integral along each pixel's ray ([`reference::reference`], 8 samples per

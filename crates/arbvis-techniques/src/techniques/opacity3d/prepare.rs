@@ -21,6 +21,9 @@ pub struct Prepared {
     pub dims: [usize; 3],
     /// Half-extents of the box (longest side spans [-1, 1]).
     pub half: DVec3,
+    /// The box's sides in the data's own units (dims times spacing): where it lies in a
+    /// layered scene's world ([`crate::techniques::world`]).
+    pub size: DVec3,
     /// RGB per voxel, i fastest: R tertiary, G primary, B secondary (0 when absent).
     pub packed: Vec<u8>,
     /// Tables of primary, secondary, tertiary (None when the attribute is absent).
@@ -162,6 +165,10 @@ pub fn from_volumes(
     Ok(Prepared {
         dims: first.dims,
         half: DVec3::from_array(first.half_extent()),
+        size: DVec3::from_array(std::array::from_fn(|a| {
+            let s = first.spacing[a];
+            first.dims[a] as f64 * if s.is_finite() && s > 0.0 { s } else { 1.0 }
+        })),
         packed,
         tables,
         ranges,
@@ -259,6 +266,7 @@ mod tests {
         let prepared = Prepared {
             dims,
             half: DVec3::ONE,
+            size: DVec3::ONE,
             packed: pack([Some(&levels), None, None], n),
             tables: [Some(ColorTable::builtin("grey").unwrap()), None, None],
             ranges: [None; 3],
@@ -293,6 +301,7 @@ mod tests {
         let prepared = Prepared {
             dims: [2, 1, 1],
             half: DVec3::ONE,
+            size: DVec3::ONE,
             packed: pack([Some(&[10, 11]), None, Some(&[30, 31])], 2),
             tables: [Some(grey.clone()), None, Some(grey)],
             ranges: [None; 3],

@@ -128,6 +128,21 @@ impl crate::techniques::Technique for SplatsScene {
         ))
     }
 
+    /// The cloud in its file's coordinates, framed by its frame (a COPC file's header
+    /// box, the same for every cut).
+    fn world(
+        &self,
+        (cloud, _, _): &prepare::PreparedCloud,
+    ) -> Option<crate::techniques::world::World> {
+        let [lo, hi] = cloud.frame.map(glam::DVec3::from_array);
+        Some(crate::techniques::world::World {
+            half: ((hi - lo) / (2.0 * cloud.scale)).max(glam::DVec3::splat(1e-9)),
+            units: cloud.scale,
+            rotation: glam::DQuat::IDENTITY,
+            centre: glam::DVec3::from_array(cloud.origin),
+        })
+    }
+
     /// The cloud loaded (a COPC cloud's nodes chosen for the first view) and prepared.
     fn prepare(
         &self,

@@ -1,0 +1,227 @@
+//! `[technique.surface]` / `[layer.surface]`: a triangle surface (OBJ, STL, PLY), a
+//! horizon, a fault, a body's boundary, coloured by a constant or by its elevation,
+//! unlit or lit, opaque or translucent; the layer a scene draws beside its volumes,
+//! meshes and clouds (issue 55; the seismic readers of issue 57 feed it).
+//!
+//! # How it works
+//! The file's triangles are read ([`arbvis_data::surface`]), centred and scaled so that
+//! the longest side spans [-1, 1] (its world frame: the file's coordinates, z up), and
+//! given smooth normals (each vertex the area-weighted mean of its triangles' normals)
+//! and a colour per vertex (the constant, or the colour table at the vertex's height
+//! between the surface's lowest and highest z). Lighting is a headlight: ambient 0.2
+//! plus 0.8 of `|n . v|` (two-sided: a horizon lights from above and below), no
+//! specular. **Faithful** lights each vertex and interpolates the colour, as the era's
+//! fixed-function pipeline did (`programs/surface/gouraud.*`); **precise** interpolates
+//! the normal and lights each pixel (`phong.*`). Drawn with a depth test and depth
+//! writes: in a layered scene an opaque surface hides what lies behind it. A translucent
+//! surface (`opacity` below 1) blends premultiplied over what is drawn, its nearest
+//! sheet only where it does not overlap itself in the view (a horizon seen from above);
+//! [`reference`] is its f64 CPU twin (nearest hit per pixel centre, the same lighting).
+
+pub mod prepare;
+pub mod reference;
+pub mod renderer;
+
+use std::path::PathBuf;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::RenderResult;
+use crate::programs::ProgramPair;
+use crate::techniques::world::World;
+use crate::techniques::{ReferenceView, Renderer, Settings, Technique};
+use arbvis_core::colortable::TableSpec;
+use arbvis_core::vocab::{Fidelity, FieldError};
+use arbvis_gl::{Gpu, ProgramChoice, ProgramKind};
+
+/// `[technique.surface]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceScene {
+    /// The triangle file (`.obj`, `.stl`, `.ply`), relative to the scene's folder.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+    /// Or a generated horizon (the demos' surface, no file needed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub synthetic: Option<SyntheticHorizon>,
+    /// The constant colour, RGB in [0, 1] (where `colour_by` is absent).
+    #[serde(default = "default_colour")]
+    pub colour: [f64; 3],
+    /// Colour by the surface's own elevation (its z, lowest to highest) through `table`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour_by: Option<ColourBy>,
+    /// The table `colour_by` reads (by default `viridis`).
+    #[serde(default = "default_table")]
+    pub table: TableSpec,
+    /// `"phong"` (a headlight) or `"none"` (the colour as given).
+    #[serde(default)]
+    pub lighting: Lighting,
+    /// In (0, 1]: below 1 the surface is translucent.
+    #[serde(default = "one")]
+    pub opacity: f64,
+}
+
+/// A generated horizon: a height field of `size` nodes 25 m apart, folded and cut by a
+/// fault (a 120 m step across x), depths around -1000 m; `seed` turns the folds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SyntheticHorizon {
+    /// Nodes along x and y (2 to 2048 each).
+    pub size: [usize; 2],
+    /// Turns the folds.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// What a surface's colour follows besides the constant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum ColourBy {
+    /// Its z, lowest to highest, through the table.
+    Elevation,
+}
+
+/// How a surface is lit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Lighting {
+    /// A headlight: ambient plus two-sided diffuse.
+    #[default]
+    Phong,
+    /// Unlit: the colour as given.
+    None,
+}
+
+fn default_colour() -> [f64; 3] {
+    [0.8, 0.8, 0.8]
+}
+
+fn default_table() -> TableSpec {
+    TableSpec::builtin("viridis")
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// The headlight's ambient term.
+pub const AMBIENT: f64 = 0.2;
+/// The headlight's diffuse weight.
+pub const DIFFUSE: f64 = 0.8;
+
+impl SurfaceScene {
+    /// A surface from `file` with every other value at its default.
+    pub fn of(file: impl Into<PathBuf>) -> SurfaceScene {
+        SurfaceScene {
+            file: Some(file.into()),
+            synthetic: None,
+            colour: default_colour(),
+            colour_by: None,
+            table: default_table(),
+            lighting: Lighting::default(),
+            opacity: 1.0,
+        }
+    }
+
+    /// Ambient, diffuse and opacity as the programs take them (`program.local`).
+    pub fn light_terms(&self) -> [f64; 4] {
+        match self.lighting {
+            Lighting::Phong => [AMBIENT, DIFFUSE, self.opacity, 0.0],
+            Lighting::None => [1.0, 0.0, self.opacity, 0.0],
+        }
+    }
+}
+
+impl Technique for SurfaceScene {
+    const NAME: &'static str = "surface";
+    const DEMOS: &'static [(&'static str, &'static str)] =
+        &[crate::techniques::demo!("surface-horizon")];
+
+    fn validate(&self, _: Fidelity, _: ProgramChoice) -> Result<(), FieldError> {
+        match (&self.file, &self.synthetic) {
+            (Some(_), Some(_)) | (None, None) => {
+                return Err(FieldError::new(
+                    "file",
+                    "a surface reads a file (file = \"top.obj\") or makes a horizon (synthetic = { size = [48, 32] }), one of them",
+                ))
+            }
+            (None, Some(s)) if s.size.iter().any(|n| !(2..=2048).contains(n)) => {
+                return Err(FieldError::new(
+                    "synthetic.size",
+                    format!("{:?}: 2 to 2048 nodes each way", s.size),
+                ))
+            }
+            _ => {}
+        }
+        if self.colour.iter().any(|c| !(0.0..=1.0).contains(c)) {
+            return Err(FieldError::new(
+                "colour",
+                format!("{:?}: each of r, g, b in [0, 1]", self.colour),
+            ));
+        }
+        if !(self.opacity > 0.0 && self.opacity <= 1.0) {
+            return Err(FieldError::new(
+                "opacity",
+                format!("{}: above 0 and at most 1", self.opacity),
+            ));
+        }
+        self.table.validate().map_err(|e| e.within("table"))
+    }
+
+    fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut PathBuf)) {
+        if let Some(p) = self.file.as_mut() {
+            f("file", p);
+        }
+        if let Some(p) = self.table.file.as_mut() {
+            f("table.file", p);
+        }
+    }
+
+    fn program_pairs() -> Vec<ProgramPair> {
+        renderer::program_pairs()
+    }
+
+    type Prepared = prepare::Prepared;
+
+    fn prepare(
+        &self,
+        settings: &Settings<'_>,
+        _: &arbvis_data::volume::Limits,
+    ) -> RenderResult<prepare::Prepared> {
+        Technique::validate(self, settings.fidelity, settings.programs)?;
+        prepare::prepare(self, settings.base)
+    }
+
+    fn renderer(
+        &self,
+        gpu: &Gpu,
+        settings: &Settings<'_>,
+        kind: ProgramKind,
+        prepared: prepare::Prepared,
+    ) -> RenderResult<Box<dyn Renderer>> {
+        Ok(Box::new(
+            renderer::SurfaceRenderer::new(gpu, kind, settings.fidelity, self, prepared)?
+                .with_base(settings.base),
+        ))
+    }
+
+    /// The nearest hit at each pixel centre, lit as `fidelity` lights it.
+    fn reference(
+        &self,
+        prepared: &prepare::Prepared,
+        view: &ReferenceView<'_>,
+    ) -> Option<arbvis_core::image::Image> {
+        Some(reference::reference(
+            prepared,
+            self,
+            Fidelity::Precise,
+            &view.camera,
+            view.size,
+            view.background,
+        ))
+    }
+
+    fn world(&self, prepared: &prepare::Prepared) -> Option<World> {
+        Some(prepared.world)
+    }
+}

@@ -1,0 +1,148 @@
+//! A surface's CPU preparation (no GL): its triangles in the object frame with smooth
+//! normals and a colour per corner.
+
+use std::path::Path;
+
+use glam::DVec3;
+
+use super::{ColourBy, SurfaceScene};
+use crate::error::RenderResult;
+use crate::techniques::world::World;
+use arbvis_data::surface::TriangleMesh;
+
+/// A triangle's corner as drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Corner {
+    /// In the object frame (the longest side spans [-1, 1]).
+    pub position: DVec3,
+    /// The vertex's smooth normal (unit, or zero where every triangle at it is flat).
+    pub normal: DVec3,
+    /// RGB in [0, 1].
+    pub colour: DVec3,
+}
+
+/// What the renderer and the reference draw.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Prepared {
+    /// Three corners per triangle.
+    pub corners: Vec<Corner>,
+    /// Where the object frame lies in the world (the file's coordinates).
+    pub world: World,
+}
+
+/// Read `scene.file` (relative to `base`) and prepare it.
+pub fn prepare(scene: &SurfaceScene, base: &Path) -> RenderResult<Prepared> {
+    let mesh = match (&scene.file, &scene.synthetic) {
+        (Some(file), _) => arbvis_data::surface::read(&base.join(file))?,
+        (None, Some(s)) => synthetic_horizon(s),
+        (None, None) => {
+            return Err(
+                arbvis_core::vocab::FieldError::new("file", "a surface needs a file").into(),
+            )
+        }
+    };
+    let table = match scene.colour_by {
+        Some(ColourBy::Elevation) => Some(scene.table.build(base)?),
+        None => None,
+    };
+    Ok(of_mesh(&mesh, scene, table.as_ref()))
+}
+
+/// [`prepare`] of a surface already read; `table` colours it by elevation where given.
+pub fn of_mesh(
+    mesh: &TriangleMesh,
+    scene: &SurfaceScene,
+    table: Option<&arbvis_core::colortable::ColorTable>,
+) -> Prepared {
+    let (lo, hi) = mesh.bounds();
+    let world = World::of_box(lo, hi);
+    let normals = vertex_normals(mesh);
+    let (z0, z1) = (lo[2], hi[2]);
+    let colour_of = |p: [f64; 3]| match table {
+        Some(t) => {
+            let s = if z1 > z0 {
+                (p[2] - z0) / (z1 - z0)
+            } else {
+                0.5
+            };
+            table_colour(t, s)
+        }
+        None => DVec3::from_array(scene.colour),
+    };
+    let corners = mesh
+        .triangles
+        .iter()
+        .flat_map(|t| t.map(|v| v as usize))
+        .map(|v| {
+            let p = mesh.vertices[v];
+            Corner {
+                position: (DVec3::from_array(p) - world.centre) / world.units,
+                normal: normals[v],
+                colour: colour_of(p),
+            }
+        })
+        .collect();
+    Prepared { corners, world }
+}
+
+/// Each vertex's normal: the area-weighted sum of its triangles' normals, normalized
+/// (zero where they cancel or every triangle is flat).
+pub fn vertex_normals(mesh: &TriangleMesh) -> Vec<DVec3> {
+    let mut sums = vec![DVec3::ZERO; mesh.vertices.len()];
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|v| DVec3::from_array(mesh.vertices[v as usize]));
+        // The cross product's length is twice the area: area-weighted as it stands.
+        let n = (b - a).cross(c - a);
+        for &v in t {
+            sums[v as usize] += n;
+        }
+    }
+    sums.into_iter().map(|n| n.normalize_or_zero()).collect()
+}
+
+/// The table's colour at `s` in [0, 1]: linear between the two nearest of its 256
+/// entries (entry k at s = k / 255).
+pub fn table_colour(table: &arbvis_core::colortable::ColorTable, s: f64) -> DVec3 {
+    let x = s.clamp(0.0, 1.0) * 255.0;
+    let k = (x.floor() as usize).min(254);
+    let f = x - k as f64;
+    let entry = |k: usize| {
+        let e = table.entries[k];
+        DVec3::new(e[0] as f64, e[1] as f64, e[2] as f64) / 255.0
+    };
+    entry(k) * (1.0 - f) + entry(k + 1) * f
+}
+
+/// The triangles of a [`SyntheticHorizon`] (the fault's throw between two columns of
+/// nodes, so the triangles across it are the fault's face).
+pub fn synthetic_horizon(h: &super::SyntheticHorizon) -> TriangleMesh {
+    let [nx, ny] = h.size.map(|n| n.clamp(2, 2048));
+    let phase = (h.seed % 1000) as f64 * 0.618;
+    let fault = 0.55 * (nx - 1) as f64 * 25.0;
+    let depth = |x: f64, y: f64| {
+        let fold = 150.0 * (x / 160.0 + phase).sin() * (y / 230.0 - phase / 2.0).cos();
+        let dip = -0.05 * x - 0.02 * y;
+        // A normal fault along a line of nodes: the far side thrown down 120 m.
+        let throw = if x > fault { -120.0 } else { 0.0 };
+        -1000.0 + fold + dip + throw
+    };
+    let mut vertices = Vec::with_capacity(nx * ny);
+    for j in 0..ny {
+        for i in 0..nx {
+            let (x, y) = (i as f64 * 25.0, j as f64 * 25.0);
+            vertices.push([x, y, depth(x, y)]);
+        }
+    }
+    let node = |i: usize, j: usize| (j * nx + i) as u32;
+    let mut triangles = Vec::with_capacity(2 * (nx - 1) * (ny - 1));
+    for j in 0..ny - 1 {
+        for i in 0..nx - 1 {
+            triangles.push([node(i, j), node(i + 1, j), node(i + 1, j + 1)]);
+            triangles.push([node(i, j), node(i + 1, j + 1), node(i, j + 1)]);
+        }
+    }
+    TriangleMesh {
+        vertices,
+        triangles,
+    }
+}
