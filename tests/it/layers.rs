@@ -40,6 +40,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("what panels show of prepared data", &["summary"]),
     ("techniques", &["techniques", "error"]),
     ("the catalog of techniques", &["catalog"]),
+    ("a scene's layers in one frame", &["layered"]),
     (
         "scenes and rendering",
         &["scene", "session", "render", "annotate", "inspect", "info"],

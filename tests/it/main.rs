@@ -27,6 +27,7 @@ mod first_picture;
 mod hostile;
 mod irregular;
 mod isovalue_units;
+mod layered;
 mod layers;
 mod mdio;
 mod mdio_flavours;

@@ -65,6 +65,9 @@ pub struct DrawCall<'a> {
     pub cull_back: bool,
     /// Triangles or point sprites.
     pub primitive: Primitive,
+    /// A pass over the whole frame (a full-screen composite), never occluded by depth
+    /// ([`Gpu::set_occluded`]).
+    pub covers_frame: bool,
 }
 
 impl<'a> DrawCall<'a> {
@@ -80,6 +83,7 @@ impl<'a> DrawCall<'a> {
             depth_test: false,
             cull_back: false,
             primitive: Primitive::Triangles,
+            covers_frame: false,
         }
     }
 }
@@ -135,6 +139,10 @@ pub fn draw(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<()
             gl.enable(glow::DEPTH_TEST);
             gl.depth_func(glow::LESS);
             gl.depth_mask(true);
+        } else if gpu.occluded() && !call.covers_frame {
+            gl.enable(glow::DEPTH_TEST);
+            gl.depth_func(glow::LESS);
+            gl.depth_mask(false);
         } else {
             gl.disable(glow::DEPTH_TEST);
         }
@@ -216,6 +224,9 @@ pub fn draw(gpu: &Gpu, surface: Surface<'_>, call: &DrawCall<'_>) -> GlResult<()
         };
         call.mesh.draw_elements(mode, first, count);
     }
+    // SAFETY: a plain state call: depth writes back on (an occluded draw turned them
+    // off; a depth clear honours the mask).
+    unsafe { gl.depth_mask(true) };
     if points {
         coord_replace(false);
         // SAFETY: plain state calls.

@@ -128,9 +128,25 @@ pub struct Gpu {
     resources: Rc<RefCell<Vec<Resource>>>,
     /// The filter and interpolation errors ([`super::precision`]), measured on first use.
     precision: Cell<Option<(f32, f32)>>,
+    /// Whether draws without a depth test of their own are tested against the depth
+    /// already drawn, without writing it ([`Gpu::set_occluded`]).
+    occluded: Cell<bool>,
 }
 
 impl Gpu {
+    /// While `occluded`, a draw that does not test depth itself is tested (`LESS`)
+    /// against the depth the surface holds, without writing it, unless it covers the
+    /// frame ([`crate::DrawCall::covers_frame`]): how a layered scene draws its
+    /// translucent layers behind and in front of its opaque ones.
+    pub fn set_occluded(&self, occluded: bool) {
+        self.occluded.set(occluded);
+    }
+
+    /// Whether draws are occluded by the depth drawn ([`Gpu::set_occluded`]).
+    pub fn occluded(&self) -> bool {
+        self.occluded.get()
+    }
+
     /// Wrap the context that is current on this thread; `loader` is its `get_proc_address`.
     pub fn from_loader(mut loader: impl FnMut(&CStr) -> *const c_void) -> GlResult<Gpu> {
         // SAFETY: the caller made a context current on this thread and `loader`
@@ -144,6 +160,7 @@ impl Gpu {
             caps,
             resources: Rc::default(),
             precision: Cell::new(None),
+            occluded: Cell::new(false),
         };
         gl_check!(gpu)?;
         Ok(gpu)

@@ -22,6 +22,8 @@ use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::quad::QuadScene;
 use crate::techniques::splats::SplatsScene;
+use crate::techniques::surface::SurfaceScene;
+use crate::techniques::world::World;
 pub use crate::techniques::Settings;
 use crate::techniques::{Params, ReferenceView, Renderer, Technique};
 use arbvis_core::camera::Camera;
@@ -35,7 +37,7 @@ use arbvis_gl::{GlError, Gpu, ProgramChoice, ProgramKind};
 /// the dispatch below and [`TECHNIQUES`] (demos, program pairs, names) are made from it,
 /// so adding a technique is its folder plus one line here.
 macro_rules! techniques {
-    ($($(#[$doc:meta])* $variant:ident($type:ty)),* $(,)?) => {
+    ($($(#[$doc:meta])* $field:ident => $variant:ident($type:ty)),* $(,)?) => {
         /// Which technique and its parameters; in TOML a `[technique.NAME]` table.
         #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
         #[serde(rename_all = "kebab-case", deny_unknown_fields)]
@@ -69,18 +71,122 @@ macro_rules! techniques {
         /// Every technique, in the catalog's order: what the lists of demos and program
         /// pairs (and the viewer's faces, checked against it) derive from.
         pub const TECHNIQUES: &[Registration] = &[$(Registration::of::<$type>(),)*];
+
+        /// A `[[layer]]` table as a scene's text holds it: its name, visibility and
+        /// placement, and one technique's table (`[layer.surface]`), exactly one.
+        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+        #[serde(deny_unknown_fields)]
+        pub struct LayerTable {
+            /// The layer's name (in errors, legends and the viewer's list).
+            #[serde(default, skip_serializing_if = "String::is_empty")]
+            pub name: String,
+            /// Drawn or not (a hidden layer stays in the scene's frame).
+            #[serde(default = "visible", skip_serializing_if = "is_visible")]
+            pub visible: bool,
+            /// Added to the data's world coordinates (after `scale`).
+            #[serde(default, skip_serializing_if = "is_zero")]
+            pub offset: [f64; 3],
+            /// The data's world coordinates multiplied by it (above 0).
+            #[serde(default = "unit", skip_serializing_if = "is_unit")]
+            pub scale: f64,
+            $($(#[$doc])*
+            #[serde(default, skip_serializing_if = "Option::is_none")]
+            pub $field: Option<Box<$type>>,)*
+        }
+
+        impl LayerTable {
+            /// The layer's name, visibility and placement, and its technique where the
+            /// table names exactly one; else the names it holds.
+            pub fn split(self) -> Result<(LayerInfo, TechniqueScene), Vec<&'static str>> {
+                let info = LayerInfo {
+                    name: self.name,
+                    visible: self.visible,
+                    offset: self.offset,
+                    scale: self.scale,
+                };
+                let mut found = Vec::new();
+                $(if let Some(p) = self.$field {
+                    found.push(TechniqueScene::$variant(p));
+                })*
+                match found.len() {
+                    1 => Ok((info, found.remove(0))),
+                    _ => Err(found.iter().map(TechniqueScene::name).collect()),
+                }
+            }
+
+            /// The table of a layer.
+            pub fn of(info: LayerInfo, technique: TechniqueScene) -> LayerTable {
+                let mut table = LayerTable {
+                    name: info.name,
+                    visible: info.visible,
+                    offset: info.offset,
+                    scale: info.scale,
+                    $($field: None,)*
+                };
+                match technique {
+                    $(TechniqueScene::$variant(p) => table.$field = Some(p),)*
+                }
+                table
+            }
+        }
     };
+}
+
+/// A layer's name, visibility and hand placement (`world = scale * data + offset`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct LayerInfo {
+    /// Its name (empty: none given).
+    pub name: String,
+    /// Drawn or not; a hidden layer stays in the scene's frame.
+    pub visible: bool,
+    /// Added to the data's world coordinates.
+    pub offset: [f64; 3],
+    /// The data's world coordinates multiplied by it.
+    pub scale: f64,
+}
+
+impl Default for LayerInfo {
+    fn default() -> Self {
+        LayerInfo {
+            name: String::new(),
+            visible: true,
+            offset: [0.0; 3],
+            scale: 1.0,
+        }
+    }
+}
+
+fn visible() -> bool {
+    true
+}
+
+fn is_visible(v: &bool) -> bool {
+    *v
+}
+
+fn is_zero(v: &[f64; 3]) -> bool {
+    *v == [0.0; 3]
+}
+
+fn unit() -> f64 {
+    1.0
+}
+
+fn is_unit(v: &f64) -> bool {
+    *v == 1.0
 }
 
 techniques!(
     /// The full-screen quad demo.
-    Quad(QuadScene),
+    quad => Quad(QuadScene),
     /// v3o2's 3D opacity (with its clip).
-    Opacity3d(Opacity3dScene),
+    opacity3d => Opacity3d(Opacity3dScene),
     /// Isosurfaces and volumes of tetrahedral meshes by cell projection.
-    Cellproj(CellprojScene),
+    cellproj => Cellproj(CellprojScene),
     /// Point-based rendering of geological sections as splats.
-    Splats(SplatsScene),
+    splats => Splats(SplatsScene),
+    /// A triangle surface (a horizon, a fault, a body's boundary), a layer beside the others.
+    surface => Surface(SurfaceScene),
 );
 
 /// What a technique declares once, read by every list of techniques.
@@ -151,6 +257,7 @@ trait AnyTechnique: Any {
         view: &ReferenceView<'_>,
     ) -> RenderResult<Option<Image>>;
     fn summary(&self, prepared: &dyn Any, base: &Path) -> Option<Summary>;
+    fn world(&self, prepared: &dyn Any) -> Option<World>;
 }
 
 impl<T: Technique> AnyTechnique for T {
@@ -239,6 +346,11 @@ impl<T: Technique> AnyTechnique for T {
     /// [`Technique::summary`] of `prepared` (none where it is another technique's).
     fn summary(&self, prepared: &dyn Any, base: &Path) -> Option<Summary> {
         Technique::summary(self, prepared.downcast_ref::<T::Prepared>()?, base)
+    }
+
+    /// [`Technique::world`] of `prepared` (none where it is another technique's).
+    fn world(&self, prepared: &dyn Any) -> Option<World> {
+        Technique::world(self, prepared.downcast_ref::<T::Prepared>()?)
     }
 }
 
@@ -368,6 +480,12 @@ pub fn summary(
     base: &Path,
 ) -> Option<Summary> {
     technique.technique().summary(prepared.as_ref(), base)
+}
+
+/// Where what [`prepare`] made for `technique` lies in the world frame a scene's layers
+/// share ([`Technique::world`]).
+pub fn world(technique: &TechniqueScene, prepared: &PreparedData) -> Option<World> {
+    technique.technique().world(prepared.as_ref())
 }
 
 /// The renderer of what [`prepare`] made for `technique`, with programs of `kind`.

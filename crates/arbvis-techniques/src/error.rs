@@ -50,6 +50,19 @@ pub enum RenderError {
     /// table).
     #[error(transparent)]
     Parameters(#[from] FieldError),
+    /// One layer of a layered scene failed: the error names it.
+    #[error("layer {index} ({name}): {source}")]
+    Layer {
+        /// 0-based, as `layer.INDEX` keys count.
+        index: usize,
+        /// Its name, or "unnamed".
+        name: String,
+        /// What failed.
+        source: Box<RenderError>,
+    },
+    /// A layer whose data cannot be placed in a scene's world frame.
+    #[error("{0}")]
+    Unplaced(String),
     /// A worker thread could not be started.
     #[error("cannot start a thread: {0}")]
     Thread(std::io::Error),

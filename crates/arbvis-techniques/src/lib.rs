@@ -13,6 +13,7 @@ pub mod catalog;
 pub mod error;
 pub mod info;
 pub mod inspect;
+pub mod layered;
 pub mod programs;
 pub mod render;
 pub mod scene;

@@ -59,7 +59,8 @@ pub fn build(
     scene: &Scene,
     kind: ProgramKind,
 ) -> RenderResult<Box<dyn Renderer>> {
-    crate::catalog::build(gpu, &scene.technique, &scene.settings(), kind)
+    let layers: Vec<_> = scene.layers().collect();
+    crate::layered::build_any(gpu, &layers, &scene.settings(), kind)
 }
 
 /// Render `scene` offscreen on `backend`.

@@ -6,14 +6,14 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
-pub use crate::catalog::{demos, TechniqueScene};
+pub use crate::catalog::{demos, LayerInfo, LayerTable, TechniqueScene};
 use arbvis_core::camera::Camera;
 pub use arbvis_core::vocab::{Fidelity, FieldError};
 use arbvis_gl::{ProgramChoice, TargetFormat};
 
 /// A whole scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(try_from = "SceneText", into = "SceneText")]
 pub struct Scene {
     /// Image size in pixels `[width, height]`.
     #[serde(default = "default_size")]
@@ -52,14 +52,233 @@ pub struct Scene {
     /// conversion command), said when a file the scene reads is missing.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub data_from: Option<String>,
-    /// The technique and its parameters.
+    /// The technique and its parameters: a one-layer scene's, or a layered scene's first
+    /// layer's.
     pub technique: TechniqueScene,
+    /// The first layer's name, visibility and placement (the defaults for a
+    /// `[technique.NAME]` scene).
+    #[serde(skip)]
+    pub layer: LayerInfo,
+    /// The layers after the first, in order: each its name, visibility, placement and
+    /// technique. Empty for a one-layer scene.
+    #[serde(skip)]
+    pub more_layers: Vec<(LayerInfo, TechniqueScene)>,
     /// Folder that relative data paths are read from: the scene file's folder, or the
     /// current folder for demos and scenes given as text.
     #[serde(skip)]
     pub base: std::path::PathBuf,
 }
 
+/// A scene as its text holds it: one technique (`[technique.NAME]`) or layers
+/// (`[[layer]]`), read into and written from [`Scene`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneText {
+    /// Image size in pixels `[width, height]`.
+    #[serde(default = "default_size")]
+    size: [u32; 2],
+    /// Faithful or precise.
+    #[serde(default)]
+    fidelity: Fidelity,
+    /// ARB, GLSL or auto.
+    #[serde(default)]
+    programs: ProgramChoice,
+    /// Colour target; by default RGBA8 when faithful, RGBA32F when precise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    target: Option<TargetFormat>,
+    /// Clear colour, RGBA.
+    #[serde(default)]
+    background: [f32; 4],
+    /// Write pictures with a transparent background (straight colour, alpha = coverage)
+    /// instead of what the screen shows (opaque, composited over `background`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    transparent: bool,
+    /// The camera.
+    #[serde(default)]
+    camera: Camera,
+    /// Draw the colour tables (with their value ranges) and keys into offscreen pictures
+    /// (`crate::annotate`); off, so that a picture holds the renderer's pixels alone.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    legend: bool,
+    /// Draw the box's axes with ticks in the data's own numbers into offscreen pictures.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    axes: bool,
+    /// The memory budget this scene asks for (`"16G"`, `"75%"`): taken where neither
+    /// `--memory-budget` nor `ARBVIS_MEMORY_BUDGET` sets one ([`arbvis_core::budget`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    memory_budget: Option<String>,
+    /// How to get the scene's data where it is not in the clone (a download or a
+    /// conversion command), said when a file the scene reads is missing.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    data_from: Option<String>,
+    /// The technique and its parameters (a one-layer scene).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    technique: Option<TechniqueScene>,
+    /// The layers, in order.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    layer: Vec<crate::catalog::LayerTable>,
+}
+
+/// Why a scene's text holds no drawable technique.
+#[derive(Debug, thiserror::Error)]
+pub enum LayersError {
+    /// Neither `[technique.NAME]` nor `[[layer]]`.
+    #[error("a scene needs a [technique.NAME] table or [[layer]] tables")]
+    Neither,
+    /// Both.
+    #[error("a scene has a [technique.NAME] table or [[layer]] tables, not both")]
+    Both,
+    /// A layer naming no technique or several.
+    #[error("layer {index} ({name}) must name exactly one technique's table ([layer.surface], [layer.opacity3d], ...); it names {found}")]
+    Techniques {
+        /// 0-based.
+        index: usize,
+        /// Its name or "unnamed".
+        name: String,
+        /// What it names.
+        found: String,
+    },
+}
+
+impl TryFrom<SceneText> for Scene {
+    type Error = LayersError;
+
+    fn try_from(t: SceneText) -> Result<Scene, LayersError> {
+        let mut layers = Vec::with_capacity(t.layer.len());
+        for (index, table) in t.layer.into_iter().enumerate() {
+            let name = table.name.clone();
+            layers.push(table.split().map_err(|found| LayersError::Techniques {
+                index,
+                name: if name.is_empty() {
+                    "unnamed".into()
+                } else {
+                    name
+                },
+                found: match found.len() {
+                    0 => "none".into(),
+                    _ => found.join(", "),
+                },
+            })?);
+        }
+        let mut layers = layers.into_iter();
+        let ((layer, technique), more_layers) = match (t.technique, layers.next()) {
+            (Some(_), Some(_)) => return Err(LayersError::Both),
+            (None, None) => return Err(LayersError::Neither),
+            (Some(technique), None) => ((LayerInfo::default(), technique), Vec::new()),
+            (None, Some(first)) => (first, layers.collect()),
+        };
+        Ok(Scene {
+            size: t.size,
+            fidelity: t.fidelity,
+            programs: t.programs,
+            target: t.target,
+            background: t.background,
+            transparent: t.transparent,
+            camera: t.camera,
+            legend: t.legend,
+            axes: t.axes,
+            memory_budget: t.memory_budget,
+            data_from: t.data_from,
+            technique,
+            layer,
+            more_layers,
+            base: Default::default(),
+        })
+    }
+}
+
+impl From<Scene> for SceneText {
+    fn from(s: Scene) -> SceneText {
+        let (technique, layer) = if s.is_layered() {
+            let first = std::iter::once((s.layer, s.technique));
+            let tables = first
+                .chain(s.more_layers)
+                .map(|(i, t)| LayerTable::of(i, t));
+            (None, tables.collect())
+        } else {
+            (Some(s.technique), Vec::new())
+        };
+        SceneText {
+            size: s.size,
+            fidelity: s.fidelity,
+            programs: s.programs,
+            target: s.target,
+            background: s.background,
+            transparent: s.transparent,
+            camera: s.camera,
+            legend: s.legend,
+            axes: s.axes,
+            memory_budget: s.memory_budget,
+            data_from: s.data_from,
+            technique,
+            layer,
+        }
+    }
+}
+
+impl Scene {
+    /// Whether the scene is written as layers: more than one, or one with a name,
+    /// hidden or placed by hand.
+    pub fn is_layered(&self) -> bool {
+        !self.more_layers.is_empty() || self.layer != LayerInfo::default()
+    }
+
+    /// Every layer in order: its info and technique (one for a `[technique.NAME]` scene).
+    pub fn layers(&self) -> impl Iterator<Item = (&LayerInfo, &TechniqueScene)> {
+        std::iter::once((&self.layer, &self.technique))
+            .chain(self.more_layers.iter().map(|(i, t)| (i, t)))
+    }
+
+    /// [`Scene::layers`], to change.
+    pub fn layers_mut(&mut self) -> impl Iterator<Item = (&mut LayerInfo, &mut TechniqueScene)> {
+        std::iter::once((&mut self.layer, &mut self.technique))
+            .chain(self.more_layers.iter_mut().map(|(i, t)| (i, t)))
+    }
+
+    /// Every layer in order, owned (the scene keeps none until [`Scene::set_layers`]).
+    pub fn layer_list(&self) -> Vec<(LayerInfo, TechniqueScene)> {
+        self.layers().map(|(i, t)| (i.clone(), t.clone())).collect()
+    }
+
+    /// Replace the layers by `layers` (at least one: an empty list is refused).
+    pub fn set_layers(
+        &mut self,
+        layers: Vec<(LayerInfo, TechniqueScene)>,
+    ) -> Result<(), FieldError> {
+        let mut layers = layers.into_iter();
+        let (info, technique) = layers
+            .next()
+            .ok_or_else(|| FieldError::new("layer", "a scene keeps at least one layer"))?;
+        self.layer = info;
+        self.technique = technique;
+        self.more_layers = layers.collect();
+        Ok(())
+    }
+
+    /// Move layer `from` to position `to` (both below the count; drawn in the new order).
+    pub fn move_layer(&mut self, from: usize, to: usize) -> Result<(), FieldError> {
+        let mut layers = self.layer_list();
+        if from >= layers.len() || to >= layers.len() {
+            return Err(FieldError::new(
+                "layer",
+                format!("{from} to {to}: the scene has {} layers", layers.len()),
+            ));
+        }
+        let layer = layers.remove(from);
+        layers.insert(to, layer);
+        self.set_layers(layers)
+    }
+
+    /// The dotted key of a technique's `key` (`technique.NAME.rest`, as the catalog
+    /// names it) in layer `index`: itself in a one-layer scene, `layer.INDEX.NAME.rest`
+    /// in a layered one.
+    pub fn layer_key(&self, index: usize, key: &str) -> String {
+        match (self.is_layered(), key.strip_prefix("technique.")) {
+            (true, Some(rest)) => format!("layer.{index}.{rest}"),
+            _ => key.to_string(),
+        }
+    }
+}
 /// A data file a scene reads ([`Scene::data_files`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DataFile {
@@ -149,14 +368,27 @@ impl Scene {
         let mut scene = scene;
         // Defaults that depend on the data the scene names, for the keys it leaves out.
         if let Ok(written) = text.parse::<toml::Table>() {
-            let written = |key: &str| is_written(&written, key);
-            let Scene {
-                technique,
-                camera,
-                fidelity,
-                ..
-            } = &mut scene;
-            technique.unwritten_defaults(&written, camera, fidelity);
+            let layered = scene.is_layered();
+            let (camera, mut fidelity) = (scene.camera, scene.fidelity);
+            let mut cameras = Vec::new();
+            for (index, (_, technique)) in scene.layers_mut().enumerate() {
+                // A layer's keys are read where its text writes them (`layer.I.NAME...`).
+                let written = |key: &str| match key.strip_prefix("technique.") {
+                    Some(rest) if layered => is_written(&written, &format!("layer.{index}.{rest}")),
+                    _ => is_written(&written, key),
+                };
+                let mut its_camera = camera;
+                technique.unwritten_defaults(&written, &mut its_camera, &mut fidelity);
+                cameras.push(its_camera);
+            }
+            scene.fidelity = fidelity;
+            // A one-layer scene takes its technique's camera; a layered scene its own
+            // (the world's z up: crate::layered).
+            scene.camera = match layered {
+                false => cameras[0],
+                true if !is_written(&written, "camera") => crate::layered::default_camera(),
+                true => scene.camera,
+            };
         }
         let checked = longer_arrays(text, &scene).map_or_else(|| scene.validate(), Err);
         checked.map_err(|e| {
@@ -211,7 +443,13 @@ impl Scene {
     /// Call `f` on every data file the scene names (volumes, table files, clip meshes and
     /// masks, meshes, clouds), with the dotted key that holds it.
     pub fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut std::path::PathBuf)) {
-        self.technique.for_each_data_path(f)
+        let layered = self.is_layered();
+        for (index, (_, technique)) in self.layers_mut().enumerate() {
+            technique.for_each_data_path(&mut |key, path| match key.strip_prefix("technique.") {
+                Some(rest) if layered => f(&format!("layer.{index}.{rest}"), path),
+                _ => f(key, path),
+            });
+        }
     }
 
     /// Every data file the scene reads: its key, the path as written and as resolved
@@ -333,7 +571,9 @@ impl Scene {
                 BYTES_PER_READ_PIXEL,
             ));
         }
-        out.extend(self.technique.memory_estimate(self.size));
+        for (_, technique) in self.layers() {
+            out.extend(technique.memory_estimate(self.size));
+        }
         out
     }
 
@@ -365,8 +605,28 @@ impl Scene {
             return Err(FieldError::new("camera.rotation", "must be finite"));
         }
         self.memory_budget_bytes()?;
-        self.technique.validate(self.fidelity, self.programs)
+        for (index, (info, technique)) in self.layers().enumerate() {
+            validate_layer(info).map_err(|e| e.within(&format!("layer.{index}")))?;
+            technique
+                .validate(self.fidelity, self.programs)
+                .map_err(|e| FieldError::new(self.layer_key(index, &e.key), e.message))?;
+        }
+        Ok(())
     }
+}
+
+/// A layer's hand placement: finite, its scale above 0.
+fn validate_layer(info: &LayerInfo) -> Result<(), FieldError> {
+    if info.offset.iter().any(|v| !v.is_finite()) {
+        return Err(FieldError::new("offset", "must be finite"));
+    }
+    if !(info.scale.is_finite() && info.scale > 0.0) {
+        return Err(FieldError::new(
+            "scale",
+            format!("{}: a finite factor above 0", info.scale),
+        ));
+    }
+    Ok(())
 }
 
 /// The error for a data file given where a scene was expected (a SEG-Y, a mesh, a cloud:
@@ -455,12 +715,27 @@ fn key_position(text: &str, key: &str) -> (usize, usize) {
     };
     let mut table = root.get_ref();
     let mut at = 0;
-    for part in key.split('.') {
+    let mut parts = key.split('.').peekable();
+    while let Some(part) = parts.next() {
         let Some((k, v)) = table.get_key_value(part) else {
             break;
         };
         at = k.span().start;
-        match v.get_ref() {
+        let mut value = v.get_ref();
+        // An array of tables (`[[layer]]`) is entered by the index that follows.
+        if let (DeValue::Array(items), Some(i)) =
+            (value, parts.peek().and_then(|p| p.parse::<usize>().ok()))
+        {
+            parts.next();
+            match items.get(i) {
+                Some(item) => {
+                    at = item.span().start;
+                    value = item.get_ref();
+                }
+                None => break,
+            }
+        }
+        match value {
             DeValue::Table(t) => table = t,
             _ => break,
         }
@@ -540,7 +815,10 @@ fn is_written(table: &toml::Table, key: &str) -> bool {
     };
     let mut value = table.get(first);
     for part in parts {
-        value = value.and_then(|v| v.as_table()).and_then(|t| t.get(part));
+        value = value.and_then(|v| match (v, part.parse::<usize>()) {
+            (toml::Value::Array(a), Ok(i)) => a.get(i),
+            _ => v.as_table().and_then(|t| t.get(part)),
+        });
     }
     value.is_some()
 }

@@ -127,7 +127,10 @@ impl Session {
     /// technique, fidelity, program choice, target format or data folder).
     pub fn apply(&mut self, gpu: &Gpu, scene: &Scene) -> RenderResult<()> {
         let old = &self.scene;
+        // A layered scene's renderer is rebuilt when any layer but the first changes.
         let same_renderer = old.technique.name() == scene.technique.name()
+            && old.more_layers == scene.more_layers
+            && old.layer == scene.layer
             && old.fidelity == scene.fidelity
             && old.programs == scene.programs
             && old.target_format() == scene.target_format()
@@ -278,5 +281,6 @@ fn build_renderer(gpu: &Gpu, scene: &Scene, kind: ProgramKind) -> RenderResult<B
         &format!("this {} scene", scene.technique.name()),
         &scene.memory_estimate(true),
     )?;
-    crate::catalog::build(gpu, &scene.technique, &scene.settings(), kind)
+    let layers: Vec<_> = scene.layers().collect();
+    crate::layered::build_any(gpu, &layers, &scene.settings(), kind)
 }

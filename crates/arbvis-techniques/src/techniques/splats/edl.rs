@@ -122,6 +122,7 @@ impl EdlPass {
             &DrawCall {
                 textures: &[(0, self.depth.color())],
                 blend: Blend::Multiply,
+                covers_frame: true,
                 ..DrawCall::new(&self.shade, &self.quad)
             },
         )?)

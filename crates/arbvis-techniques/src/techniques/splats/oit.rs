@@ -110,6 +110,7 @@ impl OitPass {
             &DrawCall {
                 textures: &[(0, self.accum.color()), (1, self.reveal.color())],
                 blend: Blend::Over,
+                covers_frame: true,
                 ..DrawCall::new(&self.composite, &self.quad)
             },
         )?)

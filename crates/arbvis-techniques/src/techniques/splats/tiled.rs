@@ -193,6 +193,7 @@ impl TilePass {
             &DrawCall {
                 textures: &[(0, offsets), (1, entries), (2, colours)],
                 blend: Blend::PremultipliedOver,
+                covers_frame: true,
                 ..DrawCall::new(&self.program, &self.blocks)
             },
         )?)

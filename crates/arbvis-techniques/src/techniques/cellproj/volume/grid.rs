@@ -261,6 +261,7 @@ impl GridCaster {
             &DrawCall {
                 textures: &[(0, &self.grid), (1, &self.table)],
                 blend: Blend::PremultipliedOver,
+                covers_frame: true,
                 ..DrawCall::new(p, &self.quad)
             },
         )?)

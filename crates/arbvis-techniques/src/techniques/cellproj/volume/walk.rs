@@ -456,6 +456,7 @@ impl Precise {
                     &DrawCall {
                         textures: &textures,
                         blend: Blend::PremultipliedOver,
+                        covers_frame: true,
                         ..DrawCall::new(&p.walk, &p.quad)
                     },
                 )?);

@@ -1,0 +1,348 @@
+//! Scenes of layers (`[[layer]]`, issue 55): the text read and written, each technique's
+//! place in one world frame, the surface layer against its f64 reference, and opaque
+//! layers composited with translucent ones by depth.
+
+use crate::common;
+
+use arbvis::gl::{Backend, ProgramChoice, TargetFormat};
+use arbvis::render::render_on;
+use arbvis::scene::{Fidelity, Scene, SceneError};
+use arbvis::techniques::surface::{prepare, reference, SurfaceScene};
+use common::{headless, LEVEL};
+
+/// A quad (two triangles) at height `z` spanning `[x0, x1] x [y0, y1]`, as OBJ text.
+fn plane_obj(x: [f64; 2], y: [f64; 2], z: f64) -> String {
+    format!(
+        "v {x0} {y0} {z}\nv {x1} {y0} {z}\nv {x1} {y1} {z}\nv {x0} {y1} {z}\nf 1 2 3\nf 1 3 4\n",
+        x0 = x[0],
+        x1 = x[1],
+        y0 = y[0],
+        y1 = y[1]
+    )
+}
+
+/// An uneven height field of `n` x `m` cells (a horizon-like sheet with a fold and a
+/// step), as OBJ text: not smooth, not symmetric.
+fn horizon_obj(n: usize, m: usize) -> String {
+    let mut text = String::new();
+    for j in 0..=m {
+        for i in 0..=n {
+            let (x, y) = (i as f64 * 13.0 + 635_000.0, j as f64 * 17.0 + 848_000.0);
+            let z = -400.0
+                + 30.0 * ((i as f64) * 0.7).sin() * ((j as f64) * 0.45).cos()
+                + if i > n / 2 { 12.0 } else { 0.0 }
+                + 0.37 * (i * j % 7) as f64;
+            text += &format!("v {x} {y} {z}\n");
+        }
+    }
+    for j in 0..m {
+        for i in 0..n {
+            let v = |i: usize, j: usize| j * (n + 1) + i + 1;
+            text += &format!("f {} {} {}\n", v(i, j), v(i + 1, j), v(i + 1, j + 1));
+            text += &format!("f {} {} {}\n", v(i, j), v(i + 1, j + 1), v(i, j + 1));
+        }
+    }
+    text
+}
+
+fn parse(text: &str) -> Result<Scene, SceneError> {
+    Scene::parse(text, "layered.toml")
+}
+
+#[test]
+fn a_layered_scene_reads_and_writes_its_layers() {
+    let text = r#"
+size = [64, 48]
+[[layer]]
+name = "the cube"
+[layer.opacity3d.primary]
+volume = { synthetic = { size = [9, 7, 11], seed = 3 } }
+attribute = "amplitude"
+[[layer]]
+name = "horizon"
+visible = false
+offset = [1.0, -2.0, 3.5]
+scale = 0.25
+[layer.surface]
+file = "top.obj"
+colour = [0.9, 0.75, 0.2]
+lighting = "none"
+"#;
+    let scene = parse(text).unwrap();
+    assert!(scene.is_layered());
+    let layers: Vec<_> = scene.layers().collect();
+    assert_eq!(layers.len(), 2);
+    assert_eq!(layers[0].0.name, "the cube");
+    assert_eq!(layers[0].1.name(), "opacity3d");
+    assert_eq!(layers[1].1.name(), "surface");
+    assert!(!layers[1].0.visible);
+    assert_eq!(layers[1].0.offset, [1.0, -2.0, 3.5]);
+    // Written back as layers and read again: the same scene.
+    let again = parse(&scene.to_toml()).unwrap();
+    assert_eq!(again, scene);
+    assert!(scene.to_toml().contains("[[layer]]"));
+    // Data files are named by their layer's key.
+    let keys: Vec<_> = scene.data_files().into_iter().map(|f| f.key).collect();
+    assert_eq!(keys, ["layer.1.surface.file"]);
+    // A one-technique scene stays one: written as [technique.NAME].
+    let one = Scene::demo("v3o2-sum").unwrap();
+    assert!(!one.is_layered() && one.to_toml().contains("[technique.opacity3d]"));
+}
+
+#[test]
+fn a_wrong_layer_is_named_by_its_key_and_line() {
+    let head = "size = [32, 32]\n[[layer]]\n[layer.surface]\nfile = \"a.obj\"\n";
+    // A bad value: its dotted key with the layer's index, at its line.
+    let bad =
+        format!("{head}[[layer]]\nname = \"b\"\nscale = -2.0\n[layer.surface]\nfile = \"b.obj\"\n");
+    let e = parse(&bad).unwrap_err();
+    let SceneError::Invalid { key, line, .. } = &e else {
+        panic!("{e}");
+    };
+    assert_eq!((key.as_str(), *line), ("layer.1.scale", 7), "{e}");
+    let bad = format!("{head}[[layer]]\n[layer.surface]\nfile = \"b.obj\"\nopacity = 1.5\n");
+    let e = parse(&bad).unwrap_err();
+    let SceneError::Invalid { key, line, .. } = &e else {
+        panic!("{e}");
+    };
+    assert_eq!((key.as_str(), *line), ("layer.1.surface.opacity", 8), "{e}");
+    // A layer of two techniques, of none, and a scene of both forms.
+    let two = format!("{head}[layer.quad]\n");
+    assert!(parse(&two)
+        .unwrap_err()
+        .to_string()
+        .contains("layer 0 (unnamed) must name exactly one technique's table"));
+    let none = format!("{head}[[layer]]\nname = \"empty\"\n");
+    assert!(parse(&none)
+        .unwrap_err()
+        .to_string()
+        .contains("layer 1 (empty)"));
+    let both = format!("{head}[technique.quad]\n");
+    assert!(parse(&both).unwrap_err().to_string().contains("not both"));
+    assert!(parse("size = [8, 8]\n")
+        .unwrap_err()
+        .to_string()
+        .contains("[[layer]]"));
+}
+
+#[test]
+fn a_missing_layer_file_names_the_layer_and_a_broken_hidden_layer_is_still_an_error() {
+    let dir = common::temp_dir("layered-missing");
+    std::fs::write(dir.join("a.obj"), plane_obj([0.0, 1.0], [0.0, 1.0], 0.0)).unwrap();
+    let text = "[[layer]]\n[layer.surface]\nfile = \"a.obj\"\n[[layer]]\nname = \"gone\"\n[layer.surface]\nfile = \"gone.obj\"\n";
+    std::fs::write(dir.join("scene.toml"), text).unwrap();
+    let e = Scene::load_checked(&dir.join("scene.toml")).unwrap_err();
+    assert!(e.to_string().contains("layer.1.surface.file"), "{e}");
+    // Hidden, with a broken file: it still has a place in the frame, so it is read.
+    let broken = "[[layer]]\n[layer.surface]\nfile = \"a.obj\"\n[[layer]]\nname = \"broken\"\nvisible = false\n[layer.surface]\nfile = \"bad.obj\"\n";
+    std::fs::write(dir.join("bad.obj"), "v 0 0 0\nv 1 0 0\nf 1 2 9\n").unwrap();
+    std::fs::write(dir.join("broken.toml"), broken).unwrap();
+    let scene = Scene::load(&dir.join("broken.toml")).unwrap();
+    let h = headless(Backend::Egl);
+    let e = render_on(&h, &scene)
+        .err()
+        .expect("a broken hidden layer fails");
+    assert!(e.to_string().starts_with("layer 1 (broken): "), "{e}");
+}
+
+/// A technique's picture alone and as the one named layer of a layered scene: the same
+/// pixels, so each technique's place in the world frame matches how it frames itself.
+#[test]
+fn one_named_layer_draws_what_its_technique_draws_alone() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("layered-one");
+    std::fs::write(dir.join("h.obj"), horizon_obj(9, 6)).unwrap();
+    let surface = format!(
+        "size = [61, 47]\n[camera]\nrotation = [0.31, -0.22, 0.12, 0.917]\nzoom = 0.8\n[technique.surface]\nfile = \"{}\"\ncolour_by = \"elevation\"\n",
+        dir.join("h.obj").display()
+    );
+    let mut scenes = vec![("surface", parse(&surface).unwrap())];
+    for demo in [
+        "v3o2-sum",
+        "cellproj-spherical",
+        "splats-section",
+        "splats-section-precise",
+    ] {
+        let mut scene = Scene::demo(demo).unwrap();
+        scene.size = [53, 41];
+        scenes.push((demo, scene));
+    }
+    for (name, alone) in scenes {
+        let mut layered = alone.clone();
+        layered.layer.name = "it".into();
+        assert!(layered.is_layered());
+        let a = render_on(&h, &alone).unwrap().image;
+        let b = render_on(&h, &layered).unwrap().image;
+        let d = a.compare(&b, 0.0).unwrap();
+        assert_eq!(d.pixels_over, 0, "{name}: {d:?}");
+        assert!(common::lit_pixels(&a, 0.05) > 100, "{name} draws something");
+    }
+}
+
+/// A surface against its f64 reference (nearest hit per pixel centre, the headlight
+/// per vertex or per pixel), ARB and GLSL, faithful and precise, on an uneven horizon in
+/// UTM coordinates at an odd size and a rotated perspective camera.
+#[test]
+fn a_surface_matches_its_reference_in_both_fidelities_and_program_kinds() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("layered-surface");
+    std::fs::write(dir.join("h.obj"), horizon_obj(11, 8)).unwrap();
+    let params = SurfaceScene {
+        colour_by: Some(arbvis::techniques::surface::ColourBy::Elevation),
+        ..SurfaceScene::of(dir.join("h.obj"))
+    };
+    let mesh = arbvis::surface::read(&dir.join("h.obj")).unwrap();
+    let table = params.table.build(&dir).unwrap();
+    let prepared = prepare::of_mesh(&mesh, &params, Some(&table));
+    for fidelity in [Fidelity::Faithful, Fidelity::Precise] {
+        for programs in [ProgramChoice::Arb, ProgramChoice::Glsl] {
+            let mut scene =
+                parse("size = [73, 58]\n[technique.surface]\nfile = \"x.obj\"\n").unwrap();
+            scene.technique = params.clone().into();
+            scene.fidelity = fidelity;
+            scene.programs = programs;
+            scene.target = Some(TargetFormat::Rgba32f);
+            scene.camera.projection = arbvis::camera::Projection::Perspective;
+            scene.camera.rotation = [-0.21, 0.09, 0.13, 0.965];
+            let gpu = render_on(&h, &scene).unwrap().image;
+            let cpu = reference::reference(
+                &prepared,
+                &params,
+                fidelity,
+                &scene.camera,
+                scene.size,
+                [0.0; 4],
+            );
+            // Inside triangles the GPU's f32 interpolation and lighting agree with f64
+            // to ~1e-5; a pixel whose centre lies within f32 rounding of an edge may take
+            // the other triangle (or the background at the silhouette), so the count of
+            // pixels over one 8-bit level is bounded by the edge pixels (under 2 %).
+            let d = gpu.compare(&cpu, LEVEL).unwrap();
+            let pixels = (scene.size[0] * scene.size[1]) as usize;
+            assert!(
+                d.pixels_over * 50 < pixels,
+                "{fidelity:?} {programs:?}: {d:?}"
+            );
+            assert!(d.rmse < 0.01, "{fidelity:?} {programs:?}: {d:?}");
+            let lit = common::lit_pixels(&gpu, 0.05);
+            // Perspective frames the unit sphere: the sheet covers about a quarter.
+            assert!(
+                lit > pixels / 6,
+                "the horizon is in view: {lit} of {pixels}"
+            );
+        }
+    }
+}
+
+/// An unlit plane behind a translucent volume: exactly the volume drawn over the plane's
+/// colour (a background of that colour); in front: the plane's colour wherever it lies.
+#[test]
+fn an_opaque_surface_hides_a_volume_behind_it_and_shows_through_one_in_front() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("layered-occlusion");
+    // The cube's world box: [0, 17] x [0, 13] x [0, 15] (synthetic, spacing 1). A square
+    // plane centred on it, wider than it, below it (seen from above: behind) and above
+    // it (in front); the frame's longest side is the plane's 37.
+    let (x, y) = ([-10.0, 27.0], [-12.0, 25.0]);
+    std::fs::write(dir.join("below.obj"), plane_obj(x, y, -4.0)).unwrap();
+    std::fs::write(dir.join("above.obj"), plane_obj(x, y, 19.0)).unwrap();
+    let colour = [0.25, 0.5, 0.75];
+    let cube = r#"[layer.opacity3d]
+combine = "sum"
+slices = 96
+[layer.opacity3d.primary]
+volume = { synthetic = { size = [17, 13, 15], seed = 5 } }
+attribute = "amplitude"
+table = { builtin = "seismic", alpha = [[0.0, 0.7], [0.4, 0.0], [0.6, 0.0], [1.0, 0.7]] }
+"#;
+    let plane = |file: &str| {
+        format!(
+            "[[layer]]\nname = \"plane\"\n[layer.surface]\nfile = \"{}\"\ncolour = {colour:?}\nlighting = \"none\"\n",
+            dir.join(file).display()
+        )
+    };
+    // Seen from straight above (identity rotation: z toward the viewer), orthographic.
+    // Zoom 1.15: the view spans +-0.87 of the frame, inside the plane's +-1.
+    let head = "size = [61, 61]\nbackground = [0.0, 0.0, 0.0, 1.0]\n[camera]\nzoom = 1.15\n";
+    let behind = parse(&format!(
+        "{head}[[layer]]\nname = \"cube\"\n{cube}{}",
+        plane("below.obj")
+    ))
+    .unwrap();
+    let front = parse(&format!(
+        "{head}{}[[layer]]\nname = \"cube\"\n{cube}",
+        plane("above.obj")
+    ))
+    .unwrap();
+    let behind_image = render_on(&h, &behind).unwrap().image;
+    let front_image = render_on(&h, &front).unwrap().image;
+    // The frame of the two planes and the cube is the planes' box: place the cube alone
+    // there by drawing it with an invisible plane (hidden layers keep their place).
+    let mut alone = behind.clone();
+    alone.more_layers[0].0.visible = false;
+    alone.background = [colour[0] as f32, colour[1] as f32, colour[2] as f32, 1.0];
+    let over_colour = render_on(&h, &alone).unwrap().image;
+    // Faithful, RGBA8: the same blends from the same bytes: identical.
+    let d = behind_image.compare(&over_colour, 0.0).unwrap();
+    assert_eq!(d.pixels_over, 0, "the volume over the plane: {d:?}");
+    assert!(
+        behind_image
+            .compare(&front_image, LEVEL)
+            .unwrap()
+            .pixels_over
+            > 100,
+        "the cube shows over the plane behind it"
+    );
+    // In front: every pixel is the plane's colour (it covers the view).
+    let want = [colour[0] as f32, colour[1] as f32, colour[2] as f32, 1.0];
+    for (x, y) in [(0, 0), (30, 30), (60, 60), (20, 40)] {
+        common::assert_close(front_image.pixel(x, y), want, LEVEL, "the plane in front");
+    }
+    let flat = arbvis::image::Image::filled(61, 61, TargetFormat::Rgba8, want);
+    assert!(front_image.compare(&flat, LEVEL).unwrap().pixels_over == 0);
+}
+
+/// A translucent closed surface (the cow, every sheet blended back to front) against the
+/// reference that composites every hit of each pixel's ray in depth order.
+#[test]
+fn a_translucent_surface_composites_every_sheet_as_the_reference_does() {
+    let h = headless(Backend::Egl);
+    let file = common::data_file("surfaces/cow.obj");
+    let params = SurfaceScene {
+        opacity: 0.35,
+        colour: [0.9, 0.6, 0.3],
+        ..SurfaceScene::of(&file)
+    };
+    let mesh = arbvis::surface::read(&file).unwrap();
+    let prepared = prepare::of_mesh(&mesh, &params, None);
+    for (fidelity, programs) in [
+        (Fidelity::Faithful, ProgramChoice::Arb),
+        (Fidelity::Precise, ProgramChoice::Glsl),
+    ] {
+        let mut scene = parse("size = [71, 53]\n[technique.surface]\nfile = \"x.obj\"\n").unwrap();
+        scene.technique = params.clone().into();
+        scene.fidelity = fidelity;
+        scene.programs = programs;
+        scene.target = Some(TargetFormat::Rgba32f);
+        scene.camera.rotation = [0.35, -0.41, 0.12, 0.83];
+        let gpu = render_on(&h, &scene).unwrap().image;
+        let cpu = reference::reference(
+            &prepared,
+            &params,
+            fidelity,
+            &scene.camera,
+            scene.size,
+            [0.0; 4],
+        );
+        // The renderer orders triangles by their centroids, the reference each pixel's
+        // hits exactly: they differ where two triangles overlap out of centroid order,
+        // and at edges as for an opaque surface; both are a few pixels of the picture.
+        let d = gpu.compare(&cpu, 2.0 * LEVEL).unwrap();
+        let pixels = (scene.size[0] * scene.size[1]) as usize;
+        assert!(d.pixels_over * 25 < pixels, "{fidelity:?}: {d:?}");
+        assert!(d.rmse < 0.01, "{fidelity:?}: {d:?}");
+        // Several sheets: the densest pixel holds more than one layer's opacity.
+        let densest = gpu.data.chunks(4).map(|p| p[3]).fold(0.0f32, f32::max);
+        assert!(densest > 0.35 + 0.1, "sheets accumulate: {densest}");
+    }
+}
