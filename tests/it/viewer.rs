@@ -750,3 +750,44 @@ fn drawing_in_parts_equals_one_draw() {
         }
     }
 }
+
+/// A layered scene's panel: a layer hidden and moved up through its controls, drawn as
+/// the saved scene draws offscreen.
+#[test]
+fn the_layer_list_hides_and_orders_layers_and_reaches_the_saved_scene() {
+    let dir = temp_dir("layers-scene");
+    let scene = dir.join("layers.toml");
+    std::fs::write(
+        &scene,
+        "[[layer]]\nname = \"horizon\"\n[layer.surface]\nsynthetic = { size = [17, 11], seed = 2 }\ncolour_by = \"elevation\"\n[[layer]]\nname = \"cube\"\n[layer.opacity3d.primary]\nvolume = { synthetic = { size = [19, 13, 17], seed = 4 } }\nattribute = \"amplitude\"\n",
+    )
+    .unwrap();
+    let script = "\
+resize 900 640
+wait 2
+click layer 1: cube (opacity3d) visible
+wait 1
+click layer 1: cube (opacity3d) up
+wait 2
+click Screenshot
+click Save scene
+";
+    let Some((out, _)) = run_script("layers", scene.to_str().unwrap(), "200x150", script) else {
+        return;
+    };
+    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let layers: Vec<_> = saved.layers().collect();
+    assert_eq!(layers.len(), 2);
+    assert_eq!(
+        (layers[0].0.name.as_str(), layers[0].0.visible),
+        ("cube", false)
+    );
+    assert_eq!(
+        (layers[1].0.name.as_str(), layers[1].0.visible),
+        ("horizon", true)
+    );
+    let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&dir);
+}

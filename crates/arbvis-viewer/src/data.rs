@@ -107,6 +107,12 @@ pub fn build(
     kind: ProgramKind,
     data: &mut ViewData,
 ) -> RenderResult<Box<dyn Renderer>> {
+    if scene.is_layered() {
+        // The panels' data are one technique's: a layered scene shows its layers' editors.
+        (data.volume, data.cloud, data.mesh) = (None, None, None);
+        let layers: Vec<_> = scene.layers().collect();
+        return arbvis_techniques::layered::build_any(gpu, &layers, &scene.settings(), kind);
+    }
     if let Some(params) = scene.technique.get::<Opacity3dScene>() {
         return build_volume(gpu, scene, params, kind, data);
     }

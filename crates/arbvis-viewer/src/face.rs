@@ -20,6 +20,7 @@ use arbvis_techniques::techniques::cellproj::CellprojScene;
 use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
 use arbvis_techniques::techniques::quad::QuadScene;
 use arbvis_techniques::techniques::splats::SplatsScene;
+use arbvis_techniques::techniques::surface::SurfaceScene;
 
 /// What an editor may read and keep besides the parameters it edits.
 pub struct EditContext<'a> {
@@ -134,6 +135,41 @@ impl Face for SplatsScene {
     }
 }
 
+impl Face for SurfaceScene {
+    fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool {
+        use arbvis_techniques::techniques::surface::{ColourBy, Lighting};
+        ui.separator();
+        ui.label("Surface");
+        let mut changed = false;
+        let mut by_elevation = self.colour_by == Some(ColourBy::Elevation);
+        let r = ui.checkbox(&mut by_elevation, "Colour by elevation");
+        if cx.widgets.add(ui, "Colour by elevation", &r) && r.changed() {
+            self.colour_by = by_elevation.then_some(ColourBy::Elevation);
+            changed = true;
+        }
+        if !by_elevation {
+            ui.horizontal(|ui| {
+                ui.label("Colour");
+                let mut c = self.colour.map(|v| v as f32);
+                let r = ui.color_edit_button_rgb(&mut c);
+                if cx.widgets.add(ui, "Surface colour", &r) && r.changed() {
+                    self.colour = c.map(|v| v as f64);
+                    changed = true;
+                }
+            });
+        }
+        let mut lit = self.lighting == Lighting::Phong;
+        let r = ui.checkbox(&mut lit, "Lit (headlight)");
+        if cx.widgets.add(ui, "Lit", &r) && r.changed() {
+            self.lighting = if lit { Lighting::Phong } else { Lighting::None };
+            changed = true;
+        }
+        let r = ui.add(egui::Slider::new(&mut self.opacity, 0.01..=1.0).text("Opacity"));
+        changed |= cx.widgets.add(ui, "Opacity", &r) && r.changed();
+        changed
+    }
+}
+
 /// The face of parameters of type `T`, if `parameters` are.
 fn face_of<T: Face + Any>(parameters: &dyn Any) -> Option<&dyn Face> {
     parameters.downcast_ref::<T>().map(|t| t as &dyn Face)
@@ -157,6 +193,7 @@ const FACES: &[FaceLookup] = &[
     (face_of::<Opacity3dScene>, face_of_mut::<Opacity3dScene>),
     (face_of::<CellprojScene>, face_of_mut::<CellprojScene>),
     (face_of::<SplatsScene>, face_of_mut::<SplatsScene>),
+    (face_of::<SurfaceScene>, face_of_mut::<SurfaceScene>),
 ];
 
 /// The face of the scene's technique.

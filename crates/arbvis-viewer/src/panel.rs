@@ -345,19 +345,64 @@ fn technique_editors(
     state: &mut PanelState,
     actions: &mut Vec<UiAction>,
 ) {
+    let base = scene.base.clone();
     let mut cx = EditContext {
         fidelity: scene.fidelity,
-        base: &scene.base,
+        base: &base,
         data,
         widgets: &mut state.widgets,
         clip: &mut state.clip,
         transfer: &mut state.transfer,
     };
+    if scene.is_layered() {
+        if layer_editors(ui, scene, &mut cx) {
+            actions.push(UiAction::ParamsChanged);
+        }
+        return;
+    }
     if let Some(face) = face_mut(&mut scene.technique) {
         if face.editors(ui, &mut cx) {
             actions.push(UiAction::ParamsChanged);
         }
     }
+}
+
+/// A layered scene's layers: each one's visibility, its place in the order, and its
+/// technique's editors (folded); true when something changed.
+fn layer_editors(ui: &mut egui::Ui, scene: &mut Scene, cx: &mut EditContext<'_>) -> bool {
+    ui.separator();
+    ui.label("Layers (drawn opaque first, then in this order)");
+    let count = scene.layers().count();
+    let mut changed = false;
+    let mut moved = None;
+    for (index, (info, technique)) in scene.layers_mut().enumerate() {
+        let name = match info.name.as_str() {
+            "" => format!("layer {index}: {}", technique.name()),
+            n => format!("layer {index}: {n} ({})", technique.name()),
+        };
+        ui.horizontal(|ui| {
+            let r = ui.checkbox(&mut info.visible, "");
+            changed |= cx.widgets.add(ui, &format!("{name} visible"), &r) && r.changed();
+            let up = ui.add_enabled(index > 0, egui::Button::new("^"));
+            if cx.widgets.add(ui, &format!("{name} up"), &up) && up.clicked() {
+                moved = Some((index, index - 1));
+            }
+            let down = ui.add_enabled(index + 1 < count, egui::Button::new("v"));
+            if cx.widgets.add(ui, &format!("{name} down"), &down) && down.clicked() {
+                moved = Some((index, index + 1));
+            }
+            ui.label(&name);
+        });
+        if let Some(face) = face_mut(technique) {
+            egui::CollapsingHeader::new(format!("{name} settings"))
+                .id_salt(("layer", index))
+                .show(ui, |ui| changed |= face.editors(ui, cx));
+        }
+    }
+    if let Some((from, to)) = moved {
+        changed |= scene.move_layer(from, to).is_ok();
+    }
+    changed
 }
 
 /// The camera, the interactive quality and what is drawn over the picture.

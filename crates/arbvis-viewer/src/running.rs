@@ -364,7 +364,14 @@ impl Running {
             match action {
                 UiAction::SetPrograms(kind) => self.set_programs(*kind),
                 UiAction::ParamsChanged => {
-                    if let Err(e) = self.session.params_changed(self.window.gpu(), &self.scene) {
+                    // A layered scene's renderer takes the first layer's parameters and
+                    // is rebuilt for any other layer's (Session::apply tells which).
+                    let gpu = self.window.gpu();
+                    let result = match self.scene.is_layered() {
+                        true => self.session.apply(gpu, &self.scene),
+                        false => self.session.params_changed(gpu, &self.scene),
+                    };
+                    if let Err(e) = result {
                         self.fail_action(format!("error: {e}"));
                     }
                 }
