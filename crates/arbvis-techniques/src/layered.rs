@@ -78,6 +78,8 @@ struct Drawn {
     renderer: Option<Box<dyn Renderer>>,
     /// Drawn in the first pass, with depth.
     opaque: bool,
+    /// The layer's name (its legends' titles).
+    name: String,
 }
 
 /// The renderer of a layered scene: its layers' renderers, each placed in the frame.
@@ -149,6 +151,7 @@ pub fn build(
         drawn.push(Drawn {
             placement: placements[index],
             opaque: renderer.as_ref().is_some_and(|r| r.opaque()),
+            name: info.name.clone(),
             renderer,
         });
     }
@@ -203,6 +206,29 @@ impl Renderer for LayeredRenderer {
             .iter()
             .find_map(|d| d.renderer.as_ref())
             .map_or(ProgramKind::Glsl, |r| r.program_kind())
+    }
+
+    /// Every visible layer's legends, each titled with its layer's name; no axes (each
+    /// layer's are its own frame's).
+    fn annotations(&self) -> crate::techniques::annotations::Annotations {
+        use crate::techniques::annotations::{Annotations, Legend};
+        let mut legends = Vec::new();
+        for d in &self.layers {
+            let Some(r) = d.renderer.as_ref() else {
+                continue;
+            };
+            for mut legend in r.annotations().legends {
+                let (Legend::Bar { title, .. } | Legend::Keys { title, .. }) = &mut legend;
+                if !d.name.is_empty() {
+                    *title = format!("{}: {title}", d.name);
+                }
+                legends.push(legend);
+            }
+        }
+        Annotations {
+            legends,
+            axes: None,
+        }
     }
 
     fn needs_depth(&self) -> bool {

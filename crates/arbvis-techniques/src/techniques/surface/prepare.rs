@@ -28,6 +28,9 @@ pub struct Prepared {
     pub corners: Vec<Corner>,
     /// Where the object frame lies in the world (the file's coordinates).
     pub world: World,
+    /// The lowest and highest z (what an elevation table spans), and the table's
+    /// colours where the surface is coloured by elevation (its legend).
+    pub elevation: ([f64; 2], Option<Vec<[u8; 3]>>),
 }
 
 /// Read `scene.file` (relative to `base`) and prepare it.
@@ -82,7 +85,12 @@ pub fn of_mesh(
             }
         })
         .collect();
-    Prepared { corners, world }
+    let colours = table.map(|t| crate::techniques::annotations::colours(&t.entries));
+    Prepared {
+        corners,
+        world,
+        elevation: ([z0, z1], colours),
+    }
 }
 
 /// Each vertex's normal: the area-weighted sum of its triangles' normals, normalized

@@ -134,6 +134,7 @@ impl SurfaceRenderer {
                 .flat_map(|&t| corners[t * 3..t * 3 + 3].iter().copied())
                 .collect(),
             world: self.prepared.world,
+            elevation: self.prepared.elevation.clone(),
         };
         self.mesh.update(gpu, &vertex_floats(&sorted))?;
         self.sorted_for = Some(key);
@@ -200,6 +201,36 @@ impl Renderer for SurfaceRenderer {
 
     fn needs_depth(&self) -> bool {
         true
+    }
+
+    /// The elevation table over the surface's z range, or its colour as a key.
+    fn annotations(&self) -> crate::techniques::annotations::Annotations {
+        use crate::techniques::annotations::{rgb8, Annotations, Legend};
+        let legend = match &self.prepared.elevation {
+            ([low, high], Some(colours)) => Legend::Bar {
+                title: "elevation (z)".into(),
+                colours: colours.clone(),
+                low: *low,
+                high: *high,
+            },
+            (_, None) => {
+                let [r, g, b] = self.params.colour;
+                Legend::Keys {
+                    title: "surface".into(),
+                    keys: vec![(
+                        rgb8([r, g, b, 1.0]),
+                        match self.params.opacity {
+                            o if o < 1.0 => format!("opacity {o}"),
+                            _ => "opaque".into(),
+                        },
+                    )],
+                }
+            }
+        };
+        Annotations {
+            legends: vec![legend],
+            axes: None,
+        }
     }
 
     fn opaque(&self) -> bool {
