@@ -715,8 +715,9 @@ fn malformed_transfer_functions_are_refused_at_their_line_and_column() {
     };
     for (volume, line, what) in [
         (
+            // The array's element itself, on the line after the key.
             "points = [[0.0, 0, 0, 0, 0], [0.5, 1, 1, 1, 1],\n  [0.2, 1, 1, 1, 1]]",
-            7,
+            8,
             "ascending",
         ),
         ("points = [[0.0, 0, 0, 0, 2.0]]", 7, "points.0"),

@@ -346,3 +346,55 @@ fn a_translucent_surface_composites_every_sheet_as_the_reference_does() {
         assert!(densest > 0.35 + 0.1, "sheets accumulate: {densest}");
     }
 }
+
+/// Many layers of one surface placed apart share its data (read and uploaded once) and
+/// draw in bounded time; past the limit a scene is refused by key.
+#[test]
+fn many_layers_of_one_file_are_read_once_and_too_many_are_refused() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("layered-many");
+    std::fs::write(dir.join("p.obj"), plane_obj([0.0, 1.0], [0.0, 1.0], 0.0)).unwrap();
+    let layer = |i: usize| {
+        format!(
+            "[[layer]]\noffset = [{}.0, {}.0, 0.0]\n[layer.surface]\nfile = \"p.obj\"\nlighting = \"none\"\n",
+            (i % 40) * 2,
+            (i / 40) * 2
+        )
+    };
+    let text: String = (0..1600).map(layer).collect();
+    std::fs::write(
+        dir.join("many.toml"),
+        format!("size = [80, 80]\n[camera]\nzoom = 1.4\n{text}"),
+    )
+    .unwrap();
+    let scene = Scene::load(&dir.join("many.toml")).unwrap();
+    let rendered = render_on(&h, &scene).unwrap();
+    // 1600 unit squares on a 40 x 40 grid, 2 apart: a quarter of the grid's area.
+    let lit = common::lit_pixels(&rendered.image, 0.5);
+    assert!(lit > 80 * 80 / 8 && lit < 80 * 80 / 2, "{lit}");
+    // One renderer for the 1600 layers: one vertex buffer holds the surface.
+    let buffers = rendered
+        .resources
+        .iter()
+        .filter(|r| r.label == "vertices surface")
+        .count();
+    assert_eq!(buffers, 1, "{:?}", rendered.resources);
+    let text: String = (0..4097).map(layer).collect();
+    let e = parse(&text).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("layer: 4097 layers: a scene holds at most 4096"),
+        "{e}"
+    );
+}
+
+/// A value of the wrong shape in a layer is named with the layer's index, as the text's
+/// `[[layer]]` tables count.
+#[test]
+fn a_value_of_the_wrong_shape_names_its_layer() {
+    let text = "[[layer]]\n[layer.surface]\nfile = \"a.obj\"\n[[layer]]\nname = \"b\"\n[layer.surface]\nfile = \"b.obj\"\ncolour = [0.5, 0.5]\n";
+    let SceneError::Parse { key, line, .. } = parse(text).unwrap_err() else {
+        panic!("a parse error");
+    };
+    assert_eq!((key.as_deref(), line), (Some("layer.1.surface.colour"), 8));
+}

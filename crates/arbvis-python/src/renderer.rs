@@ -218,12 +218,16 @@ impl PyRenderer {
     /// The f64 CPU reference of the scene's picture as it is now (float32, as `render()`
     /// shows a picture), computed on the CPU with the GIL released: the yardstick the
     /// precise modes are measured against. None where the technique has none (splats,
-    /// isosurfaces alone, a survey store, a clipped 3D opacity scene).
+    /// isosurfaces alone, a survey store, a clipped 3D opacity scene, a layered scene:
+    /// the exact composite of several layers is not built yet).
     fn reference<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         // A closed renderer draws nothing more, its reference neither.
         self.jobs()?;
         let current = lock(&self.scene).clone_ref(py);
         let scene = scene_now(py, &current)?;
+        if scene.is_layered() {
+            return Ok(None);
+        }
         let limits = Limits::for_max_side(self.max_3d_texture_size);
         let image = py
             .detach(|| {

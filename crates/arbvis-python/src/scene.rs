@@ -140,9 +140,13 @@ fn matrix(py: Python<'_>, m: glam::DMat4) -> Bound<'_, numpy::PyArray2<f64>> {
     numpy::PyArray2::from_vec2(py, &rows).expect("four rows of four")
 }
 
-/// The value at dotted `key` in `tree`.
+/// The value at dotted `key` in `tree` (a number indexes an array: `layer.1.surface`).
 fn at<'t>(tree: &'t serde_json::Value, key: &str) -> Option<&'t serde_json::Value> {
-    key.split('.').try_fold(tree, |node, part| node.get(part))
+    key.split('.')
+        .try_fold(tree, |node, part| match (node, part.parse::<usize>()) {
+            (serde_json::Value::Array(items), Ok(i)) => items.get(i),
+            _ => node.get(part),
+        })
 }
 
 /// Put `value` at dotted `key` in `tree` (tables made on the way); `None` removes it.
@@ -151,12 +155,19 @@ fn put(tree: &mut serde_json::Value, key: &str, value: Option<serde_json::Value>
     let (last, path) = parts.split_last().expect("split gives one part at least");
     let mut node = tree;
     for part in path {
-        let map = node
-            .as_object_mut()
-            .ok_or_else(|| PyKeyError::new_err(format!("{key}: {part} is inside a value")))?;
-        node = map
-            .entry(part.to_string())
-            .or_insert_with(|| serde_json::Value::Object(Default::default()));
+        node = match (node, part.parse::<usize>()) {
+            (serde_json::Value::Array(items), Ok(i)) => {
+                let count = items.len();
+                items.get_mut(i).ok_or_else(|| {
+                    PyKeyError::new_err(format!("{key}: {i} is past the {count} there are"))
+                })?
+            }
+            (node, _) => node
+                .as_object_mut()
+                .ok_or_else(|| PyKeyError::new_err(format!("{key}: {part} is inside a value")))?
+                .entry(part.to_string())
+                .or_insert_with(|| serde_json::Value::Object(Default::default())),
+        };
     }
     let map = node
         .as_object_mut()
@@ -187,7 +198,27 @@ pub struct PyScene {
     pub kept: Vec<Kept>,
 }
 
+/// The scene's layers as `[[layer]]` tables (a one-technique scene's one table).
+fn layer_tables(scene: &Scene) -> Vec<serde_json::Value> {
+    let tree = tree_of(scene);
+    match (tree.get("layer"), tree.get("technique")) {
+        (Some(serde_json::Value::Array(layers)), _) => layers.clone(),
+        (_, Some(technique)) => vec![technique.clone()],
+        _ => Vec::new(),
+    }
+}
+
 impl PyScene {
+    /// The scene with `layers` as its `[[layer]]` tables, validated.
+    fn set_layer_tables(&mut self, _: Python<'_>, layers: Vec<serde_json::Value>) -> PyResult<()> {
+        let mut tree = tree_of(&self.scene);
+        let map = tree.as_object_mut().expect("a scene is a table");
+        map.remove("technique");
+        map.insert("layer".into(), serde_json::Value::Array(layers));
+        self.scene = scene_of(&tree, self.scene.base.clone(), None)?;
+        Ok(())
+    }
+
     /// Turn the scene's rotation by `degrees` about `axis` of the screen (eye space).
     fn turn(&mut self, axis: glam::DVec3, degrees: f64) -> PyResult<()> {
         if !degrees.is_finite() {
@@ -289,6 +320,82 @@ impl PyScene {
         self.scene = scene_of(&tree, self.scene.base.clone(), Some(key))?;
         self.kept.extend(kept);
         Ok(())
+    }
+
+    /// The layers, in drawing order, each a dict shaped as its `[[layer]]` table (a
+    /// copy: change them by dotted key, `scene["layer.1.surface.opacity"] = 0.5`). A
+    /// one-technique scene is one layer.
+    #[getter]
+    fn layers<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_loads(
+            py,
+            &serde_json::Value::Array(layer_tables(&self.scene)).to_string(),
+        )
+    }
+
+    /// Add a layer drawing `technique` with `params` (a dict shaped as its table, where an
+    /// `arbvis.Volume`, `Cloud` or `Mesh` stands for a data file), at the end or at
+    /// `index`; `name`, `visible`, `offset` and `scale` as in a `[[layer]]` table.
+    /// Validated as a scene file is: a bad value raises `SceneError` naming
+    /// `layer.INDEX....`.
+    #[pyo3(signature = (technique, params = None, *, name = None, visible = true, offset = None, scale = None, index = None))]
+    #[allow(clippy::too_many_arguments)]
+    fn add_layer(
+        &mut self,
+        py: Python<'_>,
+        technique: &str,
+        params: Option<&Bound<'_, PyAny>>,
+        name: Option<String>,
+        visible: bool,
+        offset: Option<[f64; 3]>,
+        scale: Option<f64>,
+        index: Option<usize>,
+    ) -> PyResult<()> {
+        let mut kept = Vec::new();
+        let params = match params {
+            Some(p) => json_of(&naming_volumes(p, &mut kept)?)?,
+            None => serde_json::json!({}),
+        };
+        let mut table = serde_json::Map::new();
+        if let Some(name) = name {
+            table.insert("name".into(), name.into());
+        }
+        if !visible {
+            table.insert("visible".into(), false.into());
+        }
+        if let Some(offset) = offset {
+            table.insert("offset".into(), serde_json::json!(offset));
+        }
+        if let Some(scale) = scale {
+            table.insert("scale".into(), serde_json::json!(scale));
+        }
+        table.insert(technique.to_string(), params);
+        let mut layers = layer_tables(&self.scene);
+        let index = index.unwrap_or(layers.len()).min(layers.len());
+        layers.insert(index, serde_json::Value::Object(table));
+        self.set_layer_tables(py, layers)?;
+        self.kept.extend(kept);
+        Ok(())
+    }
+
+    /// Remove layer `index` (a scene keeps one at least).
+    fn remove_layer(&mut self, py: Python<'_>, index: usize) -> PyResult<()> {
+        let mut layers = layer_tables(&self.scene);
+        if index >= layers.len() || layers.len() == 1 {
+            return Err(pyo3::exceptions::PyIndexError::new_err(format!(
+                "layer {index} of {}: a scene keeps one layer at least",
+                layers.len()
+            )));
+        }
+        layers.remove(index);
+        self.set_layer_tables(py, layers)
+    }
+
+    /// Move layer `from_index` to `to_index` (the drawing order of translucent layers).
+    fn move_layer(&mut self, from_index: usize, to_index: usize) -> PyResult<()> {
+        self.scene
+            .move_layer(from_index, to_index)
+            .map_err(|e| pyo3::exceptions::PyIndexError::new_err(e.to_string()))
     }
 
     /// Whether the scene holds a value at dotted `key`.

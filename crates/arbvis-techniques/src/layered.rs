@@ -71,11 +71,15 @@ pub fn placements(worlds: &[World]) -> Vec<Placement> {
         .collect()
 }
 
+/// Most layers a scene holds (each is prepared, placed and drawn: bounded work).
+pub const MAX_LAYERS: usize = 4096;
+
 /// One layer as drawn.
 struct Drawn {
     placement: Placement,
-    /// None for a hidden layer (prepared for its place in the frame, never built).
-    renderer: Option<Box<dyn Renderer>>,
+    /// Its renderer in [`LayeredRenderer::renderers`] (layers with equal parameters share
+    /// one: their data are read and uploaded once); None for a hidden layer.
+    renderer: Option<usize>,
     /// Drawn in the first pass, with depth.
     opaque: bool,
     /// The layer's name (its legends' titles).
@@ -85,6 +89,7 @@ struct Drawn {
 /// The renderer of a layered scene: its layers' renderers, each placed in the frame.
 pub struct LayeredRenderer {
     layers: Vec<Drawn>,
+    renderers: Vec<Box<dyn Renderer>>,
 }
 
 /// `error` named as layer `index`'s.
@@ -115,7 +120,8 @@ pub fn build_any(
     }
 }
 
-/// Prepare every layer, place them in one frame, build the visible ones' renderers.
+/// Prepare every distinct layer once (layers of equal parameters share their data), place
+/// them in one frame, build the renderers the visible ones need.
 pub fn build(
     gpu: &Gpu,
     layers: &[(&LayerInfo, &TechniqueScene)],
@@ -123,51 +129,82 @@ pub fn build(
     kind: ProgramKind,
 ) -> RenderResult<LayeredRenderer> {
     let limits = Limits::for_max_side(gpu.caps().max_3d_texture_size);
-    let mut prepared = Vec::with_capacity(layers.len());
-    let mut worlds = Vec::with_capacity(layers.len());
+    // Each layer's distinct technique: the first layer with equal parameters.
+    let first: Vec<usize> = (0..layers.len())
+        .map(|i| (0..i).find(|&j| layers[j].1 == layers[i].1).unwrap_or(i))
+        .collect();
+    let mut prepared: Vec<Option<crate::catalog::PreparedData>> = Vec::new();
+    // Each layer's world as its data give it, before its hand placement.
+    let mut own: Vec<World> = Vec::with_capacity(layers.len());
     for (index, (info, technique)) in layers.iter().enumerate() {
-        let data = crate::catalog::prepare(technique, settings, &limits)
-            .map_err(|e| in_layer(index, info, e))?;
-        let world = crate::catalog::world(technique, &data).ok_or_else(|| {
-            let why = RenderError::Unplaced(format!(
-                "a {} layer has no place in a world frame yet (a layered scene takes surfaces, clouds, meshes and volumes read whole, not survey stores or the quad)",
-                technique.name()
-            ));
-            in_layer(index, info, why)
-        })?;
-        worlds.push(placed_world(world, info));
-        prepared.push(data);
+        if first[index] == index {
+            let data = crate::catalog::prepare(technique, settings, &limits)
+                .map_err(|e| in_layer(index, info, e))?;
+            let world = crate::catalog::world(technique, &data).ok_or_else(|| {
+                let why = RenderError::Unplaced(format!(
+                    "a {} layer has no place in a world frame yet (a layered scene takes surfaces, clouds, meshes and volumes read whole, not survey stores or the quad)",
+                    technique.name()
+                ));
+                in_layer(index, info, why)
+            })?;
+            own.push(world);
+            prepared.push(Some(data));
+        } else {
+            own.push(own[first[index]]);
+            prepared.push(None);
+        }
     }
+    let worlds: Vec<World> = own
+        .into_iter()
+        .zip(layers)
+        .map(|(world, (info, _))| placed_world(world, info))
+        .collect();
     let placements = placements(&worlds);
-    let mut drawn = Vec::with_capacity(layers.len());
-    for (index, ((info, technique), data)) in layers.iter().zip(prepared).enumerate() {
-        let renderer = match info.visible {
-            true => Some(
-                crate::catalog::renderer(technique, gpu, settings, kind, data)
-                    .map_err(|e| in_layer(index, info, e))?,
-            ),
-            false => None,
-        };
-        drawn.push(Drawn {
-            placement: placements[index],
-            opaque: renderer.as_ref().is_some_and(|r| r.opaque()),
-            name: info.name.clone(),
-            renderer,
-        });
+    // A renderer for each distinct technique some visible layer draws.
+    let wanted = |i: usize| (0..layers.len()).any(|l| first[l] == i && layers[l].0.visible);
+    let mut renderers = Vec::new();
+    let mut slot = vec![None; layers.len()];
+    for (index, data) in prepared.into_iter().enumerate() {
+        let (info, technique) = layers[index];
+        if let Some(data) = data.filter(|_| wanted(index)) {
+            let renderer = crate::catalog::renderer(technique, gpu, settings, kind, data)
+                .map_err(|e| in_layer(index, info, e))?;
+            slot[index] = Some(renderers.len());
+            renderers.push(renderer);
+        }
     }
-    Ok(LayeredRenderer { layers: drawn })
+    let layers = layers
+        .iter()
+        .enumerate()
+        .map(|(index, (info, _))| {
+            let renderer = slot[first[index]].filter(|_| info.visible);
+            Drawn {
+                placement: placements[index],
+                opaque: renderer.is_some_and(|r| renderers[r].opaque()),
+                name: info.name.clone(),
+                renderer,
+            }
+        })
+        .collect();
+    Ok(LayeredRenderer { layers, renderers })
 }
 
 impl LayeredRenderer {
-    /// The visible layers in drawing order: opaque first, then translucent, each in the
-    /// scene's order.
-    fn in_order(&mut self) -> impl Iterator<Item = (Placement, bool, &mut Box<dyn Renderer>)> {
-        let (opaque, translucent): (Vec<_>, Vec<_>) =
-            self.layers.iter_mut().partition(|d| d.opaque);
-        opaque
-            .into_iter()
-            .chain(translucent)
-            .filter_map(|d| Some((d.placement, d.opaque, d.renderer.as_mut()?)))
+    /// The visible layers in drawing order (opaque first, then translucent, each in the
+    /// scene's order): placement, opacity and renderer index.
+    fn in_order(&self) -> Vec<(Placement, bool, usize)> {
+        let visible = |opaque: bool| {
+            self.layers
+                .iter()
+                .filter(move |d| d.opaque == opaque)
+                .filter_map(|d| Some((d.placement, d.opaque, d.renderer?)))
+        };
+        visible(true).chain(visible(false)).collect()
+    }
+
+    /// The distinct renderers that draw.
+    fn drawn(&self) -> impl Iterator<Item = &Box<dyn Renderer>> {
+        self.renderers.iter()
     }
 }
 
@@ -181,9 +218,9 @@ fn placed(frame: &Frame, placement: Placement) -> Frame {
 impl Renderer for LayeredRenderer {
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
         let mut result = Ok(());
-        for (placement, opaque, renderer) in self.in_order() {
+        for (placement, opaque, r) in self.in_order() {
             gpu.set_occluded(!opaque);
-            result = renderer.draw(gpu, surface, &placed(frame, placement));
+            result = self.renderers[r].draw(gpu, surface, &placed(frame, placement));
             if result.is_err() {
                 break;
             }
@@ -195,16 +232,15 @@ impl Renderer for LayeredRenderer {
     /// The first layer's parameters (what the session's one-technique editors change);
     /// a change to any other layer rebuilds the scene's renderer.
     fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> RenderResult<()> {
-        match self.layers.first_mut().and_then(|d| d.renderer.as_mut()) {
-            Some(r) => r.update(gpu, params),
+        match self.layers.first().and_then(|d| d.renderer) {
+            Some(r) => self.renderers[r].update(gpu, params),
             None => Ok(()),
         }
     }
 
     fn program_kind(&self) -> ProgramKind {
-        self.layers
-            .iter()
-            .find_map(|d| d.renderer.as_ref())
+        self.drawn()
+            .next()
             .map_or(ProgramKind::Glsl, |r| r.program_kind())
     }
 
@@ -214,10 +250,10 @@ impl Renderer for LayeredRenderer {
         use crate::techniques::annotations::{Annotations, Legend};
         let mut legends = Vec::new();
         for d in &self.layers {
-            let Some(r) = d.renderer.as_ref() else {
+            let Some(r) = d.renderer else {
                 continue;
             };
-            for mut legend in r.annotations().legends {
+            for mut legend in self.renderers[r].annotations().legends {
                 let (Legend::Bar { title, .. } | Legend::Keys { title, .. }) = &mut legend;
                 if !d.name.is_empty() {
                     *title = format!("{}: {title}", d.name);
@@ -232,10 +268,23 @@ impl Renderer for LayeredRenderer {
     }
 
     fn needs_depth(&self) -> bool {
-        self.layers
+        self.drawn().any(|r| r.needs_depth())
+    }
+
+    /// Each visible layer's line, named.
+    fn status(&self) -> Option<String> {
+        let lines: Vec<String> = self
+            .layers
             .iter()
-            .filter_map(|d| d.renderer.as_ref())
-            .any(|r| r.needs_depth())
+            .filter_map(|d| {
+                let line = self.renderers[d.renderer?].status()?;
+                Some(match d.name.as_str() {
+                    "" => line,
+                    name => format!("{name}: {line}"),
+                })
+            })
+            .collect();
+        (!lines.is_empty()).then(|| lines.join("; "))
     }
 
     fn streaming(&self) -> Option<&dyn Streaming> {
@@ -249,31 +298,89 @@ impl Renderer for LayeredRenderer {
 
 impl Streaming for LayeredRenderer {
     fn set_streaming(&mut self, streaming: bool) {
-        for d in &mut self.layers {
-            if let Some(r) = d.renderer.as_mut() {
-                r.set_streaming(streaming);
-            }
+        for r in &mut self.renderers {
+            r.set_streaming(streaming);
         }
     }
 
     fn pending(&self) -> bool {
-        self.layers
-            .iter()
-            .filter_map(|d| d.renderer.as_ref())
-            .any(|r| r.pending())
+        self.drawn().any(|r| r.pending())
     }
 
     fn settle(&mut self, gpu: &Gpu, camera: &Camera, size: [u32; 2]) -> RenderResult<bool> {
         let mut arrived = false;
-        for d in &mut self.layers {
-            if let Some(r) = d.renderer.as_mut() {
-                let camera = Camera {
-                    placement: d.placement,
-                    ..*camera
-                };
-                arrived |= r.settle(gpu, &camera, size)?;
-            }
+        // A shared renderer settles for the first layer that draws it.
+        for (placement, _, r) in self.in_order() {
+            let camera = Camera {
+                placement,
+                ..*camera
+            };
+            arrived |= self.renderers[r].settle(gpu, &camera, size)?;
         }
         Ok(arrived)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn world_at(centre: DVec3, units: f64) -> World {
+        World {
+            half: DVec3::new(1.0, 0.5, 0.25),
+            units,
+            rotation: DQuat::IDENTITY,
+            centre,
+        }
+    }
+
+    /// Layers in UTM coordinates a millimetre apart stay a millimetre apart in the
+    /// frame: positions are subtracted in f64 before they are scaled.
+    #[test]
+    fn utm_layers_keep_their_millimetres() {
+        let utm = DVec3::new(635_123.456, 6_123_456.789, -1234.5);
+        for shift in [1e-3, 2.5e-3, -7e-3] {
+            let worlds = [
+                world_at(utm, 600.0),
+                world_at(utm + DVec3::new(shift, 0.0, -shift), 600.0),
+            ];
+            let p = placements(&worlds);
+            // The frame's longest side is 1200 m: 2 / 1200 scene units per metre.
+            let s = 2.0 / (1200.0 + shift.abs());
+            let apart = p[1].offset - p[0].offset;
+            // f64 rounding of 6e6 is 1e-9 m: far below the millimetre.
+            assert!((apart.x - shift * s).abs() < 1e-11 * s * 1e3, "{apart}");
+            assert!((apart.z + shift * s).abs() < 1e-11 * s * 1e3, "{apart}");
+        }
+    }
+
+    /// One layer alone sits at the frame's centre at the scale its technique framed it
+    /// (its longest side [-1, 1]): the identity placement, whatever its coordinates.
+    #[test]
+    fn one_layer_is_placed_as_it_frames_itself() {
+        for (centre, units) in [
+            (DVec3::new(635_000.0, 848_000.0, -400.0), 71.5),
+            (DVec3::new(-3.0, 0.25, 9.0), 0.013),
+        ] {
+            let p = placements(&[world_at(centre, units)])[0];
+            assert!((p.scale - 1.0).abs() < 1e-12);
+            assert!(p.offset.length() < 1e-9, "{:?}", p.offset);
+        }
+    }
+
+    /// A hand placement scales the data's coordinates and then moves them.
+    #[test]
+    fn scale_then_offset() {
+        let w = world_at(DVec3::new(10.0, 20.0, 30.0), 5.0);
+        let info = LayerInfo {
+            scale: 2.0,
+            offset: [1.0, -1.0, 0.5],
+            ..LayerInfo::default()
+        };
+        let placed = placed_world(w, &info);
+        assert_eq!(placed.units, 10.0);
+        assert_eq!(placed.centre, DVec3::new(21.0, 39.0, 60.5));
+        // A data point at object (1, 0, 0) lies at 2 * (15, 20, 30) + offset.
+        assert_eq!(placed.to_world(DVec3::X), DVec3::new(31.0, 39.0, 60.5));
     }
 }

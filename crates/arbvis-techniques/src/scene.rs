@@ -605,6 +605,16 @@ impl Scene {
             return Err(FieldError::new("camera.rotation", "must be finite"));
         }
         self.memory_budget_bytes()?;
+        let count = self.layers().count();
+        if count > crate::layered::MAX_LAYERS {
+            return Err(FieldError::new(
+                "layer",
+                format!(
+                    "{count} layers: a scene holds at most {}",
+                    crate::layered::MAX_LAYERS
+                ),
+            ));
+        }
         for (index, (info, technique)) in self.layers().enumerate() {
             validate_layer(info).map_err(|e| e.within(&format!("layer.{index}")))?;
             technique
@@ -799,11 +809,33 @@ fn key_at(text: &str, at: usize) -> Option<String> {
                 .map(|(k, _)| k.trim().trim_matches('"').to_string());
         }
     }
+    let table = table.map(|t| in_array_of_tables(&text[..line_start], t));
     match (table, key) {
         (Some(t), Some(k)) => Some(format!("{t}.{k}")),
         (None, Some(k)) => Some(k),
         (Some(t), None) => Some(t),
         (None, None) => None,
+    }
+}
+
+/// Table `t` (`layer.surface`) with the index of the array of tables it lies in
+/// (`layer.1.surface`): `[[layer]]` headers counted in `before`, the text above it.
+fn in_array_of_tables(before: &str, t: String) -> String {
+    let arrays = before.lines().filter_map(|l| {
+        let l = l.trim();
+        l.strip_prefix("[[")?.strip_suffix("]]").map(str::trim)
+    });
+    let Some(name) = arrays
+        .clone()
+        .filter(|a| t == *a || t.starts_with(&format!("{a}.")))
+        .last()
+    else {
+        return t;
+    };
+    let index = arrays.filter(|a| *a == name).count().saturating_sub(1);
+    match t.strip_prefix(name) {
+        Some(rest) => format!("{name}.{index}{rest}"),
+        None => t,
     }
 }
 
