@@ -402,3 +402,50 @@ def test_an_array_changed_after_it_was_handed_over_changes_no_picture(tmp_path):
     view = cube.copy()
     view.flags.writeable = False
     arbvis.Volume(view, (1.0, 1.0, 1.0))
+
+
+def test_an_xarray_survey_lies_where_its_segy_does_in_a_layered_scene(tmp_path):
+    """Placed by cdp_x/cdp_y as the SEG-Y by its trace headers: beside a plane in map
+    coordinates through the survey's middle, the same picture from either."""
+    xr = pytest.importorskip("xarray")
+    cube = random_cube()
+    write_segy(tmp_path / "cube.sgy", cube)
+    ni, nx, ns = cube.shape
+    xy = np.array([[trace_xy(k, j) for j in range(nx)] for k in range(ni)]) / 100.0
+    x0, y0 = xy[..., 0].min() - 50, xy[..., 1].min() - 50
+    x1, y1 = xy[..., 0].max() + 50, xy[..., 1].max() + 50
+    # A plane 60 m down (the survey's 31 samples of 4 ms reach 120 m), a little tilted.
+    (tmp_path / "plane.obj").write_text(
+        f"v {x0} {y0} -60\nv {x1} {y0} -60\nv {x1} {y1} -55\nv {x0} {y1} -55\nf 1 2 3\nf 1 3 4\n"
+    )
+    layers = f"""size = [73, 61]
+[[layer]]
+name = "survey"
+[layer.opacity3d.primary]
+volume = {{ segy = "cube.sgy" }}
+attribute = "amplitude"
+[[layer]]
+name = "plane"
+[layer.surface]
+file = "plane.obj"
+colour = [0.9, 0.75, 0.2]
+"""
+    scene = arbvis.Scene.from_toml(layers, base=tmp_path)
+    want = render(scene)
+    da = xr.DataArray(
+        cube,
+        dims=("inline", "crossline", "time"),
+        coords={
+            "inline": 100 + np.arange(ni),
+            "crossline": 200 + np.arange(nx),
+            "time": DT_MS * np.arange(ns, dtype=np.float64),
+            "cdp_x": (("inline", "crossline"), xy[..., 0]),
+            "cdp_y": (("inline", "crossline"), xy[..., 1]),
+        },
+    )
+    scene["layer.0.opacity3d.primary.volume"] = arbvis.Volume(da)
+    got = render(scene)
+    assert np.array_equal(got, want)
+    # The plane cuts the survey: hiding it changes the picture where the survey was hidden.
+    scene["layer.1.visible"] = False
+    assert np.abs(render(scene) - want).max() > 0.1

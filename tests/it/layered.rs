@@ -398,3 +398,45 @@ fn a_value_of_the_wrong_shape_names_its_layer() {
     };
     assert_eq!((key.as_deref(), line), (Some("layer.1.surface.colour"), 8));
 }
+
+/// F3's SEG-Y in the world: its first trace's first sample at the trace's CDP
+/// coordinates (read here from the file's bytes) at z = 0, its samples downwards.
+#[test]
+fn a_segy_survey_lies_at_its_cdp_coordinates() {
+    let path = common::data_file("seismic/f3.sgy");
+    let bytes = std::fs::read(&path).unwrap();
+    let header = &bytes[3600..3600 + 240];
+    let i32_at = |at: usize| i32::from_be_bytes(header[at..at + 4].try_into().unwrap());
+    let scalar = i16::from_be_bytes([header[70], header[71]]) as f64;
+    let scale = if scalar < 0.0 {
+        -1.0 / scalar
+    } else if scalar > 0.0 {
+        scalar
+    } else {
+        1.0
+    };
+    assert_eq!(
+        (i32_at(188), i32_at(192)),
+        (111, 875),
+        "the file's first trace is the grid's first"
+    );
+    let cdp = [i32_at(180) as f64 * scale, i32_at(184) as f64 * scale];
+    let scene = Scene::load(std::path::Path::new("scenes/data/f3-minimal.toml")).unwrap();
+    let settings = scene.settings();
+    let limits = arbvis::volume::Limits::for_max_side(2048);
+    let prepared = arbvis::catalog::prepare(&scene.technique, &settings, &limits).unwrap();
+    let world = arbvis::catalog::world(&scene.technique, &prepared).unwrap();
+    // The first voxel's centre: half a voxel in from the box's corner (75 x 18 x 23).
+    let dims = glam::DVec3::new(75.0, 18.0, 23.0);
+    let first = -world.half + world.half / dims;
+    let at = world.to_world(first);
+    // The CDP coordinates are whole metres or finer; f64 at 6e6: 1e-8.
+    assert!(
+        (at.x - cdp[0]).abs() < 1e-6 && (at.y - cdp[1]).abs() < 1e-6,
+        "{at} vs {cdp:?}"
+    );
+    assert!(at.z.abs() < 1e-9, "{at}");
+    // The last sample lies 74 samples of 4 m below.
+    let last = world.to_world(first + glam::DVec3::X * (world.half.x * 2.0 * 74.0 / 75.0));
+    assert!((last.z + 296.0).abs() < 1e-6, "{last}");
+}

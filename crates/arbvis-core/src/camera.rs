@@ -34,7 +34,8 @@ pub struct Camera {
 }
 
 /// A layer's own frame placed in the scene's: `scene = scale * rotation * own + offset`.
-/// Uniform and rigid, so depth order, angles and proportions are the layer's own.
+/// Uniform and rigid, so depth order, angles and proportions are the layer's own; a
+/// negative scale mirrors (a survey grid turned the other way round).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Placement {
     /// Scene units per unit of the layer's frame (above 0).
@@ -105,7 +106,8 @@ impl Camera {
     /// The unit direction toward the viewer in the drawn layer's frame (the slices'
     /// normal; the opposite of the viewing direction).
     pub fn toward_viewer(&self) -> DVec3 {
-        self.placement.rotation.inverse() * (self.quat().inverse() * DVec3::Z)
+        let mirrored = self.placement.scale.signum();
+        self.placement.rotation.inverse() * (self.quat().inverse() * DVec3::Z) * mirrored
     }
 
     /// The eye in the drawn layer's frame (perspective): `R⁻¹ (0, 0, d)` in the scene's,
@@ -347,6 +349,12 @@ mod placement_tests {
                 rotation: DQuat::from_rotation_y(-std::f64::consts::FRAC_PI_2),
                 offset: DVec3::new(-1.0, 0.0, 0.4),
             },
+            // Mirrored.
+            Placement {
+                scale: -0.8,
+                rotation: DQuat::from_euler(glam::EulerRot::ZXY, 0.3, 0.1, -1.2),
+                offset: DVec3::new(0.5, 0.25, -0.75),
+            },
         ];
         for projection in [Projection::Perspective, Projection::Orthographic] {
             let unplaced = Camera {
@@ -364,7 +372,7 @@ mod placement_tests {
                 // f64 arithmetic on values of order 10: 1e-12.
                 let eye = m.transform_point3(placed.eye());
                 assert!((eye - unplaced.eye()).length() < 1e-12, "{placement:?}");
-                let toward = m.transform_vector3(placed.toward_viewer()) / placement.scale;
+                let toward = m.transform_vector3(placed.toward_viewer()) / placement.scale.abs();
                 assert!((toward - unplaced.toward_viewer()).length() < 1e-12);
                 let p = DVec3::new(0.3, -0.8, 0.5);
                 let a = placed.view_projection(1.3).project_point3(p);

@@ -14,7 +14,7 @@ use std::sync::Arc;
 use numpy::{PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::prelude::*;
 
-use arbvis_data::volume::segy::geometry::survey_spacing;
+use arbvis_data::volume::segy::geometry::{survey_spacing, MapFrame};
 use arbvis_data::volume::{memory, Volume};
 
 use crate::errors;
@@ -58,17 +58,24 @@ impl PyVolume {
             .call_method1("volume_parts", (data, spacing))?;
         let (values, spacing, cdp, axis): Parts<'_> = parts.extract()?;
         let [nk, nj, ni] = <[usize; 3]>::try_from(values.shape()).expect("a 3D array");
+        let cdp = cdp.map(|(x, y)| [x, y]);
         let spacing = match spacing {
             Some((inline, crossline, sample)) => [sample, crossline, inline],
             None => {
-                let cdp = cdp.map(|(x, y)| [x, y]);
                 let axis = axis.as_ref().map(|(domain, step)| (domain.as_str(), *step));
                 survey_spacing(cdp.as_ref(), None, [nj, nk], axis)
             }
         };
         let samples = values.as_slice().map_err(errors::input_error)?.to_vec();
-        let volume = Volume::new([ni, nj, nk], spacing, samples)
+        let mut volume = Volume::new([ni, nj, nk], spacing, samples)
             .map_err(|e| errors::input_error(format!("volume: {e}")))?;
+        // Placed on the map by its corner traces' cdp_x/cdp_y, as a SEG-Y is.
+        volume.map = cdp.as_ref().and_then(|[x, y]| {
+            MapFrame::of_corners(nj, nk, |k, j| {
+                let t = k * nj + j;
+                Some([*x.get(t)?, *y.get(t)?]).filter(|p| p.iter().all(|v| v.is_finite()))
+            })
+        });
         let volume = Arc::new(volume);
         let name = memory::register(&volume);
         Ok(PyVolume { volume, name })

@@ -827,8 +827,7 @@ fn in_array_of_tables(before: &str, t: String) -> String {
     });
     let Some(name) = arrays
         .clone()
-        .filter(|a| t == *a || t.starts_with(&format!("{a}.")))
-        .last()
+        .rfind(|a| t == *a || t.starts_with(&format!("{a}.")))
     else {
         return t;
     };

@@ -20,7 +20,7 @@ use crate::volume::{nifti_file, Endian, SampleType, Volume, VolumeError};
 #[derive(Debug)]
 pub enum Input {
     /// SEG-Y, trace by trace.
-    Segy(SegyStream, SourceMeta),
+    Segy(Box<SegyStream>, SourceMeta),
     /// Samples at fixed offsets of a file (raw, uncompressed NIfTI).
     Flat(Flat),
     /// A volume held whole (gzip NIfTI).
@@ -173,7 +173,7 @@ impl Input {
         m.inlines = Some(step(&s.grid.inlines));
         m.crosslines = Some(step(&s.grid.crosslines));
         m.interval_us = Some(s.interval_us);
-        Ok(Input::Segy(s, m))
+        Ok(Input::Segy(Box::new(s), m))
     }
 
     /// Whether the input gives map coordinates per trace (SEG-Y's CDP x and y, an MDIO

@@ -29,6 +29,8 @@ pub struct Volume {
     pub spacing: [f64; 3],
     /// `ni * nj * nk` samples, i fastest. May hold NaN or infinities from files.
     pub values: Vec<f32>,
+    /// Where a survey's traces lie on the map (its CDP coordinates), where its file says.
+    pub map: Option<segy::geometry::MapFrame>,
 }
 
 impl Volume {
@@ -52,6 +54,7 @@ impl Volume {
             dims,
             spacing,
             values,
+            map: None,
         })
     }
 

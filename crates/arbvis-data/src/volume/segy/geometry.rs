@@ -33,6 +33,49 @@ pub struct Geometry {
     pub spacing: [f64; 3],
     /// Whether the trace steps were measured.
     pub bins: BinsFrom,
+    /// Where the grid lies on the map, from its corner traces' CDP coordinates.
+    pub map: Option<MapFrame>,
+}
+
+/// A survey grid on the map: its first trace's CDP coordinates and the unit directions in
+/// which crossline and inline indices grow (what places it in a layered scene's world).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapFrame {
+    /// CDP x and y of the trace at the first inline and crossline.
+    pub origin: [f64; 2],
+    /// Unit map direction of growing crossline index.
+    pub crossline: [f64; 2],
+    /// Unit map direction of growing inline index.
+    pub inline: [f64; 2],
+}
+
+impl MapFrame {
+    /// The frame of a grid of `nj` crosslines by `nk` inlines from the CDP coordinates of
+    /// three corner traces (`at(k, j)`); None where one is missing or the grid has a
+    /// single line either way (no direction), or the two directions are not independent.
+    pub fn of_corners(
+        nj: usize,
+        nk: usize,
+        mut at: impl FnMut(usize, usize) -> Option<[f64; 2]>,
+    ) -> Option<MapFrame> {
+        if nj < 2 || nk < 2 {
+            return None;
+        }
+        let origin = at(0, 0)?;
+        let unit = |p: [f64; 2]| {
+            let d = [p[0] - origin[0], p[1] - origin[1]];
+            let n = d[0].hypot(d[1]);
+            (n > 0.0 && n.is_finite()).then(|| [d[0] / n, d[1] / n])
+        };
+        let crossline = unit(at(0, nj - 1)?)?;
+        let inline = unit(at(nk - 1, 0)?)?;
+        let cross = crossline[0] * inline[1] - crossline[1] * inline[0];
+        (cross.abs() > 0.1).then_some(MapFrame {
+            origin,
+            crossline,
+            inline,
+        })
+    }
 }
 
 impl Geometry {
@@ -45,8 +88,21 @@ impl Geometry {
                 "no usable CDP coordinates (bytes 181-188): {ASSUMED_BIN_M} m bins assumed; a scene's spacing sets them"
             ),
         };
+        let map = match &self.map {
+            Some(m) => {
+                let azimuth = |d: [f64; 2]| round(d[0].atan2(d[1]).to_degrees().rem_euclid(360.0));
+                format!(
+                    "\nmap: first trace at CDP ({}, {}); inline numbers grow toward {} degrees, crossline numbers toward {} (from grid north, clockwise); placed there in a layered scene",
+                    round(m.origin[0]),
+                    round(m.origin[1]),
+                    azimuth(m.inline),
+                    azimuth(m.crossline)
+                )
+            }
+            None => "\nmap: no corner CDP coordinates; in a layered scene the first trace lies at the origin".into(),
+        };
         format!(
-            "trace spacing: {} m between crosslines, {} m between inlines ({from})\nsample spacing shown: {} m ({} ms of two-way time at {VELOCITY_M_S} m/s)",
+            "trace spacing: {} m between crosslines, {} m between inlines ({from})\nsample spacing shown: {} m ({} ms of two-way time at {VELOCITY_M_S} m/s){map}",
             round(x),
             round(i),
             round(s),
@@ -95,11 +151,13 @@ pub(crate) fn geometry(
 ) -> Geometry {
     let sample = interval_us as f64 / 1000.0 * VELOCITY_M_S / 2000.0;
     let sample = if sample > 0.0 { sample } else { 1.0 };
-    let at = |k, j| header(k, j).and_then(|h| cdp(&h, big));
+    let mut at = |k, j| header(k, j).and_then(|h| cdp(&h, big));
+    let map = MapFrame::of_corners(nj, nk, &mut at);
     let ([crossline, inline], bins) = trace_steps(nj, nk, spread, at);
     Geometry {
         spacing: [sample, crossline, inline],
         bins,
+        map,
     }
 }
 

@@ -416,7 +416,8 @@ pub fn parse(path: &Path, bytes: &[u8], options: &ReadOptions) -> Result<SegyCub
             bytes[at..at + TRACE_HEADER].try_into().ok()
         },
     );
-    let volume = Volume::new(dims, geometry.spacing, values)?;
+    let mut volume = Volume::new(dims, geometry.spacing, values)?;
+    volume.map = geometry.map;
     Ok(SegyCube {
         volume,
         revision: h.revision,

@@ -158,6 +158,7 @@ mod tests {
             dims,
             half: DVec3::ONE,
             size: DVec3::ONE,
+            map: None,
             packed: super::super::prepare::pack([Some(&levels), None, None], n),
             tables: [Some(table), None, None],
             ranges: [Some((0.0, 255.0)), None, None],

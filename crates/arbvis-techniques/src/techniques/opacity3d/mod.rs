@@ -276,7 +276,7 @@ impl crate::techniques::Technique for Opacity3dScene {
         use crate::techniques::world::World;
         let p = prepared.as_ref()?;
         if self.primary.volume.data_kind() == arbvis_data::sniff::DataKind::Survey {
-            return Some(World::of_survey(p.size, p.half));
+            return Some(World::of_survey(p.dims, p.size, p.half, p.map.as_ref()));
         }
         Some(World::of_box([0.0; 3], p.size.to_array()))
     }

@@ -24,6 +24,8 @@ pub struct Prepared {
     /// The box's sides in the data's own units (dims times spacing): where it lies in a
     /// layered scene's world ([`crate::techniques::world`]).
     pub size: DVec3,
+    /// Where a survey's traces lie on the map (its CDP coordinates), where known.
+    pub map: Option<arbvis_data::volume::segy::geometry::MapFrame>,
     /// RGB per voxel, i fastest: R tertiary, G primary, B secondary (0 when absent).
     pub packed: Vec<u8>,
     /// Tables of primary, secondary, tertiary (None when the attribute is absent).
@@ -169,6 +171,7 @@ pub fn from_volumes(
             let s = first.spacing[a];
             first.dims[a] as f64 * if s.is_finite() && s > 0.0 { s } else { 1.0 }
         })),
+        map: first.map,
         packed,
         tables,
         ranges,
@@ -267,6 +270,7 @@ mod tests {
             dims,
             half: DVec3::ONE,
             size: DVec3::ONE,
+            map: None,
             packed: pack([Some(&levels), None, None], n),
             tables: [Some(ColorTable::builtin("grey").unwrap()), None, None],
             ranges: [None; 3],
@@ -302,6 +306,7 @@ mod tests {
             dims: [2, 1, 1],
             half: DVec3::ONE,
             size: DVec3::ONE,
+            map: None,
             packed: pack([Some(&[10, 11]), None, Some(&[30, 31])], 2),
             tables: [Some(grey.clone()), None, Some(grey)],
             ranges: [None; 3],

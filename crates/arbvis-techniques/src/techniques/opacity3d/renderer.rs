@@ -648,6 +648,9 @@ impl Opacity3dRenderer {
                     Blend::Over
                 },
                 cull_back: raycast,
+                // Each ray runs the whole box: in a layered scene it is not cut by an
+                // opaque layer's depth (docs/scenes.md, Layers).
+                covers_frame: raycast,
                 primitive: Default::default(),
                 ..DrawCall::new(&self.program, mesh)
             },
