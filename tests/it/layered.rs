@@ -440,3 +440,47 @@ fn a_segy_survey_lies_at_its_cdp_coordinates() {
     let last = world.to_world(first + glam::DVec3::X * (world.half.x * 2.0 * 74.0 / 75.0));
     assert!((last.z + 296.0).abs() < 1e-6, "{last}");
 }
+
+/// A layered scene's memory estimate says which layer makes each allocation.
+#[test]
+fn the_memory_estimate_names_each_layer() {
+    let text = "[[layer]]\nname = \"cube\"\n[layer.opacity3d.primary]\nvolume = { synthetic = { size = [31, 17, 23], seed = 1 } }\nattribute = \"amplitude\"\n[[layer]]\n[layer.surface]\nsynthetic = { size = [9, 7] }\n";
+    let scene = parse(text).unwrap();
+    let estimates = scene.memory_estimate(false);
+    assert!(
+        estimates
+            .iter()
+            .any(|e| e.what.starts_with("layer 0 (cube): ")),
+        "{estimates:?}"
+    );
+    let horizon = "layer 1: the 9x7 generated horizon's corners";
+    let e = estimates
+        .iter()
+        .find(|e| e.what == horizon)
+        .expect("the horizon's estimate");
+    assert_eq!(e.bytes, 6 * 8 * 6 * 120);
+}
+
+/// A generated horizon past the memory budget is refused before anything is made, naming
+/// its layer.
+#[test]
+fn a_horizon_past_the_memory_budget_is_refused_by_its_layer() {
+    let dir = common::temp_dir("layered-budget");
+    let scene = dir.join("big.toml");
+    std::fs::write(
+        &scene,
+        "[[layer]]\nname = \"huge\"\n[layer.surface]\nsynthetic = { size = [2048, 2048] }\n[[layer]]\n[layer.surface]\nsynthetic = { size = [4, 4] }\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_arbvis"))
+        .args(["render", scene.to_str().unwrap(), "-o"])
+        .arg(dir.join("big.png"))
+        .args(["--memory-budget", "64M"])
+        .output()
+        .unwrap();
+    common::refused(
+        &out,
+        "layer 0 (huge): the 2048x2048 generated horizon's corners",
+    );
+    assert!(!dir.join("big.png").exists());
+}

@@ -571,8 +571,19 @@ impl Scene {
                 BYTES_PER_READ_PIXEL,
             ));
         }
-        for (_, technique) in self.layers() {
-            out.extend(technique.memory_estimate(self.size));
+        let layered = self.is_layered();
+        for (index, (info, technique)) in self.layers().enumerate() {
+            let estimates = technique.memory_estimate(self.size).into_iter();
+            // A layered scene's estimates say which layer makes them.
+            out.extend(estimates.map(|mut e| {
+                if layered {
+                    e.what = match info.name.as_str() {
+                        "" => format!("layer {index}: {}", e.what),
+                        name => format!("layer {index} ({name}): {}", e.what),
+                    };
+                }
+                e
+            }));
         }
         out
     }

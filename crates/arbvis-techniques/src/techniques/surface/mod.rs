@@ -181,6 +181,20 @@ impl Technique for SurfaceScene {
         renderer::program_pairs()
     }
 
+    /// A generated horizon's corners, as prepared and uploaded (a file's are checked
+    /// when it is read).
+    fn memory_estimate(&self, _: [u32; 2]) -> Vec<arbvis_core::budget::Estimate> {
+        let Some(h) = &self.synthetic else {
+            return Vec::new();
+        };
+        let [nx, ny] = h.size.map(|n| n.clamp(2, 2048) as u64);
+        vec![arbvis_core::budget::Estimate::of(
+            format!("the {nx}x{ny} generated horizon's corners"),
+            6 * (nx - 1) * (ny - 1),
+            prepare::BYTES_PER_CORNER,
+        )]
+    }
+
     type Prepared = prepare::Prepared;
 
     fn prepare(

@@ -33,7 +33,12 @@ pub struct Prepared {
     pub elevation: ([f64; 2], Option<Vec<[u8; 3]>>),
 }
 
-/// Read `scene.file` (relative to `base`) and prepare it.
+/// Memory per drawn corner: the prepared [`Corner`] (three f64 vectors) and its twelve
+/// uploaded floats.
+pub const BYTES_PER_CORNER: u64 = 72 + 48;
+
+/// Read `scene.file` (relative to `base`) and prepare it, its corners held to the memory
+/// budget.
 pub fn prepare(scene: &SurfaceScene, base: &Path) -> RenderResult<Prepared> {
     let mesh = match (&scene.file, &scene.synthetic) {
         (Some(file), _) => arbvis_data::surface::read(&base.join(file))?,
@@ -44,6 +49,11 @@ pub fn prepare(scene: &SurfaceScene, base: &Path) -> RenderResult<Prepared> {
             )
         }
     };
+    let corners = 3 * mesh.triangles.len() as u64;
+    arbvis_core::budget::check(
+        format!("the surface's {corners} corners"),
+        arbvis_core::budget::times(corners, BYTES_PER_CORNER),
+    )?;
     let table = match scene.colour_by {
         Some(ColourBy::Elevation) => Some(scene.table.build(base)?),
         None => None,
