@@ -89,15 +89,18 @@ def with_volume(scene, volume):
     return scene
 
 
-def test_an_xarray_survey_draws_as_its_segy(tmp_path):
-    xr = pytest.importorskip("xarray")
-    cube = random_cube()
-    scene = segy_scene(tmp_path, cube)
-    want = render(scene)
+def survey_xy(cube):
+    """The traces' map coordinates in metres, [inline, crossline, (x, y)]."""
+    ni, nx, _ = cube.shape
+    return np.array([[trace_xy(k, j) for j in range(nx)] for k in range(ni)]) / 100.0
+
+
+def survey_dataarray(xr, cube):
+    """`cube` as mdio names it: dimensions inline, crossline, time; the map coordinates
+    beside."""
     ni, nx, ns = cube.shape
-    xy = np.array([[trace_xy(k, j) for j in range(nx)] for k in range(ni)]) / 100.0
-    # As mdio names it: dimensions inline, crossline, time; the map coordinates beside.
-    da = xr.DataArray(
+    xy = survey_xy(cube)
+    return xr.DataArray(
         cube,
         dims=("inline", "crossline", "time"),
         coords={
@@ -108,6 +111,14 @@ def test_an_xarray_survey_draws_as_its_segy(tmp_path):
             "cdp_y": (("inline", "crossline"), xy[..., 1]),
         },
     )
+
+
+def test_an_xarray_survey_draws_as_its_segy(tmp_path):
+    xr = pytest.importorskip("xarray")
+    cube = random_cube()
+    scene = segy_scene(tmp_path, cube)
+    want = render(scene)
+    da = survey_dataarray(xr, cube)
     volume = arbvis.Volume(da)
     # The proportions measured as the SEG-Y's are: 25 m, 12.5 m and 4 ms as 4 m
     # (the centimetres of the coordinates round the bins by far less than 1e-6 m).
@@ -410,8 +421,7 @@ def test_an_xarray_survey_lies_where_its_segy_does_in_a_layered_scene(tmp_path):
     xr = pytest.importorskip("xarray")
     cube = random_cube()
     write_segy(tmp_path / "cube.sgy", cube)
-    ni, nx, ns = cube.shape
-    xy = np.array([[trace_xy(k, j) for j in range(nx)] for k in range(ni)]) / 100.0
+    xy = survey_xy(cube)
     x0, y0 = xy[..., 0].min() - 50, xy[..., 1].min() - 50
     x1, y1 = xy[..., 0].max() + 50, xy[..., 1].max() + 50
     # A plane 60 m down (the survey's 31 samples of 4 ms reach 120 m), a little tilted.
@@ -432,17 +442,7 @@ colour = [0.9, 0.75, 0.2]
 """
     scene = arbvis.Scene.from_toml(layers, base=tmp_path)
     want = render(scene)
-    da = xr.DataArray(
-        cube,
-        dims=("inline", "crossline", "time"),
-        coords={
-            "inline": 100 + np.arange(ni),
-            "crossline": 200 + np.arange(nx),
-            "time": DT_MS * np.arange(ns, dtype=np.float64),
-            "cdp_x": (("inline", "crossline"), xy[..., 0]),
-            "cdp_y": (("inline", "crossline"), xy[..., 1]),
-        },
-    )
+    da = survey_dataarray(xr, cube)
     scene["layer.0.opacity3d.primary.volume"] = arbvis.Volume(da)
     got = render(scene)
     assert np.array_equal(got, want)

@@ -179,6 +179,25 @@ fn one_named_layer_draws_what_its_technique_draws_alone() {
     }
 }
 
+/// A surface scene of `params` drawn on the GPU (RGBA32F) and by its reference.
+fn gpu_and_reference(
+    h: &arbvis::gl::Headless,
+    params: &SurfaceScene,
+    prepared: &prepare::Prepared,
+    fidelity: Fidelity,
+    programs: ProgramChoice,
+    camera: arbvis::camera::Camera,
+    size: [u32; 2],
+) -> (arbvis::image::Image, arbvis::image::Image) {
+    let mut scene = parse("[technique.surface]\nfile = \"x.obj\"\n").unwrap();
+    scene.technique = params.clone().into();
+    (scene.fidelity, scene.programs, scene.camera, scene.size) = (fidelity, programs, camera, size);
+    scene.target = Some(TargetFormat::Rgba32f);
+    let gpu = render_on(h, &scene).unwrap().image;
+    let cpu = reference::reference(prepared, params, fidelity, &camera, size, [0.0; 4]);
+    (gpu, cpu)
+}
+
 /// A surface against its f64 reference (nearest hit per pixel centre, the headlight
 /// per vertex or per pixel), ARB and GLSL, faithful and precise, on an uneven horizon in
 /// UTM coordinates at an odd size and a rotated perspective camera.
@@ -196,29 +215,20 @@ fn a_surface_matches_its_reference_in_both_fidelities_and_program_kinds() {
     let prepared = prepare::of_mesh(&mesh, &params, Some(&table));
     for fidelity in [Fidelity::Faithful, Fidelity::Precise] {
         for programs in [ProgramChoice::Arb, ProgramChoice::Glsl] {
-            let mut scene =
-                parse("size = [73, 58]\n[technique.surface]\nfile = \"x.obj\"\n").unwrap();
-            scene.technique = params.clone().into();
-            scene.fidelity = fidelity;
-            scene.programs = programs;
-            scene.target = Some(TargetFormat::Rgba32f);
-            scene.camera.projection = arbvis::camera::Projection::Perspective;
-            scene.camera.rotation = [-0.21, 0.09, 0.13, 0.965];
-            let gpu = render_on(&h, &scene).unwrap().image;
-            let cpu = reference::reference(
-                &prepared,
-                &params,
-                fidelity,
-                &scene.camera,
-                scene.size,
-                [0.0; 4],
-            );
+            let camera = arbvis::camera::Camera {
+                projection: arbvis::camera::Projection::Perspective,
+                rotation: [-0.21, 0.09, 0.13, 0.965],
+                ..Default::default()
+            };
+            let (gpu, cpu) =
+                gpu_and_reference(&h, &params, &prepared, fidelity, programs, camera, [73, 58]);
+            let scene_size = [73u32, 58];
             // Inside triangles the GPU's f32 interpolation and lighting agree with f64
             // to ~1e-5; a pixel whose centre lies within f32 rounding of an edge may take
             // the other triangle (or the background at the silhouette), so the count of
             // pixels over one 8-bit level is bounded by the edge pixels (under 2 %).
             let d = gpu.compare(&cpu, LEVEL).unwrap();
-            let pixels = (scene.size[0] * scene.size[1]) as usize;
+            let pixels = (scene_size[0] * scene_size[1]) as usize;
             assert!(
                 d.pixels_over * 50 < pixels,
                 "{fidelity:?} {programs:?}: {d:?}"
@@ -319,26 +329,18 @@ fn a_translucent_surface_composites_every_sheet_as_the_reference_does() {
         (Fidelity::Faithful, ProgramChoice::Arb),
         (Fidelity::Precise, ProgramChoice::Glsl),
     ] {
-        let mut scene = parse("size = [71, 53]\n[technique.surface]\nfile = \"x.obj\"\n").unwrap();
-        scene.technique = params.clone().into();
-        scene.fidelity = fidelity;
-        scene.programs = programs;
-        scene.target = Some(TargetFormat::Rgba32f);
-        scene.camera.rotation = [0.35, -0.41, 0.12, 0.83];
-        let gpu = render_on(&h, &scene).unwrap().image;
-        let cpu = reference::reference(
-            &prepared,
-            &params,
-            fidelity,
-            &scene.camera,
-            scene.size,
-            [0.0; 4],
-        );
+        let camera = arbvis::camera::Camera {
+            rotation: [0.35, -0.41, 0.12, 0.83],
+            ..Default::default()
+        };
+        let (gpu, cpu) =
+            gpu_and_reference(&h, &params, &prepared, fidelity, programs, camera, [71, 53]);
+        let scene_size = [71u32, 53];
         // The renderer orders triangles by their centroids, the reference each pixel's
         // hits exactly: they differ where two triangles overlap out of centroid order,
         // and at edges as for an opaque surface; both are a few pixels of the picture.
         let d = gpu.compare(&cpu, 2.0 * LEVEL).unwrap();
-        let pixels = (scene.size[0] * scene.size[1]) as usize;
+        let pixels = (scene_size[0] * scene_size[1]) as usize;
         assert!(d.pixels_over * 25 < pixels, "{fidelity:?}: {d:?}");
         assert!(d.rmse < 0.01, "{fidelity:?}: {d:?}");
         // Several sheets: the densest pixel holds more than one layer's opacity.
