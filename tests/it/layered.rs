@@ -310,6 +310,25 @@ table = { builtin = "seismic", alpha = [[0.0, 0.7], [0.4, 0.0], [0.6, 0.0], [1.0
     }
     let flat = arbvis::image::Image::filled(61, 61, TargetFormat::Rgba8, want);
     assert!(front_image.compare(&flat, LEVEL).unwrap().pixels_over == 0);
+    // Precise with the ray caster (a pass over the whole box): drawn on precise slices
+    // beside the opaque plane, so the plane in front still hides it (f32 target: exact).
+    let mut precise = front.clone();
+    precise.fidelity = Fidelity::Precise;
+    let raycast = "[layer.opacity3d.raycast]\nsteps_per_voxel = 1.0\n";
+    let text = precise.to_toml().replacen(
+        "[layer.opacity3d.primary]",
+        &format!("{raycast}[layer.opacity3d.primary]"),
+        1,
+    );
+    let precise = parse(&text).unwrap();
+    assert!(precise.to_toml().contains("[layer.opacity3d.raycast]"));
+    let image = render_on(&h, &precise).unwrap().image;
+    let flat = arbvis::image::Image::filled(61, 61, TargetFormat::Rgba32f, want);
+    assert_eq!(
+        image.compare(&flat, 1e-6).unwrap().pixels_over,
+        0,
+        "the ray caster hidden"
+    );
 }
 
 /// A translucent closed surface (the cow, every sheet blended back to front) against the
@@ -485,4 +504,73 @@ fn a_horizon_past_the_memory_budget_is_refused_by_its_layer() {
         "layer 0 (huge): the 2048x2048 generated horizon's corners",
     );
     assert!(!dir.join("big.png").exists());
+}
+
+/// A precise cloud drawn by tiles (one pass over the frame) beside an opaque plane: drawn
+/// as points instead, which the plane's depth hides behind it and shows in front of it.
+#[test]
+fn an_opaque_plane_hides_a_precise_cloud_behind_it() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("layered-cloud");
+    let cloud = "[layer.splats]\ncloud = { section = { points = 20000, seed = 3 } }\ncolour = \"facies\"\npoint_size = 6.0\nkernel = \"gaussian\"\ngauss_width = 0.35\nsort = \"radix\"\ndraw = \"tiles\"\n";
+    // The cloud's world box, for planes that cover it.
+    let probe = parse(&format!(
+        "fidelity = \"precise\"\n[[layer]]\nname = \"c\"\n{cloud}"
+    ))
+    .unwrap();
+    let limits = arbvis::volume::Limits::for_max_side(2048);
+    let data = arbvis::catalog::prepare(&probe.technique, &probe.settings(), &limits).unwrap();
+    let [lo, hi] = arbvis::catalog::world(&probe.technique, &data)
+        .unwrap()
+        .bounds();
+    let margin = (hi - lo).max_element();
+    let (x, y) = (
+        [lo.x - margin, hi.x + margin],
+        [lo.y - margin, hi.y + margin],
+    );
+    std::fs::write(dir.join("below.obj"), plane_obj(x, y, lo.z - 0.1 * margin)).unwrap();
+    std::fs::write(dir.join("above.obj"), plane_obj(x, y, hi.z + 0.1 * margin)).unwrap();
+    let colour = [0.25f32, 0.5, 0.75];
+    let plane = |file: &str| {
+        format!(
+            "[[layer]]\nname = \"plane\"\n[layer.surface]\nfile = \"{}\"\ncolour = {colour:?}\nlighting = \"none\"\n",
+            dir.join(file).display()
+        )
+    };
+    // From straight above; the view inside the planes (zoom: the frame is 3x the cloud).
+    let head = "size = [64, 48]\nfidelity = \"precise\"\nprograms = \"glsl\"\nbackground = [0.0, 0.0, 0.0, 1.0]\n[camera]\nzoom = 2.0\n";
+    let layered = |plane_file: &str| {
+        parse(&format!(
+            "{head}[[layer]]\nname = \"cloud\"\n{cloud}{}",
+            plane(plane_file)
+        ))
+        .unwrap()
+    };
+    let want = [colour[0], colour[1], colour[2], 1.0];
+    let front = render_on(&h, &layered("above.obj")).unwrap().image;
+    let flat = arbvis::image::Image::filled(64, 48, TargetFormat::Rgba32f, want);
+    // An unlit plane's colour, exactly: f32 arithmetic on exact values.
+    assert_eq!(
+        front.compare(&flat, 1e-6).unwrap().pixels_over,
+        0,
+        "the plane hides the cloud"
+    );
+    // Behind: the cloud as points over the plane's colour, exactly.
+    let behind = render_on(&h, &layered("below.obj")).unwrap().image;
+    let mut alone = layered("below.obj");
+    alone.more_layers[0].0.visible = false;
+    alone.background = want;
+    alone
+        .technique
+        .get_mut::<arbvis::techniques::splats::SplatsScene>()
+        .unwrap()
+        .draw = arbvis::techniques::splats::scene::DrawChoice::Points;
+    let over_colour = render_on(&h, &alone).unwrap().image;
+    let d = behind.compare(&over_colour, 0.0).unwrap();
+    assert_eq!(d.pixels_over, 0, "{d:?}");
+    assert!(common::lit_pixels(&behind, 0.05) > 0);
+    assert!(
+        behind.compare(&flat, LEVEL).unwrap().pixels_over > 50,
+        "the cloud shows"
+    );
 }

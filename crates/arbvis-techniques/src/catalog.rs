@@ -241,6 +241,8 @@ trait AnyTechnique: Any {
         fidelity: &mut Fidelity,
     );
     fn for_interaction(&mut self, scale: f64);
+    fn draws_opaque(&self) -> bool;
+    fn occludable(&mut self);
     fn memory_estimate(&self, size: [u32; 2]) -> Vec<arbvis_core::budget::Estimate>;
     fn prepare(&self, settings: &Settings<'_>, limits: &Limits) -> RenderResult<PreparedData>;
     fn renderer(
@@ -303,6 +305,14 @@ impl<T: Technique> AnyTechnique for T {
 
     fn for_interaction(&mut self, scale: f64) {
         Technique::for_interaction(self, scale)
+    }
+
+    fn draws_opaque(&self) -> bool {
+        Technique::draws_opaque(self)
+    }
+
+    fn occludable(&mut self) {
+        Technique::occludable(self)
     }
 
     fn memory_estimate(&self, size: [u32; 2]) -> Vec<arbvis_core::budget::Estimate> {
@@ -423,6 +433,19 @@ impl TechniqueScene {
         let mut reduced = self.clone();
         reduced.technique_mut().for_interaction(scale);
         reduced
+    }
+
+    /// Whether it draws opaque geometry only ([`Technique::draws_opaque`]).
+    pub fn draws_opaque(&self) -> bool {
+        self.technique().draws_opaque()
+    }
+
+    /// The same picture drawn as geometry an opaque layer's depth can hide
+    /// ([`Technique::occludable`]).
+    pub fn occludable(&self) -> TechniqueScene {
+        let mut occludable = self.clone();
+        occludable.technique_mut().occludable();
+        occludable
     }
 
     /// The large allocations preparing and drawing it at `size` makes that the scene

@@ -12,9 +12,11 @@
 //! isosurfaces) with a depth test and depth writes, then the translucent layers in the
 //! scene's order, each tested against that depth without writing it
 //! (`Gpu::set_occluded`): a translucent volume, cell volume or splat is hidden behind an
-//! opaque surface and drawn over it in front. Passes that cover the whole frame (precise
-//! splats' tiles and OIT composite, precise cell volumes' walk) are not occluded yet: in
-//! a layered scene those techniques draw over opaque layers (docs/scenes.md, "Layers").
+//! opaque surface and drawn over it in front. Where an opaque layer is in view, the other
+//! layers draw as geometry its depth can hide (`Technique::occludable`: splats as points,
+//! not tiles; 3D opacity on precise slices, not the ray caster; cell volumes by projected
+//! cells, not the walk or the grid); what still passes over the whole frame (the splats'
+//! OIT composite and eye-dome lighting) is not occluded (docs/scenes.md, "Layers").
 
 use arbvis_core::camera::{Camera, Placement};
 use glam::{DQuat, DVec3};
@@ -129,6 +131,17 @@ pub fn build(
     kind: ProgramKind,
 ) -> RenderResult<LayeredRenderer> {
     let limits = Limits::for_max_side(gpu.caps().max_3d_texture_size);
+    // With an opaque layer in view, the others draw as geometry its depth can hide.
+    let occluding = layers.iter().any(|(i, t)| i.visible && t.draws_opaque());
+    let owned: Vec<(&LayerInfo, TechniqueScene)> = layers
+        .iter()
+        .map(|(info, t)| match occluding && !t.draws_opaque() {
+            true => (*info, t.occludable()),
+            false => (*info, (*t).clone()),
+        })
+        .collect();
+    let layers: Vec<(&LayerInfo, &TechniqueScene)> = owned.iter().map(|(i, t)| (*i, t)).collect();
+    let layers = layers.as_slice();
     // Each layer's distinct technique: the first layer with equal parameters.
     let first: Vec<usize> = (0..layers.len())
         .map(|i| (0..i).find(|&j| layers[j].1 == layers[i].1).unwrap_or(i))

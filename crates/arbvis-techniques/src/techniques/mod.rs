@@ -233,6 +233,15 @@ pub trait Technique: Any + Sized {
     fn for_interaction(&mut self, scale: f64) {
         let _ = scale;
     }
+    /// Whether its parameters draw opaque geometry only (an opaque surface,
+    /// isosurfaces): a layered scene draws those first, and the others against their depth.
+    fn draws_opaque(&self) -> bool {
+        false
+    }
+    /// Parameters of the same picture drawn as geometry an opaque layer's depth can hide
+    /// (not a pass over the whole frame), for a layered scene with opaque layers; by
+    /// default the same parameters.
+    fn occludable(&mut self) {}
     /// Every program pair its renderers can draw with, both kinds (the
     /// compile-everything test).
     fn program_pairs() -> Vec<ProgramPair>;

@@ -333,6 +333,21 @@ impl crate::techniques::Technique for CellprojScene {
         }))
     }
 
+    fn draws_opaque(&self) -> bool {
+        self.mode == Mode::Isosurfaces
+    }
+
+    /// The neighbour walk and the grid pass over the whole frame: the projected cells'
+    /// exact integral per fragment instead (exact where the projection's order is).
+    fn occludable(&mut self) {
+        use transfer::Precise;
+        if let Some(v) = self.volume.as_mut() {
+            if matches!(v.precise, Precise::Walk | Precise::Grid) {
+                v.precise = Precise::Projected;
+            }
+        }
+    }
+
     /// The mesh in its file's coordinates.
     fn world(&self, mesh: &prepare::Prepared) -> Option<crate::techniques::world::World> {
         let [lo, hi] = mesh.bounds;

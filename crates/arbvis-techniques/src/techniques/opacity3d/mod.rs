@@ -266,6 +266,11 @@ impl crate::techniques::Technique for Opacity3dScene {
         prepare::prepare(self, settings.base, limits).map(Some)
     }
 
+    /// The ray caster runs each ray through the whole box: precise slices instead.
+    fn occludable(&mut self) {
+        self.raycast = None;
+    }
+
     /// A survey hangs from the origin with its samples downwards; other volumes keep
     /// their grid's axes, first voxel at the origin. None for a store (drawn brick by
     /// brick, not yet placed in a layered scene).

@@ -128,6 +128,12 @@ impl crate::techniques::Technique for SplatsScene {
         ))
     }
 
+    /// Tiles gather every splat of a pixel in one pass over the frame: points draw the
+    /// same picture as geometry.
+    fn occludable(&mut self) {
+        self.draw = scene::DrawChoice::Points;
+    }
+
     /// The cloud in its file's coordinates, framed by its frame (a COPC file's header
     /// box, the same for every cut).
     fn world(

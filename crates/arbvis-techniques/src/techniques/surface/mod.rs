@@ -181,6 +181,10 @@ impl Technique for SurfaceScene {
         renderer::program_pairs()
     }
 
+    fn draws_opaque(&self) -> bool {
+        self.opacity >= 1.0
+    }
+
     /// A generated horizon's corners, as prepared and uploaded (a file's are checked
     /// when it is read).
     fn memory_estimate(&self, _: [u32; 2]) -> Vec<arbvis_core::budget::Estimate> {
