@@ -461,6 +461,13 @@ fn obj_corpus() -> Vec<Vec<u8>> {
     corpus
 }
 
+fn tsurf_corpus() -> Vec<Vec<u8>> {
+    vec![
+        b"GOCAD TSurf 1\nHEADER {\nname:top\n}\nZPOSITIVE Depth\nTFACE\nVRTX 1 0 0 10\nPVRTX 2 1 0 11 0.5\nVRTX 3 0 1 12\nATOM 4 2\nTRGL 1 2 3\nTFACE\nVRTX 5 1 1 9\nTRGL 3 4 5\nEND\nGOCAD TSurf 1\nVRTX 1 5 5 5\nVRTX 2 6 5 5\nVRTX 3 5 6 5\nTRGL 1 2 3\nEND\n"
+            .to_vec(),
+    ]
+}
+
 fn stl_corpus() -> Vec<Vec<u8>> {
     let tris: [[[f32; 3]; 3]; 4] = [
         [[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]],
@@ -592,6 +599,13 @@ fn targets() -> Vec<Target> {
             sections: false,
             corpus: obj_corpus(),
             run: |b| surface(b, "fuzz.obj"),
+        },
+        Target {
+            name: "surface-tsurf",
+            text: true,
+            sections: false,
+            corpus: tsurf_corpus(),
+            run: |b| surface(b, "fuzz.ts"),
         },
         Target {
             name: "surface-stl",

@@ -574,3 +574,36 @@ fn an_opaque_plane_hides_a_precise_cloud_behind_it() {
         "the cloud shows"
     );
 }
+
+/// A horizon exported as GOCAD TSurf (time positive downwards, UTM coordinates) lies in
+/// the world where a survey in time hangs: z = -time; `inspect` describes it.
+#[test]
+fn a_tsurf_horizon_lies_at_minus_its_time() {
+    let dir = common::temp_dir("layered-tsurf");
+    let ts = "GOCAD TSurf 1\nHEADER {\nname:horizon\n}\nZPOSITIVE Depth\nTFACE\nVRTX 1 620200 6074300 140\nVRTX 2 620500 6074300 152\nVRTX 3 620200 6074700 148\nVRTX 4 620500 6074700 161\nTRGL 1 2 3\nTRGL 2 4 3\nEND\n";
+    std::fs::write(dir.join("h.ts"), ts).unwrap();
+    let scene = Scene::parse(
+        &format!(
+            "[[layer]]\nname = \"h\"\n[layer.surface]\nfile = \"{}\"\n",
+            dir.join("h.ts").display()
+        ),
+        "h.toml",
+    )
+    .unwrap();
+    let limits = arbvis::volume::Limits::for_max_side(2048);
+    let data = arbvis::catalog::prepare(&scene.technique, &scene.settings(), &limits).unwrap();
+    let [lo, hi] = arbvis::catalog::world(&scene.technique, &data)
+        .unwrap()
+        .bounds();
+    // f64 through the object frame and back: 1e-9 of 6e6.
+    assert!(
+        lo.abs_diff_eq(glam::DVec3::new(620200.0, 6074300.0, -161.0), 1e-6),
+        "{lo}"
+    );
+    assert!(
+        hi.abs_diff_eq(glam::DVec3::new(620500.0, 6074700.0, -140.0), 1e-6),
+        "{hi}"
+    );
+    let said = common::inspect(&dir.join("h.ts"));
+    common::assert_says(&said, &["vertices: 4", "triangles: 2"]);
+}

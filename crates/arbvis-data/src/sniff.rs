@@ -147,10 +147,14 @@ pub const READERS: &[Reader] = &[
     },
     Reader {
         format: Format::Surface,
-        reads: "OBJ (.obj), STL (.stl)",
+        reads: "OBJ (.obj), STL (.stl), GOCAD TSurf (.ts)",
         kind: DataKind::Surface,
         url: false,
-        claims: |name, _| name.ends_with(".obj") || name.ends_with(".stl"),
+        claims: |name, head| {
+            name.ends_with(".obj")
+                || name.ends_with(".stl")
+                || (name.ends_with(".ts") && head.trim_ascii_start().starts_with(b"GOCAD TSurf"))
+        },
         guesses: never,
     },
     Reader {
@@ -315,7 +319,7 @@ mod tests {
         // A SEG-Y binary header's sample format code (5: IEEE float) at byte 3224.
         let mut segy = vec![b' '; 3600];
         segy[3224..3226].copy_from_slice(&5u16.to_be_bytes());
-        let cases: [(&str, &[u8], Option<Format>); 12] = [
+        let cases: [(&str, &[u8], Option<Format>); 14] = [
             ("a.NII.GZ", b"", Some(Format::Nifti)),
             ("a.sgy", b"", Some(Format::Segy)),
             ("a.vtu", b"", Some(Format::Mesh)),
@@ -326,6 +330,8 @@ mod tests {
             ("a.dat", b"ply\n", Some(Format::Ply)),
             ("a.dat", b"1 2 3\n", Some(Format::Dat)),
             ("a.STL", b"solid", Some(Format::Surface)),
+            ("h.ts", b"\nGOCAD TSurf 1", Some(Format::Surface)),
+            ("app.ts", b"const x = 1;", None),
             ("a.vtk", &segy, Some(Format::Mesh)),
             ("traces.bin", &segy, Some(Format::Segy)),
             ("notes.txt", b"hello", None),

@@ -24,6 +24,7 @@
 pub mod obj;
 pub mod stl;
 pub mod topology;
+pub mod tsurf;
 
 use std::path::{Path, PathBuf};
 
@@ -217,10 +218,11 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
         "obj" => obj::parse(name, bytes),
         "stl" => stl::parse(name, bytes),
         "ply" => parse_ply(name, bytes),
+        "ts" => tsurf::parse(name, bytes),
         _ => Err(SurfaceError::Unsupported {
             path: name.to_path_buf(),
             message: format!(
-                "unknown surface extension {:?}: expected .obj, .stl or .ply",
+                "unknown surface extension {:?}: expected .obj, .stl, .ply or .ts (GOCAD TSurf)",
                 arbvis_core::input::shorten(&ext, 20)
             ),
         }),

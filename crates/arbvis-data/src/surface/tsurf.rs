@@ -1,0 +1,323 @@
+//! GOCAD TSurf (`.ts`): the triangulated surfaces interpretation tools export for
+//! horizons and faults (Petrel, OpendTect, SKUA-GOCAD, GemPy).
+//!
+//! # Decisions
+//! - A file may hold several objects (`GOCAD TSurf 1` ... `END`), each with its own vertex
+//!   ids; they are read into one surface. Within an object, `TFACE` starts another face
+//!   of the same surface (its vertices stay shared).
+//! - `VRTX id x y z` and `PVRTX id x y z props...` define vertices (properties ignored);
+//!   `ATOM id ref` and `PATOM id ref ...` reuse vertex `ref`'s position; `TRGL a b c`
+//!   names three vertex ids. Other keywords (`HEADER { ... }`, the coordinate system,
+//!   `BSTONE`, `BORDER`, `PROPERTIES`, ...) are skipped.
+//! - `ZPOSITIVE Depth` (z grows downwards: depth, or time in ms) is turned into z up, as
+//!   every layer is placed: `z = -z`. `ZPOSITIVE Elevation` (the default) is kept.
+//! - Every error names the line and column of the token at fault.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use super::{Position, SurfaceError, TriangleMesh};
+
+/// What the reader found besides the triangles (`inspect`).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct TsurfFacts {
+    /// Objects (`GOCAD TSurf` headers) read.
+    pub objects: usize,
+    /// Whether z was given positive downwards (and turned).
+    pub depth_positive: bool,
+}
+
+/// One object's vertex ids to the surface's vertex indices.
+type Ids = HashMap<u64, u32>;
+
+/// Parse TSurf text (`name` names it in errors).
+pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
+    parse_with_facts(name, bytes).map(|(mesh, _)| mesh)
+}
+
+/// [`parse`], and what else the file said.
+pub fn parse_with_facts(
+    name: &Path,
+    bytes: &[u8],
+) -> Result<(TriangleMesh, TsurfFacts), SurfaceError> {
+    let text = super::utf8(name, bytes)?;
+    let mut reader = Reader::new(name);
+    for (index, line) in text.lines().enumerate() {
+        reader.line(index + 1, line)?;
+    }
+    if reader.facts.objects == 0 {
+        return Err(reader.error(1, 1, "not a GOCAD TSurf: expected a `GOCAD TSurf 1` header"));
+    }
+    let Reader {
+        vertices,
+        triangles,
+        facts,
+        ..
+    } = reader;
+    let mesh = TriangleMesh::from_indexed(name, vertices, triangles)?;
+    Ok((mesh, facts))
+}
+
+/// The reader's state line by line.
+struct Reader<'a> {
+    name: &'a Path,
+    vertices: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    ids: Ids,
+    /// Inside an object (after its header, before its `END`).
+    open: bool,
+    /// Inside a `HEADER { ... }` block.
+    in_header: bool,
+    /// z is positive downwards in the current object.
+    depth: bool,
+    facts: TsurfFacts,
+}
+
+impl<'a> Reader<'a> {
+    fn new(name: &'a Path) -> Reader<'a> {
+        Reader {
+            name,
+            vertices: Vec::new(),
+            triangles: Vec::new(),
+            ids: Ids::new(),
+            open: false,
+            in_header: false,
+            depth: false,
+            facts: TsurfFacts::default(),
+        }
+    }
+
+    fn error(&self, line: usize, column: usize, message: impl Into<String>) -> SurfaceError {
+        SurfaceError::format(self.name, Position::Line { line, column }, message)
+    }
+
+    /// Read one line (1-based number `n`).
+    fn line(&mut self, n: usize, text: &str) -> Result<(), SurfaceError> {
+        let tokens = tokens(text);
+        let Some(&(column, keyword)) = tokens.first() else {
+            return Ok(());
+        };
+        if self.in_header {
+            self.in_header = !text.trim_end().ends_with('}');
+            return Ok(());
+        }
+        match keyword {
+            "GOCAD" => {
+                if tokens.get(1).map(|t| t.1) != Some("TSurf") {
+                    return Err(self.error(
+                        n,
+                        column,
+                        "expected `GOCAD TSurf`: only triangulated surfaces are read",
+                    ));
+                }
+                self.open = true;
+                self.ids.clear();
+                self.depth = false;
+                self.facts.objects += 1;
+            }
+            _ if !self.open => {
+                return Err(self.error(
+                    n,
+                    column,
+                    format!("{keyword:?} outside a `GOCAD TSurf 1` object"),
+                ));
+            }
+            "HEADER" => self.in_header = !text.trim_end().ends_with('}'),
+            "ZPOSITIVE" => match tokens.get(1).map(|t| t.1) {
+                Some("Depth") => {
+                    self.depth = true;
+                    self.facts.depth_positive = true;
+                }
+                Some("Elevation") => self.depth = false,
+                other => {
+                    let column = tokens.get(1).map_or(column, |t| t.0);
+                    return Err(self.error(
+                        n,
+                        column,
+                        format!("ZPOSITIVE {other:?}: expected Depth or Elevation"),
+                    ));
+                }
+            },
+            "VRTX" | "PVRTX" => self.vertex(n, &tokens)?,
+            "ATOM" | "PATOM" => self.atom(n, &tokens)?,
+            "TRGL" => self.triangle(n, &tokens)?,
+            "END" => self.open = false,
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// `VRTX id x y z`.
+    fn vertex(&mut self, n: usize, tokens: &[(usize, &str)]) -> Result<(), SurfaceError> {
+        let id = self.id(n, tokens, 1)?;
+        let mut p = [0.0; 3];
+        for (a, value) in p.iter_mut().enumerate() {
+            let (column, token) = self.token(n, tokens, 2 + a, "x, y and z")?;
+            *value = token
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    self.error(
+                        n,
+                        column,
+                        format!("{token:?}: a coordinate must be a finite number"),
+                    )
+                })?;
+        }
+        if self.depth {
+            p[2] = -p[2];
+        }
+        self.add(n, tokens[1].0, id, p)
+    }
+
+    /// `ATOM id ref`: vertex `id` at vertex `ref`'s position.
+    fn atom(&mut self, n: usize, tokens: &[(usize, &str)]) -> Result<(), SurfaceError> {
+        let id = self.id(n, tokens, 1)?;
+        let of = self.index(n, tokens, 2)?;
+        let p = self.vertices[of as usize];
+        self.add(n, tokens[1].0, id, p)
+    }
+
+    /// `TRGL a b c`.
+    fn triangle(&mut self, n: usize, tokens: &[(usize, &str)]) -> Result<(), SurfaceError> {
+        let t = [
+            self.index(n, tokens, 1)?,
+            self.index(n, tokens, 2)?,
+            self.index(n, tokens, 3)?,
+        ];
+        self.triangles.push(t);
+        Ok(())
+    }
+
+    fn add(&mut self, n: usize, column: usize, id: u64, p: [f64; 3]) -> Result<(), SurfaceError> {
+        let index = u32::try_from(self.vertices.len())
+            .map_err(|_| self.error(n, column, "more vertices than 2^32"))?;
+        if self.ids.insert(id, index).is_some() {
+            return Err(self.error(
+                n,
+                column,
+                format!("vertex id {id} defined twice in this object"),
+            ));
+        }
+        self.vertices.push(p);
+        Ok(())
+    }
+
+    fn token<'t>(
+        &self,
+        n: usize,
+        tokens: &[(usize, &'t str)],
+        at: usize,
+        what: &str,
+    ) -> Result<(usize, &'t str), SurfaceError> {
+        tokens.get(at).copied().ok_or_else(|| {
+            let column = tokens.last().map_or(1, |t| t.0 + t.1.chars().count());
+            self.error(n, column, format!("{} needs {what}", tokens[0].1))
+        })
+    }
+
+    /// The vertex id at token `at`.
+    fn id(&self, n: usize, tokens: &[(usize, &str)], at: usize) -> Result<u64, SurfaceError> {
+        let (column, token) = self.token(n, tokens, at, "a vertex id")?;
+        token.parse::<u64>().map_err(|_| {
+            self.error(
+                n,
+                column,
+                format!("{token:?}: a vertex id is a whole number"),
+            )
+        })
+    }
+
+    /// The index of the vertex whose id is at token `at` (defined earlier in the object).
+    fn index(&self, n: usize, tokens: &[(usize, &str)], at: usize) -> Result<u32, SurfaceError> {
+        let id = self.id(n, tokens, at)?;
+        self.ids.get(&id).copied().ok_or_else(|| {
+            self.error(
+                n,
+                tokens[at].0,
+                format!("vertex id {id} is not defined above in this object"),
+            )
+        })
+    }
+}
+
+/// The whitespace-separated tokens of `line` with their 1-based columns (in characters).
+fn tokens(line: &str) -> Vec<(usize, &str)> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (column, (byte, c)) in line.char_indices().enumerate() {
+        match (c.is_whitespace(), start) {
+            (false, None) => start = Some((column + 1, byte)),
+            (true, Some((col, from))) => {
+                out.push((col, &line[from..byte]));
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some((col, from)) = start {
+        out.push((col, &line[from..]));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TWO: &str = "GOCAD TSurf 1\nHEADER {\nname: top F3 {odd}\n}\nGOCAD_ORIGINAL_COORDINATE_SYSTEM\nNAME Default\nZPOSITIVE Depth\nEND_ORIGINAL_COORDINATE_SYSTEM\nPROPERTIES amp\nTFACE\nVRTX 10 620000.5 6074000.25 812.5\nPVRTX 11 620025.5 6074000.25 815 0.3\nVRTX 12 620000.5 6074025.25 809\nATOM 13 11\nTRGL 10 11 12\nTFACE\nVRTX 14 620025.5 6074025.25 811\nTRGL 12 13 14\nEND\nGOCAD TSurf 1\nVRTX 1 0 0 5\nVRTX 2 1 0 5\nVRTX 3 0 1 6\nTRGL 1 2 3\nEND\n";
+
+    #[test]
+    fn objects_faces_atoms_and_depth_are_read() {
+        let (mesh, facts) = parse_with_facts(Path::new("h.ts"), TWO.as_bytes()).unwrap();
+        assert_eq!(
+            facts,
+            TsurfFacts {
+                objects: 2,
+                depth_positive: true
+            }
+        );
+        assert_eq!(mesh.vertices.len(), 8);
+        assert_eq!(mesh.triangles, vec![[0, 1, 2], [2, 3, 4], [5, 6, 7]]);
+        // Depth turned upwards; the atom at its vertex's position; the second object
+        // keeps its own ids and its z (elevation).
+        assert_eq!(mesh.vertices[0], [620000.5, 6074000.25, -812.5]);
+        assert_eq!(mesh.vertices[3], mesh.vertices[1]);
+        assert_eq!(mesh.vertices[7], [0.0, 1.0, 6.0]);
+    }
+
+    #[test]
+    fn errors_name_the_line_and_column() {
+        let cases = [
+            ("VRTX 1 0 0 0\n", 1, 1, "outside"),
+            ("GOCAD TSurf 1\nVRTX 1 0 nan 0\n", 2, 10, "finite"),
+            ("GOCAD TSurf 1\nVRTX 1 0 0\n", 2, 11, "needs x, y and z"),
+            (
+                "GOCAD TSurf 1\nVRTX 1 0 0 0\nVRTX 2 1 0 0\nTRGL 1 2 7\n",
+                4,
+                10,
+                "vertex id 7",
+            ),
+            ("GOCAD TSurf 1\nVRTX 1 0 0 0\nVRTX 1 1 0 0\n", 3, 6, "twice"),
+            ("GOCAD TSurf 1\nZPOSITIVE Up\n", 2, 11, "Depth or Elevation"),
+            ("GOCAD PLine 1\n", 1, 1, "only triangulated"),
+            ("GOCAD TSurf 1\nVRTX -1 0 0 0\n", 2, 6, "whole number"),
+            ("GOCAD TSurf 1\nVRTX 1 0 0 0\nEND\n", 1, 1, "no triangles"),
+            ("hello\n", 1, 1, "outside"),
+            ("", 1, 1, "not a GOCAD TSurf"),
+        ];
+        for (text, line, column, says) in cases {
+            let e = parse(Path::new("bad.ts"), text.as_bytes())
+                .unwrap_err()
+                .to_string();
+            let at = format!("line {line}, column {column}");
+            let item = "polygon 0";
+            assert!(
+                e.contains(&at) || (says == "no triangles" && e.contains(item)),
+                "{text:?}: {e}"
+            );
+            assert!(e.contains(says), "{text:?}: {e}");
+        }
+    }
+}
