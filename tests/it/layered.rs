@@ -607,3 +607,91 @@ fn a_tsurf_horizon_lies_at_minus_its_time() {
     let said = common::inspect(&dir.join("h.ts"));
     common::assert_says(&said, &["vertices: 4", "triangles: 2"]);
 }
+
+/// A horizontal sheet through a volume whose values change only with height takes, at
+/// every corner, the volume's colour at that height: each of two sheets one colour, the
+/// one the volume's table gives its slab ("seismic on the horizon", `colour_from`).
+#[test]
+fn a_surface_takes_the_colours_of_the_layer_it_lies_in() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("layered-colour-from");
+    // 8 x 6 x 5 voxels of 1 m, the value of slab k: 30 + 50 k (u8).
+    let values: Vec<u8> = (0..5)
+        .flat_map(|k| vec![30 + 50 * k as u8; 8 * 6])
+        .collect();
+    std::fs::write(dir.join("v.raw"), &values).unwrap();
+    // A sheet of 12 x 12 nodes inside the footprint at height z (slab centres: k + 0.5).
+    let sheet = |z: f64| {
+        let mut text = String::new();
+        for j in 0..12 {
+            for i in 0..12 {
+                text += &format!(
+                    "v {} {} {z}\n",
+                    0.6 + 6.8 * i as f64 / 11.0,
+                    0.6 + 4.8 * j as f64 / 11.0
+                );
+            }
+        }
+        for j in 0..11 {
+            for i in 0..11 {
+                let v = |i: usize, j: usize| j * 12 + i + 1;
+                text += &format!(
+                    "f {} {} {}\nf {} {} {}\n",
+                    v(i, j),
+                    v(i + 1, j),
+                    v(i + 1, j + 1),
+                    v(i, j),
+                    v(i + 1, j + 1),
+                    v(i, j + 1)
+                );
+            }
+        }
+        text
+    };
+    std::fs::write(dir.join("low.obj"), sheet(1.5)).unwrap();
+    std::fs::write(dir.join("high.obj"), sheet(3.5)).unwrap();
+    let volume = "[[layer]]\nname = \"v\"\nvisible = false\n[layer.opacity3d.primary]\nvolume = { raw = { path = \"v.raw\", dims = [8, 6, 5], type = \"u8\" } }\nquantize = { range = [0.0, 255.0] }\ntable = { builtin = \"viridis\" }\n";
+    let sheet_layer = |file: &str| {
+        format!("[[layer]]\nname = \"{file}\"\n[layer.surface]\nfile = \"{file}\"\ncolour_from = {{ layer = \"v\" }}\nlighting = \"none\"\n")
+    };
+    let text = format!(
+        "size = [40, 30]\nfidelity = \"precise\"\n{volume}{}{}",
+        sheet_layer("low.obj"),
+        sheet_layer("high.obj")
+    );
+    std::fs::write(dir.join("s.toml"), &text).unwrap();
+    let scene = Scene::load(&dir.join("s.toml")).unwrap();
+    let image = render_on(&h, &scene).unwrap().image;
+    // Seen from above the high sheet hides the low one: one colour, slab 3's (180).
+    let viridis = arbvis::colortable::ColorTable::builtin("viridis").unwrap();
+    let colour = |level: usize| viridis.entries[level].map(|c| c as f32 / 255.0);
+    let want = colour(180);
+    let centre = image.pixel(20, 15);
+    common::assert_close(
+        centre,
+        [want[0], want[1], want[2], 1.0],
+        1e-5,
+        "slab 3's colour",
+    );
+    // Without the high sheet: the low one, slab 1's (80).
+    let mut low_only = scene.clone();
+    low_only.more_layers[1].0.visible = false;
+    let image = render_on(&h, &low_only).unwrap().image;
+    let want = colour(80);
+    common::assert_close(
+        image.pixel(20, 15),
+        [want[0], want[1], want[2], 1.0],
+        1e-5,
+        "slab 1's colour",
+    );
+    // A source that is not a layer of the scene is named.
+    let bad = text.replace("layer = \"v\"", "layer = \"nope\"");
+    std::fs::write(dir.join("bad.toml"), bad).unwrap();
+    let e = render_on(&h, &Scene::load(&dir.join("bad.toml")).unwrap())
+        .err()
+        .unwrap();
+    assert!(
+        e.to_string().contains("colour_from names layer \"nope\""),
+        "{e}"
+    );
+}

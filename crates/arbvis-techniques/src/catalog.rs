@@ -260,6 +260,14 @@ trait AnyTechnique: Any {
     ) -> RenderResult<Option<Image>>;
     fn summary(&self, prepared: &dyn Any, base: &Path) -> Option<Summary>;
     fn world(&self, prepared: &dyn Any) -> Option<World>;
+    fn colours_at(
+        &self,
+        prepared: &dyn Any,
+        points: &[glam::DVec3],
+    ) -> Option<Vec<Option<[f64; 3]>>>;
+    fn colour_source(&self) -> Option<&str>;
+    fn coloured_points(&self, prepared: &dyn Any) -> Vec<glam::DVec3>;
+    fn take_colours(&self, prepared: &mut dyn Any, colours: &[Option<[f64; 3]>]);
 }
 
 impl<T: Technique> AnyTechnique for T {
@@ -361,6 +369,30 @@ impl<T: Technique> AnyTechnique for T {
     /// [`Technique::world`] of `prepared` (none where it is another technique's).
     fn world(&self, prepared: &dyn Any) -> Option<World> {
         Technique::world(self, prepared.downcast_ref::<T::Prepared>()?)
+    }
+
+    fn colours_at(
+        &self,
+        prepared: &dyn Any,
+        points: &[glam::DVec3],
+    ) -> Option<Vec<Option<[f64; 3]>>> {
+        Technique::colours_at(self, prepared.downcast_ref::<T::Prepared>()?, points)
+    }
+
+    fn colour_source(&self) -> Option<&str> {
+        Technique::colour_source(self)
+    }
+
+    fn coloured_points(&self, prepared: &dyn Any) -> Vec<glam::DVec3> {
+        prepared
+            .downcast_ref::<T::Prepared>()
+            .map_or_else(Vec::new, |p| Technique::coloured_points(self, p))
+    }
+
+    fn take_colours(&self, prepared: &mut dyn Any, colours: &[Option<[f64; 3]>]) {
+        if let Some(p) = prepared.downcast_mut::<T::Prepared>() {
+            Technique::take_colours(self, p, colours)
+        }
     }
 }
 
@@ -509,6 +541,37 @@ pub fn summary(
 /// share ([`Technique::world`]).
 pub fn world(technique: &TechniqueScene, prepared: &PreparedData) -> Option<World> {
     technique.technique().world(prepared.as_ref())
+}
+
+/// A layer coloured by another: the layer it names, where it does
+/// ([`Technique::colour_source`]).
+pub fn colour_source(technique: &TechniqueScene) -> Option<&str> {
+    technique.technique().colour_source()
+}
+
+/// The points of `prepared` that take another layer's colours, in its object frame.
+pub fn coloured_points(technique: &TechniqueScene, prepared: &PreparedData) -> Vec<glam::DVec3> {
+    technique.technique().coloured_points(prepared.as_ref())
+}
+
+/// The colours `technique` shows at `points` of its object frame (None outside).
+pub fn colours_at(
+    technique: &TechniqueScene,
+    prepared: &PreparedData,
+    points: &[glam::DVec3],
+) -> Option<Vec<Option<[f64; 3]>>> {
+    technique.technique().colours_at(prepared.as_ref(), points)
+}
+
+/// `prepared` takes `colours` for its [`coloured_points`].
+pub fn take_colours(
+    technique: &TechniqueScene,
+    prepared: &mut PreparedData,
+    colours: &[Option<[f64; 3]>],
+) {
+    technique
+        .technique()
+        .take_colours(prepared.as_mut(), colours)
 }
 
 /// The renderer of what [`prepare`] made for `technique`, with programs of `kind`.

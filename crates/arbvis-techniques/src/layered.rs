@@ -173,6 +173,7 @@ pub fn build(
         .map(|(world, (info, _))| placed_world(world, info))
         .collect();
     let placements = placements(&worlds);
+    colour_across(layers, &first, &worlds, &mut prepared)?;
     // A renderer for each distinct technique some visible layer draws.
     let wanted = |i: usize| (0..layers.len()).any(|l| first[l] == i && layers[l].0.visible);
     let mut renderers = Vec::new();
@@ -200,6 +201,53 @@ pub fn build(
         })
         .collect();
     Ok(LayeredRenderer { layers, renderers })
+}
+
+/// Layers coloured by another (`colour_from`): each of their points takes the colour the
+/// named layer shows where it lies in the world.
+fn colour_across(
+    layers: &[(&LayerInfo, &TechniqueScene)],
+    first: &[usize],
+    worlds: &[World],
+    prepared: &mut [Option<crate::catalog::PreparedData>],
+) -> RenderResult<()> {
+    for (index, (info, technique)) in layers.iter().enumerate() {
+        let Some(source) = crate::catalog::colour_source(technique) else {
+            continue;
+        };
+        if first[index] != index {
+            continue;
+        }
+        let named = layers.iter().position(|(i, _)| i.name == source);
+        let from = named.filter(|&s| s != index).ok_or_else(|| {
+            let why = RenderError::Unplaced(format!(
+                "colour_from names layer {source:?}, which is not another layer of the scene"
+            ));
+            in_layer(index, info, why)
+        })?;
+        let Some(Some(data)) = prepared.get(index) else {
+            continue;
+        };
+        let points: Vec<DVec3> = crate::catalog::coloured_points(technique, data)
+            .into_iter()
+            .map(|p| worlds[from].to_object(worlds[index].to_world(p)))
+            .collect();
+        let Some(Some(source_data)) = prepared.get(first[from]) else {
+            continue;
+        };
+        let colours =
+            crate::catalog::colours_at(layers[from].1, source_data, &points).ok_or_else(|| {
+                let why = RenderError::Unplaced(format!(
+                    "layer {source:?} ({}) has no colours to give",
+                    layers[from].1.name()
+                ));
+                in_layer(index, info, why)
+            })?;
+        if let Some(Some(data)) = prepared.get_mut(index) {
+            crate::catalog::take_colours(technique, data, &colours);
+        }
+    }
+    Ok(())
 }
 
 impl LayeredRenderer {

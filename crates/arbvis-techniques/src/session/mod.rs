@@ -131,6 +131,8 @@ impl Session {
         let same_renderer = old.technique.name() == scene.technique.name()
             && old.more_layers == scene.more_layers
             && old.layer == scene.layer
+            // A layered scene's first layer too: layers may take each other's colours.
+            && (!scene.is_layered() || old.technique == scene.technique)
             && old.fidelity == scene.fidelity
             && old.programs == scene.programs
             && old.target_format() == scene.target_format()

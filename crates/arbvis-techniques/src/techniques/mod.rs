@@ -281,6 +281,31 @@ pub trait Technique: Any + Sized {
         let _ = prepared;
         None
     }
+    /// The colour it shows at each of `points` (its object frame), None outside its data:
+    /// what another layer coloured by this one takes (a survey's primary attribute
+    /// through its table). None where the technique has no colour at a point.
+    fn colours_at(
+        &self,
+        prepared: &Self::Prepared,
+        points: &[glam::DVec3],
+    ) -> Option<Vec<Option<[f64; 3]>>> {
+        let _ = (prepared, points);
+        None
+    }
+    /// The layer whose colours it takes where it lies (`colour_from`), if any.
+    fn colour_source(&self) -> Option<&str> {
+        None
+    }
+    /// Its points to colour (object frame), and takes their colours (None: outside the
+    /// source, kept as it was): a layer coloured by another ([`Technique::colour_source`]).
+    fn coloured_points(&self, prepared: &Self::Prepared) -> Vec<glam::DVec3> {
+        let _ = prepared;
+        Vec::new()
+    }
+    /// Take the colours of [`Technique::coloured_points`].
+    fn take_colours(&self, prepared: &mut Self::Prepared, colours: &[Option<[f64; 3]>]) {
+        let _ = (prepared, colours);
+    }
 }
 
 /// What a reference picture is computed for ([`Technique::reference`]).

@@ -106,6 +106,11 @@ impl World {
         [self.centre - reach, self.centre + reach]
     }
 
+    /// A point of the world in the object frame.
+    pub fn to_object(&self, world: DVec3) -> DVec3 {
+        self.rotation.inverse() * ((world - self.centre) / self.units)
+    }
+
     /// A point of the object frame in the world.
     pub fn to_world(&self, object: DVec3) -> DVec3 {
         self.centre + self.rotation * (object * self.units)

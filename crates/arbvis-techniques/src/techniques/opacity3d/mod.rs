@@ -266,6 +266,17 @@ impl crate::techniques::Technique for Opacity3dScene {
         prepare::prepare(self, settings.base, limits).map(Some)
     }
 
+    /// The primary attribute's colour through its table where each point lies (a
+    /// horizon coloured by its survey).
+    fn colours_at(
+        &self,
+        prepared: &Option<prepare::Prepared>,
+        points: &[glam::DVec3],
+    ) -> Option<Vec<Option<[f64; 3]>>> {
+        let p = prepared.as_ref()?;
+        Some(points.iter().map(|&x| p.primary_colour_at(x)).collect())
+    }
+
     /// The ray caster runs each ray through the whole box: precise slices instead.
     fn occludable(&mut self) {
         self.raycast = None;

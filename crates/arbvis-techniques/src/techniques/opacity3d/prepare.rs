@@ -42,6 +42,45 @@ pub struct Prepared {
 pub const CHANNEL: [usize; 3] = [1, 2, 0];
 
 impl Prepared {
+    /// The primary attribute's colour at `p` (object frame) through its table: the
+    /// quantized level interpolated trilinearly between the voxel centres around `p`
+    /// (clamped at the box's faces), the table linear between its entries; None outside
+    /// the box or without a primary table.
+    pub fn primary_colour_at(&self, p: DVec3) -> Option<[f64; 3]> {
+        let table = self.tables[0].as_ref()?;
+        let u = (p + self.half) / (2.0 * self.half);
+        if !u.is_finite() || u.min_element() < 0.0 || u.max_element() > 1.0 {
+            return None;
+        }
+        let dims = self.dims.map(|d| d.max(1));
+        let c = std::array::from_fn::<f64, 3, _>(|a| {
+            (u[a] * dims[a] as f64 - 0.5).clamp(0.0, (dims[a] - 1) as f64)
+        });
+        let lo = c.map(|x| x.floor() as usize);
+        let f: [f64; 3] = std::array::from_fn(|a| c[a] - lo[a] as f64);
+        let mut level = 0.0;
+        for corner in 0..8 {
+            let at: [usize; 3] =
+                std::array::from_fn(|a| (lo[a] + (corner >> a & 1)).min(dims[a] - 1));
+            let w: f64 = (0..3)
+                .map(|a| {
+                    if corner >> a & 1 == 1 {
+                        f[a]
+                    } else {
+                        1.0 - f[a]
+                    }
+                })
+                .product();
+            let v = at[0] + dims[0] * (at[1] + dims[1] * at[2]);
+            level += w * self.byte(v, 0) as f64;
+        }
+        let k = (level.floor() as usize).min(254);
+        let t = level - k as f64;
+        let entry = |k: usize| table.entries[k].map(|c| c as f64 / 255.0);
+        let (a, b) = (entry(k), entry(k + 1));
+        Some(std::array::from_fn(|i| a[i] * (1.0 - t) + b[i] * t))
+    }
+
     /// Quantized value of attribute `a` at voxel index `v`.
     pub fn byte(&self, v: usize, a: usize) -> u8 {
         self.packed[v * 3 + CHANNEL[a]]

@@ -50,6 +50,11 @@ pub struct SurfaceScene {
     /// Colour by the surface's own elevation (its z, lowest to highest) through `table`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub colour_by: Option<ColourBy>,
+    /// Colour by the colours another layer of the scene shows where the surface lies (a
+    /// survey's primary attribute through its table: "seismic on the horizon");
+    /// `colour`, or `colour_by`, where the surface lies outside it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub colour_from: Option<ColourFrom>,
     /// The table `colour_by` reads (by default `viridis`).
     #[serde(default = "default_table")]
     pub table: TableSpec,
@@ -71,6 +76,14 @@ pub struct SyntheticHorizon {
     /// Turns the folds.
     #[serde(default)]
     pub seed: u64,
+}
+
+/// `colour_from = { layer = "F3" }`: the layer (by name) whose colours a surface takes.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ColourFrom {
+    /// The layer's name.
+    pub layer: String,
 }
 
 /// What a surface's colour follows besides the constant.
@@ -117,6 +130,7 @@ impl SurfaceScene {
             synthetic: None,
             colour: default_colour(),
             colour_by: None,
+            colour_from: None,
             table: default_table(),
             lighting: Lighting::default(),
             opacity: 1.0,
@@ -163,6 +177,16 @@ impl Technique for SurfaceScene {
             return Err(FieldError::new(
                 "opacity",
                 format!("{}: above 0 and at most 1", self.opacity),
+            ));
+        }
+        if self
+            .colour_from
+            .as_ref()
+            .is_some_and(|c| c.layer.is_empty())
+        {
+            return Err(FieldError::new(
+                "colour_from.layer",
+                "the name of a layer of the scene",
             ));
         }
         self.table.validate().map_err(|e| e.within("table"))
@@ -241,5 +265,21 @@ impl Technique for SurfaceScene {
 
     fn world(&self, prepared: &prepare::Prepared) -> Option<World> {
         Some(prepared.world)
+    }
+
+    fn colour_source(&self) -> Option<&str> {
+        self.colour_from.as_ref().map(|c| c.layer.as_str())
+    }
+
+    fn coloured_points(&self, prepared: &prepare::Prepared) -> Vec<glam::DVec3> {
+        prepared.corners.iter().map(|c| c.position).collect()
+    }
+
+    fn take_colours(&self, prepared: &mut prepare::Prepared, colours: &[Option<[f64; 3]>]) {
+        for (corner, colour) in prepared.corners.iter_mut().zip(colours) {
+            if let Some(c) = colour {
+                corner.colour = glam::DVec3::from_array(*c);
+            }
+        }
     }
 }
