@@ -206,6 +206,10 @@ impl Renderer for SurfaceRenderer {
     /// The elevation table over the surface's z range, or its colour as a key.
     fn annotations(&self) -> crate::techniques::annotations::Annotations {
         use crate::techniques::annotations::{rgb8, Annotations, Legend};
+        // Coloured by another layer: that layer's legend says what the colours mean.
+        if self.params.colour_from.is_some() {
+            return Annotations::default();
+        }
         let legend = match &self.prepared.elevation {
             ([low, high], Some(colours)) => Legend::Bar {
                 title: "elevation (z)".into(),
