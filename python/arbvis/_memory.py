@@ -243,3 +243,50 @@ def json_default(value):
     if isinstance(value, (np.generic, np.ndarray)):
         return value.tolist()
     raise TypeError(f"Object of type {type(value).__name__} is not a value a scene holds")
+
+
+def surface_parts(vertices, triangles):
+    """(vertices N x 3 float64 in C order, triangles M x 3 uint32 in C order) of numpy
+    arrays, checked: finite vertices, indices below N."""
+    xyz = np.asarray(vertices)
+    if xyz.ndim != 2 or xyz.shape[1] != 3 or xyz.dtype.kind not in "iuf":
+        raise InputError(f"surface: vertices are an (N, 3) array of numbers, got {xyz.shape} {xyz.dtype}")
+    tri = np.asarray(triangles)
+    if tri.ndim != 2 or tri.shape[1] != 3 or tri.dtype.kind not in "iu":
+        raise InputError(f"surface: triangles are an (M, 3) array of integers, got {tri.shape} {tri.dtype}")
+    check_budget(f"surface: {xyz.shape[0]} vertices and {tri.shape[0]} triangles", xyz.shape[0] * 24 + tri.shape[0] * 12)
+    if not np.isfinite(xyz).all():
+        bad = int(np.argwhere(~np.isfinite(xyz))[0][0])
+        raise InputError(f"surface: vertex {bad} has a non-finite coordinate {xyz[bad].tolist()}")
+    if len(tri) == 0:
+        raise InputError("surface: no triangles")
+    if tri.min() < 0 or tri.max() >= len(xyz):
+        bad = int(np.argwhere((tri < 0) | (tri >= len(xyz)))[0][0])
+        raise InputError(f"surface: triangle {bad} is {tri[bad].tolist()}, but there are {len(xyz)} vertices")
+    return np.ascontiguousarray(xyz, dtype=np.float64), np.ascontiguousarray(tri, dtype=np.uint32)
+
+
+def grid_surface(z, x, y):
+    """A 2D grid of heights (or times, downwards: pass -time) as vertices and triangles:
+    node [i, j] at (x[i], y[j], z[i, j]); a cell's two triangles where its three corners
+    are defined (NaN marks an undefined node, as interpretation tools leave holes)."""
+    z = np.asarray(z, dtype=np.float64)
+    if z.ndim != 2 or min(z.shape) < 2:
+        raise InputError(f"surface: a grid is a 2D array of at least 2 x 2 heights, got {z.shape}")
+    nx, ny = z.shape
+    x = np.arange(nx, dtype=np.float64) if x is None else np.asarray(x, dtype=np.float64)
+    y = np.arange(ny, dtype=np.float64) if y is None else np.asarray(y, dtype=np.float64)
+    if x.shape != (nx,) or y.shape != (ny,):
+        raise InputError(f"surface: x has {x.shape} and y {y.shape} values for a grid of {z.shape}")
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    vertices = np.stack([gx.ravel(), gy.ravel(), z.ravel()], axis=1)
+    node = np.arange(nx * ny).reshape(nx, ny)
+    a, b, c, d = node[:-1, :-1].ravel(), node[1:, :-1].ravel(), node[1:, 1:].ravel(), node[:-1, 1:].ravel()
+    triangles = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    defined = np.isfinite(vertices[:, 2])
+    triangles = triangles[defined[triangles].all(axis=1)]
+    # Undefined nodes are left out and the rest renumbered.
+    keep = np.flatnonzero(defined)
+    index = np.full(len(vertices), -1)
+    index[keep] = np.arange(len(keep))
+    return vertices[keep], index[triangles]

@@ -77,3 +77,40 @@ def test_a_layered_picture_draws_each_visible_layer():
     assert lit(horizon_only) > 100 and lit(cube_only) > 100
     assert np.abs(both - horizon_only).max() > 0.1
     assert np.abs(both - cube_only).max() > 0.1
+
+
+def test_a_surface_from_arrays_and_from_a_grid_draws_as_its_file(tmp_path):
+    """An uneven height field as an OBJ file, as vertices and triangles, and as a grid:
+    one picture; a NaN node leaves its cells out; bad arrays are refused by name."""
+    rng = np.random.default_rng(4)
+    x, y = 635000.0 + 25.0 * np.arange(9), 848000.0 + 12.5 * np.arange(7)
+    z = -400 + 30 * rng.standard_normal((9, 7))
+    grid = arbvis.Surface.grid(z, x, y)
+    assert len(grid) == 2 * 8 * 6
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    vertices = np.stack([gx.ravel(), gy.ravel(), z.ravel()], axis=1)
+    node = np.arange(63).reshape(9, 7)
+    a, b, c, d = node[:-1, :-1].ravel(), node[1:, :-1].ravel(), node[1:, 1:].ravel(), node[:-1, 1:].ravel()
+    triangles = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    obj = "".join(f"v {float(p[0])!r} {float(p[1])!r} {float(p[2])!r}\n" for p in vertices)
+    obj += "".join(f"f {t[0] + 1} {t[1] + 1} {t[2] + 1}\n" for t in triangles)
+    (tmp_path / "h.obj").write_text(obj)
+    text = "size = [57, 43]\n[technique.surface]\nfile = \"h.obj\"\ncolour_by = \"elevation\"\n"
+    scene = arbvis.Scene.from_toml(text, base=tmp_path)
+    want, _ = render(scene)
+    for surface in (arbvis.Surface(vertices, triangles), grid):
+        scene["technique.surface.file"] = surface
+        assert scene["technique.surface.file"] == {"memory": surface.name}
+        got, _ = render(scene)
+        assert np.array_equal(got, want)
+    holed = z.copy()
+    holed[4, 3] = np.nan
+    assert len(arbvis.Surface.grid(holed, x, y)) == 2 * 8 * 6 - 6, "the node's six triangles"
+    with pytest.raises(arbvis.InputError, match="surface: triangle 1 is"):
+        arbvis.Surface(vertices, np.array([[0, 1, 2], [0, 1, 99]]))
+    with pytest.raises(arbvis.InputError, match="surface: vertex 2 has a non-finite"):
+        bad = vertices.copy()
+        bad[2, 1] = np.inf
+        arbvis.Surface(bad, triangles)
+    with pytest.raises(arbvis.SceneError):
+        scene["technique.surface.file"] = 5

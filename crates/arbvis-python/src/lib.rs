@@ -14,6 +14,7 @@ mod images;
 mod mesh;
 mod renderer;
 mod scene;
+mod surface;
 mod tools;
 mod volume;
 
@@ -59,6 +60,7 @@ fn _arbvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<volume::PyVolume>()?;
     m.add_class::<cloud::PyCloud>()?;
     m.add_class::<mesh::PyMesh>()?;
+    m.add_class::<surface::PySurface>()?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(check_budget, m)?)?;
     m.add_function(wrap_pyfunction!(tools::inspect, m)?)?;

@@ -74,6 +74,11 @@ fn naming_volumes<'py>(
         kept.push(m.mesh.clone());
         return named(&m.name);
     }
+    if let Ok(s) = value.cast::<crate::surface::PySurface>() {
+        let s = s.get();
+        kept.push(s.surface.clone());
+        return named(&s.name);
+    }
     if let Ok(d) = value.cast::<PyDict>() {
         let out = PyDict::new(py);
         for (k, v) in d.iter() {

@@ -207,6 +207,9 @@ impl TriangleMesh {
     }
 }
 
+/// Surfaces handed over in memory (`arbvis.Surface`), by name.
+pub static SURFACES: crate::memory::Shelf<TriangleMesh> = crate::memory::Shelf::new("surface");
+
 /// Parse a surface from bytes; the format is chosen from `name`'s extension (`.obj`,
 /// `.stl`), `name` naming the source in errors.
 pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {

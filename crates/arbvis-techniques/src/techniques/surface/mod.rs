@@ -38,9 +38,10 @@ use arbvis_gl::{Gpu, ProgramChoice, ProgramKind};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SurfaceScene {
-    /// The triangle file (`.obj`, `.stl`, `.ply`), relative to the scene's folder.
+    /// The triangle file (`.obj`, `.stl`, `.ply`, `.ts`), relative to the scene's
+    /// folder, or a surface handed over in memory (`{ memory = NAME }`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub file: Option<PathBuf>,
+    pub file: Option<SurfaceFile>,
     /// Or a generated horizon (the demos' surface, no file needed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub synthetic: Option<SyntheticHorizon>,
@@ -64,6 +65,22 @@ pub struct SurfaceScene {
     /// In (0, 1]: below 1 the surface is translucent.
     #[serde(default = "one")]
     pub opacity: f64,
+}
+
+/// Where a surface's triangles are: a file, or a surface handed over in memory.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(
+    untagged,
+    expecting = "a surface file's path, or { memory = NAME } (an arbvis.Surface)"
+)]
+pub enum SurfaceFile {
+    /// A file, relative to the scene's folder.
+    Path(PathBuf),
+    /// A surface handed over in memory, by its name.
+    Memory {
+        /// Its name (`surface-1`).
+        memory: String,
+    },
 }
 
 /// A generated horizon: a height field of `size` nodes 25 m apart, folded and cut by a
@@ -126,7 +143,7 @@ impl SurfaceScene {
     /// A surface from `file` with every other value at its default.
     pub fn of(file: impl Into<PathBuf>) -> SurfaceScene {
         SurfaceScene {
-            file: Some(file.into()),
+            file: Some(SurfaceFile::Path(file.into())),
             synthetic: None,
             colour: default_colour(),
             colour_by: None,
@@ -193,7 +210,7 @@ impl Technique for SurfaceScene {
     }
 
     fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut PathBuf)) {
-        if let Some(p) = self.file.as_mut() {
+        if let Some(SurfaceFile::Path(p)) = self.file.as_mut() {
             f("file", p);
         }
         if let Some(p) = self.table.file.as_mut() {

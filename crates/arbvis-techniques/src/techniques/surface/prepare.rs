@@ -41,7 +41,10 @@ pub const BYTES_PER_CORNER: u64 = 72 + 48;
 /// budget.
 pub fn prepare(scene: &SurfaceScene, base: &Path) -> RenderResult<Prepared> {
     let mesh = match (&scene.file, &scene.synthetic) {
-        (Some(file), _) => arbvis_data::surface::read(&base.join(file))?,
+        (Some(super::SurfaceFile::Path(file)), _) => arbvis_data::surface::read(&base.join(file))?,
+        (Some(super::SurfaceFile::Memory { memory }), _) => arbvis_data::surface::SURFACES
+            .copy(memory)
+            .map_err(|e| arbvis_core::vocab::FieldError::new("file", e.to_string()))?,
         (None, Some(s)) => synthetic_horizon(s),
         (None, None) => {
             return Err(
