@@ -608,6 +608,13 @@ fn targets() -> Vec<Target> {
             run: |b| surface(b, "fuzz.ts"),
         },
         Target {
+            name: "surface-zmap",
+            text: true,
+            sections: false,
+            corpus: vec![b"! exported\n@top, GRID, 4\n15, -99999.0, , 4, 1\n3, 4, 100.0, 130.0, 200.0, 220.0\n0.0, 0.0, 0.0\n@\n  -1.0  -2.0  -3.0  -4.0\n  -5.0  -6.0  -7.0 -99999.0\n  -9.0 -10.0 -11.0 -12.0\n".to_vec()],
+            run: |b| surface(b, "fuzz.zmap"),
+        },
+        Target {
             name: "surface-stl",
             text: false,
             sections: false,

@@ -736,3 +736,35 @@ fn the_tracked_f3_horizon_lies_on_the_surveys_peaks() {
         "on the peak {share}, 20 ms below {off}"
     );
 }
+
+/// A ZMap+ grid of time (positive downwards, as it does not say) drawn with `z_down`:
+/// its nodes at z = -time, the null node left out.
+#[test]
+fn a_zmap_time_grid_lies_at_minus_its_time() {
+    let dir = common::temp_dir("layered-zmap");
+    let grid = "@top, GRID, 3\n15, 1e30, , 4, 1\n2, 3, 620000.0, 620050.0, 6074000.0, 6074040.0\n0.0, 0.0, 0.0\n@\n120.0 122.5 121.0\n1e30 125.0 130.0\n";
+    std::fs::write(dir.join("t.zmap"), grid).unwrap();
+    let text = format!(
+        "[[layer]]\n[layer.surface]\nfile = \"{}\"\nz_down = true\n",
+        dir.join("t.zmap").display()
+    );
+    let scene = Scene::parse(&text, "t.toml").unwrap();
+    let limits = arbvis::volume::Limits::for_max_side(2048);
+    let data = arbvis::catalog::prepare(&scene.technique, &scene.settings(), &limits).unwrap();
+    let [lo, hi] = arbvis::catalog::world(&scene.technique, &data)
+        .unwrap()
+        .bounds();
+    // Column by column, north to south: the null is column 1's south node, which takes
+    // five of the six triangles with it; the one left joins column 1's north node (121 ms)
+    // to column 2's two (125, 130 ms).
+    assert!(
+        (lo.z + 130.0).abs() < 1e-9 && (hi.z + 121.0).abs() < 1e-9,
+        "{lo} {hi}"
+    );
+    assert!(
+        (lo.x - 620025.0).abs() < 1e-6 && (hi.y - 6074040.0).abs() < 1e-6,
+        "{lo} {hi}"
+    );
+    let said = common::inspect(&dir.join("t.zmap"));
+    common::assert_says(&said, &["vertices: 5", "triangles: 1"]);
+}

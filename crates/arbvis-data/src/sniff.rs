@@ -147,13 +147,14 @@ pub const READERS: &[Reader] = &[
     },
     Reader {
         format: Format::Surface,
-        reads: "OBJ (.obj), STL (.stl), GOCAD TSurf (.ts)",
+        reads: "OBJ (.obj), STL (.stl), GOCAD TSurf (.ts), ZMap+ grids (.zmap)",
         kind: DataKind::Surface,
         url: false,
         claims: |name, head| {
             name.ends_with(".obj")
                 || name.ends_with(".stl")
                 || (name.ends_with(".ts") && head.trim_ascii_start().starts_with(b"GOCAD TSurf"))
+                || name.ends_with(".zmap")
         },
         guesses: never,
     },

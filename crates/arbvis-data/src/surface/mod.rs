@@ -25,6 +25,7 @@ pub mod obj;
 pub mod stl;
 pub mod topology;
 pub mod tsurf;
+pub mod zmap;
 
 use std::path::{Path, PathBuf};
 
@@ -222,10 +223,11 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
         "stl" => stl::parse(name, bytes),
         "ply" => parse_ply(name, bytes),
         "ts" => tsurf::parse(name, bytes),
+        "zmap" => zmap::parse(name, bytes),
         _ => Err(SurfaceError::Unsupported {
             path: name.to_path_buf(),
             message: format!(
-                "unknown surface extension {:?}: expected .obj, .stl, .ply or .ts (GOCAD TSurf)",
+                "unknown surface extension {:?}: expected .obj, .stl, .ply, .ts (GOCAD TSurf) or .zmap (ZMap+ grid)",
                 arbvis_core::input::shorten(&ext, 20)
             ),
         }),
@@ -383,7 +385,10 @@ mod tests {
         let e = parse(Path::new("x.ply"), b"ply\n").unwrap_err().to_string();
         assert!(e.contains("x.ply"), "{e}");
         let e = parse(Path::new("x.off"), b"OFF\n").unwrap_err().to_string();
-        assert!(e.contains("expected .obj, .stl or .ply"), "{e}");
+        assert!(
+            e.contains("expected .obj, .stl, .ply, .ts (GOCAD TSurf) or .zmap"),
+            "{e}"
+        );
         let e = read(Path::new("/")).unwrap_err().to_string();
         assert!(e.contains("directory"), "{e}");
         let m = parse(Path::new("X.OBJ"), b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n").unwrap();

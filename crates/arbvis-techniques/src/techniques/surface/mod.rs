@@ -59,6 +59,11 @@ pub struct SurfaceScene {
     /// The table `colour_by` reads (by default `viridis`).
     #[serde(default = "default_table")]
     pub table: TableSpec,
+    /// The file's z grows downwards (a grid of time in ms or depth, as ZMap+ grids often
+    /// are, which do not say): drawn as z = -z, z up as every layer. A TSurf says so itself
+    /// (`ZPOSITIVE Depth`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub z_down: bool,
     /// `"phong"` (a headlight) or `"none"` (the colour as given).
     #[serde(default)]
     pub lighting: Lighting,
@@ -148,6 +153,7 @@ impl SurfaceScene {
             colour: default_colour(),
             colour_by: None,
             colour_from: None,
+            z_down: false,
             table: default_table(),
             lighting: Lighting::default(),
             opacity: 1.0,

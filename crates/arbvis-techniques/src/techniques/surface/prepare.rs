@@ -52,6 +52,10 @@ pub fn prepare(scene: &SurfaceScene, base: &Path) -> RenderResult<Prepared> {
             )
         }
     };
+    let mesh = match scene.z_down {
+        true => mesh.map_vertices(|[x, y, z]| [x, y, -z]),
+        false => mesh,
+    };
     let corners = 3 * mesh.triangles.len() as u64;
     arbvis_core::budget::check(
         format!("the surface's {corners} corners"),

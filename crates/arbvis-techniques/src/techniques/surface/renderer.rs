@@ -182,6 +182,7 @@ impl Renderer for SurfaceRenderer {
         let params = params.get::<SurfaceScene>()?;
         let recoloured = params.file != self.params.file
             || params.synthetic != self.params.synthetic
+            || params.z_down != self.params.z_down
             || params.colour != self.params.colour
             || params.colour_by != self.params.colour_by
             || params.table != self.params.table;
