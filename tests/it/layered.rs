@@ -45,6 +45,21 @@ fn horizon_obj(n: usize, m: usize) -> String {
     text
 }
 
+/// Layer `index` of `scene` prepared on the CPU, and where it lies in the world.
+fn prepared_in_world(
+    scene: &Scene,
+    index: usize,
+) -> (
+    arbvis::catalog::PreparedData,
+    arbvis::techniques::world::World,
+) {
+    let technique = scene.layers().nth(index).unwrap().1;
+    let limits = arbvis::volume::Limits::for_max_side(2048);
+    let data = arbvis::catalog::prepare(technique, &scene.settings(), &limits).unwrap();
+    let world = arbvis::catalog::world(technique, &data).unwrap();
+    (data, world)
+}
+
 fn parse(text: &str) -> Result<Scene, SceneError> {
     Scene::parse(text, "layered.toml")
 }
@@ -443,10 +458,7 @@ fn a_segy_survey_lies_at_its_cdp_coordinates() {
     );
     let cdp = [i32_at(180) as f64 * scale, i32_at(184) as f64 * scale];
     let scene = Scene::load(std::path::Path::new("scenes/data/f3-minimal.toml")).unwrap();
-    let settings = scene.settings();
-    let limits = arbvis::volume::Limits::for_max_side(2048);
-    let prepared = arbvis::catalog::prepare(&scene.technique, &settings, &limits).unwrap();
-    let world = arbvis::catalog::world(&scene.technique, &prepared).unwrap();
+    let (_, world) = prepared_in_world(&scene, 0);
     // The first voxel's centre: half a voxel in from the box's corner (75 x 18 x 23).
     let dims = glam::DVec3::new(75.0, 18.0, 23.0);
     let first = -world.half + world.half / dims;
@@ -518,11 +530,7 @@ fn an_opaque_plane_hides_a_precise_cloud_behind_it() {
         "fidelity = \"precise\"\n[[layer]]\nname = \"c\"\n{cloud}"
     ))
     .unwrap();
-    let limits = arbvis::volume::Limits::for_max_side(2048);
-    let data = arbvis::catalog::prepare(&probe.technique, &probe.settings(), &limits).unwrap();
-    let [lo, hi] = arbvis::catalog::world(&probe.technique, &data)
-        .unwrap()
-        .bounds();
+    let [lo, hi] = prepared_in_world(&probe, 0).1.bounds();
     let margin = (hi - lo).max_element();
     let (x, y) = (
         [lo.x - margin, hi.x + margin],
@@ -590,11 +598,7 @@ fn a_tsurf_horizon_lies_at_minus_its_time() {
         "h.toml",
     )
     .unwrap();
-    let limits = arbvis::volume::Limits::for_max_side(2048);
-    let data = arbvis::catalog::prepare(&scene.technique, &scene.settings(), &limits).unwrap();
-    let [lo, hi] = arbvis::catalog::world(&scene.technique, &data)
-        .unwrap()
-        .bounds();
+    let [lo, hi] = prepared_in_world(&scene, 0).1.bounds();
     // f64 through the object frame and back: 1e-9 of 6e6.
     assert!(
         lo.abs_diff_eq(glam::DVec3::new(620200.0, 6074300.0, -161.0), 1e-6),
@@ -703,13 +707,9 @@ fn a_surface_takes_the_colours_of_the_layer_it_lies_in() {
 #[test]
 fn the_tracked_f3_horizon_lies_on_the_surveys_peaks() {
     let scene = Scene::load(std::path::Path::new("scenes/data/f3-horizon.toml")).unwrap();
-    let limits = arbvis::volume::Limits::for_max_side(2048);
     let layers: Vec<_> = scene.layers().collect();
-    let settings = scene.settings();
-    let prepare = |t| arbvis::catalog::prepare(t, &settings, &limits).unwrap();
-    let (survey, horizon) = (prepare(layers[0].1), prepare(layers[1].1));
-    let world = |t, p| arbvis::catalog::world(t, p).unwrap();
-    let (survey_world, horizon_world) = (world(layers[0].1, &survey), world(layers[1].1, &horizon));
+    let (survey, survey_world) = prepared_in_world(&scene, 0);
+    let (horizon, horizon_world) = prepared_in_world(&scene, 1);
     // The share of the horizon's corners on a positive amplitude, moved `down` metres (ms).
     let on_peaks = |down: f64| {
         let points: Vec<_> = arbvis::catalog::coloured_points(layers[1].1, &horizon)
@@ -749,11 +749,7 @@ fn a_zmap_time_grid_lies_at_minus_its_time() {
         dir.join("t.zmap").display()
     );
     let scene = Scene::parse(&text, "t.toml").unwrap();
-    let limits = arbvis::volume::Limits::for_max_side(2048);
-    let data = arbvis::catalog::prepare(&scene.technique, &scene.settings(), &limits).unwrap();
-    let [lo, hi] = arbvis::catalog::world(&scene.technique, &data)
-        .unwrap()
-        .bounds();
+    let [lo, hi] = prepared_in_world(&scene, 0).1.bounds();
     // Column by column, north to south: the null is column 1's south node, which takes
     // five of the six triangles with it; the one left joins column 1's north node (121 ms)
     // to column 2's two (125, 130 ms).

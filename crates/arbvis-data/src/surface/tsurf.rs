@@ -16,7 +16,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use super::{Position, SurfaceError, TriangleMesh};
+use super::{tokens, Position, SurfaceError, TriangleMesh};
 
 /// What the reader found besides the triangles (`inspect`).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -240,26 +240,6 @@ impl<'a> Reader<'a> {
             )
         })
     }
-}
-
-/// The whitespace-separated tokens of `line` with their 1-based columns (in characters).
-fn tokens(line: &str) -> Vec<(usize, &str)> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for (column, (byte, c)) in line.char_indices().enumerate() {
-        match (c.is_whitespace(), start) {
-            (false, None) => start = Some((column + 1, byte)),
-            (true, Some((col, from))) => {
-                out.push((col, &line[from..byte]));
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    if let Some((col, from)) = start {
-        out.push((col, &line[from..]));
-    }
-    out
 }
 
 #[cfg(test)]

@@ -15,7 +15,7 @@
 
 use std::path::Path;
 
-use super::{Position, SurfaceError, TriangleMesh};
+use super::{tokens, Position, SurfaceError, TriangleMesh};
 
 /// What the header says (`inspect`).
 #[derive(Debug, Clone, PartialEq)]
@@ -238,26 +238,6 @@ fn split_fields<'t>(n: usize, line: &'t str, rest: &'t str) -> Vec<(usize, usize
         start += part.len() + 1;
     }
     out
-}
-
-/// The whitespace-separated tokens of a line with their 1-based columns.
-fn tokens(line: &str) -> impl Iterator<Item = (usize, &str)> {
-    let mut column = 0;
-    let mut rest = line;
-    std::iter::from_fn(move || {
-        let skipped = rest.len() - rest.trim_start().len();
-        column += rest[..skipped].chars().count();
-        rest = &rest[skipped..];
-        if rest.is_empty() {
-            return None;
-        }
-        let end = rest.find(char::is_whitespace).unwrap_or(rest.len());
-        let token = &rest[..end];
-        let at = column + 1;
-        column += token.chars().count();
-        rest = &rest[end..];
-        Some((at, token))
-    })
 }
 
 #[cfg(test)]
