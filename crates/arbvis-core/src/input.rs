@@ -145,6 +145,28 @@ pub fn data_file(relative: &str) -> std::path::PathBuf {
     path
 }
 
+/// The whitespace-separated words of a text line with their 1-based columns (in
+/// characters): what the line-oriented readers (PLY headers, TSurf, ZMap+) place their
+/// errors by.
+pub fn words(line: &str) -> Vec<(usize, &str)> {
+    let mut out = Vec::new();
+    let mut start = None;
+    for (column, (byte, c)) in line.char_indices().enumerate() {
+        match (c.is_whitespace(), start) {
+            (false, None) => start = Some((column + 1, byte)),
+            (true, Some((col, from))) => {
+                out.push((col, &line[from..byte]));
+                start = None;
+            }
+            _ => {}
+        }
+    }
+    if let Some((col, from)) = start {
+        out.push((col, &line[from..]));
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -208,27 +208,6 @@ impl TriangleMesh {
     }
 }
 
-/// The whitespace-separated tokens of a text line with their 1-based columns (in
-/// characters): what the line-oriented readers (TSurf, ZMap+) place their errors by.
-pub(crate) fn tokens(line: &str) -> Vec<(usize, &str)> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for (column, (byte, c)) in line.char_indices().enumerate() {
-        match (c.is_whitespace(), start) {
-            (false, None) => start = Some((column + 1, byte)),
-            (true, Some((col, from))) => {
-                out.push((col, &line[from..byte]));
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    if let Some((col, from)) = start {
-        out.push((col, &line[from..]));
-    }
-    out
-}
-
 /// Surfaces handed over in memory (`arbvis.Surface`), by name.
 pub static SURFACES: crate::memory::Shelf<TriangleMesh> = crate::memory::Shelf::new("surface");
 

@@ -16,7 +16,8 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use super::{tokens, Position, SurfaceError, TriangleMesh};
+use super::{Position, SurfaceError, TriangleMesh};
+use arbvis_core::input::words as tokens;
 
 /// What the reader found besides the triangles (`inspect`).
 #[derive(Debug, Clone, Default, PartialEq)]

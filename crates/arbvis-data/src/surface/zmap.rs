@@ -15,7 +15,8 @@
 
 use std::path::Path;
 
-use super::{tokens, Position, SurfaceError, TriangleMesh};
+use super::{Position, SurfaceError, TriangleMesh};
+use arbvis_core::input::words as tokens;
 
 /// What the header says (`inspect`).
 #[derive(Debug, Clone, PartialEq)]

@@ -132,7 +132,7 @@ impl<'a> Line<'a> {
             name,
             number,
             line,
-            words: words(line),
+            words: arbvis_core::input::words(line),
         })
     }
 
@@ -292,26 +292,6 @@ impl<'a> Line<'a> {
         element.properties.push(declared);
         Ok(())
     }
-}
-
-/// Words of a header line with their 1-based columns.
-fn words(line: &str) -> Vec<(usize, &str)> {
-    let mut out = Vec::new();
-    let mut start = None;
-    for (column, (i, c)) in line.char_indices().enumerate() {
-        match (c.is_whitespace(), start) {
-            (false, None) => start = Some((column + 1, i)),
-            (true, Some((col, s))) => {
-                out.push((col, &line[s..i]));
-                start = None;
-            }
-            _ => {}
-        }
-    }
-    if let Some((col, s)) = start {
-        out.push((col, &line[s..]));
-    }
-    out
 }
 
 fn rest(line: &str, keyword: &str) -> String {
