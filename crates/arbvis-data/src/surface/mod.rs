@@ -208,6 +208,17 @@ impl TriangleMesh {
     }
 }
 
+/// Test helper of the line-oriented readers: `text` parsed as `name` is refused at `line`,
+/// `column`, saying `says`.
+#[cfg(test)]
+pub(crate) fn assert_refused_at(name: &str, text: &str, line: usize, column: usize, says: &str) {
+    let e = parse(Path::new(name), text.as_bytes())
+        .unwrap_err()
+        .to_string();
+    let at = format!("line {line}, column {column}");
+    assert!(e.contains(&at) && e.contains(says), "{text:?}: {e}");
+}
+
 /// Surfaces handed over in memory (`arbvis.Surface`), by name.
 pub static SURFACES: crate::memory::Shelf<TriangleMesh> = crate::memory::Shelf::new("surface");
 

@@ -294,14 +294,7 @@ mod tests {
             (GRID.replace("3, 4,", "100000, 100000,"), 4, 1, "more than"),
         ];
         for (text, line, column, says) in cases {
-            let e = parse(Path::new("bad.zmap"), text.as_bytes())
-                .unwrap_err()
-                .to_string();
-            assert!(
-                e.contains(&format!("line {line}, column {column}")),
-                "{says}: {e}"
-            );
-            assert!(e.contains(says), "{says}: {e}");
+            crate::surface::assert_refused_at("bad.zmap", &text, line, column, says);
         }
     }
 }
