@@ -114,3 +114,33 @@ def test_a_surface_from_arrays_and_from_a_grid_draws_as_its_file(tmp_path):
         arbvis.Surface(bad, triangles)
     with pytest.raises(arbvis.SceneError):
         scene["technique.surface.file"] = 5
+
+
+def test_a_section_moves_by_key_for_the_cost_of_a_frame(tmp_path):
+    """A layered scene's section moved from Python (`scene["layer.1.section.inline"]`) is
+    drawn by the renderer it has, which reads no file for it (the survey's file is gone by
+    then): the same picture as a fresh renderer's of the moved scene."""
+    rng = np.random.default_rng(5)
+    dims = [19, 13, 11]  # samples fastest, as a raw volume's dims
+    values = rng.standard_normal(dims[::-1]).astype("<f4")
+    values.tofile(tmp_path / "survey.raw")
+    volume = {"raw": {"path": str(tmp_path / "survey.raw"), "dims": dims, "type": "f32"}}
+    scene = arbvis.Scene.from_dict(
+        {
+            "size": [57, 43],
+            "fidelity": "precise",
+            "technique": {"section": {"volume": volume, "inline": 2}},
+        }
+    )
+    scene.add_layer("section", {"volume": volume, "time": 7.5}, name="time 7.5")
+    with arbvis.Renderer(scene) as r:
+        before = r.render()
+        (tmp_path / "survey.raw").rename(tmp_path / "moved.raw")
+        scene["layer.1.section.time"] = 3.25
+        scene["layer.0.section.inline"] = 8
+        kept = r.render()
+        (tmp_path / "moved.raw").rename(tmp_path / "survey.raw")
+    with arbvis.Renderer(scene) as r:
+        fresh = r.render()
+    assert np.array_equal(kept, fresh)
+    assert np.abs(kept.astype(float) - before.astype(float)).max() > 0.1, "the sections moved"

@@ -40,6 +40,7 @@ mod programs;
 mod quad;
 mod remote;
 mod remote_secrets;
+mod section;
 mod segy_keys;
 mod session;
 mod splats;

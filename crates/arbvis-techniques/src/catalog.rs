@@ -21,6 +21,7 @@ use crate::summary::Summary;
 use crate::techniques::cellproj::CellprojScene;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::quad::QuadScene;
+use crate::techniques::section::SectionScene;
 use crate::techniques::splats::SplatsScene;
 use crate::techniques::surface::SurfaceScene;
 use crate::techniques::world::World;
@@ -187,6 +188,8 @@ techniques!(
     splats => Splats(SplatsScene),
     /// A triangle surface (a horizon, a fault, a body's boundary), a layer beside the others.
     surface => Surface(SurfaceScene),
+    /// An inline, crossline or time section of a survey, a plane coloured by a table.
+    section => Section(SectionScene),
 );
 
 /// What a technique declares once, read by every list of techniques.
@@ -242,6 +245,7 @@ trait AnyTechnique: Any {
     );
     fn for_interaction(&mut self, scale: f64);
     fn draws_opaque(&self) -> bool;
+    fn keeps_place(&self, new: &dyn Any) -> bool;
     fn occludable(&mut self);
     fn memory_estimate(&self, size: [u32; 2]) -> Vec<arbvis_core::budget::Estimate>;
     fn prepare(&self, settings: &Settings<'_>, limits: &Limits) -> RenderResult<PreparedData>;
@@ -317,6 +321,11 @@ impl<T: Technique> AnyTechnique for T {
 
     fn draws_opaque(&self) -> bool {
         Technique::draws_opaque(self)
+    }
+
+    fn keeps_place(&self, new: &dyn Any) -> bool {
+        new.downcast_ref::<T>()
+            .is_some_and(|new| Technique::keeps_place(self, new))
     }
 
     fn occludable(&mut self) {
@@ -470,6 +479,12 @@ impl TechniqueScene {
     /// Whether it draws opaque geometry only ([`Technique::draws_opaque`]).
     pub fn draws_opaque(&self) -> bool {
         self.technique().draws_opaque()
+    }
+
+    /// Whether `new` draws the same data in the same place, only differently
+    /// ([`Technique::keeps_place`]); false for another technique.
+    pub fn keeps_place(&self, new: &TechniqueScene) -> bool {
+        self.technique().keeps_place(new.technique().as_any())
     }
 
     /// The same picture drawn as geometry an opaque layer's depth can hide

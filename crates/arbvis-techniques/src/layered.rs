@@ -203,6 +203,49 @@ pub fn build(
     Ok(LayeredRenderer { layers, renderers })
 }
 
+/// The layers of `new` whose parameters differ from `old`'s and that can take them in
+/// place (through [`Renderer::update_layer`]), each as its renderer was built to take it;
+/// None where the scene must be built again: a layer added, removed, moved, shown, hidden
+/// or placed, one whose data or place change ([`TechniqueScene::keeps_place`]), one turned
+/// opaque or translucent, or one that gives or takes colours.
+pub fn changes_in_place(
+    old: &[(&LayerInfo, &TechniqueScene)],
+    new: &[(&LayerInfo, &TechniqueScene)],
+) -> Option<Vec<(usize, TechniqueScene)>> {
+    if old.len() != new.len() || old.iter().zip(new).any(|(a, b)| a.0 != b.0) {
+        return None;
+    }
+    let occluding = |layers: &[(&LayerInfo, &TechniqueScene)]| {
+        layers.iter().any(|(i, t)| i.visible && t.draws_opaque())
+    };
+    let occluding = match (occluding(old), occluding(new)) {
+        (a, b) if a == b => b,
+        _ => return None,
+    };
+    let mut changes = Vec::new();
+    for (index, ((info, was), (_, is))) in old.iter().zip(new).enumerate() {
+        if was == is {
+            continue;
+        }
+        let gives = new
+            .iter()
+            .any(|(_, t)| crate::catalog::colour_source(t) == Some(info.name.as_str()));
+        let takes = crate::catalog::colour_source(was).is_some()
+            || crate::catalog::colour_source(is).is_some();
+        if gives || takes || !was.keeps_place(is) || was.draws_opaque() != is.draws_opaque() {
+            return None;
+        }
+        changes.push((
+            index,
+            match occluding && !is.draws_opaque() {
+                true => is.occludable(),
+                false => (*is).clone(),
+            },
+        ));
+    }
+    Some(changes)
+}
+
 /// Layers coloured by another (`colour_from`): each of their points takes the colour the
 /// named layer shows where it lies in the world.
 fn colour_across(
@@ -297,6 +340,32 @@ impl Renderer for LayeredRenderer {
             Some(r) => self.renderers[r].update(gpu, params),
             None => Ok(()),
         }
+    }
+
+    /// Layer `index`'s renderer takes `params`, unless another layer draws with it too; a
+    /// hidden layer draws nothing to change.
+    fn update_layer(&mut self, gpu: &Gpu, index: usize, params: Params<'_>) -> RenderResult<bool> {
+        let Some(drawn) = self.layers.get(index) else {
+            return Ok(false);
+        };
+        let Some(r) = drawn.renderer else {
+            return Ok(true);
+        };
+        if self.layers.iter().filter(|d| d.renderer == Some(r)).count() > 1 {
+            return Ok(false);
+        }
+        let name = drawn.name.clone();
+        self.renderers[r]
+            .update(gpu, params)
+            .map_err(|e| RenderError::Layer {
+                index,
+                name: match name.as_str() {
+                    "" => "unnamed".into(),
+                    n => n.into(),
+                },
+                source: Box::new(e),
+            })?;
+        Ok(true)
     }
 
     fn program_kind(&self) -> ProgramKind {

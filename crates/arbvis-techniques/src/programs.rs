@@ -54,6 +54,14 @@ pub const SURFACE_PHONG_ARBFP: ProgramText = program!("surface/phong.arbfp");
 pub const SURFACE_PHONG_VERT: ProgramText = program!("surface/phong.vert");
 /// GLSL twin of [`SURFACE_PHONG_ARBFP`].
 pub const SURFACE_PHONG_FRAG: ProgramText = program!("surface/phong.frag");
+/// A section as the era drew it (faithful): 8-bit levels, the table's nearest entry.
+pub const SECTION_FAITHFUL_ARBFP: ProgramText = program!("section/faithful.arbfp");
+/// GLSL twin of [`SECTION_FAITHFUL_ARBFP`].
+pub const SECTION_FAITHFUL_FRAG: ProgramText = program!("section/faithful.frag");
+/// A section in precise mode: float values interpolated in the program, the table between entries.
+pub const SECTION_PRECISE_ARBFP: ProgramText = program!("section/precise.arbfp");
+/// GLSL twin of [`SECTION_PRECISE_ARBFP`].
+pub const SECTION_PRECISE_FRAG: ProgramText = program!("section/precise.frag");
 
 /// The seed's Cg vertex program (reference text, not compiled).
 pub const CELLPROJ_SEED_VERTEX_CG: ProgramText = program!("cellproj/seed_vertex.cg");
@@ -213,6 +221,10 @@ pub fn all_texts() -> Vec<ProgramText> {
         SURFACE_PHONG_ARBFP,
         SURFACE_PHONG_VERT,
         SURFACE_PHONG_FRAG,
+        SECTION_FAITHFUL_ARBFP,
+        SECTION_FAITHFUL_FRAG,
+        SECTION_PRECISE_ARBFP,
+        SECTION_PRECISE_FRAG,
         CELLPROJ_SEED_VERTEX_CG,
         CELLPROJ_SEED_FRAGMENT_CG,
         CELLPROJ_PERSPECTIVE_ARBVP,

@@ -19,6 +19,7 @@ use arbvis_techniques::scene::Scene;
 use arbvis_techniques::techniques::cellproj::CellprojScene;
 use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
 use arbvis_techniques::techniques::quad::QuadScene;
+use arbvis_techniques::techniques::section::SectionScene;
 use arbvis_techniques::techniques::splats::SplatsScene;
 use arbvis_techniques::techniques::surface::SurfaceScene;
 
@@ -170,6 +171,32 @@ impl Face for SurfaceScene {
     }
 }
 
+impl Face for SectionScene {
+    /// The cut's number (dragged, or typed: inline and crossline numbers step by one, time
+    /// by a millisecond) and the opacity; a number outside the survey is refused by name.
+    fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool {
+        ui.separator();
+        ui.label("Section");
+        let mut changed = false;
+        for (key, number) in [
+            ("Inline", &mut self.inline),
+            ("Crossline", &mut self.crossline),
+            ("Time (ms)", &mut self.time),
+            ("Depth", &mut self.depth),
+        ] {
+            let Some(n) = number.as_mut() else { continue };
+            ui.horizontal(|ui| {
+                ui.label(key);
+                let r = ui.add(egui::DragValue::new(n).speed(0.25).fixed_decimals(1));
+                changed |= cx.widgets.add(ui, key, &r) && r.changed();
+            });
+        }
+        let r = ui.add(egui::Slider::new(&mut self.opacity, 0.01..=1.0).text("Opacity"));
+        changed |= cx.widgets.add(ui, "Opacity", &r) && r.changed();
+        changed
+    }
+}
+
 /// The face of parameters of type `T`, if `parameters` are.
 fn face_of<T: Face + Any>(parameters: &dyn Any) -> Option<&dyn Face> {
     parameters.downcast_ref::<T>().map(|t| t as &dyn Face)
@@ -194,6 +221,7 @@ const FACES: &[FaceLookup] = &[
     (face_of::<CellprojScene>, face_of_mut::<CellprojScene>),
     (face_of::<SplatsScene>, face_of_mut::<SplatsScene>),
     (face_of::<SurfaceScene>, face_of_mut::<SurfaceScene>),
+    (face_of::<SectionScene>, face_of_mut::<SectionScene>),
 ];
 
 /// The face of the scene's technique.

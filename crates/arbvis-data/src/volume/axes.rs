@@ -233,21 +233,7 @@ pub fn describe(source: &VolumeSource, base: &Path, dims: [usize; 3]) -> [Axis; 
                 keys: s.keys,
             };
             match segy::read(&base.join(&s.path), &options) {
-                Ok(cube) if cube.volume.dims == dims => [
-                    linear("time (ms)", dims[0], cube.interval_us as f64 / 1000.0),
-                    Axis {
-                        name: "crossline".into(),
-                        len: dims[1],
-                        numbers: Numbers::Listed(
-                            cube.crosslines.iter().map(|&v| v as f64).collect(),
-                        ),
-                    },
-                    Axis {
-                        name: "inline".into(),
-                        len: dims[2],
-                        numbers: Numbers::Listed(cube.inlines.iter().map(|&v| v as f64).collect()),
-                    },
-                ],
+                Ok(cube) if cube.volume.dims == dims => segy_axes(&cube),
                 _ => plain(),
             }
         }
@@ -277,6 +263,47 @@ pub fn describe(source: &VolumeSource, base: &Path, dims: [usize; 3]) -> [Axis; 
             indices("inline", dims[2]),
         ],
     }
+}
+
+/// A SEG-Y cube's axes: time in ms from its sample interval, its crossline and inline
+/// numbers from the trace headers.
+pub fn segy_axes(cube: &segy::SegyCube) -> [Axis; 3] {
+    let dims = cube.volume.dims;
+    [
+        linear("time (ms)", dims[0], cube.interval_us as f64 / 1000.0),
+        Axis {
+            name: "crossline".into(),
+            len: dims[1],
+            numbers: Numbers::Listed(cube.crosslines.iter().map(|&v| v as f64).collect()),
+        },
+        Axis {
+            name: "inline".into(),
+            len: dims[2],
+            numbers: Numbers::Listed(cube.inlines.iter().map(|&v| v as f64).collect()),
+        },
+    ]
+}
+
+/// Read `source` (relative paths from `base`, within `limits`) and its axes in the data's
+/// own numbers, a SEG-Y file once.
+pub fn load_with_axes(
+    source: &VolumeSource,
+    base: &Path,
+    limits: &Limits,
+) -> Result<(crate::volume::Volume, [Axis; 3]), crate::volume::VolumeError> {
+    if let VolumeSource::Segy(s) = source {
+        let options = ReadOptions {
+            limits: *limits,
+            prestack: s.prestack,
+            keys: s.keys,
+        };
+        let cube = segy::read(&base.join(&s.path), &options)?;
+        let axes = segy_axes(&cube);
+        return Ok((cube.volume, axes));
+    }
+    let volume = source.load(base, limits)?;
+    let axes = describe(source, base, volume.dims);
+    Ok((volume, axes))
 }
 
 #[cfg(test)]

@@ -126,6 +126,10 @@ impl Session {
     /// [`Renderer::update`]; a new renderer where it cannot take them (another
     /// technique, fidelity, program choice, target format or data folder).
     pub fn apply(&mut self, gpu: &Gpu, scene: &Scene) -> RenderResult<()> {
+        if self.update_layers(gpu, scene)? {
+            self.scene = scene.clone();
+            return Ok(());
+        }
         let old = &self.scene;
         // A layered scene's renderer is rebuilt when any layer but the first changes.
         let same_renderer = old.technique.name() == scene.technique.name()
@@ -147,6 +151,36 @@ impl Session {
         }
         self.scene = scene.clone();
         Ok(())
+    }
+
+    /// A layered scene whose layers changed only in ways their renderers take in place
+    /// (a section moved: a frame, not a build; [`crate::layered::changes_in_place`]):
+    /// given them, true; false where the scene must be built again.
+    fn update_layers(&mut self, gpu: &Gpu, scene: &Scene) -> RenderResult<bool> {
+        let old = &self.scene;
+        let same_settings = old.fidelity == scene.fidelity
+            && old.programs == scene.programs
+            && old.target_format() == scene.target_format()
+            && old.base == scene.base;
+        if !(old.is_layered() && scene.is_layered() && same_settings) {
+            return Ok(false);
+        }
+        let (was, is): (Vec<_>, Vec<_>) = (old.layers().collect(), scene.layers().collect());
+        let Some(changes) = crate::layered::changes_in_place(&was, &is) else {
+            return Ok(false);
+        };
+        for (index, technique) in &changes {
+            if !self
+                .renderer
+                .update_layer(gpu, *index, technique.params())?
+            {
+                return Ok(false);
+            }
+        }
+        if !changes.is_empty() {
+            self.changed();
+        }
+        Ok(true)
     }
 
     /// Take `scene`'s parameters (an editor changed them in place): through

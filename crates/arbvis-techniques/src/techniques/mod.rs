@@ -26,6 +26,7 @@ pub mod clip;
 pub mod opacity3d;
 pub mod quad;
 pub mod rays;
+pub mod section;
 pub mod splats;
 pub mod surface;
 pub mod world;
@@ -109,6 +110,13 @@ pub trait Renderer {
     /// Its frame drawn in parts, where one frame can be slow ([`DrawInParts`]).
     fn in_parts(&mut self) -> Option<&mut dyn DrawInParts> {
         None
+    }
+    /// A layered scene's layer `index` takes new parameters through its renderer's
+    /// [`Renderer::update`] (a section moved, a colour changed); false where it cannot
+    /// (not layered, or a renderer two layers share) and must be built again.
+    fn update_layer(&mut self, gpu: &Gpu, index: usize, params: Params<'_>) -> RenderResult<bool> {
+        let _ = (gpu, index, params);
+        Ok(false)
     }
 }
 
@@ -236,6 +244,14 @@ pub trait Technique: Any + Sized {
     /// Whether its parameters draw opaque geometry only (an opaque surface,
     /// isosurfaces): a layered scene draws those first, and the others against their depth.
     fn draws_opaque(&self) -> bool {
+        false
+    }
+    /// Whether `new` (other parameters of this technique) draws the same data in the same
+    /// place, only differently (a section at another inline, a surface's colour): a layered
+    /// scene's renderer then takes it through [`Renderer::update`] instead of being built
+    /// again. False by default.
+    fn keeps_place(&self, new: &Self) -> bool {
+        let _ = new;
         false
     }
     /// Parameters of the same picture drawn as geometry an opaque layer's depth can hide

@@ -123,7 +123,7 @@ pub const SURVEY_VIEW: [f64; 4] = [0.326506, -0.092296, -0.701057, 0.627211];
 
 /// A three-quarter view of a survey ([`SURVEY_VIEW`]), zoomed so that a box of any
 /// proportions stays whole at any rotation.
-fn survey_camera() -> arbvis_core::camera::Camera {
+pub(crate) fn survey_camera() -> arbvis_core::camera::Camera {
     arbvis_core::camera::Camera {
         rotation: SURVEY_VIEW,
         // The prepared box's longest half side is 1, so its bounding sphere's radius is at

@@ -232,6 +232,11 @@ impl Technique for SurfaceScene {
         self.opacity >= 1.0
     }
 
+    /// Another colour, table, lighting or opacity of the same triangles.
+    fn keeps_place(&self, new: &Self) -> bool {
+        self.file == new.file && self.synthetic == new.synthetic && self.z_down == new.z_down
+    }
+
     /// A generated horizon's corners, as prepared and uploaded (a file's are checked
     /// when it is read).
     fn memory_estimate(&self, _: [u32; 2]) -> Vec<arbvis_core::budget::Estimate> {
