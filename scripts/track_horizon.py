@@ -4,6 +4,8 @@ scenes/data/f3-horizon.toml.
 
     python3 scripts/track_horizon.py data/seismic/f3.sgy data/seismic/f3-horizon.ts
 
+(and data/seismic/f3-horizon.xyz beside it).
+
 The tracker is the simplest an interpreter uses: from a seed (the strongest peak within
 SEED_WINDOW_MS of SEED_MS on the first trace), each trace's peak is the largest amplitude
 within WINDOW_MS of its neighbour's already tracked (inline by inline, crossline by
@@ -11,7 +13,9 @@ crossline), refined to the vertex of the parabola through the peak sample and it
 neighbours; where the window holds no peak (its largest sample on an edge) the
 neighbour's time is carried, so the tracker never slides onto another event. Times are
 two-way in ms; the TSurf holds one vertex per trace at its CDP
-coordinates, ZPOSITIVE Depth (time grows downwards), two triangles per grid cell. Plain
+coordinates, ZPOSITIVE Depth (time grows downwards), two triangles per grid cell; the x y z
+grid the same nodes as OpendTect exports a horizon with X/Y and Inl/Crl and a header
+(`"X" "Y" "Inline" "Crossline" "Z (ms)"`, tab-separated, time positive down). Plain
 Python, no packages: the SEG-Y is read with struct (big-endian int16 samples, rev 1).
 """
 
@@ -95,10 +99,21 @@ def write_tsurf(path, traces, inlines, crosslines, times):
         out.write("\n".join(lines) + "\n")
 
 
+def write_xyz(path, traces, inlines, crosslines, times):
+    lines = ['"X"\t"Y"\t"Inline"\t"Crossline"\t"Z (ms)"']
+    for il in inlines:
+        for xl in crosslines:
+            x, y, _ = traces[(il, xl)]
+            lines.append(f"{x:.2f}\t{y:.2f}\t{il}\t{xl}\t{times[(il, xl)]:.3f}")
+    with open(path, "w") as out:
+        out.write("\n".join(lines) + "\n")
+
+
 def main(segy, target):
     traces, dt = read_segy(segy)
     inlines, crosslines, times = track(traces, dt)
     write_tsurf(target, traces, inlines, crosslines, times)
+    write_xyz(target.rsplit(".", 1)[0] + ".xyz", traces, inlines, crosslines, times)
     print(f"{target}: {len(times)} traces, {min(times.values()):.1f}-{max(times.values()):.1f} ms")
 
 

@@ -615,6 +615,16 @@ fn targets() -> Vec<Target> {
             run: |b| surface(b, "fuzz.zmap"),
         },
         Target {
+            name: "surface-xyz",
+            text: true,
+            sections: false,
+            corpus: vec![
+                b"\"X\"\t\"Y\"\t\"Inline\"\t\"Crossline\"\t\"Z (ms)\"\n0\t0\t1\t1\t5\n25\t0\t2\t1\t6\n0\t25\t1\t2\t1e30\n25\t25\t2\t2\t7\n".to_vec(),
+                b"# x, y, z\n0, 0, 5\n25, 0, 6\n0, 25, nan\n25, 25, 7\n50, 10, 8\n".to_vec(),
+            ],
+            run: |b| surface(b, "fuzz.xyz"),
+        },
+        Target {
             name: "surface-stl",
             text: false,
             sections: false,

@@ -24,6 +24,7 @@ mod copclib;
 mod data;
 mod docs;
 mod first_picture;
+mod horizons;
 mod hostile;
 mod irregular;
 mod isovalue_units;

@@ -147,7 +147,7 @@ pub const READERS: &[Reader] = &[
     },
     Reader {
         format: Format::Surface,
-        reads: "OBJ (.obj), STL (.stl), GOCAD TSurf (.ts), ZMap+ grids (.zmap)",
+        reads: "OBJ (.obj), STL (.stl), GOCAD TSurf (.ts), ZMap+ grids (.zmap), x y z grids (.xyz, .xyt)",
         kind: DataKind::Surface,
         url: false,
         claims: |name, head| {
@@ -155,6 +155,8 @@ pub const READERS: &[Reader] = &[
                 || name.ends_with(".stl")
                 || (name.ends_with(".ts") && head.trim_ascii_start().starts_with(b"GOCAD TSurf"))
                 || name.ends_with(".zmap")
+                || name.ends_with(".xyz")
+                || name.ends_with(".xyt")
         },
         guesses: never,
     },

@@ -138,14 +138,11 @@ fn describe(
         }
         Some(DataKind::Mesh) => Ok(arbvis_data::mesh::inspect(path)?),
         Some(DataKind::Cloud | DataKind::SeedCloud) => Ok(arbvis_data::points::inspect(path)?),
-        Some(DataKind::Surface) => {
-            let mesh = arbvis_data::surface::read(path)?;
-            Ok(format!(
-                "{}\n{}\n",
-                path.display(),
-                arbvis_data::surface::describe(&mesh)
-            ))
-        }
+        Some(DataKind::Surface) => Ok(format!(
+            "{}\n{}\n",
+            path.display(),
+            arbvis_data::surface::describe_file(path)?
+        )),
         None => Err(InspectError::Unknown {
             path: path.display().to_string(),
             what: looks_like(&head),

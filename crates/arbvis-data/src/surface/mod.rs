@@ -25,6 +25,7 @@ pub mod obj;
 pub mod stl;
 pub mod topology;
 pub mod tsurf;
+pub mod xyz;
 pub mod zmap;
 
 use std::path::{Path, PathBuf};
@@ -235,10 +236,11 @@ pub fn parse(name: &Path, bytes: &[u8]) -> Result<TriangleMesh, SurfaceError> {
         "ply" => parse_ply(name, bytes),
         "ts" => tsurf::parse(name, bytes),
         "zmap" => zmap::parse(name, bytes),
+        "xyz" | "xyt" => xyz::parse(name, bytes),
         _ => Err(SurfaceError::Unsupported {
             path: name.to_path_buf(),
             message: format!(
-                "unknown surface extension {:?}: expected .obj, .stl, .ply, .ts (GOCAD TSurf) or .zmap (ZMap+ grid)",
+                "unknown surface extension {:?}: expected .obj, .stl, .ply, .ts (GOCAD TSurf), .zmap (ZMap+ grid) or .xyz, .xyt (x y z grid)",
                 arbvis_core::input::shorten(&ext, 20)
             ),
         }),
@@ -348,6 +350,46 @@ pub fn describe(mesh: &TriangleMesh) -> String {
     inspect(mesh).to_string()
 }
 
+/// `arbvis inspect` text for a surface file: what a grid's reader found (its shape and
+/// undefined nodes, for ZMap+ and x y z grids), then [`describe`].
+pub fn describe_file(path: &Path) -> Result<String, SurfaceError> {
+    let bytes = arbvis_core::input::read_regular(path, MAX_SURFACE_BYTES).map_err(|error| {
+        SurfaceError::Io {
+            path: path.to_path_buf(),
+            error,
+        }
+    })?;
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    let (mesh, grid) = match ext.as_str() {
+        "zmap" => {
+            let (mesh, g) = zmap::parse_with_grid(path, &bytes)?;
+            let [x0, x1, y0, y1] = g.extent;
+            let grid = format!(
+                "grid: {} rows x {} columns over x {x0}..{x1}, y {y0}..{y1} (ZMap+)\nundefined nodes: {} (left out)\n",
+                g.shape[0], g.shape[1], g.undefined
+            );
+            (mesh, grid)
+        }
+        "xyz" | "xyt" => {
+            let (mesh, g) = xyz::parse_with_grid(path, &bytes)?;
+            let how = match g.lattice {
+                Some([i, c]) => format!("on its grid of {i} inlines x {c} crosslines (its inline and crossline columns)"),
+                None => "by Delaunay over x, y (no inline and crossline columns)".into(),
+            };
+            let grid = format!(
+                "nodes: {} defined, {} undefined (left out); triangulated {how}\n",
+                g.nodes, g.undefined
+            );
+            (mesh, grid)
+        }
+        _ => (parse(path, &bytes)?, String::new()),
+    };
+    Ok(format!("{grid}{}", describe(&mesh)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -397,7 +439,7 @@ mod tests {
         assert!(e.contains("x.ply"), "{e}");
         let e = parse(Path::new("x.off"), b"OFF\n").unwrap_err().to_string();
         assert!(
-            e.contains("expected .obj, .stl, .ply, .ts (GOCAD TSurf) or .zmap"),
+            e.contains("expected .obj, .stl, .ply, .ts (GOCAD TSurf), .zmap (ZMap+ grid) or .xyz"),
             "{e}"
         );
         let e = read(Path::new("/")).unwrap_err().to_string();
