@@ -15,7 +15,7 @@
 #![deny(unsafe_code)]
 
 pub use arbvis_core::{budget, camera, colortable, image, input, png_io, progress, secrets, vocab};
-pub use arbvis_data::{fetch, mesh, points, store, surface, volume};
+pub use arbvis_data::{fetch, lines, mesh, points, store, surface, volume};
 pub use arbvis_gl as gl;
 pub use arbvis_gl::{gl_check, gl_check_alloc, gl_debug_check};
 pub use arbvis_techniques::{

@@ -625,6 +625,28 @@ fn targets() -> Vec<Target> {
             run: |b| surface(b, "fuzz.xyz"),
         },
         Target {
+            name: "lines-polylines",
+            text: true,
+            sections: false,
+            corpus: vec![b"x,y,z,value\n0,0,0,1\n10,0,-5,2\n\n3,3,3,nan\n4,4,4,5\n".to_vec()],
+            run: |b| {
+                let _ = arbvis::lines::parse_polylines(Path::new("fuzz.csv"), b);
+            },
+        },
+        Target {
+            name: "lines-well",
+            text: true,
+            sections: false,
+            corpus: vec![b"MD,INC,AZI\n0,0,0\n60,0,0\n90,6,125\n240,36,125\n330,36,125\n".to_vec()],
+            run: |b| {
+                if let Ok(stations) = arbvis::lines::parse_survey(Path::new("fuzz.csv"), b) {
+                    let well = arbvis::lines::Well::of(stations);
+                    let _ = well.path([0.0, 0.0], 0.0, 2.0);
+                }
+                let _ = arbvis::lines::parse_log(Path::new("fuzz.csv"), b);
+            },
+        },
+        Target {
             name: "surface-stl",
             text: false,
             sections: false,

@@ -33,7 +33,8 @@ const LAYERS: &[(&str, &[&str])] = &[
     (
         "data and GL",
         &[
-            "le", "memory", "fetch", "sniff", "volume", "store", "mesh", "points", "surface", "gl",
+            "le", "memory", "fetch", "sniff", "volume", "store", "mesh", "points", "surface",
+            "lines", "gl",
         ],
     ),
     ("program texts", &["programs"]),

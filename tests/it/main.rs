@@ -30,6 +30,7 @@ mod irregular;
 mod isovalue_units;
 mod layered;
 mod layers;
+mod lines;
 mod mdio;
 mod mdio_flavours;
 mod mdio_positions;

@@ -68,8 +68,8 @@ fn a_depth_dataset_keeps_its_depths_and_map_positions_into_a_store() {
 #[cfg(feature = "viewer")]
 fn pointer_over_a_section(store: &Store, xy: &[Vec<f64>; 2]) {
     use arbvis::viewer::data::SectionGrid;
-    use arbvis::viewer::store_sections::store_axes;
     use arbvis::viewer::store_sections::MapPositions;
+    use arbvis::volume::axes::store_axes;
     use std::sync::Arc;
     // Samples 10..70, crosslines 3..17, inlines 2..21 of the 75 x 18 x 23 survey.
     let window = [[10, 3, 2], [70, 17, 21]];

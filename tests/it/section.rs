@@ -204,8 +204,8 @@ fn a_section_seen_face_on_shows_the_surveys_samples() {
     }
 }
 
-/// A cut that is not in the survey, two cuts, none, and a store are refused by their key
-/// and line, saying what the survey holds.
+/// A cut that is not in the survey, two cuts and none are refused by their key and line,
+/// saying what the survey holds; a store that is not there by its path.
 #[test]
 fn a_section_outside_the_survey_is_refused_by_its_key() {
     let h = headless(Backend::Egl);
@@ -239,12 +239,14 @@ fn a_section_outside_the_survey_is_refused_by_its_key() {
         assert!(e.contains("technique.section.inline"), "{e}");
         assert!(e.contains("one of inline = N, crossline = N"), "{e}");
     }
-    let text = "[technique.section]\nvolume = { store = \"x.arbvis\" }\ninline = 3\n";
-    let e = Scene::parse(text, "s.toml").unwrap_err().to_string();
-    assert!(
-        e.contains("technique.section.volume") && e.contains("store"),
-        "{e}"
+    let missing = dir.join("missing.zarr");
+    let text = format!(
+        "[technique.section]\nvolume = {{ store = \"{}\" }}\ninline = 3\n",
+        missing.display()
     );
+    let scene = Scene::parse(&text, "s.toml").unwrap();
+    let e = render_on(&h, &scene).err().unwrap().to_string();
+    assert!(e.contains("missing.zarr"), "{e}");
 }
 
 /// Beside a 3D-opacity layer of the same survey the section lies in the same world frame;
@@ -292,4 +294,38 @@ fn a_section_moves_in_a_layered_scene_without_a_build() {
         before.compare(&fresh, 0.0).unwrap().pixels_over > 100,
         "it moved"
     );
+}
+
+/// A section of F3 converted into a store (bricks of 8: a plane crosses several) draws the
+/// SEG-Y's section exactly, at an inline, a crossline and a time between samples, and in
+/// the same world frame; the store's plane is read at full resolution as it is needed.
+#[test]
+fn a_section_of_a_store_draws_the_segys_section() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("section-store");
+    let f3 = common::data_file("seismic/f3.sgy");
+    let store = dir.join("f3.zarr");
+    crate::mdio::convert_quietly(&f3, &store, Some(8));
+    let scene = |volume: String, cut: &str| {
+        // A store's range is its min-max (its percentiles are not computed): the SEG-Y's too.
+        let text = format!(
+            "size = [61, 45]\nfidelity = \"precise\"\n[technique.section]\nvolume = {volume}\n{cut}\nquantize = \"min-max\"\n"
+        );
+        Scene::parse(&text, "s.toml").unwrap()
+    };
+    for cut in ["inline = 127", "crossline = 880", "time = 141"] {
+        let a = scene(format!("{{ segy = \"{}\" }}", f3.display()), cut);
+        let b = scene(format!("{{ store = \"{}\" }}", store.display()), cut);
+        let (pa, pb) = (prepared(&a), prepared(&b));
+        assert_eq!(pa.world, pb.world, "{cut}: one place");
+        assert_eq!(pa.plane, pb.plane, "{cut}: one plane");
+        let (ia, ib) = (
+            render_on(&h, &a).unwrap().image,
+            render_on(&h, &b).unwrap().image,
+        );
+        assert_eq!(ia.compare(&ib, 0.0).unwrap().pixels_over, 0, "{cut}");
+        // Each plane seen from the survey's three-quarter view: 144 to 172 of 2,745 pixels.
+        let lit = common::lit_pixels(&ia, 0.05);
+        assert!(lit > 100, "{cut}: in view ({lit})");
+    }
 }

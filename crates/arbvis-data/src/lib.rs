@@ -14,6 +14,7 @@ extern crate self as arbvis;
 
 pub mod fetch;
 pub mod le;
+pub mod lines;
 pub mod memory;
 pub mod mesh;
 pub mod points;

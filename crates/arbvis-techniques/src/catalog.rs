@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 use crate::programs::ProgramPair;
 use crate::summary::Summary;
 use crate::techniques::cellproj::CellprojScene;
+use crate::techniques::lines::LinesScene;
 use crate::techniques::opacity3d::Opacity3dScene;
 use crate::techniques::quad::QuadScene;
 use crate::techniques::section::SectionScene;
@@ -190,6 +191,8 @@ techniques!(
     surface => Surface(SurfaceScene),
     /// An inline, crossline or time section of a survey, a plane coloured by a table.
     section => Section(SectionScene),
+    /// Polylines and wells as tubes, coloured by a value along them.
+    lines => Lines(LinesScene),
 );
 
 /// What a technique declares once, read by every list of techniques.

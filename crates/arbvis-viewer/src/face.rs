@@ -17,6 +17,7 @@ use arbvis_core::vocab::Fidelity;
 use arbvis_techniques::catalog::TechniqueScene;
 use arbvis_techniques::scene::Scene;
 use arbvis_techniques::techniques::cellproj::CellprojScene;
+use arbvis_techniques::techniques::lines::LinesScene;
 use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
 use arbvis_techniques::techniques::quad::QuadScene;
 use arbvis_techniques::techniques::section::SectionScene;
@@ -197,6 +198,30 @@ impl Face for SectionScene {
     }
 }
 
+impl Face for LinesScene {
+    /// The tubes' radius and their colour where there is no value.
+    fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool {
+        ui.separator();
+        ui.label("Lines");
+        let r = ui.add(
+            egui::Slider::new(&mut self.radius, 0.5..=100.0)
+                .logarithmic(true)
+                .text("Radius (m)"),
+        );
+        let mut changed = cx.widgets.add(ui, "Radius", &r) && r.changed();
+        ui.horizontal(|ui| {
+            ui.label("Colour");
+            let mut c = self.colour.map(|v| v as f32);
+            let r = ui.color_edit_button_rgb(&mut c);
+            if cx.widgets.add(ui, "Lines colour", &r) && r.changed() {
+                self.colour = c.map(|v| v as f64);
+                changed = true;
+            }
+        });
+        changed
+    }
+}
+
 /// The face of parameters of type `T`, if `parameters` are.
 fn face_of<T: Face + Any>(parameters: &dyn Any) -> Option<&dyn Face> {
     parameters.downcast_ref::<T>().map(|t| t as &dyn Face)
@@ -222,6 +247,7 @@ const FACES: &[FaceLookup] = &[
     (face_of::<SplatsScene>, face_of_mut::<SplatsScene>),
     (face_of::<SurfaceScene>, face_of_mut::<SurfaceScene>),
     (face_of::<SectionScene>, face_of_mut::<SectionScene>),
+    (face_of::<LinesScene>, face_of_mut::<LinesScene>),
 ];
 
 /// The face of the scene's technique.

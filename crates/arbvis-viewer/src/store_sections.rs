@@ -16,7 +16,7 @@ use std::sync::Arc;
 use glam::DVec3;
 
 use arbvis_data::store::{Store, StoreError};
-use arbvis_data::volume::axes::{Axis, Numbers};
+use arbvis_data::volume::axes::{store_axes, Axis};
 use arbvis_data::volume::quantize::quantize_value;
 use arbvis_techniques::error::{RenderError, RenderResult};
 use arbvis_techniques::techniques::opacity3d::bricked::StoreScene;
@@ -182,39 +182,4 @@ fn read_sections(store: &Store, requests: Receiver<Request>, replies: Sender<Rep
             return;
         }
     }
-}
-
-/// The axes of a store's window: the sample axis as the store numbers it (SEG-Y time in
-/// ms, an MDIO dataset's time or depth), crossline and inline numbers from the source's
-/// first and step; plain indices where it gave none.
-pub fn store_axes(
-    meta: &arbvis_data::store::meta::StoreMeta,
-    window: [[usize; 3]; 2],
-) -> [Axis; 3] {
-    let len = |a: usize| window[1][a].saturating_sub(window[0][a]);
-    let numbered = |name: &str, a: usize, start: f64, step: f64| Axis {
-        name: name.to_string(),
-        len: len(a),
-        numbers: Numbers::Linear {
-            start: start + window[0][a] as f64 * step,
-            step,
-        },
-    };
-    let s = &meta.source;
-    let samples = s.sample_axis();
-    let line = |name: &str, plain: &str, a: usize, first_step: Option<[i64; 2]>| match first_step {
-        Some([first, step]) => numbered(name, a, first as f64, step as f64),
-        None => numbered(plain, a, 0.0, 1.0),
-    };
-    let plain = samples.unit.is_empty() && s.inlines.is_none() && s.crosslines.is_none();
-    let (i, j, k) = if plain {
-        ("i".to_string(), "j", "k")
-    } else {
-        (samples.label(), "crossline", "inline")
-    };
-    [
-        numbered(&i, 0, samples.first, samples.step),
-        line("crossline", j, 1, s.crosslines),
-        line("inline", k, 2, s.inlines),
-    ]
 }

@@ -69,7 +69,7 @@ fn column_of(name: &str) -> Option<&'static str> {
 
 /// A line's fields, with the 1-based column each starts at: separated by whitespace,
 /// commas or semicolons; a field in double quotes (a header's `"Z (ms)"`) is one.
-fn fields(line: &str) -> Vec<(usize, &str)> {
+pub(crate) fn fields(line: &str) -> Vec<(usize, &str)> {
     let mut out = Vec::new();
     let mut start: Option<usize> = None;
     let mut quoted = false;

@@ -23,6 +23,7 @@ pub(crate) use demo;
 pub mod annotations;
 pub mod cellproj;
 pub mod clip;
+pub mod lines;
 pub mod opacity3d;
 pub mod quad;
 pub mod rays;

@@ -42,7 +42,7 @@ use arbvis_gl::{Gpu, ProgramChoice, ProgramKind};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SectionScene {
-    /// The survey (as 3D opacity's `volume`; a store is not read yet).
+    /// The survey (as 3D opacity's `volume`; a store's planes are read as they are needed).
     pub volume: VolumeSource,
     /// The attribute shown (amplitude = the samples themselves).
     #[serde(default)]
@@ -146,12 +146,6 @@ impl Technique for SectionScene {
                 format!("{}: a number", cut.number),
             ));
         }
-        if matches!(self.volume, VolumeSource::Store(_)) {
-            return Err(FieldError::new(
-                "volume",
-                "a section of a store is not read yet: give the SEG-Y or MDIO file it was converted from",
-            ));
-        }
         if !(self.opacity > 0.0 && self.opacity <= 1.0) {
             return Err(FieldError::new(
                 "opacity",
@@ -243,7 +237,9 @@ impl Technique for SectionScene {
         if !written("camera") {
             *camera = crate::techniques::opacity3d::survey_camera();
         }
-        if !written("technique.section.quantize") {
+        // A store's percentiles are not computed: its min-max.
+        let store = matches!(self.volume, VolumeSource::Store(_));
+        if !store && !written("technique.section.quantize") {
             self.quantize = Quantization::Percentile([1.0, 99.0]);
         }
     }

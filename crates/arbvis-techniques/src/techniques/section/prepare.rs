@@ -1,8 +1,10 @@
-//! A section's CPU side: the survey loaded and its attribute derived, the cut found in the
+//! A section's CPU side: the survey loaded and its attribute derived (or a store opened,
+//! whose planes are read at full resolution as they are needed), the cut found in the
 //! survey's numbers, and the plane's samples taken out (blended between the two samples
 //! either side of a position between them).
 
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::DVec3;
 
@@ -11,16 +13,38 @@ use crate::error::RenderResult;
 use crate::techniques::world::World;
 use arbvis_core::colortable::ColorTable;
 use arbvis_core::vocab::FieldError;
+use arbvis_data::store::Store;
 use arbvis_data::volume::attributes::derive;
-use arbvis_data::volume::axes::{load_with_axes, section_axes, Axis, Numbers};
-use arbvis_data::volume::quantize::range;
-use arbvis_data::volume::{Limits, Volume};
+use arbvis_data::volume::axes::{load_with_axes, section_axes, store_axes, Axis, Numbers};
+use arbvis_data::volume::quantize::{range, Quantization};
+use arbvis_data::volume::segy::geometry::MapFrame;
+use arbvis_data::volume::{Limits, Volume, VolumeSource};
+
+/// Where a section's samples come from.
+#[derive(Clone)]
+pub enum Samples {
+    /// The attribute's values over the whole survey, in memory.
+    Whole(Volume),
+    /// A store (or an MDIO dataset), its attribute's index: each plane read at level 0.
+    Store(Arc<Store>, usize),
+}
+
+impl std::fmt::Debug for Samples {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Samples::Whole(v) => write!(f, "Whole({:?})", v.dims),
+            Samples::Store(s, a) => write!(f, "Store({}, attribute {a})", s.path.display()),
+        }
+    }
+}
 
 /// A section as prepared: the survey, its axes, the table's range and the plane shown.
 #[derive(Debug, Clone)]
 pub struct Prepared {
-    /// The attribute's values over the whole survey (moving the section reads them).
-    pub volume: Volume,
+    /// Where moving the section reads its samples.
+    pub samples: Samples,
+    /// The survey's voxels (samples, crosslines, inlines).
+    pub dims: [usize; 3],
     /// The survey's axes in its own numbers (time, crossline, inline).
     pub axes: [Axis; 3],
     /// The values the table's first and last entries stand for.
@@ -49,10 +73,45 @@ pub struct Plane {
 }
 
 impl Prepared {
-    /// The plane at `cut`, or an error naming the key and the survey's range.
-    pub fn plane_at(&self, cut: Cut) -> Result<Plane, FieldError> {
+    /// The plane at `cut`, or an error naming the key and the survey's range (or the
+    /// store's that could not be read).
+    pub fn plane_at(&self, cut: Cut) -> RenderResult<Plane> {
         let position = position(&self.axes[cut.axis], cut)?;
-        Ok(plane(&self.volume, cut.axis, position))
+        match &self.samples {
+            Samples::Whole(volume) => Ok(plane(volume, cut.axis, position)),
+            Samples::Store(store, attr) => {
+                // The one or two samples either side along the axis, every one across.
+                let last = self.dims[cut.axis].saturating_sub(1);
+                let first = (position.floor().max(0.0) as usize).min(last);
+                let (mut lo, mut hi) = ([0; 3], self.dims);
+                lo[cut.axis] = first;
+                hi[cut.axis] = (first + 2).min(last + 1);
+                let window = store.window(*attr, lo, hi)?;
+                let mut p = plane(&window, cut.axis, position - first as f64);
+                p.position = position;
+                Ok(p)
+            }
+        }
+    }
+
+    /// The values the table spans under `quantize`: a store's from its metadata (min-max
+    /// or a range; its percentiles are not computed).
+    pub fn range_of(&self, quantize: Quantization) -> RenderResult<(f64, f64)> {
+        match &self.samples {
+            Samples::Whole(volume) => Ok(range(volume, quantize)?),
+            Samples::Store(store, attr) => {
+                let meta = &store.meta.attributes[*attr];
+                match quantize {
+                    Quantization::MinMax => Ok((meta.min.unwrap_or(0.0), meta.max.unwrap_or(0.0))),
+                    Quantization::Range([l, h]) => Ok((l, h)),
+                    Quantization::Percentile(_) => Err(FieldError::new(
+                        "quantize",
+                        "percentiles of a store are not computed; use \"min-max\" or { range = [low, high] }",
+                    )
+                    .into()),
+                }
+            }
+        }
     }
 
     /// The plane's four corners in the object frame (counter-clockwise: low-low,
@@ -60,7 +119,7 @@ impl Prepared {
     pub fn corners(&self) -> [(DVec3, [f64; 2]); 4] {
         let Plane { axis, position, .. } = self.plane;
         let (u, w) = section_axes(axis);
-        let n = self.volume.dims[axis].max(1) as f64;
+        let n = self.dims[axis].max(1) as f64;
         let at = ((position + 0.5) / n * 2.0 - 1.0) * self.half[axis];
         [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]].map(|st: [f64; 2]| {
             let mut p = DVec3::ZERO;
@@ -155,39 +214,64 @@ pub fn plane(volume: &Volume, axis: usize, position: f64) -> Plane {
     }
 }
 
-/// Load, derive, find the cut and take its plane.
+/// Load, derive (or open the store), find the cut and take its plane.
 pub fn prepare(scene: &SectionScene, base: &Path, limits: &Limits) -> RenderResult<Prepared> {
     let cut = scene.cut()?;
-    let (loaded, axes) = load_with_axes(&scene.volume, base, limits)?;
-    let volume = derive(&loaded, scene.attribute);
-    drop(loaded);
-    let range = range(&volume, scene.quantize)?;
+    let (samples, axes, spacing, map) = match &scene.volume {
+        VolumeSource::Store(path) => {
+            let store = Arc::new(Store::open(&arbvis_data::fetch::resolve(base, path))?);
+            let attr = store.attribute_index(scene.attribute.name())?;
+            let meta = &store.meta;
+            let axes = store_axes(meta, [[0; 3], meta.dims]);
+            let [_, nj, nk] = meta.dims;
+            let map = store.map_coordinates()?.and_then(|xy| {
+                MapFrame::of_corners(nj, nk, |k, j| {
+                    let t = k * nj + j;
+                    Some([*xy[0].get(t)?, *xy[1].get(t)?])
+                })
+            });
+            let spacing = meta.spacing;
+            (Samples::Store(store, attr), axes, spacing, map)
+        }
+        source => {
+            let (loaded, axes) = load_with_axes(source, base, limits)?;
+            let volume = derive(&loaded, scene.attribute);
+            let (spacing, map) = (volume.spacing, volume.map);
+            (Samples::Whole(volume), axes, spacing, map)
+        }
+    };
+    let dims: [usize; 3] = std::array::from_fn(|a| axes[a].len);
     let table = scene
         .table
         .build(base)
         .map_err(|e| FieldError::new("table", e.to_string()))?;
     let size = DVec3::from_array(std::array::from_fn(|a| {
-        let s = volume.spacing[a];
-        volume.dims[a] as f64 * if s.is_finite() && s > 0.0 { s } else { 1.0 }
+        let s = spacing[a];
+        dims[a] as f64 * if s.is_finite() && s > 0.0 { s } else { 1.0 }
     }));
-    let half = DVec3::from_array(volume.half_extent());
+    let half = size / size.max_element();
     let world = match scene.volume.data_kind() {
-        arbvis_data::sniff::DataKind::Survey => {
-            World::of_survey(volume.dims, size, half, volume.map.as_ref())
-        }
+        arbvis_data::sniff::DataKind::Survey => World::of_survey(dims, size, half, map.as_ref()),
         _ => World::of_box([0.0; 3], size.to_array()),
     };
-    let position = position(&axes[cut.axis], cut)?;
-    let plane = plane(&volume, cut.axis, position);
-    Ok(Prepared {
-        volume,
+    let mut prepared = Prepared {
+        samples,
+        dims,
         axes,
-        range,
+        range: (0.0, 0.0),
         table,
         half,
         world,
-        plane,
-    })
+        plane: Plane {
+            axis: cut.axis,
+            position: 0.0,
+            size: [0, 0],
+            values: Vec::new(),
+        },
+    };
+    prepared.range = prepared.range_of(scene.quantize)?;
+    prepared.plane = prepared.plane_at(cut)?;
+    Ok(prepared)
 }
 
 #[cfg(test)]

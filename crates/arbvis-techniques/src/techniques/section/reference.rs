@@ -71,7 +71,7 @@ pub fn hit(prepared: &Prepared, inverse: glam::DMat4, ndc: [f64; 2]) -> Option<[
     let (near, far) = (unproject(-1.0), unproject(1.0));
     let axis = prepared.plane.axis;
     let (u, w) = section_axes(axis);
-    let n = prepared.volume.dims[axis].max(1) as f64;
+    let n = prepared.dims[axis].max(1) as f64;
     let at = ((prepared.plane.position + 0.5) / n * 2.0 - 1.0) * prepared.half[axis];
     let d: DVec3 = far - near;
     let t = (at - near[axis]) / d[axis];

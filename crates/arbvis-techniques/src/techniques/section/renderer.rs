@@ -236,8 +236,7 @@ impl Renderer for SectionRenderer {
             return Ok(());
         }
         if params.quantize != old.quantize {
-            self.prepared.range =
-                arbvis_data::volume::quantize::range(&self.prepared.volume, params.quantize)?;
+            self.prepared.range = self.prepared.range_of(params.quantize)?;
         }
         if params.table != old.table {
             self.prepared.table = params

@@ -75,38 +75,50 @@ pub fn of_mesh(
     table: Option<&arbvis_core::colortable::ColorTable>,
 ) -> Prepared {
     let (lo, hi) = mesh.bounds();
+    let (z0, z1) = (lo[2], hi[2]);
+    let colours: Vec<DVec3> = mesh
+        .vertices
+        .iter()
+        .map(|p| match table {
+            Some(t) => {
+                let s = if z1 > z0 {
+                    (p[2] - z0) / (z1 - z0)
+                } else {
+                    0.5
+                };
+                table_colour(t, s)
+            }
+            None => DVec3::from_array(scene.colour),
+        })
+        .collect();
+    let legend = table.map(|t| crate::techniques::annotations::colours(&t.entries));
+    of_coloured_mesh(mesh, &colours, ([z0, z1], legend))
+}
+
+/// A mesh with a colour per vertex, in the object frame of its box; `legend` is what
+/// [`Prepared::elevation`] holds (the range a table spans and its colours).
+pub fn of_coloured_mesh(
+    mesh: &TriangleMesh,
+    colours: &[DVec3],
+    legend: ([f64; 2], Option<Vec<[u8; 3]>>),
+) -> Prepared {
+    let (lo, hi) = mesh.bounds();
     let world = World::of_box(lo, hi);
     let normals = vertex_normals(mesh);
-    let (z0, z1) = (lo[2], hi[2]);
-    let colour_of = |p: [f64; 3]| match table {
-        Some(t) => {
-            let s = if z1 > z0 {
-                (p[2] - z0) / (z1 - z0)
-            } else {
-                0.5
-            };
-            table_colour(t, s)
-        }
-        None => DVec3::from_array(scene.colour),
-    };
     let corners = mesh
         .triangles
         .iter()
         .flat_map(|t| t.map(|v| v as usize))
-        .map(|v| {
-            let p = mesh.vertices[v];
-            Corner {
-                position: (DVec3::from_array(p) - world.centre) / world.units,
-                normal: normals[v],
-                colour: colour_of(p),
-            }
+        .map(|v| Corner {
+            position: (DVec3::from_array(mesh.vertices[v]) - world.centre) / world.units,
+            normal: normals[v],
+            colour: colours[v],
         })
         .collect();
-    let colours = table.map(|t| crate::techniques::annotations::colours(&t.entries));
     Prepared {
         corners,
         world,
-        elevation: ([z0, z1], colours),
+        elevation: legend,
     }
 }
 

@@ -107,6 +107,11 @@ impl SurfaceRenderer {
         })
     }
 
+    /// The corners drawn (their colours' legend in `elevation`).
+    pub fn prepared(&self) -> &Prepared {
+        &self.prepared
+    }
+
     /// Read files named relative to `base` when parameters change.
     pub fn with_base(mut self, base: &std::path::Path) -> SurfaceRenderer {
         self.base = base.to_path_buf();

@@ -1,0 +1,444 @@
+//! `[technique.lines]` / `[layer.lines]`: polylines and wells drawn as tubes of a set
+//! radius in metres, coloured by a constant or by a value along them (a log along a
+//! well): the wells that tie a survey, picked fault traces, cables (issue 57 item 3).
+//!
+//! # How it works
+//! The lines come from a CSV file (`x, y, z[, value]`, a blank line between lines) or a
+//! well: its deviation survey by minimum curvature ([`arbvis_data::lines::Well`]), placed
+//! at its wellhead below its datum, the path taken every 2 m of measured depth and at
+//! every station, with a log's value at each point. Each line becomes a tube: a ring of
+//! `sides` vertices around each point, square to the path and turned along it by parallel
+//! transport, joined ring to ring; each vertex takes its point's colour (the table over
+//! `range`, else the values' own span; the constant where there is no value). The tube
+//! is then drawn and referenced as a surface is ([`super::surface`]: a headlight per
+//! vertex faithful, per pixel precise; opaque, with depth), in the file's coordinates, z up.
+
+use std::path::PathBuf;
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+use super::surface::{self, prepare::Prepared, Lighting, SurfaceScene};
+use crate::error::RenderResult;
+use crate::programs::ProgramPair;
+use crate::techniques::world::World;
+use crate::techniques::{Frame, Params, ReferenceView, Renderer, Settings, Technique};
+use arbvis_core::colortable::TableSpec;
+use arbvis_core::vocab::{Fidelity, FieldError};
+use arbvis_data::lines::{Polyline, Well};
+use arbvis_data::surface::TriangleMesh;
+use arbvis_gl::{Gpu, ProgramChoice, ProgramKind, Surface};
+
+/// `[technique.lines]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LinesScene {
+    /// Polylines: `x, y, z[, value]` rows, a blank line between lines.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub file: Option<PathBuf>,
+    /// Or a well from its deviation survey.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub well: Option<WellScene>,
+    /// The tubes' radius in the data's units (metres).
+    #[serde(default = "default_radius")]
+    pub radius: f64,
+    /// Vertices around each ring (3 to 64).
+    #[serde(default = "default_sides")]
+    pub sides: usize,
+    /// The colour where there is no value, RGB in [0, 1].
+    #[serde(default = "default_colour")]
+    pub colour: [f64; 3],
+    /// The table values are coloured through (by default `viridis`).
+    #[serde(default = "default_table")]
+    pub table: TableSpec,
+    /// The values the table's ends stand for (by default the values' own lowest and
+    /// highest).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range: Option<[f64; 2]>,
+}
+
+/// A well: its deviation survey, where it starts, and a log along it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WellScene {
+    /// `md, inclination, azimuth` rows (degrees; azimuth clockwise from north).
+    pub survey: PathBuf,
+    /// The wellhead's map x (east) and y (north).
+    pub head: [f64; 2],
+    /// The elevation of measured depth 0 (z up).
+    #[serde(default)]
+    pub datum: f64,
+    /// `md, value` rows: the values the tube is coloured by.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log: Option<PathBuf>,
+}
+
+fn default_radius() -> f64 {
+    10.0
+}
+
+fn default_sides() -> usize {
+    8
+}
+
+fn default_colour() -> [f64; 3] {
+    [0.9, 0.85, 0.3]
+}
+
+fn default_table() -> TableSpec {
+    TableSpec::builtin("viridis")
+}
+
+/// Measured depth between a well's drawn points (and at every station).
+pub const WELL_STEP: f64 = 2.0;
+
+/// Most rings a scene's tubes hold (a million rings of 64 sides is 128 M triangles).
+const MAX_RINGS: usize = 1 << 20;
+
+impl LinesScene {
+    /// The parameters a tube is drawn with as a surface: lit, opaque, its colours its own.
+    fn as_surface(&self) -> SurfaceScene {
+        SurfaceScene {
+            file: None,
+            synthetic: None,
+            colour: self.colour,
+            colour_by: None,
+            colour_from: None,
+            table: self.table.clone(),
+            z_down: false,
+            lighting: Lighting::Phong,
+            opacity: 1.0,
+        }
+    }
+}
+
+/// The lines `scene` names, read relative to `base`.
+pub fn polylines(scene: &LinesScene, base: &std::path::Path) -> RenderResult<Vec<Polyline>> {
+    if let Some(file) = &scene.file {
+        return Ok(arbvis_data::lines::read_polylines(&base.join(file))?);
+    }
+    let Some(w) = &scene.well else {
+        return Err(FieldError::new(
+            "file",
+            "lines read a file (file = \"faults.csv\") or a well (well = { survey = ... })",
+        )
+        .into());
+    };
+    let well = Well::of(arbvis_data::lines::read_survey(&base.join(&w.survey))?);
+    let path = well.path(w.head, w.datum, WELL_STEP);
+    let values = match &w.log {
+        Some(log) => {
+            let log = arbvis_data::lines::read_log(&base.join(log))?;
+            Some(
+                path.iter()
+                    .map(|(md, _)| arbvis_data::lines::log_at(&log, *md))
+                    .collect(),
+            )
+        }
+        None => None,
+    };
+    Ok(vec![Polyline {
+        points: path.into_iter().map(|(_, p)| p).collect(),
+        values,
+    }])
+}
+
+/// A unit vector square to `t`.
+fn square_to(t: DVec3) -> DVec3 {
+    let helper = if t.z.abs() < 0.9 { DVec3::Z } else { DVec3::X };
+    t.cross(helper).normalize()
+}
+
+/// The tubes of `lines` (radius `radius`, `sides` around), and each vertex's value.
+pub fn tubes(lines: &[Polyline], radius: f64, sides: usize) -> (TriangleMesh, Vec<f64>) {
+    let (mut vertices, mut triangles, mut values) = (Vec::new(), Vec::new(), Vec::new());
+    for line in lines {
+        // Points equal to the one before add nothing.
+        let mut kept: Vec<(DVec3, f64)> = Vec::new();
+        for (i, p) in line.points.iter().enumerate() {
+            let p = DVec3::from_array(*p);
+            let v = line.values.as_ref().map_or(f64::NAN, |v| v[i]);
+            if kept.last().is_none_or(|(q, _)| *q != p) {
+                kept.push((p, v));
+            }
+        }
+        if kept.len() < 2 {
+            continue;
+        }
+        let n = kept.len();
+        let tangent =
+            |i: usize| (kept[(i + 1).min(n - 1)].0 - kept[i.saturating_sub(1)].0).normalize();
+        let mut normal = square_to(tangent(0));
+        let first = vertices.len() as u32;
+        for (i, (p, v)) in kept.iter().enumerate() {
+            let t = tangent(i);
+            // Parallel transport: the last ring's normal made square to this tangent.
+            let moved = normal - t * normal.dot(t);
+            normal = if moved.length() > 1e-9 {
+                moved.normalize()
+            } else {
+                square_to(t)
+            };
+            let binormal = t.cross(normal);
+            for k in 0..sides {
+                let a = k as f64 / sides as f64 * std::f64::consts::TAU;
+                let q = *p + (normal * a.cos() + binormal * a.sin()) * radius;
+                vertices.push(q.to_array());
+                values.push(*v);
+            }
+        }
+        for i in 0..n as u32 - 1 {
+            for k in 0..sides as u32 {
+                let ring = |r: u32, k: u32| first + r * sides as u32 + k % sides as u32;
+                let (a, b, c, d) = (
+                    ring(i, k),
+                    ring(i, k + 1),
+                    ring(i + 1, k + 1),
+                    ring(i + 1, k),
+                );
+                triangles.push([a, b, c]);
+                triangles.push([a, c, d]);
+            }
+        }
+    }
+    (
+        TriangleMesh {
+            vertices,
+            triangles,
+        },
+        values,
+    )
+}
+
+/// Read the lines, make their tubes and colour them.
+pub fn prepare(scene: &LinesScene, base: &std::path::Path) -> RenderResult<Prepared> {
+    let lines = polylines(scene, base)?;
+    let rings: usize = lines.iter().map(|l| l.points.len()).sum();
+    if rings > MAX_RINGS {
+        return Err(FieldError::new("file", format!("{rings} points: at most {MAX_RINGS}")).into());
+    }
+    let (mesh, values) = tubes(&lines, scene.radius, scene.sides);
+    if mesh.triangles.is_empty() {
+        return Err(FieldError::new("file", "no line of two distinct points").into());
+    }
+    let finite = values.iter().copied().filter(|v| v.is_finite());
+    let span = finite.fold(None, |s: Option<[f64; 2]>, v| {
+        Some(s.map_or([v, v], |[lo, hi]| [lo.min(v), hi.max(v)]))
+    });
+    let (colours, legend) = match scene.range.or(span) {
+        Some([lo, hi]) => {
+            let table = scene.table.build(base)?;
+            let colours = values
+                .iter()
+                .map(|&v| match v.is_finite() {
+                    true => {
+                        let s = if hi > lo { (v - lo) / (hi - lo) } else { 0.5 };
+                        surface::prepare::table_colour(&table, s)
+                    }
+                    false => DVec3::from_array(scene.colour),
+                })
+                .collect::<Vec<_>>();
+            let legend = crate::techniques::annotations::colours(&table.entries);
+            (colours, ([lo, hi], Some(legend)))
+        }
+        None => (
+            vec![DVec3::from_array(scene.colour); values.len()],
+            ([0.0, 0.0], None),
+        ),
+    };
+    Ok(surface::prepare::of_coloured_mesh(&mesh, &colours, legend))
+}
+
+impl Technique for LinesScene {
+    const NAME: &'static str = "lines";
+    const DEMOS: &'static [(&'static str, &'static str)] = &[];
+
+    fn validate(&self, _: Fidelity, _: ProgramChoice) -> Result<(), FieldError> {
+        if self.file.is_some() == self.well.is_some() {
+            return Err(FieldError::new(
+                "file",
+                "lines read a file (file = \"faults.csv\") or a well (well = { survey = \"w.csv\", head = [x, y] }), one of them",
+            ));
+        }
+        if !(self.radius.is_finite() && self.radius > 0.0) {
+            return Err(FieldError::new(
+                "radius",
+                format!("{}: above 0", self.radius),
+            ));
+        }
+        if !(3..=64).contains(&self.sides) {
+            return Err(FieldError::new("sides", format!("{}: 3 to 64", self.sides)));
+        }
+        if self.colour.iter().any(|c| !(0.0..=1.0).contains(c)) {
+            return Err(FieldError::new(
+                "colour",
+                format!("{:?}: each of r, g, b in [0, 1]", self.colour),
+            ));
+        }
+        if let Some(w) = &self.well {
+            if !(w.head.iter().all(|v| v.is_finite()) && w.datum.is_finite()) {
+                return Err(FieldError::new(
+                    "well.head",
+                    "the wellhead's x, y and the datum: finite",
+                ));
+            }
+        }
+        if let Some([lo, hi]) = self.range {
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(FieldError::new(
+                    "range",
+                    format!("[{lo}, {hi}]: finite, low below high"),
+                ));
+            }
+        }
+        self.table.validate().map_err(|e| e.within("table"))
+    }
+
+    fn for_each_data_path(&mut self, f: &mut dyn FnMut(&str, &mut PathBuf)) {
+        if let Some(p) = self.file.as_mut() {
+            f("file", p);
+        }
+        if let Some(w) = self.well.as_mut() {
+            f("well.survey", &mut w.survey);
+            if let Some(p) = w.log.as_mut() {
+                f("well.log", p);
+            }
+        }
+        if let Some(p) = self.table.file.as_mut() {
+            f("table.file", p);
+        }
+    }
+
+    fn program_pairs() -> Vec<ProgramPair> {
+        surface::renderer::program_pairs()
+    }
+
+    fn draws_opaque(&self) -> bool {
+        true
+    }
+
+    type Prepared = Prepared;
+
+    fn prepare(
+        &self,
+        settings: &Settings<'_>,
+        _: &arbvis_data::volume::Limits,
+    ) -> RenderResult<Prepared> {
+        Technique::validate(self, settings.fidelity, settings.programs)?;
+        prepare(self, settings.base)
+    }
+
+    fn renderer(
+        &self,
+        gpu: &Gpu,
+        settings: &Settings<'_>,
+        kind: ProgramKind,
+        prepared: Prepared,
+    ) -> RenderResult<Box<dyn Renderer>> {
+        Ok(Box::new(LinesRenderer {
+            tubes: surface::renderer::SurfaceRenderer::new(
+                gpu,
+                kind,
+                settings.fidelity,
+                &self.as_surface(),
+                prepared,
+            )?,
+            fidelity: settings.fidelity,
+            params: self.clone(),
+            base: settings.base.to_path_buf(),
+        }))
+    }
+
+    /// The tubes' nearest hit at each pixel centre, lit as the precise programs light it.
+    fn reference(
+        &self,
+        prepared: &Prepared,
+        view: &ReferenceView<'_>,
+    ) -> Option<arbvis_core::image::Image> {
+        Some(surface::reference::reference(
+            prepared,
+            &self.as_surface(),
+            Fidelity::Precise,
+            &view.camera,
+            view.size,
+            view.background,
+        ))
+    }
+
+    fn world(&self, prepared: &Prepared) -> Option<World> {
+        Some(prepared.world)
+    }
+}
+
+/// The tubes as a surface's renderer draws them; new parameters read the lines again.
+pub struct LinesRenderer {
+    tubes: surface::renderer::SurfaceRenderer,
+    fidelity: Fidelity,
+    params: LinesScene,
+    base: PathBuf,
+}
+
+impl Renderer for LinesRenderer {
+    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
+        self.tubes.draw(gpu, surface, frame)
+    }
+
+    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> RenderResult<()> {
+        let params = params.get::<LinesScene>()?;
+        if *params != self.params {
+            let prepared = prepare(params, &self.base)?;
+            let kind = self.tubes.program_kind();
+            self.tubes = surface::renderer::SurfaceRenderer::new(
+                gpu,
+                kind,
+                self.fidelity,
+                &params.as_surface(),
+                prepared,
+            )?;
+            self.params = params.clone();
+        }
+        Ok(())
+    }
+
+    fn program_kind(&self) -> ProgramKind {
+        self.tubes.program_kind()
+    }
+
+    fn needs_depth(&self) -> bool {
+        true
+    }
+
+    fn opaque(&self) -> bool {
+        true
+    }
+
+    /// The table over the values' range, or the tubes' colour as a key.
+    fn annotations(&self) -> crate::techniques::annotations::Annotations {
+        use crate::techniques::annotations::{rgb8, Annotations, Legend};
+        let legend = match self.tubes.prepared().elevation.clone() {
+            ([low, high], Some(colours)) => Legend::Bar {
+                title: match &self.params.well {
+                    Some(_) => "log".into(),
+                    None => "value".into(),
+                },
+                colours,
+                low,
+                high,
+            },
+            (_, None) => {
+                let [r, g, b] = self.params.colour;
+                Legend::Keys {
+                    title: "lines".into(),
+                    keys: vec![(
+                        rgb8([r, g, b, 1.0]),
+                        format!("radius {} m", self.params.radius),
+                    )],
+                }
+            }
+        };
+        Annotations {
+            legends: vec![legend],
+            axes: None,
+        }
+    }
+}

@@ -1,0 +1,186 @@
+//! Lines and wells (issue 57 item 3): a well's tube follows its minimum-curvature path and
+//! is coloured by its log; tubes drawn against their f64 reference, ARB and GLSL,
+//! faithful and precise; a well lies in a survey's world frame; bad files named by line.
+
+use crate::common;
+
+use arbvis::gl::{Backend, ProgramChoice, TargetFormat};
+use arbvis::render::render_on;
+use arbvis::scene::{Fidelity, Scene};
+use arbvis::techniques::lines::{polylines, tubes, LinesScene};
+use common::{headless, LEVEL};
+
+/// The repository's synthetic well through F3 (`scripts/make_well.py`).
+fn f3_well(extra: &str) -> String {
+    format!(
+        "[technique.lines]\nwell = {{ survey = \"{}\", head = [620420.0, 6074520.0], log = \"{}\" }}\nradius = 7.0\n{extra}",
+        common::data_file("seismic/f3-well-survey.csv").display(),
+        common::data_file("seismic/f3-well-log.csv").display()
+    )
+}
+
+/// Each ring of the tube is centred on the well's path (every 2 m and at every station),
+/// the path goes through the survey's stations where minimum curvature puts them, and
+/// each ring's colour is the log's value there through the table.
+#[test]
+fn a_wells_tube_follows_its_path_and_its_log() {
+    let scene = Scene::parse(&f3_well(""), "w.toml").unwrap();
+    let params = scene.technique.get::<LinesScene>().unwrap();
+    let lines = polylines(params, std::path::Path::new("")).unwrap();
+    let path = &lines[0].points;
+    // 0 to 330 m every 2 m, and the stations at odd multiples of 15 m: 166 + 11.
+    assert_eq!(path.len(), 177);
+    assert_eq!(path[0], [620420.0, 6074520.0, 0.0]);
+    // Vertical to 60 m, then a build of 0.2 degrees per metre toward azimuth 125 to 36
+    // degrees at 240 m: the arc's end lies R (1 - cos 36) across and R sin 36 down,
+    // R = 1 / 0.2 degrees per metre.
+    let r = 1.0 / 0.2f64.to_radians();
+    let (across, down) = (
+        r * (1.0 - 36f64.to_radians().cos()),
+        r * 36f64.to_radians().sin(),
+    );
+    let at_240 = path.iter().find(|p| (p[2] + 60.0 + down).abs() < 1e-6);
+    let p = at_240.expect("a point at the end of the build");
+    let (east, north) = (p[0] - 620420.0, p[1] - 6074520.0);
+    assert!((east.hypot(north) - across).abs() < 1e-6, "{east} {north}");
+    assert!((north.atan2(east).to_degrees() - (90.0 - 125.0)).abs() < 1e-9);
+    let (mesh, values) = tubes(&lines, 7.0, 8);
+    for (i, point) in path.iter().enumerate() {
+        let ring = &mesh.vertices[i * 8..i * 8 + 8];
+        let centre: [f64; 3] =
+            std::array::from_fn(|k| ring.iter().map(|v| v[k]).sum::<f64>() / 8.0);
+        for k in 0..3 {
+            // Eight points evenly round a circle average to its centre (f64, UTM: 1e-7).
+            assert!((centre[k] - point[k]).abs() < 1e-7, "ring {i}");
+        }
+        assert!(ring.iter().all(|v| {
+            let d = (0..3)
+                .map(|k| (v[k] - point[k]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            (d - 7.0).abs() < 1e-7
+        }));
+        assert_eq!(values[i * 8], lines[0].values.as_ref().unwrap()[i]);
+    }
+}
+
+/// A well's tube drawn on the GPU against the surface reference it is drawn as, at an odd
+/// size and a rotated perspective camera: as the surface test bounds it.
+#[test]
+fn a_wells_tube_matches_its_reference() {
+    let h = headless(Backend::Egl);
+    for fidelity in [Fidelity::Faithful, Fidelity::Precise] {
+        for programs in [ProgramChoice::Arb, ProgramChoice::Glsl] {
+            let text = format!(
+                "size = [71, 93]\n[camera]\nprojection = \"perspective\"\nrotation = [-0.35, 0.12, 0.2, 0.906]\n{}",
+                // A thick tube: 60 m across a frame of the well's 300 m depth.
+                f3_well("").replace("radius = 7.0", "radius = 30.0")
+            );
+            let mut scene = Scene::parse(&text, "w.toml").unwrap();
+            (scene.fidelity, scene.programs) = (fidelity, programs);
+            scene.target = Some(TargetFormat::Rgba32f);
+            scene.background = [0.0; 4];
+            let gpu = render_on(&h, &scene).unwrap().image;
+            let technique = &scene.technique;
+            let limits = arbvis::volume::Limits::for_max_side(2048);
+            let view = arbvis::techniques::ReferenceView {
+                camera: scene.camera,
+                size: scene.size,
+                background: [0.0; 4],
+                base: std::path::Path::new(""),
+            };
+            let cpu = arbvis::catalog::reference(technique, &scene.settings(), &limits, &view)
+                .unwrap()
+                .unwrap();
+            // Precise: the surface programs' per-pixel headlight in f32 against f64 (measured
+            // 1.2e-4 at most); a pixel whose centre lies within f32 rounding of a triangle's
+            // edge may take the other triangle or the background: 1 % of the pixels over a
+            // level at most. Faithful lights each vertex and interpolates, against the
+            // per-pixel reference: the RMSE the ring's 8 sides allow (measured 0.0026).
+            let d = gpu.compare(&cpu, LEVEL).unwrap();
+            let pixels = (71 * 93) as usize;
+            let lit = common::lit_pixels(&gpu, 0.05);
+            // A tube 60 m across and 300 m long in perspective: about 4 % of the picture.
+            assert!(
+                lit > pixels / 40,
+                "{fidelity:?} {programs:?}: the well is in view ({lit})"
+            );
+            match fidelity {
+                Fidelity::Precise => assert!(
+                    d.pixels_over * 50 < pixels && d.rmse < 0.01,
+                    "{programs:?}: {d:?}"
+                ),
+                Fidelity::Faithful => assert!(d.rmse < 0.05, "{programs:?}: {d:?}"),
+            }
+        }
+    }
+}
+
+/// In a layered scene with F3, the well starts at the survey's top, in its map area, and
+/// reaches the depth its survey says (z = -301 m at 330 m, lined up with 301 ms).
+#[test]
+fn a_well_lies_in_the_surveys_world() {
+    let text = format!(
+        "[[layer]]\nname = \"F3\"\n[layer.opacity3d.primary]\nvolume = {{ segy = \"{}\" }}\n[[layer]]\nname = \"well\"\n{}",
+        common::data_file("seismic/f3.sgy").display(),
+        f3_well("").replace("[technique.lines]", "[layer.lines]")
+    );
+    let scene = Scene::parse(&text, "w.toml").unwrap();
+    let limits = arbvis::volume::Limits::for_max_side(2048);
+    let bounds: Vec<_> = scene
+        .layers()
+        .map(|(_, t)| {
+            let data = arbvis::catalog::prepare(t, &scene.settings(), &limits).unwrap();
+            arbvis::catalog::world(t, &data).unwrap().bounds()
+        })
+        .collect();
+    let ([slo, shi], [wlo, whi]) = (bounds[0], bounds[1]);
+    for k in 0..2 {
+        assert!(
+            wlo[k] > slo[k] && whi[k] < shi[k],
+            "inside the survey's map area"
+        );
+    }
+    // The tube's top ring at z = 0 and radius 7 (its ends are open rings).
+    assert!((whi.z - 0.0).abs() < 7.0 + 1e-6);
+    let tvd =
+        60.0 + 36f64.to_radians().sin() / 0.2f64.to_radians() + 90.0 * 36f64.to_radians().cos();
+    assert!((wlo.z + tvd).abs() < 7.0 + 1e-6, "{} {tvd}", wlo.z);
+}
+
+/// A survey or a log that is not one is named by its file, line and column; a scene
+/// with both a file and a well, or neither, by its key.
+#[test]
+fn bad_lines_are_refused_where_they_are() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("lines-bad");
+    std::fs::write(dir.join("s.csv"), "MD,INC,AZI\n0,0,0\n10,5,0\n20,4\n").unwrap();
+    std::fs::write(dir.join("p.csv"), "0 0 0 1\n1 1 1 2\n").unwrap();
+    let text = format!(
+        "[technique.lines]\nwell = {{ survey = \"{}\", head = [0.0, 0.0] }}\n",
+        dir.join("s.csv").display()
+    );
+    let e = render_on(&h, &Scene::parse(&text, "l.toml").unwrap())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("s.csv") && e.contains("line 4"), "{e}");
+    let both = format!(
+        "[technique.lines]\nfile = \"{}\"\nwell = {{ survey = \"x.csv\", head = [0.0, 0.0] }}\n",
+        dir.join("p.csv").display()
+    );
+    let e = Scene::parse(&both, "l.toml").unwrap_err().to_string();
+    assert!(
+        e.contains("technique.lines.file") && e.contains("one of them"),
+        "{e}"
+    );
+    let e = Scene::parse("[technique.lines]\nradius = 0.0\n", "l.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("technique.lines"), "{e}");
+    let fine = format!(
+        "[technique.lines]\nfile = \"{}\"\nradius = 0.1\n",
+        dir.join("p.csv").display()
+    );
+    assert!(render_on(&h, &Scene::parse(&fine, "l.toml").unwrap()).is_ok());
+}
