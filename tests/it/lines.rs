@@ -178,6 +178,16 @@ fn bad_lines_are_refused_where_they_are() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("technique.lines"), "{e}");
+    // Stations in the scene are checked as a survey file's rows, by their number.
+    let text = "[technique.lines]\nwell = { head = [0.0, 0.0], stations = [[0.0, 0.0, 0.0], [100.0, 5.0, 0.0], [90.0, 6.0, 0.0]] }\n";
+    let e = render_on(&h, &Scene::parse(text, "l.toml").unwrap())
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        e.contains("well.stations") && e.contains("station 3") && e.contains("increasing"),
+        "{e}"
+    );
     let fine = format!(
         "[technique.lines]\nfile = \"{}\"\nradius = 0.1\n",
         dir.join("p.csv").display()

@@ -62,7 +62,11 @@ pub struct LinesScene {
 #[serde(deny_unknown_fields)]
 pub struct WellScene {
     /// `md, inclination, azimuth` rows (degrees; azimuth clockwise from north).
-    pub survey: PathBuf,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub survey: Option<PathBuf>,
+    /// Or the stations themselves, `[md, inclination, azimuth]` each.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stations: Option<Vec<[f64; 3]>>,
     /// The wellhead's map x (east) and y (north).
     pub head: [f64; 2],
     /// The elevation of measured depth 0 (z up).
@@ -124,7 +128,18 @@ pub fn polylines(scene: &LinesScene, base: &std::path::Path) -> RenderResult<Vec
         )
         .into());
     };
-    let well = Well::of(arbvis_data::lines::read_survey(&base.join(&w.survey))?);
+    let stations = match (&w.survey, &w.stations) {
+        (Some(file), None) => arbvis_data::lines::read_survey(&base.join(file))?,
+        (None, Some(rows)) => stations_of(rows)?,
+        _ => {
+            return Err(FieldError::new(
+                "well.survey",
+                "a well's survey is a file (survey = \"w.csv\") or its stations (stations = [[md, inclination, azimuth], ...]), one of them",
+            )
+            .into())
+        }
+    };
+    let well = Well::of(stations);
     let path = well.path(w.head, w.datum, WELL_STEP);
     let values = match &w.log {
         Some(log) => {
@@ -141,6 +156,22 @@ pub fn polylines(scene: &LinesScene, base: &std::path::Path) -> RenderResult<Vec
         points: path.into_iter().map(|(_, p)| p).collect(),
         values,
     }])
+}
+
+/// Stations given in the scene, checked as a survey file's rows are.
+fn stations_of(rows: &[[f64; 3]]) -> Result<Vec<arbvis_data::lines::Station>, FieldError> {
+    let text: String = rows
+        .iter()
+        .map(|[m, i, a]| format!("{m},{i},{a}\n"))
+        .collect();
+    arbvis_data::lines::parse_survey(std::path::Path::new("stations"), text.as_bytes()).map_err(
+        |e| {
+            FieldError::new(
+                "well.stations",
+                e.to_string().replace("stations: line ", "station "),
+            )
+        },
+    )
 }
 
 /// A unit vector square to `t`.
@@ -251,7 +282,8 @@ pub fn prepare(scene: &LinesScene, base: &std::path::Path) -> RenderResult<Prepa
 
 impl Technique for LinesScene {
     const NAME: &'static str = "lines";
-    const DEMOS: &'static [(&'static str, &'static str)] = &[];
+    const DEMOS: &'static [(&'static str, &'static str)] =
+        &[crate::techniques::demo!("lines-well")];
 
     fn validate(&self, _: Fidelity, _: ProgramChoice) -> Result<(), FieldError> {
         if self.file.is_some() == self.well.is_some() {
@@ -299,7 +331,9 @@ impl Technique for LinesScene {
             f("file", p);
         }
         if let Some(w) = self.well.as_mut() {
-            f("well.survey", &mut w.survey);
+            if let Some(p) = w.survey.as_mut() {
+                f("well.survey", p);
+            }
             if let Some(p) = w.log.as_mut() {
                 f("well.log", p);
             }
