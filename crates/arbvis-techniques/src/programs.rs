@@ -148,6 +148,20 @@ pub const SPLATS_EDL_DEPTH_FRAG: ProgramText = program!("splats/edl_depth.frag")
 /// See [`SPLATS_EDL_DEPTH_VERT`].
 pub const SPLATS_EDL_FRAG: ProgramText = program!("splats/edl.frag");
 
+/// The pair `pair` chooses for each fidelity and program kind (faithful ARB, faithful
+/// GLSL, precise ARB, precise GLSL): a technique's [`crate::techniques::Technique::program_pairs`]
+/// where one pair draws each combination.
+pub fn each_fidelity_and_kind(
+    pair: fn(arbvis_core::vocab::Fidelity, arbvis_gl::ProgramKind) -> ProgramPair,
+) -> Vec<ProgramPair> {
+    use arbvis_core::vocab::Fidelity;
+    use arbvis_gl::ProgramKind;
+    [Fidelity::Faithful, Fidelity::Precise]
+        .into_iter()
+        .flat_map(|f| [ProgramKind::Arb, ProgramKind::Glsl].map(|k| pair(f, k)))
+        .collect()
+}
+
 /// A vertex + fragment pair of one kind.
 #[derive(Debug, Clone)]
 pub struct ProgramPair {

@@ -34,10 +34,7 @@ pub fn pair(fidelity: Fidelity, kind: ProgramKind) -> ProgramPair {
 
 /// Every pair a section draws with.
 pub fn program_pairs() -> Vec<ProgramPair> {
-    [Fidelity::Faithful, Fidelity::Precise]
-        .into_iter()
-        .flat_map(|f| [ProgramKind::Arb, ProgramKind::Glsl].map(|k| pair(f, k)))
-        .collect()
+    programs::each_fidelity_and_kind(pair)
 }
 
 /// The plane's two triangles: position (x y z 1) and texture coordinates (s t 0 1).

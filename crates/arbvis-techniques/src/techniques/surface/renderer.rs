@@ -32,10 +32,7 @@ pub fn pair(fidelity: Fidelity, kind: ProgramKind) -> ProgramPair {
 
 /// Every pair a surface draws with.
 pub fn program_pairs() -> Vec<ProgramPair> {
-    [Fidelity::Faithful, Fidelity::Precise]
-        .into_iter()
-        .flat_map(|f| [ProgramKind::Arb, ProgramKind::Glsl].map(|k| pair(f, k)))
-        .collect()
+    programs::each_fidelity_and_kind(pair)
 }
 
 /// The corners as the mesh's floats: position (x y z 1), normal (x y z 0), colour
