@@ -144,3 +144,31 @@ def test_a_section_moves_by_key_for_the_cost_of_a_frame(tmp_path):
         fresh = r.render()
     assert np.array_equal(kept, fresh)
     assert np.abs(kept.astype(float) - before.astype(float)).max() > 0.1, "the sections moved"
+
+
+def test_a_section_of_a_survey_in_memory_draws_as_its_file(tmp_path):
+    """A section layer takes an `arbvis.Volume` as it takes a file: a C-order cube indexed
+    [inline, crossline, sample] in memory and the same bytes as a raw file (sample fastest)
+    draw the same inline section, given the same spacing (a survey in memory without one
+    takes a seismic survey's default, the raw file 1 m)."""
+    rng = np.random.default_rng(11)
+    cube = rng.standard_normal((9, 13, 21)).astype(np.float32)
+    cube.tofile(tmp_path / "cube.raw")
+    raw = {"raw": {"path": str(tmp_path / "cube.raw"), "dims": [21, 13, 9], "type": "f32"}}
+    camera = {"projection": "orthographic", "rotation": [0.3265, -0.0923, -0.701, 0.6272]}
+    pictures = []
+    for volume in (arbvis.Volume(cube, spacing=(1.0, 1.0, 1.0)), raw):
+        scene = arbvis.Scene.from_dict(
+            {
+                "size": [48, 40],
+                "fidelity": "precise",
+                "camera": camera,
+                "technique": {
+                    "section": {"volume": volume, "inline": 5, "quantize": "min-max"}
+                },
+            }
+        )
+        with arbvis.Renderer(scene) as r:
+            pictures.append(r.render())
+    assert np.array_equal(pictures[0], pictures[1])
+    assert (pictures[0][..., 3] > 0).sum() > 200, "the section is in view"

@@ -13,6 +13,8 @@
 //! is then drawn and referenced as a surface is ([`super::surface`]: a headlight per
 //! vertex faithful, per pixel precise; opaque, with depth), in the file's coordinates, z up.
 
+pub mod renderer;
+
 use std::path::PathBuf;
 
 use glam::DVec3;
@@ -22,12 +24,12 @@ use super::surface::{self, prepare::Prepared, Lighting, SurfaceScene};
 use crate::error::RenderResult;
 use crate::programs::ProgramPair;
 use crate::techniques::world::World;
-use crate::techniques::{Frame, Params, ReferenceView, Renderer, Settings, Technique};
+use crate::techniques::{ReferenceView, Renderer, Settings, Technique};
 use arbvis_core::colortable::TableSpec;
 use arbvis_core::vocab::{Fidelity, FieldError};
 use arbvis_data::lines::{Polyline, Well};
 use arbvis_data::surface::TriangleMesh;
-use arbvis_gl::{Gpu, ProgramChoice, ProgramKind, Surface};
+use arbvis_gl::{Gpu, ProgramChoice, ProgramKind};
 
 /// `[technique.lines]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -101,7 +103,7 @@ const MAX_RINGS: usize = 1 << 20;
 
 impl LinesScene {
     /// The parameters a tube is drawn with as a surface: lit, opaque, its colours its own.
-    fn as_surface(&self) -> SurfaceScene {
+    pub fn as_surface(&self) -> SurfaceScene {
         SurfaceScene {
             file: None,
             synthetic: None,
@@ -369,18 +371,14 @@ impl Technique for LinesScene {
         kind: ProgramKind,
         prepared: Prepared,
     ) -> RenderResult<Box<dyn Renderer>> {
-        Ok(Box::new(LinesRenderer {
-            tubes: surface::renderer::SurfaceRenderer::new(
-                gpu,
-                kind,
-                settings.fidelity,
-                &self.as_surface(),
-                prepared,
-            )?,
-            fidelity: settings.fidelity,
-            params: self.clone(),
-            base: settings.base.to_path_buf(),
-        }))
+        Ok(Box::new(renderer::LinesRenderer::new(
+            gpu,
+            kind,
+            settings.fidelity,
+            self,
+            settings.base,
+            prepared,
+        )?))
     }
 
     /// The tubes' nearest hit at each pixel centre, lit as the precise programs light it.
@@ -401,78 +399,5 @@ impl Technique for LinesScene {
 
     fn world(&self, prepared: &Prepared) -> Option<World> {
         Some(prepared.world)
-    }
-}
-
-/// The tubes as a surface's renderer draws them; new parameters read the lines again.
-pub struct LinesRenderer {
-    tubes: surface::renderer::SurfaceRenderer,
-    fidelity: Fidelity,
-    params: LinesScene,
-    base: PathBuf,
-}
-
-impl Renderer for LinesRenderer {
-    fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
-        self.tubes.draw(gpu, surface, frame)
-    }
-
-    fn update(&mut self, gpu: &Gpu, params: Params<'_>) -> RenderResult<()> {
-        let params = params.get::<LinesScene>()?;
-        if *params != self.params {
-            let prepared = prepare(params, &self.base)?;
-            let kind = self.tubes.program_kind();
-            self.tubes = surface::renderer::SurfaceRenderer::new(
-                gpu,
-                kind,
-                self.fidelity,
-                &params.as_surface(),
-                prepared,
-            )?;
-            self.params = params.clone();
-        }
-        Ok(())
-    }
-
-    fn program_kind(&self) -> ProgramKind {
-        self.tubes.program_kind()
-    }
-
-    fn needs_depth(&self) -> bool {
-        true
-    }
-
-    fn opaque(&self) -> bool {
-        true
-    }
-
-    /// The table over the values' range, or the tubes' colour as a key.
-    fn annotations(&self) -> crate::techniques::annotations::Annotations {
-        use crate::techniques::annotations::{rgb8, Annotations, Legend};
-        let legend = match self.tubes.prepared().elevation.clone() {
-            ([low, high], Some(colours)) => Legend::Bar {
-                title: match &self.params.well {
-                    Some(_) => "log".into(),
-                    None => "value".into(),
-                },
-                colours,
-                low,
-                high,
-            },
-            (_, None) => {
-                let [r, g, b] = self.params.colour;
-                Legend::Keys {
-                    title: "lines".into(),
-                    keys: vec![(
-                        rgb8([r, g, b, 1.0]),
-                        format!("radius {} m", self.params.radius),
-                    )],
-                }
-            }
-        };
-        Annotations {
-            legends: vec![legend],
-            axes: None,
-        }
     }
 }
