@@ -101,3 +101,96 @@ fn an_xyz_grid_without_inline_numbers_is_triangulated_over_its_nodes() {
     let said = common::inspect(&dir.join("h.xyz"));
     common::assert_says(&said, &["nodes: 33 defined, 1 undefined", "by Delaunay"]);
 }
+
+/// Three squares of one TSurf coloured by their vertices' own property (`colour_by =
+/// { property = "throw" }`) over `range = [0, 10]`, unlit, seen from above: throw 5 takes
+/// the table's middle, a square without the property the constant colour, throw 20 the
+/// table's top (clamped); in both fidelities. A property the file lacks is refused by its
+/// key, naming those it has; `inspect` lists them with their ranges.
+#[test]
+fn a_surface_is_coloured_by_its_own_vertex_property() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("surface-property");
+    let square = |first: u32, x: f64, throw: Option<f64>| -> String {
+        let corners = [[x, 0.0], [x + 1.0, 0.0], [x + 1.0, 1.0], [x, 1.0]];
+        let mut text = String::from("TFACE\n");
+        for (k, [cx, cy]) in corners.into_iter().enumerate() {
+            let id = first + k as u32;
+            text += &match throw {
+                // The dip column is there to be skipped.
+                Some(t) => format!("PVRTX {id} {cx} {cy} 0 {t} 33\n"),
+                None => format!("VRTX {id} {cx} {cy} 0\n"),
+            };
+        }
+        let [a, b, c, d] = [0, 1, 2, 3].map(|k| first + k);
+        text + &format!("TRGL {a} {b} {c}\nTRGL {a} {c} {d}\n")
+    };
+    let ts = format!(
+        "GOCAD TSurf 1\nPROPERTIES throw dip\nNO_DATA_VALUES -99999 -99999\n{}{}{}END\n",
+        square(1, 0.0, Some(5.0)),
+        square(5, 2.0, None),
+        square(9, 4.0, Some(20.0)),
+    );
+    std::fs::write(dir.join("f.ts"), ts).unwrap();
+    let scene = |fidelity: &str, property: &str| {
+        let text = format!(
+            "size = [90, 30]\nfidelity = \"{fidelity}\"\n[camera]\nprojection = \"orthographic\"\nzoom = 2.5\n[technique.surface]\nfile = \"{}\"\ncolour = [0.9, 0.1, 0.6]\ncolour_by = {{ property = \"{property}\" }}\nrange = [0.0, 10.0]\nlighting = \"none\"\ntable = {{ builtin = \"viridis\" }}\n",
+            dir.join("f.ts").display()
+        );
+        Scene::parse(&text, "f.toml").unwrap()
+    };
+    let table = arbvis::colortable::ColorTable::builtin("viridis").unwrap();
+    let colour = |s: f64| arbvis::techniques::surface::prepare::table_colour(&table, s);
+    let wanted = [colour(0.5), glam::DVec3::new(0.9, 0.1, 0.6), colour(1.0)];
+    for fidelity in ["faithful", "precise"] {
+        let image = render_on(&h, &scene(fidelity, "throw")).unwrap().image;
+        for (k, want) in wanted.iter().enumerate() {
+            // A colour constant over each square: the 8-bit target's rounding (half a
+            // level) and the float interpolation of three equal corners, within 1 level.
+            let hits = (0..image.height)
+                .flat_map(|y| (0..image.width).map(move |x| (x, y)))
+                .filter(|&(x, y)| {
+                    let p = image.pixel(x, y);
+                    (0..3).all(|c| (p[c] as f64 - want[c]).abs() <= 1.0 / 255.0)
+                })
+                .count();
+            // The 5-unit row spans 75 of the 90 pixels at zoom 2.5: each square 15 x 15
+            // pixels (225), less its rasterized edges.
+            assert!(hits > 180, "{fidelity}: square {k} ({want}): {hits} pixels");
+        }
+    }
+    let e = render_on(&h, &scene("precise", "porosity"))
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(
+        e.contains("colour_by.property") && e.contains("\"throw\", \"dip\""),
+        "{e}"
+    );
+    let said = common::inspect(&dir.join("f.ts"));
+    common::assert_says(
+        &said,
+        &[
+            "property \"throw\": 8 of 12 vertices, 5 to 20",
+            "property \"dip\": 8 of 12 vertices, 33 to 33",
+        ],
+    );
+}
+
+/// The synthetic fault of `scripts/make_fault.py` (`data/seismic/f3-fault.ts`) carries its
+/// throw at every vertex but the ten tips left unpicked (`NO_DATA_VALUES`), 0 at the
+/// edges to 18 ms in the middle, and lies inside F3's map area and time range.
+#[test]
+fn the_f3_fault_carries_its_throw_inside_the_survey() {
+    let fault = arbvis::surface::read(&common::data_file("seismic/f3-fault.ts")).unwrap();
+    let throw = fault.property("throw").expect("its throw");
+    assert_eq!(throw.range(), Some([0.0, 18.0]));
+    assert_eq!(throw.values.iter().filter(|v| v.is_nan()).count(), 10);
+    let (lo, hi) = fault.bounds();
+    // F3's crop: its corner traces' CDP coordinates (inspect's map line) and 0..296 ms,
+    // time turned to z = -t by ZPOSITIVE Depth.
+    let (x, y) = ([620_197.0, 620_623.0], [6_074_232.0, 6_074_784.0]);
+    assert!(lo[0] > x[0] && hi[0] < x[1], "{lo:?} {hi:?}");
+    assert!(lo[1] > y[0] && hi[1] < y[1], "{lo:?} {hi:?}");
+    assert!(lo[2] >= -296.0 && hi[2] <= 0.0, "{lo:?} {hi:?}");
+}

@@ -43,6 +43,30 @@ pub struct TriangleMesh {
     pub vertices: Vec<[f64; 3]>,
     /// Triangles, every index `< vertices.len()`; at least one.
     pub triangles: Vec<[u32; 3]>,
+    /// Values per vertex the file names (a TSurf's `PROPERTIES`, an x y z grid's other
+    /// columns); none for formats without them.
+    pub properties: Vec<VertexProperty>,
+}
+
+/// One named value per vertex, NaN where a vertex has none (a no-data value, a vertex
+/// of an object that does not carry the property).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VertexProperty {
+    /// The name the file gives it.
+    pub name: String,
+    /// One per vertex.
+    pub values: Vec<f64>,
+}
+
+impl VertexProperty {
+    /// The smallest and largest defined value, None where every value is NaN.
+    pub fn range(&self) -> Option<[f64; 2]> {
+        let defined = self.values.iter().copied().filter(|v| v.is_finite());
+        defined.fold(None, |r, v| match r {
+            None => Some([v, v]),
+            Some([lo, hi]) => Some([lo.min(v), hi.max(v)]),
+        })
+    }
 }
 
 /// Where in a file a problem is.
@@ -176,7 +200,39 @@ impl TriangleMesh {
         Ok(TriangleMesh {
             vertices,
             triangles,
+            properties: Vec::new(),
         })
+    }
+
+    /// The mesh with `properties` (each one value per vertex), or an error naming the
+    /// first that is not.
+    pub fn with_properties(
+        mut self,
+        name: &Path,
+        properties: Vec<VertexProperty>,
+    ) -> Result<TriangleMesh, SurfaceError> {
+        if let Some(p) = properties
+            .iter()
+            .find(|p| p.values.len() != self.vertices.len())
+        {
+            return Err(SurfaceError::format(
+                name,
+                Position::Item("vertex", p.values.len().min(self.vertices.len())),
+                format!(
+                    "property {:?} has {} values for {} vertices",
+                    p.name,
+                    p.values.len(),
+                    self.vertices.len()
+                ),
+            ));
+        }
+        self.properties = properties;
+        Ok(self)
+    }
+
+    /// The property called `name`.
+    pub fn property(&self, name: &str) -> Option<&VertexProperty> {
+        self.properties.iter().find(|p| p.name == name)
     }
 
     /// The three corners of triangle `t`.
@@ -205,6 +261,7 @@ impl TriangleMesh {
         TriangleMesh {
             vertices: self.vertices.iter().map(|&p| f(p)).collect(),
             triangles: self.triangles.clone(),
+            properties: self.properties.clone(),
         }
     }
 }
@@ -387,7 +444,29 @@ pub fn describe_file(path: &Path) -> Result<String, SurfaceError> {
         }
         _ => (parse(path, &bytes)?, String::new()),
     };
-    Ok(format!("{grid}{}", describe(&mesh)))
+    Ok(format!(
+        "{grid}{}{}",
+        describe(&mesh),
+        describe_properties(&mesh)
+    ))
+}
+
+/// A line per vertex property: its name, how many vertices have it, and its range.
+pub fn describe_properties(mesh: &TriangleMesh) -> String {
+    let mut out = String::new();
+    for p in &mesh.properties {
+        let defined = p.values.iter().filter(|v| v.is_finite()).count();
+        let range = match p.range() {
+            Some([lo, hi]) => format!(", {lo} to {hi}"),
+            None => String::new(),
+        };
+        out += &format!(
+            "property {:?}: {defined} of {} vertices{range}\n",
+            p.name,
+            p.values.len()
+        );
+    }
+    out
 }
 
 #[cfg(test)]

@@ -529,6 +529,7 @@ mod tests {
         let mut m = TriangleMesh {
             vertices: face.to_vec(),
             triangles: Vec::new(),
+            properties: Vec::new(),
         };
         for c in 0..copies as u32 {
             if shared {
@@ -581,6 +582,7 @@ mod tests {
         let mut m = TriangleMesh {
             vertices: Vec::new(),
             triangles: Vec::new(),
+            properties: Vec::new(),
         };
         for i in 0..100 {
             for j in 0..200 {

@@ -5,10 +5,14 @@
 //! - A file may hold several objects (`GOCAD TSurf 1` ... `END`), each with its own vertex
 //!   ids; they are read into one surface. Within an object, `TFACE` starts another face
 //!   of the same surface (its vertices stay shared).
-//! - `VRTX id x y z` and `PVRTX id x y z props...` define vertices (properties ignored);
-//!   `ATOM id ref` and `PATOM id ref ...` reuse vertex `ref`'s position; `TRGL a b c`
-//!   names three vertex ids. Other keywords (`HEADER { ... }`, the coordinate system,
-//!   `BSTONE`, `BORDER`, `PROPERTIES`, ...) are skipped.
+//! - `VRTX id x y z` and `PVRTX id x y z values...` define vertices; `ATOM id ref` and
+//!   `PATOM id ref values...` reuse vertex `ref`'s position (an `ATOM` its values too);
+//!   `TRGL a b c` names three vertex ids. Other keywords (`HEADER { ... }`, the
+//!   coordinate system, `BSTONE`, `BORDER`, ...) are skipped.
+//! - Properties: `PROPERTIES a b` names an object's per-vertex values, `ESIZES` their
+//!   sizes (a vector property takes that many values and is not kept), `NO_DATA_VALUES`
+//!   the value that marks none (NaN). Objects' properties of one name are one property;
+//!   vertices without it (a `VRTX`, another object) have NaN.
 //! - `ZPOSITIVE Depth` (z grows downwards: depth, or time in ms) is turned into z up, as
 //!   every layer is placed: `z = -z`. `ZPOSITIVE Elevation` (the default) is kept.
 //! - Every error names the line and column of the token at fault.
@@ -16,7 +20,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use super::{Position, SurfaceError, TriangleMesh};
+use super::{Position, SurfaceError, TriangleMesh, VertexProperty};
 use arbvis_core::input::words as tokens;
 
 /// What the reader found besides the triangles (`inspect`).
@@ -53,9 +57,16 @@ pub fn parse_with_facts(
         vertices,
         triangles,
         facts,
+        properties,
+        vectors,
         ..
     } = reader;
-    let mesh = TriangleMesh::from_indexed(name, vertices, triangles)?;
+    let properties = properties
+        .into_iter()
+        .filter(|p| !vectors.contains(&p.name))
+        .collect();
+    let mesh =
+        TriangleMesh::from_indexed(name, vertices, triangles)?.with_properties(name, properties)?;
     Ok((mesh, facts))
 }
 
@@ -72,6 +83,12 @@ struct Reader<'a> {
     /// z is positive downwards in the current object.
     depth: bool,
     facts: TsurfFacts,
+    /// Every object's properties, one value per vertex read so far.
+    properties: Vec<VertexProperty>,
+    /// The current object's properties: index into `properties`, size, no-data value.
+    object: Vec<(usize, usize, Option<f64>)>,
+    /// Names of properties of more than one value (not kept).
+    vectors: Vec<String>,
 }
 
 impl<'a> Reader<'a> {
@@ -85,6 +102,9 @@ impl<'a> Reader<'a> {
             in_header: false,
             depth: false,
             facts: TsurfFacts::default(),
+            properties: Vec::new(),
+            object: Vec::new(),
+            vectors: Vec::new(),
         }
     }
 
@@ -113,6 +133,7 @@ impl<'a> Reader<'a> {
                 }
                 self.open = true;
                 self.ids.clear();
+                self.object.clear();
                 self.depth = false;
                 self.facts.objects += 1;
             }
@@ -139,6 +160,8 @@ impl<'a> Reader<'a> {
                     ));
                 }
             },
+            "PROPERTIES" => self.declare(&tokens),
+            "ESIZES" | "NO_DATA_VALUES" => self.describe(n, &tokens)?,
             "VRTX" | "PVRTX" => self.vertex(n, &tokens)?,
             "ATOM" | "PATOM" => self.atom(n, &tokens)?,
             "TRGL" => self.triangle(n, &tokens)?,
@@ -169,15 +192,117 @@ impl<'a> Reader<'a> {
         if self.depth {
             p[2] = -p[2];
         }
-        self.add(n, tokens[1].0, id, p)
+        let values = match tokens[0].1 {
+            "PVRTX" => self.values(n, tokens, 5)?,
+            _ => Vec::new(),
+        };
+        self.add(n, tokens[1].0, id, p)?;
+        self.set_values(&values);
+        Ok(())
     }
 
     /// `ATOM id ref`: vertex `id` at vertex `ref`'s position.
     fn atom(&mut self, n: usize, tokens: &[(usize, &str)]) -> Result<(), SurfaceError> {
         let id = self.id(n, tokens, 1)?;
-        let of = self.index(n, tokens, 2)?;
-        let p = self.vertices[of as usize];
-        self.add(n, tokens[1].0, id, p)
+        let of = self.index(n, tokens, 2)? as usize;
+        let p = self.vertices[of];
+        let values = match tokens[0].1 {
+            "PATOM" => self.values(n, tokens, 3)?,
+            _ => Vec::new(),
+        };
+        self.add(n, tokens[1].0, id, p)?;
+        match tokens[0].1 {
+            "PATOM" => self.set_values(&values),
+            _ => {
+                for property in &mut self.properties {
+                    *property.values.last_mut().expect("added") = property.values[of];
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `PROPERTIES a b ...`: the current object's properties, each of size 1 until
+    /// `ESIZES` says otherwise.
+    fn declare(&mut self, tokens: &[(usize, &str)]) {
+        self.object.clear();
+        for &(_, name) in &tokens[1..] {
+            let index = match self.properties.iter().position(|p| p.name == name) {
+                Some(i) => i,
+                None => {
+                    self.properties.push(VertexProperty {
+                        name: name.to_string(),
+                        values: vec![f64::NAN; self.vertices.len()],
+                    });
+                    self.properties.len() - 1
+                }
+            };
+            self.object.push((index, 1, None));
+        }
+    }
+
+    /// `ESIZES n ...` or `NO_DATA_VALUES v ...`, one per declared property.
+    fn describe(&mut self, n: usize, tokens: &[(usize, &str)]) -> Result<(), SurfaceError> {
+        let sizes = tokens[0].1 == "ESIZES";
+        for (k, &(column, token)) in tokens[1..].iter().enumerate().take(self.object.len()) {
+            if sizes {
+                let size = token.parse::<usize>().ok().filter(|s| (1..=64).contains(s));
+                let size = size.ok_or_else(|| {
+                    self.error(n, column, format!("{token:?}: a size is 1 to 64"))
+                })?;
+                self.object[k].1 = size;
+                let name = &self.properties[self.object[k].0].name;
+                if size > 1 && !self.vectors.contains(name) {
+                    self.vectors.push(name.clone());
+                }
+            } else {
+                self.object[k].2 = token.parse::<f64>().ok();
+            }
+        }
+        Ok(())
+    }
+
+    /// The property values of a `PVRTX`/`PATOM` from token `first` on: one per declared
+    /// property (NaN for no data and vector properties).
+    fn values(
+        &self,
+        n: usize,
+        tokens: &[(usize, &str)],
+        first: usize,
+    ) -> Result<Vec<f64>, SurfaceError> {
+        let mut at = first;
+        let mut out = Vec::with_capacity(self.object.len());
+        for &(index, size, no_data) in &self.object {
+            let Some(&(column, token)) = tokens.get(at + size - 1) else {
+                let what = format!("its values ({})", self.declared());
+                return Err(self.token(n, tokens, at + size - 1, &what).unwrap_err());
+            };
+            let value = token.parse::<f64>().map_err(|_| {
+                let name = &self.properties[index].name;
+                self.error(n, column, format!("{token:?}: {name} is a number"))
+            })?;
+            let defined = size == 1 && value.is_finite() && Some(value) != no_data;
+            out.push(if defined { value } else { f64::NAN });
+            at += size;
+        }
+        Ok(out)
+    }
+
+    /// The current object's property names, for messages.
+    fn declared(&self) -> String {
+        let names: Vec<&str> = self
+            .object
+            .iter()
+            .map(|&(i, _, _)| self.properties[i].name.as_str())
+            .collect();
+        format!("PROPERTIES {}", names.join(" "))
+    }
+
+    /// The last vertex's values of the current object's properties (the others NaN).
+    fn set_values(&mut self, values: &[f64]) {
+        for (&(index, _, _), &v) in self.object.iter().zip(values) {
+            *self.properties[index].values.last_mut().expect("added") = v;
+        }
     }
 
     /// `TRGL a b c`.
@@ -202,6 +327,9 @@ impl<'a> Reader<'a> {
             ));
         }
         self.vertices.push(p);
+        for property in &mut self.properties {
+            property.values.push(f64::NAN);
+        }
         Ok(())
     }
 
@@ -266,6 +394,75 @@ mod tests {
         assert_eq!(mesh.vertices[0], [620000.5, 6074000.25, -812.5]);
         assert_eq!(mesh.vertices[3], mesh.vertices[1]);
         assert_eq!(mesh.vertices[7], [0.0, 1.0, 6.0]);
+    }
+
+    /// A property's values with NaN as None (NaN != NaN in assert_eq).
+    fn values(mesh: &TriangleMesh, name: &str) -> Vec<Option<f64>> {
+        let p = mesh.property(name).expect(name);
+        p.values
+            .iter()
+            .map(|v| v.is_finite().then_some(*v))
+            .collect()
+    }
+
+    #[test]
+    fn properties_follow_their_vertices() {
+        let mesh = parse(Path::new("h.ts"), TWO.as_bytes()).unwrap();
+        // PVRTX 11 has 0.3, its ATOM 13 the same; VRTX and the second object's vertices
+        // have none.
+        let mut amp = vec![None; 8];
+        amp[1] = Some(0.3);
+        amp[3] = Some(0.3);
+        assert_eq!(values(&mesh, "amp"), amp);
+        // Two properties, one a vector (ESIZES 3: skipped, not kept), a no-data value,
+        // a PATOM with its own values, an object that declares one of them again.
+        let text = "GOCAD TSurf 1\nPROPERTIES throw dir dip\nESIZES 1 3 1\nNO_DATA_VALUES -999 -999 -99\n\
+                    PVRTX 1 0 0 0 12.5 1 0 0 40\nPVRTX 2 1 0 0 -999 0 1 0 -99\nPVRTX 3 0 1 0 7 0 0 1 45.5\n\
+                    PATOM 4 3 8 0 0 1 50\nTRGL 1 2 3\nTRGL 2 4 1\nEND\n\
+                    GOCAD TSurf 1\nPROPERTIES dip\nPVRTX 1 5 5 5 30\nPVRTX 2 6 5 5 nan\nVRTX 3 5 6 5\nTRGL 1 2 3\nEND\n";
+        let mesh = parse(Path::new("f.ts"), text.as_bytes()).unwrap();
+        let names: Vec<&str> = mesh.properties.iter().map(|p| p.name.as_str()).collect();
+        assert_eq!(names, ["throw", "dip"]);
+        assert_eq!(
+            values(&mesh, "throw"),
+            [Some(12.5), None, Some(7.0), Some(8.0), None, None, None]
+        );
+        assert_eq!(
+            values(&mesh, "dip"),
+            [
+                Some(40.0),
+                None,
+                Some(45.5),
+                Some(50.0),
+                Some(30.0),
+                None,
+                None
+            ]
+        );
+        assert_eq!(mesh.property("dip").unwrap().range(), Some([30.0, 50.0]));
+        let cases = [
+            (
+                "GOCAD TSurf 1\nPROPERTIES a b\nPVRTX 1 0 0 0 1\n",
+                3,
+                16,
+                "needs its values (PROPERTIES a b)",
+            ),
+            (
+                "GOCAD TSurf 1\nPROPERTIES a\nPVRTX 1 0 0 0 x\n",
+                3,
+                15,
+                "a is a number",
+            ),
+            (
+                "GOCAD TSurf 1\nPROPERTIES a\nESIZES 0\n",
+                3,
+                8,
+                "a size is 1 to 64",
+            ),
+        ];
+        for (text, line, column, says) in cases {
+            crate::surface::assert_refused_at("bad.ts", text, line, column, says);
+        }
     }
 
     #[test]

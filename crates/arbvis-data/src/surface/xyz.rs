@@ -9,8 +9,10 @@
 //! - Columns: a first line of names (OpendTect's header) says which is which: `x` (or
 //!   `easting`, `cdp_x`, `utm x`...), `y` (`northing`, `cdp_y`), `z` (`time`, `twt`,
 //!   `depth`, `tvdss`, `z (ms)`...), `inline` (`inl`, `il`, `iline`), `crossline` (`crl`,
-//!   `xl`, `xline`); others (attributes) are skipped. Without names, x, y, z are the first
-//!   three. A file of inline, crossline and z without x and y is refused: it has no place
+//!   `xl`, `xline`); the others are the nodes' properties by their names (an attribute
+//!   along the horizon). Without names, x, y, z are the first three and the others
+//!   properties `column 4`, `column 5`...; a property's undefined values (nan, 1e29 or
+//!   more in magnitude) are NaN. A file of inline, crossline and z without x and y is refused: it has no place
 //!   without its survey's geometry.
 //! - Undefined nodes are left out: a z of magnitude 1e29 or more (OpendTect's 1e30), or
 //!   `nan`; so are nodes a file leaves out.
@@ -23,7 +25,7 @@
 
 use std::path::Path;
 
-use super::{Position, SurfaceError, TriangleMesh};
+use super::{Position, SurfaceError, TriangleMesh, VertexProperty};
 
 /// Most nodes a file may hold (2^24: a 4096 x 4096 horizon).
 pub const MAX_NODES: usize = 1 << 24;
@@ -42,13 +44,15 @@ pub struct XyzGrid {
     pub lattice: Option<[usize; 2]>,
 }
 
-/// The columns of x, y, z, and of inline and crossline where present.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// The columns of x, y, z, of inline and crossline where present, and of the properties
+/// (column, name).
+#[derive(Debug, Clone, PartialEq)]
 struct Columns {
     x: usize,
     y: usize,
     z: usize,
     lines: Option<[usize; 2]>,
+    others: Vec<(usize, String)>,
 }
 
 /// The column a header name stands for, if one of ours.
@@ -106,6 +110,7 @@ struct Node {
     at: [f64; 3],
     lines: Option<[f64; 2]>,
     line: usize,
+    values: Vec<f64>,
 }
 
 /// [`parse`], and what the reader found.
@@ -139,6 +144,9 @@ pub fn parse_with_grid(name: &Path, bytes: &[u8]) -> Result<(TriangleMesh, XyzGr
                         y: 1,
                         z: 2,
                         lines: None,
+                        others: (3..width)
+                            .map(|i| (i, format!("column {}", i + 1)))
+                            .collect(),
                     })
                 }
                 None => {
@@ -150,7 +158,7 @@ pub fn parse_with_grid(name: &Path, bytes: &[u8]) -> Result<(TriangleMesh, XyzGr
                 }
             }
         }
-        let c = columns.expect("set above");
+        let c = columns.as_ref().expect("set above");
         if words.len() != width {
             return Err(error(
                 n,
@@ -191,10 +199,16 @@ pub fn parse_with_grid(name: &Path, bytes: &[u8]) -> Result<(TriangleMesh, XyzGr
         if nodes.len() == MAX_NODES {
             return Err(error(n, 1, format!("more than {MAX_NODES} nodes")));
         }
+        let mut values = Vec::with_capacity(c.others.len());
+        for &(i, _) in &c.others {
+            let v = number(i)?;
+            values.push(if v.abs() < UNDEFINED { v } else { f64::NAN });
+        }
         nodes.push(Node {
             at: [x, y, z],
             lines,
             line: n,
+            values,
         });
     }
     if nodes.len() < 3 {
@@ -207,7 +221,7 @@ pub fn parse_with_grid(name: &Path, bytes: &[u8]) -> Result<(TriangleMesh, XyzGr
             ),
         ));
     }
-    let (triangles, lattice) = match columns.and_then(|c| c.lines) {
+    let (triangles, lattice) = match columns.as_ref().and_then(|c| c.lines) {
         Some(_) => {
             let (triangles, shape) =
                 lattice_triangles(&nodes).map_err(|(line, m)| error(line, 1, m))?;
@@ -231,7 +245,17 @@ pub fn parse_with_grid(name: &Path, bytes: &[u8]) -> Result<(TriangleMesh, XyzGr
         lattice,
     };
     let vertices = nodes.iter().map(|n| n.at).collect();
-    let mesh = TriangleMesh::from_indexed(name, vertices, triangles.iter().map(|t| t.to_vec()))?;
+    let properties = columns
+        .map_or_else(Vec::new, |c| c.others)
+        .into_iter()
+        .enumerate()
+        .map(|(k, (_, name))| VertexProperty {
+            name,
+            values: nodes.iter().map(|n| n.values[k]).collect(),
+        })
+        .collect();
+    let mesh = TriangleMesh::from_indexed(name, vertices, triangles.iter().map(|t| t.to_vec()))?
+        .with_properties(name, properties)?;
     Ok((mesh, grid))
 }
 
@@ -250,7 +274,22 @@ fn header(words: &[(usize, &str)]) -> Result<Option<Columns>, (usize, String)> {
         _ => None,
     };
     match (find("x"), find("y"), find("z")) {
-        (Some(x), Some(y), Some(z)) => Ok(Some(Columns { x, y, z, lines })),
+        (Some(x), Some(y), Some(z)) => {
+            let ours = [Some(x), Some(y), Some(z), lines.map(|l| l[0]), lines.map(|l| l[1])];
+            let others = words
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| !ours.contains(&Some(*i)))
+                .map(|(i, (_, w))| (i, w.trim_matches(|c: char| c == '"' || c == '\'').to_string()))
+                .collect();
+            Ok(Some(Columns {
+                x,
+                y,
+                z,
+                lines,
+                others,
+            }))
+        }
         (None, None, Some(_)) if lines.is_some() => Err((
             1,
             "inline, crossline and z without x and y: a grid placed by the survey's numbers only; export it with X/Y".into(),
@@ -412,7 +451,15 @@ mod tests {
                     1200.0 + il as f64 * 3.0 - xl as f64
                 };
                 text += &match with_lines {
-                    true => format!("{x:.2}\t{y:.2}\t{}\t{}\t{z}\t0.5\n", 100 + il * 2, 300 + xl),
+                    true => {
+                        // An amplitude per node, undefined (1e30) at node (0, 2).
+                        let a = if (il, xl) == (0, 2) {
+                            1e30
+                        } else {
+                            il as f64 * 10.0 + xl as f64 - 7.5
+                        };
+                        format!("{x:.2}\t{y:.2}\t{}\t{}\t{z}\t{a}\n", 100 + il * 2, 300 + xl)
+                    }
                     false => format!("{x:.2}, {y:.2}, {z}\n"),
                 };
             }
@@ -435,6 +482,25 @@ mod tests {
         // triangles that touch it.
         assert_eq!(mesh.triangles.len(), 12 - 6);
         assert_eq!(mesh.vertices[0], [620_000.5, 6_074_000.25, 1200.0]);
+        // The other column is a property of the nodes, in their order (node (2, 1) left
+        // out with its z), undefined at node (0, 2).
+        let amplitude = mesh.property("Amplitude").expect("a property");
+        let expected: Vec<f64> = (0..4)
+            .flat_map(|il| (0..3).map(move |xl| (il, xl)))
+            .filter(|&n| n != (2, 1))
+            .map(|(il, xl)| match (il, xl) {
+                (0, 2) => f64::NAN,
+                _ => il as f64 * 10.0 + xl as f64 - 7.5,
+            })
+            .collect();
+        assert_eq!(amplitude.values.len(), expected.len());
+        for (a, e) in amplitude.values.iter().zip(&expected) {
+            assert!(a == e || (a.is_nan() && e.is_nan()), "{a} against {e}");
+        }
+        assert_eq!(amplitude.range(), Some([-7.5, 24.5]));
+        // Without names, a fourth column is "column 4".
+        let (mesh, _) = read("0 0 1 9\n1 0 1 8\n0 1 2 7\n");
+        assert_eq!(mesh.property("column 4").unwrap().values, [9.0, 8.0, 7.0]);
     }
 
     #[test]

@@ -109,6 +109,7 @@ impl LinesScene {
             synthetic: None,
             colour: self.colour,
             colour_by: None,
+            range: None,
             colour_from: None,
             table: self.table.clone(),
             z_down: false,
@@ -238,6 +239,7 @@ pub fn tubes(lines: &[Polyline], radius: f64, sides: usize) -> (TriangleMesh, Ve
         TriangleMesh {
             vertices,
             triangles,
+            properties: Vec::new(),
         },
         values,
     )

@@ -1,6 +1,6 @@
 //! `[technique.surface]` / `[layer.surface]`: a triangle surface (OBJ, STL, PLY), a
-//! horizon, a fault, a body's boundary, coloured by a constant or by its elevation,
-//! unlit or lit, opaque or translucent; the layer a scene draws beside its volumes,
+//! horizon, a fault, a body's boundary, coloured by a constant, its elevation or one of
+//! its own vertex properties (a TSurf's `PROPERTIES`, an x y z grid's columns), unlit or lit, opaque or translucent; the layer a scene draws beside its volumes,
 //! meshes and clouds (issue 55; the seismic readers of issue 57 feed it).
 //!
 //! # How it works
@@ -48,9 +48,15 @@ pub struct SurfaceScene {
     /// The constant colour, RGB in [0, 1] (where `colour_by` is absent).
     #[serde(default = "default_colour")]
     pub colour: [f64; 3],
-    /// Colour by the surface's own elevation (its z, lowest to highest) through `table`.
+    /// Colour through `table` by the surface's own elevation (`"elevation"`: its z) or
+    /// one of its vertex properties (`{ property = "throw" }`), over `range`; vertices
+    /// without a value take `colour`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub colour_by: Option<ColourBy>,
+    /// The values the table spans, low to high (by default the lowest to the highest
+    /// the surface has); values beyond take the table's ends.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub range: Option<[f64; 2]>,
     /// Colour by the colours another layer of the scene shows where the surface lies (a
     /// survey's primary attribute through its table: "seismic on the horizon");
     /// `colour`, or `colour_by`, where the surface lies outside it.
@@ -109,11 +115,23 @@ pub struct ColourFrom {
 }
 
 /// What a surface's colour follows besides the constant.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum ColourBy {
     /// Its z, lowest to highest, through the table.
     Elevation,
+    /// One of its vertex properties, by name.
+    Property(String),
+}
+
+impl ColourBy {
+    /// What the legend calls the values.
+    pub fn title(&self) -> String {
+        match self {
+            ColourBy::Elevation => "elevation (z)".into(),
+            ColourBy::Property(name) => name.clone(),
+        }
+    }
 }
 
 /// How a surface is lit.
@@ -152,6 +170,7 @@ impl SurfaceScene {
             synthetic: None,
             colour: default_colour(),
             colour_by: None,
+            range: None,
             colour_from: None,
             z_down: false,
             table: default_table(),
@@ -201,6 +220,14 @@ impl Technique for SurfaceScene {
                 "opacity",
                 format!("{}: above 0 and at most 1", self.opacity),
             ));
+        }
+        if let Some(r) = self.range {
+            if !(r.iter().all(|v| v.is_finite()) && r[0] < r[1]) {
+                return Err(FieldError::new(
+                    "range",
+                    format!("{r:?}: two finite numbers, low below high"),
+                ));
+            }
         }
         if self
             .colour_from

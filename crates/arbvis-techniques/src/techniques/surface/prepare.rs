@@ -28,8 +28,9 @@ pub struct Prepared {
     pub corners: Vec<Corner>,
     /// Where the object frame lies in the world (the file's coordinates).
     pub world: World,
-    /// The lowest and highest z (what an elevation table spans), and the table's
-    /// colours where the surface is coloured by elevation (its legend).
+    /// The values the table spans (lowest and highest z or property value, or the scene's
+    /// `range`), and the table's colours where the surface is coloured by them (its
+    /// legend).
     pub elevation: ([f64; 2], Option<Vec<[u8; 3]>>),
 }
 
@@ -61,38 +62,73 @@ pub fn prepare(scene: &SurfaceScene, base: &Path) -> RenderResult<Prepared> {
         format!("the surface's {corners} corners"),
         arbvis_core::budget::times(corners, BYTES_PER_CORNER),
     )?;
-    let table = match scene.colour_by {
-        Some(ColourBy::Elevation) => Some(scene.table.build(base)?),
+    let table = match &scene.colour_by {
+        Some(_) => Some(scene.table.build(base)?),
         None => None,
     };
+    if let Some(ColourBy::Property(name)) = &scene.colour_by {
+        if mesh.property(name).is_none() {
+            let has: Vec<String> = mesh
+                .properties
+                .iter()
+                .map(|p| format!("{:?}", p.name))
+                .collect();
+            let has = match has.is_empty() {
+                true => "it has none".to_string(),
+                false => format!("it has {}", has.join(", ")),
+            };
+            return Err(arbvis_core::vocab::FieldError::new(
+                "colour_by.property",
+                format!("{name:?}: the surface has no vertex property of that name ({has})"),
+            )
+            .into());
+        }
+    }
     Ok(of_mesh(&mesh, scene, table.as_ref()))
 }
 
-/// [`prepare`] of a surface already read; `table` colours it by elevation where given.
+/// [`prepare`] of a surface already read; `table` colours it by `scene.colour_by` where
+/// given (a property it lacks colours nothing: [`prepare`] refuses it).
 pub fn of_mesh(
     mesh: &TriangleMesh,
     scene: &SurfaceScene,
     table: Option<&arbvis_core::colortable::ColorTable>,
 ) -> Prepared {
-    let (lo, hi) = mesh.bounds();
-    let (z0, z1) = (lo[2], hi[2]);
-    let colours: Vec<DVec3> = mesh
-        .vertices
+    let values: Vec<f64> = match &scene.colour_by {
+        Some(ColourBy::Property(name)) => match mesh.property(name) {
+            Some(p) => p.values.clone(),
+            None => vec![f64::NAN; mesh.vertices.len()],
+        },
+        _ => mesh.vertices.iter().map(|p| p[2]).collect(),
+    };
+    let [low, high] = scene.range.unwrap_or_else(|| {
+        let used = mesh.triangles.iter().flatten().map(|&v| values[v as usize]);
+        used.filter(|v| v.is_finite())
+            .fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| {
+                [lo.min(v), hi.max(v)]
+            })
+    });
+    let constant = DVec3::from_array(scene.colour);
+    let colours: Vec<DVec3> = values
         .iter()
-        .map(|p| match table {
-            Some(t) => {
-                let s = if z1 > z0 {
-                    (p[2] - z0) / (z1 - z0)
+        .map(|&v| match table {
+            Some(t) if v.is_finite() => {
+                let s = if high > low {
+                    (v - low) / (high - low)
                 } else {
                     0.5
                 };
                 table_colour(t, s)
             }
-            None => DVec3::from_array(scene.colour),
+            _ => constant,
         })
         .collect();
     let legend = table.map(|t| crate::techniques::annotations::colours(&t.entries));
-    of_coloured_mesh(mesh, &colours, ([z0, z1], legend))
+    let span = match low <= high {
+        true => [low, high],
+        false => [0.0, 0.0],
+    };
+    of_coloured_mesh(mesh, &colours, (span, legend))
 }
 
 /// A mesh with a colour per vertex, in the object frame of its box; `legend` is what
@@ -181,5 +217,6 @@ pub fn synthetic_horizon(h: &super::SyntheticHorizon) -> TriangleMesh {
     TriangleMesh {
         vertices,
         triangles,
+        properties: Vec::new(),
     }
 }

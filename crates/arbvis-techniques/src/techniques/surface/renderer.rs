@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use glam::DVec3;
 
 use super::prepare::Prepared;
-use super::SurfaceScene;
+use super::{ColourBy, SurfaceScene};
 use crate::error::RenderResult;
 use crate::programs::{self, ProgramPair};
 use crate::techniques::{Frame, Params, Renderer};
@@ -187,6 +187,7 @@ impl Renderer for SurfaceRenderer {
             || params.z_down != self.params.z_down
             || params.colour != self.params.colour
             || params.colour_by != self.params.colour_by
+            || params.range != self.params.range
             || params.table != self.params.table;
         if recoloured {
             let prepared = super::prepare::prepare(params, &self.base)?;
@@ -215,7 +216,11 @@ impl Renderer for SurfaceRenderer {
         }
         let legend = match &self.prepared.elevation {
             ([low, high], Some(colours)) => Legend::Bar {
-                title: "elevation (z)".into(),
+                title: self
+                    .params
+                    .colour_by
+                    .as_ref()
+                    .map_or_else(|| "elevation (z)".into(), ColourBy::title),
                 colours: colours.clone(),
                 low: *low,
                 high: *high,
