@@ -266,6 +266,26 @@ def surface_parts(vertices, triangles):
     return np.ascontiguousarray(xyz, dtype=np.float64), np.ascontiguousarray(tri, dtype=np.uint32)
 
 
+def surface_properties(properties, n, shape=None):
+    """[(name, float64 array of n values)] of a dict of per-vertex values: each a 1D array
+    of n numbers, or (for a grid, `shape` given) an array of the grid's shape, flattened
+    as its nodes are; NaN (or inf) where a vertex has none."""
+    if properties is None:
+        return []
+    if not isinstance(properties, dict):
+        raise InputError(f"surface: properties are a dict of name to values, got {type(properties).__name__}")
+    out = []
+    for name, values in properties.items():
+        if not isinstance(name, str) or not name:
+            raise InputError(f"surface: a property's name is a non-empty string, got {name!r}")
+        v = np.asarray(values)
+        want = (n,) if shape is None else tuple(shape)
+        if v.shape != want or v.dtype.kind not in "iuf":
+            raise InputError(f"surface: property {name!r} is an array of {want} numbers, got {v.shape} {v.dtype}")
+        out.append((name, np.ascontiguousarray(v.ravel(), dtype=np.float64)))
+    return out
+
+
 def grid_surface(z, x, y):
     """A 2D grid of heights (or times, downwards: pass -time) as vertices and triangles:
     node [i, j] at (x[i], y[j], z[i, j]); a cell's two triangles where its three corners
@@ -289,4 +309,9 @@ def grid_surface(z, x, y):
     keep = np.flatnonzero(defined)
     index = np.full(len(vertices), -1)
     index[keep] = np.arange(len(keep))
-    return vertices[keep], index[triangles]
+    return vertices[keep], index[triangles], keep
+
+
+def grid_properties(properties, z, keep):
+    """`surface_properties` of a grid: arrays of `z`'s shape, at the nodes `keep` kept."""
+    return [(name, v[keep]) for name, v in surface_properties(properties, None, np.shape(z))]

@@ -116,6 +116,49 @@ def test_a_surface_from_arrays_and_from_a_grid_draws_as_its_file(tmp_path):
         scene["technique.surface.file"] = 5
 
 
+def test_a_surface_with_a_property_draws_as_its_tsurf(tmp_path):
+    """Values per vertex handed over with the arrays (`properties=`) or the grid colour a
+    surface as the same values in a TSurf's PVRTX lines do (`colour_by = { property }`);
+    a NaN is a vertex without a value; values of the wrong shape are refused by name."""
+    rng = np.random.default_rng(8)
+    x, y = 620000.0 + 25.0 * np.arange(7), 6074000.0 + 25.0 * np.arange(5)
+    z = -130.0 + 6.0 * rng.standard_normal((7, 5))
+    throw = 18.0 * rng.random((7, 5))
+    throw[2, 3] = np.nan
+    grid = arbvis.Surface.grid(z, x, y, properties={"throw": throw})
+    assert grid.properties == ["throw"]
+    gx, gy = np.meshgrid(x, y, indexing="ij")
+    vertices = np.stack([gx.ravel(), gy.ravel(), z.ravel()], axis=1)
+    node = np.arange(35).reshape(7, 5)
+    a, b, c, d = node[:-1, :-1].ravel(), node[1:, :-1].ravel(), node[1:, 1:].ravel(), node[:-1, 1:].ravel()
+    triangles = np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)])
+    ts = "GOCAD TSurf 1\nPROPERTIES throw\nNO_DATA_VALUES -99999\nTFACE\n"
+    for k, (p, t) in enumerate(zip(vertices, throw.ravel())):
+        t = -99999.0 if np.isnan(t) else float(t)
+        ts += f"PVRTX {k + 1} {float(p[0])!r} {float(p[1])!r} {float(p[2])!r} {t!r}\n"
+    ts += "".join(f"TRGL {t[0] + 1} {t[1] + 1} {t[2] + 1}\n" for t in triangles) + "END\n"
+    (tmp_path / "f.ts").write_text(ts)
+    text = (
+        "size = [53, 41]\nfidelity = \"precise\"\n[technique.surface]\nfile = \"f.ts\"\n"
+        "colour_by = { property = \"throw\" }\ntable = { builtin = \"plasma\" }\n"
+    )
+    scene = arbvis.Scene.from_toml(text, base=tmp_path)
+    want, _ = render(scene)
+    assert np.abs(want[..., :3] - want[20, 26, :3]).max() > 0.2, "the colours vary"
+    arrays = arbvis.Surface(vertices, triangles, properties={"throw": throw.ravel()})
+    for surface in (arrays, grid):
+        scene["technique.surface.file"] = surface
+        got, _ = render(scene)
+        assert np.array_equal(got, want)
+    with pytest.raises(arbvis.InputError, match="property 'throw' is an array of \\(35,\\)"):
+        arbvis.Surface(vertices, triangles, properties={"throw": throw})
+    with pytest.raises(arbvis.InputError, match="property 'p' is an array of \\(7, 5\\)"):
+        arbvis.Surface.grid(z, x, y, properties={"p": throw[:3]})
+    scene["technique.surface.colour_by"] = {"property": "dip"}
+    with pytest.raises(arbvis.SceneError, match='colour_by.property: "dip".*it has "throw"'):
+        render(scene)
+
+
 def test_a_section_moves_by_key_for_the_cost_of_a_frame(tmp_path):
     """A layered scene's section moved from Python (`scene["layer.1.section.inline"]`) is
     drawn by the renderer it has, which reads no file for it (the survey's file is gone by
