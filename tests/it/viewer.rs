@@ -791,3 +791,53 @@ click Save scene
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A surface layer's colour from its panel (issue 57 item 6): its settings opened, the
+/// drop-down offers its file's property and the other layer; seismic from the cube
+/// switched on, then the property instead: the saved scene follows, and the screenshot
+/// is the saved scene drawn offscreen.
+#[test]
+fn a_surface_layers_colour_is_switched_between_a_layer_and_its_property() {
+    let dir = temp_dir("surface-colour-scene");
+    let ts = "GOCAD TSurf 1\nPROPERTIES throw\nPVRTX 1 0 0 5 0\nPVRTX 2 19 0 6 4\nPVRTX 3 19 13 8 9\nPVRTX 4 0 13 7 2\nTRGL 1 2 3\nTRGL 1 3 4\nEND\n";
+    std::fs::write(dir.join("f.ts"), ts).unwrap();
+    let scene = dir.join("layers.toml");
+    std::fs::write(
+        &scene,
+        format!("[[layer]]\nname = \"fault\"\n[layer.surface]\nfile = \"{}\"\n[[layer]]\nname = \"cube\"\n[layer.opacity3d.primary]\nvolume = {{ synthetic = {{ size = [19, 13, 17], seed = 4 }} }}\nattribute = \"amplitude\"\n", dir.join("f.ts").display()),
+    )
+    .unwrap();
+    let script = "\
+resize 900 640
+wait 2
+click layer 0: fault (surface) settings
+wait 1
+set layer 0 colour = layer cube
+wait 2
+set layer 0 colour = property throw
+wait 2
+click Screenshot
+click Save scene
+";
+    let Some((out, _)) = run_script("surface-colour", scene.to_str().unwrap(), "200x150", script)
+    else {
+        return;
+    };
+    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let layers: Vec<_> = saved.layers().collect();
+    let surface = layers[0]
+        .1
+        .get::<arbvis::techniques::surface::SurfaceScene>()
+        .expect("a surface");
+    assert_eq!(
+        surface.colour_by,
+        Some(arbvis::techniques::surface::ColourBy::Property(
+            "throw".into()
+        ))
+    );
+    assert_eq!(surface.colour_from, None);
+    let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -39,6 +39,10 @@ pub struct EditContext<'a> {
     pub clip: &'a mut ClipEditor,
     /// The transfer function editor's state.
     pub transfer: &'a mut TransferState,
+    /// The scene's layer names, in order (empty for a one-technique scene).
+    pub layers: Vec<String>,
+    /// The layer being edited: its index and name.
+    pub layer: Option<(usize, String)>,
 }
 
 /// A technique as the viewer shows it.
@@ -139,17 +143,14 @@ impl Face for SplatsScene {
 
 impl Face for SurfaceScene {
     fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool {
-        use arbvis_techniques::techniques::surface::{ColourBy, Lighting};
+        use super::surface_colour::{self, ColourChoice};
+        use arbvis_techniques::techniques::surface::Lighting;
         ui.separator();
         ui.label("Surface");
-        let mut changed = false;
-        let mut by_elevation = self.colour_by == Some(ColourBy::Elevation);
-        let r = ui.checkbox(&mut by_elevation, "Colour by elevation");
-        if cx.widgets.add(ui, "Colour by elevation", &r) && r.changed() {
-            self.colour_by = by_elevation.then_some(ColourBy::Elevation);
-            changed = true;
-        }
-        if !by_elevation {
+        let mut changed = surface_colour::editor(ui, self, cx);
+        // The constant colours what the choice leaves uncoloured (vertices without the
+        // property, the surface outside the layer it takes colours from).
+        if ColourChoice::of(self) != ColourChoice::Elevation {
             ui.horizontal(|ui| {
                 ui.label("Colour");
                 let mut c = self.colour.map(|v| v as f32);

@@ -41,6 +41,7 @@ pub mod screenshot;
 pub mod script;
 pub mod splats;
 pub mod store_sections;
+pub mod surface_colour;
 pub mod transfer;
 pub mod widgets;
 

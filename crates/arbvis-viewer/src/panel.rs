@@ -353,6 +353,8 @@ fn technique_editors(
         widgets: &mut state.widgets,
         clip: &mut state.clip,
         transfer: &mut state.transfer,
+        layers: scene.layers().map(|(info, _)| info.name.clone()).collect(),
+        layer: None,
     };
     if scene.is_layered() {
         if layer_editors(ui, scene, &mut cx) {
@@ -394,9 +396,13 @@ fn layer_editors(ui: &mut egui::Ui, scene: &mut Scene, cx: &mut EditContext<'_>)
             ui.label(&name);
         });
         if let Some(face) = face_mut(technique) {
-            egui::CollapsingHeader::new(format!("{name} settings"))
+            cx.layer = Some((index, info.name.clone()));
+            let label = format!("{name} settings");
+            let r = egui::CollapsingHeader::new(&label)
                 .id_salt(("layer", index))
                 .show(ui, |ui| changed |= face.editors(ui, cx));
+            // Recorded, so that a script opens it as a user does (`click ... settings`).
+            cx.widgets.add(ui, &label, &r.header_response);
         }
     }
     if let Some((from, to)) = moved {

@@ -16,6 +16,7 @@
 //! scroll 120                      # scroll over the 3D view by DY points (zoom)
 //! set primary Cr 0.25             # give a slider / number its value, a check box true or
 //! set primary table magma         #     false, a choice one of its options (by name)
+//! set layer 0 colour = layer F3   # ` = ` when the value has spaces
 //! key Home                        # press and release a key (egui's key names): Home resets
 //!                                 #     the camera, F12 takes a screenshot
 //! resize 1280 800                 # resize the window (pixels)
@@ -336,10 +337,16 @@ fn parse_action(line: &str) -> Result<Action, String> {
             Action::Scroll(dy)
         }
         "set" => {
+            // `set LABEL = VALUE` for values with spaces (a choice named "layer F3");
+            // otherwise the value is the last word.
             let (label, value) = rest
-                .rsplit_once(char::is_whitespace)
-                .map(|(l, v)| (l.trim(), v))
-                .filter(|(l, _)| !l.is_empty())
+                .split_once(" = ")
+                .map(|(l, v)| (l.trim(), v.trim()))
+                .or_else(|| {
+                    rest.rsplit_once(char::is_whitespace)
+                        .map(|(l, v)| (l.trim(), v))
+                })
+                .filter(|(l, v)| !l.is_empty() && !v.is_empty())
                 .ok_or_else(|| format!("set takes a widget label and a value, got {rest:?}"))?;
             Action::Set {
                 label: label.to_string(),
@@ -442,6 +449,7 @@ mod tests {
                 "click-at primary alpha 0.25 0.75\nright-click-at primary alpha 0 1\n\
                  double-click-at x 1 0\ndrag-on secondary alpha 0.5 0.5 -30 12.5\n\
                  scroll -120\nset primary Cr 0.25\nset primary table magma\n\
+                 set layer 0 colour = layer inline 128\n\
                  key Home\nresize 1280 800\nidle 1000\nmeasure 20 interactive\n\
                  print Clip stats\ncheck layout\nwindow-shot\n"
             ),
@@ -474,6 +482,10 @@ mod tests {
                 Action::Set {
                     label: "primary table".into(),
                     value: "magma".into()
+                },
+                Action::Set {
+                    label: "layer 0 colour".into(),
+                    value: "layer inline 128".into()
                 },
                 Action::Key("Home".into()),
                 Action::Resize(1280, 800),
