@@ -147,7 +147,12 @@ impl Face for SurfaceScene {
         use arbvis_techniques::techniques::surface::Lighting;
         ui.separator();
         ui.label("Surface");
-        let mut changed = surface_colour::editor(ui, self, cx);
+        let place = surface_colour::Context {
+            base: cx.base,
+            layers: &cx.layers,
+            layer: cx.layer.as_ref(),
+        };
+        let mut changed = surface_colour::editor(ui, self, &place, cx.widgets);
         // The constant colours what the choice leaves uncoloured (vertices without the
         // property, the surface outside the layer it takes colours from).
         if ColourChoice::of(self) != ColourChoice::Elevation {

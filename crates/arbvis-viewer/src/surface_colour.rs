@@ -8,7 +8,18 @@ use std::sync::Arc;
 
 use arbvis_techniques::techniques::surface::{ColourBy, ColourFrom, SurfaceFile, SurfaceScene};
 
-use super::face::EditContext;
+use super::widgets::Widgets;
+
+/// Where the surface being edited lies: the scene's folder, its layers' names and which
+/// of them is this one (index and name), for a one-technique scene none.
+pub struct Context<'a> {
+    /// The folder the scene's relative paths are read from.
+    pub base: &'a Path,
+    /// The scene's layer names, in order.
+    pub layers: &'a [String],
+    /// This layer's index and name.
+    pub layer: Option<&'a (usize, String)>,
+}
 
 /// What a surface's colour follows.
 #[derive(Debug, Clone, PartialEq)]
@@ -58,11 +69,7 @@ impl ColourChoice {
 
 /// The choices for `scene`: constant, elevation, each property its file has (and the one
 /// it names), each other layer of the scene.
-pub fn choices(
-    scene: &SurfaceScene,
-    cx: &EditContext<'_>,
-    ctx: &egui::Context,
-) -> Vec<ColourChoice> {
+pub fn choices(scene: &SurfaceScene, cx: &Context<'_>, ctx: &egui::Context) -> Vec<ColourChoice> {
     let mut out = vec![ColourChoice::Constant, ColourChoice::Elevation];
     let mut properties = match &scene.file {
         Some(SurfaceFile::Path(p)) => property_names(ctx, &cx.base.join(p)).to_vec(),
@@ -74,7 +81,7 @@ pub fn choices(
         }
     }
     out.extend(properties.into_iter().map(ColourChoice::Property));
-    let own = cx.layer.as_ref().map(|(_, name)| name.as_str());
+    let own = cx.layer.map(|(_, name)| name.as_str());
     let others = cx
         .layers
         .iter()
@@ -89,7 +96,12 @@ pub fn choices(
 }
 
 /// The drop-down; true when the choice changed.
-pub fn editor(ui: &mut egui::Ui, scene: &mut SurfaceScene, cx: &mut EditContext<'_>) -> bool {
+pub fn editor(
+    ui: &mut egui::Ui,
+    scene: &mut SurfaceScene,
+    cx: &Context<'_>,
+    widgets: &mut Widgets,
+) -> bool {
     let options = choices(scene, cx, ui.ctx());
     let names: Vec<String> = options.iter().map(ColourChoice::name).collect();
     let pairs: Vec<(ColourChoice, &str)> = options
@@ -97,7 +109,7 @@ pub fn editor(ui: &mut egui::Ui, scene: &mut SurfaceScene, cx: &mut EditContext<
         .cloned()
         .zip(names.iter().map(String::as_str))
         .collect();
-    let label = match &cx.layer {
+    let label = match cx.layer {
         Some((index, _)) => format!("layer {index} colour"),
         None => "Surface colour by".into(),
     };
@@ -105,7 +117,7 @@ pub fn editor(ui: &mut egui::Ui, scene: &mut SurfaceScene, cx: &mut EditContext<
     let mut changed = false;
     ui.horizontal(|ui| {
         ui.label("Colour by");
-        changed = cx.widgets.choice(ui, &label, &mut choice, &pairs, 160.0);
+        changed = widgets.choice(ui, &label, &mut choice, &pairs, 160.0);
     });
     if changed {
         choice.apply(scene);
