@@ -465,6 +465,9 @@ fn tsurf_corpus() -> Vec<Vec<u8>> {
     vec![
         b"GOCAD TSurf 1\nHEADER {\nname:top\n}\nZPOSITIVE Depth\nTFACE\nVRTX 1 0 0 10\nPVRTX 2 1 0 11 0.5\nVRTX 3 0 1 12\nATOM 4 2\nTRGL 1 2 3\nTFACE\nVRTX 5 1 1 9\nTRGL 3 4 5\nEND\nGOCAD TSurf 1\nVRTX 1 5 5 5\nVRTX 2 6 5 5\nVRTX 3 5 6 5\nTRGL 1 2 3\nEND\n"
             .to_vec(),
+        // Properties: a scalar, a vector (ESIZES 3), no-data values, PATOM and ATOM.
+        b"GOCAD TSurf 1\nPROPERTIES throw dir\nESIZES 1 3\nNO_DATA_VALUES -99999 -99999\nPVRTX 1 0 0 0 12.5 1 0 0\nPVRTX 2 1 0 0 -99999 0 1 0\nPVRTX 3 0 1 0 7 0 0 1\nPATOM 4 3 8 0 0 1\nATOM 5 2\nTRGL 1 2 3\nTRGL 2 4 5\nEND\n"
+            .to_vec(),
     ]
 }
 

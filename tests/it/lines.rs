@@ -194,3 +194,50 @@ fn bad_lines_are_refused_where_they_are() {
     );
     assert!(render_on(&h, &Scene::parse(&fine, "l.toml").unwrap()).is_ok());
 }
+
+/// `arbvis inspect` of lines files (the reader registry's `.csv`): the F3 well's survey
+/// is a build-and-hold well whose end the textbook's arc formulas give (vertical to 60 m,
+/// a 2-degree-per-10-m build to 36 degrees at 240 m, radius 180 / 0.6283 = 286.48 m, then
+/// 90 m held: true vertical depth 60 + R sin 36 + 90 cos 36 = 301.20, displacement
+/// R (1 - cos 36) + 90 sin 36 = 107.61 toward azimuth 125), its log's rows and range, and
+/// polylines with their length.
+#[test]
+fn inspect_tells_a_survey_a_log_and_polylines_apart() {
+    let said = common::inspect(&common::data_file("seismic/f3-well-survey.csv"));
+    common::assert_says(
+        &said,
+        &[
+            "read as a deviation survey (by its first line of names)",
+            "stations: 23, measured depth 0 to 330",
+            "largest inclination: 36.00 degrees at measured depth 240",
+            "largest dogleg: 6.00 degrees per 30",
+            "88.15 east, -61.72 north of the wellhead, true vertical depth 301.20",
+            "horizontal displacement: 107.61",
+        ],
+    );
+    let said = common::inspect(&common::data_file("seismic/f3-well-log.csv"));
+    common::assert_says(
+        &said,
+        &[
+            "read as a log",
+            "rows: 661, measured depth 0 to 330",
+            "(0 rows without a value)",
+        ],
+    );
+    let dir = common::temp_dir("lines-inspect");
+    let file = dir.join("faults.csv");
+    std::fs::write(
+        &file,
+        "x,y,z,throw\n0,0,0,1\n3,4,0,2\n\n10,0,0,nan\n10,0,12,5\n",
+    )
+    .unwrap();
+    common::assert_says(
+        &common::inspect(&file),
+        &[
+            "read as polylines",
+            "lines: 2, points: 4, length 17.00",
+            "bounds: [0.0, 0.0, 0.0] .. [10.0, 4.0, 12.0]",
+            "values: 1 to 5",
+        ],
+    );
+}

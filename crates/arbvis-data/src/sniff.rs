@@ -27,6 +27,8 @@ pub enum Format {
     Surface,
     /// A folder: a bricked multi-resolution store (zarr v3) or an MDIO dataset.
     Store,
+    /// Lines and wells as CSV: polylines, a deviation survey, a log.
+    Lines,
 }
 
 /// The kind of data a reader yields: what a scene's defaults follow.
@@ -45,6 +47,8 @@ pub enum DataKind {
     SeedCloud,
     /// A triangle surface.
     Surface,
+    /// Polylines and wells (a `lines` layer).
+    Lines,
 }
 
 /// One reader as the registry knows it.
@@ -161,6 +165,14 @@ pub const READERS: &[Reader] = &[
         guesses: never,
     },
     Reader {
+        format: Format::Lines,
+        reads: "lines and wells as CSV (.csv: x, y, z polylines, MD/INC/AZI deviation surveys, MD and value logs)",
+        kind: DataKind::Lines,
+        url: false,
+        claims: |name, _| name.ends_with(".csv"),
+        guesses: never,
+    },
+    Reader {
         format: Format::Store,
         reads: "survey stores and MDIO datasets (a folder, from `arbvis convert` or mdio-python)",
         kind: DataKind::Survey,
@@ -200,6 +212,7 @@ pub fn reads() -> String {
         (DataKind::Cloud, "point clouds"),
         (DataKind::SeedCloud, "the seed's point clouds"),
         (DataKind::Surface, "surfaces"),
+        (DataKind::Lines, "lines"),
     ];
     let groups: Vec<String> = kinds
         .iter()
@@ -315,6 +328,7 @@ mod tests {
             Format::Dat,
             Format::Surface,
             Format::Store,
+            Format::Lines,
         ];
         for f in formats {
             assert_eq!(READERS.iter().filter(|r| r.format == f).count(), 1, "{f:?}");
@@ -322,9 +336,10 @@ mod tests {
         // A SEG-Y binary header's sample format code (5: IEEE float) at byte 3224.
         let mut segy = vec![b' '; 3600];
         segy[3224..3226].copy_from_slice(&5u16.to_be_bytes());
-        let cases: [(&str, &[u8], Option<Format>); 14] = [
+        let cases: [(&str, &[u8], Option<Format>); 15] = [
             ("a.NII.GZ", b"", Some(Format::Nifti)),
             ("a.sgy", b"", Some(Format::Segy)),
+            ("well.CSV", b"MD,INC,AZI", Some(Format::Lines)),
             ("a.vtu", b"", Some(Format::Mesh)),
             ("mesh", b"  # vtk DataFile Version 2.0", Some(Format::Mesh)),
             ("a.laz", b"LASF", Some(Format::Las)),

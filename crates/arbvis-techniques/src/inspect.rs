@@ -143,6 +143,11 @@ fn describe(
             path.display(),
             arbvis_data::surface::describe_file(path)?
         )),
+        Some(DataKind::Lines) => Ok(format!(
+            "{}\n{}",
+            path.display(),
+            arbvis_data::lines::describe_file(path)?
+        )),
         None => Err(InspectError::Unknown {
             path: path.display().to_string(),
             what: looks_like(&head),

@@ -17,6 +17,10 @@
 
 use std::path::Path;
 
+pub mod describe;
+
+pub use describe::describe_file;
+
 use crate::surface::{Position, SurfaceError};
 
 /// Largest file of lines read (16 MiB: a million rows).
