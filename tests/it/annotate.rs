@@ -102,7 +102,7 @@ fn each_technique_says_its_tables_and_keys() {
     assert_eq!(labels, ["0.7", "1", "1.3"]);
     assert_eq!(keys[0].0, [51, 102, 255]);
     // Its axes in the file's coordinates: x, y, z over the mesh's bounds.
-    let (_, axes) = a.axes.as_ref().unwrap();
+    let axes = &a.axes.as_ref().unwrap().axes;
     let names: Vec<&str> = axes.iter().map(|a| a.name.as_str()).collect();
     assert_eq!(names, ["x", "y", "z"]);
     // F3: amplitude over its 1-99 % range, and inline / crossline / time axes.
@@ -119,7 +119,7 @@ fn each_technique_says_its_tables_and_keys() {
         *low < 0.0 && *high > 0.0 && low.abs() < 10239.0,
         "{low} {high}"
     );
-    let (_, axes) = a.axes.as_ref().unwrap();
+    let axes = &a.axes.as_ref().unwrap().axes;
     let names: Vec<&str> = axes.iter().map(|a| a.name.as_str()).collect();
     assert_eq!(names, ["time (ms)", "crossline", "inline"]);
     assert_eq!(axes[2].label(0), "111");
@@ -168,4 +168,47 @@ fn the_command_line_draws_them_only_when_asked() {
     let scene = Scene::parse(&text, "keys").unwrap();
     assert!(scene.legend && scene.axes);
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A layered scene's axes are the first visible layer's box with that layer's placement:
+/// a cube moved into the left of a frame it shares with a small horizon (hidden, but in
+/// the frame) gets its axes around where it is drawn, not around the frame's middle.
+#[test]
+fn a_layered_scenes_axes_follow_their_layer() {
+    let h = headless(Backend::Egl);
+    let text = "size = [240, 180]\n[camera]\nrotation = [-0.483, -0.1294, -0.2241, 0.8365]\n\
+                [[layer]]\nname = \"cube\"\n[layer.opacity3d.primary]\n\
+                volume = { synthetic = { size = [19, 13, 17], seed = 4 } }\nattribute = \"amplitude\"\n\
+                [[layer]]\nname = \"horizon\"\nvisible = false\noffset = [30.0, 0.0, 205.0]\nscale = 0.2\n\
+                [layer.surface]\nsynthetic = { size = [3, 3], seed = 1 }\n";
+    let mut scene = Scene::parse(text, "axes.toml").unwrap();
+    let plain = render_on(&h, &scene).unwrap().image;
+    scene.axes = true;
+    let annotated = render_on(&h, &scene).unwrap().image;
+    let width = plain.width as usize;
+    // Bounding boxes (x0, y0, x1, y1) of the pixels a test picks.
+    let bbox = |keep: &dyn Fn(usize) -> bool| {
+        let mut b = [i64::MAX, i64::MAX, i64::MIN, i64::MIN];
+        for p in (0..plain.data.len() / 4).filter(|&p| keep(p)) {
+            let (x, y) = ((p % width) as i64, (p / width) as i64);
+            b = [b[0].min(x), b[1].min(y), b[2].max(x), b[3].max(y)];
+        }
+        b
+    };
+    let cube = bbox(&|p| plain.data[4 * p..4 * p + 3].iter().any(|&v| v > 0.02));
+    let axes = bbox(&|p| annotated.data[4 * p..4 * p + 4] != plain.data[4 * p..4 * p + 4]);
+    assert!(
+        (cube[0] + cube[2]) / 2 < 90,
+        "the cube is drawn in the left of the frame: {cube:?}"
+    );
+    // The axes run along three of the cube's box edges, their ticks and labels a few text
+    // heights (about 10 pixels at 180 rows) outside: within the cube's bounds grown by 30
+    // pixels. Drawn for the unplaced box (the cube alone, framed in the middle) they
+    // reach the frame's right side, far past it.
+    let grown = [cube[0] - 30, cube[1] - 30, cube[2] + 30, cube[3] + 30];
+    assert!(
+        axes[0] >= grown[0] && axes[1] >= grown[1] && axes[2] <= grown[2] && axes[3] <= grown[3],
+        "axes {axes:?} outside the cube's {cube:?} grown by 30"
+    );
+    assert!(axes[2] - axes[0] > 40, "the axes are drawn: {axes:?}");
 }

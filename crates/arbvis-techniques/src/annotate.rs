@@ -67,8 +67,13 @@ pub fn draw(
         let area = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
         let size = text_size(h);
         if show.axes {
-            if let Some((half, axes)) = &annotations.axes {
-                draw_axes(&area, camera, [w, h], *half, axes, size, ink)?;
+            if let Some(b) = &annotations.axes {
+                // Seen as the layer the box belongs to is drawn.
+                let camera = Camera {
+                    placement: b.placement,
+                    ..*camera
+                };
+                draw_axes(&area, &camera, [w, h], b.half, &b.axes, size, ink)?;
             }
         }
         if show.legend {

@@ -374,16 +374,25 @@ impl Renderer for LayeredRenderer {
             .map_or(ProgramKind::Glsl, |r| r.program_kind())
     }
 
-    /// Every visible layer's legends, each titled with its layer's name; no axes (each
-    /// layer's are its own frame's).
+    /// Every visible layer's legends, each titled with its layer's name; the axes of the
+    /// first visible layer that has them (a survey's inline, crossline and time), placed
+    /// as that layer is.
     fn annotations(&self) -> crate::techniques::annotations::Annotations {
         use crate::techniques::annotations::{Annotations, Legend};
         let mut legends = Vec::new();
+        let mut axes = None;
         for d in &self.layers {
             let Some(r) = d.renderer else {
                 continue;
             };
-            for mut legend in self.renderers[r].annotations().legends {
+            let own = self.renderers[r].annotations();
+            if axes.is_none() {
+                axes = own.axes.map(|mut b| {
+                    b.placement = d.placement;
+                    b
+                });
+            }
+            for mut legend in own.legends {
                 let (Legend::Bar { title, .. } | Legend::Keys { title, .. }) = &mut legend;
                 if !d.name.is_empty() {
                     *title = format!("{}: {title}", d.name);
@@ -391,10 +400,7 @@ impl Renderer for LayeredRenderer {
                 legends.push(legend);
             }
         }
-        Annotations {
-            legends,
-            axes: None,
-        }
+        Annotations { legends, axes }
     }
 
     fn needs_depth(&self) -> bool {

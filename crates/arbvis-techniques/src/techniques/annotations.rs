@@ -3,6 +3,7 @@
 //! isovalues or classes as keys, and the box's three axes in the data's own numbers. The
 //! viewer draws its own; `crate::annotate` draws these into offscreen pictures.
 
+use arbvis_core::camera::Placement;
 use arbvis_data::volume::axes::Axis;
 
 /// One legend.
@@ -34,9 +35,30 @@ pub enum Legend {
 pub struct Annotations {
     /// Legends, in the order they are drawn.
     pub legends: Vec<Legend>,
-    /// The box drawn (half-extents in object units, as the renderer places it) and its
-    /// three axes (x, y, z of the object box), where the data has them.
-    pub axes: Option<([f64; 3], [Axis; 3])>,
+    /// The box drawn and its three axes, where the data has them.
+    pub axes: Option<BoxAxes>,
+}
+
+/// A box with its three axes in the data's own numbers.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoxAxes {
+    /// Half-extents in object units, as the renderer places its data.
+    pub half: [f64; 3],
+    /// The axes along x, y and z of the object box.
+    pub axes: [Axis; 3],
+    /// Where the object frame sits in the scene's (a layer's placement; identity alone).
+    pub placement: Placement,
+}
+
+impl BoxAxes {
+    /// The box of `half` extents with `axes`, unplaced.
+    pub fn new(half: [f64; 3], axes: [Axis; 3]) -> BoxAxes {
+        BoxAxes {
+            half,
+            axes,
+            placement: Placement::default(),
+        }
+    }
 }
 
 /// A table's 256 colours without their alpha.

@@ -386,7 +386,10 @@ impl Renderer for CellprojRenderer {
         });
         Annotations {
             legends,
-            axes: Some((self.prepared.half.to_array(), axes)),
+            axes: Some(crate::techniques::annotations::BoxAxes::new(
+                self.prepared.half.to_array(),
+                axes,
+            )),
         }
     }
 

@@ -681,7 +681,10 @@ impl Renderer for Opacity3dRenderer {
             arbvis_data::volume::axes::describe(&self.params.primary.volume, &self.base, p.dims);
         Annotations {
             legends,
-            axes: Some((p.half.to_array(), axes)),
+            axes: Some(crate::techniques::annotations::BoxAxes::new(
+                p.half.to_array(),
+                axes,
+            )),
         }
     }
 

@@ -753,7 +753,7 @@ impl Renderer for SplatsRenderer {
         });
         Annotations {
             legends: legend.into_iter().collect(),
-            axes: Some((half, axes)),
+            axes: Some(crate::techniques::annotations::BoxAxes::new(half, axes)),
         }
     }
 
