@@ -841,3 +841,51 @@ click Save scene
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A section layer's slider (issue 57 item 6): over F3's inlines 111..=133, a typed
+/// 125.4 lands on inline 125 (the survey's step), the saved scene and the screenshot
+/// follow; a number outside the survey is refused by the slider with its range.
+#[test]
+fn a_sections_slider_moves_it_over_the_surveys_numbers() {
+    let dir = temp_dir("section-slider-scene");
+    let scene = dir.join("section.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "[[layer]]\nname = \"inline\"\n[layer.section]\nvolume = {{ segy = \"{}\" }}\ninline = 120\n",
+            common::data_file("seismic/f3.sgy").display()
+        ),
+    )
+    .unwrap();
+    let opening = "resize 900 640\nwait 2\nclick layer 0: inline (section) settings\nwait 1\n";
+    let script = format!("{opening}set Inline 125.4\nwait 2\nclick Screenshot\nclick Save scene\n");
+    let Some((out, _)) = run_script(
+        "section-slider",
+        scene.to_str().unwrap(),
+        "200x150",
+        &script,
+    ) else {
+        return;
+    };
+    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let layers: Vec<_> = saved.layers().collect();
+    let section = layers[0]
+        .1
+        .get::<arbvis::techniques::section::SectionScene>()
+        .expect("a section");
+    assert_eq!(section.inline, Some(125.0));
+    let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, &saved);
+    let _ = std::fs::remove_dir_all(&out);
+    let outside = format!("{opening}set Inline 200\n");
+    let Some(errors) = failing_scripts("section-outside", scene.to_str().unwrap(), &[&outside])
+    else {
+        return;
+    };
+    assert!(
+        errors[0].contains("Inline: 200 is outside 111..=133"),
+        "{}",
+        errors[0]
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -179,24 +179,26 @@ impl Face for SurfaceScene {
 }
 
 impl Face for SectionScene {
-    /// The cut's number (dragged, or typed: inline and crossline numbers step by one, time
-    /// by a millisecond) and the opacity; a number outside the survey is refused by name.
+    /// The cut's number on a slider over the survey's numbers (inline and crossline
+    /// numbers step by the survey's step; time and depth anywhere between the first and
+    /// last sample), and the opacity. Where the survey does not read, a number box (the
+    /// layer's own error says why).
     fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool {
         ui.separator();
         ui.label("Section");
+        let ranges = super::section_range::ranges(ui.ctx(), self, cx.base);
         let mut changed = false;
-        for (key, number) in [
-            ("Inline", &mut self.inline),
-            ("Crossline", &mut self.crossline),
-            ("Time (ms)", &mut self.time),
-            ("Depth", &mut self.depth),
+        for (key, axis, number) in [
+            ("Inline", 2, &mut self.inline),
+            ("Crossline", 1, &mut self.crossline),
+            ("Time (ms)", 0, &mut self.time),
+            ("Depth", 0, &mut self.depth),
         ] {
             let Some(n) = number.as_mut() else { continue };
-            ui.horizontal(|ui| {
-                ui.label(key);
-                let r = ui.add(egui::DragValue::new(n).speed(0.25).fixed_decimals(1));
-                changed |= cx.widgets.add(ui, key, &r) && r.changed();
-            });
+            changed |= match ranges.as_ref().map(|r| r[axis]) {
+                Some(range) => super::section_range::slider(ui, cx.widgets, key, n, range),
+                None => cx.widgets.drag_value(ui, key, n, f64::MIN..=f64::MAX, 0.25),
+            };
         }
         let r = ui.add(egui::Slider::new(&mut self.opacity, 0.01..=1.0).text("Opacity"));
         changed |= cx.widgets.add(ui, "Opacity", &r) && r.changed();

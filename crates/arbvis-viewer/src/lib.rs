@@ -39,6 +39,7 @@ pub mod runner;
 mod running;
 pub mod screenshot;
 pub mod script;
+pub mod section_range;
 pub mod splats;
 pub mod store_sections;
 pub mod surface_colour;

@@ -214,6 +214,19 @@ pub fn plane(volume: &Volume, axis: usize, position: f64) -> Plane {
     }
 }
 
+/// The survey's axes in its own numbers (time, crossline, inline), as [`prepare`] finds
+/// them: a store's from its metadata, a file's by reading it (once; the viewer keeps them
+/// to bound its sliders).
+pub fn survey_axes(scene: &SectionScene, base: &Path) -> RenderResult<[Axis; 3]> {
+    match &scene.volume {
+        VolumeSource::Store(path) => {
+            let store = Store::open(&arbvis_data::fetch::resolve(base, path))?;
+            Ok(store_axes(&store.meta, [[0; 3], store.meta.dims]))
+        }
+        source => Ok(load_with_axes(source, base, &Limits::default())?.1),
+    }
+}
+
 /// Load, derive (or open the store), find the cut and take its plane.
 pub fn prepare(scene: &SectionScene, base: &Path, limits: &Limits) -> RenderResult<Prepared> {
     let cut = scene.cut()?;
