@@ -241,3 +241,115 @@ fn inspect_tells_a_survey_a_log_and_polylines_apart() {
         ],
     );
 }
+
+/// Lines and a well's log given in the scene itself (`polylines = [...]`, `log_rows =
+/// [...]`; what Python's arrays become) draw exactly the pictures of their files; bad
+/// points are refused by their key (line and point from 0).
+#[test]
+fn lines_and_a_log_typed_in_the_scene_draw_as_their_files() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("lines-inline");
+    // Two uneven lines, values on each point, one without (nan).
+    let lines = [
+        vec![
+            [0.0, 0.0, 0.0, 1.5],
+            [40.0, 10.0, -5.0, 2.0],
+            [70.0, 45.0, -20.0, f64::NAN],
+        ],
+        vec![[10.0, 60.0, -30.0, 4.0], [35.0, 80.0, -12.5, 0.25]],
+    ];
+    let csv: String = lines
+        .iter()
+        .map(|l| {
+            l.iter()
+                .map(|p| format!("{},{},{},{}\n", p[0], p[1], p[2], p[3]))
+                .collect::<String>()
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(dir.join("l.csv"), csv).unwrap();
+    let typed: Vec<String> = lines
+        .iter()
+        .map(|l| {
+            let points: Vec<String> = l
+                .iter()
+                .map(|p| {
+                    format!(
+                        "[{:?}, {:?}, {:?}, {}]",
+                        p[0],
+                        p[1],
+                        p[2],
+                        if p[3].is_nan() {
+                            "nan".to_string()
+                        } else {
+                            format!("{:?}", p[3])
+                        }
+                    )
+                })
+                .collect();
+            format!("[{}]", points.join(", "))
+        })
+        .collect();
+    let head = "size = [64, 48]\nfidelity = \"precise\"\n[camera]\nrotation = [0.31, -0.22, 0.12, 0.917]\n[technique.lines]\nradius = 4.0\n";
+    let draw = |text: &str| {
+        render_on(&h, &Scene::parse(text, "l.toml").unwrap())
+            .unwrap()
+            .image
+    };
+    let from_file = draw(&format!(
+        "{head}file = \"{}\"\n",
+        dir.join("l.csv").display()
+    ));
+    let typed_in = draw(&format!("{head}polylines = [{}]\n", typed.join(", ")));
+    assert_eq!(from_file.compare(&typed_in, 0.0).unwrap().pixels_over, 0);
+    assert!(
+        common::lit_pixels(&from_file, 0.05) > 100,
+        "the lines are in view"
+    );
+    // The F3 well's log as rows, against its file.
+    let log = arbvis::lines::read_log(&common::data_file("seismic/f3-well-log.csv")).unwrap();
+    let rows: Vec<String> = log.iter().map(|(m, v)| format!("[{m:?}, {v:?}]")).collect();
+    let well = |log: &str| {
+        format!(
+            "size = [64, 48]\n[technique.lines]\nwell = {{ survey = \"{}\", head = [620420.0, 6074520.0], {log} }}\nradius = 7.0\n",
+            common::data_file("seismic/f3-well-survey.csv").display()
+        )
+    };
+    let file_log = format!(
+        "log = \"{}\"",
+        common::data_file("seismic/f3-well-log.csv").display()
+    );
+    let a = draw(&well(&file_log));
+    let b = draw(&well(&format!("log_rows = [{}]", rows.join(", "))));
+    assert_eq!(a.compare(&b, 0.0).unwrap().pixels_over, 0);
+    // Refusals by key.
+    for (polylines, key, says) in [
+        (
+            "[[[0.0, 0.0, 0.0], [1.0, 1.0]]]",
+            "polylines.0.1",
+            "2 numbers",
+        ),
+        (
+            "[[[0.0, 0.0, 0.0]], [[1.0, 1.0, 1.0], [2.0, inf, 0.0]]]",
+            "polylines.1.1",
+            "finite",
+        ),
+        ("[[[0.0, 0.0, 0.0]]]", "polylines", "two points"),
+    ] {
+        let e = render_on(
+            &h,
+            &Scene::parse(&format!("{head}polylines = {polylines}\n"), "l.toml").unwrap(),
+        )
+        .err()
+        .expect("refused")
+        .to_string();
+        assert!(e.contains(key) && e.contains(says), "{polylines}: {e}");
+    }
+    let e = Scene::parse(
+        &format!("{head}polylines = [[[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]]]\nfile = \"l.csv\"\n"),
+        "l.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("one of them"), "{e}");
+}

@@ -41,6 +41,10 @@ pub struct LinesScene {
     /// Or a well from its deviation survey.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub well: Option<WellScene>,
+    /// Or the polylines themselves: each a list of `[x, y, z]` or `[x, y, z, value]`
+    /// points (lines typed in a scene, or arrays handed over from Python).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub polylines: Option<Vec<Vec<Vec<f64>>>>,
     /// The tubes' radius in the data's units (metres).
     #[serde(default = "default_radius")]
     pub radius: f64,
@@ -77,6 +81,9 @@ pub struct WellScene {
     /// `md, value` rows: the values the tube is coloured by.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub log: Option<PathBuf>,
+    /// Or the log's rows themselves, `[md, value]` each.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub log_rows: Option<Vec<[f64; 2]>>,
 }
 
 fn default_radius() -> f64 {
@@ -124,6 +131,9 @@ pub fn polylines(scene: &LinesScene, base: &std::path::Path) -> RenderResult<Vec
     if let Some(file) = &scene.file {
         return Ok(arbvis_data::lines::read_polylines(&base.join(file))?);
     }
+    if let Some(rows) = &scene.polylines {
+        return Ok(lines_of(rows)?);
+    }
     let Some(w) = &scene.well else {
         return Err(FieldError::new(
             "file",
@@ -144,17 +154,23 @@ pub fn polylines(scene: &LinesScene, base: &std::path::Path) -> RenderResult<Vec
     };
     let well = Well::of(stations);
     let path = well.path(w.head, w.datum, WELL_STEP);
-    let values = match &w.log {
-        Some(log) => {
-            let log = arbvis_data::lines::read_log(&base.join(log))?;
-            Some(
-                path.iter()
-                    .map(|(md, _)| arbvis_data::lines::log_at(&log, *md))
-                    .collect(),
+    let log = match (&w.log, &w.log_rows) {
+        (Some(file), None) => Some(arbvis_data::lines::read_log(&base.join(file))?),
+        (None, Some(rows)) => Some(log_of(rows)?),
+        (None, None) => None,
+        (Some(_), Some(_)) => {
+            return Err(FieldError::new(
+                "well.log",
+                "a well's log is a file (log = \"gr.csv\") or its rows (log_rows = [[md, value], ...]), one of them",
             )
+            .into())
         }
-        None => None,
     };
+    let values = log.map(|log| {
+        path.iter()
+            .map(|(md, _)| arbvis_data::lines::log_at(&log, *md))
+            .collect()
+    });
     Ok(vec![Polyline {
         points: path.into_iter().map(|(_, p)| p).collect(),
         values,
@@ -175,6 +191,57 @@ fn stations_of(rows: &[[f64; 3]]) -> Result<Vec<arbvis_data::lines::Station>, Fi
             )
         },
     )
+}
+
+/// A log given in the scene, checked as a log file's rows are.
+fn log_of(rows: &[[f64; 2]]) -> Result<Vec<(f64, f64)>, FieldError> {
+    let text: String = rows.iter().map(|[m, v]| format!("{m},{v}\n")).collect();
+    arbvis_data::lines::parse_log(std::path::Path::new("rows"), text.as_bytes()).map_err(|e| {
+        FieldError::new(
+            "well.log_rows",
+            e.to_string().replace("rows: line ", "row "),
+        )
+    })
+}
+
+/// Polylines given in the scene: every point of a line three numbers (x, y, z) or four
+/// (and a value; NaN or infinite: none), x, y and z finite; one line of two points at
+/// least. Errors name the line and point (`polylines.1.4`, from 0).
+fn lines_of(rows: &[Vec<Vec<f64>>]) -> Result<Vec<Polyline>, FieldError> {
+    let mut lines = Vec::with_capacity(rows.len());
+    for (l, line) in rows.iter().enumerate() {
+        let width = line.first().map_or(3, Vec::len);
+        for (k, p) in line.iter().enumerate() {
+            let key = || format!("polylines.{l}.{k}");
+            if p.len() != width || !(3..=4).contains(&p.len()) {
+                return Err(FieldError::new(
+                    key(),
+                    format!(
+                        "{} numbers: x, y, z (and a value), as the line's first point ({width})",
+                        p.len()
+                    ),
+                ));
+            }
+            if !p[..3].iter().all(|v| v.is_finite()) {
+                return Err(FieldError::new(key(), format!("{p:?}: x, y and z finite")));
+            }
+        }
+        lines.push(Polyline {
+            points: line.iter().map(|p| [p[0], p[1], p[2]]).collect(),
+            values: (width == 4).then(|| {
+                line.iter()
+                    .map(|p| if p[3].is_finite() { p[3] } else { f64::NAN })
+                    .collect()
+            }),
+        });
+    }
+    if lines.iter().all(|l| l.points.len() < 2) {
+        return Err(FieldError::new(
+            "polylines",
+            "no line of two points or more",
+        ));
+    }
+    Ok(lines)
 }
 
 /// A unit vector square to `t`.
@@ -290,10 +357,15 @@ impl Technique for LinesScene {
         &[crate::techniques::demo!("lines-well")];
 
     fn validate(&self, _: Fidelity, _: ProgramChoice) -> Result<(), FieldError> {
-        if self.file.is_some() == self.well.is_some() {
+        let sources = [
+            self.file.is_some(),
+            self.well.is_some(),
+            self.polylines.is_some(),
+        ];
+        if sources.iter().filter(|&&s| s).count() != 1 {
             return Err(FieldError::new(
                 "file",
-                "lines read a file (file = \"faults.csv\") or a well (well = { survey = \"w.csv\", head = [x, y] }), one of them",
+                "lines read a file (file = \"faults.csv\"), a well (well = { survey = \"w.csv\", head = [x, y] }) or their points (polylines = [[[x, y, z], ...], ...]), one of them",
             ));
         }
         if !(self.radius.is_finite() && self.radius > 0.0) {
