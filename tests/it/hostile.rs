@@ -944,3 +944,89 @@ fn an_open_clip_mesh_is_clipped_in_seconds() {
     );
     assert!(took < REFUSAL_TIME, "{took:?}");
 }
+
+/// Lines and grids at their worst under 2 MB (issue 57's readers, found by a hostile run):
+/// 190,000 rows of a log and one line of 600,000 fields were quadratic (a row count and
+/// each field's column recounted from the start: 80,000 rows took 20 s); a survey 1e308
+/// deep made a well of a million rings (5 GB) and NaN positions; a byte-order mark made a
+/// survey polylines. Each now read or refused within the small-file bound.
+#[test]
+fn lines_and_grids_under_2_mb_are_read_or_refused_in_seconds() {
+    let two_mb = 2 << 20;
+    let log: String = std::iter::once("MD,GR\n".to_string())
+        .chain((0..190_000).map(|i| format!("{i},{}\n", i % 97)))
+        .collect();
+    assert!(log.len() <= two_mb);
+    inspected("long.csv", log.as_bytes(), &[], true, &["rows: 190000"]);
+    let wide = format!("MD,INC,AZI\n{}\n", "1,".repeat(600_000));
+    assert!(wide.len() <= two_mb);
+    // One station of 600,000 numbers (columns past the third are a survey's own, TVD...).
+    inspected(
+        "wide.csv",
+        wide.as_bytes(),
+        &[],
+        false,
+        &["a survey of two stations or more"],
+    );
+    let wide_xyz = format!("{}\n1 0 0\n", "0 ".repeat(600_000));
+    inspected(
+        "wide.xyz",
+        wide_xyz.as_bytes(),
+        &[],
+        false,
+        &["wide.xyz: line 2"],
+    );
+    let header = format!("{}\n0 0 0\n", "name ".repeat(300_000));
+    let text = inspected(
+        "names.xyz",
+        header.as_bytes(),
+        &[],
+        false,
+        &["names.xyz: line 1"],
+    );
+    assert!(
+        text.len() < 2000,
+        "the names are shortened: {} bytes",
+        text.len()
+    );
+    inspected(
+        "deep.csv",
+        b"MD,INC,AZI\n0,0,0\n1e308,10,45\n",
+        &[],
+        false,
+        &["deep.csv: line 3, column 1", "at most 1e5"],
+    );
+    // A deep well's tubes are held to the memory budget before they are made.
+    let dir = temp_dir("deep-well");
+    let scene = dir.join("well.toml");
+    std::fs::write(
+        &scene,
+        "[technique.lines]\nwell = { head = [0.0, 0.0], stations = [[0.0, 0.0, 0.0], [90000.0, 10.0, 45.0]] }\n",
+    )
+    .unwrap();
+    let png = dir.join("well.png");
+    let (out, took) = arbvis(
+        &[
+            "--memory-budget",
+            "64M",
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            png.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let said = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && said.contains("the lines' 45001 rings of 8 sides"),
+        "{said}"
+    );
+    assert!(took < small_file_time() && !png.exists(), "{took:?}");
+    inspected(
+        "bom.csv",
+        b"\xEF\xBB\xBFMD,INC,AZI\n0,0,0\n100,10,45\n",
+        &[],
+        true,
+        &["read as a deviation survey"],
+    );
+}

@@ -26,6 +26,10 @@ use crate::surface::{Position, SurfaceError};
 /// Largest file of lines read (16 MiB: a million rows).
 pub const MAX_LINES_BYTES: u64 = 16 << 20;
 
+/// Largest measured depth a survey may give, in its units (100 km: eight times the
+/// deepest hole drilled).
+pub const MAX_DEPTH: f64 = 1e5;
+
 /// A polyline's points and the value at each, where the file gives one.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Polyline {
@@ -155,6 +159,7 @@ fn rows(name: &Path, bytes: &[u8], least: usize) -> Result<Vec<(usize, Vec<f64>)
     let mut out: Vec<(usize, Vec<f64>)> = Vec::new();
     let mut width = None;
     let mut first = true;
+    let mut count = 0usize;
     for (i, line) in text.lines().enumerate() {
         let n = i + 1;
         let trimmed = line.trim();
@@ -201,7 +206,8 @@ fn rows(name: &Path, bytes: &[u8], least: usize) -> Result<Vec<(usize, Vec<f64>)
                 format!("{} values, expected {}", words.len(), width.max(least)),
             ));
         }
-        if out.iter().filter(|r| !r.1.is_empty()).count() >= (MAX_LINES_BYTES / 4) as usize {
+        count += 1;
+        if count > (MAX_LINES_BYTES / 4) as usize {
             return Err(error(n, 1, "too many rows".into()));
         }
         out.push((
@@ -290,6 +296,15 @@ pub fn parse_survey(name: &Path, bytes: &[u8]) -> Result<Vec<Station>, SurfaceEr
             return Err(error(
                 1,
                 format!("measured depth {}: finite and increasing", s.md),
+            ));
+        }
+        if s.md.abs() > MAX_DEPTH {
+            return Err(error(
+                1,
+                format!(
+                    "measured depth {:e}: at most {MAX_DEPTH:e} (the deepest holes are 12 km)",
+                    s.md
+                ),
             ));
         }
         if !(0.0..=180.0).contains(&s.inclination) {

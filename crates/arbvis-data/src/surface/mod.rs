@@ -383,6 +383,8 @@ pub fn read(path: &Path) -> Result<TriangleMesh, SurfaceError> {
 /// `bytes` as UTF-8 text, or an error naming the line, column and byte of the first byte
 /// that is not (OBJ and ASCII STL are text).
 pub(crate) fn utf8<'a>(name: &Path, bytes: &'a [u8]) -> Result<&'a str, SurfaceError> {
+    // A byte-order mark (spreadsheets write one) is not part of the first line.
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     std::str::from_utf8(bytes).map_err(|e| {
         let at = e.valid_up_to();
         let valid = &bytes[..at];
@@ -444,11 +446,11 @@ pub fn describe_file(path: &Path) -> Result<String, SurfaceError> {
         }
         _ => (parse(path, &bytes)?, String::new()),
     };
-    Ok(format!(
-        "{grid}{}{}",
-        describe(&mesh),
-        describe_properties(&mesh)
-    ))
+    let mut text = format!("{grid}{}", describe(&mesh));
+    if !text.ends_with('\n') {
+        text.push('\n');
+    }
+    Ok(text + &describe_properties(&mesh))
 }
 
 /// A line per vertex property: its name, how many vertices have it, and its range.

@@ -244,6 +244,20 @@ impl<'a> Reader<'a> {
     /// `ESIZES n ...` or `NO_DATA_VALUES v ...`, one per declared property.
     fn describe(&mut self, n: usize, tokens: &[(usize, &str)]) -> Result<(), SurfaceError> {
         let sizes = tokens[0].1 == "ESIZES";
+        if tokens.len() - 1 != self.object.len() {
+            let column = tokens.last().map_or(1, |t| t.0);
+            return Err(self.error(
+                n,
+                column,
+                format!(
+                    "{} gives {} values for {} properties ({})",
+                    tokens[0].1,
+                    tokens.len() - 1,
+                    self.object.len(),
+                    self.declared()
+                ),
+            ));
+        }
         for (k, &(column, token)) in tokens[1..].iter().enumerate().take(self.object.len()) {
             if sizes {
                 let size = token.parse::<usize>().ok().filter(|s| (1..=64).contains(s));
@@ -458,6 +472,18 @@ mod tests {
                 3,
                 8,
                 "a size is 1 to 64",
+            ),
+            (
+                "GOCAD TSurf 1\nPROPERTIES a b\nNO_DATA_VALUES -99999\n",
+                3,
+                16,
+                "1 values for 2 properties (PROPERTIES a b)",
+            ),
+            (
+                "GOCAD TSurf 1\nPROPERTIES a\nESIZES 1 1\n",
+                3,
+                10,
+                "2 values for 1 properties",
             ),
         ];
         for (text, line, column, says) in cases {

@@ -75,29 +75,29 @@ fn column_of(name: &str) -> Option<&'static str> {
 /// commas or semicolons; a field in double quotes (a header's `"Z (ms)"`) is one.
 pub(crate) fn fields(line: &str) -> Vec<(usize, &str)> {
     let mut out = Vec::new();
-    let mut start: Option<usize> = None;
+    // The field's byte offset and its column (characters from 1), counted as we go:
+    // linear in the line however many fields it has.
+    let mut start: Option<(usize, usize)> = None;
     let mut quoted = false;
-    for (i, c) in line.char_indices() {
+    for (column, (i, c)) in line.char_indices().enumerate() {
         let separator = !quoted && (c.is_whitespace() || c == ',' || c == ';');
         match (separator, start) {
-            (true, Some(s)) => {
-                out.push((s, &line[s..i]));
+            (true, Some((s, col))) => {
+                out.push((col, &line[s..i]));
                 start = None;
             }
             (false, None) => {
-                start = Some(i);
+                start = Some((i, column + 1));
                 quoted = c == '"';
             }
             (false, Some(_)) if quoted && c == '"' => quoted = false,
             _ => {}
         }
     }
-    if let Some(s) = start {
-        out.push((s, &line[s..]));
+    if let Some((s, col)) = start {
+        out.push((col, &line[s..]));
     }
-    out.into_iter()
-        .map(|(s, f)| (line[..s].chars().count() + 1, f))
-        .collect()
+    out
 }
 
 /// Parse x y z text (`name` names it in errors).
@@ -298,7 +298,10 @@ fn header(words: &[(usize, &str)]) -> Result<Option<Columns>, (usize, String)> {
             1,
             format!(
                 "a first line of names ({}) without x, y and z columns: expected names such as X, Y, Z, Inline, Crossline, or numbers",
-                words.iter().map(|(_, w)| *w).collect::<Vec<_>>().join(" ")
+                arbvis_core::input::shorten(
+                    &words.iter().map(|(_, w)| *w).collect::<Vec<_>>().join(" "),
+                    200
+                )
             ),
         )),
     }

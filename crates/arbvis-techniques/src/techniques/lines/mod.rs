@@ -319,6 +319,12 @@ pub fn prepare(scene: &LinesScene, base: &std::path::Path) -> RenderResult<Prepa
     if rings > MAX_RINGS {
         return Err(FieldError::new("file", format!("{rings} points: at most {MAX_RINGS}")).into());
     }
+    // Each ring's quads to the next: two triangles, six drawn corners a side.
+    let corners = (rings as u64).saturating_mul(6 * scene.sides as u64);
+    arbvis_core::budget::check(
+        format!("the lines' {rings} rings of {} sides", scene.sides),
+        arbvis_core::budget::times(corners, surface::prepare::BYTES_PER_CORNER),
+    )?;
     let (mesh, values) = tubes(&lines, scene.radius, scene.sides);
     if mesh.triangles.is_empty() {
         return Err(FieldError::new("file", "no line of two distinct points").into());
