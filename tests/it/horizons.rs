@@ -194,3 +194,26 @@ fn the_f3_fault_carries_its_throw_inside_the_survey() {
     assert!(lo[1] > y[0] && hi[1] < y[1], "{lo:?} {hi:?}");
     assert!(lo[2] >= -296.0 && hi[2] <= 0.0, "{lo:?} {hi:?}");
 }
+
+/// A choice given two keys (`colour_by = { property = ..., bogus = 1 }`) is told as such
+/// at its line, not as a second technique; two techniques are told with every technique's
+/// table, from the catalog (the list had fallen behind it).
+#[test]
+fn a_choice_of_two_keys_is_not_told_as_two_techniques() {
+    let e = Scene::parse(
+        "[technique.surface]\nfile = \"f.ts\"\ncolour_by = { property = \"throw\", bogus = 1 }\n",
+        "cb.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(
+        e.contains("cb.toml:3:") && e.contains("more than one key") && !e.contains("technique"),
+        "{e}"
+    );
+    let e = Scene::parse("[technique.quad]\n[technique.lines]\n", "two.toml")
+        .unwrap_err()
+        .to_string();
+    for t in arbvis::catalog::TECHNIQUES {
+        assert!(e.contains(&format!("[technique.{}]", t.name)), "{e}");
+    }
+}

@@ -777,9 +777,24 @@ fn parse_message(text: &str, start: usize, message: &str) -> String {
         && !matches!(word.as_str(), "true" | "false" | "inf" | "nan")
         && text[..start].trim_end().ends_with('=');
     let message = arbvis_core::input::shorten(message.trim(), MESSAGE_CHARS);
-    // serde's words for a second table in [technique], which holds one technique.
+    // serde's words for a table that picks one of several things given more than one:
+    // [technique] (one technique) or a choice such as `colour_by = { property = ... }`.
     if message.contains("wanted exactly 1 element, more than 1 element") {
-        return "a scene draws one technique: [technique] holds one table ([technique.opacity3d], [technique.cellproj], [technique.splats] or [technique.quad]); draw each dataset in a scene of its own".into();
+        let line_start = text[..start.min(text.len())]
+            .rfind('\n')
+            .map_or(0, |p| p + 1);
+        let line = text[line_start..].trim_start();
+        if line.starts_with("[technique") || line.starts_with("technique") {
+            let tables: Vec<String> = crate::catalog::TECHNIQUES
+                .iter()
+                .map(|t| format!("[technique.{}]", t.name))
+                .collect();
+            return format!(
+                "a scene draws one technique: [technique] holds one table (one of {}); draw each dataset in a scene of its own, or as [[layer]]s of one",
+                tables.join(", ")
+            );
+        }
+        return "a table that picks one of several choices has more than one key: give one (check its spelling)".into();
     }
     if bare {
         format!("{message} (a word must be quoted: \"{word}\")")
