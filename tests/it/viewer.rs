@@ -30,6 +30,23 @@ use arbvis::techniques::clip::{ClipSpec, ShapeSpec};
 use arbvis::techniques::opacity3d::Combine;
 use arbvis::techniques::quad::{reference_image, QuadScene};
 
+/// The scene the viewer saved in `dir` (`Save scene`).
+fn saved_scene(dir: &Path) -> Scene {
+    Scene::load(&dir.join("arbvis-scene.toml")).unwrap()
+}
+
+/// The viewer's first screenshot in `dir` is `saved` drawn offscreen.
+fn assert_first_screenshot_is(dir: &Path, saved: &Scene) {
+    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
+    assert_screenshot_is_the_scene(&shot, saved);
+}
+
+/// Layer `index` of `saved`, as technique `T`'s parameters.
+fn saved_layer<T: arbvis::techniques::Technique + Clone>(saved: &Scene, index: usize) -> T {
+    let (_, technique) = saved.layers().nth(index).expect("the layer");
+    technique.get::<T>().expect("the layer's technique").clone()
+}
+
 /// The screenshot equals an offscreen render of the saved scene at its size, within one
 /// 8-bit level (same driver, same program).
 fn assert_screenshot_is_the_scene(shot: &Image, saved: &Scene) {
@@ -84,7 +101,7 @@ fn frame_screenshot_and_program_switch() {
     }
 
     // "Save scene" wrote a scene that parses, records the switch and has the view's size.
-    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&dir);
     assert_eq!(saved.programs, arbvis::gl::ProgramChoice::Glsl);
     assert_eq!(saved.size, [glsl.width, glsl.height]);
     let _ = std::fs::remove_dir_all(&dir);
@@ -100,7 +117,7 @@ fn drag_rotates_the_camera() {
     ) else {
         return;
     };
-    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&dir);
     // A horizontal drag rotates about the vertical axis only.
     let q = saved.camera.quat();
     let (axis, angle) = q.to_axis_angle();
@@ -184,7 +201,7 @@ fn the_volume_stays_framed_at_two_window_aspects() {
     assert_framed(&tall, black, "tall view");
     assert_framed(&wide, black, "wide view");
     // Home reset the rotation and framed the volume: a unit cube's bounding sphere fits.
-    let home = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let home = saved_scene(&dir);
     assert_eq!(home.camera.rotation, [0.0, 0.0, 0.0, 1.0]);
     let fit = arbvis::viewer::fit_zoom(&home.camera, glam::DVec3::ONE);
     assert!(
@@ -234,7 +251,7 @@ click Save scene
     let Some((dir, stdout)) = run_script("lut3d", "v3o2-sum", "160x160", script) else {
         return;
     };
-    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&dir);
     let o = opacity3d(&saved);
     assert_eq!(o.combine, Combine::Product);
     assert_eq!(o.slices, 48);
@@ -257,8 +274,7 @@ click Save scene
     assert_eq!(secondary.table.alpha, vec![[0.0, 0.0], [1.0, 0.8]]);
     // The interactive quality is a viewer setting (not in the scene): `measure` shows it.
     assert!(stdout.contains("interactive quality quarter"), "{stdout}");
-    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
-    assert_screenshot_is_the_scene(&shot, &saved);
+    assert_first_screenshot_is(&dir, &saved);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -279,7 +295,7 @@ click Save scene
     let Some((dir, _)) = run_script("isovalues", "cellproj-spherical", "160x120", script) else {
         return;
     };
-    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&dir);
     let TechniqueScene::Cellproj(c) = &saved.technique else {
         panic!("saved scene is not cellproj");
     };
@@ -291,8 +307,7 @@ click Save scene
     assert!((values[2] - 0.6).abs() < 1e-12, "{values:?}");
     assert!(c.shading);
     assert_eq!(saved.fidelity, arbvis::scene::Fidelity::Precise);
-    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
-    assert_screenshot_is_the_scene(&shot, &saved);
+    assert_first_screenshot_is(&dir, &saved);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -323,7 +338,7 @@ click Save scene
     for want in ["overlay \"legend volume: ", "overlay \"legend isovalues"] {
         assert!(stdout.contains(want), "{want} not in {stdout}");
     }
-    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&dir);
     let TechniqueScene::Cellproj(c) = &saved.technique else {
         panic!("saved scene is not cellproj");
     };
@@ -354,8 +369,7 @@ click Save scene
             assert!((p[c + 1] - want[c]).abs() <= 1e-3, "{p:?} vs {want:?}");
         }
     }
-    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
-    assert_screenshot_is_the_scene(&shot, &saved);
+    assert_first_screenshot_is(&dir, &saved);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -387,7 +401,7 @@ click Save scene
     let Some((out, _)) = run_script("splats", scene.to_str().unwrap(), "200x150", script) else {
         return;
     };
-    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&out);
     let TechniqueScene::Splats(s) = &saved.technique else {
         panic!("saved scene is not splats");
     };
@@ -403,8 +417,7 @@ click Save scene
     assert_eq!(s.tile, 3);
     assert_eq!(s.mode, arbvis::techniques::splats::scene::Mode::Volume);
     assert_eq!(s.volume.threshold, 0.01);
-    let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();
-    assert_screenshot_is_the_scene(&shot, &saved);
+    assert_first_screenshot_is(&out, &saved);
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -439,7 +452,7 @@ click Save scene
     else {
         return;
     };
-    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&out);
     let TechniqueScene::Splats(s) = &saved.technique else {
         panic!("saved scene is not splats");
     };
@@ -450,8 +463,7 @@ click Save scene
         arbvis::techniques::splats::scene::ColourMode::Elevation
     );
     assert_eq!(s.property, "gps_time");
-    let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();
-    assert_screenshot_is_the_scene(&shot, &saved);
+    assert_first_screenshot_is(&out, &saved);
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -495,7 +507,7 @@ click Save scene
     let Some((dir, stdout)) = run_script("clip", "clip-sphere", "200x200", script) else {
         return;
     };
-    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&dir);
     let clip = opacity3d(&saved)
         .clip
         .clone()
@@ -554,8 +566,7 @@ click Save scene
     );
     assert!(stats.ratio > 0.0 && stats.ratio < 1.0, "{stats:?}");
 
-    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
-    assert_screenshot_is_the_scene(&shot, &saved);
+    assert_first_screenshot_is(&dir, &saved);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -591,7 +602,7 @@ click Save scene
         stdout.contains("print Clip shape details: difference (read-only)"),
         "{stdout}"
     );
-    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&out);
     let clip = opacity3d(&saved).clip.clone().unwrap();
     let original = Scene::load(&scene).unwrap();
     let mut want = opacity3d(&original).clip.clone().unwrap();
@@ -612,7 +623,7 @@ fn save_tables_writes_them_and_the_scene_uses_them() {
     ) else {
         return;
     };
-    let saved = Scene::load(&dir.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&dir);
     let o = opacity3d(&saved);
     for (role, attr) in ["primary", "secondary", "tertiary"]
         .iter()
@@ -634,8 +645,7 @@ fn save_tables_writes_them_and_the_scene_uses_them() {
         table.entries[100][3], 67,
         "(0.55 - 100/255) / 0.3 * 0.5 * 255"
     );
-    let (shot, _) = read_png(&dir.join("arbvis-screenshot-001.png")).unwrap();
-    assert_screenshot_is_the_scene(&shot, &saved);
+    assert_first_screenshot_is(&dir, &saved);
     // The transparent switch: the second screenshot is the transparent render.
     let (clear, text) = read_png(&dir.join("arbvis-screenshot-002.png")).unwrap();
     let scene_text = &text.iter().find(|(k, _)| k == "arbvis:scene").unwrap().1;
@@ -775,7 +785,7 @@ click Save scene
     let Some((out, _)) = run_script("layers", scene.to_str().unwrap(), "200x150", script) else {
         return;
     };
-    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
+    let saved = saved_scene(&out);
     let layers: Vec<_> = saved.layers().collect();
     assert_eq!(layers.len(), 2);
     assert_eq!(
@@ -786,8 +796,7 @@ click Save scene
         (layers[1].0.name.as_str(), layers[1].0.visible),
         ("horizon", true)
     );
-    let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();
-    assert_screenshot_is_the_scene(&shot, &saved);
+    assert_first_screenshot_is(&out, &saved);
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -823,12 +832,8 @@ click Save scene
     else {
         return;
     };
-    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
-    let layers: Vec<_> = saved.layers().collect();
-    let surface = layers[0]
-        .1
-        .get::<arbvis::techniques::surface::SurfaceScene>()
-        .expect("a surface");
+    let saved = saved_scene(&out);
+    let surface: arbvis::techniques::surface::SurfaceScene = saved_layer(&saved, 0);
     assert_eq!(
         surface.colour_by,
         Some(arbvis::techniques::surface::ColourBy::Property(
@@ -836,8 +841,7 @@ click Save scene
         ))
     );
     assert_eq!(surface.colour_from, None);
-    let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();
-    assert_screenshot_is_the_scene(&shot, &saved);
+    assert_first_screenshot_is(&out, &saved);
     let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -867,15 +871,10 @@ fn a_sections_slider_moves_it_over_the_surveys_numbers() {
     ) else {
         return;
     };
-    let saved = Scene::load(&out.join("arbvis-scene.toml")).unwrap();
-    let layers: Vec<_> = saved.layers().collect();
-    let section = layers[0]
-        .1
-        .get::<arbvis::techniques::section::SectionScene>()
-        .expect("a section");
+    let saved = saved_scene(&out);
+    let section: arbvis::techniques::section::SectionScene = saved_layer(&saved, 0);
     assert_eq!(section.inline, Some(125.0));
-    let (shot, _) = read_png(&out.join("arbvis-screenshot-001.png")).unwrap();
-    assert_screenshot_is_the_scene(&shot, &saved);
+    assert_first_screenshot_is(&out, &saved);
     let _ = std::fs::remove_dir_all(&out);
     let outside = format!("{opening}set Inline 200\n");
     let Some(errors) = failing_scripts("section-outside", scene.to_str().unwrap(), &[&outside])
