@@ -19,16 +19,9 @@ use arbvis_gl::{
 /// fragment stage.
 pub fn pair(fidelity: Fidelity, kind: ProgramKind) -> ProgramPair {
     use programs::*;
-    let (vertex, fragment) = match (fidelity, kind) {
-        (Fidelity::Faithful, ProgramKind::Arb) => (TRANSFORM_ARBVP, SECTION_FAITHFUL_ARBFP),
-        (Fidelity::Faithful, ProgramKind::Glsl) => (TRANSFORM_VERT, SECTION_FAITHFUL_FRAG),
-        (Fidelity::Precise, ProgramKind::Arb) => (TRANSFORM_ARBVP, SECTION_PRECISE_ARBFP),
-        (Fidelity::Precise, ProgramKind::Glsl) => (TRANSFORM_VERT, SECTION_PRECISE_FRAG),
-    };
-    ProgramPair {
-        kind,
-        vertex,
-        fragment,
+    match fidelity {
+        Fidelity::Faithful => with_transform(kind, &SECTION_FAITHFUL_ARBFP, &SECTION_FAITHFUL_FRAG),
+        Fidelity::Precise => with_transform(kind, &SECTION_PRECISE_ARBFP, &SECTION_PRECISE_FRAG),
     }
 }
 
