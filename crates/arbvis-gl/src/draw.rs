@@ -86,6 +86,21 @@ impl<'a> DrawCall<'a> {
             covers_frame: false,
         }
     }
+
+    /// A layer's sheet: opaque, replacing what is drawn and depth tested (depth writes
+    /// are the target's), so a layered scene's other layers meet it; translucent,
+    /// premultiplied over what is drawn without a depth test of its own (a layered scene
+    /// tests it against its opaque layers).
+    pub fn sheet(self, translucent: bool) -> DrawCall<'a> {
+        DrawCall {
+            blend: match translucent {
+                true => Blend::PremultipliedOver,
+                false => Blend::Replace,
+            },
+            depth_test: !translucent,
+            ..self
+        }
+    }
 }
 
 /// Draw `call` onto `surface` and count the samples that passed every test (an

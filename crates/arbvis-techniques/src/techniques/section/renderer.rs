@@ -11,8 +11,8 @@ use crate::techniques::{Frame, Params, Renderer};
 use arbvis_core::vocab::Fidelity;
 use arbvis_data::volume::quantize::quantize_value;
 use arbvis_gl::{
-    Blend, DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, TexelData,
-    TexelFormat, Texture,
+    DrawCall, Extent, Filter, Gpu, Mesh, Program, ProgramKind, Surface, TexelData, TexelFormat,
+    Texture,
 };
 
 /// The program pair of `fidelity` and `kind`: the common transform and the section's
@@ -193,18 +193,12 @@ impl Renderer for SectionRenderer {
             }
         }
         let translucent = opacity < 1.0;
-        // Opaque: depth tested and written, so a layered scene's other layers meet it.
-        // Translucent: blended over what is drawn, depth neither tested (a layered scene
-        // tests it against its opaque layers) nor written.
+        let textures = [(0, &self.plane), (1, &self.table)];
         let call = DrawCall {
-            textures: &[(0, &self.plane), (1, &self.table)],
-            blend: match translucent {
-                true => Blend::PremultipliedOver,
-                false => Blend::Replace,
-            },
-            depth_test: !translucent,
+            textures: &textures,
             ..DrawCall::new(&self.program, &self.mesh)
-        };
+        }
+        .sheet(translucent);
         Ok(arbvis_gl::draw(gpu, surface, &call)?)
     }
 

@@ -11,7 +11,7 @@ use crate::error::RenderResult;
 use crate::programs::{self, ProgramPair};
 use crate::techniques::{Frame, Params, Renderer};
 use arbvis_core::vocab::Fidelity;
-use arbvis_gl::{Blend, DrawCall, Gpu, Mesh, Program, ProgramKind, Surface};
+use arbvis_gl::{DrawCall, Gpu, Mesh, Program, ProgramKind, Surface};
 
 /// The program pair of `fidelity` and `kind`: faithful lights each vertex, precise each
 /// pixel.
@@ -166,16 +166,8 @@ impl Renderer for SurfaceRenderer {
             self.sort_for(gpu, camera)?;
         }
         // Opaque: the depth test keeps the nearest sheet. Translucent: every sheet blended
-        // back to front, depth neither tested (a layered scene tests it against its
-        // opaque layers) nor written.
-        let call = DrawCall {
-            blend: match translucent {
-                true => Blend::PremultipliedOver,
-                false => Blend::Replace,
-            },
-            depth_test: !translucent,
-            ..DrawCall::new(&self.program, &self.mesh)
-        };
+        // back to front (sorted above).
+        let call = DrawCall::new(&self.program, &self.mesh).sheet(translucent);
         Ok(arbvis_gl::draw(gpu, surface, &call)?)
     }
 
