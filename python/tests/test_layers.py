@@ -236,6 +236,11 @@ def test_lines_and_a_well_log_from_arrays_draw_as_their_files(tmp_path):
     assert int((want[..., :3].sum(axis=2) > 0.05).sum()) > 100, "the lines are in view"
     got = draw({"polylines": lines, "radius": 3.0})
     assert np.array_equal(got, want)
+    # A ribbon 3 pixels wide (shaped for the view) from the arrays, as from the file.
+    ribbon = {"style": "ribbon", "width": {"pixels": 3.0}}
+    want = draw({"file": "l.csv", **ribbon})
+    assert int((want[..., :3].sum(axis=2) > 0.05).sum()) > 60, "the ribbons are in view"
+    assert np.array_equal(draw({"polylines": lines, **ribbon}), want)
     md = np.arange(0.0, 100.5, 0.5)
     log = np.column_stack([md, 50.0 + 40.0 * np.sin(md / 7.0)])
     (tmp_path / "gr.csv").write_text("MD,GR\n" + "".join(f"{m!r},{v!r}\n" for m, v in log.tolist()))

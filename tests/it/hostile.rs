@@ -1018,7 +1018,7 @@ fn lines_and_grids_under_2_mb_are_read_or_refused_in_seconds() {
     );
     let said = String::from_utf8_lossy(&out.stderr);
     assert!(
-        !out.status.success() && said.contains("the lines' 45001 rings of 8 sides"),
+        !out.status.success() && said.contains("the lines' 45001 points of 8 vertices"),
         "{said}"
     );
     assert!(took < small_file_time() && !png.exists(), "{took:?}");

@@ -31,6 +31,7 @@ mod isovalue_units;
 mod layered;
 mod layers;
 mod lines;
+mod lines_width;
 mod mdio;
 mod mdio_flavours;
 mod mdio_positions;

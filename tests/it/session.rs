@@ -48,7 +48,7 @@ fn demo_session(h: &Headless, name: &str, edit: impl FnOnce(&mut Scene)) -> (Sce
 
 /// Pictures of `scene` turned through an orbit by one session, each beside a fresh
 /// render of the same view.
-fn turned_and_fresh(mut scene: Scene) -> Vec<(Image, Image)> {
+pub fn turned_and_fresh(mut scene: Scene) -> Vec<(Image, Image)> {
     let mut session = Offscreen::new(&scene, Backend::Egl).unwrap();
     orbit(5)
         .into_iter()
@@ -70,7 +70,7 @@ fn fresh_render(scene: &Scene) -> Image {
 }
 
 /// Exact: the same cut, the same bricks, the same sort and programs draw the same bytes.
-fn assert_each_view_equal(pairs: &[(Image, Image)], what: &str) {
+pub fn assert_each_view_equal(pairs: &[(Image, Image)], what: &str) {
     for (k, (turned, fresh)) in pairs.iter().enumerate() {
         assert!(
             turned.data == fresh.data,

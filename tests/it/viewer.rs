@@ -846,6 +846,52 @@ click Save scene
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// A lines layer's panel (issue 57 items 3 and 6): the F3 well switched to a ribbon 6
+/// pixels wide; the saved scene follows, and the screenshot (the ribbon shaped for the
+/// viewer's picture) is the saved scene drawn offscreen.
+#[test]
+fn a_wells_panel_makes_it_a_ribbon_in_pixels() {
+    let dir = temp_dir("lines-ribbon-scene");
+    let scene = dir.join("well.toml");
+    std::fs::write(
+        &scene,
+        format!(
+            "[camera]\nprojection = \"perspective\"\nrotation = [-0.35, 0.12, 0.2, 0.906]\n[[layer]]\nname = \"well\"\n[layer.lines]\nwell = {{ survey = \"{}\", head = [620420.0, 6074520.0], log = \"{}\" }}\nradius = 7.0\n",
+            common::data_file("seismic/f3-well-survey.csv").display(),
+            common::data_file("seismic/f3-well-log.csv").display()
+        ),
+    )
+    .unwrap();
+    let script = "\
+resize 900 640
+wait 2
+click layer 0: well (lines) settings
+wait 1
+set Lines style ribbon
+wait 1
+set Width in pixels true
+wait 1
+set Lines width 6
+wait 2
+click Screenshot
+click Save scene
+";
+    let Some((out, _)) = run_script("lines-ribbon", scene.to_str().unwrap(), "200x150", script)
+    else {
+        return;
+    };
+    let saved = saved_scene(&out);
+    let lines: arbvis::techniques::lines::LinesScene = saved_layer(&saved, 0);
+    assert_eq!(lines.style, arbvis::techniques::lines::LineStyle::Ribbon);
+    assert_eq!(
+        lines.width,
+        Some(arbvis::techniques::lines::Width::Pixels(6.0))
+    );
+    assert_first_screenshot_is(&out, &saved);
+    let _ = std::fs::remove_dir_all(&out);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A section layer's slider (issue 57 item 6): over F3's inlines 111..=133, a typed
 /// 125.4 lands on inline 125 (the survey's step), the saved scene and the screenshot
 /// follow; a number outside the survey is refused by the slider with its range.

@@ -17,7 +17,7 @@ use arbvis_core::vocab::Fidelity;
 use arbvis_techniques::catalog::TechniqueScene;
 use arbvis_techniques::scene::Scene;
 use arbvis_techniques::techniques::cellproj::CellprojScene;
-use arbvis_techniques::techniques::lines::LinesScene;
+use arbvis_techniques::techniques::lines::{LineStyle, LinesScene, Width};
 use arbvis_techniques::techniques::opacity3d::Opacity3dScene;
 use arbvis_techniques::techniques::quad::QuadScene;
 use arbvis_techniques::techniques::section::SectionScene;
@@ -207,16 +207,41 @@ impl Face for SectionScene {
 }
 
 impl Face for LinesScene {
-    /// The tubes' radius and their colour where there is no value.
+    /// Tubes or ribbons, their width in metres or pixels, and their colour where there
+    /// is no value.
     fn editors(&mut self, ui: &mut egui::Ui, cx: &mut EditContext<'_>) -> bool {
         ui.separator();
         ui.label("Lines");
-        let r = ui.add(
-            egui::Slider::new(&mut self.radius, 0.5..=100.0)
-                .logarithmic(true)
-                .text("Radius (m)"),
-        );
-        let mut changed = cx.widgets.add(ui, "Radius", &r) && r.changed();
+        let styles = [(LineStyle::Tube, "tube"), (LineStyle::Ribbon, "ribbon")];
+        let mut changed = cx
+            .widgets
+            .choice(ui, "Lines style", &mut self.style, &styles, 90.0);
+        // The width's unit; a new unit starts from a width a line is seen at.
+        let mut pixels = matches!(self.width(), Width::Pixels(_));
+        if cx
+            .widgets
+            .checkbox(ui, "Width in pixels", &mut pixels, "Width in pixels")
+        {
+            self.width = Some(match pixels {
+                true => Width::Pixels(4.0),
+                false => Width::Metres(2.0 * self.radius),
+            });
+            changed = true;
+        }
+        let (mut w, range, text) = match self.width() {
+            Width::Metres(w) => (w, 0.5..=500.0, "Width (m)"),
+            Width::Pixels(w) => (w, 1.0..=64.0, "Width (px)"),
+        };
+        if cx
+            .widgets
+            .slider(ui, "Lines width", &mut w, range, text, true)
+        {
+            self.width = Some(match pixels {
+                true => Width::Pixels(w),
+                false => Width::Metres(w),
+            });
+            changed = true;
+        }
         ui.horizontal(|ui| {
             ui.label("Colour");
             let mut c = self.colour.map(|v| v as f32);

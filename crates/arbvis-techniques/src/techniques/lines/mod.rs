@@ -1,6 +1,7 @@
-//! `[technique.lines]` / `[layer.lines]`: polylines and wells drawn as tubes of a set
-//! radius in metres, coloured by a constant or by a value along them (a log along a
-//! well): the wells that tie a survey, picked fault traces, cables (issue 57 item 3).
+//! `[technique.lines]` / `[layer.lines]`: polylines and wells drawn as tubes or ribbons
+//! of a set width in metres or pixels, coloured by a constant or by a value along them (a
+//! log along a well): the wells that tie a survey, picked fault traces, cables (issue 57
+//! item 3).
 //!
 //! # How it works
 //! The lines come from a CSV file (`x, y, z[, value]`, a blank line between lines) or a
@@ -12,15 +13,18 @@
 //! `range`, else the values' own span; the constant where there is no value). The tube
 //! is then drawn and referenced as a surface is ([`super::surface`]: a headlight per
 //! vertex faithful, per pixel precise; opaque, with depth), in the file's coordinates, z up.
+//! A ribbon is a flat band turned to face the viewer, unlit; ribbons, and tubes as wide
+//! as a number of pixels, are shaped again for each view ([`shape`]).
 
 pub mod renderer;
+pub mod shape;
 
 use std::path::PathBuf;
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
-use super::surface::{self, prepare::Prepared, Lighting, SurfaceScene};
+use super::surface::{self, Lighting, SurfaceScene};
 use crate::error::RenderResult;
 use crate::programs::ProgramPair;
 use crate::techniques::world::World;
@@ -30,6 +34,8 @@ use arbvis_core::vocab::{Fidelity, FieldError};
 use arbvis_data::lines::{Polyline, Well};
 use arbvis_data::surface::TriangleMesh;
 use arbvis_gl::{Gpu, ProgramChoice, ProgramKind};
+use shape::PreparedLines;
+pub use shape::{LineStyle, Shape, Width};
 
 /// `[technique.lines]`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -45,9 +51,16 @@ pub struct LinesScene {
     /// points (lines typed in a scene, or arrays handed over from Python).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub polylines: Option<Vec<Vec<Vec<f64>>>>,
-    /// The tubes' radius in the data's units (metres).
+    /// The tubes' radius in the data's units (metres), where `width` is not given.
     #[serde(default = "default_radius")]
     pub radius: f64,
+    /// `"tube"` (lit, round) or `"ribbon"` (a flat band facing the viewer, unlit).
+    #[serde(default, skip_serializing_if = "is_tube")]
+    pub style: LineStyle,
+    /// Across the line: `{ metres = 20 }` or `{ pixels = 3 }` (the same on screen at
+    /// every zoom); by default twice `radius`, in metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub width: Option<Width>,
     /// Vertices around each ring (3 to 64).
     #[serde(default = "default_sides")]
     pub sides: usize,
@@ -62,6 +75,13 @@ pub struct LinesScene {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub range: Option<[f64; 2]>,
 }
+
+fn is_tube(style: &LineStyle) -> bool {
+    *style == LineStyle::Tube
+}
+
+/// The widest line in pixels (a band wider than most pictures is a mistake).
+const MAX_PIXELS: f64 = 1024.0;
 
 /// A well: its deviation survey, where it starts, and a log along it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -109,7 +129,22 @@ pub const WELL_STEP: f64 = 2.0;
 const MAX_RINGS: usize = 1 << 20;
 
 impl LinesScene {
-    /// The parameters a tube is drawn with as a surface: lit, opaque, its colours its own.
+    /// The width across the lines: `width`, else twice `radius` in metres.
+    pub fn width(&self) -> Width {
+        self.width.unwrap_or(Width::Metres(2.0 * self.radius))
+    }
+
+    /// The lines' shape: style, width and a tube's sides.
+    pub fn shape(&self) -> Shape {
+        Shape {
+            style: self.style,
+            width: self.width(),
+            sides: self.sides,
+        }
+    }
+
+    /// The parameters the lines are drawn with as a surface: opaque, their colours their
+    /// own; tubes lit, ribbons not.
     pub fn as_surface(&self) -> SurfaceScene {
         SurfaceScene {
             file: None,
@@ -120,7 +155,10 @@ impl LinesScene {
             colour_from: None,
             table: self.table.clone(),
             z_down: false,
-            lighting: Lighting::Phong,
+            lighting: match self.style {
+                LineStyle::Tube => Lighting::Phong,
+                LineStyle::Ribbon => Lighting::None,
+            },
             opacity: 1.0,
         }
     }
@@ -244,117 +282,131 @@ fn lines_of(rows: &[Vec<Vec<f64>>]) -> Result<Vec<Polyline>, FieldError> {
     Ok(lines)
 }
 
-/// A unit vector square to `t`.
-fn square_to(t: DVec3) -> DVec3 {
-    let helper = if t.z.abs() < 0.9 { DVec3::Z } else { DVec3::X };
-    t.cross(helper).normalize()
-}
-
-/// The tubes of `lines` (radius `radius`, `sides` around), and each vertex's value.
-pub fn tubes(lines: &[Polyline], radius: f64, sides: usize) -> (TriangleMesh, Vec<f64>) {
-    let (mut vertices, mut triangles, mut values) = (Vec::new(), Vec::new(), Vec::new());
-    for line in lines {
-        // Points equal to the one before add nothing.
-        let mut kept: Vec<(DVec3, f64)> = Vec::new();
-        for (i, p) in line.points.iter().enumerate() {
-            let p = DVec3::from_array(*p);
-            let v = line.values.as_ref().map_or(f64::NAN, |v| v[i]);
-            if kept.last().is_none_or(|(q, _)| *q != p) {
-                kept.push((p, v));
-            }
-        }
-        if kept.len() < 2 {
-            continue;
-        }
-        let n = kept.len();
-        let tangent =
-            |i: usize| (kept[(i + 1).min(n - 1)].0 - kept[i.saturating_sub(1)].0).normalize();
-        let mut normal = square_to(tangent(0));
-        let first = vertices.len() as u32;
-        for (i, (p, v)) in kept.iter().enumerate() {
-            let t = tangent(i);
-            // Parallel transport: the last ring's normal made square to this tangent.
-            let moved = normal - t * normal.dot(t);
-            normal = if moved.length() > 1e-9 {
-                moved.normalize()
-            } else {
-                square_to(t)
-            };
-            let binormal = t.cross(normal);
-            for k in 0..sides {
-                let a = k as f64 / sides as f64 * std::f64::consts::TAU;
-                let q = *p + (normal * a.cos() + binormal * a.sin()) * radius;
-                vertices.push(q.to_array());
-                values.push(*v);
-            }
-        }
-        for i in 0..n as u32 - 1 {
-            for k in 0..sides as u32 {
-                let ring = |r: u32, k: u32| first + r * sides as u32 + k % sides as u32;
-                let (a, b, c, d) = (
-                    ring(i, k),
-                    ring(i, k + 1),
-                    ring(i + 1, k + 1),
-                    ring(i + 1, k),
-                );
-                triangles.push([a, b, c]);
-                triangles.push([a, c, d]);
-            }
+/// A line's distinct points (a point equal to the one before adds nothing), each with its
+/// value (NaN where none).
+fn distinct(line: &Polyline) -> Vec<(DVec3, f64)> {
+    let mut kept: Vec<(DVec3, f64)> = Vec::new();
+    for (i, p) in line.points.iter().enumerate() {
+        let p = DVec3::from_array(*p);
+        let v = line.values.as_ref().map_or(f64::NAN, |v| v[i]);
+        if kept.last().is_none_or(|(q, _)| *q != p) {
+            kept.push((p, v));
         }
     }
+    kept
+}
+
+/// The tubes of `lines` (radius `radius`, `sides` around) in the lines' coordinates, and
+/// each vertex's value; lines of fewer than two distinct points are left out.
+pub fn tubes(lines: &[Polyline], radius: f64, sides: usize) -> (TriangleMesh, Vec<f64>) {
+    let kept: Vec<Vec<(DVec3, f64)>> = lines
+        .iter()
+        .map(distinct)
+        .filter(|l| l.len() >= 2)
+        .collect();
+    let points: Vec<Vec<DVec3>> = kept
+        .iter()
+        .map(|l| l.iter().map(|(p, _)| *p).collect())
+        .collect();
+    let values: Vec<f64> = kept.iter().flatten().map(|(_, v)| *v).collect();
     (
-        TriangleMesh {
-            vertices,
-            triangles,
-            properties: Vec::new(),
-        },
-        values,
+        shape::tubes(&points, sides, |_| radius),
+        shape::per_vertex(&values, sides),
     )
 }
 
-/// Read the lines, make their tubes and colour them.
-pub fn prepare(scene: &LinesScene, base: &std::path::Path) -> RenderResult<Prepared> {
+/// Read the lines and colour their points; make their tubes when they are drawn in metres.
+pub fn prepare(scene: &LinesScene, base: &std::path::Path) -> RenderResult<PreparedLines> {
     let lines = polylines(scene, base)?;
     let rings: usize = lines.iter().map(|l| l.points.len()).sum();
     if rings > MAX_RINGS {
         return Err(FieldError::new("file", format!("{rings} points: at most {MAX_RINGS}")).into());
     }
-    // Each ring's quads to the next: two triangles, six drawn corners a side.
-    let corners = (rings as u64).saturating_mul(6 * scene.sides as u64);
+    // Each point's quads to the next: two triangles, six drawn corners a side (a ribbon
+    // has one side).
+    let per_point = scene.shape().vertices_per_point() as u64;
+    let corners = (rings as u64).saturating_mul(6 * per_point);
     arbvis_core::budget::check(
-        format!("the lines' {rings} rings of {} sides", scene.sides),
+        format!("the lines' {rings} points of {per_point} vertices"),
         arbvis_core::budget::times(corners, surface::prepare::BYTES_PER_CORNER),
     )?;
-    let (mesh, values) = tubes(&lines, scene.radius, scene.sides);
-    if mesh.triangles.is_empty() {
+    let kept: Vec<Vec<(DVec3, f64)>> = lines
+        .iter()
+        .map(distinct)
+        .filter(|l| l.len() >= 2)
+        .collect();
+    if kept.is_empty() {
         return Err(FieldError::new("file", "no line of two distinct points").into());
     }
+    let values: Vec<f64> = kept.iter().flatten().map(|(_, v)| *v).collect();
+    let (colours, legend) = colours(scene, base, &values)?;
+    let points: Vec<Vec<DVec3>> = kept
+        .iter()
+        .map(|l| l.iter().map(|(p, _)| *p).collect())
+        .collect();
+    let (world, fixed) = match (scene.shape().fixed(), scene.width()) {
+        (true, Width::Metres(w)) => {
+            let mesh = shape::tubes(&points, scene.sides, |_| w / 2.0);
+            let per_vertex = shape::per_vertex(&colours, scene.sides);
+            let tubes = surface::prepare::of_coloured_mesh(&mesh, &per_vertex, legend.clone());
+            (tubes.world, Some(tubes))
+        }
+        // Shaped for each view: the frame of the points, widened by half a width in metres.
+        (_, width) => {
+            let half = match width {
+                Width::Metres(w) => w / 2.0,
+                Width::Pixels(_) => 0.0,
+            };
+            let all = points.iter().flatten();
+            let lo = all.clone().fold(DVec3::INFINITY, |a, p| a.min(*p)) - half;
+            let hi = all.fold(DVec3::NEG_INFINITY, |a, p| a.max(*p)) + half;
+            (World::of_box(lo.to_array(), hi.to_array()), None)
+        }
+    };
+    let in_frame = |p: &DVec3| (*p - world.centre) / world.units;
+    Ok(PreparedLines {
+        lines: points
+            .iter()
+            .map(|l| l.iter().map(in_frame).collect())
+            .collect(),
+        colours,
+        world,
+        legend,
+        fixed,
+    })
+}
+
+/// The legend's range and colours.
+type Legend = ([f64; 2], Option<Vec<[u8; 3]>>);
+
+/// Each point's colour from its value (the table over `range`, else over the values' own
+/// span; the constant where it has none), and the legend.
+fn colours(
+    scene: &LinesScene,
+    base: &std::path::Path,
+    values: &[f64],
+) -> RenderResult<(Vec<DVec3>, Legend)> {
     let finite = values.iter().copied().filter(|v| v.is_finite());
     let span = finite.fold(None, |s: Option<[f64; 2]>, v| {
         Some(s.map_or([v, v], |[lo, hi]| [lo.min(v), hi.max(v)]))
     });
-    let (colours, legend) = match scene.range.or(span) {
-        Some([lo, hi]) => {
-            let table = scene.table.build(base)?;
-            let colours = values
-                .iter()
-                .map(|&v| match v.is_finite() {
-                    true => {
-                        let s = if hi > lo { (v - lo) / (hi - lo) } else { 0.5 };
-                        surface::prepare::table_colour(&table, s)
-                    }
-                    false => DVec3::from_array(scene.colour),
-                })
-                .collect::<Vec<_>>();
-            let legend = crate::techniques::annotations::colours(&table.entries);
-            (colours, ([lo, hi], Some(legend)))
-        }
-        None => (
-            vec![DVec3::from_array(scene.colour); values.len()],
-            ([0.0, 0.0], None),
-        ),
+    let constant = DVec3::from_array(scene.colour);
+    let Some([lo, hi]) = scene.range.or(span) else {
+        return Ok((vec![constant; values.len()], ([0.0, 0.0], None)));
     };
-    Ok(surface::prepare::of_coloured_mesh(&mesh, &colours, legend))
+    let table = scene.table.build(base)?;
+    let colours = values
+        .iter()
+        .map(|&v| match v.is_finite() {
+            true => {
+                let s = if hi > lo { (v - lo) / (hi - lo) } else { 0.5 };
+                surface::prepare::table_colour(&table, s)
+            }
+            false => constant,
+        })
+        .collect();
+    let legend = crate::techniques::annotations::colours(&table.entries);
+    Ok((colours, ([lo, hi], Some(legend))))
 }
 
 impl Technique for LinesScene {
@@ -379,6 +431,18 @@ impl Technique for LinesScene {
                 "radius",
                 format!("{}: above 0", self.radius),
             ));
+        }
+        match self.width {
+            Some(Width::Metres(w)) if !(w.is_finite() && w > 0.0) => {
+                return Err(FieldError::new("width.metres", format!("{w}: above 0")));
+            }
+            Some(Width::Pixels(w)) if !(w.is_finite() && w > 0.0 && w <= MAX_PIXELS) => {
+                return Err(FieldError::new(
+                    "width.pixels",
+                    format!("{w}: above 0, at most {MAX_PIXELS}"),
+                ));
+            }
+            _ => {}
         }
         if !(3..=64).contains(&self.sides) {
             return Err(FieldError::new("sides", format!("{}: 3 to 64", self.sides)));
@@ -433,13 +497,13 @@ impl Technique for LinesScene {
         true
     }
 
-    type Prepared = Prepared;
+    type Prepared = PreparedLines;
 
     fn prepare(
         &self,
         settings: &Settings<'_>,
         _: &arbvis_data::volume::Limits,
-    ) -> RenderResult<Prepared> {
+    ) -> RenderResult<PreparedLines> {
         Technique::validate(self, settings.fidelity, settings.programs)?;
         prepare(self, settings.base)
     }
@@ -449,7 +513,7 @@ impl Technique for LinesScene {
         gpu: &Gpu,
         settings: &Settings<'_>,
         kind: ProgramKind,
-        prepared: Prepared,
+        prepared: PreparedLines,
     ) -> RenderResult<Box<dyn Renderer>> {
         Ok(Box::new(renderer::LinesRenderer::new(
             gpu,
@@ -461,14 +525,15 @@ impl Technique for LinesScene {
         )?))
     }
 
-    /// The tubes' nearest hit at each pixel centre, lit as the precise programs light it.
+    /// The lines' nearest hit at each pixel centre (shaped for the view), lit as the
+    /// precise programs light it.
     fn reference(
         &self,
-        prepared: &Prepared,
+        prepared: &PreparedLines,
         view: &ReferenceView<'_>,
     ) -> Option<arbvis_core::image::Image> {
         Some(surface::reference::reference(
-            prepared,
+            &prepared.shaped(self.shape(), &view.camera, view.size),
             &self.as_surface(),
             Fidelity::Precise,
             &view.camera,
@@ -477,7 +542,7 @@ impl Technique for LinesScene {
         ))
     }
 
-    fn world(&self, prepared: &Prepared) -> Option<World> {
+    fn world(&self, prepared: &PreparedLines) -> Option<World> {
         Some(prepared.world)
     }
 }

@@ -1,22 +1,29 @@
-//! The lines' GL state: their tubes drawn by a surface's renderer; new parameters read the
-//! lines again (files of lines and logs are small).
+//! The lines' GL state: their tubes or ribbons drawn by a surface's renderer, shaped again
+//! when the view changes where their shape follows it; new parameters read the lines
+//! again (files of lines and logs are small).
 
 use std::path::{Path, PathBuf};
 
-use super::{prepare, LinesScene};
+use glam::DMat4;
+
+use super::shape::PreparedLines;
+use super::{prepare, LinesScene, Width};
 use crate::error::RenderResult;
-use crate::techniques::surface::prepare::Prepared;
 use crate::techniques::surface::renderer::SurfaceRenderer;
 use crate::techniques::{Frame, Params, Renderer};
 use arbvis_core::vocab::Fidelity;
 use arbvis_gl::{Gpu, ProgramKind, Surface};
 
-/// The tubes as a surface's renderer draws them; new parameters read the lines again.
+/// The lines as a surface's renderer draws them; new parameters read the lines again.
 pub struct LinesRenderer {
     tubes: SurfaceRenderer,
     fidelity: Fidelity,
     params: LinesScene,
     base: PathBuf,
+    /// The lines, to be shaped for each view where their shape follows it.
+    prepared: PreparedLines,
+    /// The view-projection and size the uploaded shape was made for.
+    shaped_for: Option<(DMat4, [u32; 2])>,
 }
 
 impl LinesRenderer {
@@ -27,19 +34,34 @@ impl LinesRenderer {
         fidelity: Fidelity,
         params: &LinesScene,
         base: &Path,
-        prepared: Prepared,
+        prepared: PreparedLines,
     ) -> RenderResult<LinesRenderer> {
+        // A shape for a first view; one that follows the view is made again at the draw.
+        let first = prepared.shaped(params.shape(), &Default::default(), [64, 64]);
         Ok(LinesRenderer {
-            tubes: SurfaceRenderer::new(gpu, kind, fidelity, &params.as_surface(), prepared)?,
+            tubes: SurfaceRenderer::new(gpu, kind, fidelity, &params.as_surface(), first)?,
             fidelity,
             params: params.clone(),
             base: base.to_path_buf(),
+            prepared,
+            shaped_for: None,
         })
     }
 }
 
 impl Renderer for LinesRenderer {
     fn draw(&mut self, gpu: &Gpu, surface: Surface<'_>, frame: &Frame) -> RenderResult<()> {
+        if !self.params.shape().fixed() {
+            let size = [frame.width, frame.height];
+            let view = (frame.camera.view_projection(frame.aspect()), size);
+            if self.shaped_for != Some(view) {
+                let shaped = self
+                    .prepared
+                    .shaped(self.params.shape(), &frame.camera, size);
+                self.tubes.replace(gpu, shaped)?;
+                self.shaped_for = Some(view);
+            }
+        }
         self.tubes.draw(gpu, surface, frame)
     }
 
@@ -47,10 +69,13 @@ impl Renderer for LinesRenderer {
         let params = params.get::<LinesScene>()?;
         if *params != self.params {
             let prepared = prepare(params, &self.base)?;
+            let first = prepared.shaped(params.shape(), &Default::default(), [64, 64]);
             let kind = self.tubes.program_kind();
             self.tubes =
-                SurfaceRenderer::new(gpu, kind, self.fidelity, &params.as_surface(), prepared)?;
+                SurfaceRenderer::new(gpu, kind, self.fidelity, &params.as_surface(), first)?;
             self.params = params.clone();
+            self.prepared = prepared;
+            self.shaped_for = None;
         }
         Ok(())
     }
@@ -70,7 +95,7 @@ impl Renderer for LinesRenderer {
     /// The table over the values' range, or the tubes' colour as a key.
     fn annotations(&self) -> crate::techniques::annotations::Annotations {
         use crate::techniques::annotations::{rgb8, Annotations, Legend};
-        let legend = match self.tubes.prepared().elevation.clone() {
+        let legend = match self.prepared.legend.clone() {
             ([low, high], Some(colours)) => Legend::Bar {
                 title: match &self.params.well {
                     Some(_) => "log".into(),
@@ -86,7 +111,10 @@ impl Renderer for LinesRenderer {
                     title: "lines".into(),
                     keys: vec![(
                         rgb8([r, g, b, 1.0]),
-                        format!("radius {} m", self.params.radius),
+                        match self.params.width() {
+                            Width::Metres(w) => format!("{w} m across"),
+                            Width::Pixels(w) => format!("{w} pixels across"),
+                        },
                     )],
                 }
             }

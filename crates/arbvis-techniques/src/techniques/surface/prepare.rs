@@ -140,13 +140,36 @@ pub fn of_coloured_mesh(
 ) -> Prepared {
     let (lo, hi) = mesh.bounds();
     let world = World::of_box(lo, hi);
+    let in_frame = |v: [f64; 3]| (DVec3::from_array(v) - world.centre) / world.units;
+    corners_of(mesh, in_frame, colours, legend, world)
+}
+
+/// [`of_coloured_mesh`] of a mesh already in the object frame of `world` (a shape made
+/// for each view keeps the frame of the lines it is drawn around).
+pub fn of_frame_mesh(
+    mesh: &TriangleMesh,
+    colours: &[DVec3],
+    legend: ([f64; 2], Option<Vec<[u8; 3]>>),
+    world: World,
+) -> Prepared {
+    corners_of(mesh, DVec3::from_array, colours, legend, world)
+}
+
+/// The corners of `mesh`, each vertex taken into the object frame by `in_frame`.
+fn corners_of(
+    mesh: &TriangleMesh,
+    in_frame: impl Fn([f64; 3]) -> DVec3,
+    colours: &[DVec3],
+    legend: ([f64; 2], Option<Vec<[u8; 3]>>),
+    world: World,
+) -> Prepared {
     let normals = vertex_normals(mesh);
     let corners = mesh
         .triangles
         .iter()
         .flat_map(|t| t.map(|v| v as usize))
         .map(|v| Corner {
-            position: (DVec3::from_array(mesh.vertices[v]) - world.centre) / world.units,
+            position: in_frame(mesh.vertices[v]),
             normal: normals[v],
             colour: colours[v],
         })

@@ -109,6 +109,15 @@ impl SurfaceRenderer {
         &self.prepared
     }
 
+    /// Draw `prepared` from now on (a shape made again for a new view): its corners
+    /// uploaded into the same buffer.
+    pub fn replace(&mut self, gpu: &Gpu, prepared: Prepared) -> RenderResult<()> {
+        self.mesh.update(gpu, &vertex_floats(&prepared))?;
+        self.prepared = prepared;
+        self.sorted_for = None;
+        Ok(())
+    }
+
     /// Read files named relative to `base` when parameters change.
     pub fn with_base(mut self, base: &std::path::Path) -> SurfaceRenderer {
         self.base = base.to_path_buf();
