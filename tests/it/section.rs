@@ -329,3 +329,71 @@ fn a_section_of_a_store_draws_the_segys_section() {
         assert!(lit > 100, "{cut}: in view ({lit})");
     }
 }
+
+/// A survey in depth (F3's store declared in depth, 4 m a sample, as an MDIO dataset with
+/// a depth axis says) is cut by `depth`: the same plane, place and picture as the store in
+/// time cut by `time` at the same number (a survey in time lies at 1 m per ms); `time` on
+/// the survey in depth, and `depth` on the one in time or on the SEG-Y, are refused by key
+/// with the survey's vertical axis named.
+#[test]
+fn a_survey_in_depth_is_cut_by_depth() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("section-depth");
+    let f3 = common::data_file("seismic/f3.sgy");
+    let timed = dir.join("f3.zarr");
+    crate::mdio::convert_quietly(&f3, &timed, Some(8));
+    let deep = dir.join("f3-depth.zarr");
+    common::copy_tree(&timed, &deep);
+    let root = deep.join("zarr.json");
+    let mut meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&root).unwrap()).unwrap();
+    meta["attributes"]["arbvis"]["source"]["samples"] =
+        serde_json::json!({"domain": "depth", "unit": "m", "first": 0.0, "step": 4.0});
+    std::fs::write(&root, serde_json::to_vec(&meta).unwrap()).unwrap();
+    let scene = |store: &std::path::Path, cut: &str| {
+        let text = format!(
+            "size = [61, 45]\nfidelity = \"precise\"\n[technique.section]\nvolume = {{ store = \"{}\" }}\n{cut}\nquantize = \"min-max\"\n",
+            store.display()
+        );
+        Scene::parse(&text, "s.toml").unwrap()
+    };
+    // On a sample and between two.
+    for number in [140.0, 141.0] {
+        let a = scene(&timed, &format!("time = {number:?}"));
+        let b = scene(&deep, &format!("depth = {number:?}"));
+        let (pa, pb) = (prepared(&a), prepared(&b));
+        assert_eq!(pa.world, pb.world, "{number}: one place");
+        assert_eq!(pa.plane, pb.plane, "{number}: one plane");
+        let (ia, ib) = (
+            render_on(&h, &a).unwrap().image,
+            render_on(&h, &b).unwrap().image,
+        );
+        assert_eq!(ia.compare(&ib, 0.0).unwrap().pixels_over, 0, "{number}");
+        assert!(common::lit_pixels(&ib, 0.05) > 100, "{number}: in view");
+    }
+    let segy = format!("{{ segy = \"{}\" }}", f3.display());
+    for (text, key, says) in [
+        (
+            scene(&deep, "time = 140"),
+            "time",
+            "vertical axis is depth (m)",
+        ),
+        (
+            scene(&timed, "depth = 140"),
+            "depth",
+            "vertical axis is time (ms)",
+        ),
+        (
+            Scene::parse(
+                &format!("[technique.section]\nvolume = {segy}\ndepth = 140\n"),
+                "s.toml",
+            )
+            .unwrap(),
+            "depth",
+            "use time = N",
+        ),
+    ] {
+        let e = render_on(&h, &text).err().expect("refused").to_string();
+        assert!(e.contains(key) && e.contains(says), "{e}");
+    }
+}

@@ -136,6 +136,19 @@ impl Prepared {
 pub fn position(axis: &Axis, cut: Cut) -> Result<f64, FieldError> {
     let len = axis.len.max(1);
     let outside = |what: String| FieldError::new(cut.key, what);
+    // A survey that says its vertical axis is time is not cut by depth, nor one in depth
+    // by time (a SEG-Y's samples are read as time; plain sample numbers take either).
+    let other = match cut.key {
+        "time" => Some("depth"),
+        "depth" => Some("time"),
+        _ => None,
+    };
+    if let Some(other) = other.filter(|o| axis.name.starts_with(o)) {
+        return Err(outside(format!(
+            "{} {}: the survey's vertical axis is {} (a SEG-Y's samples are read as time); use {other} = N",
+            cut.key, cut.number, axis.name
+        )));
+    }
     match &axis.numbers {
         Numbers::Listed(numbers) => numbers
             .iter()
@@ -327,6 +340,20 @@ mod tests {
         let e = position(&time, cut(0, 16.5)).unwrap_err();
         assert!(e.message.contains("runs from 0 to 16"), "{}", e.message);
         assert!(position(&time, cut(0, -0.1)).is_err());
+        // A depth cut of a survey in time, a time cut of one in depth: refused by key.
+        let depth_cut = Cut {
+            key: "depth",
+            ..cut(0, 6.0)
+        };
+        let e = position(&time, depth_cut).unwrap_err().to_string();
+        assert!(e.contains("depth") && e.contains("use time = N"), "{e}");
+        let depth = Axis {
+            name: "depth (m)".into(),
+            ..time.clone()
+        };
+        assert_eq!(position(&depth, depth_cut).unwrap(), 1.5);
+        let e = position(&depth, cut(0, 6.0)).unwrap_err().to_string();
+        assert!(e.contains("use depth = N"), "{e}");
     }
 
     #[test]
