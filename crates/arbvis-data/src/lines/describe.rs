@@ -46,7 +46,8 @@ pub fn kind_of_header(line: &str) -> Option<LinesKind> {
     };
     let has = |keys: &[&str]| names.iter().any(|n| keys.contains(&first_word(n).as_str()));
     let md = has(&["md", "measured", "dept", "depth", "mdepth"]);
-    let survey = has(&["inc", "incl", "inclination"]) && has(&["azi", "az", "azim", "azimuth"]);
+    // Either of a survey's names makes it one (`MD,INC` is a survey short of a column).
+    let survey = has(&["inc", "incl", "inclination"]) || has(&["azi", "az", "azim", "azimuth"]);
     Some(match (md, survey) {
         (true, true) => LinesKind::Survey,
         (true, false) => LinesKind::Log,
@@ -188,6 +189,7 @@ mod tests {
                 Some(LinesKind::Survey),
             ),
             ("md;incl;azim;tvd", Some(LinesKind::Survey)),
+            ("MD,INC", Some(LinesKind::Survey)),
             ("DEPT GR", Some(LinesKind::Log)),
             ("MD,GR,RHOB", Some(LinesKind::Log)),
             ("x,y,z,value", Some(LinesKind::Polylines)),

@@ -197,8 +197,9 @@ fn rows(name: &Path, bytes: &[u8], least: usize) -> Result<Vec<(usize, Vec<f64>)
         }
         let width = *width.get_or_insert(words.len());
         if words.len() != width || width < least {
+            // Too many: the first value past the row's width; too few: the last given.
             let column = words
-                .get(width.min(words.len()).saturating_sub(1))
+                .get(width.min(words.len().saturating_sub(1)))
                 .map_or(1, |w| w.0);
             return Err(error(
                 n,
@@ -319,7 +320,11 @@ pub fn parse_survey(name: &Path, bytes: &[u8]) -> Result<Vec<Station>, SurfaceEr
         if !s.azimuth.is_finite() {
             return Err(error(3, "azimuth: degrees clockwise from north".into()));
         }
-        stations.push(s);
+        // 360 and -10 are north and 350: reduced into 0..360 (as `inspect` says them).
+        stations.push(Station {
+            azimuth: s.azimuth.rem_euclid(360.0),
+            ..s
+        });
     }
     if stations.len() < 2 {
         return Err(SurfaceError::format(
@@ -348,6 +353,13 @@ pub fn parse_log(name: &Path, bytes: &[u8]) -> Result<Vec<(f64, f64)>, SurfaceEr
         }
         let v = if r[1] == -999.25 { f64::NAN } else { r[1] };
         log.push((r[0], v));
+    }
+    if log.is_empty() {
+        return Err(SurfaceError::format(
+            name,
+            Position::Line { line: 1, column: 1 },
+            "a log of one row or more (md, value)",
+        ));
     }
     Ok(log)
 }
@@ -455,10 +467,16 @@ mod tests {
         assert!(e(survey("0,0,0\n")).contains("two stations"));
         let log = |t: &str| parse_log(Path::new("l.csv"), t.as_bytes()).map(|_| ());
         assert!(e(log("1,2\n1,3\n")).contains("line 2"));
+        assert!(e(log("MD,GR\n")).contains("one row or more"));
+        let turned = parse_survey(Path::new("w.csv"), b"0,0,-10\n10,1,370\n").unwrap();
+        assert_eq!([turned[0].azimuth, turned[1].azimuth], [350.0, 10.0]);
         let lines = |t: &str| parse_polylines(Path::new("p.csv"), t.as_bytes()).map(|_| ());
         assert!(e(lines("0 0 0\n1 x 1\n")).contains("line 2, column 3: expected a number"));
         assert!(e(lines("0 0 0\n\n1 1 1\n")).contains("no line of two points"));
         assert!(e(lines("0 0 nan\n1 1 1\n")).contains("finite"));
+        // Too many values: the column of the first one past the row's width.
+        assert!(e(lines("0 0 0\n1 1 1 7 8\n")).contains("line 2, column 7: 5 values, expected 3"));
+        assert!(e(lines("0 0 0 0\n1 1 1\n")).contains("line 2, column 5: 3 values, expected 4"));
         let two = parse_polylines(
             Path::new("p.csv"),
             b"x,y,z,v\n0,0,0,1\n1,0,0,2\n\n5,5,5,3\n6,6,6,4\n7,7,7,5\n",

@@ -438,11 +438,31 @@ pub fn describe_file(path: &Path) -> Result<String, SurfaceError> {
                 Some([i, c]) => format!("on its grid of {i} inlines x {c} crosslines (its inline and crossline columns)"),
                 None => "by Delaunay over x, y (no inline and crossline columns)".into(),
             };
+            let repeated = match g.repeated {
+                0 => String::new(),
+                r => format!("; {r} at the x, y of an earlier node (left out)"),
+            };
             let grid = format!(
-                "nodes: {} defined, {} undefined (left out); triangulated {how}\n",
+                "nodes: {} defined, {} undefined (left out){repeated}; triangulated {how}\n",
                 g.nodes, g.undefined
             );
             (mesh, grid)
+        }
+        "ts" => {
+            let (mesh, facts) = tsurf::parse_with_facts(path, &bytes)?;
+            let mut said = format!(
+                "objects: {}; z positive {}\n",
+                facts.objects,
+                if facts.depth_positive {
+                    "downwards (depth, turned up)"
+                } else {
+                    "upwards (elevation)"
+                }
+            );
+            for (name, size) in &facts.vectors {
+                said += &format!("property {name:?}: a vector of {size} values (not drawn)\n");
+            }
+            (mesh, said)
         }
         _ => (parse(path, &bytes)?, String::new()),
     };

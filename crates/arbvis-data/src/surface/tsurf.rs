@@ -30,6 +30,8 @@ pub struct TsurfFacts {
     pub objects: usize,
     /// Whether z was given positive downwards (and turned).
     pub depth_positive: bool,
+    /// Properties of more than one value (`ESIZES`), with their sizes: not kept.
+    pub vectors: Vec<(String, usize)>,
 }
 
 /// One object's vertex ids to the surface's vertex indices.
@@ -58,12 +60,11 @@ pub fn parse_with_facts(
         triangles,
         facts,
         properties,
-        vectors,
         ..
     } = reader;
     let properties = properties
         .into_iter()
-        .filter(|p| !vectors.contains(&p.name))
+        .filter(|p| !facts.vectors.iter().any(|(v, _)| *v == p.name))
         .collect();
     let mesh =
         TriangleMesh::from_indexed(name, vertices, triangles)?.with_properties(name, properties)?;
@@ -87,8 +88,6 @@ struct Reader<'a> {
     properties: Vec<VertexProperty>,
     /// The current object's properties: index into `properties`, size, no-data value.
     object: Vec<(usize, usize, Option<f64>)>,
-    /// Names of properties of more than one value (not kept).
-    vectors: Vec<String>,
 }
 
 impl<'a> Reader<'a> {
@@ -104,7 +103,6 @@ impl<'a> Reader<'a> {
             facts: TsurfFacts::default(),
             properties: Vec::new(),
             object: Vec::new(),
-            vectors: Vec::new(),
         }
     }
 
@@ -160,7 +158,7 @@ impl<'a> Reader<'a> {
                     ));
                 }
             },
-            "PROPERTIES" => self.declare(&tokens),
+            "PROPERTIES" => self.declare(n, &tokens)?,
             "ESIZES" | "NO_DATA_VALUES" => self.describe(n, &tokens)?,
             "VRTX" | "PVRTX" => self.vertex(n, &tokens)?,
             "ATOM" | "PATOM" => self.atom(n, &tokens)?,
@@ -224,9 +222,12 @@ impl<'a> Reader<'a> {
 
     /// `PROPERTIES a b ...`: the current object's properties, each of size 1 until
     /// `ESIZES` says otherwise.
-    fn declare(&mut self, tokens: &[(usize, &str)]) {
+    fn declare(&mut self, n: usize, tokens: &[(usize, &str)]) -> Result<(), SurfaceError> {
         self.object.clear();
-        for &(_, name) in &tokens[1..] {
+        for (k, &(column, name)) in tokens.iter().enumerate().skip(1) {
+            if tokens[1..k].iter().any(|t| t.1 == name) {
+                return Err(self.error(n, column, format!("property {name:?} named twice")));
+            }
             let index = match self.properties.iter().position(|p| p.name == name) {
                 Some(i) => i,
                 None => {
@@ -239,6 +240,7 @@ impl<'a> Reader<'a> {
             };
             self.object.push((index, 1, None));
         }
+        Ok(())
     }
 
     /// `ESIZES n ...` or `NO_DATA_VALUES v ...`, one per declared property.
@@ -266,8 +268,8 @@ impl<'a> Reader<'a> {
                 })?;
                 self.object[k].1 = size;
                 let name = &self.properties[self.object[k].0].name;
-                if size > 1 && !self.vectors.contains(name) {
-                    self.vectors.push(name.clone());
+                if size > 1 && !self.facts.vectors.iter().any(|(v, _)| v == name) {
+                    self.facts.vectors.push((name.clone(), size));
                 }
             } else {
                 self.object[k].2 = token.parse::<f64>().ok();
@@ -298,6 +300,17 @@ impl<'a> Reader<'a> {
             let defined = size == 1 && value.is_finite() && Some(value) != no_data;
             out.push(if defined { value } else { f64::NAN });
             at += size;
+        }
+        if let Some(&(column, token)) = tokens.get(at) {
+            let extra = tokens.len() - at;
+            return Err(self.error(
+                n,
+                column,
+                format!(
+                    "{token:?}: {extra} value(s) past the ones {} declares",
+                    self.declared()
+                ),
+            ));
         }
         Ok(out)
     }
@@ -398,7 +411,8 @@ mod tests {
             facts,
             TsurfFacts {
                 objects: 2,
-                depth_positive: true
+                depth_positive: true,
+                vectors: Vec::new(),
             }
         );
         assert_eq!(mesh.vertices.len(), 8);
@@ -434,9 +448,10 @@ mod tests {
                     PVRTX 1 0 0 0 12.5 1 0 0 40\nPVRTX 2 1 0 0 -999 0 1 0 -99\nPVRTX 3 0 1 0 7 0 0 1 45.5\n\
                     PATOM 4 3 8 0 0 1 50\nTRGL 1 2 3\nTRGL 2 4 1\nEND\n\
                     GOCAD TSurf 1\nPROPERTIES dip\nPVRTX 1 5 5 5 30\nPVRTX 2 6 5 5 nan\nVRTX 3 5 6 5\nTRGL 1 2 3\nEND\n";
-        let mesh = parse(Path::new("f.ts"), text.as_bytes()).unwrap();
+        let (mesh, facts) = parse_with_facts(Path::new("f.ts"), text.as_bytes()).unwrap();
         let names: Vec<&str> = mesh.properties.iter().map(|p| p.name.as_str()).collect();
         assert_eq!(names, ["throw", "dip"]);
+        assert_eq!(facts.vectors, [("dir".to_string(), 3)], "told, not drawn");
         assert_eq!(
             values(&mesh, "throw"),
             [Some(12.5), None, Some(7.0), Some(8.0), None, None, None]
@@ -484,6 +499,18 @@ mod tests {
                 3,
                 10,
                 "2 values for 1 properties",
+            ),
+            (
+                "GOCAD TSurf 1\nPROPERTIES a b a\n",
+                2,
+                16,
+                "property \"a\" named twice",
+            ),
+            (
+                "GOCAD TSurf 1\nPROPERTIES a\nPVRTX 1 0 0 0 4 5 6\n",
+                3,
+                17,
+                "2 value(s) past the ones PROPERTIES a declares",
             ),
         ];
         for (text, line, column, says) in cases {

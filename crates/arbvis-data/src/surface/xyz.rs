@@ -33,6 +33,10 @@ pub const MAX_NODES: usize = 1 << 24;
 /// A z at least this large in magnitude marks an undefined node (OpendTect writes 1e30).
 pub const UNDEFINED: f64 = 1e29;
 
+/// The largest map coordinate taken (a trillion metres: far past any map projection's,
+/// and small enough for the triangulation's arithmetic).
+pub const MAX_COORDINATE: f64 = 1e12;
+
 /// What the reader found (`inspect`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct XyzGrid {
@@ -42,6 +46,8 @@ pub struct XyzGrid {
     pub undefined: usize,
     /// Inlines and crosslines of the grid, where the file gives them.
     pub lattice: Option<[usize; 2]>,
+    /// Nodes at the x, y of an earlier node (left out of a Delaunay triangulation).
+    pub repeated: usize,
 }
 
 /// The columns of x, y, z, of inline and crossline where present, and of the properties
@@ -188,6 +194,18 @@ pub fn parse_with_grid(name: &Path, bytes: &[u8]) -> Result<(TriangleMesh, XyzGr
         if !(x.is_finite() && y.is_finite()) {
             return Err(error(n, words[c.x].0, "x and y must be finite".into()));
         }
+        if x.abs().max(y.abs()) > MAX_COORDINATE {
+            let column = if x.abs() > MAX_COORDINATE {
+                words[c.x].0
+            } else {
+                words[c.y].0
+            };
+            return Err(error(
+                n,
+                column,
+                format!("x {x:e}, y {y:e}: map coordinates within {MAX_COORDINATE:e}"),
+            ));
+        }
         if !z.is_finite() || z.abs() >= UNDEFINED {
             undefined += 1;
             continue;
@@ -239,10 +257,15 @@ pub fn parse_with_grid(name: &Path, bytes: &[u8]) -> Result<(TriangleMesh, XyzGr
             ),
         ));
     }
+    let repeated = match lattice {
+        Some(_) => 0,
+        None => repeated_positions(&nodes),
+    };
     let grid = XyzGrid {
         nodes: nodes.len(),
         undefined,
         lattice,
+        repeated,
     };
     let vertices = nodes.iter().map(|n| n.at).collect();
     let properties = columns
@@ -391,6 +414,13 @@ fn lattice_triangles(nodes: &[Node]) -> Result<Lattice, (usize, String)> {
     Ok((triangles, shape))
 }
 
+/// How many nodes lie at the x, y of another (all but the first at each).
+fn repeated_positions(nodes: &[Node]) -> usize {
+    let mut at: Vec<[f64; 2]> = nodes.iter().map(|n| [n.at[0], n.at[1]]).collect();
+    at.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])));
+    at.windows(2).filter(|w| w[0] == w[1]).count()
+}
+
 /// The Delaunay triangles of the nodes' x, y (relative to the first node, so that UTM
 /// coordinates keep their precision), less those with an edge over twice the median edge.
 fn delaunay_triangles(nodes: &[Node]) -> Vec<[u32; 3]> {
@@ -478,7 +508,8 @@ mod tests {
             XyzGrid {
                 nodes: 11,
                 undefined: 1,
-                lattice: Some([4, 3])
+                lattice: Some([4, 3]),
+                repeated: 0,
             }
         );
         // 3 x 2 cells of two triangles; the undefined node (2, 1) takes away the six
@@ -501,6 +532,9 @@ mod tests {
             assert!(a == e || (a.is_nan() && e.is_nan()), "{a} against {e}");
         }
         assert_eq!(amplitude.range(), Some([-7.5, 24.5]));
+        // A node at the x, y of another is counted (Delaunay leaves it out).
+        let (_, grid) = read("0 0 1\n1 0 1\n0 1 2\n1 0 5\n0 0 3\n");
+        assert_eq!(grid.repeated, 2);
         // Without names, a fourth column is "column 4".
         let (mesh, _) = read("0 0 1 9\n1 0 1 8\n0 1 2 7\n");
         assert_eq!(mesh.property("column 4").unwrap().values, [9.0, 8.0, 7.0]);
@@ -514,7 +548,8 @@ mod tests {
             XyzGrid {
                 nodes: 11,
                 undefined: 1,
-                lattice: None
+                lattice: None,
+                repeated: 0,
             }
         );
         // The lattice's cells, each split one way or the other; none spans the missing
@@ -567,6 +602,13 @@ mod tests {
         );
         assert_refused_at("h.xyz", "1 2 3\n4 5 6\n", 2, 1, "2 defined nodes");
         assert_refused_at("h.xyz", "1 1 3\n2 2 3\n3 3 3\n", 1, 1, "no triangle");
+        assert_refused_at(
+            "h.xyz",
+            "1 2 3\n4 1e308 6\n7 8 9\n",
+            2,
+            3,
+            "map coordinates within 1e12",
+        );
         assert_refused_at(
             "h.xyz",
             "1 2 1e30\n4 5 nan\n7 8 9\n",
