@@ -239,7 +239,11 @@ def mesh_parts(points, cells, point_data, cell_data):
 
 def json_default(value):
     """numpy's numbers and arrays as the Python numbers and lists a scene holds (json's
-    `default`); anything else is json's TypeError."""
+    `default`); an array's NaN as None (JSON has no NaN: a scene reads null where it takes
+    a value of none, a log's or a line's, and refuses it elsewhere); anything else is
+    json's TypeError."""
+    if isinstance(value, np.ndarray) and value.dtype.kind == "f" and np.isnan(value).any():
+        return np.where(np.isnan(value), None, value).tolist()
     if isinstance(value, (np.generic, np.ndarray)):
         return value.tolist()
     raise TypeError(f"Object of type {type(value).__name__} is not a value a scene holds")

@@ -220,10 +220,11 @@ def test_a_section_of_a_survey_in_memory_draws_as_its_file(tmp_path):
 def test_lines_and_a_well_log_from_arrays_draw_as_their_files(tmp_path):
     """Polylines handed over as numpy arrays (`polylines=[array, ...]`, (N, 3) or (N, 4)
     with a value) and a well's log as an (N, 2) array (`log_rows`) draw exactly what
-    their CSV files draw; bad points are refused by key. (A value of none, NaN, cannot
-    cross: a scene holds no NaN from Python; a scene file's `nan` can.)"""
+    their CSV files draw, a NaN value (none: the constant colour) included; bad points are
+    refused by key."""
     rng = np.random.default_rng(21)
     lines = [np.column_stack([rng.random((n, 3)) * 80.0, rng.random(n)]) for n in (4, 7)]
+    lines[1][2, 3] = np.nan
     text = "\n".join("".join(f"{p[0]!r},{p[1]!r},{p[2]!r},{p[3]!r}\n" for p in l.tolist()) for l in lines)
     (tmp_path / "l.csv").write_text(text)
     base = {"size": [64, 48], "fidelity": "precise", "camera": {"rotation": [0.31, -0.22, 0.12, 0.917]}}
@@ -243,6 +244,7 @@ def test_lines_and_a_well_log_from_arrays_draw_as_their_files(tmp_path):
     assert np.array_equal(draw({"polylines": lines, **ribbon}), want)
     md = np.arange(0.0, 100.5, 0.5)
     log = np.column_stack([md, 50.0 + 40.0 * np.sin(md / 7.0)])
+    log[30:41, 1] = np.nan  # a gap in the log, as lasio reads -999.25
     (tmp_path / "gr.csv").write_text("MD,GR\n" + "".join(f"{m!r},{v!r}\n" for m, v in log.tolist()))
     well = {"head": [10.0, 20.0], "stations": [[0.0, 0.0, 0.0], [50.0, 20.0, 45.0], [100.0, 30.0, 60.0]]}
     want = draw({"well": {**well, "log": "gr.csv"}, "radius": 5.0})

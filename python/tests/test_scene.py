@@ -1,5 +1,6 @@
 """arbvis.Scene: read, edit by dotted key, validated as scene files are."""
 
+import numpy as np
 import pytest
 
 import arbvis
@@ -93,6 +94,13 @@ def test_values_no_scene_file_could_hold_are_refused_cleanly():
         scene.zoom = float("inf")
     with pytest.raises(KeyError):
         scene["size.width"] = 3
+    # A numpy array's NaN crosses as a value of none (a log's, a line's); where a number
+    # is needed it is refused by key.
+    v3o2 = arbvis.Scene.demo("v3o2-sum")
+    with pytest.raises(arbvis.SceneError, match=r"coefficients: \[NaN, 0.3, 0.1, 0.9\]: must be finite"):
+        v3o2["technique.opacity3d.primary.coefficients"] = np.array([np.nan, 0.3, 0.1, 0.9])
+    with pytest.raises(arbvis.SceneError, match="^size: "):
+        v3o2["size"] = np.array([np.nan, 3.0])
     with pytest.raises(arbvis.SceneError) as e:
         scene["camera.rotation"] = [1, 2]
     assert e.value.key == "camera.rotation"

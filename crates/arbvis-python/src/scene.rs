@@ -111,7 +111,7 @@ fn scene_of(tree: &serde_json::Value, base: PathBuf, key: Option<&str>) -> PyRes
         };
         errors::scene_error(message, At::key(key))
     };
-    let value = toml::Value::try_from(tree).map_err(|e| bad(e.to_string()))?;
+    let value = toml_of(tree).map_err(bad)?;
     let text = toml::to_string(&value).map_err(|e| bad(e.to_string()))?;
     match Scene::parse(&text, "scene") {
         Ok(mut scene) => {
@@ -137,6 +137,32 @@ fn scene_of(tree: &serde_json::Value, base: PathBuf, key: Option<&str>) -> PyRes
         )),
         Err(e) => Err(errors::from_scene(e)),
     }
+}
+
+/// The TOML value of a JSON tree: a null in an array is `nan` (a numpy array's NaN crosses
+/// JSON as null: a value of none where a scene takes one, refused by key elsewhere), a
+/// null in a table no key.
+fn toml_of(json: &serde_json::Value) -> Result<toml::Value, String> {
+    use serde_json::Value as J;
+    Ok(match json {
+        J::Null => return Err("null is no value a scene holds".into()),
+        J::Array(items) => toml::Value::Array(
+            items
+                .iter()
+                .map(|v| match v {
+                    J::Null => Ok(toml::Value::Float(f64::NAN)),
+                    v => toml_of(v),
+                })
+                .collect::<Result<_, _>>()?,
+        ),
+        J::Object(map) => toml::Value::Table(
+            map.iter()
+                .filter(|(_, v)| !v.is_null())
+                .map(|(k, v)| Ok((k.clone(), toml_of(v)?)))
+                .collect::<Result<_, String>>()?,
+        ),
+        other => toml::Value::try_from(other).map_err(|e| e.to_string())?,
+    })
 }
 
 /// `m` as a row-major numpy array.

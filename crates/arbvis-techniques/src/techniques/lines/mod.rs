@@ -48,9 +48,14 @@ pub struct LinesScene {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub well: Option<WellScene>,
     /// Or the polylines themselves: each a list of `[x, y, z]` or `[x, y, z, value]`
-    /// points (lines typed in a scene, or arrays handed over from Python).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub polylines: Option<Vec<Vec<Vec<f64>>>>,
+    /// points (lines typed in a scene, or arrays handed over from Python); a value of
+    /// `nan` (null from JSON, as Python's NaN crosses) is none.
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "null_is_nan::polylines"
+    )]
+    pub polylines: Option<Vec<Points>>,
     /// The tubes' radius in the data's units (metres), where `width` is not given.
     #[serde(default = "default_radius")]
     pub radius: f64,
@@ -80,8 +85,52 @@ fn is_tube(style: &LineStyle) -> bool {
     *style == LineStyle::Tube
 }
 
+/// Numbers that may be null: JSON, through which Python hands a scene over, has no NaN
+/// (numpy arrays' NaN cross as null), TOML has `nan`; both are NaN here.
+mod null_is_nan {
+    use serde::{Deserialize, Deserializer};
+
+    /// A number, or null.
+    #[derive(Deserialize)]
+    #[serde(transparent)]
+    struct OrNull(Option<f64>);
+
+    impl OrNull {
+        fn value(self) -> f64 {
+            self.0.unwrap_or(f64::NAN)
+        }
+    }
+
+    /// `polylines`: lines of points of numbers.
+    pub fn polylines<'de, D: Deserializer<'de>>(
+        d: D,
+    ) -> Result<Option<Vec<super::Points>>, D::Error> {
+        let lines: Option<Vec<Vec<Vec<OrNull>>>> = Option::deserialize(d)?;
+        Ok(lines.map(|lines| {
+            let point = |p: Vec<OrNull>| p.into_iter().map(OrNull::value).collect();
+            lines
+                .into_iter()
+                .map(|l| l.into_iter().map(point).collect())
+                .collect()
+        }))
+    }
+
+    /// `log_rows`: pairs of numbers.
+    pub fn rows<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<[f64; 2]>>, D::Error> {
+        let rows: Option<Vec<[OrNull; 2]>> = Option::deserialize(d)?;
+        Ok(rows.map(|rows| {
+            rows.into_iter()
+                .map(|[m, v]| [m.value(), v.value()])
+                .collect()
+        }))
+    }
+}
+
 /// The widest line in pixels (a band wider than most pictures is a mistake).
 const MAX_PIXELS: f64 = 1024.0;
+
+/// One line's points, each `[x, y, z]` or `[x, y, z, value]`.
+pub type Points = Vec<Vec<f64>>;
 
 /// A well: its deviation survey, where it starts, and a log along it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -101,8 +150,12 @@ pub struct WellScene {
     /// `md, value` rows: the values the tube is coloured by.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub log: Option<PathBuf>,
-    /// Or the log's rows themselves, `[md, value]` each.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    /// Or the log's rows themselves, `[md, value]` each (a value of `nan` or null: none).
+    #[serde(
+        default,
+        skip_serializing_if = "Option::is_none",
+        deserialize_with = "null_is_nan::rows"
+    )]
     pub log_rows: Option<Vec<[f64; 2]>>,
 }
 
