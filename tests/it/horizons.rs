@@ -193,6 +193,16 @@ fn the_f3_fault_carries_its_throw_inside_the_survey() {
     assert!(lo[0] > x[0] && hi[0] < x[1], "{lo:?} {hi:?}");
     assert!(lo[1] > y[0] && hi[1] < y[1], "{lo:?} {hi:?}");
     assert!(lo[2] >= -296.0 && hi[2] <= 0.0, "{lo:?} {hi:?}");
+    // inspect names its coordinate system and that z was turned.
+    let said = common::inspect(&common::data_file("seismic/f3-fault.ts"));
+    common::assert_says(
+        &said,
+        &[
+            "objects: 1; z positive downwards (depth, turned up)",
+            "coordinate system (as the file names it; not applied): NAME Default; AXIS_NAME \"X\" \"Y\" \"Z\"; AXIS_UNIT \"m\" \"m\" \"ms\"",
+            "property \"throw\": 263 of 273 vertices, 0 to 18",
+        ],
+    );
 }
 
 /// A choice given two keys (`colour_by = { property = ..., bogus = 1 }`) is told as such

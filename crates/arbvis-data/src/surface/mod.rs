@@ -459,6 +459,12 @@ pub fn describe_file(path: &Path) -> Result<String, SurfaceError> {
                     "upwards (elevation)"
                 }
             );
+            if !facts.coordinate_system.is_empty() {
+                said += &format!(
+                    "coordinate system (as the file names it; not applied): {}\n",
+                    facts.coordinate_system.join("; ")
+                );
+            }
             for (name, size) in &facts.vectors {
                 said += &format!("property {name:?}: a vector of {size} values (not drawn)\n");
             }

@@ -32,6 +32,9 @@ pub struct TsurfFacts {
     pub depth_positive: bool,
     /// Properties of more than one value (`ESIZES`), with their sizes: not kept.
     pub vectors: Vec<(String, usize)>,
+    /// The coordinate system's lines as the first object gives them (`NAME Default`,
+    /// `AXIS_UNIT "m" "m" "ms"`, `PROJECTION ...`, `DATUM ...`): shown, not applied.
+    pub coordinate_system: Vec<String>,
 }
 
 /// One object's vertex ids to the surface's vertex indices.
@@ -143,6 +146,12 @@ impl<'a> Reader<'a> {
                 ));
             }
             "HEADER" => self.in_header = !text.trim_end().ends_with('}'),
+            "NAME" | "AXIS_NAME" | "AXIS_UNIT" | "PROJECTION" | "DATUM"
+                if self.facts.objects == 1 && self.facts.coordinate_system.len() < 16 =>
+            {
+                let line = arbvis_core::input::shorten(text.trim(), 80);
+                self.facts.coordinate_system.push(line.to_string());
+            }
             "ZPOSITIVE" => match tokens.get(1).map(|t| t.1) {
                 Some("Depth") => {
                     self.depth = true;
@@ -413,6 +422,7 @@ mod tests {
                 objects: 2,
                 depth_positive: true,
                 vectors: Vec::new(),
+                coordinate_system: vec!["NAME Default".into()],
             }
         );
         assert_eq!(mesh.vertices.len(), 8);
