@@ -226,3 +226,49 @@ fn a_stride_thins_the_splats_and_one_restores_them() {
     let e = session.params_changed(gpu, &bad).unwrap_err().to_string();
     assert!(e.contains("stride"), "{e}");
 }
+
+/// A layered scene's reduced frames reduce every layer, not only the first (issue 53 item
+/// 2): at a quarter, two 3D-opacity layers each draw a quarter of their slices into a
+/// picture a quarter of each side, exactly as a fresh render of that scene draws it.
+#[test]
+fn a_layered_scenes_reduced_frame_reduces_every_layer() {
+    use arbvis::session::InteractiveQuality;
+    let h = headless(Backend::Egl);
+    let gpu = h.gpu();
+    let layer = |name: &str, seed: u32, offset: f64| {
+        format!("[[layer]]\nname = \"{name}\"\noffset = [{offset}, 0.0, 0.0]\n[layer.opacity3d]\nslices = 96\n[layer.opacity3d.primary]\nvolume = {{ synthetic = {{ size = [19, 13, 17], seed = {seed} }} }}\nattribute = \"amplitude\"\n")
+    };
+    let text = format!(
+        "size = [96, 72]\n[camera]\nrotation = [0.2, -0.3, 0.1, 0.926]\n{}{}",
+        layer("a", 4, 0.0),
+        layer("b", 5, 14.0)
+    );
+    let scene = Scene::parse(&text, "layers.toml").unwrap();
+    let kind = scene.programs.resolve(gpu);
+    let mut session = Session::build(gpu, &scene, kind, true).unwrap();
+    session.quality = InteractiveQuality::Quarter;
+    let pending = session.frame(gpu, &scene, Mode::Interacting).unwrap();
+    assert_eq!(pending, Pending::Refine);
+    let reduced = session.shown().unwrap().read(gpu).unwrap();
+    assert_eq!([reduced.width, reduced.height], [24, 18]);
+    // The scene as the reduced frame should draw it: every layer's cheaper parameters,
+    // a quarter of each side; and as it was drawn when only the first layer was reduced.
+    let reduced_scene = |layers: usize| {
+        let mut s = scene.clone();
+        s.size = [24, 18];
+        for (_, t) in s.layers_mut().take(layers) {
+            *t = t.for_interaction(4.0);
+        }
+        s
+    };
+    let want = fresh_render(&reduced_scene(2));
+    assert!(
+        reduced.data == want.data,
+        "the reduced frame differs from its scene's render"
+    );
+    let first_only = fresh_render(&reduced_scene(1));
+    assert!(
+        first_only.data != want.data,
+        "the second layer's slices change its picture"
+    );
+}

@@ -219,10 +219,11 @@ impl Session {
         }
         let key = self.key(scene);
         let sync = matches!(mode, Mode::Now | Mode::Complete);
+        let layers: Vec<&crate::scene::TechniqueScene> = scene.layers().map(|(_, t)| t).collect();
         self.picture.update(
             gpu,
             &mut *self.renderer,
-            &scene.technique,
+            &layers,
             &key,
             interacting,
             self.quality,

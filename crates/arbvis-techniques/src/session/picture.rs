@@ -221,6 +221,31 @@ pub fn next_scale(scale: f64, ms: f64, budget_ms: f64) -> f64 {
     wanted.clamp(scale / 2.0, scale * 2.0).clamp(1.0, MAX_SCALE)
 }
 
+/// Every layer's renderer takes its cheaper parameters for an image of 1/`scale` of each
+/// side ([`TechniqueScene::for_interaction`]), or its own again (`None`): a one-layer
+/// renderer through `update`, a layered one layer by layer through `update_layer` (a
+/// renderer two layers share keeps its parameters).
+fn reduce(
+    gpu: &Gpu,
+    renderer: &mut dyn Renderer,
+    layers: &[&TechniqueScene],
+    scale: Option<f64>,
+) -> RenderResult<()> {
+    let params = |t: &TechniqueScene| match scale {
+        Some(s) => t.for_interaction(s),
+        None => t.clone(),
+    };
+    match layers {
+        [one] => renderer.update(gpu, params(one).params()),
+        _ => {
+            for (index, layer) in layers.iter().enumerate() {
+                renderer.update_layer(gpu, index, params(layer).params())?;
+            }
+            Ok(())
+        }
+    }
+}
+
 impl Picture {
     /// Draw the full-quality picture again (a streaming renderer has more data for it).
     pub fn refine(&mut self) {
@@ -229,15 +254,15 @@ impl Picture {
         }
     }
 
-    /// Bring the picture up to date with `key`: reduced at `quality` while
-    /// `interacting`, else in full-quality parts within the budget (`sync` draws them
-    /// all now).
+    /// Bring the picture of the scene's `layers` (one for a one-layer scene) up to date
+    /// with `key`: reduced at `quality` while `interacting`, else in full-quality parts
+    /// within the budget (`sync` draws them all now).
     #[allow(clippy::too_many_arguments)]
     pub fn update(
         &mut self,
         gpu: &Gpu,
         renderer: &mut dyn Renderer,
-        technique: &TechniqueScene,
+        layers: &[&TechniqueScene],
         key: &Key,
         interacting: bool,
         quality: InteractiveQuality,
@@ -253,7 +278,7 @@ impl Picture {
         let shown_current = self.shown.as_ref().is_some_and(|p| p.key == *key);
         if (interacting || self.shown.is_none()) && quality != InteractiveQuality::Full && !sync {
             if !shown_current {
-                self.draw_reduced(gpu, renderer, technique, key, quality)?;
+                self.draw_reduced(gpu, renderer, layers, key, quality)?;
             }
             if interacting {
                 self.building = None;
@@ -267,7 +292,7 @@ impl Picture {
         &mut self,
         gpu: &Gpu,
         renderer: &mut dyn Renderer,
-        technique: &TechniqueScene,
+        layers: &[&TechniqueScene],
         key: &Key,
         quality: InteractiveQuality,
     ) -> RenderResult<()> {
@@ -282,9 +307,9 @@ impl Picture {
             renderer.needs_depth(),
         )?;
         target.clear(gpu, key.background)?;
-        renderer.update(gpu, technique.for_interaction(scale).params())?;
+        reduce(gpu, renderer, layers, Some(scale))?;
         let drawn = renderer.draw(gpu, Surface::Target(&target), &frame);
-        renderer.update(gpu, technique.params())?;
+        reduce(gpu, renderer, layers, None)?;
         drawn?;
         gpu.finish();
         self.interactive_ms = t0.elapsed().as_secs_f64() * 1e3;
