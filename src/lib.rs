@@ -19,7 +19,7 @@ pub use arbvis_data::{fetch, lines, mesh, points, store, surface, volume};
 pub use arbvis_gl as gl;
 pub use arbvis_gl::{gl_check, gl_check_alloc, gl_debug_check};
 pub use arbvis_techniques::{
-    annotate, catalog, info, inspect, programs, render, scene, session, study, techniques,
+    annotate, catalog, info, inspect, layered, programs, render, scene, session, study, techniques,
 };
 #[cfg(feature = "viewer")]
 pub use arbvis_viewer as viewer;

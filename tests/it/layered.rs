@@ -474,6 +474,74 @@ fn a_segy_survey_lies_at_its_cdp_coordinates() {
     assert!((last.z + 296.0).abs() < 1e-6, "{last}");
 }
 
+/// A survey store is a 3D-opacity layer (issue 55): F3 converted into a store lies where
+/// the SEG-Y lies (the same world, to f64 rounding of the CDP corners read from the
+/// store's coordinate arrays); a layered scene of the store alone draws exactly its
+/// one-technique picture; beside a horizon it draws; a window of the store is refused by
+/// its layer.
+#[test]
+fn a_survey_store_is_a_layer_where_its_segy_lies() {
+    let h = headless(Backend::Egl);
+    let dir = common::temp_dir("layered-store");
+    let f3 = common::data_file("seismic/f3.sgy");
+    let store = dir.join("f3.zarr");
+    crate::mdio::convert_quietly(&f3, &store, Some(8));
+    let volume =
+        |v: String| format!("[layer.opacity3d.primary]\nvolume = {v}\nattribute = \"amplitude\"\n");
+    let segy = volume(format!("{{ segy = \"{}\" }}", f3.display()));
+    let zarr = volume(format!("{{ store = \"{}\" }}", store.display()));
+    let worlds: Vec<_> = [&segy, &zarr]
+        .iter()
+        .map(|layer| {
+            let scene = parse(&format!("[[layer]]\nname = \"F3\"\n{layer}")).unwrap();
+            prepared_in_world(&scene, 0).1
+        })
+        .collect();
+    let (a, b) = (worlds[0], worlds[1]);
+    // Metres at 6e6 in f64, through two sums: a micrometre.
+    assert!(
+        (a.centre - b.centre).abs().max_element() < 1e-6,
+        "{a:?} {b:?}"
+    );
+    assert!((a.half - b.half).abs().max_element() < 1e-12, "{a:?} {b:?}");
+    assert!((a.units - b.units).abs() < 1e-9 && a.rotation.abs_diff_eq(b.rotation, 1e-12));
+    // The store's layer draws what the store alone draws under the layer's placement:
+    // the same renderer, the same bricks, the same pixels.
+    let head = "size = [72, 56]\nfidelity = \"precise\"\n[camera]\nrotation = [0.31, -0.22, 0.12, 0.917]\n";
+    let layered = format!("{head}[[layer]]\nname = \"F3\"\n{zarr}");
+    let mut alone = parse(&format!(
+        "{head}{}",
+        zarr.replace("[layer.opacity3d", "[technique.opacity3d")
+    ))
+    .unwrap();
+    alone.camera.placement = arbvis::layered::placements(&[b])[0];
+    let draw = |text: &str| render_on(&h, &parse(text).unwrap()).unwrap().image;
+    let got = draw(&layered);
+    let want = render_on(&h, &alone).unwrap().image;
+    assert_eq!(got.compare(&want, 0.0).unwrap().pixels_over, 0);
+    assert!(
+        common::lit_pixels(&got, 0.05) > 500,
+        "the survey is in view"
+    );
+    // Beside the tracked horizon (its own file's coordinates).
+    let horizon = format!(
+        "[[layer]]\nname = \"horizon\"\n[layer.surface]\nfile = \"{}\"\ncolour = [0.9, 0.75, 0.2]\n",
+        common::data_file("seismic/f3-horizon.ts").display()
+    );
+    let both = draw(&format!("{layered}{horizon}"));
+    assert!(
+        both.compare(&got, 0.0).unwrap().pixels_over > 100,
+        "the horizon shows"
+    );
+    let windowed =
+        format!("{layered}[layer.opacity3d.store]\nwindow = [[0, 0, 0], [40, 18, 23]]\n");
+    let e = render_on(&h, &parse(&windowed).unwrap())
+        .err()
+        .expect("refused")
+        .to_string();
+    assert!(e.contains("F3") && e.contains("a window of a store"), "{e}");
+}
+
 /// A layered scene's memory estimate says which layer makes each allocation.
 #[test]
 fn the_memory_estimate_names_each_layer() {

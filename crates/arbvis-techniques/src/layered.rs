@@ -155,7 +155,7 @@ pub fn build(
                 .map_err(|e| in_layer(index, info, e))?;
             let world = crate::catalog::world(technique, &data).ok_or_else(|| {
                 let why = RenderError::Unplaced(format!(
-                    "a {} layer has no place in a world frame yet (a layered scene takes surfaces, clouds, meshes and volumes read whole, not survey stores or the quad)",
+                    "a {} layer has no place in a world frame yet (a layered scene takes surfaces, lines, sections, clouds, meshes, volumes and whole survey stores, not a window of a store or the quad)",
                     technique.name()
                 ));
                 in_layer(index, info, why)

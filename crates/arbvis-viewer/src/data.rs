@@ -187,7 +187,10 @@ fn build_volume(
         gpu,
         &scene.settings(),
         kind,
-        Box::new(Some(prepared)),
+        Box::new(arbvis_techniques::techniques::opacity3d::Prepared3d {
+            whole: Some(prepared),
+            store_world: None,
+        }),
     )
 }
 

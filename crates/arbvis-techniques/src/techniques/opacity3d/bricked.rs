@@ -164,6 +164,30 @@ pub struct StoreScene {
 }
 
 impl StoreScene {
+    /// Where the store lies in the world, as the same survey read whole lies (its traces at
+    /// their CDP coordinates where the store has them, its samples downwards); `None` for a
+    /// window of it (`store.window`: not placed in a layered scene yet).
+    pub fn world(&self) -> RenderResult<Option<crate::techniques::world::World>> {
+        use crate::techniques::world::World;
+        let meta = &self.store.meta;
+        if self.pyramid.window != [[0; 3], meta.dims] {
+            return Ok(None);
+        }
+        let [_, nj, nk] = meta.dims;
+        let map = self.store.map_coordinates()?.and_then(|xy| {
+            arbvis_data::volume::segy::geometry::MapFrame::of_corners(nj, nk, |k, j| {
+                let t = k * nj + j;
+                Some([*xy[0].get(t)?, *xy[1].get(t)?])
+            })
+        });
+        let size = glam::DVec3::from_array(std::array::from_fn(|a| {
+            let s = self.pyramid.spacing[a];
+            meta.dims[a] as f64 * if s.is_finite() && s > 0.0 { s } else { 1.0 }
+        }));
+        let half = self.pyramid.half();
+        Ok(Some(World::of_survey(meta.dims, size, half, map.as_ref())))
+    }
+
     /// Open the store `params` names (relative to `base`), if it names one.
     pub fn open(params: &Opacity3dScene, base: &Path) -> RenderResult<Option<StoreScene>> {
         let Some(path) = store_of(params)? else {

@@ -81,6 +81,16 @@ use arbvis_gl::{Filter, ProgramChoice};
 
 pub use renderer::Opacity3dRenderer;
 
+/// What 3D opacity prepares: the volume read whole, or for a survey store (read brick by
+/// brick by its renderer) only where it lies.
+#[derive(Debug)]
+pub struct Prepared3d {
+    /// The volume, read whole; `None` for a store.
+    pub whole: Option<prepare::Prepared>,
+    /// A store's place in the world (`None` for a window of it).
+    pub store_world: Option<crate::techniques::world::World>,
+}
+
 /// Sum (eq. 1) or product (eqs. 2-3).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -252,28 +262,35 @@ impl crate::techniques::Technique for Opacity3dScene {
     }
 
     /// The volume prepared whole; `None` for a survey store, streamed by its renderer.
-    type Prepared = Option<prepare::Prepared>;
+    type Prepared = Prepared3d;
 
     fn prepare(
         &self,
         settings: &crate::techniques::Settings<'_>,
         limits: &arbvis_data::volume::Limits,
-    ) -> crate::error::RenderResult<Option<prepare::Prepared>> {
-        if bricked::store_of(self)?.is_some() {
-            return Ok(None);
+    ) -> crate::error::RenderResult<Prepared3d> {
+        if let Some(store) = bricked::StoreScene::open(self, settings.base)? {
+            return Ok(Prepared3d {
+                whole: None,
+                store_world: store.world()?,
+            });
         }
         Opacity3dScene::validate(self)?;
-        prepare::prepare(self, settings.base, limits).map(Some)
+        let whole = prepare::prepare(self, settings.base, limits)?;
+        Ok(Prepared3d {
+            whole: Some(whole),
+            store_world: None,
+        })
     }
 
     /// The primary attribute's colour through its table where each point lies (a
     /// horizon coloured by its survey).
     fn colours_at(
         &self,
-        prepared: &Option<prepare::Prepared>,
+        prepared: &Prepared3d,
         points: &[glam::DVec3],
     ) -> Option<Vec<Option<[f64; 3]>>> {
-        let p = prepared.as_ref()?;
+        let p = prepared.whole.as_ref()?;
         Some(points.iter().map(|&x| p.primary_colour_at(x)).collect())
     }
 
@@ -282,15 +299,14 @@ impl crate::techniques::Technique for Opacity3dScene {
         self.raycast = None;
     }
 
-    /// A survey hangs from the origin with its samples downwards; other volumes keep
-    /// their grid's axes, first voxel at the origin. None for a store (drawn brick by
-    /// brick, not yet placed in a layered scene).
-    fn world(
-        &self,
-        prepared: &Option<prepare::Prepared>,
-    ) -> Option<crate::techniques::world::World> {
+    /// A survey hangs from the origin with its samples downwards (a store as the survey
+    /// read whole); other volumes keep their grid's axes, first voxel at the origin. None
+    /// for a window of a store.
+    fn world(&self, prepared: &Prepared3d) -> Option<crate::techniques::world::World> {
         use crate::techniques::world::World;
-        let p = prepared.as_ref()?;
+        let Some(p) = prepared.whole.as_ref() else {
+            return prepared.store_world;
+        };
         if self.primary.volume.data_kind() == arbvis_data::sniff::DataKind::Survey {
             return Some(World::of_survey(p.dims, p.size, p.half, p.map.as_ref()));
         }
@@ -303,10 +319,10 @@ impl crate::techniques::Technique for Opacity3dScene {
     /// reference spacing); none for a store (drawn brick by brick) or a clipped scene.
     fn reference(
         &self,
-        prepared: &Option<prepare::Prepared>,
+        prepared: &Prepared3d,
         view: &crate::techniques::ReferenceView<'_>,
     ) -> Option<arbvis_core::image::Image> {
-        let prepared = prepared.as_ref().filter(|_| self.clip.is_none())?;
+        let prepared = prepared.whole.as_ref().filter(|_| self.clip.is_none())?;
         Some(reference::reference(
             prepared,
             self,
@@ -322,10 +338,10 @@ impl crate::techniques::Technique for Opacity3dScene {
         gpu: &arbvis_gl::Gpu,
         settings: &crate::techniques::Settings<'_>,
         kind: arbvis_gl::ProgramKind,
-        prepared: Option<prepare::Prepared>,
+        prepared: Prepared3d,
     ) -> crate::error::RenderResult<Box<dyn crate::techniques::Renderer>> {
         let fidelity = settings.fidelity;
-        let Some(prepared) = prepared else {
+        let Some(prepared) = prepared.whole else {
             let kind = if fidelity == Fidelity::Precise && settings.programs == ProgramChoice::Auto
             {
                 arbvis_gl::ProgramKind::Glsl
