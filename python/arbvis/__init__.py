@@ -16,7 +16,9 @@ colour table of an array or a matplotlib colormap; `info()` reports the driver; 
 `inspect` and `convert`; `read_png`, `write_png`, `compare` and `diff_image` read, write and compare pictures
 as the Rust tests do. Errors are `ArbvisError` and its subclasses `SceneError`, `InputError`,
 `GLError`, `RenderError`. The pytest plugin (`arbvis.pytest_plugin`, loaded by pytest)
-adds the `arbvis_image` fixture; `arbvis.dask` renders many views on a Dask cluster.
+adds the `arbvis_image` fixture; `arbvis.dask` renders many views on a Dask cluster;
+`arbvis.notebook.View(scene)` shows a scene in a notebook and turns it with the mouse
+(anywidget).
 """
 
 from ._arbvis import (  # noqa: F401

@@ -67,6 +67,18 @@ pub fn read_png(py: Python<'_>, path: PathBuf) -> PyResult<Bound<'_, PyAny>> {
     Ok(to_u8_array(py, &image))
 }
 
+/// An `(height, width, 4)` array (uint8, or float32 in 0..1) as the bytes of an 8-bit PNG
+/// (what a notebook view sends to the page).
+#[pyfunction]
+pub fn png_bytes<'py>(
+    py: Python<'py>,
+    array: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, pyo3::types::PyBytes>> {
+    let image = levels(image_of(array)?);
+    let bytes = png_io::encode_png("picture", &image, &[]).map_err(crate::errors::input_error)?;
+    Ok(pyo3::types::PyBytes::new(py, &bytes))
+}
+
 /// Write an `(height, width, 4)` array (uint8, or float32 in 0..1) as an 8-bit PNG,
 /// atomically.
 #[pyfunction]

@@ -68,6 +68,7 @@ fn _arbvis(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(tools::fetch_stats, m)?)?;
     m.add_function(wrap_pyfunction!(images::read_png, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_png, m)?)?;
+    m.add_function(wrap_pyfunction!(images::png_bytes, m)?)?;
     m.add_function(wrap_pyfunction!(images::compare, m)?)?;
     m.add_function(wrap_pyfunction!(images::diff_image, m)?)?;
     Ok(())
