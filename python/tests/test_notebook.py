@@ -2,8 +2,8 @@
 frames are the renderer's pictures as PNG; the page's drags turn the scene (smaller
 frames within the budget while dragging, the full picture on release), its wheel zooms,
 its resizes are clamped; what the page sends that is not a message is said and ignored;
-edits made from Python show; two views live side by side. (The page itself, in a
-browser, is not tested here: see the note of issue 56.)"""
+edits made from Python show; two views live side by side. (The page in a browser:
+test_notebook_browser.py.)"""
 
 import numpy as np
 import pytest
