@@ -22,6 +22,7 @@ done
 "$arbvis" render scenes/data/bracket-layers.toml --legend -o "$out/data-bracket-layers.png"
 "$arbvis" render scenes/data/f3-horizon.toml --legend -o "$out/data-f3-horizon.png"
 "$arbvis" render scenes/data/f3-interpretation.toml --legend --axes -o "$out/data-f3-interpretation.png"
+"$arbvis" render scenes/data/f3-interpretation.toml --fidelity precise --legend --axes -o "$out/data-f3-interpretation-precise.png"
 "$arbvis" render scenes/bench/cellproj-seed-volume.toml -o "$out/cellproj-seed-volume.png"
 # The README's Python example (scripts/python-tests.sh makes target/python-venv).
 if [ -x target/python-venv/bin/python ]; then

@@ -12,7 +12,8 @@
 //!   over an 8-bit copy of the picture; only the pixels the overlay changes are written
 //!   back (opaque), so the rest keeps a float target's precision.
 //! - Legends stack in the top right corner, text in white on dark backgrounds and black on
-//!   light ones (read from the picture's corner). Each axis is drawn along the box edge
+//!   light ones (read from the picture's corner), over a panel of that background at 75 %
+//!   (a white section or a bright surface behind a legend would hide its white numbers). Each axis is drawn along the box edge
 //!   parallel to it that lies farthest out on screen, its labels outside the box; an axis
 //!   seen nearly end on (shorter than four text heights) is left out.
 
@@ -62,6 +63,7 @@ pub fn draw(
         .collect();
     let before = buffer.clone();
     let ink = ink_for(&buffer);
+    let backdrop = plotters::style::RGBColor(buffer[0], buffer[1], buffer[2]);
     {
         use plotters::prelude::*;
         let area = BitMapBackend::with_buffer(&mut buffer, (w, h)).into_drawing_area();
@@ -77,7 +79,7 @@ pub fn draw(
             }
         }
         if show.legend {
-            draw_legends(&area, &annotations.legends, [w, h], size, ink)?;
+            draw_legends(&area, &annotations.legends, [w, h], size, (ink, backdrop))?;
         }
         area.present().map_err(AnnotateError::Draw)?;
     }
@@ -162,12 +164,23 @@ pub fn first_bar(w: u32, h: u32) -> [i32; 4] {
     ]
 }
 
+/// The height in pixels of `legend` in the stack (text `size`).
+fn legend_height(legend: &Legend, size: f64) -> i32 {
+    let line = (size * 1.3) as i32;
+    match legend {
+        Legend::Bar { .. } => line + (size * 0.9) as i32 + 2 + line + line / 2,
+        Legend::Keys { keys, .. } => line + keys.len() as i32 * line + line / 2,
+    }
+}
+
+/// The legends stacked in the top right corner, over a panel of the background
+/// (`colours`: the text's ink and the backdrop).
 fn draw_legends(
     area: &Area<'_>,
     legends: &[Legend],
     [w, h]: [u32; 2],
     size: f64,
-    ink: plotters::style::RGBColor,
+    (ink, backdrop): (plotters::style::RGBColor, plotters::style::RGBColor),
 ) -> Result<(), AnnotateError> {
     use plotters::prelude::*;
     use plotters::style::text_anchor::{HPos, VPos};
@@ -175,6 +188,18 @@ fn draw_legends(
     let right = left + width;
     let line = (size * 1.3) as i32;
     let mut y = size as i32;
+    if !legends.is_empty() {
+        let pad = (size / 2.0) as i32;
+        let bottom = y + legends.iter().map(|l| legend_height(l, size)).sum::<i32>();
+        area.draw(&Rectangle::new(
+            [
+                (left - pad, y - pad),
+                (right + pad, bottom - line / 2 + pad),
+            ],
+            backdrop.mix(0.75).filled(),
+        ))
+        .map_err(AnnotateError::Draw)?;
+    }
     for legend in legends {
         match legend {
             Legend::Bar {
