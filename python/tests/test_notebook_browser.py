@@ -8,6 +8,7 @@ shows, and that the second view turns on its own.
 Needs Chromium (`scripts/install-deps.sh` installs Debian's); without it the test says so
 and is skipped, unless ARBVIS_NO_SKIP=1 (set by .ci/run) makes that a failure."""
 
+import contextlib
 import json
 import os
 import shutil
@@ -58,22 +59,19 @@ def free_port():
         return s.getsockname()[1]
 
 
-@pytest.fixture
-def lab(tmp_path):
-    """A JupyterLab server over `tmp_path` (with the notebook): its URL and token."""
-    if CHROMIUM is None:
-        if os.environ.get("ARBVIS_NO_SKIP") == "1":
-            pytest.fail("no Chromium for the notebook view's browser test (scripts/install-deps.sh installs it)")
-        pytest.skip("no Chromium (scripts/install-deps.sh installs Debian's)")
-    (tmp_path / "view.ipynb").write_text(json.dumps(notebook(CELLS)))
+@contextlib.contextmanager
+def serve_lab(directory):
+    """A JupyterLab server over `directory` on a free local port: its URL and token;
+    stopped by its PID on leaving."""
     port, token = free_port(), os.urandom(16).hex()
     bin_dir = Path(sys.executable).parent
-    log = open(tmp_path / "server.log", "w")
+    log_path = Path(directory) / "server.log"
+    log = open(log_path, "w")
     server = subprocess.Popen(
         [
             str(bin_dir / "jupyter"), "lab", "--no-browser", "--allow-root",
             f"--port={port}", "--ServerApp.ip=127.0.0.1",
-            f"--IdentityProvider.token={token}", f"--ServerApp.root_dir={tmp_path}",
+            f"--IdentityProvider.token={token}", f"--ServerApp.root_dir={directory}",
             "--LabApp.expose_app_in_browser=True", "--LabApp.news_url=None",
             "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
         ],
@@ -85,7 +83,7 @@ def lab(tmp_path):
     try:
         deadline = time.monotonic() + 60
         while True:
-            assert server.poll() is None, (tmp_path / "server.log").read_text()[-2000:]
+            assert server.poll() is None, log_path.read_text()[-2000:]
             try:
                 urllib.request.urlopen(f"{url}/api/status?token={token}", timeout=1)
                 break
@@ -103,6 +101,38 @@ def lab(tmp_path):
         log.close()
 
 
+def open_notebook(page, url, token, name):
+    """Open notebook `name` in JupyterLab and wait until its kernel is connected."""
+    page.goto(f"{url}/lab/tree/{name}?token={token}")
+    page.wait_for_function(
+        "(() => { const w = window.jupyterapp && window.jupyterapp.shell.currentWidget;"
+        " const k = w && w.sessionContext && w.sessionContext.session && w.sessionContext.session.kernel;"
+        " return k && k.connectionStatus === 'connected'; })()",
+        timeout=60_000,
+    )
+
+
+def run_cell(page, index):
+    """Run cell `index` of the open notebook."""
+    page.evaluate(
+        "(i) => { const nb = window.jupyterapp.shell.currentWidget; nb.content.activeCellIndex = i;"
+        " return window.jupyterapp.commands.execute('notebook:run-cell'); }",
+        index,
+    )
+
+
+@pytest.fixture
+def lab(tmp_path):
+    """A JupyterLab server over `tmp_path` (with the notebook): its URL and token."""
+    if CHROMIUM is None:
+        if os.environ.get("ARBVIS_NO_SKIP") == "1":
+            pytest.fail("no Chromium for the notebook view's browser test (scripts/install-deps.sh installs it)")
+        pytest.skip("no Chromium (scripts/install-deps.sh installs Debian's)")
+    (tmp_path / "view.ipynb").write_text(json.dumps(notebook(CELLS)))
+    with serve_lab(tmp_path) as served:
+        yield served
+
+
 def test_the_view_shows_turns_and_follows_python_in_a_browser(lab):
     from playwright.sync_api import sync_playwright
 
@@ -111,20 +141,7 @@ def test_the_view_shows_turns_and_follows_python_in_a_browser(lab):
         browser = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
         try:
             page = browser.new_page(viewport={"width": 1200, "height": 900})
-            page.goto(f"{url}/lab/tree/view.ipynb?token={token}")
-            page.wait_for_function(
-                "(() => { const w = window.jupyterapp && window.jupyterapp.shell.currentWidget;"
-                " const k = w && w.sessionContext && w.sessionContext.session && w.sessionContext.session.kernel;"
-                " return k && k.connectionStatus === 'connected'; })()",
-                timeout=60_000,
-            )
-
-            def run_cell(index):
-                page.evaluate(
-                    "(i) => { const nb = window.jupyterapp.shell.currentWidget; nb.content.activeCellIndex = i;"
-                    " return window.jupyterapp.commands.execute('notebook:run-cell'); }",
-                    index,
-                )
+            open_notebook(page, url, token, "view.ipynb")
 
             def frames(n):
                 return int(page.locator("img.arbvis-view").nth(n).get_attribute("data-frames") or 0)
@@ -148,8 +165,8 @@ def test_the_view_shows_turns_and_follows_python_in_a_browser(lab):
                         return count
                     count = now
 
-            run_cell(0)
-            run_cell(1)
+            run_cell(page, 0)
+            run_cell(page, 1)
             first_frames, second_frames = settled(0, 0), settled(1, 0)
             views = page.locator("img.arbvis-view")
             assert views.count() == 2
@@ -174,7 +191,7 @@ def test_the_view_shows_turns_and_follows_python_in_a_browser(lab):
             assert turned != before[0], "the drag turned the first view"
             assert views.nth(1).screenshot() == before[1]
 
-            run_cell(2)  # an edit made from Python: a closer zoom
+            run_cell(page, 2)  # an edit made from Python: a closer zoom
             settled(0, first_frames)
             assert views.nth(0).screenshot() != turned, "the edit from Python shows"
 
