@@ -16,7 +16,7 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 "$venv/bin/python" -m pip install -q --disable-pip-version-check \
   "maturin>=1.5,<2" numpy pytest "dask[distributed]" xarray laspy meshio anywidget \
-  jupyterlab playwright
+  jupyterlab playwright nbclient zarr
 # Not pyproject.toml's release profile: the dev profile with the test profile's opt-level
 # (Cargo.toml), so that the extension reuses `cargo test`'s crates instead of compiling them
 # again (maturin's `--profile test` would build a test harness, not a library).
