@@ -64,6 +64,32 @@ fn a_wells_tube_follows_its_path_and_its_log() {
     }
 }
 
+/// The lines scene `text` drawn at `fidelity` with `programs` into a float target on
+/// black, and its f64 reference.
+pub fn drawn_and_reference(
+    h: &arbvis::gl::Headless,
+    text: &str,
+    fidelity: Fidelity,
+    programs: ProgramChoice,
+) -> (arbvis::image::Image, arbvis::image::Image) {
+    let mut scene = Scene::parse(text, "w.toml").unwrap();
+    (scene.fidelity, scene.programs) = (fidelity, programs);
+    scene.target = Some(TargetFormat::Rgba32f);
+    scene.background = [0.0; 4];
+    let gpu = render_on(h, &scene).unwrap().image;
+    let limits = arbvis::volume::Limits::for_max_side(2048);
+    let view = arbvis::techniques::ReferenceView {
+        camera: scene.camera,
+        size: scene.size,
+        background: [0.0; 4],
+        base: std::path::Path::new(""),
+    };
+    let cpu = arbvis::catalog::reference(&scene.technique, &scene.settings(), &limits, &view)
+        .unwrap()
+        .unwrap();
+    (gpu, cpu)
+}
+
 /// A well's tube drawn on the GPU against the surface reference it is drawn as, at an odd
 /// size and a rotated perspective camera: as the surface test bounds it.
 #[test]
@@ -76,22 +102,7 @@ fn a_wells_tube_matches_its_reference() {
                 // A thick tube: 60 m across a frame of the well's 300 m depth.
                 f3_well("").replace("radius = 7.0", "radius = 30.0")
             );
-            let mut scene = Scene::parse(&text, "w.toml").unwrap();
-            (scene.fidelity, scene.programs) = (fidelity, programs);
-            scene.target = Some(TargetFormat::Rgba32f);
-            scene.background = [0.0; 4];
-            let gpu = render_on(&h, &scene).unwrap().image;
-            let technique = &scene.technique;
-            let limits = arbvis::volume::Limits::for_max_side(2048);
-            let view = arbvis::techniques::ReferenceView {
-                camera: scene.camera,
-                size: scene.size,
-                background: [0.0; 4],
-                base: std::path::Path::new(""),
-            };
-            let cpu = arbvis::catalog::reference(technique, &scene.settings(), &limits, &view)
-                .unwrap()
-                .unwrap();
+            let (gpu, cpu) = drawn_and_reference(&h, &text, fidelity, programs);
             // Precise: the surface programs' per-pixel headlight in f32 against f64 (measured
             // 1.2e-4 at most); a pixel whose centre lies within f32 rounding of a triangle's
             // edge may take the other triangle or the background: 1 % of the pixels over a

@@ -5,7 +5,7 @@
 
 use crate::common;
 
-use arbvis::gl::{Backend, ProgramChoice, TargetFormat};
+use arbvis::gl::{Backend, ProgramChoice};
 use arbvis::image::Image;
 use arbvis::render::render_on;
 use arbvis::scene::{Fidelity, Scene};
@@ -118,22 +118,7 @@ fn ribbons_match_their_reference() {
                 let text = format!(
                     "size = [71, 93]\n[camera]\nprojection = \"perspective\"\nrotation = [-0.35, 0.12, 0.2, 0.906]\n{well}width = {width}\n"
                 );
-                let mut scene = Scene::parse(&text, "w.toml").unwrap();
-                (scene.fidelity, scene.programs) = (fidelity, programs);
-                scene.target = Some(TargetFormat::Rgba32f);
-                scene.background = [0.0; 4];
-                let gpu = render_on(&h, &scene).unwrap().image;
-                let limits = arbvis::volume::Limits::for_max_side(2048);
-                let view = arbvis::techniques::ReferenceView {
-                    camera: scene.camera,
-                    size: scene.size,
-                    background: [0.0; 4],
-                    base: std::path::Path::new(""),
-                };
-                let cpu =
-                    arbvis::catalog::reference(&scene.technique, &scene.settings(), &limits, &view)
-                        .unwrap()
-                        .unwrap();
+                let (gpu, cpu) = crate::lines::drawn_and_reference(&h, &text, fidelity, programs);
                 let d = gpu.compare(&cpu, LEVEL).unwrap();
                 let pixels = 71 * 93;
                 let lit = common::lit_pixels(&gpu, 0.05);

@@ -216,10 +216,20 @@ fn ribbons(lines: &[Vec<DVec3>], corner: impl Fn(DVec3, (f64, DVec3)) -> DVec3) 
                 first + 2 * i + 3,
                 first + 2 * i + 2,
             );
-            triangles.push([a, b, c]);
-            triangles.push([a, c, d]);
+            push_quad(&mut triangles, [a, b, c, d]);
         }
     }
+    mesh(vertices, triangles)
+}
+
+/// The quad `a b c d` (in order round it) as two triangles.
+fn push_quad(triangles: &mut Vec<[u32; 3]>, [a, b, c, d]: [u32; 4]) {
+    triangles.push([a, b, c]);
+    triangles.push([a, c, d]);
+}
+
+/// A mesh of `vertices` and `triangles`, without properties.
+fn mesh(vertices: Vec<[f64; 3]>, triangles: Vec<[u32; 3]>) -> TriangleMesh {
     TriangleMesh {
         vertices,
         triangles,
@@ -260,16 +270,11 @@ pub fn tubes(lines: &[Vec<DVec3>], sides: usize, radius: impl Fn(DVec3) -> f64) 
                     ring(i + 1, k + 1),
                     ring(i + 1, k),
                 );
-                triangles.push([a, b, c]);
-                triangles.push([a, c, d]);
+                push_quad(&mut triangles, [a, b, c, d]);
             }
         }
     }
-    TriangleMesh {
-        vertices,
-        triangles,
-        properties: Vec::new(),
-    }
+    mesh(vertices, triangles)
 }
 
 #[cfg(test)]
