@@ -111,7 +111,7 @@ fn scene_of(tree: &serde_json::Value, base: PathBuf, key: Option<&str>) -> PyRes
         };
         errors::scene_error(message, At::key(key))
     };
-    let value = toml_of(tree).map_err(bad)?;
+    let value = toml_of(tree).map_err(|e| bad(e.to_string()))?;
     let text = toml::to_string(&value).map_err(|e| bad(e.to_string()))?;
     match Scene::parse(&text, "scene") {
         Ok(mut scene) => {
@@ -142,26 +142,24 @@ fn scene_of(tree: &serde_json::Value, base: PathBuf, key: Option<&str>) -> PyRes
 /// The TOML value of a JSON tree: a null in an array is `nan` (a numpy array's NaN crosses
 /// JSON as null: a value of none where a scene takes one, refused by key elsewhere), a
 /// null in a table no key.
-fn toml_of(json: &serde_json::Value) -> Result<toml::Value, String> {
+fn toml_of(json: &serde_json::Value) -> Result<toml::Value, toml::ser::Error> {
     use serde_json::Value as J;
     Ok(match json {
-        J::Null => return Err("null is no value a scene holds".into()),
+        // A null stands only in an array here (a table's null keys are left out below).
+        J::Null => toml::Value::Float(f64::NAN),
         J::Array(items) => toml::Value::Array(
             items
                 .iter()
-                .map(|v| match v {
-                    J::Null => Ok(toml::Value::Float(f64::NAN)),
-                    v => toml_of(v),
-                })
-                .collect::<Result<_, _>>()?,
+                .map(toml_of)
+                .collect::<Result<_, toml::ser::Error>>()?,
         ),
         J::Object(map) => toml::Value::Table(
             map.iter()
                 .filter(|(_, v)| !v.is_null())
                 .map(|(k, v)| Ok((k.clone(), toml_of(v)?)))
-                .collect::<Result<_, String>>()?,
+                .collect::<Result<_, toml::ser::Error>>()?,
         ),
-        other => toml::Value::try_from(other).map_err(|e| e.to_string())?,
+        other => toml::Value::try_from(other)?,
     })
 }
 

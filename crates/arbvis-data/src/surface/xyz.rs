@@ -239,6 +239,20 @@ pub fn parse_with_grid(name: &Path, bytes: &[u8]) -> Result<(TriangleMesh, XyzGr
             ),
         ));
     }
+    triangulated(name, nodes, columns, undefined)
+}
+
+/// The surface of the defined `nodes` (three or more): on their inline/crossline lattice
+/// where `columns` give one, else by Delaunay; `columns`' other values as properties.
+fn triangulated(
+    name: &Path,
+    nodes: Vec<Node>,
+    columns: Option<Columns>,
+    undefined: usize,
+) -> Result<(TriangleMesh, XyzGrid), SurfaceError> {
+    let error = |line: usize, column: usize, message: String| {
+        SurfaceError::format(name, Position::Line { line, column }, message)
+    };
     let (triangles, lattice) = match columns.as_ref().and_then(|c| c.lines) {
         Some(_) => {
             let (triangles, shape) =
