@@ -393,12 +393,14 @@ fn layer_editors(ui: &mut egui::Ui, scene: &mut Scene, cx: &mut EditContext<'_>)
             if cx.widgets.add(ui, &format!("{name} down"), &down) && down.clicked() {
                 moved = Some((index, index + 1));
             }
-            ui.label(&name);
+            // Long names end in an ellipsis rather than widen the panel.
+            ui.add(egui::Label::new(&name).truncate());
         });
         if let Some(face) = face_mut(technique) {
             cx.layer = Some((index, info.name.clone()));
             let label = format!("{name} settings");
-            let r = egui::CollapsingHeader::new(&label)
+            // Shown as "settings" under the layer's row; recorded by the whole label.
+            let r = egui::CollapsingHeader::new("settings")
                 .id_salt(("layer", index))
                 .show(ui, |ui| changed |= face.editors(ui, cx));
             // Recorded, so that a script opens it as a user does (`click ... settings`).
