@@ -442,3 +442,25 @@ fn legends_name_colours_and_axes_carry_units() {
         assert!(f3.iter().any(|n| n == want), "{want} not in {f3:?}");
     }
 }
+
+/// The interpretation scene's six layers keep to the panel (`check layout`: every control
+/// whole inside the window): its longest layer name overflowed the panel before names
+/// were truncated and the settings headers shortened.
+#[test]
+fn a_layered_scenes_layer_list_keeps_to_the_panel() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/data/f3-interpretation.toml");
+    let Some((dir, stdout)) = run_script_on(
+        Some("1280x1024"),
+        "layer-list-layout",
+        scene.to_str().unwrap(),
+        "",
+        "wait 2\ncheck layout\n",
+    ) else {
+        return;
+    };
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        stdout.contains("controls whole inside"),
+        "the layout check ran: {stdout}"
+    );
+}
