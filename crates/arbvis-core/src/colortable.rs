@@ -37,7 +37,7 @@ pub struct TableSpec {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub alpha: Vec<[f64; 2]>,
     /// Alpha from the data's own distribution ([`alpha_from_histogram`]) instead of the
-    /// table's: by default (`None`) for a survey's attribute (SEG-Y) whose scene gives no
+    /// table's: by default (`None`) for a survey's attribute (SEG-Y, a store) whose scene gives no
     /// `alpha`, no `file` and no `colors`; `false` keeps the table's own alpha, `true` asks for it on
     /// any volume.
     #[serde(default, skip_serializing_if = "Option::is_none")]

@@ -149,6 +149,33 @@ pub fn store_of(params: &Opacity3dScene) -> Result<Option<PathBuf>, FieldError> 
     }
 }
 
+/// Most voxels read to learn a store's distribution (16 MiB of f32).
+const DISTRIBUTION_VOXELS: usize = 1 << 22;
+
+/// The alpha of the distribution of attribute `index` over `low..high`
+/// ([`arbvis_core::colortable::alpha_from_histogram`]), read from the finest level of at
+/// most [`DISTRIBUTION_VOXELS`]: level 0 itself where the survey is that small (then the
+/// alpha is exactly the survey read whole's), else a level whose voxels are the means of
+/// the ones they cover (a narrower distribution: an approximation a store larger than
+/// memory cannot avoid). NaN (no data) is left out. A level that cannot be read (a damaged
+/// chunk, which streaming reports brick by brick) gives way to the next coarser one;
+/// `None` where none can be read (the table keeps its own alpha).
+fn alpha_of_store(store: &Store, index: usize, low: f64, high: f64) -> Option<[u8; 256]> {
+    let last = store.meta.levels.saturating_sub(1);
+    let fits =
+        |l: &usize| store.meta.level_dims(*l).iter().product::<usize>() <= DISTRIBUTION_VOXELS;
+    let first = (0..last).find(fits).unwrap_or(last);
+    let values = (first..=last).find_map(|level| {
+        let dims = store.meta.level_dims(level);
+        store.region(index, level, [0; 3], dims).ok()
+    })?;
+    let mut counts = [0u64; 256];
+    for &v in values.iter().filter(|v| !v.is_nan()) {
+        counts[arbvis_data::volume::quantize::quantize_value(v, low, high) as usize] += 1;
+    }
+    Some(arbvis_core::colortable::alpha_from_histogram(&counts))
+}
+
 /// A scene's store opened: its view settings, the window's pyramid, and per scene
 /// attribute the store's attribute index and quantization range (what the renderers and
 /// the viewer's sections share).
@@ -270,6 +297,9 @@ pub struct BrickedRenderer {
     /// What NaN ("no data": dead traces) became in each attribute's levels; where level 0
     /// is reserved for it, the table's entry 0 is cleared, so no data is transparent.
     no_data: [NoData; 3],
+    /// Per attribute, the alpha of the store's own distribution over its range (for a
+    /// table that takes its alpha from the data, as a survey read whole does).
+    data_alpha: [Option<[u8; 256]>; 3],
     mesh: Option<Mesh>,
     streaming: bool,
     last: (usize, usize, usize),
@@ -355,6 +385,9 @@ impl BrickedRenderer {
         };
         // Which levels each brick may hold: what lets `draw` leave out clear bricks.
         let levels = super::brick_ranges::brick_ranges(&store, &attrs)?;
+        let data_alpha = attrs.map(|at| {
+            at.and_then(|(index, low, high, _)| alpha_of_store(&store, index, low, high))
+        });
         let pair = faithful_pair(kind, params.combine);
         let program = Program::new(gpu, pair.kind, &pair.vertex, &pair.fragment)?;
         let paged = match fidelity {
@@ -376,6 +409,7 @@ impl BrickedRenderer {
             levels,
             table_alpha: [None, None, None],
             no_data: no_data_of,
+            data_alpha,
             mesh: None,
             streaming: false,
             last: (0, 0, 0),
@@ -393,6 +427,15 @@ impl BrickedRenderer {
             match attr {
                 Some(attr) => {
                     let mut t = attr.table.build(&self.base)?;
+                    // A store is a survey: its table's alpha from its data, as the
+                    // survey read whole takes it, unless the table says otherwise.
+                    if let Some(alpha) = self.data_alpha[a] {
+                        if attr.table.wants_alpha_from_data(true) {
+                            for (entry, alpha) in t.entries.iter_mut().zip(alpha) {
+                                entry[3] = alpha;
+                            }
+                        }
+                    }
                     if self.no_data[a] == NoData::Reserved {
                         t.entries[0] = [0; 4];
                     }
