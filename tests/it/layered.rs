@@ -482,10 +482,7 @@ fn a_segy_survey_lies_at_its_cdp_coordinates() {
 #[test]
 fn a_survey_store_is_a_layer_where_its_segy_lies() {
     let h = headless(Backend::Egl);
-    let dir = common::temp_dir("layered-store");
-    let f3 = common::data_file("seismic/f3.sgy");
-    let store = dir.join("f3.zarr");
-    crate::mdio::convert_quietly(&f3, &store, Some(8));
+    let (_dir, f3, store) = crate::mdio::f3_store("layered-store");
     let volume =
         |v: String| format!("[layer.opacity3d.primary]\nvolume = {v}\nattribute = \"amplitude\"\n");
     let segy = volume(format!("{{ segy = \"{}\" }}", f3.display()));

@@ -65,6 +65,16 @@ pub(crate) fn f3_ingested(
     Some((dir, sgy, mdio))
 }
 
+/// A fresh folder for test `name`, F3's SEG-Y, and F3 converted into `f3.zarr` in that
+/// folder in bricks of 8 (a plane crosses several).
+pub(crate) fn f3_store(name: &str) -> (std::path::PathBuf, std::path::PathBuf, std::path::PathBuf) {
+    let dir = temp_dir(name);
+    let f3 = data_file("seismic/f3.sgy");
+    let store = dir.join("f3.zarr");
+    convert_quietly(&f3, &store, Some(8));
+    (dir, f3, store)
+}
+
 /// `src` converted into the store `dst` by the library, quietly, in bricks of `brick`
 /// (`None`: the default).
 pub(crate) fn convert_quietly(src: &Path, dst: &Path, brick: Option<usize>) {

@@ -296,16 +296,28 @@ fn a_section_moves_in_a_layered_scene_without_a_build() {
     );
 }
 
+/// Scenes `a` and `b` cut one plane in one place and draw one picture, exactly, with the
+/// section in view (over 100 lit pixels).
+fn assert_one_section(h: &arbvis::gl::Headless, a: &Scene, b: &Scene, what: &str) {
+    let (pa, pb) = (prepared(a), prepared(b));
+    assert_eq!(pa.world, pb.world, "{what}: one place");
+    assert_eq!(pa.plane, pb.plane, "{what}: one plane");
+    let (ia, ib) = (
+        render_on(h, a).unwrap().image,
+        render_on(h, b).unwrap().image,
+    );
+    assert_eq!(ia.compare(&ib, 0.0).unwrap().pixels_over, 0, "{what}");
+    let lit = common::lit_pixels(&ia, 0.05);
+    assert!(lit > 100, "{what}: in view ({lit})");
+}
+
 /// A section of F3 converted into a store (bricks of 8: a plane crosses several) draws the
 /// SEG-Y's section exactly, at an inline, a crossline and a time between samples, and in
 /// the same world frame; the store's plane is read at full resolution as it is needed.
 #[test]
 fn a_section_of_a_store_draws_the_segys_section() {
     let h = headless(Backend::Egl);
-    let dir = common::temp_dir("section-store");
-    let f3 = common::data_file("seismic/f3.sgy");
-    let store = dir.join("f3.zarr");
-    crate::mdio::convert_quietly(&f3, &store, Some(8));
+    let (_dir, f3, store) = crate::mdio::f3_store("section-store");
     let scene = |volume: String, cut: &str| {
         // A store's range is its min-max (its percentiles are not computed): the SEG-Y's too.
         let text = format!(
@@ -316,17 +328,8 @@ fn a_section_of_a_store_draws_the_segys_section() {
     for cut in ["inline = 127", "crossline = 880", "time = 141"] {
         let a = scene(format!("{{ segy = \"{}\" }}", f3.display()), cut);
         let b = scene(format!("{{ store = \"{}\" }}", store.display()), cut);
-        let (pa, pb) = (prepared(&a), prepared(&b));
-        assert_eq!(pa.world, pb.world, "{cut}: one place");
-        assert_eq!(pa.plane, pb.plane, "{cut}: one plane");
-        let (ia, ib) = (
-            render_on(&h, &a).unwrap().image,
-            render_on(&h, &b).unwrap().image,
-        );
-        assert_eq!(ia.compare(&ib, 0.0).unwrap().pixels_over, 0, "{cut}");
         // Each plane seen from the survey's three-quarter view: 144 to 172 of 2,745 pixels.
-        let lit = common::lit_pixels(&ia, 0.05);
-        assert!(lit > 100, "{cut}: in view ({lit})");
+        assert_one_section(&h, &a, &b, cut);
     }
 }
 
@@ -338,10 +341,7 @@ fn a_section_of_a_store_draws_the_segys_section() {
 #[test]
 fn a_survey_in_depth_is_cut_by_depth() {
     let h = headless(Backend::Egl);
-    let dir = common::temp_dir("section-depth");
-    let f3 = common::data_file("seismic/f3.sgy");
-    let timed = dir.join("f3.zarr");
-    crate::mdio::convert_quietly(&f3, &timed, Some(8));
+    let (dir, f3, timed) = crate::mdio::f3_store("section-depth");
     let deep = dir.join("f3-depth.zarr");
     common::copy_tree(&timed, &deep);
     let root = deep.join("zarr.json");
@@ -361,15 +361,7 @@ fn a_survey_in_depth_is_cut_by_depth() {
     for number in [140.0, 141.0] {
         let a = scene(&timed, &format!("time = {number:?}"));
         let b = scene(&deep, &format!("depth = {number:?}"));
-        let (pa, pb) = (prepared(&a), prepared(&b));
-        assert_eq!(pa.world, pb.world, "{number}: one place");
-        assert_eq!(pa.plane, pb.plane, "{number}: one plane");
-        let (ia, ib) = (
-            render_on(&h, &a).unwrap().image,
-            render_on(&h, &b).unwrap().image,
-        );
-        assert_eq!(ia.compare(&ib, 0.0).unwrap().pixels_over, 0, "{number}");
-        assert!(common::lit_pixels(&ib, 0.05) > 100, "{number}: in view");
+        assert_one_section(&h, &a, &b, &format!("{number}"));
     }
     let segy = format!("{{ segy = \"{}\" }}", f3.display());
     for (text, key, says) in [

@@ -854,10 +854,7 @@ fn a_store_of_the_layout_before_mdio_still_reads() {
 #[test]
 fn a_store_takes_its_alpha_from_its_data_as_its_segy_does() {
     let h: Headless = headless(Backend::Egl);
-    let dir = crate::common::temp_dir("store-data-alpha");
-    let f3 = crate::common::data_file("seismic/f3.sgy");
-    let store = dir.join("f3.zarr");
-    crate::mdio::convert_quietly(&f3, &store, Some(8));
+    let (_dir, f3, store) = crate::mdio::f3_store("store-data-alpha");
     let scene = |volume: String, fidelity: &str| {
         let text = format!(
             "size = [96, 80]\nfidelity = \"{fidelity}\"\nprograms = \"glsl\"\ntarget = \"rgba32f\"\n[camera]\nrotation = [0.31, -0.22, 0.12, 0.917]\n[technique.opacity3d.primary]\nvolume = {volume}\nattribute = \"amplitude\"\nquantize = \"min-max\"\n[technique.opacity3d.raycast]\njitter = false\nmargins = true\nbake = false\n[technique.opacity3d.store]\nlevel = 0\n"

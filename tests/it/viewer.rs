@@ -47,6 +47,22 @@ fn saved_layer<T: arbvis::techniques::Technique + Clone>(saved: &Scene, index: u
     technique.get::<T>().expect("the layer's technique").clone()
 }
 
+/// The scene `text`, written into `dir` as `NAME.toml`, opened in the viewer (a 900 x 640
+/// window, a 200 x 150 picture), `steps` run, a screenshot taken and the scene saved: the
+/// saved scene, once the screenshot is checked to be it drawn offscreen. None without a
+/// display.
+fn saved_after(name: &str, dir: &Path, text: &str, steps: &str) -> Option<Scene> {
+    let scene = dir.join(format!("{name}.toml"));
+    std::fs::write(&scene, text).unwrap();
+    let script =
+        format!("resize 900 640\nwait 2\n{steps}wait 2\nclick Screenshot\nclick Save scene\n");
+    let (out, _) = run_script(name, scene.to_str().unwrap(), "200x150", &script)?;
+    let saved = saved_scene(&out);
+    assert_first_screenshot_is(&out, &saved);
+    let _ = std::fs::remove_dir_all(&out);
+    Some(saved)
+}
+
 /// The screenshot equals an offscreen render of the saved scene at its size, within one
 /// 8-bit level (same driver, same program).
 fn assert_screenshot_is_the_scene(shot: &Image, saved: &Scene) {
@@ -766,26 +782,12 @@ fn drawing_in_parts_equals_one_draw() {
 #[test]
 fn the_layer_list_hides_and_orders_layers_and_reaches_the_saved_scene() {
     let dir = temp_dir("layers-scene");
-    let scene = dir.join("layers.toml");
-    std::fs::write(
-        &scene,
-        "[[layer]]\nname = \"horizon\"\n[layer.surface]\nsynthetic = { size = [17, 11], seed = 2 }\ncolour_by = \"elevation\"\n[[layer]]\nname = \"cube\"\n[layer.opacity3d.primary]\nvolume = { synthetic = { size = [19, 13, 17], seed = 4 } }\nattribute = \"amplitude\"\n",
-    )
-    .unwrap();
-    let script = "\
-resize 900 640
-wait 2
-click layer 1: cube (opacity3d) visible
-wait 1
-click layer 1: cube (opacity3d) up
-wait 2
-click Screenshot
-click Save scene
-";
-    let Some((out, _)) = run_script("layers", scene.to_str().unwrap(), "200x150", script) else {
+    let text = "[[layer]]\nname = \"horizon\"\n[layer.surface]\nsynthetic = { size = [17, 11], seed = 2 }\ncolour_by = \"elevation\"\n[[layer]]\nname = \"cube\"\n[layer.opacity3d.primary]\nvolume = { synthetic = { size = [19, 13, 17], seed = 4 } }\nattribute = \"amplitude\"\n";
+    let steps =
+        "click layer 1: cube (opacity3d) visible\nwait 1\nclick layer 1: cube (opacity3d) up\n";
+    let Some(saved) = saved_after("layers", &dir, text, steps) else {
         return;
     };
-    let saved = saved_scene(&out);
     let layers: Vec<_> = saved.layers().collect();
     assert_eq!(layers.len(), 2);
     assert_eq!(
@@ -796,8 +798,6 @@ click Save scene
         (layers[1].0.name.as_str(), layers[1].0.visible),
         ("horizon", true)
     );
-    assert_first_screenshot_is(&out, &saved);
-    let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -810,29 +810,11 @@ fn a_surface_layers_colour_is_switched_between_a_layer_and_its_property() {
     let dir = temp_dir("surface-colour-scene");
     let ts = "GOCAD TSurf 1\nPROPERTIES throw\nPVRTX 1 0 0 5 0\nPVRTX 2 19 0 6 4\nPVRTX 3 19 13 8 9\nPVRTX 4 0 13 7 2\nTRGL 1 2 3\nTRGL 1 3 4\nEND\n";
     std::fs::write(dir.join("f.ts"), ts).unwrap();
-    let scene = dir.join("layers.toml");
-    std::fs::write(
-        &scene,
-        format!("[[layer]]\nname = \"fault\"\n[layer.surface]\nfile = \"{}\"\n[[layer]]\nname = \"cube\"\n[layer.opacity3d.primary]\nvolume = {{ synthetic = {{ size = [19, 13, 17], seed = 4 }} }}\nattribute = \"amplitude\"\n", dir.join("f.ts").display()),
-    )
-    .unwrap();
-    let script = "\
-resize 900 640
-wait 2
-click layer 0: fault (surface) settings
-wait 1
-set layer 0 colour = layer cube
-wait 2
-set layer 0 colour = property throw
-wait 2
-click Screenshot
-click Save scene
-";
-    let Some((out, _)) = run_script("surface-colour", scene.to_str().unwrap(), "200x150", script)
-    else {
+    let text = format!("[[layer]]\nname = \"fault\"\n[layer.surface]\nfile = \"{}\"\n[[layer]]\nname = \"cube\"\n[layer.opacity3d.primary]\nvolume = {{ synthetic = {{ size = [19, 13, 17], seed = 4 }} }}\nattribute = \"amplitude\"\n", dir.join("f.ts").display());
+    let steps = "click layer 0: fault (surface) settings\nwait 1\nset layer 0 colour = layer cube\nwait 2\nset layer 0 colour = property throw\n";
+    let Some(saved) = saved_after("surface-colour", &dir, &text, steps) else {
         return;
     };
-    let saved = saved_scene(&out);
     let surface: arbvis::techniques::surface::SurfaceScene = saved_layer(&saved, 0);
     assert_eq!(
         surface.colour_by,
@@ -841,8 +823,6 @@ click Save scene
         ))
     );
     assert_eq!(surface.colour_from, None);
-    assert_first_screenshot_is(&out, &saved);
-    let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -852,43 +832,21 @@ click Save scene
 #[test]
 fn a_wells_panel_makes_it_a_ribbon_in_pixels() {
     let dir = temp_dir("lines-ribbon-scene");
-    let scene = dir.join("well.toml");
-    std::fs::write(
-        &scene,
-        format!(
-            "[camera]\nprojection = \"perspective\"\nrotation = [-0.35, 0.12, 0.2, 0.906]\n[[layer]]\nname = \"well\"\n[layer.lines]\nwell = {{ survey = \"{}\", head = [620420.0, 6074520.0], log = \"{}\" }}\nradius = 7.0\n",
-            common::data_file("seismic/f3-well-survey.csv").display(),
-            common::data_file("seismic/f3-well-log.csv").display()
-        ),
-    )
-    .unwrap();
-    let script = "\
-resize 900 640
-wait 2
-click layer 0: well (lines) settings
-wait 1
-set Lines style ribbon
-wait 1
-set Width in pixels true
-wait 1
-set Lines width 6
-wait 2
-click Screenshot
-click Save scene
-";
-    let Some((out, _)) = run_script("lines-ribbon", scene.to_str().unwrap(), "200x150", script)
-    else {
+    let text = format!(
+        "[camera]\nprojection = \"perspective\"\nrotation = [-0.35, 0.12, 0.2, 0.906]\n[[layer]]\nname = \"well\"\n[layer.lines]\nwell = {{ survey = \"{}\", head = [620420.0, 6074520.0], log = \"{}\" }}\nradius = 7.0\n",
+        common::data_file("seismic/f3-well-survey.csv").display(),
+        common::data_file("seismic/f3-well-log.csv").display()
+    );
+    let steps = "click layer 0: well (lines) settings\nwait 1\nset Lines style ribbon\nwait 1\nset Width in pixels true\nwait 1\nset Lines width 6\n";
+    let Some(saved) = saved_after("lines-ribbon", &dir, &text, steps) else {
         return;
     };
-    let saved = saved_scene(&out);
     let lines: arbvis::techniques::lines::LinesScene = saved_layer(&saved, 0);
     assert_eq!(lines.style, arbvis::techniques::lines::LineStyle::Ribbon);
     assert_eq!(
         lines.width,
         Some(arbvis::techniques::lines::Width::Pixels(6.0))
     );
-    assert_first_screenshot_is(&out, &saved);
-    let _ = std::fs::remove_dir_all(&out);
     let _ = std::fs::remove_dir_all(&dir);
 }
 
@@ -898,31 +856,19 @@ click Save scene
 #[test]
 fn a_sections_slider_moves_it_over_the_surveys_numbers() {
     let dir = temp_dir("section-slider-scene");
-    let scene = dir.join("section.toml");
-    std::fs::write(
-        &scene,
-        format!(
-            "[[layer]]\nname = \"inline\"\n[layer.section]\nvolume = {{ segy = \"{}\" }}\ninline = 120\n",
-            common::data_file("seismic/f3.sgy").display()
-        ),
-    )
-    .unwrap();
-    let opening = "resize 900 640\nwait 2\nclick layer 0: inline (section) settings\nwait 1\n";
-    let script = format!("{opening}set Inline 125.4\nwait 2\nclick Screenshot\nclick Save scene\n");
-    let Some((out, _)) = run_script(
-        "section-slider",
-        scene.to_str().unwrap(),
-        "200x150",
-        &script,
-    ) else {
+    let text = format!(
+        "[[layer]]\nname = \"inline\"\n[layer.section]\nvolume = {{ segy = \"{}\" }}\ninline = 120\n",
+        common::data_file("seismic/f3.sgy").display()
+    );
+    let opening = "click layer 0: inline (section) settings\nwait 1\n";
+    let steps = format!("{opening}set Inline 125.4\n");
+    let Some(saved) = saved_after("section-slider", &dir, &text, &steps) else {
         return;
     };
-    let saved = saved_scene(&out);
     let section: arbvis::techniques::section::SectionScene = saved_layer(&saved, 0);
     assert_eq!(section.inline, Some(125.0));
-    assert_first_screenshot_is(&out, &saved);
-    let _ = std::fs::remove_dir_all(&out);
-    let outside = format!("{opening}set Inline 200\n");
+    let outside = format!("resize 900 640\nwait 2\n{opening}set Inline 200\n");
+    let scene = dir.join("section-slider.toml");
     let Some(errors) = failing_scripts("section-outside", scene.to_str().unwrap(), &[&outside])
     else {
         return;

@@ -421,17 +421,9 @@ fn legends_name_colours_and_axes_carry_units() {
         "{layers:?}"
     );
     // SEG-Y: line numbers and time in ms on the F3 crop (its crosslines 875..892).
-    let f3 = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/data/f3.toml");
-    let Some((dir, stdout)) = run_script_on(
-        Some("1920x1080"),
-        "legend-f3",
-        f3.to_str().unwrap(),
-        "",
-        "wait 2\ncheck layout\n",
-    ) else {
+    let Some(stdout) = layout_of("f3", "1920x1080") else {
         return;
     };
-    let _ = std::fs::remove_dir_all(&dir);
     let f3 = names(&stdout);
     for want in [
         "label time (ms)",
@@ -448,19 +440,26 @@ fn legends_name_colours_and_axes_carry_units() {
 /// were truncated and the settings headers shortened.
 #[test]
 fn a_layered_scenes_layer_list_keeps_to_the_panel() {
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/data/f3-interpretation.toml");
-    let Some((dir, stdout)) = run_script_on(
-        Some("1280x1024"),
-        "layer-list-layout",
-        scene.to_str().unwrap(),
-        "",
-        "wait 2\ncheck layout\n",
-    ) else {
+    let Some(stdout) = layout_of("f3-interpretation", "1280x1024") else {
         return;
     };
-    let _ = std::fs::remove_dir_all(&dir);
     assert!(
         stdout.contains("controls whole inside"),
         "the layout check ran: {stdout}"
     );
+}
+
+/// What `check layout` prints for `scenes/data/NAME.toml` on a screen of `screen` pixels
+/// (None without a display).
+fn layout_of(name: &str, screen: &str) -> Option<String> {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/data/{name}.toml"));
+    let (dir, stdout) = run_script_on(
+        Some(screen),
+        &format!("layout-{name}"),
+        scene.to_str().unwrap(),
+        "",
+        "wait 2\ncheck layout\n",
+    )?;
+    let _ = std::fs::remove_dir_all(&dir);
+    Some(stdout)
 }
